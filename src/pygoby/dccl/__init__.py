@@ -1,0 +1,1 @@
+"""DCCL: the Dynamic Compact Control Language (byte-compatible with the C++ DCCL library)."""

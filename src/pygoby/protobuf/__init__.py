@@ -1,0 +1,11 @@
+"""Our .proto files (under their upstream import paths) and the run-time .proto loader."""
+
+from pygoby.protobuf.loader import (
+    BUILTIN_PROTO_DIR,
+    ProtoError,
+    ProtoLoader,
+    builtin_class,
+    default_loader,
+)
+
+__all__ = ["BUILTIN_PROTO_DIR", "ProtoError", "ProtoLoader", "builtin_class", "default_loader"]

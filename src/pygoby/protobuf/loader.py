@@ -1,0 +1,168 @@
+"""Load protobuf message definitions from .proto files at run time.
+
+protoc (from grpcio-tools, in process) compiles the files into a FileDescriptorSet, which is added
+to a descriptor pool; message classes are then made from the pool. Our own .proto files live in
+this folder under their upstream import paths ("dccl/option_extensions.proto", ...), and this
+folder is always on the include path, so users' files that import them compile unchanged.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import tempfile
+from collections.abc import Iterable, Sequence
+from importlib import resources
+from pathlib import Path
+
+from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+from google.protobuf.descriptor import Descriptor, FileDescriptor
+from google.protobuf.message import Message
+
+BUILTIN_PROTO_DIR = Path(__file__).resolve().parent
+
+
+class ProtoError(Exception):
+    """A .proto file could not be compiled or a message type could not be found."""
+
+
+@functools.cache
+def _well_known_include_dir() -> str:
+    return str(resources.files("grpc_tools") / "_proto")
+
+
+class ProtoLoader:
+    """Compiles .proto files into one descriptor pool and hands out message classes.
+
+    Loading the same file twice is free; two different files with the same import name are an
+    error (protobuf's pools are keyed by file name).
+    """
+
+    def __init__(
+        self,
+        include_dirs: Iterable[str | os.PathLike[str]] = (),
+        pool: descriptor_pool.DescriptorPool | None = None,
+    ) -> None:
+        self.include_dirs: list[Path] = [Path(d).resolve() for d in include_dirs]
+        self.pool = pool if pool is not None else descriptor_pool.DescriptorPool()
+
+    def add_include_dir(self, directory: str | os.PathLike[str]) -> None:
+        resolved = Path(directory).resolve()
+        if resolved not in self.include_dirs:
+            self.include_dirs.append(resolved)
+
+    def _search_path(self, extra: Sequence[Path]) -> list[str]:
+        dirs = [*extra, *self.include_dirs, BUILTIN_PROTO_DIR]
+        unique = list(dict.fromkeys(str(d) for d in dirs))
+        return [*unique, _well_known_include_dir()]
+
+    def _import_name(self, path: Path, search: Sequence[str]) -> str | None:
+        for directory in search:
+            try:
+                return path.relative_to(directory).as_posix()
+            except ValueError:
+                continue
+        return None
+
+    def load_file(
+        self, path: str | os.PathLike[str], include_dirs: Iterable[str | os.PathLike[str]] = ()
+    ) -> FileDescriptor:
+        """Compile `path` (and its imports) into the pool; returns its FileDescriptor.
+
+        `path` may be a file on disk or an import name found on the include path.
+        """
+        extra = [Path(d).resolve() for d in include_dirs]
+        candidate = Path(path)
+        search = self._search_path(extra)
+        if candidate.is_file():
+            resolved = candidate.resolve()
+            name = self._import_name(resolved, search)
+            if name is None:
+                # Not under any include dir: its own directory becomes one (as protoc users do).
+                extra.append(resolved.parent)
+                search = self._search_path(extra)
+                name = resolved.name
+        else:
+            name = candidate.as_posix()
+            if not any((Path(d) / name).is_file() for d in search):
+                raise ProtoError(f"cannot find .proto file {str(path)!r} (searched {search})")
+        try:
+            return self.pool.FindFileByName(name)
+        except KeyError:
+            pass
+        for file_proto in self._compile(name, search):
+            self._add(file_proto)
+        return self.pool.FindFileByName(name)
+
+    def _compile(self, name: str, search: Sequence[str]) -> list[descriptor_pb2.FileDescriptorProto]:
+        from grpc_tools import protoc  # imported lazily: it is slow to import
+
+        with tempfile.TemporaryDirectory(prefix="pygoby-protoc-") as tmp:
+            out = os.path.join(tmp, "set.pb")
+            args = ["protoc", *(f"-I{d}" for d in search)]
+            args += [f"--descriptor_set_out={out}", "--include_imports", name]
+            with _captured_stderr() as err:
+                status = protoc.main(args)
+            if status != 0:
+                raise ProtoError(f"protoc failed on {name}:\n{err.read().strip()}")
+            fds = descriptor_pb2.FileDescriptorSet()
+            fds.ParseFromString(Path(out).read_bytes())
+        return list(fds.file)
+
+    def _add(self, file_proto: descriptor_pb2.FileDescriptorProto) -> None:
+        try:
+            existing = self.pool.FindFileByName(file_proto.name)
+        except KeyError:
+            self.pool.Add(file_proto)
+            return
+        known = descriptor_pb2.FileDescriptorProto()
+        existing.CopyToProto(known)
+        if known.SerializeToString(deterministic=True) != file_proto.SerializeToString(
+            deterministic=True
+        ) and file_proto.name != "google/protobuf/descriptor.proto":
+            raise ProtoError(f"{file_proto.name} is already loaded with a different definition")
+
+    def find_descriptor(self, full_name: str) -> Descriptor:
+        try:
+            return self.pool.FindMessageTypeByName(full_name)
+        except KeyError:
+            raise ProtoError(f"unknown message type {full_name!r}") from None
+
+    def message_class(self, full_name: str) -> type[Message]:
+        return message_factory.GetMessageClass(self.find_descriptor(full_name))
+
+    def load_files(
+        self,
+        paths: Iterable[str | os.PathLike[str]],
+        include_dirs: Iterable[str | os.PathLike[str]] = (),
+    ) -> list[FileDescriptor]:
+        dirs = list(include_dirs)
+        return [self.load_file(p, dirs) for p in paths]
+
+
+class _captured_stderr:
+    """protoc writes its diagnostics to fd 2; capture them for the error message."""
+
+    def __enter__(self):
+        self._file = tempfile.TemporaryFile(mode="w+")
+        self._saved = os.dup(2)
+        os.dup2(self._file.fileno(), 2)
+        return self._file
+
+    def __exit__(self, *exc) -> None:
+        os.dup2(self._saved, 2)
+        os.close(self._saved)
+        self._file.seek(0)
+
+
+@functools.cache
+def default_loader() -> ProtoLoader:
+    """The process-wide loader used for pygoby's own messages and configs."""
+    return ProtoLoader()
+
+
+def builtin_class(proto_file: str, full_name: str) -> type[Message]:
+    """A message class from one of our own .proto files (loaded on first use)."""
+    loader = default_loader()
+    loader.load_file(proto_file)
+    return loader.message_class(full_name)

@@ -1,0 +1,1 @@
+"""Small shared utilities: clocks, geodesy, NMEA, line-based I/O."""
