@@ -1,0 +1,88 @@
+"""netsim_manager configuration: protobuf TextFormat, loaded and checked like upstream.
+
+Upstream configuration files contain Goby3 middleware blocks (``app { ... }``,
+``interprocess { ... }``, the serial settings of ``gps_out``) that pygoby does not use. Their
+contents are accepted and ignored; everywhere else an unknown field name is an error, so typos in
+the parts pygoby uses are still caught.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+from google.protobuf import text_format
+from google.protobuf.message import Message
+
+from pygoby.protobuf import builtin_class
+
+CONFIG_PROTO = "netsim/messages/manager_config.proto"
+CONFIG_TYPE = "netsim.protobuf.NetSimManagerConfig"
+
+# Message types whose contents stand for upstream blocks with more fields than pygoby declares.
+_OPEN_BLOCKS = frozenset({"netsim.protobuf.UnusedGoby3Block", "netsim.protobuf.SerialPortConfig"})
+
+EXAMPLE_CONFIG = """\
+# netsim_manager configuration (protobuf TextFormat; the same file upstream netsim reads).
+# One sim_env_pair per simulated vehicle: its modem TCP port, the only IP address allowed to
+# report its position, and the environment whose bounds apply.
+sim_env_pair { modem_tcp_port: 62000 endpoint_ip_address: "127.0.0.1" environment_id: 0 }
+sim_env_pair { modem_tcp_port: 62001 endpoint_ip_address: "127.0.0.1" environment_id: 0 }
+# Region of each environment (inclusive; depth_min defaults to 0, so negative depths fail).
+env_bounds { environment_id: 0 lat_min: 41.5 lon_min: -71.0 lat_max: 42.5 lon_max: -69.5
+             depth_min: 0 depth_max: 200 }
+manager_tcp_port: 61999          # default 61999
+# pygoby-only settings:
+listen_address: "0.0.0.0"        # IPv4 address to listen on
+reject_nonfinite_position: true  # NaN/inf lat, lon or depth -> OUT_OF_DEFINED_REGION
+max_line_length: 1048576         # longer NETSIM lines are discarded
+"""
+
+
+class ConfigError(Exception):
+    """The configuration cannot be used (parse error or a fatal start-up check)."""
+
+
+@cache
+def config_class() -> type[Message]:
+    return builtin_class(CONFIG_PROTO, CONFIG_TYPE)
+
+
+class _Parser(text_format._Parser):  # noqa: SLF001 - per-message control of unknown fields
+    """TextFormat parser that skips unknown fields only inside the open upstream blocks."""
+
+    def _MergeField(self, tokenizer, message):  # noqa: N802 - overrides protobuf's method
+        self.allow_unknown_field = message.DESCRIPTOR.full_name in _OPEN_BLOCKS
+        super()._MergeField(tokenizer, message)
+
+
+def parse_config(text: str) -> Message:
+    """Parse and validate a TextFormat configuration; raises ConfigError."""
+    config = config_class()()
+    try:
+        _Parser().ParseLines(text.split("\n"), config)
+    except text_format.ParseError as exc:
+        raise ConfigError(f"cannot parse configuration: {exc}") from exc
+    validate_config(config)
+    return config
+
+
+def validate_config(config: Message) -> None:
+    """The start-up checks of upstream, in its order; the first failure raises ConfigError."""
+    if not config.IsInitialized():
+        missing = ", ".join(config.FindInitializationErrors())
+        raise ConfigError(f"configuration is missing required fields: {missing}")
+    environments: set[int] = set()
+    for bounds in config.env_bounds:
+        if bounds.environment_id in environments:
+            raise ConfigError(f"duplicate env_bounds.environment_id {bounds.environment_id}")
+        environments.add(bounds.environment_id)
+    ports: set[int] = set()
+    for pair in config.sim_env_pair:
+        if pair.modem_tcp_port in ports:
+            raise ConfigError(f"duplicate sim_env_pair.modem_tcp_port {pair.modem_tcp_port}")
+        ports.add(pair.modem_tcp_port)
+        if pair.environment_id not in environments:
+            raise ConfigError(
+                f"no env_bounds for environment {pair.environment_id} "
+                f"(used by modem_tcp_port {pair.modem_tcp_port})"
+            )

@@ -1,0 +1,191 @@
+"""netsim_manager's request processing, sans-I/O.
+
+`NetSimManager.handle_request(request, peer_ip)` applies the checks of spec §4.3 in upstream's
+order (for each nav: configured port -> source address -> region; stop at the first failure;
+stats are passed on regardless) and returns a `RequestOutcome` with the one response to send,
+the navs accepted for the simulation and the stats received. Accepted, complete navs become the
+latest position of their modem port (`position(port)`, `positions()`); listeners registered with
+`on_nav` / `on_stats` see them as they arrive (the channel and the modem emulators use this).
+
+`ManagerConnection` adds the line protocol for one client connection: feed it the bytes received
+and it returns the response lines to write, logging and skipping bad lines. It has no I/O of its
+own; `pygoby.netsim.server` runs it on asyncio TCP connections.
+
+Difference from upstream (configurable, `reject_nonfinite_position`, default on): a NaN or
+infinite lat, lon or depth is answered UPDATE_FAILED_OUT_OF_DEFINED_REGION; upstream accepts NaN
+because every comparison with NaN is false, and forwards it.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import logging
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from google.protobuf.message import Message
+
+from pygoby.netsim.protocol import (
+    LEGACY_RESPONSE_NAME,
+    RESPONSE_NAME,
+    LineDecoder,
+    LineError,
+    encode_line,
+    message_class,
+    request_names,
+)
+
+log = logging.getLogger(__name__)
+
+NAV_FIELDS = ("modem_tcp_port", "time", "lat", "lon", "depth", "speed", "heading")
+
+
+def status_enum():
+    return message_class("NetSimManagerResponse").Status
+
+
+def peer_ip_string(address: str) -> str:
+    """The dotted IPv4 form upstream compares against (IPv4-mapped IPv6 converted)."""
+    try:
+        ip = ipaddress.ip_address(address.split("%", 1)[0])
+    except ValueError:
+        return address
+    if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
+        return str(ip.ipv4_mapped)
+    return str(ip)
+
+
+@dataclass
+class RequestOutcome:
+    response: Message  # NetSimManagerResponse
+    forwarded: list[Message] = field(default_factory=list)  # EnvironmentNavUpdate, in order
+    stats: list[Message] = field(default_factory=list)  # ReceiveStats, in order
+
+
+NavListener = Callable[[Message], None]  # called with each forwarded EnvironmentNavUpdate
+StatsListener = Callable[[Message], None]  # called with each ReceiveStats
+
+
+class NetSimManager:
+    """The manager's state: configuration, latest position per modem port, listeners."""
+
+    def __init__(self, config: Message) -> None:
+        self.config = config
+        self._pairs = {pair.modem_tcp_port: pair for pair in config.sim_env_pair}
+        self._bounds = {bounds.environment_id: bounds for bounds in config.env_bounds}
+        self._latest: dict[int, Message] = {}
+        self._nav_listeners: list[NavListener] = []
+        self._stats_listeners: list[StatsListener] = []
+        self._response_cls = message_class("NetSimManagerResponse")
+        self._env_nav_cls = message_class("EnvironmentNavUpdate")
+
+    # -- queries -------------------------------------------------------------------------
+
+    def position(self, modem_tcp_port: int) -> Message | None:
+        """Latest accepted NavUpdate of a modem port, or None."""
+        return self._latest.get(modem_tcp_port)
+
+    def positions(self) -> dict[int, Message]:
+        return dict(self._latest)
+
+    def environment_of(self, modem_tcp_port: int) -> int | None:
+        pair = self._pairs.get(modem_tcp_port)
+        return None if pair is None else pair.environment_id
+
+    def on_nav(self, listener: NavListener) -> None:
+        self._nav_listeners.append(listener)
+
+    def on_stats(self, listener: StatsListener) -> None:
+        self._stats_listeners.append(listener)
+
+    # -- processing ----------------------------------------------------------------------
+
+    def handle_request(self, request: Message, peer_ip: str) -> RequestOutcome:
+        status = status_enum()
+        outcome = RequestOutcome(self._response_cls(request_id=request.id))
+        result = status.UPDATE_ACCEPTED
+        for nav in request.nav:
+            result = self._check_nav(nav, peer_ip)
+            if result != status.UPDATE_ACCEPTED:
+                break
+            if all(nav.HasField(name) for name in NAV_FIELDS):
+                update = self._env_nav_cls(
+                    environment_id=self._pairs[nav.modem_tcp_port].environment_id
+                )
+                update.nav.CopyFrom(nav)
+                outcome.forwarded.append(update)
+            else:
+                missing = [name for name in NAV_FIELDS if not nav.HasField(name)]
+                log.warning("nav for port %d lacks %s: not forwarded", nav.modem_tcp_port, missing)
+        outcome.response.status = result
+        outcome.stats.extend(request.stats)
+        for update in outcome.forwarded:
+            self._latest[update.nav.modem_tcp_port] = update.nav
+            for listener in self._nav_listeners:
+                listener(update)
+        for stats in outcome.stats:
+            for listener in self._stats_listeners:
+                listener(stats)
+        return outcome
+
+    def _check_nav(self, nav: Message, peer_ip: str) -> int:
+        status = status_enum()
+        pair = self._pairs.get(nav.modem_tcp_port)
+        if pair is None:
+            return status.UPDATE_FAILED_INVALID_MODEM_TCP_PORT
+        if peer_ip != pair.endpoint_ip_address:
+            return status.UPDATE_FAILED_INVALID_SOURCE_ADDRESS
+        bounds = self._bounds[pair.environment_id]
+        lat, lon, depth = nav.lat, nav.lon, nav.depth
+        if self.config.reject_nonfinite_position and not all(
+            math.isfinite(v) for v in (lat, lon, depth)
+        ):
+            return status.UPDATE_FAILED_OUT_OF_DEFINED_REGION
+        if (
+            lat < bounds.lat_min
+            or lat > bounds.lat_max
+            or lon < bounds.lon_min
+            or lon > bounds.lon_max
+            or depth < bounds.depth_min
+            or depth > bounds.depth_max
+        ):
+            return status.UPDATE_FAILED_OUT_OF_DEFINED_REGION
+        return status.UPDATE_ACCEPTED
+
+    def connection(self, peer_address: str) -> ManagerConnection:
+        return ManagerConnection(self, peer_address)
+
+
+class ManagerConnection:
+    """One client connection: bytes in, response lines out."""
+
+    def __init__(self, manager: NetSimManager, peer_address: str) -> None:
+        self.manager = manager
+        self.peer_ip = peer_ip_string(peer_address)
+        self.decoder = LineDecoder(request_names(), manager.config.max_line_length)
+        self.errors = 0  # lines dropped on this connection
+
+    def receive(self, data: bytes) -> list[bytes]:
+        replies: list[bytes] = []
+        for event in self.decoder.feed(data):
+            if isinstance(event, LineError):
+                self.errors += 1
+                self._log_dropped(event)
+                continue
+            if event.preamble != b"NETSIM":
+                log.info("%s: preamble %r instead of NETSIM", self.peer_ip, event.preamble[:20])
+            if event.parse_error:
+                log.warning(
+                    "%s: %s; answering the partial request", self.peer_ip, event.parse_error
+                )
+            outcome = self.manager.handle_request(event.message, self.peer_ip)
+            name = LEGACY_RESPONSE_NAME if event.legacy else RESPONSE_NAME
+            replies.append(encode_line(outcome.response, name))
+        return replies
+
+    def _log_dropped(self, error: LineError) -> None:
+        # A client sending garbage could produce thousands of errors a second: log the first
+        # ones in full, then only every thousandth, so logging cannot starve other clients.
+        if self.errors <= 10 or self.errors % 1000 == 0:
+            log.warning("%s: dropped line #%d: %s", self.peer_ip, self.errors, error)
