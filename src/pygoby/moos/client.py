@@ -1,0 +1,429 @@
+"""Asyncio MOOS V10 (asynchronous) client.
+
+    async with MOOSClient("myapp", port=db.port) as client:     # connects (waits for it)
+        client.subscribe("NAV_X")                                # current value comes at once
+        client.subscribe_wildcard("NAV_*", app_pattern="*", interval=0.5)
+        client.publish("DESIRED_SPEED", 1.5)                     # float -> D, str -> S, bytes -> B
+        msg = await client.receive()                             # or `async for msg in client`
+        replies = await client.server_request("VAR_SUMMARY")
+
+Behaviour: a `T` timing message leads a packet at least once a second (keep-alive and clock
+sync); everything queued is sent in one packet as soon as the event loop runs the writer. The
+client reconnects by itself (every `reconnect_interval` s) after a lost connection, sends its
+subscriptions again, calls the `on_connect` callbacks, then sends publications queued while it
+was away (bounded by `outbox_limit`; the oldest are dropped beyond it, with a warning). A `K`
+(name already in use) ends the client with `MOOSRefused`: no retry, as in C++.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import socket
+from collections import deque
+from collections.abc import AsyncIterator, Callable
+
+from pygoby.moos import protocol as p
+from pygoby.moos.protocol import MOOSMessage, Value
+from pygoby.util.clock import Clock, WallClock
+
+log = logging.getLogger(__name__)
+
+TIMING_PERIOD = 1.0
+MAX_PACKET_MESSAGES = 4096
+
+
+class MOOSRefused(Exception):
+    """The DB refused the handshake (poison message); carries the DB's reason."""
+
+
+class MOOSClient:
+    """A V10 MOOS client.
+
+    Args: name (the MOOS name), host, port, clock (MOOS local time; see
+    `pygoby.moos.timewarp.moos_clock`), on_message (callback for every received message; when
+    None, messages go to the inbox read by `receive()`), reconnect_interval (s), outbox_limit,
+    inbox_limit (messages), max_packet_size (bytes accepted from the DB).
+    """
+
+    def __init__(
+        self,
+        name: str,
+        host: str = "127.0.0.1",
+        port: int = p.DEFAULT_PORT,
+        *,
+        clock: Clock | None = None,
+        on_message: Callable[[MOOSMessage], None] | None = None,
+        reconnect_interval: float = 0.5,
+        outbox_limit: int = 100_000,
+        inbox_limit: int = 100_000,
+        max_packet_size: int = p.DEFAULT_MAX_PACKET_SIZE,
+    ) -> None:
+        if not name:
+            raise ValueError("a MOOS client needs a name")
+        self.name = name
+        self.host = "127.0.0.1" if host.upper() == "LOCALHOST" else host
+        self.port = port
+        self.clock = clock or WallClock()
+        self.on_message = on_message
+        self.on_connect: list[Callable[[], None]] = []
+        self.on_disconnect: list[Callable[[], None]] = []
+        self.reconnect_interval = reconnect_interval
+        self.outbox_limit = outbox_limit
+        self.inbox_limit = inbox_limit
+        self.max_packet_size = max_packet_size
+        self.community = ""
+        self.db_hostname = ""
+        self.skew = p.SkewFilter()
+        self.clock_correction = False
+        self.throttle = 0.0
+        self._next_id = 0
+        self._outbox: deque[MOOSMessage] = deque()
+        self._inbox: deque[MOOSMessage] = deque()
+        self._inbox_ready = asyncio.Event()
+        self._subscriptions: dict[str, float] = {}
+        self._wildcards: dict[tuple[str, str], float] = {}
+        self._wake = asyncio.Event()
+        self._connected = asyncio.Event()
+        self._stopped = asyncio.Event()
+        self._requests: list[asyncio.Future[list[MOOSMessage]]] = []
+        self._task: asyncio.Task[None] | None = None
+        self._writer: asyncio.StreamWriter | None = None
+        self.failure: BaseException | None = None
+        self.connections = 0
+
+    # -- life cycle ----------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Start connecting (and reconnecting) in the background."""
+        if self._task is None:
+            self._task = asyncio.create_task(self._run(), name=f"moos-client-{self.name}")
+
+    async def connect(self, timeout: float | None = 5.0) -> None:
+        """Start and wait until connected (TimeoutError after `timeout`; MOOSRefused on K)."""
+        self.start()
+        await self.wait_connected(timeout)
+
+    async def wait_connected(self, timeout: float | None = None) -> None:
+        waiter = asyncio.ensure_future(self._connected.wait())
+        stopper = asyncio.ensure_future(self._stopped.wait())
+        try:
+            done, _ = await asyncio.wait({waiter, stopper}, timeout=timeout,
+                                         return_when=asyncio.FIRST_COMPLETED)  # fmt: skip
+        finally:
+            waiter.cancel()
+            stopper.cancel()
+        if self.failure is not None:
+            raise self.failure
+        if not done:
+            raise TimeoutError(f"{self.name}: no connection to {self.host}:{self.port}")
+
+    async def close(self) -> None:
+        if self._task is not None:
+            self._task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await self._task
+            self._task = None
+
+    async def __aenter__(self) -> MOOSClient:
+        await self.connect()
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        await self.close()
+
+    @property
+    def connected(self) -> bool:
+        return self._connected.is_set()
+
+    # -- time ----------------------------------------------------------------------------------
+
+    def local_time(self) -> float:
+        """MOOSLocalTime: the clock (warped), without skew."""
+        return self.clock.now()
+
+    def time(self) -> float:
+        """MOOSTime: local time plus the skew estimate when clock correction is on."""
+        return self.clock.now() + (self.skew.skew if self.clock_correction else 0.0)
+
+    # -- publishing and subscribing ------------------------------------------------------------
+
+    def publish(
+        self, key: str, value: Value, *, src_aux: str = "", time: float | None = None
+    ) -> None:
+        """Queue a notification (float/int: double, str: string, bytes: binary)."""
+        if not key:
+            raise ValueError("cannot publish to an empty variable name")
+        msg = p.notify(key, value, time=self.time() if time is None else time, src=self.name,
+                       src_aux=src_aux, msg_id=self._take_id())  # fmt: skip
+        self._queue(msg)
+
+    def subscribe(self, key: str, interval: float = 0.0) -> None:
+        """Register for `key` (interval > 0: the DB drops updates closer than that)."""
+        if not key:
+            raise ValueError("cannot subscribe to an empty variable name")
+        self._subscriptions[key] = interval
+        if self.connected:
+            self._queue(self._register_msg(key, interval))
+
+    def unsubscribe(self, key: str) -> None:
+        if self._subscriptions.pop(key, None) is not None and self.connected:
+            self._queue(MOOSMessage(p.UNREGISTER, p.DOUBLE, key, self.time(), 0.0,
+                                    src=self.name, id=self._take_id()))  # fmt: skip
+
+    def subscribe_wildcard(
+        self, var_pattern: str, app_pattern: str = "*", interval: float = 0.0
+    ) -> None:
+        """Register every variable whose name matches `var_pattern` (MOOS globs `*`, `?`) and
+        whose first writer matches `app_pattern`."""
+        if not var_pattern or not app_pattern:
+            raise ValueError("wildcard patterns must not be empty")
+        self._wildcards[(var_pattern, app_pattern)] = interval
+        if self.connected:
+            self._queue(self._wildcard_msg(p.WILDCARD_REGISTER, var_pattern, app_pattern, interval))
+
+    def unsubscribe_wildcard(self, var_pattern: str, app_pattern: str = "*") -> None:
+        if self._wildcards.pop((var_pattern, app_pattern), None) is not None and self.connected:
+            self._queue(self._wildcard_msg(p.WILDCARD_UNREGISTER, var_pattern, app_pattern, 0.0))
+
+    @property
+    def subscriptions(self) -> dict[str, float]:
+        return dict(self._subscriptions)
+
+    async def server_request(self, name: str, timeout: float = 2.0) -> list[MOOSMessage]:
+        """Send a `Q` request (ALL, VAR_SUMMARY, PROC_SUMMARY, DB_CLEAR) and return the replies
+        (N messages with id -2) from the first packet that carries any; [] on timeout."""
+        if not self.connected:
+            raise ConnectionError(f"{self.name}: not connected")
+        future: asyncio.Future[list[MOOSMessage]] = asyncio.get_running_loop().create_future()
+        self._requests.append(future)
+        self._queue(MOOSMessage(p.SERVER_REQUEST, p.STRING, name, self.time(), src=self.name,
+                                id=p.SERVER_REQUEST_ID))  # fmt: skip
+        try:
+            return await asyncio.wait_for(future, timeout)
+        except TimeoutError:
+            return []
+        finally:
+            with contextlib.suppress(ValueError):
+                self._requests.remove(future)
+
+    async def flush(self, timeout: float = 5.0) -> None:
+        """Wait until the outbox has been handed to the socket (connected) or `timeout`."""
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + timeout
+        while self._outbox and loop.time() < deadline:
+            await asyncio.sleep(0.001)
+        if self._writer is not None:
+            with contextlib.suppress(ConnectionError):
+                await self._writer.drain()
+
+    # -- receiving -----------------------------------------------------------------------------
+
+    async def receive(self, timeout: float | None = None) -> MOOSMessage:
+        """The next received message (TimeoutError after `timeout`)."""
+        async with asyncio.timeout(timeout):
+            while not self._inbox:
+                self._inbox_ready.clear()
+                await self._inbox_ready.wait()
+        return self._inbox.popleft()
+
+    def fetch(self) -> list[MOOSMessage]:
+        """All messages received so far (non-blocking)."""
+        mail = list(self._inbox)
+        self._inbox.clear()
+        return mail
+
+    async def __aiter__(self) -> AsyncIterator[MOOSMessage]:
+        while True:
+            yield await self.receive()
+
+    # -- internals -----------------------------------------------------------------------------
+
+    def _take_id(self) -> int:
+        msg_id = self._next_id
+        self._next_id += 1
+        return msg_id
+
+    def _register_msg(self, key: str, interval: float) -> MOOSMessage:
+        return MOOSMessage(p.REGISTER, p.DOUBLE, key, self.time(), interval, src=self.name,
+                           id=self._take_id())  # fmt: skip
+
+    def _wildcard_msg(self, kind: str, var: str, app: str, interval: float) -> MOOSMessage:
+        return MOOSMessage(kind, p.STRING, self.name, self.time(), -1.0, -1.0,
+                           p.wildcard_sval(app, var, interval), self.name, id=self._take_id())  # fmt: skip
+
+    def _queue(self, msg: MOOSMessage) -> None:
+        self._outbox.append(msg)
+        if len(self._outbox) > self.outbox_limit:
+            dropped = len(self._outbox) - self.outbox_limit // 2
+            for _ in range(dropped):
+                self._outbox.popleft()
+            log.warning("%s: outbox over %d messages, dropped the %d oldest",
+                        self.name, self.outbox_limit, dropped)  # fmt: skip
+        self._wake.set()
+
+    def _deliver(self, msg: MOOSMessage) -> None:
+        if self.on_message is not None:
+            try:
+                self.on_message(msg)
+            except Exception:
+                log.exception("%s: message handler failed on %s", self.name, msg.key)
+            return
+        self._inbox.append(msg)
+        if len(self._inbox) > self.inbox_limit:
+            self._inbox.popleft()
+        self._inbox_ready.set()
+
+    async def _run(self) -> None:
+        try:
+            while True:
+                try:
+                    reader, writer = await asyncio.open_connection(self.host, self.port)
+                except OSError as err:
+                    log.debug("%s: cannot connect to %s:%d: %s", self.name, self.host, self.port, err)
+                    await asyncio.sleep(self.reconnect_interval)
+                    continue
+                try:
+                    await self._session(reader, writer)
+                except MOOSRefused as err:
+                    log.error("%s: %s", self.name, err)
+                    self.failure = err
+                    self._stopped.set()
+                    return
+                except (OSError, EOFError, TimeoutError, p.ProtocolError) as err:
+                    log.warning("%s: connection to %s:%d lost: %s", self.name, self.host,
+                                self.port, err or type(err).__name__)  # fmt: skip
+                finally:
+                    writer.close()
+                    self._on_lost()
+                await asyncio.sleep(self.reconnect_interval)
+        finally:
+            self._on_lost()
+            self._stopped.set()
+
+    def _on_lost(self) -> None:
+        self._writer = None
+        if not self._connected.is_set():
+            return
+        self._connected.clear()
+        # registrations are re-sent on reconnect; keep only publications and requests
+        kept = [m for m in self._outbox if m.msg_type == p.NOTIFY]
+        self._outbox = deque(kept)
+        for future in self._requests:
+            if not future.done():
+                future.set_result([])
+        for callback in self.on_disconnect:
+            callback()
+
+    async def _session(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        sock = writer.get_extra_info("socket")
+        if sock is not None:
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.skew.skew = 0.0
+        writer.write(p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(self.name, self.time())]))
+        await writer.drain()
+        framer = p.PacketFramer(self.max_packet_size)
+        welcome = await asyncio.wait_for(self._read_first_packet(reader, framer), 5.0)
+        if welcome.msg_type == p.POISON:
+            raise MOOSRefused(f"MOOSDB refused {self.name!r}: {welcome.string}")
+        if welcome.msg_type != p.WELCOME:
+            raise p.ProtocolError(f"expected a welcome, got message type {welcome.msg_type!r}")
+        self.community = welcome.community
+        self.db_hostname = p.welcome_hostname(welcome)
+        self.clock_correction = bool(self.db_hostname) and self.db_hostname != socket.gethostname()
+        if self.clock_correction:
+            self.skew.skew = welcome.dval
+        self._writer = writer
+        self._resend_registrations()
+        self.connections += 1
+        self._connected.set()
+        log.info("%s: connected to MOOSDB %s at %s:%d", self.name, self.community, self.host, self.port)
+        for callback in self.on_connect:
+            try:
+                callback()
+            except Exception:
+                log.exception("%s: on_connect callback failed", self.name)
+        write_task = asyncio.create_task(self._write_loop(writer))
+        try:
+            await self._read_loop(reader, framer)
+        finally:
+            write_task.cancel()
+            with contextlib.suppress(asyncio.CancelledError, OSError):
+                await write_task
+
+    def _resend_registrations(self) -> None:
+        pending = list(self._outbox)
+        self._outbox.clear()
+        for key, interval in self._subscriptions.items():
+            self._outbox.append(self._register_msg(key, interval))
+        for (var, app), interval in self._wildcards.items():
+            self._outbox.append(self._wildcard_msg(p.WILDCARD_REGISTER, var, app, interval))
+        self._outbox.extend(pending)
+        self._wake.set()
+
+    async def _read_first_packet(self, reader: asyncio.StreamReader, framer: p.PacketFramer) -> MOOSMessage:
+        while True:
+            data = await reader.read(65536)
+            if not data:
+                raise EOFError("MOOSDB closed the connection during the handshake")
+            framer.feed(data)
+            for packet in framer.packets():
+                msgs = p.decode_packet(packet)
+                if msgs:
+                    return msgs[0]
+
+    async def _read_loop(self, reader: asyncio.StreamReader, framer: p.PacketFramer) -> None:
+        # bytes already buffered after the welcome are in `framer`
+        while True:
+            for packet in framer.packets():
+                self._on_packet(p.decode_packet(packet))
+            data = await reader.read(262144)
+            if not data:
+                raise EOFError("MOOSDB closed the connection")
+            framer.feed(data)
+
+    def _on_packet(self, msgs: list[MOOSMessage]) -> None:
+        if msgs and msgs[0].msg_type == p.TIMING:
+            echo = msgs[0]
+            if echo.dval > 0:
+                self.skew.update(echo.time, echo.dval, self.local_time())
+            self.throttle = max(echo.dval2, 0.0)
+            msgs = msgs[1:]
+        replies = [m for m in msgs if m.id == p.SERVER_REQUEST_ID and m.msg_type == p.NOTIFY]
+        if replies and self._requests:
+            future = self._requests.pop(0)
+            if not future.done():
+                future.set_result(replies)
+        for msg in msgs:
+            kind = msg.msg_type
+            if kind == p.NULL or (kind == p.NOTIFY and msg.id == p.SERVER_REQUEST_ID):
+                continue
+            if kind in (p.WELCOME, p.POISON):
+                raise p.ProtocolError(f"unexpected {kind!r} message after the handshake")
+            self._deliver(msg)
+
+    async def _write_loop(self, writer: asyncio.StreamWriter) -> None:
+        loop = asyncio.get_running_loop()
+        last_timing = -1e9
+        while True:
+            wait = last_timing + TIMING_PERIOD - loop.time()
+            if not self._outbox and wait > 0:
+                self._wake.clear()
+                with contextlib.suppress(TimeoutError):
+                    await asyncio.wait_for(self._wake.wait(), wait)
+            batch: list[MOOSMessage] = []
+            now = loop.time()
+            if now - last_timing >= TIMING_PERIOD:
+                batch.append(p.timing_message(self.local_time()))
+                last_timing = now
+            while self._outbox and len(batch) < MAX_PACKET_MESSAGES:
+                batch.append(self._outbox.popleft())
+            if not batch:
+                continue
+            writer.write(p.encode_packet(batch))
+            await writer.drain()
+            if self.throttle > 0:
+                await asyncio.sleep(self.throttle)
+            elif not self._outbox:
+                await asyncio.sleep(0)
