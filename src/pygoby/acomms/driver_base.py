@@ -1,0 +1,193 @@
+"""ModemDriverBase: the interface every modem driver implements (spec acomms.md §4).
+
+A driver is advanced by calling `do_work()` regularly (>= 5 Hz); it reads its link, runs its
+timers against the Clock, and emits signals synchronously. Line-based drivers talk through a
+`LineLink` (pygoby.util.linebased), built from the DriverConfig by `modem_start` or injected
+(a MemoryLink makes the driver a pure sans-I/O state machine for tests and simulations).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+from abc import ABC, abstractmethod
+from typing import IO
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.signals import Signal
+from pygoby.util.clock import Clock, WallClock
+from pygoby.util.linebased import (
+    LineLink,
+    LinkClosedError,
+    SerialLink,
+    TCPClientLink,
+    TCPServerLink,
+)
+
+log = logging.getLogger(__name__)
+
+Status = m.ModemDriverStatus
+
+
+class ModemDriverException(Exception):
+    """A driver failure; `status` is a ModemDriverStatus.Status value."""
+
+    def __init__(self, message: str, status: int) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+def driver_name(cfg) -> str:
+    """`<DriverType name without DRIVER_>::<modem_id>` (or the plugin name)."""
+    if cfg.WhichOneof("driver") == "driver_name":
+        kind = cfg.driver_name
+    else:
+        kind = (
+            m.DriverConfig.DESCRIPTOR.enum_types_by_name["DriverType"]
+            .values_by_number[cfg.driver_type]
+            .name.removeprefix("DRIVER_")
+        )
+    return f"{kind}::{cfg.modem_id}"
+
+
+class ModemDriverBase(ABC):
+    """Abstract driver with goby's signals; line-based helpers for drivers that need them."""
+
+    DEFAULT_SERIAL_BAUD: int | None = None
+    DEFAULT_LINE_DELIMITER: str | None = None  # overrides DriverConfig's default when unset
+
+    def __init__(self, clock: Clock | None = None, link: LineLink | None = None) -> None:
+        self.clock: Clock = clock if clock is not None else WallClock()
+        self.signal_receive = Signal()
+        self.signal_transmit_result = Signal()
+        self.signal_data_request = Signal()
+        self.signal_modify_transmission = Signal()
+        self.signal_raw_incoming = Signal()
+        self.signal_raw_outgoing = Signal()
+        self.cfg = m.DriverConfig()
+        self.link: LineLink | None = link
+        self._injected_link = link is not None
+        self._raw_log: IO[str] | None = None
+
+    # --- the interface -------------------------------------------------------------------
+    @abstractmethod
+    def startup(self, cfg) -> None: ...
+
+    @abstractmethod
+    def shutdown(self) -> None: ...
+
+    @abstractmethod
+    def do_work(self) -> None: ...
+
+    @abstractmethod
+    def handle_initiate_transmission(self, transmission) -> None: ...
+
+    def update_cfg(self, cfg) -> None:
+        log.warning("%s: update_cfg is not implemented by this driver", type(self).__name__)
+
+    def report(self):
+        report = m.ModemReport(modem_id=self.cfg.modem_id, time=m.now_us(self.clock.now()))
+        report.link_state = (
+            m.ModemReport.LINK_AVAILABLE
+            if self.link is not None and self.link.is_open
+            else m.ModemReport.LINK_NOT_AVAILABLE
+        )
+        return report
+
+    @property
+    def modem_id(self) -> int:
+        return self.cfg.modem_id
+
+    # --- helpers for line-based modems ---------------------------------------------------
+    def modem_start(self, cfg) -> None:
+        """Validate the link settings, build (or reuse the injected) link and open it."""
+        if not cfg.HasField("modem_id"):
+            raise ModemDriverException("modem_id is required", Status.INVALID_CONFIGURATION)
+        self.cfg = cfg
+        delimiter = self.line_delimiter(cfg)
+        if not self._injected_link:
+            self.link = self._make_link(cfg, delimiter)
+        if self.link is None:
+            raise ModemDriverException("no link configured", Status.INVALID_CONFIGURATION)
+        if cfg.HasField("raw_log"):
+            stamp = dt.datetime.fromtimestamp(self.clock.now(), dt.UTC).strftime("%Y%m%dT%H%M%S")
+            self._raw_log = open(cfg.raw_log.replace("%1%", stamp), "a", encoding="latin-1")  # noqa: SIM115
+        self.link.open()
+
+    def line_delimiter(self, cfg) -> str:
+        if not cfg.HasField("line_delimiter") and self.DEFAULT_LINE_DELIMITER is not None:
+            return self.DEFAULT_LINE_DELIMITER
+        return cfg.line_delimiter
+
+    def _make_link(self, cfg, delimiter: str) -> LineLink:
+        C = m.DriverConfig
+        # Quirk A1 (sane): an implicit connection_type is the documented default, SERIAL.
+        kind = cfg.connection_type
+        if kind == C.CONNECTION_SERIAL:
+            if not cfg.HasField("serial_port"):
+                raise ModemDriverException("serial_port is required", Status.INVALID_CONFIGURATION)
+            baud = cfg.serial_baud if cfg.HasField("serial_baud") else self.DEFAULT_SERIAL_BAUD
+            if baud is None:
+                raise ModemDriverException("serial_baud is required", Status.INVALID_CONFIGURATION)
+            return SerialLink(cfg.serial_port, baud, delimiter)
+        if kind == C.CONNECTION_TCP_AS_CLIENT:
+            if not (cfg.HasField("tcp_server") and cfg.HasField("tcp_port")):
+                raise ModemDriverException(
+                    "tcp_server and tcp_port are required", Status.INVALID_CONFIGURATION
+                )
+            return TCPClientLink(cfg.tcp_server, cfg.tcp_port, delimiter, cfg.reconnect_interval)
+        if not cfg.HasField("tcp_port"):
+            raise ModemDriverException("tcp_port is required", Status.INVALID_CONFIGURATION)
+        return TCPServerLink(cfg.tcp_port, delimiter=delimiter)
+
+    def modem_read(self) -> list[str]:
+        if self.link is None:
+            return []
+        lines = self.link.read_lines()
+        for line in lines:
+            self._log_raw("[rx] ", line)
+        return lines
+
+    def modem_write(self, text: str) -> None:
+        if self.link is None:
+            raise ModemDriverException("no link", Status.CONNECTION_TO_MODEM_FAILED)
+        try:
+            self.link.write(text)
+        except LinkClosedError as exc:
+            raise ModemDriverException(str(exc), Status.CONNECTION_TO_MODEM_FAILED) from exc
+        self._log_raw("[tx] ", text.rstrip("\r\n"))
+
+    def modem_close(self) -> None:
+        if self.link is not None:
+            self.link.close()
+        if self._raw_log is not None:
+            self._raw_log.close()
+            self._raw_log = None
+
+    def _log_raw(self, prefix: str, line: str) -> None:
+        if self._raw_log is not None:
+            self._raw_log.write(prefix + line + "\n")
+            self._raw_log.flush()
+
+    def emit_raw(self, incoming: bool, raw: bytes | str, description: str = "") -> None:
+        data = raw.encode("latin-1") if isinstance(raw, str) else raw
+        msg = m.ModemRaw(raw=data)
+        if description:
+            msg.description = description
+        (self.signal_raw_incoming if incoming else self.signal_raw_outgoing).emit(msg)
+
+
+class NoDriver(ModemDriverBase):
+    """DRIVER_NONE: accepts transmissions and does nothing."""
+
+    def startup(self, cfg) -> None:
+        self.cfg = cfg
+
+    def shutdown(self) -> None:
+        pass
+
+    def do_work(self) -> None:
+        pass
+
+    def handle_initiate_transmission(self, transmission) -> None:
+        log.debug("DRIVER_NONE: ignoring transmission request")

@@ -1,0 +1,1 @@
+"""Modem drivers (all derive from pygoby.acomms.driver_base.ModemDriverBase)."""

@@ -1,0 +1,6 @@
+"""WHOI Micro-Modem NMEA driver (spec acomms.md §7)."""
+
+from pygoby.acomms.drivers.micromodem.driver import MMDriver
+from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES
+
+__all__ = ["MMDriver", "RATE_FRAME_BYTES", "RATE_NUM_FRAMES"]

@@ -1,0 +1,566 @@
+"""The WHOI Micro-Modem NMEA driver (spec acomms.md §7) as a state machine.
+
+Everything happens in `do_work()` (read lines, dispatch, run timers against the Clock) and in
+`handle_initiate_transmission()`; nothing blocks. Start-up (§7.3) is a sequence of phases
+advanced by `do_work`; `startup_complete` says when it is done. With an injected MemoryLink the
+driver is fully sans-I/O: feed lines, advance a VirtualClock, read what it wrote.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as dt
+import logging
+from collections import deque
+from enum import Enum, auto
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
+from pygoby.acomms.drivers.micromodem.statistics import parse_cst, parse_toa, parse_xst
+from pygoby.util.nmea import NMEAError, NMEASentence
+
+log = logging.getLogger(__name__)
+
+MODEM_WAIT = 5.0  # s before a sentence is resent
+RETRIES = 3
+MAX_FAILS_BEFORE_DEAD = 5
+MULTI_REPLY_QUIET = 2.0  # s of silence that ends a CFQ,ALL / CFQ,TOP burst
+DEFAULT_BAUD = 19200
+REVINIT_PAUSE = 2.0
+MM2_BITFIELD_CLOCK_REVISION = (2, 0, 26038)
+
+Status = m.ModemDriverStatus
+
+
+class Phase(Enum):
+    CONFIGURING = auto()
+    SETTING_CLOCK = auto()
+    QUERYING = auto()
+    READY = auto()
+    STOPPED = auto()
+
+
+class MMDriver(ModemDriverBase):
+    DEFAULT_SERIAL_BAUD = DEFAULT_BAUD
+    DEFAULT_LINE_DELIMITER = "\r"
+
+    def __init__(self, clock=None, link=None) -> None:
+        super().__init__(clock, link)
+        self.mm_cfg = m.MMConfig()
+        self.phase = Phase.STOPPED
+        self.nvram: dict[str, int] = {}
+        self.revision: tuple[int, int, int] = (0, 0, 0)
+        self._reset_state()
+
+    def _reset_state(self) -> None:
+        self._out: deque[NMEASentence] = deque()
+        self._written_at: float | None = None  # when the front sentence was last written
+        self._tries = 0
+        self._fails = 0
+        self._hold_until = 0.0  # no writes before this time (after $CAREV,INIT)
+        self._multi_reply = False
+        self._last_cfg_at = 0.0
+        self._last_rx_at = self.clock.now()
+        self._clock_set = False
+        self._link_was_open = False
+        # transmission state
+        self._cached = m.ModemTransmission()
+        self._frame_counter = 0
+        self._expected_acks: set[int] = set()
+        self._expected_ack_src = -1
+        self._expected_xst = 0
+        self._transmit = m.ModemTransmission()
+        # reception state
+        self._receive: m.ModemTransmission | None = None
+        self._expected_frames: set[int] = set()
+        self._expected_cst = 0
+        self._ack_msg: m.ModemTransmission | None = None
+        self._last_lbl_type = m.MICROMODEM_REMUS_LBL_RANGING
+
+    # ------------------------------------------------------------------ interface
+    @property
+    def startup_complete(self) -> bool:
+        return self.phase is Phase.READY
+
+    @property
+    def is_mm2(self) -> bool:
+        return self.revision[0] >= 2
+
+    def startup(self, cfg) -> None:
+        self._reset_state()
+        self.mm_cfg = cfg.Extensions[m.MM_CONFIG]
+        self.modem_start(cfg)
+        c = self.mm_cfg
+        if c.reset_nvram and not c.hydroid_gateway_id:
+            self._push("$CCCFG", "ALL", 0)
+        self._push("$CCCFG", "CST", 1)
+        for entry in c.nvram_cfg:
+            key, sep, value = entry.partition(",")
+            if sep and len(key) == 3:
+                entry = entry.upper()
+            self._out.append(NMEASentence.build("$CCCFG", entry.split(",")))
+        self._push("$CCCFG", "SRC", cfg.modem_id)
+        if c.HasField("revision"):
+            self.revision = (c.revision.mm_major, c.revision.mm_minor, c.revision.mm_patch)
+            self._push("$CCCFG", "REV", 0)
+        else:
+            self._push("$CCCFG", "REV", 1)
+        self._push("$CCCFG", "RXP", 1)
+        if c.use_base64_fdp:
+            self._push("$CCCFG", "recv.base64data", 1)
+        self._push("$CCMSC", cfg.modem_id, cfg.modem_id, 0)
+        self.phase = Phase.CONFIGURING
+
+    def shutdown(self) -> None:
+        self.phase = Phase.STOPPED
+        self.modem_close()
+
+    def do_work(self) -> None:
+        if self.phase is Phase.STOPPED:
+            return
+        assert self.link is not None
+        link_open = self.link.is_open
+        if link_open and not self._link_was_open:
+            self._written_at = None  # (re)connected: rewrite the outstanding sentence now
+        self._link_was_open = link_open
+        for line in self.modem_read():
+            self._handle_line(line)
+        if not link_open:
+            return  # a dead link is the link's business (it reconnects); do not count failures
+        now = self.clock.now()
+        self._check_multi_reply(now)
+        self._advance_startup(now)
+        self._check_timeout(now)
+        self._keep_alive(now)
+        self._try_write(now)
+
+    def handle_initiate_transmission(self, transmission) -> None:
+        msg = m.ModemTransmission()
+        msg.CopyFrom(transmission)
+        self.signal_modify_transmission.emit(msg)
+        if msg.type == m.DATA:
+            self._initiate_data(msg)
+        elif msg.type == m.DRIVER_SPECIFIC:
+            kind = msg.Extensions[m.MM_TRANSMISSION].type
+            if kind == m.MICROMODEM_TWO_WAY_PING:
+                self._push("$CCMPC", msg.src if msg.src >= 0 else self.modem_id, msg.dest)
+            elif kind == m.MICROMODEM_MINI_DATA:
+                self._initiate_mini(msg)
+            elif kind == m.MICROMODEM_REMUS_LBL_RANGING:
+                self._initiate_remus_lbl(msg)
+            else:
+                log.warning("Micro-Modem transmission type %d is not supported", kind)
+        else:
+            log.warning("cannot initiate a transmission of type %d", msg.type)
+
+    def set_silent(self, silent: bool) -> None:
+        """MACUpdate cycle_state: SRC,0 stops the modem acknowledging; SRC,<id> restores it."""
+        self._push("$CCCFG", "SRC", 0 if silent else self.modem_id)
+
+    # ------------------------------------------------------------------ outgoing FIFO
+    def _push(self, token: str, *values: object) -> None:
+        self._out.append(NMEASentence.build(token, values))
+
+    def _try_write(self, now: float) -> None:
+        if not self._out or self._written_at is not None or now < self._hold_until:
+            return
+        sentence = self._out[0]
+        text = sentence.message()
+        prefix = f"#M{self.mm_cfg.hydroid_gateway_id}" if self.mm_cfg.hydroid_gateway_id else ""
+        self.modem_write(prefix + text + "\r\n")
+        self.emit_raw(False, text)
+        self._written_at = now
+        self._tries += 1
+
+    def _pop_front(self) -> None:
+        if self._out:
+            self._out.popleft()
+        self._written_at = None
+        self._tries = 0
+
+    def _fail_front(self, reason: str) -> None:
+        self._fails += 1
+        front = self._out[0].message() if self._out else "?"
+        log.warning("no valid answer to %s (%s)", front, reason)
+        if self._fails >= MAX_FAILS_BEFORE_DEAD:
+            self.shutdown()
+            raise ModemDriverException(
+                f"modem did not respond to {front}", Status.MODEM_NOT_RESPONDING
+            )
+        if self._tries >= RETRIES:
+            log.warning("giving up on %s, continuing onwards anyway", front)
+            self._pop_front()
+        else:
+            self._written_at = None  # resend
+
+    def _check_timeout(self, now: float) -> None:
+        if self._written_at is not None and now - self._written_at > MODEM_WAIT:
+            self._fail_front("timeout")
+
+    def _keep_alive(self, now: float) -> None:
+        if self.phase is not Phase.READY or self._out:
+            return
+        if now - self._last_rx_at > self.mm_cfg.keep_alive_seconds:
+            if self.is_mm2:
+                self._push("$CCTMQ", 0)
+            else:
+                self._push("$CCCFQ", "SRC")
+            self._last_rx_at = now
+
+    def _check_multi_reply(self, now: float) -> None:
+        if self._multi_reply and self._last_cfg_at and now - self._last_cfg_at > MULTI_REPLY_QUIET:
+            self._multi_reply = False
+            self._last_cfg_at = 0.0
+            if self._out and self._out[0].sentence_id == "CFQ":
+                self._pop_front()
+
+    def _acknowledge(self, sentence: NMEASentence) -> None:
+        """Pop the outstanding sentence if `sentence` answers it (§7.2 table)."""
+        if not self._out or self._written_at is None:
+            return
+        front = self._out[0]
+        kind, got = front.sentence_id, sentence.sentence_id
+        if kind == "CFG":
+            if (
+                got == "CFG"
+                and len(sentence) == 3
+                and tuple(sentence.fields[1:]) == tuple(front.fields[1:3])
+            ):
+                self._pop_front()
+        elif kind == "CFQ":
+            if got == "CFG" and not self._multi_reply:
+                self._pop_front()
+        elif kind == "MSC":
+            if got in ("REV", "MSC"):
+                self._pop_front()
+        elif kind == got:
+            self._pop_front()
+
+    # ------------------------------------------------------------------ start-up phases
+    def _advance_startup(self, now: float) -> None:
+        if self.phase is Phase.CONFIGURING and not self._out:
+            self.phase = Phase.SETTING_CLOCK
+        if self.phase is Phase.SETTING_CLOCK:
+            if self._clock_set and not self._out:
+                if self.mm_cfg.query_cfg_on_startup:
+                    self._multi_reply = True
+                    self._push("$CCCFQ", "TOP" if self.is_mm2 else "ALL")
+                    self.phase = Phase.QUERYING
+                else:
+                    self.phase = Phase.READY
+        elif self.phase is Phase.QUERYING and not self._out:
+            self.phase = Phase.READY
+        if self.phase is not Phase.CONFIGURING and not self._clock_set and not self._out:
+            self._send_clock(now)
+
+    def _send_clock(self, now: float) -> None:
+        # WHOI guidance: set between 50 and 100 ms after a whole second, to the next second.
+        if not 0.05 <= now % 1.0 < 0.1:
+            return
+        t = dt.datetime.fromtimestamp(int(now) + 1, dt.UTC)  # Quirk A6 (sane): carry properly
+        if self.is_mm2:
+            self._push("$CCTMS", f"{t:%Y-%m-%dT%H:%M:%SZ}", 0)
+        else:
+            self._push("$CCCLK", t.year, t.month, t.day, t.hour, t.minute, t.second)
+        self._try_write(now)
+
+    def _check_clock(self, modem_time: float, whole_seconds: bool) -> None:
+        now = self.clock.now()
+        reference = float(int(now)) if whole_seconds else now
+        skew_ms = abs(modem_time - reference) * 1000.0
+        if skew_ms < self.mm_cfg.allowed_skew_ms:
+            self._clock_set = True
+        else:
+            log.warning("modem clock is %.0f ms off; setting it again", skew_ms)
+            self._clock_set = False
+
+    # ------------------------------------------------------------------ incoming
+    def _handle_line(self, line: str) -> None:
+        if self.mm_cfg.hydroid_gateway_id:
+            line = line[3:]
+        if not line.strip():
+            return
+        self.emit_raw(True, line.strip())
+        try:
+            sentence = NMEASentence.parse(line)
+        except NMEAError as exc:
+            log.warning("ignoring invalid line from the modem: %s", exc)
+            return
+        self._fails = 0
+        self._last_rx_at = self.clock.now()
+        try:
+            self._dispatch(sentence)
+        except (NMEAError, ValueError, IndexError) as exc:
+            log.warning("ignoring malformed %s: %s", sentence.message(), exc)
+        self._acknowledge(sentence)
+
+    def _dispatch(self, s: NMEASentence) -> None:
+        handler = getattr(self, "_on_" + s.sentence_id.lower(), None)
+        if handler is not None:
+            handler(s)
+
+    def _on_rev(self, s: NMEASentence) -> None:
+        if s[2] == "INIT":
+            log.warning("modem reported a reboot ($CAREV INIT)")
+            self._hold_until = self.clock.now() + REVINIT_PAUSE
+            self._clock_set = False
+        elif s[2] == "AUV" and not self.mm_cfg.HasField("revision"):
+            parts = [int(p) for p in s[3].split(".")]
+            patch = parts[2] * 100 + parts[3] if len(parts) > 3 else parts[2]
+            self.revision = (parts[0], parts[1], patch)
+
+    def _on_err(self, s: NMEASentence) -> None:
+        log.warning("modem error: %s", s.message())
+        if len(s) > 2 and s[2] == "NMEA" and self._out and self._written_at is not None:
+            self._fail_front("$CAERR NMEA")
+
+    def _on_cfg(self, s: NMEASentence) -> None:
+        if len(s) >= 3:
+            with contextlib.suppress(ValueError):
+                self.nvram[s[1]] = int(s[2])
+        if self._multi_reply:
+            self._last_cfg_at = self.clock.now()
+
+    def _on_clk(self, s: NMEASentence) -> None:
+        if self._outstanding("CLK"):
+            t = dt.datetime(*(s.as_int(i) for i in range(1, 7)), tzinfo=dt.UTC)
+            self._check_clock(t.timestamp(), whole_seconds=True)
+
+    def _on_tms(self, s: NMEASentence) -> None:
+        if self._outstanding("TMS"):
+            self._check_clock(_iso_time(s[2]), whole_seconds="." not in s[2])
+
+    def _on_tmq(self, s: NMEASentence) -> None:
+        if self._outstanding("TMQ"):
+            self._check_clock(_iso_time(s[1]) + 0.5, whole_seconds=False)
+
+    def _outstanding(self, kind: str) -> bool:
+        return bool(self._out) and self._written_at is not None and self._out[0].sentence_id == kind
+
+    # ------------------------------------------------------------------ data transmission
+    def _initiate_data(self, msg) -> None:
+        check_rate(msg.rate)
+        msg.max_num_frames = RATE_NUM_FRAMES[msg.rate]
+        msg.max_frame_bytes = RATE_FRAME_BYTES[msg.rate]
+        if msg.src < 0:
+            msg.src = self.modem_id
+        if msg.src != self.modem_id:
+            # third-party initiation (polling): the polled node fills the frames
+            if msg.dest < 0:  # Quirk A14 (sane)
+                log.warning("a poll must name a destination; not sending %s", msg)
+                return
+            self._push("$CCCYC", 0, msg.src, msg.dest, msg.rate, 1, msg.max_num_frames)
+            return
+        self._request_data(msg)
+        if not self._cached.frame or not self._cached.frame[0]:
+            log.debug("no data to send; no cycle started")
+            return
+        c = self._cached
+        self._expected_xst = 2 if c.rate == 0 else 1
+        self._transmit = m.ModemTransmission()
+        self._transmit.CopyFrom(c)
+        self._push("$CCCYC", 0, c.src, c.dest, c.rate, c.ack_requested, len(c.frame))
+
+    def _request_data(self, msg) -> None:
+        self._expected_acks.clear()
+        self._frame_counter = 0
+        self.signal_data_request.emit(msg)
+        if msg.dest < 0:
+            msg.dest = m.BROADCAST_ID
+        self._cached = msg
+
+    def _on_cyc(self, s: NMEASentence) -> None:
+        src, dest, rate, ack, nframes = (s.as_int(i) for i in range(2, 7))
+        if self._outstanding("CYC") and tuple(self._out[0].fields[2:5]) == tuple(s.fields[2:5]):
+            return  # the modem's echo of our own $CCCYC
+        if src == self.modem_id:
+            check_rate(rate)
+            request = m.ModemTransmission(
+                src=src, dest=dest, rate=rate, type=m.DATA, time=m.now_us(self.clock.now()),
+                max_num_frames=nframes, max_frame_bytes=RATE_FRAME_BYTES[rate],
+                ack_requested=bool(ack),
+            )  # fmt: skip
+            self._request_data(request)
+            self._expected_xst = 2 if rate == 0 else 1
+            self._transmit = m.ModemTransmission()
+            self._transmit.CopyFrom(self._cached)
+            return
+        if self._expected_frames:
+            log.warning("new cycle before frames %s arrived", sorted(self._expected_frames))
+        self._expected_frames = set(range(nframes))
+        self._expected_cst = 2 if rate == 0 else 1
+        self._receive = None
+
+    def _on_drq(self, s: NMEASentence) -> None:
+        src, dest, ack, nbytes, frame_no = (s.as_int(i) for i in range(2, 7))
+        index = frame_no - 1
+        if 0 <= index < len(self._cached.frame) and self._cached.frame[index]:
+            data = bytes(self._cached.frame[index])
+            if self.mm_cfg.pad_partial_frames:
+                data = data.ljust(nbytes, b"\0")
+            self._push("$CCTXD", src, dest, ack, data.hex())
+            if ack:
+                self._expected_acks.add(self._frame_counter)
+                self._frame_counter += 1
+                self._expected_ack_src = dest
+        else:
+            self._push("$CCTXD", src, dest, ack, "")
+
+    def _on_xst(self, s: NMEASentence) -> None:
+        self._transmit.Extensions[m.MM_TRANSMISSION].transmit_stat.append(parse_xst(s))
+        self._expected_xst -= 1
+        if self._expected_xst <= 0:
+            self.signal_transmit_result.emit(self._transmit)
+            self._transmit = m.ModemTransmission()
+
+    def _on_ack(self, s: NMEASentence) -> None:
+        src, dest, frame_no = s.as_int(1), s.as_int(2), s.as_int(3)
+        if dest != self.modem_id or src != self._expected_ack_src:
+            return
+        goby_frame = frame_no - 1
+        if goby_frame not in self._expected_acks:
+            log.warning("unexpected ACK for frame %d", goby_frame)
+            return
+        self._expected_acks.discard(goby_frame)
+        if self._ack_msg is None:
+            self._ack_msg = m.ModemTransmission(
+                type=m.ACK, src=src, dest=dest, time=m.now_us(self.clock.now())
+            )
+        self._ack_msg.acked_frame.append(goby_frame)
+        if not self._cst_enabled:
+            self._flush_ack()
+
+    def _flush_ack(self) -> None:
+        if self._ack_msg is not None:
+            ack, self._ack_msg = self._ack_msg, None
+            self.signal_receive.emit(ack)
+
+    @property
+    def _cst_enabled(self) -> bool:
+        return self.nvram.get("CST", 1) != 0
+
+    # ------------------------------------------------------------------ reception
+    def _receiving(self) -> m.ModemTransmission:
+        if self._receive is None:
+            self._receive = m.ModemTransmission(type=m.DATA)
+        return self._receive
+
+    def _on_rxd(self, s: NMEASentence) -> None:
+        src, dest, ack, frame_no = (s.as_int(i) for i in range(1, 5))
+        data = bytes.fromhex(s[5]) if len(s) > 5 else b""
+        rx = self._receiving()
+        if frame_no == 1:
+            rx.time = m.now_us(self.clock.now())
+            rx.src, rx.dest, rx.type, rx.ack_requested = src, dest, m.DATA, bool(ack)
+        if data:
+            if frame_no - 1 != len(rx.frame):
+                log.warning("frame %d arrived as frame %d", frame_no, len(rx.frame) + 1)
+            rx.frame.append(data)
+        self._expected_frames.discard(frame_no - 1)
+        if not self._cst_enabled and not self._expected_frames:
+            self._finish_receive()
+
+    def _on_msg(self, s: NMEASentence) -> None:
+        if s[1] in ("BAD_CRC", "Bad CRC") and self._expected_frames:
+            rx = self._receiving()
+            rx.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc.append(len(rx.frame))
+            rx.frame.append(b"")
+            self._expected_frames.discard(min(self._expected_frames))
+            if not self._cst_enabled and not self._expected_frames:
+                self._finish_receive()
+
+    def _on_cst(self, s: NMEASentence) -> None:
+        today = dt.datetime.fromtimestamp(self.clock.now(), dt.UTC).date()
+        stat = parse_cst(s, today, self.revision >= MM2_BITFIELD_CLOCK_REVISION)
+        if self._ack_msg is not None and self._receive is None and not self._expected_cst:
+            self._ack_msg.Extensions[m.MM_TRANSMISSION].receive_stat.append(stat)
+            self._flush_ack()
+            return
+        rx = self._receiving()
+        ext = rx.Extensions[m.MM_TRANSMISSION]
+        ext.receive_stat.append(stat)
+        rx.time, rx.time_source = stat.time, m.ModemTransmission.MODEM_TIME
+        if not rx.HasField("src"):
+            rx.src, rx.dest = stat.source, stat.dest
+        if stat.clock_mode in (2, 3):
+            ranging = ext.ranging_reply
+            ranging.one_way_travel_time.append((stat.time % 1_000_000) / 1e6)
+            ranging.ambiguity = m.RangingReply.OWTT_SECOND_AMBIGUOUS
+            ranging.receiver_clk_mode = stat.clock_mode
+            ranging.is_one_way_synchronous = True
+        self._expected_cst -= 1
+        if self._expected_cst <= 0:
+            self._finish_receive()
+        self._flush_ack()
+
+    def _finish_receive(self) -> None:
+        rx, self._receive = self._receive, None
+        self._expected_frames.clear()
+        self._expected_cst = 0
+        if rx is not None:
+            self.signal_receive.emit(rx)
+
+    # ------------------------------------------------------------------ ranging, mini-packets
+    def _on_mpr(self, s: NMEASentence) -> None:
+        # Quirk A5 (faithful): src/dest copied as they appear in the sentence
+        msg = self._ping_result(s.as_int(1), s.as_int(2))
+        msg.Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time.append(s.as_float(3))
+        self.signal_receive.emit(msg)
+
+    def _on_mpa(self, s: NMEASentence) -> None:
+        self.signal_receive.emit(self._ping_result(s.as_int(1), s.as_int(2)))
+
+    def _ping_result(self, src: int, dest: int, kind: int = m.MICROMODEM_TWO_WAY_PING):
+        msg = m.ModemTransmission(
+            type=m.DRIVER_SPECIFIC, src=src, dest=dest, time=m.now_us(self.clock.now())
+        )
+        msg.Extensions[m.MM_TRANSMISSION].type = kind
+        return msg
+
+    def _initiate_mini(self, msg) -> None:
+        msg.max_num_frames, msg.max_frame_bytes = 1, 2
+        if msg.src < 0:
+            msg.src = self.modem_id
+        if not msg.frame:
+            self.signal_data_request.emit(msg)
+        if not msg.frame or not msg.frame[0]:
+            return
+        data = bytearray(bytes(msg.frame[0])[:2].ljust(2, b"\0"))
+        if data[0] & 0xE0:
+            log.warning("mini-packets carry 13 bits; masking the top 3 bits")
+            data[0] &= 0x1F
+        self._push("$CCMUC", msg.src, msg.dest, data.hex().upper())
+
+    def _on_mua(self, s: NMEASentence) -> None:
+        msg = self._ping_result(s.as_int(1), s.as_int(2), m.MICROMODEM_MINI_DATA)
+        msg.frame.append(bytes.fromhex(s[3]))
+        self.signal_receive.emit(msg)
+
+    def _initiate_remus_lbl(self, msg) -> None:
+        params = m.MMConfig().remus_lbl
+        params.CopyFrom(self.mm_cfg.remus_lbl)
+        params.MergeFrom(msg.Extensions[m.MM_TRANSMISSION].remus_lbl)
+        if self.nvram.get("TAT") != params.turnaround_ms:
+            self._push("$CCCFG", "TAT", params.turnaround_ms)
+        timeout = int(params.lbl_max_range * 2 / 1500 * 1000 + params.turnaround_ms)
+        bits = params.enable_beacons
+        self._last_lbl_type = m.MICROMODEM_REMUS_LBL_RANGING
+        self._push(
+            "$CCPDT", 1, self.modem_id % 4 + 1, 0, 0, timeout, *((bits >> i) & 1 for i in range(4))
+        )
+
+    def _on_tta(self, s: NMEASentence) -> None:
+        msg = self._ping_result(self.modem_id, -1, self._last_lbl_type)
+        msg.ClearField("dest")
+        msg.time_source = m.ModemTransmission.MODEM_TIME
+        today = dt.datetime.fromtimestamp(self.clock.now(), dt.UTC).date()
+        msg.time = parse_toa(s[5], today)
+        reply = msg.Extensions[m.MM_TRANSMISSION].ranging_reply
+        for i in range(1, 5):
+            reply.one_way_travel_time.append(s.as_float(i) if s[i] else 0.0)
+        self.signal_receive.emit(msg)
+
+
+def _iso_time(text: str) -> float:
+    return dt.datetime.fromisoformat(text.replace("Z", "+00:00")).timestamp()

@@ -1,0 +1,127 @@
+"""$CACST / $CAXST statistics sentences <-> ReceiveStatistics / TransmitStatistics (§7.12)."""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+
+from pygoby.acomms import messages as m
+from pygoby.util.nmea import NMEAFormatError, NMEASentence
+
+log = logging.getLogger(__name__)
+
+# ReceiveStatistics fields in $CACST order after the TOA and clock mode (v0 fields 4..29)
+_CST_INT_FIELDS = (
+    "mfd_peak", "mfd_power", "mfd_ratio", "spl", "shf_agn", "shf_ainpshift", "shf_ainshift",
+    "shf_mfdshift", "shf_p2bshift", "rate", "source", "dest", "psk_error_code", "packet_type",
+    "number_frames", "number_bad_frames", "snr_rss", "snr_in", "snr_out", "snr_symbols",
+    "mse_equalizer", "data_quality_factor", "doppler", "stddev_noise", "carrier_freq", "bandwidth",
+)  # fmt: skip
+_ENUM_RANGES = {"mode": (0, 2), "psk_error_code": (0, 6), "packet_type": (1, 5)}
+_INVALID = {"mode": -1, "psk_error_code": -1, "packet_type": -1, "clock_mode": -1}
+
+
+def parse_toa(text: str, today: dt.date) -> int:
+    """`hhmmss.ffff` on `today` (UTC) -> microseconds since the epoch."""
+    whole, _, frac = text.partition(".")
+    if len(whole) != 6 or not whole.isdigit() or (frac and not frac.isdigit()):
+        raise NMEAFormatError(f"bad time of arrival {text!r}")
+    t = dt.datetime(
+        today.year, today.month, today.day, int(whole[:2]), int(whole[2:4]), int(whole[4:6]),
+        tzinfo=dt.UTC,
+    )  # fmt: skip
+    micros = int(round(float("0." + frac) * 1e6)) if frac else 0
+    return int(t.timestamp()) * 1_000_000 + micros
+
+
+def cst_offset(sentence: NMEASentence) -> tuple[int, int]:
+    """(version, offset): version-0 layout has no version field; >= 6 has one (Quirk A7)."""
+    first = sentence.as_int(1)
+    return (first, 1) if first >= 6 else (0, 0)
+
+
+def clock_mode_from_field(value: int, new_bitfield: bool) -> int:
+    if not new_bitfield:
+        return value if 0 <= value <= 3 else -1
+    rtc, pps = value & 0x3, (value >> 2) & 0x7
+    sync = pps == 3
+    good = rtc in (2, 3)
+    return (2 if sync else 0) + (1 if good else 0)
+
+
+def parse_cst(sentence: NMEASentence, today: dt.date, new_clock_bitfield: bool = False):
+    """A $CACST sentence -> ReceiveStatistics (fields up to a short sentence's end)."""
+    version, off = cst_offset(sentence)
+    stat = m.ReceiveStatistics(version=version)
+    mode = sentence.as_int(1 + off)
+    stat.mode = mode if 0 <= mode <= 2 else -1
+    stat.time = parse_toa(sentence[2 + off], today)
+    stat.clock_mode = clock_mode_from_field(sentence.as_int(3 + off), new_clock_bitfield)
+    for i, name in enumerate(_CST_INT_FIELDS):
+        index = 4 + off + i
+        if index >= len(sentence):
+            log.warning("short $CACST (%d fields): stopped at %s", len(sentence), name)
+            break
+        if name == "doppler":
+            setattr(stat, name, sentence.as_float(index))
+            continue
+        value = sentence.as_int(index)
+        lo_hi = _ENUM_RANGES.get(name)
+        if lo_hi is not None and not lo_hi[0] <= value <= lo_hi[1]:
+            value = _INVALID[name]
+        setattr(stat, name, value)
+    return stat
+
+
+def format_cst(stat, version: int = 0) -> NMEASentence:
+    """ReceiveStatistics -> $CACST (used by the emulator)."""
+    toa = dt.datetime.fromtimestamp(stat.time / 1e6, dt.UTC)
+    values: list[object] = [version] if version >= 6 else []
+    values += [stat.mode, f"{toa:%H%M%S}.{toa.microsecond // 100:04d}", stat.clock_mode]
+    for name in _CST_INT_FIELDS:
+        v = getattr(stat, name)
+        values.append(f"{v:.1f}" if name == "doppler" else int(v))
+    return NMEASentence.build("$CACST", values)
+
+
+# $CAXST v0 field order after date and time
+_XST_FIELDS = (
+    "clock_mode", "mode", "probe_length", "bandwidth", "carrier_freq", "rate", "source", "dest",
+    "ack_requested", "number_frames_expected", "number_frames_sent", "packet_type",
+    "number_bytes",
+)  # fmt: skip
+
+
+def parse_xst(sentence: NMEASentence):
+    first = sentence.as_int(1)
+    version, off = (0, 0) if first > 19_700_000 else (first, 1)
+    stat = m.TransmitStatistics(version=version, date=sentence[1 + off], time=sentence[2 + off])
+    for i, name in enumerate(_XST_FIELDS):
+        index = 3 + off + i
+        if index >= len(sentence):
+            log.warning("short $CAXST (%d fields): stopped at %s", len(sentence), name)
+            break
+        value = sentence.as_int(index)
+        if name == "ack_requested":
+            stat.ack_requested = bool(value)
+        elif name == "mode":
+            stat.mode = value if 0 <= value <= 4 else -1
+        elif name == "clock_mode":
+            stat.clock_mode = value if 0 <= value <= 3 else -1
+        elif name == "packet_type":
+            stat.packet_type = value if 1 <= value <= 5 else -1
+        else:
+            setattr(stat, name, value)
+    return stat
+
+
+def format_xst(
+    when: float, rate: int, src: int, dest: int, ack: bool, frames: int, nbytes: int
+) -> NMEASentence:
+    t = dt.datetime.fromtimestamp(when, dt.UTC)
+    packet_type = 1 if rate == 0 else 3
+    return NMEASentence.build(
+        "$CAXST",
+        [f"{t:%Y%m%d}", f"{t:%H%M%S}.{t.microsecond // 100:04d}", 0, 0, 0, 5000, 25000, rate,
+         src, dest, ack, frames, frames, packet_type, nbytes],
+    )  # fmt: skip

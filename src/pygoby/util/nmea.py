@@ -1,0 +1,131 @@
+"""NMEA-0183 sentences: parse and print with checksums (sans-I/O, generic).
+
+A sentence is `$` (or `!`), a talker+type token (`CCCYC`: talker `CC`, type `CYC`), then
+comma-separated fields, then optionally `*HH`, the XOR of every character between the start
+character and the `*`, as two hex digits. Printing always adds the checksum (upper-case hex);
+parsing accepts a sentence without one, but a checksum that is present must match.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+
+class NMEAError(ValueError):
+    """A line is not a valid NMEA sentence."""
+
+
+class NMEAFormatError(NMEAError):
+    """Missing start character, bad token, non-ASCII text or a malformed checksum field."""
+
+
+class NMEAChecksumError(NMEAError):
+    """The `*HH` checksum does not match the sentence."""
+
+
+def checksum(body: str) -> int:
+    """XOR of the characters of `body` (the text between `$`/`!` and `*`)."""
+    value = 0
+    for byte in body.encode("ascii"):
+        value ^= byte
+    return value
+
+
+@dataclass(frozen=True)
+class NMEASentence:
+    """One sentence: `fields[0]` is the token with its start character (e.g. `$CCCYC`)."""
+
+    fields: tuple[str, ...]
+
+    @classmethod
+    def build(cls, token: str, values: Iterable[object] = ()) -> NMEASentence:
+        """From a token (`"$CCCYC"`, or `"CCCYC"`, which gets a `$`) and field values."""
+        if not token.startswith(("$", "!")):
+            token = "$" + token
+        fields = (token, *(_field_text(v) for v in values))
+        sentence = cls(fields)
+        sentence._validate()
+        return sentence
+
+    @classmethod
+    def parse(cls, line: str) -> NMEASentence:
+        """Parse one line (surrounding whitespace ignored). Raises an NMEAError subclass."""
+        text = line.strip()
+        if not text.startswith(("$", "!")):
+            raise NMEAFormatError(f"NMEA sentence must start with '$' or '!': {line!r}")
+        if not text.isascii():
+            raise NMEAFormatError(f"NMEA sentence must be ASCII: {line!r}")
+        star = text.rfind("*")
+        if star != -1 and star == len(text) - 3:
+            body, given = text[1:star], text[star + 1 :]
+            try:
+                expected = int(given, 16)
+            except ValueError:
+                raise NMEAFormatError(f"bad checksum field {given!r} in {line!r}") from None
+            actual = checksum(body)
+            if actual != expected:
+                raise NMEAChecksumError(
+                    f"checksum mismatch in {line!r}: given {given}, computed {actual:02X}"
+                )
+            text = text[:star]
+        elif star != -1:
+            raise NMEAFormatError(f"'*' is not followed by a two-digit checksum: {line!r}")
+        sentence = cls(tuple(text.split(",")))
+        sentence._validate()
+        return sentence
+
+    def _validate(self) -> None:
+        token = self.fields[0]
+        if len(token) != 6:
+            raise NMEAFormatError(
+                f"NMEA token must be 6 characters (start, talker, type): {token!r}"
+            )
+        if any("*" in f or "\r" in f or "\n" in f for f in self.fields):
+            raise NMEAFormatError(f"NMEA field contains a reserved character: {self.fields!r}")
+
+    @property
+    def talker_id(self) -> str:
+        return self.fields[0][1:3]
+
+    @property
+    def sentence_id(self) -> str:
+        """The last three characters of the token (`CYC`), used for dispatch."""
+        return self.fields[0][-3:]
+
+    def __len__(self) -> int:
+        return len(self.fields)
+
+    def __getitem__(self, index: int) -> str:
+        return self.fields[index]
+
+    def as_int(self, index: int) -> int:
+        """Field `index` as an integer; NMEAFormatError if missing or not a number."""
+        try:
+            return int(self.fields[index])
+        except (IndexError, ValueError):
+            raise NMEAFormatError(
+                f"field {index} of {self.message()!r} is not an integer"
+            ) from None
+
+    def as_float(self, index: int) -> float:
+        try:
+            return float(self.fields[index])
+        except (IndexError, ValueError):
+            raise NMEAFormatError(f"field {index} of {self.message()!r} is not a number") from None
+
+    def message_no_cs(self) -> str:
+        return ",".join(self.fields)
+
+    def message(self) -> str:
+        """The sentence with its checksum, without a line terminator."""
+        body = self.message_no_cs()
+        return f"{body}*{checksum(body[1:]):02X}"
+
+
+def _field_text(value: object) -> str:
+    if isinstance(value, bool):
+        return "1" if value else "0"
+    if isinstance(value, bytes):
+        return value.hex()
+    return str(value)

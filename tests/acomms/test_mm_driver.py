@@ -1,0 +1,254 @@
+"""Micro-Modem driver as a sans-I/O state machine: MemoryLink + VirtualClock, scripted modem."""
+
+import logging
+
+import pytest
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.driver_base import ModemDriverException
+from pygoby.acomms.drivers.micromodem import MMDriver
+from pygoby.util.clock import VirtualClock
+from pygoby.util.linebased import MemoryLink
+from pygoby.util.nmea import NMEASentence
+
+T0 = 1_700_000_000.0  # 2023-11-14T22:13:20Z
+
+
+def cs(body: str) -> str:
+    return NMEASentence.parse(body).message()
+
+
+class Harness:
+    def __init__(self, modem_id=1, **mm):
+        self.clock = VirtualClock(T0)
+        self.link = MemoryLink("\r")
+        self.driver = MMDriver(self.clock, self.link)
+        self.received, self.results = [], []
+        self.driver.signal_receive.connect(self.received.append)
+        self.driver.signal_transmit_result.connect(self.results.append)
+        self.cfg = m.DriverConfig(driver_type=m.DriverConfig.DESCRIPTOR.fields_by_name[
+            "driver_type"].enum_type.values_by_name["DRIVER_WHOI_MICROMODEM"].number,
+            modem_id=modem_id)  # fmt: skip
+        self.cfg.Extensions[m.MM_CONFIG].query_cfg_on_startup = mm.pop("query", False)
+        for k, v in mm.items():
+            setattr(self.cfg.Extensions[m.MM_CONFIG], k, v)
+
+    def work(self):
+        self.driver.do_work()
+        return [line.rstrip("\r\n") for line in self.link.take_written()]
+
+    def modem(self, *lines):
+        for line in lines:
+            self.link.feed(cs(line) + "\r")
+        return self.work()
+
+    def start(self):
+        d = self.driver
+        d.startup(self.cfg)
+        mid = self.cfg.modem_id
+        assert self.work() == [cs("$CCCFG,CST,1")]
+        assert self.modem("$CACFG,CST,1") == [cs(f"$CCCFG,SRC,{mid}")]
+        assert self.modem(f"$CACFG,SRC,{mid}") == [cs("$CCCFG,REV,1")]
+        assert self.modem("$CACFG,REV,1") == [cs("$CCCFG,RXP,1")]
+        assert self.modem("$CACFG,RXP,1") == [cs(f"$CCMSC,{mid},{mid},0")]
+        assert self.modem("$CAREV,000000,AUV,0.94.0.00") == []  # waits for 50-100 ms past a second
+        self.clock.set(T0 + 0.07)
+        assert self.work() == [cs("$CCCLK,2023,11,14,22,13,21")]
+        self.clock.set(T0 + 1.0)
+        assert self.modem("$CACLK,2023,11,14,22,13,21") == []
+        assert d.startup_complete
+        return self
+
+
+def test_startup_sequence_matches_spec_trace():
+    h = Harness(modem_id=1).start()
+    assert h.driver.revision == (0, 94, 0)
+    assert h.driver.nvram == {"CST": 1, "SRC": 1, "REV": 1, "RXP": 1}
+
+
+def test_startup_queries_all_nvram_until_two_seconds_of_silence():
+    h = Harness(query=True)
+    h.driver.startup(h.cfg)
+    h.work()
+    for reply in ["$CACFG,CST,1", "$CACFG,SRC,1", "$CACFG,REV,1", "$CACFG,RXP,1"]:
+        h.modem(reply)
+    h.modem("$CAREV,000000,AUV,2.0.16421")
+    h.clock.set(T0 + 0.06)
+    assert h.work() == [cs("$CCTMS,2023-11-14T22:13:21Z,0")]  # MM2 clock command
+    h.clock.set(T0 + 0.5)
+    assert h.modem("$CATMS,0,2023-11-14T22:13:20.5Z") == [cs("$CCCFQ,TOP")]
+    h.modem("$CACFG,AGC,0", "$CACFG,AGN,250")
+    h.clock.advance(1.5)
+    h.modem("$CACFG,BND,3")
+    h.clock.advance(1.5)
+    assert h.work() == [] and not h.driver.startup_complete
+    h.clock.advance(1.0)
+    h.work()
+    assert h.driver.startup_complete and h.driver.nvram["AGN"] == 250
+
+
+def test_nvram_cfg_entries_and_reset():
+    h = Harness(reset_nvram=True)
+    h.cfg.Extensions[m.MM_CONFIG].nvram_cfg.extend(["dqf,1", "psk.packet.mod_hdr_version,1"])
+    h.driver.startup(h.cfg)
+    sent = []
+    for _ in range(5):
+        line = h.work()
+        sent += line
+        if line:
+            s = NMEASentence.parse(line[0])
+            h.link.feed(cs("$CACFG," + ",".join(s.fields[1:])) + "\r")
+    assert sent == [cs(x) for x in ["$CCCFG,ALL,0", "$CCCFG,CST,1", "$CCCFG,DQF,1",
+                                   "$CCCFG,psk.packet.mod_hdr_version,1", "$CCCFG,SRC,1"]]  # fmt: skip
+
+
+def test_local_data_transmission_rate0_with_ack():
+    h = Harness().start()
+    requests = []
+
+    def fill(msg):
+        requests.append((msg.max_num_frames, msg.max_frame_bytes))
+        msg.dest = 2
+        msg.frame.append(b"\x01\x02\x03\x04\x05")
+
+    h.driver.signal_data_request.connect(fill)
+    h.driver.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+    assert requests == [(1, 32)]
+    assert h.work() == ["$CCCYC,0,1,2,0,1,1*5A"]
+    assert h.modem("$CACYC,0,1,2,0,1,1") == []
+    h.modem("$CAXST,20231114,221320.0000,0,0,0,5000,25000,0,1,2,1,1,1,1,0")
+    assert h.results == []  # rate 0: two XSTs (the cycle-init packet and the data)
+    assert h.modem("$CADRQ,120000,1,2,1,32,1") == ["$CCTXD,1,2,1,0102030405*7B"]
+    h.modem("$CATXD,1,2,1,0102030405", "$CATXP,5", "$CATXF,5")
+    h.modem("$CAXST,20231114,221320.0000,0,0,0,5000,25000,0,1,2,1,1,1,1,5")
+    assert len(h.results) == 1
+    assert len(h.results[0].Extensions[m.MM_TRANSMISSION].transmit_stat) == 2
+    h.modem("$CAACK,2,1,1,1")
+    assert h.received == []  # delivered with the next CST
+    h.modem(CST_GOOD)
+    assert len(h.received) == 1
+    ack = h.received[0]
+    assert (ack.type, ack.src, ack.dest, list(ack.acked_frame)) == (m.ACK, 2, 1, [0])
+
+
+def test_no_data_no_cycle():
+    h = Harness().start()
+    h.driver.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=0))
+    assert h.work() == []
+
+
+def test_drq_without_data_gets_empty_txd():
+    h = Harness().start()
+    h.driver.signal_data_request.connect(lambda msg: msg.frame.extend([b"ab"]))
+    h.driver.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=1))
+    assert h.work() == [cs("$CCCYC,0,1,2,1,1,1")]
+    h.modem("$CACYC,0,1,2,1,1,1")
+    assert h.modem("$CADRQ,120000,1,2,1,64,1") == [cs("$CCTXD,1,2,1,6162")]
+    h.modem("$CATXD,1,2,1,6162")
+    assert h.modem("$CADRQ,120000,1,2,1,64,2") == ["$CCTXD,1,2,1,*7A"]
+
+
+CST_GOOD = ("$CACST,0,221320.5000,0,1,20,100,150,0,0,0,0,0,0,1,2,0,1,1,0,100,10,12,30,-10,200,"
+            "0.0,50,25000,5000")  # fmt: skip
+
+
+def test_reception_rate0_two_csts_and_bad_crc():
+    h = Harness(modem_id=2).start()
+    h.modem("$CARXP,0", "$CACYC,0,1,2,0,1,1")
+    h.modem(CST_GOOD)
+    assert h.received == []
+    h.modem("$CARXD,1,2,1,1,0102030405")
+    h.modem(CST_GOOD)
+    (rx,) = h.received
+    assert (rx.type, rx.src, rx.dest, rx.ack_requested) == (m.DATA, 1, 2, True)
+    assert list(rx.frame) == [b"\x01\x02\x03\x04\x05"]
+    assert rx.time_source == m.ModemTransmission.MODEM_TIME
+    assert rx.time == int((T0 + 0.5) * 1e6)  # TOA 22:13:20.5 on the current UTC day
+    stats = rx.Extensions[m.MM_TRANSMISSION].receive_stat
+    assert len(stats) == 2 and stats[0].snr_in == 10 and stats[0].carrier_freq == 25000
+
+    h.received.clear()
+    h.modem("$CACYC,0,1,2,3,0,2", "$CARXD,1,2,0,1,aa", "$CAMSG,BAD_CRC,2", CST_GOOD)
+    (rx,) = h.received
+    assert list(rx.frame) == [b"\xaa", b""]
+    assert list(rx.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc) == [1]
+
+
+def test_polled_node_answers_poll_from_its_queue():
+    h = Harness(modem_id=2).start()
+    h.driver.signal_data_request.connect(lambda msg: msg.frame.append(b"\x10\x20"))
+    h.modem("$CACYC,0,2,1,1,1,3")
+    assert h.modem("$CADRQ,120000,2,1,1,64,1") == [cs("$CCTXD,2,1,1,1020")]
+
+
+def test_poller_sends_third_party_cycle():
+    h = Harness(modem_id=1).start()
+    h.driver.handle_initiate_transmission(m.ModemTransmission(src=3, dest=1, rate=1))
+    assert h.work() == [cs("$CCCYC,0,3,1,1,1,3")]
+    h.driver.handle_initiate_transmission(m.ModemTransmission(src=3, dest=-1, rate=1))
+    h.modem("$CACYC,0,3,1,1,1,3")
+    assert h.work() == []  # Quirk A14: a poll without destination is refused
+
+
+def test_two_way_ping_and_ping_heard():
+    h = Harness().start()
+    ping = m.ModemTransmission(src=1, dest=2, type=m.DRIVER_SPECIFIC)
+    ping.Extensions[m.MM_TRANSMISSION].type = m.MICROMODEM_TWO_WAY_PING
+    h.driver.handle_initiate_transmission(ping)
+    assert h.work() == ["$CCMPC,1,2*5D"]
+    h.modem("$CAMPC,1,2", "$CAMPR,2,1,0.6667")
+    (r,) = h.received
+    ext = r.Extensions[m.MM_TRANSMISSION]
+    assert ext.type == m.MICROMODEM_TWO_WAY_PING and list(
+        ext.ranging_reply.one_way_travel_time
+    ) == [pytest.approx(0.6667)]
+    h.modem("$CAMPA,3,1")
+    assert (
+        h.received[1].src == 3
+        and not h.received[1].Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time
+    )
+
+
+def test_resend_retries_and_death():
+    h = Harness()
+    h.driver.startup(h.cfg)
+    assert h.work() == [cs("$CCCFG,CST,1")]
+    h.clock.advance(5.1)
+    assert h.work() == [cs("$CCCFG,CST,1")]  # resent
+    h.clock.advance(5.1)
+    assert h.work() == [cs("$CCCFG,CST,1")]
+    h.clock.advance(5.1)
+    assert h.work() == [cs("$CCCFG,SRC,1")]  # dropped after 3 tries, continuing onwards
+    h.clock.advance(5.1)
+    h.work()
+    h.clock.advance(5.1)
+    with pytest.raises(ModemDriverException) as info:
+        h.work()
+    assert info.value.status == m.ModemDriverStatus.MODEM_NOT_RESPONDING
+
+
+def test_malformed_and_bad_checksum_lines_are_logged_and_skipped(caplog):
+    h = Harness().start()
+    with caplog.at_level(logging.WARNING):
+        h.link.feed("$CARXD,1,2,1,1,0102030405*00\r")  # bad checksum
+        h.link.feed("garbage\r$CADRQ,notanumber\r$CARXD,1,2,x\r\x00\xff\r")
+        h.work()
+    assert "checksum" in caplog.text and "malformed" in caplog.text
+    assert h.driver.startup_complete and h.received == []
+
+
+def test_caerr_nmea_fails_outstanding_and_keep_alive():
+    h = Harness().start()
+    h.clock.advance(10.5)
+    assert h.work() == [cs("$CCCFQ,SRC")]  # MM1 keep-alive
+    assert h.modem("$CAERR,000000,NMEA,3,bad") == [cs("$CCCFQ,SRC")]  # resent at once
+    h.modem("$CACFG,SRC,1")
+    assert h.work() == []
+
+
+def test_rev_init_resets_clock():
+    h = Harness().start()
+    h.modem("$CAREV,000000,INIT,0.94.0.00")
+    h.clock.advance(2.5)
+    h.clock.set(int(h.clock.now()) + 1.06)
+    assert h.work()[0].startswith("$CCCLK")

@@ -1,0 +1,76 @@
+"""NMEA parse/print with checksums, against the spec's computed examples (acomms.md §7.1)."""
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from pygoby.util.nmea import NMEAChecksumError, NMEAError, NMEAFormatError, NMEASentence
+
+SPEC_EXAMPLES = [
+    "$CCCFG,SRC,1*31", "$CCCYC,0,1,2,0,1,1*5A", "$CCTMS,2019-12-02T03:02:37Z,0*7A",
+    "$CCCFG,CST,1*37", "$CCCFG,REV,1*32", "$CCCFG,RXP,1*29", "$CCCFG,ALL,0*33",
+    "$CCMSC,1,1,0*41", "$CCCFQ,SRC*3A", "$CCTMQ,0*54", "$CCCFQ,TOP*33", "$CCCFQ,ALL*39",
+    "$CADRQ,120000,1,2,1,32,1*44", "$CCTXD,1,2,1,0102030405*7B",
+    "$CARXD,1,2,1,1,0102030405*62", "$CCTXD,1,2,1,*7A", "$CACYC,0,1,2,0,1,1*58",
+    "$CAACK,2,1,1,1*48", "$CCMPC,1,2*5D",
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("line", SPEC_EXAMPLES)
+def test_spec_examples_parse_and_print_identically(line):
+    sentence = NMEASentence.parse(line + "\r\n")
+    assert sentence.message() == line
+
+
+def test_build_and_fields():
+    s = NMEASentence.build("CCTXD", [1, 2, True, b"\x01\x02\x03\x04\x05"])
+    assert s.message() == "$CCTXD,1,2,1,0102030405*7B"
+    assert (s.talker_id, s.sentence_id, s.as_int(1), s[4]) == ("CC", "TXD", 1, "0102030405")
+
+
+def test_checksum_optional_on_input():
+    assert NMEASentence.parse("$CACYC,0,1,2,0,1,1").message() == "$CACYC,0,1,2,0,1,1*58"
+
+
+@pytest.mark.parametrize(
+    "line, error",
+    [
+        ("$CCCYC,0,1,2,0,1,1*5B", NMEAChecksumError),
+        ("CCCYC,0,1,2", NMEAFormatError),
+        ("$CCCY,0,1", NMEAFormatError),
+        ("$CCCYC,0*ZZ", NMEAFormatError),
+        ("$CCCYC,0*5", NMEAFormatError),
+        ("$CCCYC,é", NMEAFormatError),
+        ("", NMEAFormatError),
+    ],
+)
+def test_bad_lines_raise_specific_errors(line, error):
+    with pytest.raises(error):
+        NMEASentence.parse(line)
+
+
+def test_as_int_on_bad_field():
+    with pytest.raises(NMEAFormatError):
+        NMEASentence.parse("$CADRQ,x").as_int(1)
+    with pytest.raises(NMEAFormatError):
+        NMEASentence.parse("$CADRQ,1").as_int(5)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(max_size=80))
+def test_fuzz_parse_only_raises_nmea_errors(text):
+    try:
+        sentence = NMEASentence.parse(text)
+    except NMEAError:
+        return
+    assert NMEASentence.parse(sentence.message()) == sentence
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.text(alphabet="ABCDEFGHIJKLMNOPQRSTUVWXYZ", min_size=5, max_size=5),
+    st.lists(st.text(alphabet="0123456789abcdefXYZ.-:T ", max_size=12), max_size=8),
+)
+def test_fuzz_round_trip(token, values):
+    s = NMEASentence.build(token, values)
+    assert NMEASentence.parse(s.message()) == s
