@@ -1,0 +1,281 @@
+"""The DCCL codec: load message types, encode, decode, sizes (spec §§2-4, 20-22)."""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+
+from google.protobuf import message_factory
+from google.protobuf.descriptor import Descriptor
+from google.protobuf.message import Message
+
+from pygoby.dccl.compiler import compile_decoder, compile_encoder
+from pygoby.dccl.crypto import BodyCipher
+from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError, DcclError, DcclLoadError
+from pygoby.dccl.plan import MessageNode, Part, Planner, root_options
+from pygoby.dccl.registry import DEFAULT_REGISTRY, CodecRegistry
+from pygoby.protobuf import ProtoError, ProtoLoader
+from pygoby.util.clock import Clock
+
+# Exceptions that bad values or bad bytes can provoke inside generated code or codecs.
+_VALUE_ERRORS = (ValueError, TypeError, OverflowError, KeyError, IndexError, UnicodeError)
+
+
+def id_width(dccl_id: int | None) -> int:
+    if dccl_id is None:
+        return 0
+    return 8 if dccl_id < 128 else 16
+
+
+@dataclass
+class CompiledType:
+    """Everything needed to encode/decode one loaded root message type."""
+
+    cls: type[Message]
+    name: str
+    version: int
+    id: int | None
+    id_bits: int
+    max_bytes: int
+    head: MessageNode
+    body: MessageNode
+    head_bytes: int  # the header is fixed-size: ceil((id_bits + head bits) / 8)
+    encode_head: Callable
+    encode_body: Callable
+    decode_head: Callable
+    decode_body: Callable
+
+    def max_size(self) -> int:
+        return self.head_bytes + (self.body.max_size() + 7) // 8
+
+    def min_size(self) -> int:
+        return self.head_bytes + (self.body.min_size() + 7) // 8
+
+
+class Codec:
+    """Encodes and decodes DCCL messages, byte-compatible with the C++ DCCL library.
+
+    `strict`: out-of-range values, over-long strings and bad repeat counts raise instead of being
+    degraded. `passphrase`: AES-256-CTR body encryption. `clock`: the receiver's clock for
+    `dccl.time` fields (defaults to the system clock).
+    """
+
+    def __init__(
+        self,
+        passphrase: str | bytes | None = None,
+        strict: bool = False,
+        clock: Clock | None = None,
+        registry: CodecRegistry | None = None,
+        do_not_encrypt_ids: Iterable[int] = (),
+        loader: ProtoLoader | None = None,
+    ) -> None:
+        self.strict = strict
+        self.registry = registry if registry is not None else DEFAULT_REGISTRY
+        self.loader = loader if loader is not None else ProtoLoader()
+        self._now: Callable[[], float] = clock.now if clock is not None else time.time
+        self._by_name: dict[str, CompiledType] = {}
+        self._by_id: dict[int, CompiledType] = {}
+        self.set_passphrase(passphrase, do_not_encrypt_ids)
+
+    def set_passphrase(self, passphrase: str | bytes | None, do_not_encrypt_ids: Iterable[int] = ()) -> None:
+        self._cipher = BodyCipher(passphrase) if passphrase else None
+        self._clear_ids = frozenset(do_not_encrypt_ids)
+
+    # ---------------------------------------------------------------- loading
+    def load(self, message_type: type[Message] | Descriptor) -> type[Message]:
+        """Validate and compile a message type (a generated class or a descriptor)."""
+        if isinstance(message_type, Descriptor):
+            descriptor = message_type
+            cls = message_factory.GetMessageClass(descriptor)
+        else:
+            cls, descriptor = message_type, message_type.DESCRIPTOR
+        known = self._by_name.get(descriptor.full_name)
+        if known is not None:
+            return known.cls
+        compiled = self._compile(cls, descriptor)
+        if compiled.id is not None:
+            other = self._by_id.get(compiled.id)
+            if other is not None:
+                raise DcclLoadError(
+                    f"{compiled.name}: id {compiled.id} is already used by {other.name}"
+                )
+            self._by_id[compiled.id] = compiled
+        self._by_name[compiled.name] = compiled
+        return cls
+
+    def load_proto(
+        self,
+        path: str | os.PathLike[str],
+        full_name: str,
+        include_dirs: Iterable[str | os.PathLike[str]] = (),
+    ) -> type[Message]:
+        """Compile a .proto file at run time and load one of its message types."""
+        try:
+            self.loader.load_file(path, include_dirs)
+            cls = self.loader.message_class(full_name)
+        except ProtoError as exc:
+            raise DcclLoadError(str(exc)) from exc
+        return self.load(cls)
+
+    def unload(self, message_type: type[Message] | Descriptor) -> None:
+        descriptor = getattr(message_type, "DESCRIPTOR", message_type)
+        compiled = self._by_name.pop(descriptor.full_name, None)
+        if compiled is not None and compiled.id is not None:
+            self._by_id.pop(compiled.id, None)
+
+    def loaded(self) -> list[type[Message]]:
+        return [c.cls for c in self._by_name.values()]
+
+    def _compile(self, cls: type[Message], descriptor: Descriptor) -> CompiledType:
+        root = root_options(descriptor)
+        planner = Planner(root, self.registry, self._now)
+        head = planner.plan_root(descriptor, Part.HEAD)
+        body = planner.plan_root(descriptor, Part.BODY)
+        id_bits = id_width(root.id)
+        head_bytes = (id_bits + head.max_size() + 7) // 8
+        max_encoded = head_bytes + (body.max_size() + 7) // 8
+        if max_encoded > root.max_bytes:
+            raise DcclLoadError(
+                f"{root.name}: the largest encoding is {max_encoded} bytes, more than"
+                f" max_bytes {root.max_bytes}"
+            )
+        if root.id is None:
+            id_raw = 0
+        else:
+            id_raw = root.id << 1 | (1 if id_bits == 16 else 0)
+        return CompiledType(
+            cls=cls,
+            name=root.name,
+            version=root.version,
+            id=root.id,
+            id_bits=id_bits,
+            max_bytes=root.max_bytes,
+            head=head,
+            body=body,
+            head_bytes=head_bytes,
+            encode_head=compile_encoder(head, "encode_head", id_raw, id_bits),
+            encode_body=compile_encoder(body, "encode_body", 0, 0),
+            decode_head=compile_decoder(head, "decode_head"),
+            decode_body=compile_decoder(body, "decode_body"),
+        )
+
+    def compiled(self, message_type: type[Message] | Descriptor | str) -> CompiledType:
+        """The compiled form of a loaded type (loading it first if it is a class/descriptor)."""
+        if isinstance(message_type, str):
+            try:
+                return self._by_name[message_type]
+            except KeyError:
+                raise DcclError(f"message type {message_type!r} is not loaded") from None
+        descriptor = getattr(message_type, "DESCRIPTOR", message_type)
+        compiled = self._by_name.get(descriptor.full_name)
+        if compiled is None:
+            self.load(message_type)
+            compiled = self._by_name[descriptor.full_name]
+        return compiled
+
+    # ---------------------------------------------------------------- encoding
+    def encode(self, msg: Message) -> bytes:
+        """Encode a message (its type is loaded on first use)."""
+        compiled = self._by_name.get(msg.DESCRIPTOR.full_name) or self.compiled(type(msg))
+        if not msg.IsInitialized():
+            missing = ", ".join(msg.FindInitializationErrors())
+            raise DcclEncodeError(f"{compiled.name}: required fields are not set: {missing}")
+        strict = self.strict
+        try:
+            hacc, hpos = compiled.encode_head(msg, strict)
+            bacc, bpos = compiled.encode_body(msg, strict)
+        except DcclError:
+            raise
+        except _VALUE_ERRORS as exc:
+            raise DcclEncodeError(f"{compiled.name}: cannot encode: {exc}") from exc
+        head = hacc.to_bytes((hpos + 7) >> 3, "little")
+        body = bacc.to_bytes((bpos + 7) >> 3, "little")
+        if self._cipher is not None and compiled.id not in self._clear_ids:
+            body = self._cipher.apply(head, body)
+        return head + body
+
+    def size(self, msg: Message) -> int:
+        """Length in bytes of `encode(msg)`."""
+        return len(self.encode(msg))
+
+    def max_size(self, message_type: type[Message] | Descriptor | str) -> int:
+        return self.compiled(message_type).max_size()
+
+    def min_size(self, message_type: type[Message] | Descriptor | str) -> int:
+        return self.compiled(message_type).min_size()
+
+    # ---------------------------------------------------------------- decoding
+    @staticmethod
+    def read_id(data: bytes) -> tuple[int, int]:
+        """(DCCL ID, ID width in bits) from the first one or two bytes (spec §4)."""
+        if not data:
+            raise DcclDecodeError("no bytes to read a DCCL ID from")
+        first = data[0]
+        if not first & 1:
+            return first >> 1, 8
+        if len(data) < 2:
+            raise DcclDecodeError("the long-form DCCL ID needs two bytes, got one")
+        return (first | data[1] << 8) >> 1, 16
+
+    def id(self, data: bytes) -> int:
+        """The DCCL ID of encoded bytes (without decoding them)."""
+        return self.read_id(data)[0]
+
+    def type_of(self, data: bytes) -> type[Message]:
+        return self._compiled_for(data, None).cls
+
+    def _compiled_for(
+        self, data: bytes, message_type: type[Message] | Descriptor | str | None
+    ) -> CompiledType:
+        if message_type is not None:
+            compiled = self.compiled(message_type)
+            if compiled.id is not None:
+                dccl_id, _ = self.read_id(data)
+                if dccl_id != compiled.id:
+                    raise DcclDecodeError(
+                        f"bytes carry id {dccl_id}, not the id {compiled.id} of {compiled.name}"
+                    )
+            return compiled
+        dccl_id, _ = self.read_id(data)
+        compiled = self._by_id.get(dccl_id)
+        if compiled is None:
+            raise DcclDecodeError(f"no message type with id {dccl_id} is loaded")
+        return compiled
+
+    def decode(
+        self, data: bytes, message_type: type[Message] | Descriptor | str | None = None
+    ) -> Message:
+        """Decode bytes; the type comes from the ID unless given (it must be for omit_id types)."""
+        return self.decode_prefix(data, message_type)[0]
+
+    def decode_prefix(
+        self, data: bytes, message_type: type[Message] | Descriptor | str | None = None
+    ) -> tuple[Message, int]:
+        """Decode one message from the start of `data`: (message, bytes it used).
+
+        With encryption the whole rest of `data` is the body (encrypted messages cannot be
+        concatenated)."""
+        data = bytes(data)
+        compiled = self._compiled_for(data, message_type)
+        head_bytes = compiled.head_bytes
+        if len(data) < head_bytes:
+            raise DcclDecodeError(
+                f"{compiled.name}: {len(data)} bytes are shorter than its {head_bytes}-byte header"
+            )
+        msg = compiled.cls()
+        head = data[:head_bytes]
+        body = data[head_bytes:]
+        if self._cipher is not None and compiled.id not in self._clear_ids:
+            body = self._cipher.apply(head, body)
+        try:
+            compiled.decode_head(
+                msg, int.from_bytes(head, "little"), compiled.id_bits, head_bytes * 8
+            )
+            used = compiled.decode_body(msg, int.from_bytes(body, "little"), 0, len(body) * 8)
+        except DcclError as exc:
+            raise DcclDecodeError(f"{compiled.name}: {exc}") from exc
+        except _VALUE_ERRORS as exc:
+            raise DcclDecodeError(f"{compiled.name}: cannot decode: {exc}") from exc
+        return msg, head_bytes + (used + 7) // 8

@@ -1,0 +1,17 @@
+"""The DcclError family: one base class for every DCCL failure."""
+
+
+class DcclError(Exception):
+    """Base class of every DCCL error."""
+
+
+class DcclLoadError(DcclError):
+    """A message definition is not valid DCCL (raised when the type is loaded)."""
+
+
+class DcclEncodeError(DcclError):
+    """A message cannot be encoded (missing required field, strict-mode violation, ...)."""
+
+
+class DcclDecodeError(DcclError):
+    """Bytes cannot be decoded (truncated, unknown ID, wrong type, ...)."""
