@@ -1,0 +1,383 @@
+"""The translator: TranslatorEntry rules applied to MOOS values and protobuf messages.
+
+Pure logic, no MOOS I/O. `Translator` converts (MOOS variable table -> message, message ->
+MOOS posts); `TranslatorRunner` adds the trigger logic (publish and time triggers, the
+variable table, run-time UTM datum) for an application to feed with mail and ticks.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+
+from google.protobuf.message import Message
+
+from pygoby.moos.translator import format as format_technique
+from pygoby.moos.translator import keyvalue
+from pygoby.moos.translator.algorithms import AlgorithmRegistry
+from pygoby.moos.translator.conversions import double_to_string17, looks_like_double
+from pygoby.moos.translator.errors import TranslatorConfigError, TranslatorError
+from pygoby.moos.translator.modem_id import ModemIdLookup
+from pygoby.moos.translator.techniques import (
+    BINARY_TECHNIQUES,
+    PROTOBUF_TECHNIQUES,
+    MoosValue,
+    Technique,
+    as_text,
+    dynamic_parse,
+    parse_protobuf,
+    serialize_protobuf,
+)
+
+log = logging.getLogger("pygoby.moos.translator")
+
+TRIGGER_PUBLISH = 1
+TRIGGER_TIME = 2
+LAT_ORIGIN_VAR = "LAT_ORIGIN"
+LONG_ORIGIN_VAR = "LONG_ORIGIN"
+
+# Outputs that may be posted as MOOS doubles when they look like numbers. goby3 converts
+# every non-binary output (Quirk Q5); hex and @PB outputs are kept as strings here.
+_NUMBER_CANDIDATES = frozenset(
+    {
+        Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT,
+        Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS,
+        Technique.TECHNIQUE_FORMAT,
+    }
+)
+
+
+@dataclass(frozen=True)
+class Post:
+    """One MOOS post: `value` is a float (MOOS double), str (string) or bytes (binary string).
+
+    String and binary posts carry `source_aux = "<type name>:<TECHNIQUE_NAME>"`."""
+
+    var: str
+    value: str | float | bytes
+    source_aux: str = ""
+
+
+def make_post(var: str, value: str | bytes, technique: Technique, type_name: str) -> Post:
+    technique = Technique(technique)
+    aux = f"{type_name}:{technique.name}"
+    if isinstance(value, bytes):
+        return Post(var, value, aux)
+    if technique in _NUMBER_CANDIDATES and looks_like_double(value):
+        return Post(var, float(value))
+    return Post(var, value, aux)
+
+
+def moos_value_to_source(value: MoosValue | None, technique: Technique) -> MoosValue:
+    """What a create rule reads from a variable: strings as they are, doubles with 17
+    significant digits, a never-received variable as the empty string."""
+    if value is None:
+        return ""
+    if isinstance(value, float | int) and not isinstance(value, bool):
+        return double_to_string17(float(value))
+    if isinstance(value, bytes) and technique not in BINARY_TECHNIQUES:
+        return as_text(value)
+    return value
+
+
+MessageResolver = Callable[[str], type[Message]]
+
+
+class Translator:
+    """Applies TranslatorEntry rules.
+
+    `entries`: goby.moos.protobuf.TranslatorEntry messages. `resolve`: full type name ->
+    message class (e.g. `ProtoLoader.message_class`). Every problem with the entries is a
+    TranslatorConfigError at construction; problems with data are TranslatorError at use.
+    """
+
+    def __init__(
+        self,
+        entries: Iterable[Message],
+        resolve: MessageResolver,
+        *,
+        lat_origin: float = 0.0,
+        lon_origin: float = 0.0,
+        modem_ids: ModemIdLookup | None = None,
+    ) -> None:
+        self.registry = AlgorithmRegistry(lat_origin, lon_origin, modem_ids)
+        self._resolve = resolve
+        self._entries: dict[str, Message] = {}
+        self._classes: dict[str, type[Message]] = {}
+        for entry in entries:
+            self.add_entry(entry)
+
+    # --- configuration -------------------------------------------------------------------
+
+    def add_entry(self, entry: Message) -> None:
+        name = entry.protobuf_name
+        if name in self._entries:
+            raise TranslatorConfigError(f"Duplicate translator entry for {name}")
+        try:
+            cls = self._resolve(name)
+        except Exception as exc:
+            raise TranslatorConfigError(
+                f"translator_entry protobuf_name {name!r} is not a loaded message type: {exc}"
+            ) from None
+        self._check_entry(entry, cls)
+        self._entries[name] = entry
+        self._classes[name] = cls
+
+    def _check_entry(self, entry: Message, cls: type[Message]) -> None:
+        name = entry.protobuf_name
+        descriptor = cls.DESCRIPTOR
+        if entry.HasField("trigger"):
+            trigger = entry.trigger
+            if trigger.type == TRIGGER_PUBLISH and not trigger.moos_var:
+                raise TranslatorConfigError(f"{name}: TRIGGER_PUBLISH needs trigger.moos_var")
+            if trigger.type == TRIGGER_TIME and trigger.period == 0:
+                raise TranslatorConfigError(f"{name}: TRIGGER_TIME needs a period > 0")
+        for create in entry.create:
+            technique = Technique(create.technique)
+            for algorithm in create.algorithm:
+                if self.registry.get(algorithm.name).needs_references:
+                    raise TranslatorConfigError(
+                        f"{name}: algorithm {algorithm.name!r} needs reference fields and cannot "
+                        "be used in a create rule"
+                    )
+            if technique == Technique.TECHNIQUE_FORMAT:
+                if not create.HasField("format"):
+                    raise TranslatorConfigError(
+                        f"{name}: create from {create.moos_var} needs a format"
+                    )
+                format_technique.check_parse_format(descriptor, create.format)
+        for publish in entry.publish:
+            technique = Technique(publish.technique)
+            for algorithm in publish.algorithm:
+                self.registry.get(algorithm.name)
+                for number in algorithm.reference_field:
+                    field = descriptor.fields_by_number.get(number)
+                    if field is None or field.is_repeated:
+                        raise TranslatorConfigError(
+                            f"{name}: algorithm {algorithm.name!r} reference field {number} is "
+                            "missing or repeated (must be optional or required)"
+                        )
+            if technique == Technique.TECHNIQUE_FORMAT:
+                if not publish.HasField("format"):
+                    raise TranslatorConfigError(
+                        f"{name}: publish to {publish.moos_var} needs a format"
+                    )
+                format_technique.check_serialize_format(descriptor, publish.format)
+                format_technique.check_serialize_format(descriptor, publish.moos_var)
+
+    def set_datum(self, lat_origin: float, lon_origin: float) -> None:
+        """Re-initialise the UTM datum used by the UTM algorithms."""
+        self.registry.set_datum(lat_origin, lon_origin)
+
+    @property
+    def entries(self) -> Mapping[str, Message]:
+        return self._entries
+
+    def message_class(self, protobuf_name: str) -> type[Message]:
+        return self._classes[protobuf_name]
+
+    def subscriptions(self) -> list[str]:
+        """Every trigger and create variable (sorted, without duplicates)."""
+        names = set()
+        for entry in self._entries.values():
+            if entry.HasField("trigger") and entry.trigger.type == TRIGGER_PUBLISH:
+                names.add(entry.trigger.moos_var)
+            names.update(create.moos_var for create in entry.create)
+        return sorted(names)
+
+    def triggered_by(self, var: str, value: MoosValue) -> list[str]:
+        """Entries whose TRIGGER_PUBLISH fires on this mail (in configuration order)."""
+        text = value if isinstance(value, str) else ""
+        return [
+            name
+            for name, entry in self._entries.items()
+            if entry.HasField("trigger")
+            and entry.trigger.type == TRIGGER_PUBLISH
+            and entry.trigger.moos_var == var
+            and entry.trigger.mandatory_content in text
+        ]
+
+    def time_triggered(self) -> dict[str, int]:
+        """{protobuf_name: period in seconds} of the TRIGGER_TIME entries."""
+        return {
+            name: entry.trigger.period
+            for name, entry in self._entries.items()
+            if entry.HasField("trigger") and entry.trigger.type == TRIGGER_TIME
+        }
+
+    # --- MOOS -> protobuf --------------------------------------------------------------------
+
+    def create(self, protobuf_name: str, variables: Mapping[str, MoosValue]) -> Message:
+        """Build a message from the newest variable values with the entry's create rules.
+
+        Raises TranslatorError if any rule fails: no partially built message comes out."""
+        entry = self._entry(protobuf_name)
+        msg = self._classes[protobuf_name]()
+        for create in entry.create:
+            technique = Technique(create.technique)
+            source = moos_value_to_source(variables.get(create.moos_var), technique)
+            try:
+                self._apply_create(msg, create, technique, source, entry.use_short_enum)
+            except TranslatorError as exc:
+                raise type(exc)(f"{protobuf_name} from {create.moos_var}: {exc}") from None
+        return msg
+
+    def _apply_create(
+        self, msg, create, technique: Technique, source: MoosValue, short: bool
+    ) -> None:
+        if technique in PROTOBUF_TECHNIQUES:
+            parse_protobuf(source, msg, technique)
+        elif technique == Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
+            keyvalue.parse(
+                as_text(source), msg, create.algorithm, short, self.registry, create.moos_var
+            )
+        else:
+            format_technique.parse(
+                as_text(source),
+                msg,
+                create.format,
+                create.repeated_delimiter,
+                create.algorithm,
+                short,
+                self.registry,
+            )
+
+    # --- protobuf -> MOOS --------------------------------------------------------------------
+
+    def publish(self, msg: Message) -> list[Post]:
+        """The entry's publish rules applied to `msg`, sorted by variable name (stable)."""
+        name = msg.DESCRIPTOR.full_name
+        entry = self._entries.get(name)
+        if entry is None:
+            raise TranslatorError(f"No TranslatorEntry for Protobuf type: {name}")
+        posts = []
+        for publish in entry.publish:
+            technique = Technique(publish.technique)
+            var = publish.moos_var
+            short = entry.use_short_enum
+            if technique == Technique.TECHNIQUE_FORMAT:
+                args = (publish.repeated_delimiter, publish.algorithm, short, self.registry)
+                var = format_technique.serialize(msg, publish.moos_var, *args)
+                value = format_technique.serialize(msg, publish.format, *args)
+            elif technique == Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
+                value = keyvalue.serialize(msg, publish.algorithm, short, self.registry)
+            else:
+                value = serialize_protobuf(msg, technique)
+            posts.append(make_post(var, value, technique, name))
+        return sorted(posts, key=lambda post: post.var)
+
+    def inverse_publish(self, msg: Message) -> list[Post]:
+        """multiplex_create_moos_var: post `msg` to its entry's create variables with the create
+        techniques (no algorithms), plus an empty trigger post if the trigger variable is not
+        one of them; sorted by variable name."""
+        name = msg.DESCRIPTOR.full_name
+        entry = self._entries.get(name)
+        if entry is None:
+            raise TranslatorError(f"No TranslatorEntry for Protobuf type: {name}")
+        posts = []
+        short = entry.use_short_enum
+        for create in entry.create:
+            technique = Technique(create.technique)
+            if technique == Technique.TECHNIQUE_FORMAT:
+                value = format_technique.serialize(
+                    msg, create.format, create.repeated_delimiter, (), short
+                )
+            elif technique == Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
+                value = keyvalue.serialize(msg, (), short)
+            else:
+                value = serialize_protobuf(msg, technique)
+            posts.append(make_post(create.moos_var, value, technique, name))
+        trigger = entry.trigger
+        if (
+            entry.HasField("trigger")
+            and trigger.type == TRIGGER_PUBLISH
+            and trigger.moos_var not in {create.moos_var for create in entry.create}
+        ):
+            posts.append(Post(trigger.moos_var, "", ""))
+        return sorted(posts, key=lambda post: post.var)
+
+    def _entry(self, protobuf_name: str) -> Message:
+        try:
+            return self._entries[protobuf_name]
+        except KeyError:
+            raise TranslatorError(
+                f"No TranslatorEntry for Protobuf type: {protobuf_name}"
+            ) from None
+
+
+class TranslatorRunner:
+    """Trigger logic around a Translator, fed by an application (sans-I/O).
+
+    `on_mail` for every mail of `subscriptions()` (with `stale=True` for mail older than the
+    application start: it updates the table but triggers nothing); `tick(now)` from the
+    application loop (time triggers, datum changes). Both return the created messages; a rule
+    that fails is logged as a warning and that message is skipped.
+    """
+
+    def __init__(
+        self, translator: Translator, start_time: float, multiplex_vars: Iterable[str] = ()
+    ) -> None:
+        self.translator = translator
+        self.variables: dict[str, MoosValue] = {}
+        self.multiplex_vars = list(multiplex_vars)
+        self._periods = translator.time_triggered()
+        self._deadlines = {name: start_time + period for name, period in self._periods.items()}
+        self._origin: dict[str, float] = {}
+        self._origin_changed = False
+
+    def subscriptions(self) -> list[str]:
+        names = set(self.translator.subscriptions())
+        names.update((LAT_ORIGIN_VAR, LONG_ORIGIN_VAR), self.multiplex_vars)
+        return sorted(names)
+
+    def on_mail(self, var: str, value: MoosValue, *, stale: bool = False) -> list[Message]:
+        self.variables[var] = value
+        if (
+            var in (LAT_ORIGIN_VAR, LONG_ORIGIN_VAR)
+            and isinstance(value, float)
+            and not math.isnan(value)
+        ):
+            self._origin[var] = value
+            self._origin_changed = True
+        if stale:
+            return []
+        created = (self._create(name) for name in self.translator.triggered_by(var, value))
+        return [msg for msg in created if msg is not None]
+
+    def on_multiplex(self, value: MoosValue, technique: Technique) -> list[Post]:
+        """Mail on a multiplex variable -> the inverse-publish posts (empty if unusable)."""
+        msg = dynamic_parse(value, self._resolve_entry_type, technique)
+        if msg is None:
+            log.warning("multiplexed value is not a prefixed message of a known type: %.80r", value)
+            return []
+        return self.translator.inverse_publish(msg)
+
+    def _resolve_entry_type(self, name: str) -> type[Message]:
+        return self.translator.message_class(name)
+
+    def tick(self, now: float) -> list[Message]:
+        if self._origin_changed and len(self._origin) == 2:
+            self.translator.set_datum(self._origin[LAT_ORIGIN_VAR], self._origin[LONG_ORIGIN_VAR])
+            self._origin_changed = False
+        created = []
+        for name, deadline in self._deadlines.items():
+            period = self._periods[name]
+            if now < deadline:
+                if deadline - now > period + 1:  # clock jumped backwards
+                    self._deadlines[name] = now + period
+                continue
+            # Late by more than 1 s (clock jump): restart the schedule from now.
+            self._deadlines[name] = now + period if now - deadline > 1 else deadline + period
+            msg = self._create(name)
+            if msg is not None:
+                created.append(msg)
+        return created
+
+    def _create(self, name: str) -> Message | None:
+        try:
+            return self.translator.create(name, self.variables)
+        except TranslatorError as exc:
+            log.warning("not creating %s: %s", name, exc)
+            return None
