@@ -1,0 +1,38 @@
+"""Packet-level acoustic channel for the netsim simulator (spec netsim.md §7).
+
+The physics are pure functions in small modules (`soundspeed`, `absorption`, `levels`,
+`geometry`, `errors`, `timing`); `model.Channel` combines them into the sans-I/O channel the
+modem emulators call (its API is documented in `pygoby.netsim.channel.model`).
+"""
+
+from pygoby.netsim.channel.errors import (
+    LogisticModel,
+    RateErrorModels,
+    TableModel,
+    ThresholdModel,
+)
+from pygoby.netsim.channel.geometry import Position
+from pygoby.netsim.channel.model import (
+    Band,
+    Channel,
+    ChannelConfig,
+    Outcome,
+    PacketKind,
+    Reception,
+    Transmission,
+)
+
+__all__ = [
+    "Band",
+    "Channel",
+    "ChannelConfig",
+    "LogisticModel",
+    "Outcome",
+    "PacketKind",
+    "Position",
+    "RateErrorModels",
+    "Reception",
+    "TableModel",
+    "ThresholdModel",
+    "Transmission",
+]

@@ -1,0 +1,89 @@
+"""Positions, ranges and travel times (spec netsim.md §7.2, §7.4).
+
+Positions are geographic (lat/lon degrees, depth metres positive down); horizontal ranges are
+WGS-84 geodesics (pyproj). Between position reports a node is dead-reckoned with its speed and
+heading (degrees true, clockwise from north).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+from pyproj import Geod
+
+WGS84 = Geod(ellps="WGS84")
+
+
+@dataclass(frozen=True)
+class Position:
+    """A node's reported state at time `time` (UNIX seconds)."""
+
+    lat: float
+    lon: float
+    depth: float
+    time: float = 0.0
+    speed: float = 0.0  # m/s over ground
+    heading: float = 0.0  # degrees true
+
+    @classmethod
+    def from_nav(cls, nav) -> Position:
+        """From a netsim NavUpdate."""
+        return cls(nav.lat, nav.lon, nav.depth, nav.time, nav.speed, nav.heading)
+
+    def at(self, t: float) -> Position:
+        """Dead-reckoned to time t (straight line along the heading, on the ellipsoid)."""
+        distance = self.speed * (t - self.time)
+        if distance == 0:
+            return replace(self, time=t)
+        lon, lat, _ = WGS84.fwd(self.lon, self.lat, self.heading, distance)
+        return replace(self, lat=lat, lon=lon, time=t)
+
+
+def dead_reckoning_offset(speed: float, heading_deg: float, dt: float) -> tuple[float, float]:
+    """(east, north) displacement in metres after dt seconds."""
+    angle = math.radians(90.0 - heading_deg)
+    return speed * dt * math.cos(angle), speed * dt * math.sin(angle)
+
+
+def horizontal_range(a: Position, b: Position) -> tuple[float, float]:
+    """(distance m, azimuth deg from a to b) along the WGS-84 geodesic."""
+    azimuth, _, distance = WGS84.inv(a.lon, a.lat, b.lon, b.lat)
+    return distance, azimuth
+
+
+def slant_range(a: Position, b: Position) -> float:
+    distance, _ = horizontal_range(a, b)
+    return math.hypot(distance, a.depth - b.depth)
+
+
+def owtt(range_m: float, sound_speed: float) -> float:
+    """One-way travel time, seconds."""
+    return range_m / sound_speed
+
+
+def arrival_delay(
+    range_at: Callable[[float], float],
+    sound_speed: float,
+    iterations: int = 4,
+) -> float:
+    """Travel time to a moving receiver: solve r(tau) = c * tau by fixed-point iteration.
+
+    `range_at(tau)` is the range from the transmitter (at transmit time) to the receiver tau
+    seconds after transmission; the static value r(0)/c is the starting guess.
+    """
+    tau = range_at(0.0) / sound_speed
+    for _ in range(iterations):
+        tau = range_at(tau) / sound_speed
+    return tau
+
+
+def closing_speed(tx: Position, rx: Position) -> float:
+    """Rate (m/s) at which the range between two dead-reckoned nodes shrinks (positive closing)."""
+    dt = 1.0
+    return slant_range(tx, rx) - slant_range(tx.at(tx.time + dt), rx.at(rx.time + dt))
+
+
+def doppler_frequency(f_tx: float, v_closing: float, sound_speed: float) -> float:
+    return f_tx * (1 + v_closing / sound_speed)

@@ -1,0 +1,357 @@
+"""The packet-level acoustic channel, sans-I/O (spec netsim.md §7.1 pipeline).
+
+API (what a modem emulator calls):
+
+* ``channel = Channel(ChannelConfig(...), seed=1)``
+* ``channel.update_position(port, Position(...))`` whenever a node's position is known, or
+  ``manager.on_nav(channel.on_environment_nav_update)`` to follow a `NetSimManager`.
+* ``channel.transmit(Transmission(source=62000, start=t, rate=1, frames=3))`` when a modem starts
+  transmitting (start = simulation time now; transmissions must not be registered in the past
+  of the last `poll`). Returns the receptions it will cause as ``[(receiver port, arrival)]``.
+* ``channel.poll(now) -> list[Reception]``: every reception whose delivery time
+  (end of reception + decode latency) is <= now, in delivery order, with its outcome: GOOD,
+  BAD_FRAMES (some frame failed; ``frames_ok`` says which, deliver the leading good ones),
+  NOT_DETECTED, RECEIVER_BUSY (arrived while the receiver was locked on another packet) or
+  HALF_DUPLEX (overlapped the receiver's own transmission). Lost ones are returned too, so the
+  emulator can decide what a real modem would report.
+* ``channel.next_delivery()``: the earliest pending delivery time (for discrete-event loops).
+
+Per transmission (source A at t0) and every other node B with a fresh position in an
+overlapping band: range from A at t0 to B at arrival (B dead-reckoned, fixed-point solution),
+``owtt = r / c``, reception interval ``[t0 + owtt, t0 + owtt + duration]``,
+``RL = SL - TL(r, f)``. At arrival: detection (SINR against ambient noise plus receptions active
+at that instant >= the rate's detection threshold) and receiver lock (the first detected packet
+is the only one decoded until it ends). At the end: ``SINR = RL - (noise + every overlapping
+reception at B)``, then one independent draw per frame from the rate's frame-error model.
+
+Determinism: each reception's draws come from a generator seeded by (seed, transmission number,
+receiver port), so results depend only on the seed and the transmissions, not on how often or
+when `poll` is called.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import random
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+from pygoby.netsim.channel.absorption import thorp
+from pygoby.netsim.channel.errors import RateErrorModels
+from pygoby.netsim.channel.geometry import Position, arrival_delay, closing_speed, slant_range
+from pygoby.netsim.channel.levels import noise_level_integrated, sinr, transmission_loss
+from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, harmonic_mean_speed
+from pygoby.netsim.channel.timing import Interval
+
+
+@dataclass(frozen=True)
+class Band:
+    carrier_hz: float = 25000.0
+    bandwidth_hz: float = 5000.0
+
+    def overlaps(self, other: Band) -> bool:
+        return (
+            abs(self.carrier_hz - other.carrier_hz) < (self.bandwidth_hz + other.bandwidth_hz) / 2
+        )
+
+
+class PacketKind(enum.Enum):
+    DATA = "data"
+    MINI = "mini"  # mini-packets, cycle-init, acknowledgements
+    PING = "ping"  # ranging pings and their replies
+
+
+DEFAULT_DURATIONS = {PacketKind.DATA: 3.25, PacketKind.MINI: 1.0, PacketKind.PING: 0.5}
+
+
+@dataclass(frozen=True)
+class ChannelConfig:
+    """Every knob of the model; defaults from spec §7.13."""
+
+    sound_speed: float | SoundSpeedProfile = 1500.0  # m/s, or a profile c(depth)
+    source_level: float = 185.0  # dB re 1 uPa @ 1 m
+    spreading: float = 1.5  # k in k*10*log10(r)
+    absorption: Callable[[float], float] = thorp  # f kHz -> dB/km
+    noise_level: float | None = None  # in-band dB re 1 uPa; None: Stojanovic over the band
+    shipping: float = 0.5
+    wind: float = 5.0  # m/s
+    band: Band = Band()
+    node_bands: Mapping[int, Band] = field(default_factory=dict)  # per-port override
+    error_models: RateErrorModels = field(default_factory=RateErrorModels)
+    durations: Mapping[PacketKind, float] = field(default_factory=lambda: dict(DEFAULT_DURATIONS))
+    half_duplex: bool = True
+    receiver_lock: bool = True
+    decode_latency: float = 0.0  # s between end of reception and delivery
+    position_staleness: float = 60.0  # s; older positions make the node absent
+    moving_receivers: bool = True  # solve the arrival time for a moving receiver
+
+    def band_of(self, port: int) -> Band:
+        return self.node_bands.get(port, self.band)
+
+
+@dataclass(frozen=True)
+class Transmission:
+    source: int  # modem port of the transmitter
+    start: float  # simulation time, seconds
+    rate: int = 0
+    frames: int = 1
+    kind: PacketKind = PacketKind.DATA
+    duration: float | None = None  # None: the configured duration for `kind`
+    dest: int | None = None  # informational (modems filter by destination themselves)
+    payload: object = None  # passed through untouched
+
+
+class Outcome(enum.Enum):
+    GOOD = "good"
+    BAD_FRAMES = "bad_frames"
+    NOT_DETECTED = "not_detected"
+    RECEIVER_BUSY = "receiver_busy"
+    HALF_DUPLEX = "half_duplex"
+
+
+@dataclass(frozen=True)
+class Reception:
+    receiver: int
+    transmission: Transmission
+    sequence: int  # number of the transmission on this channel (0, 1, ...)
+    arrival: float
+    end: float
+    deliver_at: float
+    owtt: float  # true one-way travel time, s
+    range_m: float
+    received_level: float  # dB re 1 uPa
+    noise_level: float  # ambient, in band
+    sinr: float  # over the whole reception, interference included
+    closing_speed: float  # m/s, positive when approaching
+    outcome: Outcome
+    frames_ok: tuple[bool, ...] = ()
+
+    @property
+    def good_frames(self) -> int:
+        """Number of leading good frames (what is delivered)."""
+        count = 0
+        for ok in self.frames_ok:
+            if not ok:
+                break
+            count += 1
+        return count
+
+    @property
+    def bad_frames(self) -> int:
+        return sum(not ok for ok in self.frames_ok)
+
+
+@dataclass
+class _Pending:
+    receiver: int
+    transmission: Transmission
+    sequence: int
+    interval: Interval
+    owtt: float
+    range_m: float
+    received_level: float
+    closing_speed: float
+    locked: bool | None = None  # decided once every earlier arrival is known
+    detected: bool = False
+
+
+class Channel:
+    def __init__(self, config: ChannelConfig | None = None, seed: int = 0) -> None:
+        self.config = config if config is not None else ChannelConfig()
+        self.seed = seed
+        self._positions: dict[int, Position] = {}
+        self._pending: list[_Pending] = []  # by arrival
+        self._finished: list[_Pending] = []  # kept while they can still interfere
+        self._own_tx: dict[int, list[Interval]] = {}
+        self._locked_until: dict[int, float] = {}
+        self._sequence = 0
+        self._horizon = -math.inf  # last poll time
+        self._noise_cache: dict[Band, float] = {}
+
+    # -- positions -------------------------------------------------------------------------
+
+    def update_position(self, port: int, position: Position) -> None:
+        self._positions[port] = position
+
+    def on_environment_nav_update(self, update) -> None:
+        """Listener for `NetSimManager.on_nav` (an EnvironmentNavUpdate)."""
+        self.update_position(update.nav.modem_tcp_port, Position.from_nav(update.nav))
+
+    def remove_node(self, port: int) -> None:
+        self._positions.pop(port, None)
+
+    def _fresh_position(self, port: int, t: float) -> Position | None:
+        position = self._positions.get(port)
+        if position is None or t - position.time > self.config.position_staleness:
+            return None
+        return position
+
+    # -- physics ---------------------------------------------------------------------------
+
+    def duration_of(self, tx: Transmission) -> float:
+        return tx.duration if tx.duration is not None else self.config.durations[tx.kind]
+
+    def noise_level(self, band: Band) -> float:
+        if self.config.noise_level is not None:
+            return self.config.noise_level
+        if band not in self._noise_cache:
+            self._noise_cache[band] = noise_level_integrated(
+                band.carrier_hz / 1000, band.bandwidth_hz, self.config.shipping, self.config.wind
+            )
+        return self._noise_cache[band]
+
+    def sound_speed(self, depth_a: float, depth_b: float) -> float:
+        c = self.config.sound_speed
+        return float(c) if isinstance(c, (int, float)) else harmonic_mean_speed(c, depth_a, depth_b)
+
+    # -- events ----------------------------------------------------------------------------
+
+    def transmit(self, tx: Transmission) -> list[tuple[int, float]]:
+        """Register a transmission; returns the (receiver, arrival time) it will cause."""
+        if tx.start < self._horizon:
+            raise ValueError(
+                f"transmission at {tx.start} is in the past of the last poll ({self._horizon})"
+            )
+        sequence = self._sequence
+        self._sequence += 1
+        duration = self.duration_of(tx)
+        self._own_tx.setdefault(tx.source, []).append(Interval(tx.start, tx.start + duration))
+        source = self._fresh_position(tx.source, tx.start)
+        if source is None:
+            return []
+        source = source.at(tx.start)
+        tx_band = self.config.band_of(tx.source)
+        alpha = self.config.absorption(tx_band.carrier_hz / 1000)
+        planned = []
+        for port in sorted(self._positions):
+            receiver = self._fresh_position(port, tx.start)
+            if port == tx.source or receiver is None:
+                continue
+            if not tx_band.overlaps(self.config.band_of(port)):
+                continue
+            c = self.sound_speed(source.depth, receiver.depth)
+            if self.config.moving_receivers:
+                delay = arrival_delay(
+                    lambda tau, rx=receiver: slant_range(source, rx.at(tx.start + tau)), c
+                )
+            else:
+                delay = slant_range(source, receiver.at(tx.start)) / c
+            arrival = tx.start + delay
+            range_m = delay * c
+            pending = _Pending(
+                receiver=port,
+                transmission=tx,
+                sequence=sequence,
+                interval=Interval(arrival, arrival + duration),
+                owtt=delay,
+                range_m=range_m,
+                received_level=self.config.source_level
+                - transmission_loss(range_m, alpha, self.config.spreading),
+                closing_speed=closing_speed(source, receiver.at(tx.start)),
+            )
+            self._pending.append(pending)
+            planned.append((port, arrival))
+        self._pending.sort(key=lambda p: (p.interval.start, p.receiver, p.sequence))
+        return planned
+
+    def next_delivery(self) -> float | None:
+        if not self._pending:
+            return None
+        return min(p.interval.end for p in self._pending) + self.config.decode_latency
+
+    def poll(self, now: float) -> list[Reception]:
+        """Receptions delivered by `now` (no transmission may be registered before `now` later)."""
+        self._horizon = max(self._horizon, now)
+        self._decide_locks(now)
+        due = [p for p in self._pending if p.interval.end + self.config.decode_latency <= now]
+        if not due:
+            return []
+        due_ids = {id(p) for p in due}
+        self._pending = [p for p in self._pending if id(p) not in due_ids]
+        due.sort(key=lambda p: (p.interval.end, p.receiver, p.sequence))
+        results = [self._finish(p) for p in due]
+        self._finished.extend(due)
+        self._prune(now)
+        return results
+
+    # -- internals -------------------------------------------------------------------------
+
+    def _receptions_at(self, port: int) -> list[_Pending]:
+        return [p for p in (*self._finished, *self._pending) if p.receiver == port]
+
+    def _decide_locks(self, now: float) -> None:
+        """Detection and receiver lock for every reception that has started by `now`, in
+        arrival order (all earlier arrivals are known by then)."""
+        for p in self._pending:  # sorted by arrival
+            if p.interval.start > now:
+                break
+            if p.locked is not None:
+                continue
+            others = [
+                q.received_level
+                for q in self._receptions_at(p.receiver)
+                if q is not p and q.interval.start <= p.interval.start < q.interval.end
+            ]
+            level = sinr(
+                p.received_level, self.noise_level(self.config.band_of(p.receiver)), others
+            )
+            threshold = self.config.error_models.detection_threshold(p.transmission.rate)
+            p.detected = level >= threshold or not self.config.receiver_lock
+            if not self.config.receiver_lock:
+                p.locked = True
+                continue
+            free = self._locked_until.get(p.receiver, -math.inf) <= p.interval.start
+            transmitting = self.config.half_duplex and any(
+                own.start <= p.interval.start < own.end for own in self._own_tx.get(p.receiver, ())
+            )
+            p.locked = p.detected and free and not transmitting
+            if p.locked:
+                self._locked_until[p.receiver] = p.interval.end
+
+    def _finish(self, p: _Pending) -> Reception:
+        noise = self.noise_level(self.config.band_of(p.receiver))
+        interferers = [
+            q.received_level
+            for q in self._receptions_at(p.receiver)
+            if q is not p and q.interval.overlaps(p.interval)
+        ]
+        level = sinr(p.received_level, noise, interferers)
+        frames_ok: tuple[bool, ...] = ()
+        if self.config.half_duplex and any(
+            p.interval.overlaps(own) for own in self._own_tx.get(p.receiver, ())
+        ):
+            outcome = Outcome.HALF_DUPLEX
+        elif not p.detected:
+            outcome = Outcome.NOT_DETECTED
+        elif not p.locked:
+            outcome = Outcome.RECEIVER_BUSY
+        else:
+            rng = random.Random(f"{self.seed}:{p.sequence}:{p.receiver}")
+            fer = self.config.error_models.frame_error(p.transmission.rate, level)
+            frames_ok = tuple(rng.random() > fer for _ in range(p.transmission.frames))
+            outcome = Outcome.GOOD if all(frames_ok) else Outcome.BAD_FRAMES
+        return Reception(
+            receiver=p.receiver,
+            transmission=p.transmission,
+            sequence=p.sequence,
+            arrival=p.interval.start,
+            end=p.interval.end,
+            deliver_at=p.interval.end + self.config.decode_latency,
+            owtt=p.owtt,
+            range_m=p.range_m,
+            received_level=p.received_level,
+            noise_level=noise,
+            sinr=level,
+            closing_speed=p.closing_speed,
+            outcome=outcome,
+            frames_ok=frames_ok,
+        )
+
+    def _prune(self, now: float) -> None:
+        longest = max(self.config.durations.values(), default=0.0)
+        longest = max([longest, *(self.duration_of(p.transmission) for p in self._pending)])
+        horizon = now - self.config.decode_latency - longest
+        self._finished = [p for p in self._finished if p.interval.end > horizon]
+        for port, intervals in self._own_tx.items():
+            self._own_tx[port] = [i for i in intervals if i.end > horizon]

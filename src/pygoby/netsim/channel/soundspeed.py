@@ -1,0 +1,91 @@
+"""Sound speed in sea water and depth -> pressure (spec netsim.md §7.3).
+
+Units: T in deg C, S in ppt (PSU), D depth in metres (positive down), P in dbar, c in m/s.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+SoundSpeedProfile = Callable[[float], float]  # depth (m) -> sound speed (m/s)
+
+
+def mackenzie_1981(T: float, S: float, D: float) -> float:
+    """Mackenzie (1981); valid 2..30 deg C, 25..40 ppt, 0..8000 m."""
+    return (
+        1448.96
+        + 4.591 * T
+        - 5.304e-2 * T**2
+        + 2.374e-4 * T**3
+        + 1.340 * (S - 35)
+        + 1.630e-2 * D
+        + 1.675e-7 * D**2
+        - 1.025e-2 * T * (S - 35)
+        - 7.139e-13 * T * D**3
+    )
+
+
+def medwin_1975(T: float, S: float, D: float) -> float:
+    """Medwin (1975), a simpler near-surface formula."""
+    return (
+        1449.2 + 4.6 * T - 0.055 * T**2 + 0.00029 * T**3 + (1.34 - 0.010 * T) * (S - 35) + 0.016 * D
+    )
+
+
+def t68_from_t90(T90: float) -> float:
+    return 1.00024 * T90
+
+
+# UNESCO 1983 (Chen & Millero 1977) coefficients, indexed [power of P][power of T].
+_CW = (
+    (1402.388, 5.03711, -5.80852e-2, 3.3420e-4, -1.47800e-6, 3.1464e-9),
+    (0.153563, 6.8982e-4, -8.1788e-6, 1.3621e-7, -6.1185e-10),
+    (3.1260e-5, -1.7107e-6, 2.5974e-8, -2.5335e-10, 1.0405e-12),
+    (-9.7729e-9, 3.8504e-10, -2.3643e-12),
+)
+_A = (
+    (1.389, -1.262e-2, 7.164e-5, 2.006e-6, -3.21e-8),
+    (9.4742e-5, -1.2580e-5, -6.4885e-8, 1.0507e-8, -2.0122e-10),
+    (-3.9064e-7, 9.1041e-9, -1.6002e-10, 7.988e-12),
+    (1.100e-10, 6.649e-12, -3.389e-13),
+)
+_B = ((-1.922e-2, -4.42e-5), (7.3637e-5, 1.7945e-7))
+_D = (1.727e-3, -7.9836e-6)
+
+
+def _poly2(coefficients: tuple[tuple[float, ...], ...], T: float, P: float) -> float:
+    return sum(
+        P**i * sum(c * T**j for j, c in enumerate(row)) for i, row in enumerate(coefficients)
+    )
+
+
+def unesco_1983(S: float, T68: float, P_dbar: float) -> float:
+    """UNESCO 1983 / Chen & Millero; T on IPTS-68 (use t68_from_t90 for ITS-90 input)."""
+    P = P_dbar / 10.0  # the coefficients are for bar
+    return (
+        _poly2(_CW, T68, P)
+        + _poly2(_A, T68, P) * S
+        + _poly2(_B, T68, P) * S**1.5
+        + (_D[0] + _D[1] * P) * S**2
+    )
+
+
+def saunders_pressure(depth: float, lat: float) -> float:
+    """Saunders (1981): pressure in dbar at `depth` metres and latitude `lat` degrees."""
+    c1 = 5.92e-3 + 5.25e-3 * math.sin(math.radians(lat)) ** 2
+    return ((1 - c1) - math.sqrt((1 - c1) ** 2 - 8.84e-6 * depth)) / 4.42e-6
+
+
+def harmonic_mean_speed(profile: SoundSpeedProfile, z1: float, z2: float, steps: int = 16) -> float:
+    """Effective speed along a path between depths z1 and z2: (z2 - z1) / integral(dz / c(z)).
+
+    Simpson's rule over `steps` (even) intervals; a level path gives c at that depth.
+    """
+    if z1 == z2:
+        return profile(z1)
+    h = (z2 - z1) / steps
+    total = 1 / profile(z1) + 1 / profile(z2)
+    for i in range(1, steps):
+        total += (4 if i % 2 else 2) / profile(z1 + i * h)
+    return (z2 - z1) / (total * h / 3)
