@@ -10,6 +10,8 @@ from collections.abc import Sequence
 # Each module has `register(subparsers)`, which adds parsers whose `func(args) -> int` runs them.
 SUBCOMMAND_MODULES = [
     "pygoby.dccl.cli",
+    "pygoby.acomms.cli",
+    "pygoby.moos.cli",
 ]
 
 

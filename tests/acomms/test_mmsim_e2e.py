@@ -1,0 +1,107 @@
+"""Two emulated Micro-Modems, two drivers over real TCP (and a pty): data + ack, ranging, faults."""
+
+import asyncio
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.drivers.micromodem import MMDriver
+from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
+from pygoby.acomms.mmsim.server import MMSimServer
+from pygoby.util.clock import WallClock
+
+from .mm_e2e import run_until, start_emulators, started_driver
+
+
+async def test_data_with_ack_and_ranging_over_tcp():
+    channel, (sim1, sim2) = await start_emulators([1, 2], LoopbackChannel(travel_time=0.6667))
+    d1 = await started_driver(1, sim1.port)
+    d2 = await started_driver(2, sim2.port, query=True)  # also exercises CFQ,ALL at start-up
+    try:
+        got1, got2, results = [], [], []
+        d1.signal_receive.connect(got1.append)
+        d2.signal_receive.connect(got2.append)
+        d1.signal_transmit_result.connect(results.append)
+
+        def fill(msg):
+            msg.dest = 2
+            msg.frame.append(b"hello")
+            msg.frame.append(b"world")
+
+        d1.signal_data_request.connect(fill)
+        d1.handle_initiate_transmission(m.ModemTransmission(src=1, rate=1))
+        data = lambda: [t for t in got2 if t.type == m.DATA and t.frame]  # noqa: E731
+        acks = lambda: [t for t in got1 if t.type == m.ACK]  # noqa: E731
+        await run_until(lambda: data() and acks(), [d1, d2])
+        (rx,) = data()
+        assert (rx.src, rx.dest, list(rx.frame)) == (1, 2, [b"hello", b"world"])
+        assert rx.Extensions[m.MM_TRANSMISSION].receive_stat[0].snr_in == 15
+        assert sorted(acks()[0].acked_frame) == [0, 1]
+        assert results and results[0].Extensions[m.MM_TRANSMISSION].transmit_stat
+
+        ping = m.ModemTransmission(src=1, dest=2, type=m.DRIVER_SPECIFIC)
+        ping.Extensions[m.MM_TRANSMISSION].type = m.MICROMODEM_TWO_WAY_PING
+        got1.clear()
+        d1.handle_initiate_transmission(ping)
+        await run_until(lambda: any(t.type == m.DRIVER_SPECIFIC for t in got1), [d1, d2])
+        reply = next(t for t in got1 if t.type == m.DRIVER_SPECIFIC)
+        owtt = reply.Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time
+        assert list(owtt) == [0.6667] and (reply.src, reply.dest) == (2, 1)
+        assert any(t.type == m.DRIVER_SPECIFIC and t.src == 1 for t in got2)  # $CAMPA heard
+    finally:
+        for d in (d1, d2):
+            d.shutdown()
+        for s in (sim1, sim2):
+            await s.close()
+
+
+async def test_polled_transmission_rate0_over_tcp():
+    channel, (sim1, sim2) = await start_emulators([1, 2])
+    d1, d2 = await started_driver(1, sim1.port), await started_driver(2, sim2.port)
+    try:
+        got1 = []
+        d1.signal_receive.connect(got1.append)
+        d2.signal_data_request.connect(lambda msg: msg.frame.append(b"\x2a" * 32))
+        d1.handle_initiate_transmission(m.ModemTransmission(src=2, dest=1, rate=0))  # poll node 2
+        await run_until(lambda: any(t.frame for t in got1), [d1, d2])
+        (rx,) = [t for t in got1 if t.frame]
+        assert (rx.src, rx.dest, list(rx.frame)) == (2, 1, [b"\x2a" * 32])
+    finally:
+        for d in (d1, d2):
+            d.shutdown()
+        for s in (sim1, sim2):
+            await s.close()
+
+
+async def test_driver_reconnects_after_link_drop_and_resumes():
+    channel, (sim1, sim2) = await start_emulators([1, 2])
+    d1, d2 = await started_driver(1, sim1.port), await started_driver(2, sim2.port)
+    try:
+        got2 = []
+        d2.signal_receive.connect(got2.append)
+        sim1.drop_clients()
+        await run_until(lambda: not d1.link.is_open, [d1, d2])
+        d1.signal_data_request.connect(lambda msg: msg.frame.append(b"after"))
+        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=0))
+        await run_until(lambda: any(t.frame for t in got2), [d1, d2], timeout=10)
+        assert [bytes(f) for t in got2 for f in t.frame] == [b"after"]
+    finally:
+        for d in (d1, d2):
+            d.shutdown()
+        for s in (sim1, sim2):
+            await s.close()
+
+
+async def test_driver_over_serial_pty():
+    channel = LoopbackChannel()
+    sim = MMSimServer(MicroModemModel(3, WallClock(), channel), channel, use_pty=True)
+    await sim.start()
+    cfg = m.DriverConfig(driver_type=2, modem_id=3, serial_port=sim.pty_path, serial_baud=19200)
+    cfg.Extensions[m.MM_CONFIG].query_cfg_on_startup = False
+    driver = MMDriver(WallClock())
+    driver.startup(cfg)
+    try:
+        await run_until(lambda: driver.startup_complete, [driver], timeout=15)
+        assert driver.revision == (0, 94, 0)
+    finally:
+        driver.shutdown()
+        await sim.close()
+        await asyncio.sleep(0)

@@ -1,0 +1,69 @@
+"""The emulator's modem model, sans-I/O, and the `pygoby mmsim` command."""
+
+import asyncio
+import sys
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
+from pygoby.util.clock import VirtualClock
+from pygoby.util.nmea import NMEASentence
+
+
+def say(model, body):
+    model.handle_line(NMEASentence.parse(body).message() + "\r\n")
+    return [line.strip() for line in model.take_output()]
+
+
+def test_cfg_cfq_and_unknown_commands():
+    model = MicroModemModel(4, VirtualClock(1e9))
+    assert say(model, "$CCCFG,SRC,7") == [NMEASentence.parse("$CACFG,SRC,7").message()]
+    assert model.modem_id == 7
+    assert say(model, "$CCCFQ,SRC") == [NMEASentence.parse("$CACFG,SRC,7").message()]
+    assert say(model, "$CCXYZ,1")[0].startswith("$CAERR,")
+    model.handle_line("$CCCFG,SRC,1*00\r\n")  # bad checksum -> $CAERR NMEA
+    assert ",NMEA," in model.take_output()[0]
+
+
+def test_rate_limits_frames_and_sizes():
+    channel = LoopbackChannel()
+    a, b = (
+        MicroModemModel(1, VirtualClock(1e9), channel),
+        MicroModemModel(2, VirtualClock(1e9), channel),
+    )
+    out = say(a, "$CCCYC,0,1,2,1,0,9")  # rate 1 carries at most 3 frames of 64 bytes
+    assert out[0].startswith("$CACYC,0,1,2,1,0,3*") and ",64,1*" in out[1]
+    say(a, "$CCTXD,1,2,0," + "ab" * 100)
+    say(a, "$CCTXD,1,2,0,01")
+    say(a, "$CCTXD,1,2,0,02")
+    rxd = [NMEASentence.parse(x) for x in b.take_output() if x.startswith("$CARXD")]
+    assert [len(bytes.fromhex(s[5])) for s in rxd] == [64, 1, 1]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(max_size=60))
+def test_fuzz_model_never_raises(text):
+    model = MicroModemModel(1, VirtualClock(1e9), LoopbackChannel())
+    model.handle_line(text)
+    model.handle_line("$CC" + text)
+
+
+async def test_pygoby_mmsim_command_answers_over_tcp():
+    proc = await asyncio.create_subprocess_exec(
+        sys.executable, "-m", "pygoby.cli", "mmsim", "--port", "0", "--id", "5",
+        "--channel-group", "239.255.42.98:0",
+        stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.DEVNULL,
+    )  # fmt: skip
+    try:
+        async with asyncio.timeout(20):
+            line = (await proc.stdout.readline()).decode()
+            port = int(line.rsplit(":", 1)[1])
+            reader, writer = await asyncio.open_connection("127.0.0.1", port)
+            writer.write((NMEASentence.parse("$CCCFQ,SRC").message() + "\r\n").encode())
+            reply = (await reader.readline()).decode().strip()
+        assert reply == NMEASentence.parse("$CACFG,SRC,5").message()
+        writer.close()
+    finally:
+        proc.terminate()
+        await proc.wait()
