@@ -269,9 +269,9 @@ class Channel:
             return []
         due_ids = {id(p) for p in due}
         self._pending = [p for p in self._pending if id(p) not in due_ids]
+        self._finished.extend(due)  # before finishing: they interfere with each other
         due.sort(key=lambda p: (p.interval.end, p.receiver, p.sequence))
         results = [self._finish(p) for p in due]
-        self._finished.extend(due)
         self._prune(now)
         return results
 
