@@ -141,10 +141,7 @@ class Codec:
                 f"{root.name}: the largest encoding is {max_encoded} bytes, more than"
                 f" max_bytes {root.max_bytes}"
             )
-        if root.id is None:
-            id_raw = 0
-        else:
-            id_raw = root.id << 1 | (1 if id_bits == 16 else 0)
+        id_raw = 0 if root.id is None else root.id << 1 | (1 if id_bits == 16 else 0)
         return CompiledType(
             cls=cls,
             name=root.name,

@@ -1,0 +1,66 @@
+"""`pygoby dccl encode|decode|analyze`: DCCL from the command line, one message per line."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Iterable
+
+from google.protobuf import text_format
+
+from pygoby.dccl.analyze import describe
+from pygoby.dccl.codec import Codec
+from pygoby.dccl.errors import DcclError
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser("dccl", help="encode, decode and analyze DCCL messages")
+    parser.add_argument("action", choices=["encode", "decode", "analyze"])
+    parser.add_argument("--proto", required=True, help=".proto file defining the message")
+    parser.add_argument("-I", "--include", action="append", default=[], metavar="DIR",
+                        help="include directory for imports (repeatable)")
+    parser.add_argument("--message", required=True, metavar="FULL.NAME",
+                        help="fully qualified message name")
+    parser.add_argument("--passphrase", help="encrypt/decrypt the body with this passphrase")
+    parser.add_argument("--strict", action="store_true",
+                        help="refuse out-of-range values instead of degrading them")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    codec = Codec(passphrase=args.passphrase, strict=args.strict)
+    try:
+        cls = codec.load_proto(args.proto, args.message, args.include)
+    except DcclError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if args.action == "analyze":
+        print(describe(codec.compiled(cls)))
+        return 0
+
+    def encode(line: str) -> str:
+        msg = cls()
+        text_format.Parse(line, msg)
+        return codec.encode(msg).hex()
+
+    def decode(line: str) -> str:
+        try:
+            data = bytes.fromhex(line)
+        except ValueError:
+            raise ValueError(f"not a hex string: {line!r}") from None
+        return text_format.MessageToString(codec.decode(data, cls), as_one_line=True)
+
+    return process_lines(sys.stdin, encode if args.action == "encode" else decode)
+
+
+def process_lines(lines: Iterable[str], convert: Callable[[str], str]) -> int:
+    """One output line per input line; a bad line prints `error: reason` and the rest goes on."""
+    status = 0
+    for raw in lines:
+        line = raw.strip()
+        try:
+            print(convert(line), flush=True)
+        except (DcclError, text_format.ParseError, ValueError) as exc:
+            print(f"error: {exc}", flush=True)
+            status = 1
+    return status
