@@ -1,0 +1,239 @@
+"""`.moos` mission files: globals, ProcessConfig blocks, the ANTLER block (spec moos.md 17, 19)
+and the Goby TextFormat block (goby-moos-apps.md 2.2).
+
+    mission = MissionFile.read("alpha.moos")
+    mission.get_value("ServerPort")          # "9000": first match anywhere, white space removed
+    mission.get_float("LatOrigin")           # None unless numeric
+    mission.process_config("pHelmIvP")       # [(name, value), ...] in file order (or None)
+    mission.goby_block("pAcommsHandler")     # GobyBlock(text, first_line) for TextFormat parsing
+    mission.antler()                         # AntlerConfig with its Run entries
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+_NUMERIC = re.compile(r"[0-9.eE+\-]+")
+_MACRO_USE = re.compile(r"\$\{([^}]*)\}")
+
+
+class MissionFileError(Exception):
+    pass
+
+
+def strip_comment(line: str) -> str:
+    """A line without its `//` comment; the first pair of double quotes protects its content
+    (and is removed)."""
+    text = line.strip()
+    if text.startswith("//"):
+        return ""
+    first = text.find('"')
+    second = text.find('"', first + 1) if first >= 0 else -1
+    if second < 0:
+        cut = text.find("//")
+        return text if cut < 0 else text[:cut]
+    before, inside, after = text[:first], text[first + 1 : second], text[second + 1 :]
+    cut = before.find("//")
+    if cut >= 0:
+        return before[:cut]
+    cut = after.find("//")
+    return before + inside + (after if cut < 0 else after[:cut])
+
+
+def _no_space(text: str) -> str:
+    return text.replace(" ", "").replace("\t", "").replace("\r", "")
+
+
+@dataclass
+class GobyBlock:
+    """The TextFormat text of a Goby app's block and the file line on which it starts."""
+
+    text: str
+    first_line: int  # 1-based line number of the text's first line in the file
+
+    def file_line(self, text_line: int) -> int:
+        return self.first_line + text_line - 1
+
+
+@dataclass
+class AntlerRun:
+    program: str
+    moos_name: str
+    options: dict[str, str] = field(default_factory=dict)
+    extra_args: list[str] = field(default_factory=list)
+
+
+@dataclass
+class AntlerConfig:
+    runs: list[AntlerRun]
+    ms_between_launches: float = 1000.0
+    executable_path: str | None = None
+
+
+class MissionFile:
+    def __init__(self, raw_lines: list[str], path: Path | None = None) -> None:
+        self.path = path
+        self.raw_lines = raw_lines
+        self.lines = self._preprocess(raw_lines)  # comments removed, macros expanded
+
+    @classmethod
+    def read(cls, path: str | os.PathLike[str]) -> MissionFile:
+        p = Path(path)
+        return cls(p.read_text(errors="surrogateescape").splitlines(), p)
+
+    @classmethod
+    def from_text(cls, text: str) -> MissionFile:
+        return cls(text.splitlines())
+
+    @staticmethod
+    def _preprocess(raw_lines: list[str]) -> list[str]:
+        macros: dict[str, str] = {}
+
+        def expand(match: re.Match[str]) -> str:
+            name = match.group(1)
+            return macros.get(name, os.environ.get(name, ""))
+
+        out = []
+        for raw in raw_lines:
+            line = _MACRO_USE.sub(expand, raw[:2000])
+            marker = line.find("define:")
+            if marker >= 0:
+                name, _, value = line[marker + len("define:") :].partition("=")
+                macros[_no_space(name)] = _no_space(strip_comment(value))
+                out.append("")
+                continue
+            out.append(strip_comment(line))
+        return out
+
+    # -- globals (moos.md 17.2) ----------------------------------------------------------------
+
+    def get_value(self, name: str) -> str | None:
+        """The value of the first `name = value` line anywhere in the file (case-insensitive
+        name), with all white space removed."""
+        wanted = name.lower()
+        for line in self.lines:
+            key, sep, value = _no_space(line).partition("=")
+            if sep and key.lower() == wanted:
+                return value
+        return None
+
+    def get_float(self, name: str) -> float | None:
+        value = self.get_value(name)
+        if value is None or not _NUMERIC.fullmatch(value):
+            return None
+        try:
+            return float(value)
+        except ValueError:
+            return None
+
+    def get_int(self, name: str) -> int | None:
+        number = self.get_float(name)
+        return None if number is None else int(number)
+
+    def get_bool(self, name: str) -> bool | None:
+        value = self.get_value(name)
+        if value is None:
+            return None
+        if value.upper() == "TRUE":
+            return True
+        number = self.get_float(name)
+        return number is not None and number > 0
+
+    # -- ProcessConfig blocks (moos.md 17.3) ---------------------------------------------------
+
+    def _block_lines(self, app: str) -> list[str] | None:
+        header = f"PROCESSCONFIG={app}".upper()
+        lines = self.lines
+        for i, line in enumerate(lines):
+            if _no_space(line).upper() != header:
+                continue
+            j = i + 1
+            while j < len(lines) and not lines[j].strip():
+                j += 1
+            if j >= len(lines) or not lines[j].strip().startswith("{"):
+                return None
+            body = []
+            first = lines[j].strip()[1:].strip()
+            if first:
+                body.append(first)
+            for line in lines[j + 1 :]:
+                if line.strip().startswith("}"):
+                    break
+                body.append(line)
+            return body
+        return None
+
+    def process_config(self, app: str) -> list[tuple[str, str]] | None:
+        """The block's `name = value` settings in file order, names and values trimmed
+        (GetConfigurationAndPreserveSpace); None if there is no such block."""
+        body = self._block_lines(app)
+        if body is None:
+            return None
+        out = []
+        for line in body:
+            name, sep, value = line.strip().partition("=")
+            if not sep:
+                continue
+            value = value.strip()
+            if not value and "[" not in line and "]" not in line:
+                continue
+            out.append((name.strip(), value))
+        return out
+
+    def block_value(self, app: str, name: str) -> str | None:
+        for key, value in self.process_config(app) or []:
+            if key.lower() == name.lower():
+                return value
+        return None
+
+    # -- Goby TextFormat blocks (goby-moos-apps.md 2.2) ----------------------------------------
+
+    def goby_block(self, app: str) -> GobyBlock | None:
+        """The text between the first `{` and the last `}` of the app's block, `//` replaced by
+        `#` (Goby's reader: header matched with spaces removed, no trailing comment allowed; the
+        block ends at the next line containing PROCESSCONFIG)."""
+        header = f"processconfig={app}".lower()
+        raw = self.raw_lines
+        start = next((i for i, ln in enumerate(raw) if ln.replace(" ", "").lower() == header), None)
+        if start is None:
+            return None
+        end = next(
+            (i for i in range(start + 1, len(raw)) if "PROCESSCONFIG" in raw[i].upper()), len(raw)
+        )
+        text = "\n".join(raw[start:end])
+        open_at, close_at = text.find("{"), text.rfind("}")
+        if open_at < 0 or close_at < open_at:
+            return GobyBlock("", start + 1)
+        first_line = start + 1 + text.count("\n", 0, open_at)
+        return GobyBlock(text[open_at + 1 : close_at].replace("//", "#"), first_line)
+
+    # -- pAntler (moos.md 19) ------------------------------------------------------------------
+
+    def antler(self) -> AntlerConfig:
+        settings = self.process_config("ANTLER")
+        if settings is None:
+            raise MissionFileError("no ProcessConfig = ANTLER block in the mission file")
+        compact = [(_no_space(k), _no_space(v)) for k, v in settings]
+        lookup = {k.lower(): v for k, v in reversed(compact)}  # first occurrence wins
+        runs = []
+        for key, value in compact:
+            if key.lower() != "run":
+                continue
+            spec, _, alias = value.partition("~")
+            program, _, opts = spec.partition("@")
+            options = {}
+            for item in filter(None, opts.split(",")):
+                k, _, v = item.partition("=")
+                options[k] = v
+            extra_key = next((v for k, v in options.items() if k.lower() == "extraprocessparams"), None)
+            extra = [a for a in lookup.get(extra_key.lower(), "").split(",") if a] if extra_key else []
+            runs.append(AntlerRun(program, alias or Path(program).name, options, extra))
+        pause = lookup.get("msbetweenlaunches")
+        return AntlerConfig(
+            runs,
+            float(pause) if pause and _NUMERIC.fullmatch(pause) else 1000.0,
+            lookup.get("executablepath"),
+        )
