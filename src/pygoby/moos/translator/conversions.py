@@ -113,6 +113,7 @@ def text_format_double(value: float) -> str:
 
 def text_format_float(value: float) -> str:
     """C++ TextFormat's float: %.6g unless it does not round-trip as a float, then %.9g."""
+    value = to_float32(value)
     if math.isnan(value):
         return "nan"
     if math.isinf(value):

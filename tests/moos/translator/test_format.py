@@ -1,0 +1,207 @@
+import logging
+import math
+
+import pytest
+
+from pygoby.moos.translator import TranslatorConfigError, TranslatorError
+from pygoby.moos.translator import format as fmt
+from pygoby.moos.translator.boostformat import FloatArg, IntArg, boost_format, parse_format
+
+REPEAT = [1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6, -6]
+NODE_FORMAT = "NAME=%1%,X=%202%,Y=%3%,HEADING=%201%,REPEAT={%10%}"
+INDEXED = ",REPEAT={" + ",".join(f"%10.{i}%" for i in range(12)) + "}"
+
+
+@pytest.fixture
+def report(msgs):
+    return msgs.BasicNodeReport(Name="unicorn", x=550, y=1023.5, heading=240, repeat=REPEAT)
+
+
+def test_serialize_node_report(report):
+    assert fmt.serialize(report, NODE_FORMAT + INDEXED) == (
+        "NAME=unicorn,X=550,Y=1023.5,HEADING=240,REPEAT={1,-1,2,-2,3,-3,4,-4,5,-5,6,-6},"
+        "REPEAT={1,-1,2,-2,3,-3,4,-4,5,-5,6,-6}"
+    )
+
+
+def test_parse_node_report_round_trip(report, msgs):
+    out = msgs.BasicNodeReport()
+    fmt.parse(fmt.serialize(report, NODE_FORMAT + INDEXED), out, NODE_FORMAT + INDEXED)
+    assert out.SerializeToString() == report.SerializeToString()
+
+
+def test_unset_fields_render_defaults_and_missing_numbers_render_unknown(msgs):
+    assert fmt.serialize(msgs.BasicNodeReport(), "%1%|%3%|%10%|%5%|%203%") == "|0||unknown|"
+
+
+def test_first_declared_field_counts_for_max_field_number(msgs):
+    # Name (declared first) has the largest number here; goby3 would render it empty (Q9).
+    msg = msgs.Deploy(deploy_mode=1, destination=3)
+    assert fmt.serialize(msg, "%1%,%4%") == "DEPLOY_MODE_RETURN,3"
+
+
+def test_submessage_directives(msgs):
+    msg = msgs.TestMsg()
+    msg.msg_default_optional.val = 19.998
+    assert fmt.serialize(msg, "em.val=%17:1%") == "em.val=19.998"
+    out = msgs.TestMsg()
+    fmt.parse("em.val=19.998", out, "em.val=%17:1%")
+    assert out.SerializePartialToString() == msg.SerializePartialToString()
+
+
+SUB_FORMAT = (
+    "em0.val=%117.0:1%,1uint64=%106.1%,0uint64=%106.0%.2uint64=%106.2%:em1.val=%117.1:1%,"
+    "dbl0=%101.0%,dbl1=%101.1%,dbl2=%101.2%,dbl3=%101.3%,em0.em1.val=%37:2:1%"
+)
+
+
+def test_repeated_submessages_and_past_the_end(msgs):
+    msg = msgs.TestMsg()
+    msg.msg_default_repeat.add().val = 21.123
+    msg.msg_default_repeat.add().val = 100.5
+    msg.msg_default_required.msg.val = 45
+    msg.uint64_default_repeat.extend([0, 100, 200])
+    text = fmt.serialize(msg, SUB_FORMAT)
+    assert text == (
+        "em0.val=21.123,1uint64=100,0uint64=0.2uint64=200:em1.val=100.5,dbl0=nan,dbl1=nan,"
+        "dbl2=nan,dbl3=nan,em0.em1.val=45"
+    )
+    out = msgs.TestMsg()
+    fmt.parse(text, out, SUB_FORMAT)
+    msg.double_default_repeat.extend([math.nan] * 4)
+    assert out.SerializePartialToString() == msg.SerializePartialToString()
+
+
+def test_past_the_end_sentinels(msgs):
+    msg = msgs.TestMsg()
+    assert fmt.serialize(
+        msg, "%103.0% %104.0% %105.0% %106.0% %102.0% %113.0% %114.0%|%116.0%"
+    ) == ("2147483647 9223372036854775807 4294967295 18446744073709551615 nan false |ENUM_A")
+
+
+def test_value_rendering(msgs):
+    msg = msgs.TestMsg(
+        bool_default_optional=True,
+        bytes_default_optional=b"\x01\xab",
+        enum_default_optional=2,
+        float_default_optional=1.0 / 3,
+        double_default_optional=1e-05,
+    )
+    msg.msg_default_optional.val = 1
+    assert fmt.serialize(msg, "%13% %15% %16% %2% %1% %17%") == (
+        "true 01ab ENUM_B 0.333333 1e-05 09000000000000f03f"
+    )
+
+
+def test_repeated_delimiter_whole_string_on_output_any_char_on_input(msgs):
+    msg = msgs.BasicNodeReport(repeat=[1, 2, 3])
+    assert fmt.serialize(msg, "%10%", repeated_delimiter=";:") == "1;:2;:3"
+    out = msgs.BasicNodeReport()
+    fmt.parse("4;5:6", out, "%10%", repeated_delimiter=";:")
+    assert out.repeat[:] == [4, 5, 6]
+
+
+def test_printf_specs_and_forced_precision(msgs):
+    msg = msgs.TestMsg(
+        double_default_optional=1.23456789,
+        int32_default_optional=42,
+        int64_default_optional=-1,
+        string_default_optional="ab",
+    )
+    assert fmt.serialize(msg, "%1$.3f|%3$05d|%3$x|%|3$8||%1$10.2f|%14$-4s|%4$x") == (
+        "1.234567890000000|00042|2a|      42|1.234567890000000|ab  |ffffffffffffffff"
+    )
+    assert fmt.serialize(msg, "100%% %3%") == "100% 42"
+
+
+def test_moos_var_names_can_be_formats(report):
+    assert fmt.serialize(report, "NODE_REPORT_%1%") == "NODE_REPORT_unicorn"
+
+
+def test_parse_is_case_insensitive_on_literals_and_keeps_value_case(msgs):
+    out = msgs.BasicNodeReport()
+    fmt.parse("name=UNICORN,x=5", out, "NAME=%1%,X=%202%")
+    assert out.Name == "UNICORN"
+    assert out.x == 5
+
+
+def test_parse_empty_value_gives_nan_and_int_max(msgs):
+    out = msgs.TestMsg()
+    fmt.parse("", out, "%1%")
+    assert math.isnan(out.double_default_optional)
+    out = msgs.TestMsg()
+    fmt.parse("", out, "%3%")
+    assert out.int32_default_optional == 2147483647
+
+
+def test_parse_repeated_enums_append(msgs):
+    out = msgs.TestMsg()
+    fmt.parse("ENUM_A,enum_c", out, "%116%")
+    assert out.enum_default_repeat[:] == [1, 3]
+
+
+def test_parse_short_enum(msgs):
+    out = msgs.Deploy()
+    fmt.parse("stay", out, "%1%", use_short_enum=True)
+    assert out.deploy_mode == 2
+
+
+def test_parse_bytes_and_submessage_hex(msgs):
+    out = msgs.TestMsg()
+    fmt.parse("01ab;09000000000000f03f", out, "%15%;%17%")
+    assert out.bytes_default_optional == b"\x01\xab"
+    assert out.msg_default_optional.val == 1
+
+
+def test_parse_mismatch_is_an_error(msgs):
+    with pytest.raises(TranslatorError, match="does not match format"):
+        fmt.parse("hello", msgs.BasicNodeReport(), "NAME=%1%")
+
+
+def test_parse_unknown_enum_warns(msgs, caplog):
+    out = msgs.TestMsg()
+    with caplog.at_level(logging.WARNING):
+        fmt.parse("ENUM_Q", out, "%16%")
+    assert not out.HasField("enum_default_optional")
+    assert "is not a value of enum" in caplog.text
+
+
+@pytest.mark.parametrize(
+    ("format_string", "message"),
+    [
+        ("%99%", "Bad field: 99"),
+        ("%x%", "Bad specifier: x"),
+        ("%1%%3%", "adjacent directives"),
+        ("a%%b%1%", "adjacent directives"),
+        ("%3:1%", "Invalid ':' syntax"),
+        ("%117:1%", "Invalid '.' syntax"),
+        ("%1", "unterminated"),
+    ],
+)
+def test_bad_parse_formats_rejected_up_front(msgs, format_string, message):
+    with pytest.raises(TranslatorConfigError, match=message):
+        fmt.check_parse_format(msgs.TestMsg.DESCRIPTOR, format_string)
+
+
+@pytest.mark.parametrize(
+    ("format_string", "message"),
+    [
+        ("%3:1%", "Invalid ':' syntax"),
+        ("%117:1%", "Invalid '.' syntax"),
+        ("%1$q", "bad directive"),
+        ("%1% %s", "mixes positional"),
+        ("100%", "bad directive"),
+    ],
+)
+def test_bad_serialize_formats_rejected_up_front(msgs, format_string, message):
+    with pytest.raises(TranslatorConfigError, match=message):
+        fmt.check_serialize_format(msgs.TestMsg.DESCRIPTOR, format_string)
+
+
+def test_boost_format_subset():
+    items = parse_format("%1%-%2$+d-%|3$6|-%2$#x-%3$e-%4%")
+    assert boost_format(items, ["a", IntArg(255, 32), FloatArg(1.5, 15)]) == (
+        "a-+255-   1.5-0xff-1.500000000000000e+00-"
+    )
+    assert boost_format(parse_format("%s,%d"), ["x", IntArg(-3, 32)]) == "x,-3"
+    assert boost_format(parse_format("%1$5.1s|"), ["hello"]) == "    h|"
