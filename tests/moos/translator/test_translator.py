@@ -1,0 +1,363 @@
+import logging
+import math
+
+import pytest
+from google.protobuf import text_format
+
+from pygoby.moos.translator import (
+    ModemIdLookup,
+    Post,
+    Technique,
+    Translator,
+    TranslatorConfigError,
+    TranslatorError,
+    TranslatorRunner,
+    serialize_protobuf,
+)
+
+from .test_algorithms import LOOKUP
+
+BNR = "pygoby.test.translator.BasicNodeReport"
+TEST_MSG = "pygoby.test.translator.TestMsg"
+REPEAT = [1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6, -6]
+
+
+def entry(Entry, text):
+    return text_format.Parse(text, Entry())
+
+
+def one_in_one_out(Entry, loader, technique, name=TEST_MSG):
+    e = Entry(protobuf_name=name)
+    e.create.add(technique=technique, moos_var="TEST_MSG_1")
+    e.publish.add(technique=technique, moos_var="TEST_MSG_1")
+    return Translator([e], loader.message_class)
+
+
+@pytest.mark.parametrize("technique", [1, 2, 3, 5, 6, 7, 8])
+def test_one_in_one_out_round_trip(Entry, loader, full_test_msg, technique):
+    translator = one_in_one_out(Entry, loader, technique)
+    posts = translator.publish(full_test_msg)
+    assert [p.var for p in posts] == ["TEST_MSG_1"]
+    assert posts[0].source_aux == f"{TEST_MSG}:{Technique(technique).name}"
+    if technique in (2, 8):
+        assert isinstance(posts[0].value, bytes)
+    out = translator.create(TEST_MSG, {p.var: p.value for p in posts})
+    assert out.SerializeToString() == full_test_msg.SerializeToString()
+
+
+def test_upstream_node_report_scenario(Entry, loader, msgs):
+    node_format = "NAME=%1%,X=%202%,Y=%3%,HEADING=%201%,REPEAT={%10%}"
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{BNR}"
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_X" format: "%202%" }}
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "VEHICLE_NAME" format: "%1%"
+                  algorithm {{ name: "to_lower" primary_field: 1 }} }}
+        create {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS moos_var: "NAV_HEADING"
+                  algorithm {{ name: "angle_0_360" primary_field: 201 }} }}
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_Y" format: "%3%" }}
+        publish {{ technique: TECHNIQUE_FORMAT moos_var: "NODE_REPORT_FORMAT"
+          format: "{node_format};LAT=%100%;LON=%101%;X+Y=%104%,X-Y=%105%"
+          algorithm {{ name: "utm_x2lon" output_virtual_field: 101 primary_field: 202 reference_field: 3 }}
+          algorithm {{ name: "utm_y2lat" output_virtual_field: 100 primary_field: 3 reference_field: 202 }}
+          algorithm {{ name: "name2modem_id" output_virtual_field: 102 primary_field: 1 }}
+          algorithm {{ name: "name2modem_id" output_virtual_field: 103 primary_field: 1 }}
+          algorithm {{ name: "modem_id2type" output_virtual_field: 103 primary_field: 1 }}
+          algorithm {{ name: "to_upper" output_virtual_field: 103 primary_field: 1 }}
+          algorithm {{ name: "add" output_virtual_field: 104 primary_field: 202 reference_field: 3 }}
+          algorithm {{ name: "subtract" output_virtual_field: 105 primary_field: 202 reference_field: 3 }}
+        }}""",
+    )
+    key_value = e.publish.add()
+    key_value.CopyFrom(e.publish[0])
+    key_value.ClearField("format")
+    key_value.technique = Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS
+    key_value.moos_var = "NODE_REPORT_KEY_VALUE"
+    translator = Translator(
+        [e],
+        loader.message_class,
+        lat_origin=42.35,
+        lon_origin=-70.95,
+        modem_ids=ModemIdLookup.from_text(LOOKUP),
+    )
+    variables = {
+        "NAV_X": 550.0,
+        "NAV_Y": 1023.5,
+        "NAV_HEADING": "heading=-120",
+        "VEHICLE_NAME": "UNICORN",
+    }
+    out = translator.create(BNR, variables)
+    expected = msgs.BasicNodeReport(Name="unicorn", x=550, y=1023.5, heading=240)
+    assert out.SerializeToString() == expected.SerializeToString()
+
+    # pyproj: (x, y) = (550, 1023.5) from origin (42.35, -70.95), zone 19, rounded to 12/11 decimals
+    lat_text, lon_text = "42.359325790417", "-70.94360998891"
+    posts = translator.publish(out)
+    assert posts == [
+        Post(
+            "NODE_REPORT_FORMAT",
+            f"NAME=unicorn,X=550,Y=1023.5,HEADING=240,REPEAT={{}};LAT={lat_text};LON={lon_text};"
+            "X+Y=1573.5,X-Y=-473.5",
+            f"{BNR}:TECHNIQUE_FORMAT",
+        ),
+        Post(
+            "NODE_REPORT_KEY_VALUE",
+            f"Name=unicorn,x=550,y=1023.5,heading=240,utm_y2lat(y)={lat_text},utm_x2lon(x)={lon_text},"
+            "name2modem_id(Name)=3,name2modem_id+modem_id2type+to_upper(Name)=AUV,add(x)=1573.5,"
+            "subtract(x)=-473.5",
+            f"{BNR}:TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS",
+        ),
+    ]
+
+
+def test_posts_sorted_by_variable_then_declaration(Entry, loader, msgs):
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{BNR}"
+        publish {{ technique: TECHNIQUE_FORMAT moos_var: "Z_VAR" format: "%1%" }}
+        publish {{ technique: TECHNIQUE_FORMAT moos_var: "A_VAR" format: "second %1%" }}
+        publish {{ technique: TECHNIQUE_FORMAT moos_var: "A_VAR" format: "third" }}
+        publish {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_%1%" format: "%202%" }}
+        publish {{ technique: TECHNIQUE_PROTOBUF_NATIVE_ENCODED moos_var: "B_BIN" }}
+        publish {{ technique: TECHNIQUE_FORMAT moos_var: "B_TXT" format: "%1%" }}
+        publish {{ technique: TECHNIQUE_PROTOBUF_NATIVE_HEX moos_var: "B_HEX" }}
+        """,
+    )
+    translator = Translator([e], loader.message_class)
+    report = msgs.BasicNodeReport(Name="7", x=1.5)
+    aux = f"{BNR}:TECHNIQUE_FORMAT"
+    assert translator.publish(report) == [
+        Post("A_VAR", "second 7", aux),
+        Post("A_VAR", "third", aux),
+        Post("B_BIN", report.SerializeToString(), f"{BNR}:TECHNIQUE_PROTOBUF_NATIVE_ENCODED"),
+        Post("B_HEX", "0a0137d10c000000000000f83f", f"{BNR}:TECHNIQUE_PROTOBUF_NATIVE_HEX"),
+        Post("B_TXT", 7.0),  # decided per publish: not binary after a binary publish (Q6 fixed)
+        Post("NAV_7", 1.5),
+        Post("Z_VAR", 7.0),
+    ]
+
+
+def test_hex_of_digits_stays_a_string(Entry, loader, msgs):
+    translator = one_in_one_out(Entry, loader, Technique.TECHNIQUE_PROTOBUF_NATIVE_HEX, BNR)
+    (post,) = translator.publish(msgs.BasicNodeReport(repeat=[8]))
+    assert post == Post("TEST_MSG_1", "5008", f"{BNR}:TECHNIQUE_PROTOBUF_NATIVE_HEX")
+
+
+def test_numeric_text_format_output_is_never_a_double(Entry, loader, msgs):
+    translator = one_in_one_out(Entry, loader, Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT, BNR)
+    assert translator.publish(msgs.BasicNodeReport()) == [
+        Post("TEST_MSG_1", "", f"{BNR}:TECHNIQUE_PROTOBUF_TEXT_FORMAT")
+    ]
+
+
+def test_protobuf_create_replaces_and_csv_format_merge(Entry, loader, msgs):
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{BNR}"
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%202%" }}
+        create {{ technique: TECHNIQUE_PROTOBUF_TEXT_FORMAT moos_var: "B" }}
+        create {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS moos_var: "C" }}
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "D" format: "%3%" }}
+        """,
+    )
+    translator = Translator([e], loader.message_class)
+    out = translator.create(BNR, {"A": 1.0, "B": "speed: 2 y: 9", "C": "heading=3", "D": "0.1"})
+    assert out == msgs.BasicNodeReport(speed=2, heading=3, y=0.1)
+
+
+def test_double_source_uses_17_digits(Entry, loader):
+    e = entry(
+        Entry,
+        f'protobuf_name: "{BNR}" create {{ technique: TECHNIQUE_FORMAT moos_var: "V" format: "%1%" }}',
+    )
+    assert (
+        Translator([e], loader.message_class).create(BNR, {"V": 0.1}).Name == "0.10000000000000001"
+    )
+
+
+def test_missing_variable_reads_as_empty(Entry, loader):
+    e = entry(
+        Entry,
+        f'protobuf_name: "{BNR}" create {{ technique: TECHNIQUE_FORMAT moos_var: "V" format: "%202%" }}',
+    )
+    assert math.isnan(Translator([e], loader.message_class).create(BNR, {}).x)
+
+
+def test_bad_input_creates_nothing(Entry, loader):
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{BNR}"
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "X=%202%" }}
+        create {{ technique: TECHNIQUE_PROTOBUF_TEXT_FORMAT moos_var: "B" }}""",
+    )
+    translator = Translator([e], loader.message_class)
+    with pytest.raises(TranslatorError, match=f"{BNR} from B: cannot parse"):
+        translator.create(BNR, {"A": "X=1", "B": "x: {"})
+    with pytest.raises(TranslatorError, match=f"{BNR} from A: input 'Y=1' does not match format"):
+        translator.create(BNR, {"A": "Y=1", "B": "x: 1"})
+
+
+def test_publish_without_entry_is_an_error(Entry, loader, msgs):
+    translator = Translator([], loader.message_class)
+    with pytest.raises(TranslatorError, match=f"No TranslatorEntry for Protobuf type: {BNR}"):
+        translator.publish(msgs.BasicNodeReport())
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ('protobuf_name: "no.Such"', "is not a loaded message type"),
+        (
+            f'protobuf_name: "{BNR}" create {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%1%" '
+            'algorithm { name: "frobnicate" primary_field: 1 } }',
+            "unknown algorithm 'frobnicate'",
+        ),
+        (
+            f'protobuf_name: "{BNR}" publish {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%1%" '
+            'algorithm { name: "nope" output_virtual_field: 50 primary_field: 1 } }',
+            "unknown algorithm 'nope'",
+        ),
+        (
+            f'protobuf_name: "{BNR}" create {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%1%" '
+            'algorithm { name: "add" primary_field: 1 } }',
+            "cannot be used in a create rule",
+        ),
+        (
+            f'protobuf_name: "{BNR}" create {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%77%" }}',
+            "Bad field: 77",
+        ),
+        (
+            f'protobuf_name: "{BNR}" create {{ technique: TECHNIQUE_FORMAT moos_var: "A" }}',
+            "needs a format",
+        ),
+        (
+            f'protobuf_name: "{BNR}" publish {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%1$y" }}',
+            "bad directive",
+        ),
+        (
+            f'protobuf_name: "{BNR}" publish {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%1%" '
+            'algorithm { name: "add" output_virtual_field: 50 primary_field: 1 reference_field: 10 } }',
+            "reference field 10",
+        ),
+        (f'protobuf_name: "{BNR}" trigger {{ type: TRIGGER_TIME }}', "period > 0"),
+        (f'protobuf_name: "{BNR}" trigger {{ type: TRIGGER_PUBLISH }}', "needs trigger.moos_var"),
+    ],
+)
+def test_config_errors(Entry, loader, text, message):
+    with pytest.raises(TranslatorConfigError, match=message):
+        Translator([entry(Entry, text)], loader.message_class)
+
+
+def test_duplicate_entry(Entry, loader):
+    e = entry(Entry, f'protobuf_name: "{BNR}"')
+    with pytest.raises(TranslatorConfigError, match=f"Duplicate translator entry for {BNR}"):
+        Translator([e, e], loader.message_class)
+
+
+def trigger_translator(Entry, loader):
+    return Translator(
+        [
+            entry(
+                Entry,
+                f"""protobuf_name: "{BNR}"
+                trigger {{ moos_var: "CMD" mandatory_content: "report" }}
+                create {{ technique: TECHNIQUE_FORMAT moos_var: "CMD" format: "report %1%" }}
+                create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_X" format: "%202%" }}
+                publish {{ technique: TECHNIQUE_FORMAT moos_var: "OUT" format: "%1%:%202%" }}""",
+            ),
+            entry(
+                Entry,
+                f"""protobuf_name: "{TEST_MSG}"
+                trigger {{ type: TRIGGER_TIME period: 2 }}
+                create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_X" format: "%1%" }}""",
+            ),
+        ],
+        loader.message_class,
+    )
+
+
+def test_publish_trigger_with_mandatory_content(Entry, loader):
+    translator = trigger_translator(Entry, loader)
+    assert translator.subscriptions() == ["CMD", "NAV_X"]
+    assert translator.triggered_by("CMD", "report alpha") == [BNR]
+    assert translator.triggered_by("CMD", "status") == []
+    assert translator.triggered_by("CMD", 1.0) == []
+    assert translator.triggered_by("NAV_X", "report") == []
+
+
+def test_runner_triggers_and_stale_mail(Entry, loader):
+    runner = TranslatorRunner(trigger_translator(Entry, loader), start_time=100.0)
+    assert runner.on_mail("NAV_X", 5.0) == []
+    assert runner.on_mail("CMD", "report alpha", stale=True) == []
+    (created,) = runner.on_mail("CMD", "report bravo")
+    assert (created.Name, created.x) == ("bravo", 5.0)
+    assert runner.translator.publish(created) == [Post("OUT", "bravo:5", f"{BNR}:TECHNIQUE_FORMAT")]
+
+
+def test_runner_time_trigger_schedule(Entry, loader):
+    runner = TranslatorRunner(trigger_translator(Entry, loader), start_time=100.0)
+    runner.on_mail("NAV_X", 2.5)
+    assert runner.tick(101.9) == []
+    (created,) = runner.tick(102.0)
+    assert created.double_default_optional == 2.5
+    assert runner.tick(103.5) == []
+    assert len(runner.tick(104.2)) == 1  # deadline 104 -> next 106
+    assert runner.tick(105.9) == []
+    assert len(runner.tick(110.0)) == 1  # 4 s late: schedule restarts from now
+    assert runner.tick(111.9) == []
+    assert len(runner.tick(112.0)) == 1
+
+
+def test_runner_bad_input_logged_and_skipped(Entry, loader, caplog):
+    runner = TranslatorRunner(trigger_translator(Entry, loader), start_time=0.0)
+    with caplog.at_level(logging.WARNING):
+        assert runner.on_mail("CMD", "report") == []  # no space after 'report': no match
+    assert "not creating pygoby.test.translator.BasicNodeReport" in caplog.text
+
+
+def test_runner_updates_datum_from_origin_mail(Entry, loader):
+    runner = TranslatorRunner(trigger_translator(Entry, loader), start_time=0.0)
+    assert {"LAT_ORIGIN", "LONG_ORIGIN"} <= set(runner.subscriptions())
+    runner.on_mail("LAT_ORIGIN", 42.35)
+    runner.tick(0.1)
+    assert runner.translator.registry.geodesy.zone == 31  # needs both
+    runner.on_mail("LONG_ORIGIN", -70.95)
+    runner.on_mail("LAT_ORIGIN", math.nan)
+    runner.tick(0.2)
+    geodesy = runner.translator.registry.geodesy
+    assert (geodesy.zone, geodesy.lat_origin, geodesy.lon_origin) == (19, 42.35, -70.95)
+
+
+def test_multiplex_inverse_publish(Entry, loader, msgs):
+    runner = TranslatorRunner(
+        trigger_translator(Entry, loader), start_time=0.0, multiplex_vars=["MUX"]
+    )
+    report = msgs.BasicNodeReport(Name="alpha", x=3)
+    value = serialize_protobuf(report, Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT)
+    posts = runner.on_multiplex(value, Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT)
+    aux = f"{BNR}:TECHNIQUE_FORMAT"
+    assert posts == [Post("CMD", "report alpha", aux), Post("NAV_X", 3.0)]
+    for post in posts:
+        runner.on_mail(post.var, post.value)
+    assert runner.variables["CMD"] == "report alpha"
+    assert (
+        runner.on_multiplex(
+            "@PB[nope.Type] x: 1", Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT
+        )
+        == []
+    )
+
+
+def test_inverse_publish_adds_empty_trigger_post(Entry, loader, msgs):
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{BNR}" trigger {{ moos_var: "GO" }}
+        create {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS moos_var: "KV" }}""",
+    )
+    posts = Translator([e], loader.message_class).inverse_publish(
+        msgs.BasicNodeReport(x=1, Name="a")
+    )
+    assert posts == [
+        Post("GO", ""),
+        Post("KV", "Name=a,x=1", f"{BNR}:TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS"),
+    ]
