@@ -1,0 +1,241 @@
+"""MACManager: TDMA slot scheduling aligned to UTC (spec acomms.md §6).
+
+Schemes: MAC_NONE, MAC_FIXED_DECENTRALIZED, MAC_POLLED (goby3) and MAC_AUTO_DECENTRALIZED (Goby
+1.1 passive auto-discovery, §6.7). Call `do_work()` regularly (>= 5 Hz) with a Clock; at each slot
+start the MAC may emit `signal_initiate_transmission(slot)` and always emits
+`signal_slot_start(slot)`. For auto-discovery connect the driver's receptions to
+`handle_modem_receive`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.signals import Signal
+from pygoby.util.clock import Clock
+
+log = logging.getLogger(__name__)
+
+SKEW_TOLERANCE = 2.0  # s late before a slot is skipped and the schedule re-anchored
+AUTO_ENTROPY = 5
+SECONDS_PER_DAY = 86400
+
+MACType = m.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name
+MAC_NONE = MACType["MAC_NONE"].number
+MAC_FIXED_DECENTRALIZED = MACType["MAC_FIXED_DECENTRALIZED"].number
+MAC_AUTO_DECENTRALIZED = MACType["MAC_AUTO_DECENTRALIZED"].number
+MAC_POLLED = MACType["MAC_POLLED"].number
+U = m.MACUpdate
+
+
+class MACManager:
+    def __init__(self, clock: Clock) -> None:
+        self.clock = clock
+        self.cfg = m.MACConfig()
+        self.signal_initiate_transmission = Signal()
+        self.signal_slot_start = Signal()
+        self.slots: list = []  # the cycle: ModemTransmissions, in order
+        self.running = False
+        self.current = 0  # index of the next slot to run
+        self.next_slot_time = 0.0
+        # auto-discovery: id -> last heard time (own id never expires)
+        self.heard: dict[int, float] = {}
+        self._cycle_number = 0
+
+    # ------------------------------------------------------------------ control
+    def startup(self, cfg) -> None:
+        self.cfg = m.MACConfig()
+        self.cfg.CopyFrom(cfg)
+        self.slots = []
+        if cfg.type in (MAC_FIXED_DECENTRALIZED, MAC_POLLED):
+            for slot in cfg.slot:
+                self.slots.append(_copy(slot))
+            self._renumber()
+        elif cfg.type == MAC_AUTO_DECENTRALIZED:
+            self.heard = {cfg.modem_id: self.clock.now()}
+        else:
+            return
+        self.restart()
+
+    def restart(self) -> None:
+        if self.running:
+            return
+        self.running = True
+        self.update()
+
+    def shutdown(self) -> None:
+        self.running = False
+        self.current = 0
+
+    @property
+    def cycle_duration(self) -> float:
+        return sum(s.slot_seconds for s in self.slots)
+
+    def reference_time(self, now: float) -> float:
+        if self.cfg.ref_time_type == m.MACConfig.REFERENCE_FIXED:
+            return float(self.cfg.fixed_ref_time)
+        return math.floor(now / SECONDS_PER_DAY) * SECONDS_PER_DAY
+
+    def update(self) -> None:
+        """Re-anchor the schedule to the reference after any change to the slot list."""
+        if self.cfg.type == MAC_AUTO_DECENTRALIZED:
+            self._auto_schedule()
+            return
+        self._renumber()
+        if not self.slots:
+            log.info("MAC cycle is empty: MAC stopped")
+            self.running = False
+            return
+        now = self.clock.now()
+        length = self.cycle_duration
+        if length <= 0:
+            log.warning("MAC cycle has zero length: MAC stopped")
+            self.running = False
+            return
+        ref = self.reference_time(now)
+        n = math.floor((now - ref) / length) + 1
+        t0 = ref + n * length
+        self.current, self.next_slot_time = 0, t0
+        if self.cfg.start_cycle_in_middle and len(self.slots) > 1:
+            t, index = t0 - length, 0
+            while t < now:
+                t += self.slots[index].slot_seconds
+                index = (index + 1) % len(self.slots)
+            self.current, self.next_slot_time = index, t
+
+    def _renumber(self) -> None:
+        for i, slot in enumerate(self.slots):
+            slot.slot_index = i
+
+    # ------------------------------------------------------------------ running
+    def do_work(self) -> None:
+        if not self.running or not self.slots:
+            return
+        now = self.clock.now()
+        if now <= self.next_slot_time:
+            return
+        if now - self.next_slot_time > SKEW_TOLERANCE:
+            log.warning(
+                "clock skew: %.3f s late for a slot; re-aligning", now - self.next_slot_time
+            )
+            self.update()
+            return
+        if self.cfg.type == MAC_AUTO_DECENTRALIZED and self.current == 0:
+            self._auto_place_blank(self.next_slot_time)
+        slot = _copy(self.slots[self.current])
+        slot.time = m.now_us(self.next_slot_time)
+        if self._initiates(slot):
+            self.signal_initiate_transmission.emit(slot)
+        self.signal_slot_start.emit(slot)
+        self.next_slot_time += self.slots[self.current].slot_seconds
+        self.current = (self.current + 1) % len(self.slots)
+        if self.cfg.type == MAC_AUTO_DECENTRALIZED:
+            self._auto_expire()
+
+    def _initiates(self, slot) -> bool:
+        kind = self.cfg.type
+        if kind == MAC_FIXED_DECENTRALIZED:
+            return slot.src == self.cfg.modem_id or slot.always_initiate
+        if kind == MAC_POLLED:
+            return slot.src != 0
+        if kind == MAC_AUTO_DECENTRALIZED:
+            return slot.src == self.cfg.modem_id
+        return False
+
+    # ------------------------------------------------------------------ MACUpdate
+    def apply_update(self, update) -> bool | None:
+        """Apply a MACUpdate addressed to this node (§6.6).
+
+        Returns None when `cycle_state` is absent, else True for STARTED / False for STOPPED
+        (the caller silences or restores a Micro-Modem with `SRC,0` / `SRC,<id>`).
+        """
+        if update.dest != self.cfg.modem_id:
+            return None
+        slots = [_copy(s) for s in update.slot]
+        kind = update.update_type
+        first = update.first_iterator
+        if kind == U.ASSIGN:
+            self.slots = slots
+        elif kind == U.PUSH_BACK:
+            self.slots.extend(slots)
+        elif kind == U.PUSH_FRONT:
+            for slot in slots:
+                self.slots.insert(0, slot)
+        elif kind in (U.POP_BACK, U.POP_FRONT):
+            if not self.slots:
+                log.warning("MACUpdate pop on an empty cycle")
+            else:
+                self.slots.pop(-1 if kind == U.POP_BACK else 0)
+        elif kind == U.INSERT:
+            self.slots[first:first] = slots
+        elif kind == U.ERASE:
+            second = update.second_iterator
+            del self.slots[first : (first + 1 if second == -1 else second)]
+        elif kind == U.CLEAR:
+            self.slots = []
+        if self.running:
+            self.update()
+        if not update.HasField("cycle_state"):
+            return None
+        if update.cycle_state == U.STARTED:
+            self.restart()
+            return True
+        self.shutdown()
+        return False
+
+    # ------------------------------------------------------------------ auto-discovery (Goby 1.1)
+    def handle_modem_receive(self, transmission) -> None:
+        """Learn sources heard on the link (MAC_AUTO_DECENTRALIZED only)."""
+        if self.cfg.type != MAC_AUTO_DECENTRALIZED or transmission.src <= 0:
+            return
+        known = transmission.src in self.heard
+        self.heard[transmission.src] = self.clock.now()
+        if not known:
+            log.info("MAC discovered node %d", transmission.src)
+            self._auto_schedule()
+
+    def _auto_slot(self, src: int):
+        return m.ModemTransmission(
+            src=src, dest=-1, rate=self.cfg.rate, type=m.DATA, slot_seconds=self.cfg.slot_seconds
+        )
+
+    def _auto_schedule(self) -> None:
+        """Rebuild the cycle from the known ids and wait for the next aligned cycle start."""
+        ids = sorted(self.heard)
+        self.slots = [self._auto_slot(i) for i in ids] + [self._auto_slot(0)]
+        self._renumber()
+        now = self.clock.now()
+        length = self.cycle_duration
+        ref = self.reference_time(now)
+        k = math.floor((now - ref) / length) + 1
+        self.current, self.next_slot_time = 0, ref + k * length
+
+    def _auto_place_blank(self, cycle_start: float) -> None:
+        """Blank position = N-1-[(k mod 5) == (S mod 5)] (k: cycles since midnight)."""
+        ids = sorted(self.heard)
+        n = len(ids) + 1
+        k = round((cycle_start - self.reference_time(cycle_start)) / self.cycle_duration)
+        position = n - 1 - int(k % AUTO_ENTROPY == sum(ids) % AUTO_ENTROPY)
+        nodes = [self._auto_slot(i) for i in ids]
+        self.slots = nodes[:position] + [self._auto_slot(0)] + nodes[position:]
+        self._renumber()
+
+    def _auto_expire(self) -> None:
+        limit = self.cycle_duration * self.cfg.expire_cycles
+        now = self.clock.now()
+        stale = [
+            i for i, t in self.heard.items() if i not in (self.cfg.modem_id, 0) and now - t > limit
+        ]
+        if stale:
+            for i in stale:
+                del self.heard[i]
+                log.info("MAC expired node %d", i)
+            self._auto_schedule()
+
+
+def _copy(slot):
+    out = m.ModemTransmission()
+    out.CopyFrom(slot)
+    return out
