@@ -164,28 +164,26 @@ class ManagerConnection:
         self.manager = manager
         self.peer_ip = peer_ip_string(peer_address)
         self.decoder = LineDecoder(request_names(), manager.config.max_line_length)
-        self.errors = 0  # lines dropped on this connection
+        self.errors = 0  # bad lines on this connection (dropped or partial)
 
     def receive(self, data: bytes) -> list[bytes]:
         replies: list[bytes] = []
         for event in self.decoder.feed(data):
             if isinstance(event, LineError):
-                self.errors += 1
-                self._log_dropped(event)
+                self._log_bad_line(f"dropped line: {event}")
                 continue
             if event.preamble != b"NETSIM":
                 log.info("%s: preamble %r instead of NETSIM", self.peer_ip, event.preamble[:20])
             if event.parse_error:
-                log.warning(
-                    "%s: %s; answering the partial request", self.peer_ip, event.parse_error
-                )
+                self._log_bad_line(f"{event.parse_error}; answering the partial request")
             outcome = self.manager.handle_request(event.message, self.peer_ip)
             name = LEGACY_RESPONSE_NAME if event.legacy else RESPONSE_NAME
             replies.append(encode_line(outcome.response, name))
         return replies
 
-    def _log_dropped(self, error: LineError) -> None:
+    def _log_bad_line(self, what: str) -> None:
         # A client sending garbage could produce thousands of errors a second: log the first
         # ones in full, then only every thousandth, so logging cannot starve other clients.
+        self.errors += 1
         if self.errors <= 10 or self.errors % 1000 == 0:
-            log.warning("%s: dropped line #%d: %s", self.peer_ip, self.errors, error)
+            log.warning("%s: bad line #%d: %s", self.peer_ip, self.errors, what)

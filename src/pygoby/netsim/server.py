@@ -19,7 +19,9 @@ from pygoby.netsim.manager import NetSimManager
 
 log = logging.getLogger(__name__)
 
-READ_SIZE = 65536
+# Small reads plus a yield after each one give every connection its turn: a client flooding
+# the manager with garbage can only hold the event loop for one small chunk at a time.
+READ_SIZE = 4096
 
 
 class ManagerServer:
@@ -68,6 +70,7 @@ class ManagerServer:
                 if replies:
                     writer.write(b"".join(replies))
                     await writer.drain()
+                await asyncio.sleep(0)
         except (ConnectionError, OSError) as exc:
             log.info("client %s: %s", peer, exc)
         finally:
