@@ -15,7 +15,9 @@ import sys
 from pathlib import Path
 
 from pygoby.netsim.config import EXAMPLE_CONFIG, ConfigError, parse_config
+from pygoby.netsim.gprmc import GpsOutputs
 from pygoby.netsim.manager import NetSimManager
+from pygoby.util.clock import WallClock
 
 log = logging.getLogger(__name__)
 
@@ -116,11 +118,14 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     try:
         config = parse_config(Path(args.config).read_text())
+        manager = NetSimManager(config)
+        if config.gps_out:
+            manager.on_nav(GpsOutputs.open_serial(config, WallClock()).on_nav_update)
     except (OSError, ConfigError) as exc:
         print(f"netsim_manager: {exc}", file=sys.stderr)
         return 1
     with contextlib.suppress(KeyboardInterrupt):
-        asyncio.run(_run(NetSimManager(config), args.listen, args.port))
+        asyncio.run(_run(manager, args.listen, args.port))
     return 0
 
 
