@@ -12,6 +12,7 @@ from pygoby.moos.translator import (
     TranslatorConfigError,
     TranslatorError,
     TranslatorRunner,
+    post_for_moos,
     serialize_protobuf,
 )
 
@@ -361,3 +362,21 @@ def test_inverse_publish_adds_empty_trigger_post(Entry, loader, msgs):
         Post("GO", ""),
         Post("KV", "Name=a,x=1", f"{BNR}:TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS"),
     ]
+
+
+def test_runner_reads_an_external_variable_table(Entry, loader):
+    table = {"NAV_X": 4.0}
+    runner = TranslatorRunner(trigger_translator(Entry, loader), start_time=0.0, variables=table)
+    (created,) = runner.on_mail("CMD", "report x")
+    assert created.x == 4.0
+    assert "CMD" not in table  # the application owns the table
+
+
+def test_post_for_moos(msgs):
+    report = msgs.BasicNodeReport(x=1)
+    assert post_for_moos("R", report, Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT) == Post(
+        "R", f"@PB[{BNR}] x: 1 ", f"{BNR}:TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT"
+    )
+    assert post_for_moos("R", report, Technique.TECHNIQUE_PREFIXED_PROTOBUF_NATIVE_ENCODED).value == (
+        f"@PB[{BNR}] ".encode() + report.SerializeToString()
+    )

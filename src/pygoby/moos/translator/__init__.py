@@ -28,6 +28,7 @@ from pygoby.moos.translator.translator import (
     Translator,
     TranslatorRunner,
     make_post,
+    post_for_moos,
 )
 
 TRANSLATOR_PROTO = "goby/moos/protobuf/translator.proto"
@@ -61,6 +62,7 @@ __all__ = [
     "moos_technique_from_config",
     "parse_for_moos",
     "parse_protobuf",
+    "post_for_moos",
     "render_double",
     "serialize_for_moos",
     "serialize_protobuf",

@@ -28,6 +28,7 @@ from pygoby.moos.translator.techniques import (
     as_text,
     dynamic_parse,
     parse_protobuf,
+    serialize_for_moos,
     serialize_protobuf,
 )
 
@@ -80,6 +81,11 @@ def moos_value_to_source(value: MoosValue | None, technique: Technique) -> MoosV
     if isinstance(value, bytes) and technique not in BINARY_TECHNIQUES:
         return as_text(value)
     return value
+
+
+def post_for_moos(var: str, msg: Message, technique: Technique) -> Post:
+    """An app-internal message (serialize_for_moos) as a MOOS post, with SourceAux."""
+    return make_post(var, serialize_for_moos(msg, technique), technique, msg.DESCRIPTOR.full_name)
 
 
 MessageResolver = Callable[[str], type[Message]]
@@ -317,10 +323,17 @@ class TranslatorRunner:
     """
 
     def __init__(
-        self, translator: Translator, start_time: float, multiplex_vars: Iterable[str] = ()
+        self,
+        translator: Translator,
+        start_time: float,
+        multiplex_vars: Iterable[str] = (),
+        variables: Mapping[str, MoosValue] | None = None,
     ) -> None:
         self.translator = translator
-        self.variables: dict[str, MoosValue] = {}
+        # The newest value per variable: our own table, or the application's (e.g. a view of
+        # GobyMOOSApp.dynamic_vars, which also holds mail from before the start).
+        self._owns_variables = variables is None
+        self.variables: Mapping[str, MoosValue] = {} if variables is None else variables
         self.multiplex_vars = list(multiplex_vars)
         self._periods = translator.time_triggered()
         self._deadlines = {name: start_time + period for name, period in self._periods.items()}
@@ -333,7 +346,8 @@ class TranslatorRunner:
         return sorted(names)
 
     def on_mail(self, var: str, value: MoosValue, *, stale: bool = False) -> list[Message]:
-        self.variables[var] = value
+        if self._owns_variables:
+            self.variables[var] = value  # type: ignore[index]
         if (
             var in (LAT_ORIGIN_VAR, LONG_ORIGIN_VAR)
             and isinstance(value, float)
