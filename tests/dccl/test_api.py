@@ -225,3 +225,27 @@ def test_user_codec_selected_by_name(tmp_path: Path) -> None:
     with pytest.raises(DcclLoadError, match="no codec named 'my.parity'"):
         load(tmp_path, "message Q { option (dccl.msg) = { id: 6 max_bytes: 4 codec_version: 4 };"
              " required uint32 n = 1 [(dccl.field).codec = 'my.parity']; }", "Q")
+
+
+def test_generated_python_classes_load(tmp_path: Path, monkeypatch) -> None:
+    """Classes from protoc-generated *_pb2 modules work like run-time loaded ones."""
+    from importlib import resources
+
+    from grpc_tools import protoc
+
+    from pygoby.protobuf import BUILTIN_PROTO_DIR
+    from tests.dccl.vectors import DCCL_VECTORS
+
+    well_known = resources.files("grpc_tools") / "_proto"
+    args = ["protoc", f"-I{BUILTIN_PROTO_DIR}", f"-I{DCCL_VECTORS}", f"-I{well_known}"]
+    args.append(f"--python_out={tmp_path}")
+    assert protoc.main([*args, "dccl/option_extensions.proto", "example.proto"]) == 0
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import example_pb2
+
+    codec = Codec()
+    codec.load(example_pb2.Tiny)
+    data = codec.encode(example_pb2.Tiny(a=5, b=3, c=True))
+    assert data.hex() == "042501"
+    assert codec.decode(data) == example_pb2.Tiny(a=5, b=3, c=True)
+    assert "example.Tiny" in codec.analyze(example_pb2.Tiny)
