@@ -197,6 +197,12 @@ class Codec:
         """Length in bytes of `encode(msg)`."""
         return len(self.encode(msg))
 
+    def analyze(self, message_type: type[Message] | Descriptor | str) -> str:
+        """A table of the type's fields: codec, part (head/body), bit sizes, and totals."""
+        from pygoby.dccl.analyze import describe
+
+        return describe(self.compiled(message_type))
+
     def max_size(self, message_type: type[Message] | Descriptor | str) -> int:
         return self.compiled(message_type).max_size()
 

@@ -109,6 +109,6 @@ DEFAULT_REGISTRY = _build_default_registry()
 def register_codec(
     name: str, categories: Iterable[str], factory: CodecFactory
 ) -> None:
-    """Register a user codec in the default registry (used by every Codec made afterwards
-    unless it was given a registry of its own), selected with `(dccl.field).codec = "name"`."""
+    """Register a user codec in the default registry (shared by every Codec not given a registry
+    of its own); a field selects it with `(dccl.field).codec = "name"`."""
     DEFAULT_REGISTRY.register(name, categories, factory)
