@@ -213,3 +213,26 @@ def test_channel_follows_manager_positions():
     connection.receive(encode_line(request))
     ((port, arrival),) = ch.transmit(Transmission(62000, T0 + 1))
     assert port == 62001 and arrival - (T0 + 1) == pytest.approx(2000 / 1500, abs=1e-6)
+
+
+def test_synthesized_receive_statistics():
+    from pygoby.netsim.channel.stats import receive_statistics
+
+    ch = channel({1: at(-1500), 2: at(1000), 3: at(0, speed=2.0, heading=270.0)})
+    ch.transmit(Transmission(1, T0, rate=5, frames=8))
+    ch.transmit(Transmission(2, T0 + 0.5, rate=5, frames=8))
+    at3 = {r.transmission.source: r for r in ch.poll(T0 + 20) if r.receiver == 3}
+    stats = receive_statistics(at3[1], source_id=1, dest_id=3)
+    assert stats.IsInitialized()
+    assert (stats.mode, stats.psk_error_code) == (1, 3)  # BAD_CRC, BAD_CRC_AT_LEAST_ONE_FRAME
+    assert (stats.number_frames, stats.number_bad_frames, stats.rate) == (8, 8, 5)
+    assert stats.snr_in == max(-10, round(at3[1].sinr))
+    assert stats.time == round(at3[1].arrival * 1e6)
+    assert stats.doppler == pytest.approx(2.0, abs=0.05)  # receiver heading west towards 1
+    assert stats.packet_type == 3  # PSK
+    assert receive_statistics(at3[2], source_id=2, dest_id=3) is None  # receiver was busy
+    # It fits a ReceiveStats push to the manager.
+    push = message_class("ReceiveStats")(
+        modem_tcp_port=3, tx_modem_tcp_port=1, packet_success=False, mm_stats=stats
+    )
+    assert push.IsInitialized()

@@ -1,0 +1,82 @@
+"""Micro-Modem receive statistics ($CACST / ReceiveStatistics) synthesized for a reception
+(spec netsim.md §7.12). The mapping of the channel's numbers onto the modem's fields follows
+ros_acomms; fields the model has no physics for get plausible values inside goby3's DCCL ranges.
+These are modelling choices, not measured modem behaviour.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+from google.protobuf.message import Message
+
+from pygoby.netsim.channel.model import Outcome, PacketKind, Reception
+from pygoby.protobuf import builtin_class
+
+MM_STATS_PROTO = "goby/acomms/protobuf/mm_receive_statistics.proto"
+
+
+@cache
+def receive_statistics_class() -> type[Message]:
+    return builtin_class(MM_STATS_PROTO, "goby.acomms.micromodem.protobuf.ReceiveStatistics")
+
+
+def _clamp(value: float, low: int, high: int) -> int:
+    return int(min(max(round(value), low), high))
+
+
+def receive_statistics(
+    reception: Reception,
+    *,
+    source_id: int,
+    dest_id: int,
+    carrier_hz: float = 25000.0,
+    bandwidth_hz: float = 5000.0,
+    clock_mode: str = "NO_SYNC_TO_PPS_AND_CCCLK_GOOD",
+    flexible_data_packet: bool = False,
+) -> Message | None:
+    """The $CACST a modem would report for this reception, or None if it reports nothing
+    (the packet was never detected, or the receiver was busy with another one)."""
+    if reception.outcome in (Outcome.NOT_DETECTED, Outcome.RECEIVER_BUSY):
+        return None
+    tx = reception.transmission
+    if reception.outcome is Outcome.HALF_DUPLEX:
+        mode, psk_error = "PACKET_TIMEOUT", "MISSED_START_OF_PSK_PACKET"
+    elif reception.outcome is Outcome.GOOD:
+        mode, psk_error = "RECEIVE_GOOD", "NO_ERROR"
+    else:
+        mode, psk_error = "BAD_CRC", "BAD_CRC_AT_LEAST_ONE_FRAME"
+    if flexible_data_packet:
+        packet_type = "FLEXIBLE_DATA_PACKET"
+    elif tx.kind is PacketKind.MINI:
+        packet_type = "FSK_MINI" if tx.rate == 0 else "PSK_MINI"
+    else:
+        packet_type = "FSK" if tx.rate == 0 else "PSK"
+    snr = reception.sinr
+    return receive_statistics_class()(
+        mode=mode,
+        time=int(round(reception.arrival * 1e6)),
+        clock_mode=clock_mode,
+        mfd_power=_clamp(snr / 2, -30, 40),
+        mfd_ratio=_clamp(10 ** (min(snr, 40) / 10) * 10, 0, 16383),
+        spl=round(reception.received_level),
+        shf_agn=250,
+        rate=_clamp(tx.rate, -1, 6),
+        source=_clamp(source_id, 0, 127),
+        dest=_clamp(dest_id, 0, 127),
+        psk_error_code=psk_error,
+        packet_type=packet_type,
+        number_frames=_clamp(tx.frames, 0, 8),
+        number_bad_frames=_clamp(reception.bad_frames, 0, 8),
+        snr_rss=_clamp(reception.received_level - reception.noise_level, 0, 255),
+        snr_in=_clamp(snr, -10, 30),
+        snr_out=_clamp(snr + 10, 0, 25),
+        snr_symbols=_clamp(snr + 10, 0, 30),
+        mse_equalizer=_clamp(-snr, -30, 5),
+        data_quality_factor=_clamp(snr * 10, 0, 255),
+        doppler=min(max(round(reception.closing_speed, 1), -3.0), 3.0),
+        stddev_noise=_clamp(reception.noise_level - 40, 0, 255),
+        carrier_freq=_clamp(carrier_hz, 100, 30000),
+        bandwidth=_clamp(bandwidth_hz, 1000, 5000),
+        version=6,
+    )
