@@ -365,11 +365,12 @@ def test_inverse_publish_adds_empty_trigger_post(Entry, loader, msgs):
 
 
 def test_runner_reads_an_external_variable_table(Entry, loader):
-    table = {"NAV_X": 4.0}
+    table = {"NAV_X": 4.0, "CMD": "report x"}  # the application stores mail before handling it
     runner = TranslatorRunner(trigger_translator(Entry, loader), start_time=0.0, variables=table)
     (created,) = runner.on_mail("CMD", "report x")
-    assert created.x == 4.0
-    assert "CMD" not in table  # the application owns the table
+    assert (created.Name, created.x) == ("x", 4.0)
+    runner.on_mail("NAV_X", 9.0)
+    assert table["NAV_X"] == 4.0  # the runner never writes the application's table
 
 
 def test_post_for_moos(msgs):
