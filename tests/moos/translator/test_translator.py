@@ -378,6 +378,6 @@ def test_post_for_moos(msgs):
     assert post_for_moos("R", report, Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT) == Post(
         "R", f"@PB[{BNR}] x: 1 ", f"{BNR}:TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT"
     )
-    assert post_for_moos("R", report, Technique.TECHNIQUE_PREFIXED_PROTOBUF_NATIVE_ENCODED).value == (
-        f"@PB[{BNR}] ".encode() + report.SerializeToString()
-    )
+    assert post_for_moos(
+        "R", report, Technique.TECHNIQUE_PREFIXED_PROTOBUF_NATIVE_ENCODED
+    ).value == (f"@PB[{BNR}] ".encode() + report.SerializeToString())
