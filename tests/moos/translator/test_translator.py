@@ -283,6 +283,7 @@ def test_publish_trigger_with_mandatory_content(Entry, loader):
     assert translator.triggered_by("CMD", "report alpha") == [BNR]
     assert translator.triggered_by("CMD", "status") == []
     assert translator.triggered_by("CMD", 1.0) == []
+    assert translator.triggered_by("CMD", b"\x00report") == [BNR]
     assert translator.triggered_by("NAV_X", "report") == []
 
 

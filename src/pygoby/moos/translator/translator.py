@@ -195,7 +195,8 @@ class Translator:
 
     def triggered_by(self, var: str, value: MoosValue) -> list[str]:
         """Entries whose TRIGGER_PUBLISH fires on this mail (in configuration order)."""
-        text = value if isinstance(value, str) else ""
+        # A double's string value is empty, so it never satisfies a mandatory_content.
+        text = as_text(value) if isinstance(value, str | bytes) else ""
         return [
             name
             for name, entry in self._entries.items()
