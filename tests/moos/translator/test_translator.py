@@ -6,6 +6,7 @@ from google.protobuf import text_format
 
 from pygoby.moos.translator import (
     ModemIdLookup,
+    MoosValues,
     Post,
     Technique,
     Translator,
@@ -382,3 +383,15 @@ def test_post_for_moos(msgs):
     assert post_for_moos(
         "R", report, Technique.TECHNIQUE_PREFIXED_PROTOBUF_NATIVE_ENCODED
     ).value == (f"@PB[{BNR}] ".encode() + report.SerializeToString())
+
+
+def test_moos_values_view():
+    from pygoby.moos import protocol
+
+    table = {
+        "A": protocol.MOOSMessage(key="A", data_type=protocol.DOUBLE, dval=1.5),
+        "B": protocol.MOOSMessage(key="B", data_type=protocol.STRING, sval=b"x"),
+    }
+    view = MoosValues(table)
+    assert dict(view) == {"A": 1.5, "B": "x"}
+    assert view.get("C") is None

@@ -24,6 +24,7 @@ from pygoby.moos.translator.techniques import (
 from pygoby.moos.translator.translator import (
     LAT_ORIGIN_VAR,
     LONG_ORIGIN_VAR,
+    MoosValues,
     Post,
     Translator,
     TranslatorRunner,
@@ -49,6 +50,7 @@ __all__ = [
     "AlgorithmRegistry",
     "ModemIdLookup",
     "MoosValue",
+    "MoosValues",
     "Post",
     "Technique",
     "Translator",

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 
 from google.protobuf.message import Message
@@ -312,6 +312,23 @@ class Translator:
             raise TranslatorError(
                 f"No TranslatorEntry for Protobuf type: {protobuf_name}"
             ) from None
+
+
+class MoosValues(Mapping):
+    """Read-only view of an application's newest-message table ({var: message with .value},
+    e.g. GobyMOOSApp.dynamic_vars) as {var: value}, for TranslatorRunner(variables=...)."""
+
+    def __init__(self, messages: Mapping) -> None:
+        self._messages = messages
+
+    def __getitem__(self, key: str) -> MoosValue:
+        return self._messages[key].value
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._messages)
+
+    def __len__(self) -> int:
+        return len(self._messages)
 
 
 class TranslatorRunner:
