@@ -6,12 +6,19 @@ from __future__ import annotations
 import asyncio
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from netsim_vectors import from_vector_dict, of_kind
 
 from pygoby.netsim.client import MAX_REQUEST_ID, NetSimClient, RequestTracker, status_name
 from pygoby.netsim.config import parse_config
 from pygoby.netsim.manager import NetSimManager
-from pygoby.netsim.protocol import LEGACY_REQUEST_NAME, request_class
+from pygoby.netsim.protocol import (
+    LEGACY_REQUEST_NAME,
+    encode_line,
+    request_class,
+    response_class,
+)
 from pygoby.netsim.server import ManagerServer
 
 LOOPBACK = {v["name"]: v["textformat"] for v in of_kind("manager_config")}["loopback"]
@@ -117,3 +124,21 @@ async def test_pending_request_fails_when_connection_drops():
     await client.close()
     server.close()
     await server.wait_closed()
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.binary(max_size=64), max_size=20))
+def test_fuzz_tracker_survives_garbage_and_still_matches(chunks):
+    loop = asyncio.new_event_loop()
+    try:
+        tracker = RequestTracker()
+        future = loop.create_future()
+        request = tracker.build()
+        tracker.expect(request.id, future)
+        for chunk in chunks:
+            tracker.feed(chunk)
+        answer = response_class()(request_id=request.id, status=1)
+        tracker.feed(b"\n" + encode_line(answer))
+        assert future.done() and future.result().request_id == request.id
+    finally:
+        loop.close()

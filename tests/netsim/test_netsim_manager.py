@@ -10,6 +10,8 @@ import subprocess
 import sys
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from netsim_vectors import of_kind, to_vector_dict
 
 from pygoby.netsim.config import EXAMPLE_CONFIG, ConfigError, parse_config
@@ -20,6 +22,7 @@ from pygoby.netsim.protocol import (
     encode_line,
     message_class,
     request_class,
+    request_names,
     response_names,
 )
 from pygoby.netsim.server import ManagerServer
@@ -247,3 +250,35 @@ async def test_wrong_base64_is_answered_as_a_partial_request(server):
     assert (event.message.request_id, event.message.status) == (0, 1)
     writer.close()
     await writer.wait_closed()
+
+
+_pieces = st.sampled_from(
+    [
+        b"NETSIM|",
+        b"netsim.protobuf.NetSimManagerRequest|",
+        b"NetSimManagerRequest|",
+        b"netsim.protobuf.NetSimManagerResponse|",
+        b"CAA=",
+        b"CEIS",
+        b"////",
+        b"|",
+        b"\n",
+        b"\r\n",
+    ]
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.one_of(st.binary(max_size=40), _pieces), max_size=40))
+def test_fuzz_manager_answers_each_request_line_exactly_once(chunks):
+    manager = _manager("loopback")
+    connection = manager.connection("127.0.0.1")
+    stream = b"".join(chunks) + b"\n"
+    replies = [r for chunk in chunks for r in connection.receive(chunk)]
+    replies += connection.receive(b"\n")
+    expected = [
+        e for e in LineDecoder(request_names()).feed(stream) if isinstance(e, ReceivedMessage)
+    ]
+    assert len(replies) == len(expected)
+    decoded = LineDecoder(response_names()).feed(b"".join(replies))
+    assert [e.message.request_id for e in decoded] == [e.message.id for e in expected]
