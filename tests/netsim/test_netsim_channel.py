@@ -236,3 +236,22 @@ def test_synthesized_receive_statistics():
         modem_tcp_port=3, tx_modem_tcp_port=1, packet_success=False, mm_stats=stats
     )
     assert push.IsInitialized()
+
+
+def test_protocol_model_ranges_and_collisions():
+    from pygoby.netsim.channel.errors import ProtocolModel
+
+    nodes = {1: at(0), 2: at(1999), 3: at(-2200), 4: at(2800, 100), 5: at(-3100)}
+    ch = channel(nodes, protocol_model=ProtocolModel())
+    assert sorted(port for port, _ in ch.transmit(Transmission(1, T0, frames=2))) == [2, 3, 4]
+    outcomes = {r.receiver: (r.outcome, r.frames_ok) for r in ch.poll(T0 + 20)}
+    assert outcomes == {
+        2: (Outcome.GOOD, (True, True)),
+        3: (Outcome.BAD_FRAMES, (False, False)),  # detected, beyond communication range
+        4: (Outcome.NOT_DETECTED, ()),  # only interferes
+    }
+    # 4 (800 m from 2) transmits while 1's packet reaches 2: the overlap destroys both at 2.
+    ch.transmit(Transmission(1, T0 + 30))
+    ch.transmit(Transmission(4, T0 + 30.5))
+    at2 = [r.outcome for r in ch.poll(T0 + 50) if r.receiver == 2]
+    assert at2 == [Outcome.BAD_FRAMES, Outcome.BAD_FRAMES]

@@ -24,6 +24,15 @@ at that instant >= the rate's detection threshold) and receiver lock (the first 
 is the only one decoded until it ends). At the end: ``SINR = RL - (noise + every overlapping
 reception at B)``, then one independent draw per frame from the rate's frame-error model.
 
+With ``ChannelConfig(protocol_model=ProtocolModel(...))`` links are range-based instead
+(UnetStack's protocol model, for deterministic MAC tests): decoded within the communication
+range, detected only up to the detection range, and any overlap of two receptions at a node
+destroys both; nodes beyond the interference range are not affected at all.
+
+Modelling simplifications: a reception that locks the receiver keeps it locked until its end even
+if the receiver's own transmission then aborts it; detection uses the interference present at
+the instant of arrival, decoding the interference over the whole reception.
+
 Determinism: each reception's draws come from a generator seeded by (seed, transmission number,
 receiver port), so results depend only on the seed and the transmissions, not on how often or
 when `poll` is called.
@@ -38,7 +47,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from pygoby.netsim.channel.absorption import thorp
-from pygoby.netsim.channel.errors import RateErrorModels
+from pygoby.netsim.channel.errors import ProtocolModel, RateErrorModels
 from pygoby.netsim.channel.geometry import Position, arrival_delay, closing_speed, slant_range
 from pygoby.netsim.channel.levels import noise_level_integrated, sinr, transmission_loss
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, harmonic_mean_speed
@@ -82,6 +91,10 @@ class ChannelConfig:
     durations: Mapping[PacketKind, float] = field(default_factory=lambda: dict(DEFAULT_DURATIONS))
     half_duplex: bool = True
     receiver_lock: bool = True
+    # Deterministic range-based links instead of SINR and error models (UnetStack's protocol
+    # model): decoding within communication_range, any overlap of two receptions at a node
+    # destroys both, no effect beyond interference_range. For MAC tests.
+    protocol_model: ProtocolModel | None = None
     decode_latency: float = 0.0  # s between end of reception and delivery
     position_staleness: float = 60.0  # s; older positions make the node absent
     moving_receivers: bool = True  # solve the arrival time for a moving receiver
@@ -239,6 +252,9 @@ class Channel:
                 delay = slant_range(source, receiver.at(tx.start)) / c
             arrival = tx.start + delay
             range_m = delay * c
+            protocol = self.config.protocol_model
+            if protocol is not None and not protocol.interferes(range_m):
+                continue
             pending = _Pending(
                 receiver=port,
                 transmission=tx,
@@ -288,6 +304,9 @@ class Channel:
                 break
             if p.locked is not None:
                 continue
+            if self.config.protocol_model is not None:  # decided in _protocol_outcome
+                p.detected = p.locked = True
+                continue
             others = [
                 q.received_level
                 for q in self._receptions_at(p.receiver)
@@ -318,16 +337,20 @@ class Channel:
         ]
         level = sinr(p.received_level, noise, interferers)
         frames_ok: tuple[bool, ...] = ()
+        rng = random.Random(f"{self.seed}:{p.sequence}:{p.receiver}")
         if self.config.half_duplex and any(
             p.interval.overlaps(own) for own in self._own_tx.get(p.receiver, ())
         ):
             outcome = Outcome.HALF_DUPLEX
+        elif self.config.protocol_model is not None:
+            outcome, frames_ok = self._protocol_outcome(
+                p, self.config.protocol_model, rng, collided=bool(interferers)
+            )
         elif not p.detected:
             outcome = Outcome.NOT_DETECTED
         elif not p.locked:
             outcome = Outcome.RECEIVER_BUSY
         else:
-            rng = random.Random(f"{self.seed}:{p.sequence}:{p.receiver}")
             fer = self.config.error_models.frame_error(p.transmission.rate, level)
             frames_ok = tuple(rng.random() > fer for _ in range(p.transmission.frames))
             outcome = Outcome.GOOD if all(frames_ok) else Outcome.BAD_FRAMES
@@ -346,6 +369,22 @@ class Channel:
             closing_speed=p.closing_speed,
             outcome=outcome,
             frames_ok=frames_ok,
+        )
+
+    @staticmethod
+    def _protocol_outcome(
+        p: _Pending, model: ProtocolModel, rng: random.Random, collided: bool
+    ) -> tuple[Outcome, tuple[bool, ...]]:
+        if not (model.detected(p.range_m) and rng.random() < model.p_detection):
+            return Outcome.NOT_DETECTED, ()
+        decoded = (
+            not collided
+            and p.range_m <= model.communication_range
+            and rng.random() < model.p_decoding
+        )
+        frames = p.transmission.frames
+        return (
+            (Outcome.GOOD, (True,) * frames) if decoded else (Outcome.BAD_FRAMES, (False,) * frames)
         )
 
     def _prune(self, now: float) -> None:
