@@ -79,7 +79,12 @@ async def test_driver_reconnects_after_link_drop_and_resumes():
         d2.signal_receive.connect(got2.append)
         sim1.drop_clients()
         await run_until(lambda: not d1.link.is_open, [d1, d2])
+        requests = []
+        d1.signal_data_request.connect(requests.append)
         d1.signal_data_request.connect(lambda msg: msg.frame.append(b"after"))
+        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=0))
+        assert requests == []  # link down: nothing is taken from the queue
+        await run_until(lambda: d1.link.is_open, [d1, d2], timeout=10)  # reconnects (1 s)
         d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=0))
         await run_until(lambda: any(t.frame for t in got2), [d1, d2], timeout=10)
         assert [bytes(f) for t in got2 for f in t.frame] == [b"after"]
@@ -105,3 +110,38 @@ async def test_driver_over_serial_pty():
         driver.shutdown()
         await sim.close()
         await asyncio.sleep(0)
+
+
+async def test_acked_message_queued_during_link_outage_is_delivered_after_reconnect():
+    from pygoby.acomms.bind import bind
+    from pygoby.acomms.mac import MAC_FIXED_DECENTRALIZED, MACManager
+
+    from .queue_helpers import entry, manager
+
+    channel, (sim1, sim2) = await start_emulators([1, 2])
+    d1, d2 = await started_driver(1, sim1.port), await started_driver(2, sim2.port)
+    clock = WallClock()
+    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
+    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
+    mac = MACManager(clock)  # node 1 owns every 1 s slot
+    mac.startup(m.MACConfig(modem_id=1, type=MAC_FIXED_DECENTRALIZED,
+                            slot=[m.ModemTransmission(src=1, dest=-1, rate=0, slot_seconds=1)]))  # fmt: skip
+    bind(d1, q1, mac)
+    bind(d2, q2)
+    received, acked = [], []
+    q2.signal_receive.connect(received.append)
+    q1.signal_ack.connect(lambda ack, original: acked.append(original))
+    workers = [d1, d2, mac, q1, q2]
+    try:
+        sim1.drop_clients()  # the modem link goes down...
+        await run_until(lambda: not d1.link.is_open, workers)
+        q1.push_message(Status(src=1, dest=2, value=42))  # ...while a message waits, ack=true
+        await run_until(lambda: bool(acked), workers, timeout=15)  # reconnect within 1 s
+        assert [x.value for x in received] == [42]
+        assert acked[0].value == 42 and q1.size(20) == 0
+    finally:
+        mac.shutdown()
+        for d in (d1, d2):
+            d.shutdown()
+        for s in (sim1, sim2):
+            await s.close()

@@ -136,6 +136,10 @@ class MMDriver(ModemDriverBase):
         self._try_write(now)
 
     def handle_initiate_transmission(self, transmission) -> None:
+        if self.link is None or not self.link.is_open:
+            # nothing is taken from the queue, so queued messages wait for the link
+            log.warning("link to the modem is down: transmission not started")
+            return
         msg = m.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)

@@ -1,0 +1,76 @@
+"""Priority queue throughput with 100,000 queued messages (`make bench`).
+
+The contest visits queues, not messages, so a data request costs the same with 10 or 100,000
+messages waiting; push costs one DCCL encode.
+"""
+
+import sys
+from pathlib import Path
+
+import pytest
+
+from pygoby.acomms import messages as m
+from pygoby.util.clock import VirtualClock
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from acomms.queue_helpers import entry, manager  # noqa: E402
+
+QUEUED = 100_000
+
+
+def _loaded_manager(ack: bool):
+    clock = VirtualClock(1_700_000_000.0)
+    qm, (Status, Bulk, Note) = manager(
+        clock,
+        entries=[
+            entry("Status", ack=ack, max_queue=0, ttl=0),
+            entry("Bulk", ack=ack, max_queue=0, ttl=0, value_base=2),
+        ],
+    )
+    template = Status(src=1, dest=2, value=1)
+    for i in range(QUEUED):
+        template.value = i % 1000
+        qm.push_message(template)
+    return clock, qm, Status
+
+
+@pytest.fixture(scope="module")
+def loaded():
+    return _loaded_manager(ack=False)
+
+
+def test_pop_one_frame_with_100k_queued(benchmark, loaded):
+    clock, qm, _ = loaded
+
+    def pop():
+        clock.advance(0.001)
+        request = m.ModemTransmission(src=1, dest=-1, max_num_frames=1, max_frame_bytes=32)
+        qm.handle_modem_data_request(request)
+        return request
+
+    request = benchmark(pop)
+    assert request.frame[0]
+    assert qm.size(20) > QUEUED // 2  # still ~100k queued while measuring
+
+
+def test_push_with_100k_queued(benchmark, loaded):
+    clock, qm, Status = loaded
+    msg = Status(src=1, dest=2, value=3)
+    benchmark(qm.push_message, msg)
+    assert qm.size(20) > QUEUED // 2
+
+
+def test_acked_pop_and_ack_with_100k_queued(benchmark):
+    clock, qm, _ = _loaded_manager(ack=True)
+    frame = iter(range(10**9))
+
+    def pop_and_ack():
+        clock.advance(0.001)
+        n = next(frame)
+        request = m.ModemTransmission(src=1, dest=-1, max_num_frames=1, max_frame_bytes=32,
+                                      frame_start=n)  # fmt: skip
+        qm.handle_modem_data_request(request)
+        qm.handle_modem_receive(m.ModemTransmission(type=m.ACK, src=2, dest=1, acked_frame=[n]))
+
+    benchmark(pop_and_ack)
+    assert qm.size(20) < QUEUED

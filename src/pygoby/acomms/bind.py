@@ -1,0 +1,24 @@
+"""Wire the layers together with their signals (spec acomms.md §2, goby3 bind.h)."""
+
+from __future__ import annotations
+
+
+def bind(driver, queue=None, mac=None) -> None:
+    """driver ⇄ queue (receive, data request) and mac → driver (initiate transmission).
+
+    A MAC doing auto-discovery also learns the sources the driver hears."""
+    if queue is not None:
+        driver.signal_receive.connect(queue.handle_modem_receive)
+        driver.signal_data_request.connect(queue.handle_modem_data_request)
+    if mac is not None:
+        mac.signal_initiate_transmission.connect(driver.handle_initiate_transmission)
+        driver.signal_receive.connect(mac.handle_modem_receive)
+
+
+def unbind(driver, queue=None, mac=None) -> None:
+    if queue is not None:
+        driver.signal_receive.disconnect(queue.handle_modem_receive)
+        driver.signal_data_request.disconnect(queue.handle_modem_data_request)
+    if mac is not None:
+        mac.signal_initiate_transmission.disconnect(driver.handle_initiate_transmission)
+        driver.signal_receive.disconnect(mac.handle_modem_receive)

@@ -1,0 +1,6 @@
+"""Priority queuing of DCCL messages for the acoustic link (spec acomms.md §5)."""
+
+from pygoby.acomms.queue.manager import QueueError, QueueManager
+from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
+
+__all__ = ["MessageQueue", "QueueError", "QueueManager", "QueuedItem"]

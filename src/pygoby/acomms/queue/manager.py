@@ -1,0 +1,287 @@
+"""QueueManager: the priority contest that fills ModemTransmission frames (spec acomms.md §5).
+
+Connect a driver with `driver.signal_data_request.connect(queue.handle_modem_data_request)` and
+`driver.signal_receive.connect(queue.handle_modem_receive)` (or pygoby.acomms.bind.bind). Call
+`do_work()` regularly for expiry. The per-frame contest visits the queues (one per DCCL type),
+never the queued messages, so its cost does not grow with the number of queued messages.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
+from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
+from pygoby.acomms.signals import Signal
+from pygoby.util.clock import Clock, WallClock
+
+log = logging.getLogger(__name__)
+
+
+class QueueError(Exception):
+    """A message cannot be queued (no queue for its type, empty encoding, bad config)."""
+
+
+class QueueManager:
+    def __init__(self, codec, clock: Clock | None = None) -> None:
+        """`codec` is a pygoby.dccl.Codec (types are loaded into it as queues are added)."""
+        self.codec = codec
+        self.clock: Clock = clock if clock is not None else WallClock()
+        self.cfg = m.QueueManagerConfig()
+        self.queues: dict[int, MessageQueue] = {}  # by DCCL id, kept in ascending order
+        self._by_name: dict[str, MessageQueue] = {}
+        self.signal_receive = Signal()  # (message)
+        self.signal_ack = Signal()  # (ack ModemTransmission, original message)
+        self.signal_expire = Signal()  # (original message)
+        self.signal_queue_size_change = Signal()  # (QueueSize)
+        self.signal_data_on_demand = Signal()  # (request ModemTransmission, message to fill)
+
+    @property
+    def modem_id(self) -> int:
+        return self.cfg.modem_id
+
+    # ------------------------------------------------------------------ configuration
+    def set_cfg(self, cfg) -> None:
+        self.cfg = m.QueueManagerConfig()
+        self.cfg.CopyFrom(cfg)
+        for entry in cfg.message_entry:
+            self.add_queue(entry)
+
+    def add_queue(self, entry, message_class=None) -> MessageQueue:
+        """Create (or update the options of) the queue for `entry.protobuf_name`.
+
+        The type must be known to the codec's loader or given as `message_class`."""
+        if message_class is None:
+            message_class = self.codec.loader.message_class(entry.protobuf_name)
+        self.codec.load(message_class)
+        compiled = self.codec.compiled(message_class)
+        if compiled.id is None:
+            raise QueueError(f"{entry.protobuf_name} has no DCCL id")
+        copy = m.QueuedMessageEntry()
+        copy.CopyFrom(entry)
+        roles = compile_roles(copy, message_class.DESCRIPTOR)
+        existing = self.queues.get(compiled.id)
+        if existing is not None:
+            existing.entry, existing.roles = copy, roles
+            existing.manipulators = frozenset(copy.manipulator)
+            return existing
+        queue = MessageQueue(copy, compiled.id, self.clock.now(), roles)
+        self.queues = dict(sorted({**self.queues, compiled.id: queue}.items()))
+        self._by_name[entry.protobuf_name] = queue
+        self._size_changed(queue)
+        return queue
+
+    def _size_changed(self, queue: MessageQueue) -> None:
+        self.signal_queue_size_change.emit(m.QueueSize(dccl_id=queue.dccl_id, size=len(queue)))
+
+    # ------------------------------------------------------------------ push
+    def push_message(self, msg) -> None:
+        queue = self._by_name.get(msg.DESCRIPTOR.full_name)
+        if queue is None:
+            raise QueueError(
+                f"No queue exists for message: {msg.DESCRIPTOR.full_name}; you must configure it first."
+            )
+        if queue.has("LOOPBACK"):
+            self.signal_receive.emit(msg)
+        if queue.has("NO_QUEUE"):
+            return
+        src = self._role(queue, Role.SOURCE_ID, msg, 0)
+        dest = self._role(queue, Role.DESTINATION_ID, msg, 0)
+        ack = queue.entry.ack and dest != m.BROADCAST_ID
+        if dest == self.modem_id:
+            self.signal_receive.emit(msg)
+            if queue.entry.ack:
+                now = m.now_us(self.clock.now())
+                ack_msg = m.ModemTransmission(src=dest, dest=dest, type=m.ACK, time=now)
+                self.signal_ack.emit(ack_msg, msg)
+            return
+        getter = queue.roles.get(Role.TIMESTAMP)
+        when = timestamp_us(getter, msg) if getter is not None else None
+        encoded = self.codec.encode(msg)
+        if not encoded:
+            raise QueueError(f"{queue.name}: encoded size is 0; not queued")
+        item = QueuedItem(
+            msg, encoded, src, dest, when if when is not None else m.now_us(self.clock.now()), ack
+        )
+        queue.push(item)
+        self._size_changed(queue)
+
+    def _role(self, queue: MessageQueue, role: int, msg, default: int) -> int:
+        getter = queue.roles.get(role)
+        if getter is None:
+            return default
+        value = getter.get(msg)
+        return default if value is None else int(value)
+
+    def flush_queue(self, flush) -> None:
+        queue = self.queues.get(flush.dccl_id)
+        if queue is None:
+            log.warning("flush: no queue with DCCL id %d", flush.dccl_id)
+            return
+        queue.clear()
+        self._size_changed(queue)
+
+    def size(self, dccl_id: int) -> int:
+        return len(self.queues[dccl_id])
+
+    # ------------------------------------------------------------------ data request
+    def handle_modem_data_request(self, request) -> None:
+        now = self.clock.now()
+        for queue in self.queues.values():
+            queue.clear_stale_waits(request.frame_start, now, self.cfg.minimum_ack_wait_seconds)
+        packet_ack = request.ack_requested if request.HasField("ack_requested") else False
+        packet_dest = request.dest
+        limit = request.max_frame_bytes if request.HasField("max_frame_bytes") else None
+        start = request.frame_start
+        for frame_no in range(start, start + request.max_num_frames):
+            index = frame_no - start
+            if index < len(request.frame):
+                prefix = bytes(request.frame[index])
+            else:
+                request.frame.append(b"")
+                prefix = b""
+            parts = [prefix]
+            used = len(prefix)
+            winner = self._contest(request, used, limit, now)
+            if winner is None:
+                request.dest = packet_dest
+                continue
+            while winner is not None:
+                item = self._give_data(winner, frame_no, now)
+                packet_ack |= item.ack_requested
+                if frame_no == start:
+                    if request.dest == m.QUERY_DESTINATION_ID:
+                        request.dest = item.dest
+                    if request.src == m.QUERY_SOURCE_ID:
+                        request.src = self.modem_id
+                    if packet_dest in (0, -1):
+                        packet_dest = request.dest
+                parts.append(item.encoded)
+                used += len(item.encoded)
+                if limit is not None and limit - used <= 0:
+                    break
+                winner = self._contest(request, used, limit, now)
+            request.frame[index] = b"".join(parts)
+        request.ack_requested = packet_ack
+
+    def _contest(self, request, used: int, limit: int | None, now: float) -> MessageQueue | None:
+        best: MessageQueue | None = None
+        best_priority = 0.0
+        for queue in self.queues.values():
+            if queue.has("ON_DEMAND"):
+                self._refresh_on_demand(queue, request, now)
+            if len(queue) <= queue.waiting_count:
+                continue
+            if queue.last_send_time + queue.entry.blackout_time > now:
+                continue
+            item = queue.next_item()
+            if item is None:
+                continue
+            if limit is not None and len(item.encoded) > limit - used:
+                continue
+            if (
+                request.HasField("dest")
+                and request.dest != m.QUERY_DESTINATION_ID
+                and item.dest != m.BROADCAST_ID
+                and item.dest != request.dest
+            ):
+                continue
+            if (
+                request.HasField("ack_requested")
+                and not request.ack_requested
+                and item.ack_requested
+                and request.dest != m.BROADCAST_ID
+            ):
+                continue
+            priority = queue.priority(now)
+            if (
+                best is None
+                or priority > best_priority
+                or (priority == best_priority and queue.last_send_time < best.last_send_time)
+            ):
+                best, best_priority = queue, priority
+        return best
+
+    def _refresh_on_demand(self, queue: MessageQueue, request, now: float) -> None:
+        newest = queue.back()
+        if newest is not None and now * 1e6 - newest.time <= self.cfg.on_demand_skew_seconds * 1e6:
+            return
+        fresh = self.codec.compiled(queue.name).cls()
+        self.signal_data_on_demand.emit(request, fresh)
+        if fresh.IsInitialized() and fresh.ListFields():
+            self.push_message(fresh)
+
+    def _give_data(self, queue: MessageQueue, frame_no: int, now: float) -> QueuedItem:
+        item = queue.next_item()
+        assert item is not None
+        if item.dest == m.BROADCAST_ID:
+            item.ack_requested = False
+        item.last_sent = now
+        if item.ack_requested:
+            queue.wait_for_ack(item, frame_no)
+        else:
+            queue.remove(item)
+            self._size_changed(queue)
+        queue.last_send_time = now
+        if queue.has("LOOPBACK_AS_SENT"):
+            self.signal_receive.emit(item.msg)
+        return item
+
+    # ------------------------------------------------------------------ receive
+    def handle_modem_receive(self, transmission) -> None:
+        if transmission.type == m.ACK:
+            self._handle_ack(transmission)
+        elif transmission.type == m.DATA and not self.cfg.skip_decoding:
+            for frame in transmission.frame:
+                self._decode_frame(bytes(frame))
+
+    def _handle_ack(self, ack) -> None:
+        if ack.dest != self.modem_id:
+            log.warning("ignoring an ACK for modem %d (we are %d)", ack.dest, self.modem_id)
+            return
+        for frame_no in ack.acked_frame:
+            for queue in self.queues.values():
+                items = queue.waiting.get(frame_no)
+                if not items:
+                    continue
+                for item in list(items):
+                    queue.remove(item)
+                    self._size_changed(queue)
+                    self.signal_ack.emit(ack, item.msg)
+
+    def _decode_frame(self, data: bytes) -> None:
+        offset = 0
+        while offset < len(data):
+            try:
+                msg, used = self.codec.decode_prefix(data[offset:])
+            except Exception as exc:  # any DCCL failure: keep what was decoded
+                where = "frame dropped" if offset == 0 else "rest of frame dropped"
+                log.warning("cannot decode DCCL message at byte %d (%s): %s", offset, where, exc)
+                return
+            offset += max(used, 1)
+            self._deliver(msg)
+
+    def _deliver(self, msg) -> None:
+        queue = self._by_name.get(msg.DESCRIPTOR.full_name)
+        if queue is None:
+            self.signal_receive.emit(msg)
+            return
+        src = self._role(queue, Role.SOURCE_ID, msg, 0)
+        dest = self._role(queue, Role.DESTINATION_ID, msg, 0)
+        if dest not in (m.BROADCAST_ID, self.modem_id) and not queue.has("PROMISCUOUS"):
+            return
+        if dest == m.BROADCAST_ID and src == self.modem_id and queue.roles.get(Role.SOURCE_ID):
+            return  # our own broadcast heard back
+        if queue.has("NO_DEQUEUE"):
+            return
+        self.signal_receive.emit(msg)
+
+    # ------------------------------------------------------------------ expiry
+    def do_work(self) -> None:
+        now_us = m.now_us(self.clock.now())
+        for queue in self.queues.values():
+            while (item := queue.expired_front(now_us)) is not None:
+                queue.remove(item)
+                self._size_changed(queue)
+                self.signal_expire.emit(item.msg)

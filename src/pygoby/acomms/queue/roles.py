@@ -1,0 +1,86 @@
+"""Where a queued message's source, destination and time come from (QueuedMessageEntry.role)."""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import dataclass
+
+from google.protobuf.descriptor import Descriptor, FieldDescriptor
+
+from pygoby.acomms import messages as m
+
+Role = m.QueuedMessageEntry.Role
+_INTEGER_TYPES = {
+    FieldDescriptor.TYPE_INT32, FieldDescriptor.TYPE_INT64, FieldDescriptor.TYPE_UINT32,
+    FieldDescriptor.TYPE_UINT64, FieldDescriptor.TYPE_SINT32, FieldDescriptor.TYPE_SINT64,
+    FieldDescriptor.TYPE_FIXED32, FieldDescriptor.TYPE_FIXED64, FieldDescriptor.TYPE_SFIXED32,
+    FieldDescriptor.TYPE_SFIXED64, FieldDescriptor.TYPE_ENUM,
+}  # fmt: skip
+
+
+class RoleError(ValueError):
+    """A role in the queue configuration is invalid for its message type."""
+
+
+@dataclass(frozen=True)
+class RoleGetter:
+    path: tuple[str, ...] | None  # field path, or None for a static value
+    static_value: int = 0
+    kind: int = FieldDescriptor.TYPE_INT32
+
+    def get(self, msg):
+        if self.path is None:
+            return self.static_value
+        value = msg
+        for name in self.path:
+            if not value.HasField(name):
+                return None
+            value = getattr(value, name)
+        return value
+
+
+def compile_roles(entry, descriptor: Descriptor) -> dict[int, RoleGetter]:
+    """Validate the roles of `entry` against `descriptor` (rules of spec §3.5)."""
+    getters: dict[int, RoleGetter] = {}
+    for role in entry.role:
+        if role.type in getters:
+            raise RoleError(f"{entry.protobuf_name}: role {role.type} given twice")
+        if role.setting == Role.STATIC:
+            if role.type == Role.TIMESTAMP:
+                raise RoleError(f"{entry.protobuf_name}: TIMESTAMP cannot be STATIC")
+            if not role.HasField("static_value"):
+                raise RoleError(f"{entry.protobuf_name}: STATIC role needs static_value")
+            getters[role.type] = RoleGetter(None, role.static_value)
+            continue
+        path = tuple(role.field.split("."))
+        current, field = descriptor, None
+        for name in path:
+            if current is None or name not in current.fields_by_name:
+                raise RoleError(f"{entry.protobuf_name}: no field {role.field!r}")
+            field = current.fields_by_name[name]
+            if field.is_repeated:
+                raise RoleError(f"{entry.protobuf_name}: role field {role.field!r} is repeated")
+            current = field.message_type
+        assert field is not None
+        if role.type in (Role.SOURCE_ID, Role.DESTINATION_ID) and field.type not in _INTEGER_TYPES:
+            raise RoleError(f"{entry.protobuf_name}: {role.field!r} must be an integer")
+        if role.type == Role.TIMESTAMP and field.type not in (
+            FieldDescriptor.TYPE_UINT64, FieldDescriptor.TYPE_DOUBLE, FieldDescriptor.TYPE_STRING,
+        ):  # fmt: skip
+            raise RoleError(f"{entry.protobuf_name}: {role.field!r} cannot carry a time")
+        getters[role.type] = RoleGetter(path, kind=field.type)
+    return getters
+
+
+def timestamp_us(getter: RoleGetter, msg) -> int | None:
+    value = getter.get(msg)
+    if value is None:
+        return None
+    if getter.kind == FieldDescriptor.TYPE_UINT64:
+        return int(value)
+    if getter.kind == FieldDescriptor.TYPE_DOUBLE:
+        return int(round(value * 1e6))  # Quirk A10 (sane): keep sub-second precision
+    parsed = dt.datetime.fromisoformat(str(value).replace("Z", "+00:00"))
+    if parsed.tzinfo is None:
+        parsed = parsed.replace(tzinfo=dt.UTC)
+    return int(round(parsed.timestamp() * 1e6))
