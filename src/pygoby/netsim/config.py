@@ -13,6 +13,7 @@ from functools import cache
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
+from pygoby.netsim.channel.settings import environment_channel_configs
 from pygoby.protobuf import builtin_class
 
 CONFIG_PROTO = "netsim/messages/manager_config.proto"
@@ -35,6 +36,23 @@ manager_tcp_port: 61999          # default 61999
 listen_address: "0.0.0.0"        # IPv4 address to listen on
 reject_nonfinite_position: true  # NaN/inf lat, lon or depth -> OUT_OF_DEFINED_REGION
 max_line_length: 1048576         # longer NETSIM lines are discarded
+# Channel model of environment 0 (every field optional; defaults shown or described).
+environment_channel {
+  environment_id: 0
+  channel {
+    sound_speed: 1500              # or water { temperature: 10 salinity: 35 } for Mackenzie
+    absorption: THORP              # or FRANCOIS_GARRISON (uses water { ... })
+    source_level: 185  spreading: 1.5
+    shipping: 0.5  wind_speed: 5   # Stojanovic noise; or a fixed noise_level: 60
+    carrier_hz: 25000  bandwidth_hz: 5000
+    # frame-error model per rate (built-in defaults: ros_acomms tables)
+    rate_model { rate: 5 logistic { snr50_db: 4.22 width_db: 0.12 } }
+    rate_model { rate: 0 table { snr_db: [-9, -8, -7] frame_error: [1, 0.5, 0] } }
+    data_duration: 3.25  mini_duration: 1.0  ping_duration: 0.5
+    half_duplex: true  receiver_lock: true  decode_latency: 0  position_staleness: 60
+    seed: 1
+  }
+}
 """
 
 
@@ -86,3 +104,7 @@ def validate_config(config: Message) -> None:
                 f"no env_bounds for environment {pair.environment_id} "
                 f"(used by modem_tcp_port {pair.modem_tcp_port})"
             )
+    try:
+        environment_channel_configs(config)
+    except ValueError as exc:
+        raise ConfigError(f"invalid channel model: {exc}") from None

@@ -1,0 +1,107 @@
+"""A `ChannelConfig` (and seed) from the protobuf `netsim.protobuf.ChannelModelConfig`, which
+lives per environment in the manager configuration (``environment_channel``, pygoby-only)."""
+
+from __future__ import annotations
+
+import functools
+
+from google.protobuf.message import Message
+
+from pygoby.netsim.channel.absorption import francois_garrison, thorp
+from pygoby.netsim.channel.errors import (
+    DEFAULT_RATE_MODELS,
+    FrameErrorModel,
+    LogisticModel,
+    ProtocolModel,
+    RateErrorModels,
+    TableModel,
+    ThresholdModel,
+)
+from pygoby.netsim.channel.model import Band, ChannelConfig, PacketKind
+from pygoby.netsim.channel.soundspeed import mackenzie_1981
+from pygoby.protobuf import builtin_class
+
+
+def channel_settings_class() -> type[Message]:
+    return builtin_class(
+        "netsim/messages/manager_config.proto", "netsim.protobuf.ChannelModelConfig"
+    )
+
+
+def _rate_model(entry: Message) -> FrameErrorModel:
+    kind = entry.WhichOneof("model")
+    if kind == "table":
+        try:
+            return TableModel(tuple(entry.table.snr_db), tuple(entry.table.frame_error))
+        except ValueError as exc:
+            raise ValueError(f"rate {entry.rate}: {exc}") from None
+    if kind == "logistic":
+        return LogisticModel(entry.logistic.snr50_db, entry.logistic.width_db)
+    if kind == "threshold_db":
+        return ThresholdModel(entry.threshold_db)
+    raise ValueError(f"rate_model for rate {entry.rate} has no model")
+
+
+def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
+    """(ChannelConfig, seed) for a ChannelModelConfig message. Raises ValueError."""
+    water = settings.water if settings.HasField("water") else None
+    if water is not None:
+        sound_speed = functools.partial(mackenzie_1981, water.temperature, water.salinity)
+    else:
+        sound_speed = settings.sound_speed
+    if settings.absorption == settings.FRANCOIS_GARRISON:
+        w = settings.water  # defaults apply when unset
+        absorption = functools.partial(
+            francois_garrison, T=w.temperature, S=w.salinity, D=w.absorption_depth, pH=w.ph
+        )
+    else:
+        absorption = thorp
+    by_rate = dict(DEFAULT_RATE_MODELS)
+    by_rate.update({entry.rate: _rate_model(entry) for entry in settings.rate_model})
+    protocol = None
+    if settings.HasField("protocol_model"):
+        p = settings.protocol_model
+        protocol = ProtocolModel(
+            p.communication_range,
+            p.detection_range,
+            p.interference_range,
+            p.p_detection,
+            p.p_decoding,
+        )
+    config = ChannelConfig(
+        sound_speed=sound_speed,
+        source_level=settings.source_level,
+        spreading=settings.spreading,
+        absorption=absorption,
+        noise_level=settings.noise_level if settings.HasField("noise_level") else None,
+        shipping=settings.shipping,
+        wind=settings.wind_speed,
+        band=Band(settings.carrier_hz, settings.bandwidth_hz),
+        error_models=RateErrorModels(by_rate=by_rate),
+        durations={
+            PacketKind.DATA: settings.data_duration,
+            PacketKind.MINI: settings.mini_duration,
+            PacketKind.PING: settings.ping_duration,
+        },
+        half_duplex=settings.half_duplex,
+        receiver_lock=settings.receiver_lock,
+        decode_latency=settings.decode_latency,
+        position_staleness=settings.position_staleness,
+        protocol_model=protocol,
+    )
+    return config, settings.seed
+
+
+def environment_channel_configs(manager_config: Message) -> dict[int, tuple[ChannelConfig, int]]:
+    """(ChannelConfig, seed) per environment id of a NetSimManagerConfig; environments without
+    an `environment_channel` entry get the defaults. Raises ValueError."""
+    defaults = channel_config_from_proto(channel_settings_class()())
+    configs = {bounds.environment_id: defaults for bounds in manager_config.env_bounds}
+    for entry in manager_config.environment_channel:
+        if entry.environment_id not in configs:
+            raise ValueError(
+                f"environment_channel for environment {entry.environment_id}, "
+                "which has no env_bounds"
+            )
+        configs[entry.environment_id] = channel_config_from_proto(entry.channel)
+    return configs
