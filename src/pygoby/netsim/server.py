@@ -24,6 +24,7 @@ log = logging.getLogger(__name__)
 # Small reads plus a yield after each one give every connection its turn: a client flooding
 # the manager with garbage can only hold the event loop for one small chunk at a time.
 READ_SIZE = 4096
+CLOSE_TIMEOUT = 1.0  # s
 
 
 class ManagerServer:
@@ -78,8 +79,10 @@ class ManagerServer:
         finally:
             self._tasks.discard(task)
             writer.close()
-            with contextlib.suppress(ConnectionError, OSError):
-                await writer.wait_closed()
+            try:  # a peer that never reads could keep unsent answers pending forever
+                await asyncio.wait_for(writer.wait_closed(), CLOSE_TIMEOUT)
+            except (TimeoutError, ConnectionError, OSError):
+                writer.transport.abort()
             log.info("client disconnected: %s (%d bad lines)", peer, connection.errors)
 
 
