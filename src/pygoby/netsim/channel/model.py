@@ -15,6 +15,10 @@ API (what a modem emulator calls):
   HALF_DUPLEX (overlapped the receiver's own transmission). Lost ones are returned too, so the
   emulator can decide what a real modem would report.
 * ``channel.next_delivery()``: the earliest pending delivery time (for discrete-event loops).
+* ``pygoby.netsim.channel.stats.receive_statistics(reception, source_id=, dest_id=)``: the
+  Micro-Modem ``$CACST`` (ReceiveStatistics) to report for a reception (None if none).
+* ``pygoby.netsim.channel.settings.environment_channel_configs(manager_config)``:
+  ``{environment_id: (ChannelConfig, seed)}`` from the manager's TextFormat configuration.
 
 Per transmission (source A at t0) and every other node B with a fresh position in an
 overlapping band: range from A at t0 to B at arrival (B dead-reckoned, fixed-point solution),
