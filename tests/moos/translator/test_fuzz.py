@@ -28,7 +28,13 @@ TEST_MSG = "pygoby.test.translator.TestMsg"
 format_alphabet = st.sampled_from(list("0123456789abcdeABCDE=,{}%:.;-+ _xyn\x00é\n\"'\\"))
 structured_text = st.lists(format_alphabet, max_size=60).map("".join)
 any_text = st.one_of(st.text(max_size=80), structured_text)
-any_value = st.one_of(any_text, st.binary(max_size=80), st.floats(allow_nan=True))
+# Binary strings (decoded with surrogate escapes) after keys that land in string fields.
+binary_after_key = st.builds(
+    lambda key, tail: key + tail,
+    st.sampled_from([b"", b"string_default_optional=", b"string_default_repeat={", b"x=1,"]),
+    st.binary(max_size=40),
+)
+any_value = st.one_of(any_text, binary_after_key, st.floats(allow_nan=True))
 
 PARSE_FORMATS = [
     "%1%",
@@ -103,9 +109,9 @@ def all_techniques_translator(loader, Entry):
         f"""protobuf_name: "{TEST_MSG}"
         create {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS moos_var: "KV" }}
         create {{ technique: TECHNIQUE_FORMAT moos_var: "F" format: "{PARSE_FORMATS[4]}" }}
-        create {{ technique: TECHNIQUE_FORMAT moos_var: "G" format: "%1%"
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "G" format: "%14%;%1%"
                   algorithm {{ name: "angle_0_360" primary_field: 1 }}
-                  algorithm {{ name: "to_upper" primary_field: 1 }} }}
+                  algorithm {{ name: "to_upper" primary_field: 14 }} }}
         create {{ technique: TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT moos_var: "PB" }}""",
         Entry(),
     )

@@ -395,3 +395,18 @@ def test_moos_values_view():
     view = MoosValues(table)
     assert dict(view) == {"A": 1.5, "B": "x"}
     assert view.get("C") is None
+
+
+def test_invalid_utf8_for_a_string_field_creates_nothing(Entry, loader):
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{TEST_MSG}"
+        create {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS moos_var: "KV" }}""",
+    )
+    translator = Translator([e], loader.message_class)
+    with pytest.raises(
+        TranslatorError, match="string field string_default_optional is not valid UTF-8"
+    ):
+        translator.create(
+            TEST_MSG, {"KV": b"int32_default_optional=1,string_default_optional=\xff"}
+        )

@@ -108,7 +108,15 @@ def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
     if cpp == FieldDescriptor.CPPTYPE_BOOL:
         return as_bool(text)
     if cpp == FieldDescriptor.CPPTYPE_STRING:
-        return hex_decode(text) if is_bytes(field) else text
+        if is_bytes(field):
+            return hex_decode(text)
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError:
+            raise TranslatorError(
+                f"value for string field {field.name} is not valid UTF-8"
+            ) from None
+        return text
     if cpp == FieldDescriptor.CPPTYPE_FLOAT:
         return as_float(text)
     if cpp == FieldDescriptor.CPPTYPE_DOUBLE:
