@@ -1,9 +1,24 @@
 """MOOS <-> protobuf translator (goby3 MOOSTranslator), usable without MOOS.
 
-from pygoby.moos.translator import Translator, TranslatorRunner, entry_class
-translator = Translator(entries, loader.message_class, lat_origin=42.35, lon_origin=-70.95)
-msg = translator.create("pkg.Msg", {"NAV_X": 550.0, "NAME": "unicorn"})
-posts = translator.publish(msg)   # [Post(var, value: str | float | bytes, source_aux)]
+    from pygoby.moos.translator import Translator, TranslatorRunner, MoosValues, entry_class
+
+    translator = Translator(entries, loader.message_class,          # TranslatorEntry messages
+                            lat_origin=42.35, lon_origin=-70.95,     # UTM datum (0, 0 if unset)
+                            modem_ids=ModemIdLookup.from_file(path)) # or None
+    msg = translator.create("pkg.Msg", {"NAV_X": 550.0, "NAME": "unicorn"})  # TranslatorError
+    posts = translator.publish(msg)  # [Post(var, value: float | str | bytes, source_aux)]
+
+* MOOS values are float (double), str (string) or bytes (binary string); a Post with a float
+  value is a MOOS double, bytes a binary string. Posts are sorted by variable name.
+* Entry problems (unknown type or algorithm, bad FORMAT, duplicates) raise
+  TranslatorConfigError when the Translator is built; bad data raises TranslatorError from
+  create()/publish() and nothing partial is returned. Warnings (unknown keys, unknown enum
+  values) go to the "pygoby.moos.translator" logger.
+* TranslatorRunner(translator, start_time, multiplex_vars, variables=MoosValues(app.dynamic_vars))
+  is the trigger logic: subscriptions(), on_mail(var, value, stale=) and tick(now) return the
+  created messages; on_multiplex(value, technique) returns inverse-publish posts.
+* serialize_for_moos / parse_for_moos / post_for_moos: app-internal messages (default
+  `@PB[type] text`); moos_technique_from_config(common) picks the technique.
 """
 
 from pygoby.moos.translator.algorithms import AlgorithmRegistry, render_double
