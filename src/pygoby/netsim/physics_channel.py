@@ -1,0 +1,236 @@
+"""The Micro-Modem emulators' acoustic channel, backed by netsim's packet-level physics.
+
+`PhysicsChannel` implements the pluggable channel interface of `pygoby.acomms.mmsim.channel`
+(attach / detach / transmit / do_work) on top of the sans-I/O `pygoby.netsim.channel.Channel`:
+
+* every attached emulator is a node keyed by its modem TCP port (netsim's vehicle identity);
+  `ports` maps emulator names to ports, or an emulator named by its port ("62000") needs none;
+* positions are whatever the physics Channel knows: follow a NetSimManager with
+  ``manager.on_nav(physics.channel.on_environment_nav_update)``, or feed scripted tracks with
+  ``physics.channel.update_position(port, Position(...))``;
+* `transmit` registers the packet as a Transmission starting at the clock's now; `do_work`
+  polls the Channel at the clock's now and hands each reception to its receiver at its delivery
+  time (end of reception + decode latency) with the physics' outcome: all frames good, some
+  frames bad (the emulator reports those as BAD_CRC), or nothing at all (not detected, receiver
+  busy, half-duplex; a control packet — cycle-init, ACK, ping, mini-packet — with a bad frame);
+* `$CACST` numbers (SNR, SPL, Doppler, ...) come from `pygoby.netsim.channel.stats`;
+* a ping reply carries the true travel time: the mean of the two legs' one-way travel times, each
+  computed for the nodes' positions at the time (what the modem's `(round trip - TAT) / 2` gives);
+* every transmission and reception is reported to `on_event` as a dict (JSON-ready), which
+  `pygoby.netsim.eventlog` writes as the run's event log.
+
+Randomness is the Channel's own (seeded per transmission and receiver), so a run driven by a
+virtual clock repeats exactly for the same seed.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+from pygoby.acomms.mmsim.channel import AcousticPacket, ChannelEndpoint
+from pygoby.acomms.mmsim.channel import PacketKind as ModemPacketKind
+from pygoby.acomms.mmsim.channel import Reception as ModemReception
+from pygoby.netsim.channel import Channel, Outcome, PacketKind, Reception, Transmission
+from pygoby.netsim.channel.stats import receive_statistics
+from pygoby.util.clock import Clock
+
+log = logging.getLogger(__name__)
+
+EventSink = Callable[[dict], None]
+
+# What each emulator packet is on the water: the cycle-init, ACK and mini-packets are short FSK
+# packets; pings and their replies are ranging pulses.
+PHYSICAL_KIND = {
+    ModemPacketKind.DATA: PacketKind.DATA,
+    ModemPacketKind.CYCLE: PacketKind.MINI,
+    ModemPacketKind.ACK: PacketKind.MINI,
+    ModemPacketKind.MINI: PacketKind.MINI,
+    ModemPacketKind.PING: PacketKind.PING,
+    ModemPacketKind.PING_REPLY: PacketKind.PING,
+}
+
+# $CACST fields taken from the physics (the emulator fills the rest).
+STATS_FIELDS = (
+    "mfd_power", "mfd_ratio", "spl", "snr_rss", "snr_in", "snr_out", "snr_symbols",
+    "mse_equalizer", "data_quality_factor", "doppler", "stddev_noise", "carrier_freq", "bandwidth",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class _Sent:
+    """The payload of a Transmission: who sent which packet (and, for a ping reply, the
+    travel time of the ping it answers)."""
+
+    sender: ChannelEndpoint
+    packet: AcousticPacket
+    port: int
+    first_leg_owtt: float | None = None
+
+
+class PhysicsChannel:
+    def __init__(
+        self,
+        channel: Channel,
+        clock: Clock,
+        ports: Mapping[str, int] | None = None,
+        *,
+        control_rate: int = 0,
+        on_event: EventSink | None = None,
+    ) -> None:
+        """`control_rate`: the rate whose error model applies to cycle-inits, ACKs, pings and
+        mini-packets (FSK on a Micro-Modem, so rate 0 by default)."""
+        self.channel = channel
+        self.clock = clock
+        self.ports = dict(ports or {})
+        self.control_rate = control_rate
+        self.on_event = on_event
+        self._endpoints: dict[int, ChannelEndpoint] = {}
+        self._answering: tuple[int, float] | None = None  # (port, owtt) of a ping being heard
+
+    # -- the mmsim Channel interface -----------------------------------------------------------
+
+    def port_of(self, endpoint: ChannelEndpoint) -> int:
+        port = self.ports.get(endpoint.name)
+        if port is not None:
+            return port
+        try:
+            return int(endpoint.name)
+        except ValueError:
+            raise ValueError(
+                f"emulator {endpoint.name!r} has no modem port: name it by its port or list it "
+                "in PhysicsChannel(ports=...)"
+            ) from None
+
+    def attach(self, endpoint: ChannelEndpoint) -> None:
+        port = self.port_of(endpoint)
+        existing = self._endpoints.get(port)
+        if existing is not None and existing is not endpoint:
+            raise ValueError(f"modem port {port} already has an emulator ({existing.name})")
+        self._endpoints[port] = endpoint
+
+    def detach(self, endpoint: ChannelEndpoint) -> None:
+        port = self.port_of(endpoint)
+        if self._endpoints.get(port) is endpoint:
+            del self._endpoints[port]
+
+    def transmit(self, sender: ChannelEndpoint, packet: AcousticPacket) -> None:
+        port = self.port_of(sender)
+        first_leg = None
+        if packet.kind is ModemPacketKind.PING_REPLY and self._answering is not None:
+            answering_port, owtt = self._answering
+            if answering_port == port:
+                first_leg = owtt
+        data = packet.kind is ModemPacketKind.DATA
+        tx = Transmission(
+            source=port,
+            start=self.clock.now(),
+            rate=packet.rate if data else self.control_rate,
+            frames=max(1, len(packet.frames)) if data else 1,
+            kind=PHYSICAL_KIND[packet.kind],
+            dest=packet.dest,
+            payload=_Sent(sender, packet, port, first_leg),
+        )
+        planned = self.channel.transmit(tx)
+        if self.on_event is not None:
+            self.on_event(
+                {
+                    "event": "tx",
+                    "t": tx.start,
+                    "port": port,
+                    "src": packet.src,
+                    "dest": packet.dest,
+                    "kind": packet.kind.value,
+                    "rate": packet.rate,
+                    "frames": tx.frames,
+                    "duration": self.channel.duration_of(tx),
+                    "bytes": sum(len(f) for f in packet.frames),
+                    "receivers": len(planned),
+                }  # fmt: skip
+            )
+
+    def do_work(self) -> None:
+        for reception in self.channel.poll(self.clock.now()):
+            self._deliver(reception)
+
+    def next_event_time(self) -> float | None:
+        """When `do_work` next has something to deliver (for discrete-event loops)."""
+        return self.channel.next_delivery()
+
+    # -- delivery --------------------------------------------------------------------------------
+
+    def _deliver(self, r: Reception) -> None:
+        sent: _Sent = r.transmission.payload
+        packet = sent.packet
+        endpoint = self._endpoints.get(r.receiver)
+        delivered = endpoint is not None and self._heard(r, packet)
+        travel_time = r.owtt
+        if packet.kind is ModemPacketKind.PING_REPLY and sent.first_leg_owtt is not None:
+            travel_time = (sent.first_leg_owtt + r.owtt) / 2
+        if self.on_event is not None:
+            self._log_reception(r, sent, delivered, travel_time)
+        if not delivered:
+            return
+        assert endpoint is not None
+        reception = ModemReception(
+            arrival_time=r.arrival,
+            frame_ok=None if r.outcome is Outcome.GOOD else list(r.frames_ok),
+            travel_time=travel_time,
+            stats=self._stats(r, packet),
+        )
+        self._answering = (r.receiver, r.owtt) if packet.kind is ModemPacketKind.PING else None
+        try:
+            endpoint.receive(packet, reception)
+        finally:
+            self._answering = None
+
+    @staticmethod
+    def _heard(r: Reception, packet: AcousticPacket) -> bool:
+        if r.outcome is Outcome.GOOD:
+            return True
+        # A data packet with bad frames is reported frame by frame (BAD_CRC); a control packet
+        # with its only frame bad is never noticed by the host.
+        return r.outcome is Outcome.BAD_FRAMES and packet.kind is ModemPacketKind.DATA
+
+    def _stats(self, r: Reception, packet: AcousticPacket) -> dict[str, float]:
+        band = self.channel.config.band_of(r.receiver)
+        stat = receive_statistics(
+            r,
+            source_id=packet.src,
+            dest_id=packet.dest,
+            carrier_hz=band.carrier_hz,
+            bandwidth_hz=band.bandwidth_hz,
+        )
+        if stat is None:
+            return {}
+        return {name: getattr(stat, name) for name in STATS_FIELDS}
+
+    def _log_reception(self, r: Reception, sent: _Sent, delivered: bool, owtt: float) -> None:
+        assert self.on_event is not None
+        packet = sent.packet
+        snr = r.received_level - r.noise_level
+        self.on_event(
+            {
+                "event": "rx",
+                "t": r.deliver_at,
+                "tx_t": r.transmission.start,
+                "arrival": r.arrival,
+                "port": r.receiver,
+                "tx_port": sent.port,
+                "src": packet.src,
+                "dest": packet.dest,
+                "kind": packet.kind.value,
+                "rate": packet.rate,
+                "outcome": r.outcome.value,
+                "delivered": delivered,
+                "frames": r.transmission.frames,
+                "good_frames": r.good_frames,
+                "range_m": round(r.range_m, 3),
+                "owtt": round(owtt, 6),
+                "rl": round(r.received_level, 2),
+                "snr": round(snr, 2),
+                "sinr": round(r.sinr, 2),
+                "collision": r.sinr < snr - 0.01,
+            }  # fmt: skip
+        )
