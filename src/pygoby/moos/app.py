@@ -1,0 +1,525 @@
+"""GobyMOOSApp: the base class of pygoby's Goby MOOS applications (pTranslator, pAcommsHandler,
+iFrontSeat, ...), per spec goby-moos-apps.md section 2.
+
+Writing an application
+----------------------
+::
+
+    from pygoby.moos.app import GobyMOOSApp
+
+    class pExample(GobyMOOSApp):
+        # The configuration message: either a class, or (our .proto file, full message name)
+        # loaded with pygoby.protobuf.builtin_class. It must have `common` (field 1) of type
+        # goby.moos.protobuf.GobyMOOSAppConfig.
+        config_proto = ("goby/apps/moos/protobuf/example_config.proto",
+                        "goby.apps.moos.protobuf.pExampleConfig")
+        default_name = "pExample"          # used when argv[0] is not the program name
+
+        def __init__(self, cfg, **kwargs):
+            super().__init__(cfg, **kwargs)
+            self.subscribe("NAV_X", self.on_nav_x)            # handler(msg: MOOSMessage)
+            self.subscribe("DESIRED_SPEED", blackout=1.0)     # just keep self.dynamic_vars fresh
+            self.subscribe_pattern("IFS_*", "*", self.on_ifs)
+            self.register_timer(5.0, self.every_five_seconds)
+
+        def on_nav_x(self, msg):                # msg.value: float | str | bytes
+            self.publish("NAV_X_SEEN", msg.value)             # float -> D, str -> S, bytes -> B
+
+        def loop(self):                         # every 1/common.app_tick s while connected
+            self.publish("EXAMPLE_STATUS", f"gain={self.cfg.gain}")
+
+    if __name__ == "__main__":
+        raise SystemExit(pExample.main())      # `pExample mission.moos [AppName]`
+
+The base provides
+-----------------
+* `cls.main(argv=None) -> int`: the command line `APP [options] mission.moos [moos_name]`
+  (also `-c/--moos_file`, `-a/--moos_name`, `-e/--example_config`, `-V/--version`,
+  `--<field> <value>` for any top-level config field). A configuration error prints one
+  clear message naming the file line and the field and exits 1 before connecting.
+* `cls.from_mission(path, name=None, overrides=(), **kwargs)`: read the configuration and build
+  the app (what `main` does; handy in tests).
+* Construction: `App(cfg, name=..., mission=MissionFile|None, clock=None, host=None, port=None)`.
+  `host`/`port` default to `cfg.common.server_host`/`server_port` (filled from the
+  ServerHost/ServerPort globals), else 127.0.0.1:9000; `clock` defaults to MOOS time with
+  `common.time_warp_multiplier`.
+* Running: `await app.start()` / `await app.stop()`, or `async with app:`, or `await app.run()`
+  (until `app.request_stop()`). Mail is handled and `loop()` runs every 1/app_tick seconds
+  (warped); while disconnected `loop()` is not called (as CMOOSApp).
+* `subscribe(var, handler=None, blackout=0.0)`, `subscribe_pattern(var_pattern, app_pattern,
+  handler)`, `publish(var, value, src_aux="", time=None)` (queued while disconnected, sent on
+  reconnect), `register_timer(period, callback)` (fires on multiples of `period` since the
+  epoch, checked each tick), `dynamic_vars` (newest message per variable), `start_time`,
+  `log` (a logging.Logger; terminal at `common.verbosity`, file log per `common.log`),
+  `cfg` / `common`, `client` (the MOOSClient), `moos_time()`.
+* Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`.
+* Mail older than the app's start time is stored in `dynamic_vars` but not handed to the
+  subscription's handler (`ignore_stale = True`, Goby's rule; snapshots of old values
+  therefore do not trigger handlers). Pattern handlers always run.
+* On every (re)connect the client re-subscribes, then `common.initializer` entries are posted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import logging
+import math
+import os
+import resource
+import sys
+import time as _time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import ClassVar
+
+from google.protobuf.message import Message
+
+from pygoby.moos import protocol as p
+from pygoby.moos.appconfig import ConfigError, example_config, read_configuration
+from pygoby.moos.client import MOOSClient
+from pygoby.moos.moosfile import MissionFile
+from pygoby.moos.protocol import MOOSMessage
+from pygoby.moos.timewarp import clock_warp, moos_clock
+from pygoby.protobuf import builtin_class
+from pygoby.util.clock import Clock
+
+Handler = Callable[[MOOSMessage], None]
+
+STATUS_PERIOD = 2.0
+# goby.util.protobuf.GLogConfig.Verbosity -> logging level
+VERBOSITY_LEVELS = {1: logging.CRITICAL + 10, 2: logging.WARNING, 4: logging.INFO,
+                    5: logging.DEBUG, 6: logging.DEBUG, 7: logging.DEBUG}  # fmt: skip
+
+COMMON_PROTO = ("goby/moos/protobuf/goby_moos_app.proto", "goby.moos.protobuf.GobyMOOSAppConfig")
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("pygoby")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+class _Timer:
+    def __init__(self, period: float, callback: Callable[[], None], now: float) -> None:
+        self.period = period
+        self.callback = callback
+        self.next = (math.floor(now / period) + 1) * period
+
+    def due(self, now: float) -> bool:
+        if self.next - now > 2 * self.period:  # the clock jumped backwards
+            self.next = now + self.period
+        if now < self.next:
+            return False
+        self.next = (math.floor(now / self.period) + 1) * self.period
+        return True
+
+
+class GobyMOOSApp:
+    """Base class of Goby MOOS applications; see the module docstring for the subclass API."""
+
+    config_class: ClassVar[type[Message] | None] = None
+    config_proto: ClassVar[tuple[str, str] | None] = None
+    default_name: ClassVar[str] = ""
+    ignore_stale: ClassVar[bool] = True
+
+    # -- configuration -------------------------------------------------------------------------
+
+    @classmethod
+    def load_config_class(cls) -> type[Message]:
+        config_class = cls.config_class
+        if config_class is None:
+            if cls.config_proto is None:
+                raise TypeError(f"{cls.__name__} must set config_class or config_proto")
+            config_class = builtin_class(*cls.config_proto)
+        common = config_class.DESCRIPTOR.fields_by_name.get("common")
+        if common is None or common.message_type.full_name != COMMON_PROTO[1]:
+            raise TypeError(f"{config_class.DESCRIPTOR.full_name} needs a `common` field of type {COMMON_PROTO[1]}")
+        return config_class
+
+    @classmethod
+    def read_config(
+        cls, mission: MissionFile | None, name: str, overrides: Sequence[tuple[str, str]] = ()
+    ) -> Message:
+        return read_configuration(cls.load_config_class(), mission, name, overrides)
+
+    @classmethod
+    def from_mission(
+        cls, path: str | os.PathLike[str], name: str | None = None,
+        overrides: Sequence[tuple[str, str]] = (), **kwargs: object,
+    ) -> GobyMOOSApp:  # fmt: skip
+        app_name = name or cls.default_name or cls.__name__
+        mission = MissionFile.read(path)
+        cfg = cls.read_config(mission, app_name, overrides)
+        return cls(cfg, name=app_name, mission=mission, **kwargs)  # type: ignore[arg-type]
+
+    @classmethod
+    def example_config(cls, name: str | None = None) -> str:
+        return example_config(cls.load_config_class(), name or cls.default_name or cls.__name__)
+
+    # -- construction --------------------------------------------------------------------------
+
+    def __init__(
+        self,
+        cfg: Message,
+        *,
+        name: str | None = None,
+        mission: MissionFile | None = None,
+        clock: Clock | None = None,
+        host: str | None = None,
+        port: int | None = None,
+    ) -> None:
+        self.cfg = cfg
+        self.common = cfg.common  # type: ignore[attr-defined]
+        self.name = name or self.default_name or type(self).__name__
+        self.mission = mission
+        warp = float(self.common.time_warp_multiplier or 1)
+        self.clock = clock or moos_clock(warp)
+        if host is None:
+            host = self.common.server_host if self.common.HasField("server_host") else "127.0.0.1"
+        if port is None:
+            port = self.common.server_port if self.common.HasField("server_port") else p.DEFAULT_PORT
+        self.client = MOOSClient(self.name, host, port, clock=self.clock, on_message=self._on_mail)
+        self.client.on_connect.append(self._connected)
+        self.client.on_disconnect.append(self._disconnected)
+        self.log = logging.getLogger(f"pygoby.app.{self.name}")
+        self.start_time = self.clock.now()
+        self.dynamic_vars: dict[str, MOOSMessage] = {}
+        self._handlers: dict[str, list[Handler]] = {}
+        self._pattern_handlers: list[tuple[str, str, Handler]] = []
+        self._timers: list[_Timer] = []
+        self._mail: list[MOOSMessage] = []
+        self._published: set[str] = set()
+        self._task: asyncio.Task[None] | None = None
+        self._stop_requested: asyncio.Event | None = None
+        self._log_handlers: list[logging.Handler] = []
+        self._last_status = -math.inf
+        self._last_cpu = (_time.process_time(), _time.monotonic())
+        self.iterations = 0
+
+    # -- API for subclasses --------------------------------------------------------------------
+
+    def subscribe(self, var: str, handler: Handler | None = None, blackout: float = 0.0) -> None:
+        """Register for `var` (MOOS Register with interval `blackout`); `handler(msg)` is called
+        for each fresh message; without a handler only `dynamic_vars` is kept up to date."""
+        if handler is not None:
+            self._handlers.setdefault(var, []).append(handler)
+        self.client.subscribe(var, blackout)
+
+    def subscribe_pattern(self, var_pattern: str, app_pattern: str, handler: Handler) -> None:
+        self._pattern_handlers.append((var_pattern, app_pattern, handler))
+        self.client.subscribe_wildcard(var_pattern, app_pattern)
+
+    def publish(
+        self, var: str, value: p.Value, *, src_aux: str = "", time: float | None = None
+    ) -> None:
+        self._published.add(var)
+        self.client.publish(var, value, src_aux=src_aux, time=time)
+
+    def register_timer(self, period: float, callback: Callable[[], None]) -> None:
+        if period <= 0:
+            raise ValueError("timer period must be positive")
+        self._timers.append(_Timer(period, callback, self.clock.now()))
+
+    def moos_time(self) -> float:
+        return self.client.time()
+
+    def loop(self) -> None:
+        """Called every 1/app_tick seconds while connected. Override."""
+
+    def on_connect(self) -> None:
+        """Called after every (re)connection, after subscriptions and initializers."""
+
+    def on_disconnect(self) -> None:
+        """Called when the connection to the MOOSDB is lost."""
+
+    def on_start(self) -> None:
+        """Called once by start(), before connecting."""
+
+    def on_stop(self) -> None:
+        """Called once by stop()."""
+
+    @property
+    def connected(self) -> bool:
+        return self.client.connected
+
+    # -- running -------------------------------------------------------------------------------
+
+    async def start(self, connect_timeout: float | None = None) -> None:
+        """Start logging, the comms and the tick loop. With `connect_timeout`, wait for the
+        first connection (TimeoutError otherwise); without, carry on and keep trying."""
+        self._setup_logging()
+        self._stop_requested = asyncio.Event()
+        self.start_time = self.clock.now()
+        self.on_start()
+        self.client.start()
+        self._task = asyncio.create_task(self._tick_loop(), name=f"{self.name}-ticks")
+        if connect_timeout is not None:
+            await self.client.wait_connected(connect_timeout)
+
+    async def stop(self) -> None:
+        if self._task is not None:
+            self._task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await self._task
+            self._task = None
+            self.on_stop()
+        with contextlib.suppress(Exception):
+            await self.client.flush(timeout=1.0)
+        await self.client.close()
+        self._teardown_logging()
+
+    def request_stop(self) -> None:
+        if self._stop_requested is not None:
+            self._stop_requested.set()
+
+    async def run(self) -> None:
+        await self.start()
+        assert self._stop_requested is not None
+        try:
+            await self._stop_requested.wait()
+        finally:
+            await self.stop()
+
+    async def __aenter__(self) -> GobyMOOSApp:
+        await self.start(connect_timeout=5.0)
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        await self.stop()
+
+    # -- internals -----------------------------------------------------------------------------
+
+    def _on_mail(self, msg: MOOSMessage) -> None:
+        self._mail.append(msg)
+
+    def _connected(self) -> None:
+        self._post_initializers()
+        try:
+            self.on_connect()
+        except Exception:
+            self.log.exception("on_connect failed")
+
+    def _disconnected(self) -> None:
+        self.log.warning("lost the connection to the MOOSDB; reconnecting")
+        try:
+            self.on_disconnect()
+        except Exception:
+            self.log.exception("on_disconnect failed")
+
+    def _post_initializers(self) -> None:
+        kinds = type(self.common).Initializer
+        for ini in self.common.initializer:
+            if ini.HasField("global_cfg_var"):
+                raw = self.mission.get_value(ini.global_cfg_var) if self.mission else None
+                if raw is None:
+                    self.log.warning("initializer: global %s not found; %s not posted",
+                                     ini.global_cfg_var, ini.moos_var)  # fmt: skip
+                    continue
+                if ini.type == kinds.INI_DOUBLE:
+                    try:
+                        value: p.Value = float(raw)
+                    except ValueError:
+                        value = math.nan
+                else:
+                    value = raw.strip() if ini.trim else raw
+            elif ini.type == kinds.INI_DOUBLE:
+                value = ini.dval
+            else:
+                value = ini.sval.strip() if ini.trim else ini.sval
+            self.publish(ini.moos_var, value)
+
+    def _handle_mail(self) -> None:
+        mail, self._mail = self._mail, []
+        mail.sort(key=lambda m: m.time)  # CMOOSApp's SortMailByTime
+        for msg in mail:
+            if msg.msg_type != p.NOTIFY:
+                continue
+            self.dynamic_vars[msg.key] = msg
+            handlers = self._handlers.get(msg.key, ())
+            if handlers and self.ignore_stale and msg.time < self.start_time:
+                self.log.warning("ignoring stale message %s (time %.3f before the app started)",
+                                 msg.key, msg.time)  # fmt: skip
+            else:
+                for handler in handlers:
+                    self._call(handler, msg)
+            for var_pattern, app_pattern, handler in self._pattern_handlers:
+                if p.wildcard_match(var_pattern, msg.key) and p.wildcard_match(app_pattern, msg.src):
+                    self._call(handler, msg)
+
+    def _call(self, handler: Handler, msg: MOOSMessage) -> None:
+        try:
+            handler(msg)
+        except Exception:
+            self.log.exception("handler for %s failed", msg.key)
+
+    async def _tick_loop(self) -> None:
+        loop = asyncio.get_running_loop()
+        warp = clock_warp(self.clock)
+        app_tick = self.common.app_tick
+        period = (1.0 / app_tick / warp) if app_tick > 0 else 0.0
+        next_tick = loop.time()
+        while True:
+            next_tick += period
+            await asyncio.sleep(max(next_tick - loop.time(), 0.0))
+            if loop.time() - next_tick > 10 * max(period, 0.001):
+                next_tick = loop.time()  # fell far behind: do not try to catch up
+            self._handle_mail()
+            if not self.client.connected:
+                continue
+            self._post_status()
+            try:
+                self.loop()
+            except Exception:
+                self.log.exception("loop() failed")
+            self.iterations += 1
+            now = self.clock.now()
+            for timer in self._timers:
+                if timer.due(now):
+                    try:
+                        timer.callback()
+                    except Exception:
+                        self.log.exception("timer callback failed")
+
+    def _post_status(self) -> None:
+        now = self.clock.now()
+        if now - self._last_status < STATUS_PERIOD:
+            return
+        self._last_status = now
+        usage = resource.getrusage(resource.RUSAGE_SELF)
+        cpu_now, wall_now = _time.process_time(), _time.monotonic()
+        cpu = 100.0 * (cpu_now - self._last_cpu[0]) / max(wall_now - self._last_cpu[1], 1e-6)
+        self._last_cpu = (cpu_now, wall_now)
+        subscribed = "".join(f"{v}," for v in sorted(self.client.subscriptions))
+        published = "".join(f"{v}," for v in sorted(self._published))
+        status = (f"AppErrorFlag=false,Uptime={now - self.start_time:g},cpuload={cpu:.4g},"
+                  f"memory_kb={usage.ru_maxrss},memory_max_kb={usage.ru_maxrss:.4g},"
+                  f'MOOSName={self.name},Publishing="{published}",Subscribing="{subscribed}"')  # fmt: skip
+        self.client.publish(f"{self.name.upper()}_STATUS", status)
+
+    # -- logging (spec 2.8) --------------------------------------------------------------------
+
+    def _setup_logging(self) -> None:
+        common = self.common
+        self.log.setLevel(logging.DEBUG)
+        self.log.propagate = False
+        terminal = logging.StreamHandler(sys.stdout)
+        terminal.setLevel(VERBOSITY_LEVELS.get(common.verbosity, logging.INFO))
+        terminal.setFormatter(logging.Formatter(f"{self.name} [%(asctime)s]: %(message)s"))
+        self._log_handlers.append(terminal)
+        if common.log:
+            path = self._open_log_file()
+            if path is not None:
+                handler = logging.FileHandler(path)
+                handler.setLevel(VERBOSITY_LEVELS.get(common.log_verbosity, logging.DEBUG))
+                handler.setFormatter(logging.Formatter("[ %(asctime)s ] {%(levelname)s}: %(message)s"))
+                self._log_handlers.append(handler)
+        for handler in self._log_handlers:
+            self.log.addHandler(handler)
+            logging.getLogger("pygoby.moos").addHandler(handler)
+
+    def _open_log_file(self) -> Path | None:
+        common = self.common
+        base = f"{self.name.replace('/', '_')}_{common.community}"
+        stamp = "" if common.log_omit_file_timestamp else "_" + _time.strftime("%Y%m%dT%H%M%S", _time.gmtime())
+        for directory in (Path(common.log_path), Path(".")):
+            path = directory / f"{base}{stamp}.txt"
+            try:
+                path.touch()
+            except OSError:
+                self.log.warning("cannot write a log file in %s; trying ./", directory)
+                continue
+            if not common.log_omit_latest_symlink and stamp:
+                latest = directory / f"{base}_latest.txt"
+                with contextlib.suppress(OSError):
+                    latest.unlink(missing_ok=True)
+                    latest.symlink_to(path.name)
+            return path
+        raise ConfigError(f"cannot open a log file in {common.log_path} or ./")
+
+    def _teardown_logging(self) -> None:
+        for handler in self._log_handlers:
+            self.log.removeHandler(handler)
+            logging.getLogger("pygoby.moos").removeHandler(handler)
+            handler.close()
+        self._log_handlers = []
+
+    # -- command line (spec 2.1) ---------------------------------------------------------------
+
+    @classmethod
+    def _program_name(cls, argv0: str) -> str:
+        base = Path(argv0).name
+        if not base or base.endswith(".py") or base in ("python", "python3", "-c"):
+            return cls.default_name or cls.__name__
+        return base
+
+    @classmethod
+    def main(cls, argv: Sequence[str] | None = None, prog: str | None = None) -> int:
+        """Run the app from the command line; returns the exit status."""
+        args_in = list(sys.argv[1:] if argv is None else argv)
+        program = prog or cls._program_name(sys.argv[0] if argv is None else "")
+        parser = argparse.ArgumentParser(prog=program, description=f"{program}: a Goby MOOS application")
+        parser.add_argument("mission", nargs="?", help=".moos mission file")
+        parser.add_argument("alias", nargs="?", help="name to use with the MOOSDB and ProcessConfig")
+        parser.add_argument("-c", "--moos_file", help="same as the mission positional")
+        parser.add_argument("-a", "--moos_name", help="same as the alias positional")
+        parser.add_argument("-e", "--example_config", action="store_true", help="print an example ProcessConfig block and exit")
+        parser.add_argument("-V", "--version", action="version", version=f"%(prog)s {_version()}")
+        known, rest = parser.parse_known_args(args_in)
+        name = known.moos_name or known.alias or program
+        if known.example_config:
+            sys.stdout.write(cls.example_config(name))
+            return 0
+        try:
+            overrides = _parse_overrides(rest)
+        except ValueError as err:
+            parser.error(str(err))
+        mission_path = known.moos_file or known.mission
+        mission = None
+        if mission_path:
+            try:
+                mission = MissionFile.read(mission_path)
+            except OSError as err:
+                print(f"{name}: warning: cannot open mission file {mission_path}: {err.strerror}", file=sys.stderr)
+        try:
+            cfg = cls.read_config(mission, name, overrides)
+            app = cls(cfg, name=name, mission=mission)
+        except ConfigError as err:
+            print(f"{name}: fatal configuration error: {err}", file=sys.stderr)
+            return 1
+        return _run_until_signal(app)
+
+
+def _parse_overrides(rest: list[str]) -> list[tuple[str, str]]:
+    out = []
+    items = iter(rest)
+    for item in items:
+        if not item.startswith("--"):
+            raise ValueError(f"unexpected argument {item!r}")
+        key, eq, value = item[2:].partition("=")
+        if not eq:
+            value = next(items, None)
+            if value is None:
+                raise ValueError(f"option --{key} needs a value")
+        out.append((key, value))
+    return out
+
+
+def _run_until_signal(app: GobyMOOSApp) -> int:
+    import signal
+
+    async def runner() -> None:
+        loop = asyncio.get_running_loop()
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            loop.add_signal_handler(sig, app.request_stop)
+        await app.run()
+
+    try:
+        asyncio.run(runner())
+    except KeyboardInterrupt:
+        return 130
+    return 0

@@ -1,0 +1,280 @@
+"""Goby MOOS application configuration (spec goby-moos-apps.md 2.2-2.5), sans I/O.
+
+* `read_configuration(config_class, mission, app_name, overrides)`: the app's ProcessConfig block
+  parsed as protobuf TextFormat (errors name the file line and the field), then the MOOS globals
+  named by `(goby.field).moos_global` options, then command-line overrides, then the check for
+  required fields.
+* `example_config(config_class, app_name)`: the `--example_config` text.
+* `goby_field_options(field)`: a field's `(goby.field)` options (description, example,
+  moos_global, cfg.action), read from its serialized options so that it works for classes from
+  any descriptor pool.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from collections.abc import Sequence
+
+from google.protobuf import text_format
+from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.message import Message
+
+from pygoby.moos.moosfile import MissionFile
+from pygoby.protobuf import builtin_class
+
+GOBY_FIELD_EXTENSION = 1009
+EXAMPLE_WIDTH = 66
+EXAMPLE_MIN_WIDTH = 20
+EXAMPLE_FALLBACK_INDENT = 46
+
+
+class ConfigError(Exception):
+    """The configuration could not be read; the message says where and why."""
+
+
+@functools.cache
+def _options_class() -> type[Message]:
+    return builtin_class("goby/protobuf/option_extensions.proto", "goby.GobyFieldOptions")
+
+
+def _varint(data: bytes, pos: int) -> tuple[int, int]:
+    result = shift = 0
+    while True:
+        byte = data[pos]
+        pos += 1
+        result |= (byte & 0x7F) << shift
+        shift += 7
+        if not byte & 0x80:
+            return result, pos
+
+
+def goby_field_options(field: FieldDescriptor) -> Message:
+    """The field's `(goby.field)` options (an empty GobyFieldOptions if it has none)."""
+    out = _options_class()()
+    if not field.has_options:
+        return out
+    data = field.GetOptions().SerializeToString()
+    pos = 0
+    while pos < len(data):
+        tag, pos = _varint(data, pos)
+        number, wire = tag >> 3, tag & 7
+        if wire == 0:
+            _, pos = _varint(data, pos)
+        elif wire == 1:
+            pos += 8
+        elif wire == 5:
+            pos += 4
+        elif wire == 2:
+            size, pos = _varint(data, pos)
+            if number == GOBY_FIELD_EXTENSION:
+                out.MergeFromString(data[pos : pos + size])
+            pos += size
+        else:
+            break
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Reading
+
+
+def _field_near(line_text: str, column: int) -> str | None:
+    names = re.findall(r"([A-Za-z_][\w.]*|\[[\w.]+\])\s*[:{]", line_text[: max(column, 1)])
+    return names[-1] if names else None
+
+
+def parse_block(config: Message, text: str, first_line: int, source: str) -> None:
+    """Merge TextFormat `text` into `config`; errors give the file line and the field."""
+    try:
+        text_format.Merge(text, config)
+    except text_format.ParseError as err:
+        line, column = err.GetLine(), err.GetColumn()
+        if line is None:
+            raise ConfigError(f"{source}: {err}") from None
+        lines = text.splitlines()
+        line_text = lines[line - 1] if 0 < line <= len(lines) else ""
+        detail = str(err).split(" : ", 1)[-1]
+        quoted = f"'{line_text}': "
+        if detail.startswith(quoted):
+            detail = detail[len(quoted) :]
+        field = _field_near(line_text, column or 0)
+        where = f' in field "{field}"' if field and field not in detail else ""
+        raise ConfigError(
+            f"{source}:{first_line + line - 1}: {detail}{where}\n    {line_text.strip()}"
+        ) from None
+
+
+def apply_moos_globals(config: Message, mission: MissionFile) -> None:
+    """Set every non-repeated, non-oneof field that names a MOOS global found in the mission
+    file (recursively through non-repeated sub-messages); the global wins over the block."""
+    for field in config.DESCRIPTOR.fields:
+        if field.is_repeated or field.containing_oneof is not None:
+            continue
+        if field.type == FieldDescriptor.TYPE_MESSAGE:
+            had = config.HasField(field.name)
+            sub = getattr(config, field.name)
+            apply_moos_globals(sub, mission)
+            if not had and not sub.ListFields():
+                config.ClearField(field.name)
+            continue
+        name = goby_field_options(field).moos_global
+        if not name:
+            continue
+        value = mission.get_value(name)
+        if value is None:
+            continue
+        _set_from_global(config, field, name, value, mission)
+
+
+def _set_from_global(
+    config: Message, field: FieldDescriptor, name: str, value: str, mission: MissionFile
+) -> None:
+    kind = field.type
+    if kind == FieldDescriptor.TYPE_STRING:
+        setattr(config, field.name, value)
+    elif kind == FieldDescriptor.TYPE_BOOL:
+        if value.upper() in ("TRUE", "FALSE"):
+            setattr(config, field.name, value.upper() == "TRUE")
+        elif (number := mission.get_float(name)) is not None:
+            setattr(config, field.name, number > 0)
+    elif kind == FieldDescriptor.TYPE_ENUM:
+        enum_value = field.enum_type.values_by_name.get(value)
+        if enum_value is None:
+            raise ConfigError(f'invalid enumeration "{value}" for {field.name} (MOOS global {name})')
+        setattr(config, field.name, enum_value.number)
+    elif kind in (FieldDescriptor.TYPE_DOUBLE, FieldDescriptor.TYPE_FLOAT):
+        if (number := mission.get_float(name)) is not None:
+            setattr(config, field.name, number)
+    elif (number := mission.get_float(name)) is not None:
+        try:
+            setattr(config, field.name, int(number))
+        except ValueError:
+            raise ConfigError(f"MOOS global {name}={value} is out of range for {field.name}") from None
+
+
+def apply_overrides(config: Message, overrides: Sequence[tuple[str, str]]) -> None:
+    """`--field value` pairs for top-level fields; message fields take TextFormat text."""
+    for name, value in overrides:
+        field = config.DESCRIPTOR.fields_by_name.get(name)
+        if field is None:
+            raise ConfigError(f"unknown option --{name}")
+        if field.type == FieldDescriptor.TYPE_MESSAGE:
+            text = f"{name} {{ {value} }}"
+        elif field.type == FieldDescriptor.TYPE_STRING:
+            text = f"{name}: {_quote(value)}"
+        else:
+            text = f"{name}: {value}"
+        if not field.is_repeated:
+            config.ClearField(name)
+        parse_block(config, text, 1, f"command line --{name}")
+
+
+def _quote(value: str) -> str:
+    return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def read_configuration(
+    config_class: type[Message],
+    mission: MissionFile | None,
+    app_name: str,
+    overrides: Sequence[tuple[str, str]] = (),
+) -> Message:
+    config = config_class()
+    source = str(mission.path) if mission is not None and mission.path else "mission file"
+    if mission is not None:
+        block = mission.goby_block(app_name)
+        if block is None:
+            raise ConfigError(f"no ProcessConfig block for {app_name} in {source}")
+        parse_block(config, block.text, block.first_line, source)
+        apply_moos_globals(config, mission)
+    apply_overrides(config, overrides)
+    missing = config.FindInitializationErrors()
+    if missing:
+        raise ConfigError(f"missing required configuration fields: {', '.join(missing)}")
+    return config
+
+
+# ---------------------------------------------------------------------------------------------
+# --example_config
+
+
+def _format_scalar(field: FieldDescriptor, value: object) -> str:
+    if field.type == FieldDescriptor.TYPE_ENUM:
+        return field.enum_type.values_by_number[value].name  # type: ignore[index]
+    if field.type == FieldDescriptor.TYPE_BOOL:
+        return "true" if value else "false"
+    if field.type in (FieldDescriptor.TYPE_STRING, FieldDescriptor.TYPE_BYTES):
+        raw = value.decode("latin-1") if isinstance(value, bytes) else str(value)
+        return _quote(raw)
+    if isinstance(value, float):
+        text = repr(value)
+        return text[:-2] if text.endswith(".0") else text
+    return str(value)
+
+
+def _label(field: FieldDescriptor) -> str:
+    if field.is_repeated:
+        return " (repeated)"
+    return " (required)" if field.is_required else " (optional)"
+
+
+def _wrap(prefix: str, comment: str) -> list[str]:
+    width = EXAMPLE_WIDTH - len(prefix)
+    if width < EXAMPLE_MIN_WIDTH:
+        lead, width = " " * EXAMPLE_FALLBACK_INDENT, EXAMPLE_WIDTH - EXAMPLE_FALLBACK_INDENT
+        head, pieces = [prefix.rstrip()], _wrap_words(comment, width)
+        return head + [lead + piece for piece in pieces]
+    pieces = _wrap_words(comment, width)
+    return [prefix + pieces[0]] + [" " * len(prefix) + piece for piece in pieces[1:]]
+
+
+def _wrap_words(comment: str, width: int) -> list[str]:
+    words = comment.split(" ")
+    lines: list[str] = []
+    current = ""
+    for word in words:
+        if current and len(current) + 1 + len(word) > width:
+            lines.append(current + " ")
+            current = "# " + word
+        else:
+            current = f"{current} {word}" if current else word
+    lines.append(current)
+    return lines
+
+
+def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
+    out: list[str] = []
+    indent = "  " * depth
+    for field in descriptor.fields:
+        opts = goby_field_options(field)
+        if opts.HasField("cfg") and opts.cfg.action != opts.cfg.ALWAYS:
+            continue
+        comment = "# " + opts.description
+        if field.type == FieldDescriptor.TYPE_MESSAGE:
+            out.extend(_wrap(f"{indent}{field.name} {{  ", comment + _label(field)))
+            out.extend(_describe_fields(field.message_type, depth + 1))
+            out.append(f"{indent}}}")
+            continue
+        if field.has_default_value:
+            value = _format_scalar(field, field.default_value)
+        elif opts.HasField("example"):
+            value = _quote(opts.example) if field.type == FieldDescriptor.TYPE_STRING else opts.example
+        elif field.type == FieldDescriptor.TYPE_STRING:
+            value = '""'
+        else:
+            value = ""
+        if field.type == FieldDescriptor.TYPE_ENUM:
+            comment += " (" + ", ".join(v.name for v in field.enum_type.values) + ")"
+        comment += _label(field)
+        if field.has_default_value:
+            comment += f" (default={_format_scalar(field, field.default_value)})"
+        if opts.moos_global:
+            comment += f' (can also set MOOS global "{opts.moos_global}=")'
+        out.extend(_wrap(f"{indent}{field.name}: {value}  ", comment))
+    return out
+
+
+def example_config(config_class: type[Message], app_name: str) -> str:
+    lines = [f"ProcessConfig = {app_name}", "{", *_describe_fields(config_class.DESCRIPTOR, 1), "}"]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,210 @@
+"""GobyMOOSApp: configuration (TextFormat block, globals, errors, --example_config), initializers,
+mail handling, ticks, timers and the command line, against the embedded MOOSDB."""
+
+from __future__ import annotations
+
+import asyncio
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from pygoby.moos.app import GobyMOOSApp
+from pygoby.moos.appconfig import ConfigError
+from pygoby.moos.client import MOOSClient
+from pygoby.moos.db import MOOSDB
+from pygoby.moos.moosfile import MissionFile
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from example_app import pTestApp  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+
+
+def _mission(port: int, block: str, extra: str = "") -> str:
+    return f"""\
+ServerHost = localhost
+ServerPort = {port}
+Community  = alpha
+LatOrigin  = 42.35
+VehicleName = ship one
+{extra}
+ProcessConfig = pTestApp
+{{
+{block}
+}}
+"""
+
+
+BLOCK = """\
+  common {
+    log: false
+    app_tick: 20
+    verbosity: QUIET
+    lat_origin: 1.0   // the LatOrigin global wins (goby quirk Q2)
+    initializer { type: INI_DOUBLE  moos_var: "LAT_ORIGIN"  global_cfg_var: "LatOrigin" }
+    initializer { type: INI_STRING  moos_var: "VEHICLE"  global_cfg_var: "VehicleName" }
+    initializer { type: INI_STRING  moos_var: "GREETING"  sval: "  hi  " }
+    initializer { type: INI_DOUBLE  moos_var: "CONST"  dval: 2.5 }
+    initializer { type: INI_DOUBLE  moos_var: "NEVER"  global_cfg_var: "NoSuchGlobal" }
+  }
+  gain: 2
+  out_var: "ECHO"
+"""
+
+
+def test_configuration_globals_and_defaults():
+    mission = MissionFile.from_text(_mission(9123, BLOCK))
+    cfg = pTestApp.read_config(mission, "pTestApp")
+    assert cfg.common.lat_origin == 42.35
+    assert cfg.common.community == "alpha"
+    assert cfg.common.server_port == 9123 and cfg.common.server_host == "localhost"
+    assert not cfg.common.HasField("lon_origin")
+    assert cfg.gain == 2.0 and cfg.mode == cfg.SLOW
+    assert cfg.common.app_tick == 20 and cfg.common.comm_tick == 10
+
+
+def test_parse_error_names_line_and_field(tmp_path):
+    text = _mission(9000, "  common { log: false }\n  gain: fast\n  out_var: \"X\"")
+    path = tmp_path / "m.moos"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as err:
+        pTestApp.read_config(MissionFile.read(path), "pTestApp")
+    line = text.splitlines().index("  gain: fast") + 1
+    assert f"m.moos:{line}:" in str(err.value) and "gain" in str(err.value)
+    with pytest.raises(ConfigError, match='no field named "AppTick"'):
+        pTestApp.read_config(MissionFile.from_text(_mission(9000, "  AppTick = 4")), "pTestApp")
+    with pytest.raises(ConfigError, match="no ProcessConfig block for pOther"):
+        pTestApp.read_config(MissionFile.from_text(_mission(9000, BLOCK)), "pOther")
+    with pytest.raises(ConfigError, match="out_var"):
+        pTestApp.read_config(MissionFile.from_text(_mission(9000, "  gain: 1")), "pTestApp")
+
+
+def test_enum_global_must_be_a_value_name():
+    mission = MissionFile.from_text(_mission(9000, BLOCK, "moos_parser_technique = NOPE"))
+    with pytest.raises(ConfigError, match="invalid enumeration"):
+        pTestApp.read_config(mission, "pTestApp")
+
+
+def test_main_stops_on_config_error_before_connecting(tmp_path, capsys):
+    path = tmp_path / "m.moos"
+    path.write_text(_mission(1, "  common { app_tick: many }\n  out_var: \"X\""))
+    assert pTestApp.main([str(path)], prog="pTestApp") == 1
+    err = capsys.readouterr().err
+    assert "fatal configuration error" in err and 'field "app_tick"' in err and "m.moos:9:" in err
+
+
+def test_example_config():
+    text = pTestApp.example_config("pTestApp")
+    lines = text.splitlines()
+    assert lines[:2] == ["ProcessConfig = pTestApp", "{"] and lines[-1] == "}"
+    assert lines[2].startswith("  common {  # Configuration common")
+    assert "    log: true  # Should we write a text log of the terminal " in lines
+    assert any("(default=true) (can also set " in ln for ln in lines)
+    assert '    community: "AUV23"  # The vehicle\'s name (optional) (can also ' in lines
+    assert "  mode: SLOW  #  (FAST, SLOW) (optional) (default=SLOW)" in lines
+    assert any(ln.startswith('  out_var: "OUT"  # Variable to publish (required)') for ln in lines)
+    assert "hidden" not in text  # cfg.action NEVER
+    assert "(INI_DOUBLE, " in text and "(repeated)" in text
+    # the example parses back as a configuration (once the enum without a value gets one)
+    body = "\n".join(lines[2:-1]).replace("type:   #", "type: INI_DOUBLE  #")
+    pTestApp.read_config(MissionFile.from_text(f"ProcessConfig = pTestApp\n{{\n{body}\n}}"), "pTestApp")
+
+
+async def _wait_for(cond, timeout=3.0):
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + timeout
+    while not cond():
+        assert loop.time() < deadline, "condition not met in time"
+        await asyncio.sleep(0.02)
+
+
+async def test_app_runs_against_embedded_db():
+    async with MOOSDB(port=0, community="alpha") as db, MOOSClient("tester", port=db.port) as tester:
+        tester.publish("NAV_X", 100.0)  # written before the app starts: stale for it
+        await tester.flush()
+        mission = MissionFile.from_text(_mission(db.port, BLOCK))
+        cfg = pTestApp.read_config(mission, "pTestApp")
+        await asyncio.sleep(0.02)
+        app = pTestApp(cfg, name="pTestApp", mission=mission)
+        async with app:
+            for var in ("ECHO", "LAT_ORIGIN", "VEHICLE", "GREETING", "CONST", "NEVER", "PTESTAPP_STATUS"):
+                tester.subscribe(var)
+            got: dict[str, list] = {}
+
+            async def collect(*keys):
+                while not set(keys) <= set(got):
+                    msg = await tester.receive(3)
+                    got.setdefault(msg.key, []).append(msg.value)
+
+            await collect("LAT_ORIGIN", "VEHICLE", "GREETING", "CONST")
+            assert got["LAT_ORIGIN"] == [42.35] and got["VEHICLE"] == ["shipone"]
+            assert got["GREETING"] == ["hi"] and got["CONST"] == [2.5]
+            await _wait_for(lambda: "NAV_X" in app.dynamic_vars)
+            assert app.seen == []  # the snapshot of NAV_X predates the app: not handled
+            tester.publish("NAV_X", 3.0)
+            tester.publish("PAT_A", "p")
+            await collect("ECHO")
+            assert got["ECHO"] == [6.0] and app.seen == [3.0]
+            await _wait_for(lambda: app.pattern_seen and app.timer_fired >= 1 and app.ticks >= 5)
+            assert app.pattern_seen[0].key == "PAT_A"
+            await collect("PTESTAPP_STATUS")
+            assert "MOOSName=pTestApp" in got["PTESTAPP_STATUS"][0]
+            assert "NEVER" not in got
+
+
+async def test_app_reconnects_reposts_initializers_and_keeps_queued_posts():
+    db = MOOSDB(port=0)
+    await db.start()
+    port = db.port
+    mission = MissionFile.from_text(_mission(port, BLOCK))
+    app = pTestApp(pTestApp.read_config(mission, "pTestApp"), name="pTestApp", mission=mission)
+    await app.start(connect_timeout=3)
+    await db.stop()
+    await _wait_for(lambda: not app.connected)
+    app.publish("WHILE_AWAY", 1.0)
+    db = MOOSDB(port=port)
+    await db.start()
+    try:
+        async with MOOSClient("tester", port=port) as tester:
+            await app.client.wait_connected(2.0)
+            tester.subscribe("WHILE_AWAY")
+            tester.subscribe("CONST")
+            keys = {(await tester.receive(3)).key for _ in range(2)}
+            assert keys == {"WHILE_AWAY", "CONST"}
+            tester.publish("NAV_X", 1.0)  # the app re-subscribed
+            await _wait_for(lambda: app.seen == [1.0])
+    finally:
+        await app.stop()
+        await db.stop()
+
+
+async def test_command_line_and_example_config_as_a_program(tmp_path):
+    script = HERE / "example_app.py"
+    shown = subprocess.run([sys.executable, str(script), "--example_config"], capture_output=True,
+                           text=True, timeout=30)  # fmt: skip
+    assert shown.returncode == 0 and shown.stdout.startswith("ProcessConfig = pTestApp\n{\n")
+    async with MOOSDB(port=0) as db, MOOSClient("tester", port=db.port) as tester:
+        block = BLOCK.replace("pTestApp", "pAlias")
+        path = tmp_path / "m.moos"
+        path.write_text(_mission(db.port, block).replace("ProcessConfig = pTestApp", "ProcessConfig = pAlias"))
+        tester.subscribe("ECHO")
+        proc = await asyncio.create_subprocess_exec(sys.executable, str(script), str(path), "pAlias")
+        try:
+            await _wait_for(lambda: "pAlias" in db.client_names, timeout=10)
+            await asyncio.sleep(0.3)
+            tester.publish("NAV_X", 5.0)
+            msg = await tester.receive(5)
+            assert (msg.key, msg.value, msg.src) == ("ECHO", 10.0, "pAlias")
+        finally:
+            proc.terminate()
+            assert await asyncio.wait_for(proc.wait(), 10) == 0
+
+
+def test_subclass_without_config_is_an_error():
+    class Bare(GobyMOOSApp):
+        pass
+
+    with pytest.raises(TypeError, match="config_class or config_proto"):
+        Bare.load_config_class()
