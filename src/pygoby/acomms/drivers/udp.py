@@ -1,0 +1,127 @@
+"""UDP driver (DRIVER_UDP, spec acomms.md §8.1-8.2): one datagram = one binary ModemTransmission.
+
+Wire-compatible with goby3's UDPDriver: no header or checksum, immediate ACK datagrams naming
+the Goby frame numbers (`frame_start` from a running counter). The socket is non-blocking and
+read in `do_work()`.
+"""
+
+from __future__ import annotations
+
+import logging
+import socket
+
+from google.protobuf.message import DecodeError
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+
+log = logging.getLogger(__name__)
+
+MAX_DATAGRAM = 65507
+Status = m.ModemDriverStatus
+
+
+class UDPDriver(ModemDriverBase):
+    def __init__(self, clock=None) -> None:
+        super().__init__(clock)
+        self.udp_cfg = m.UDPConfig()
+        self._sock: socket.socket | None = None
+        self._remotes: dict[int, list[tuple[str, int]]] = {}
+        self._ack_ids: set[int] = set()
+        self._frame_counter = 0
+
+    @property
+    def local_port(self) -> int:
+        assert self._sock is not None
+        return self._sock.getsockname()[1]
+
+    def startup(self, cfg) -> None:
+        if not cfg.HasField("modem_id"):
+            raise ModemDriverException("modem_id is required", Status.INVALID_CONFIGURATION)
+        self.cfg = cfg
+        self.udp_cfg = cfg.Extensions[m.UDP_CONFIG]
+        if not self.udp_cfg.HasField("local"):
+            raise ModemDriverException("UDP config needs local", Status.INVALID_CONFIGURATION)
+        family = socket.AF_INET6 if self.udp_cfg.ipv6 else socket.AF_INET
+        sock = socket.socket(family, socket.SOCK_DGRAM)
+        try:
+            sock.bind(("::" if self.udp_cfg.ipv6 else "0.0.0.0", self.udp_cfg.local.port))
+        except OSError as exc:
+            sock.close()
+            raise ModemDriverException(str(exc), Status.STARTUP_FAILED) from exc
+        sock.setblocking(False)
+        self._sock = sock
+        self._remotes = {}
+        for remote in self.udp_cfg.remote:
+            try:
+                info = socket.getaddrinfo(remote.ip, remote.port, family, socket.SOCK_DGRAM)
+            except OSError as exc:
+                raise ModemDriverException(
+                    f"cannot resolve {remote.ip}: {exc}", Status.INVALID_CONFIGURATION
+                ) from exc
+            self._remotes.setdefault(remote.modem_id, []).append(info[0][4][:2])
+        self._ack_ids = {cfg.modem_id, *self.udp_cfg.additional_application_ack_modem_id}
+
+    def shutdown(self) -> None:
+        if self._sock is not None:
+            self._sock.close()
+            self._sock = None
+
+    def handle_initiate_transmission(self, transmission) -> None:
+        msg = m.ModemTransmission()
+        msg.CopyFrom(transmission)
+        self.signal_modify_transmission.emit(msg)
+        if not msg.HasField("frame_start"):
+            msg.frame_start = self._frame_counter
+        if not msg.HasField("max_frame_bytes"):
+            msg.max_frame_bytes = self.udp_cfg.max_frame_size
+        self.signal_data_request.emit(msg)
+        self._frame_counter += len(msg.frame)
+        if msg.frame and msg.frame[0]:
+            self._send(msg)
+            self.signal_transmit_result.emit(msg)
+
+    def _send(self, msg) -> None:
+        if self._sock is None:
+            raise ModemDriverException(
+                "UDP driver is not started", Status.CONNECTION_TO_MODEM_FAILED
+            )
+        data = msg.SerializeToString()
+        targets = list(self._remotes.get(m.BROADCAST_ID, []))
+        if msg.HasField("dest") and msg.dest != m.BROADCAST_ID:
+            targets += self._remotes.get(msg.dest, [])
+        for address in targets:
+            try:
+                self._sock.sendto(data, address)
+            except OSError as exc:
+                log.warning("UDP send to %s failed: %s", address, exc)
+        self.emit_raw(False, data)
+
+    def do_work(self) -> None:
+        if self._sock is None:
+            return
+        while True:
+            try:
+                data, _ = self._sock.recvfrom(MAX_DATAGRAM)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:  # e.g. ICMP port unreachable reported on a later call
+                log.debug("UDP receive error: %s", exc)
+                continue
+            self._handle_datagram(data)
+
+    def _handle_datagram(self, data: bytes) -> None:
+        self.emit_raw(True, data)
+        msg = m.ModemTransmission()
+        try:
+            msg.ParseFromString(data)
+        except DecodeError as exc:
+            log.warning("ignoring a datagram that is not a ModemTransmission: %s", exc)
+            return
+        if msg.type != m.ACK and msg.ack_requested and msg.dest in self._ack_ids:
+            ack = m.ModemTransmission(
+                type=m.ACK, time=m.now_us(self.clock.now()), src=msg.dest, dest=msg.src
+            )
+            ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
+            self._send(ack)
+        self.signal_receive.emit(msg)
