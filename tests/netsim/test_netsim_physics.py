@@ -49,12 +49,26 @@ def test_unesco_its90_input(case):
     )
 
 
+@_cases(P["sound_speed"]["teos10_gsw"])
+def test_teos10(case):
+    c = soundspeed.teos10(case["SA"], case["CT"], case["p_dbar"])
+    assert c == pytest.approx(case["c"], abs=1e-4)
+
+
 @pytest.mark.parametrize(
     "case", P["depth_to_pressure"]["saunders_1981"], ids=lambda c: f"{c['D']}m"
 )
 def test_saunders(case):
     p = soundspeed.saunders_pressure(case["D"], case["lat"])
     assert p == pytest.approx(case["P_dbar"], abs=1e-3)
+
+
+@pytest.mark.parametrize("case", P["depth_to_pressure"]["gsw_p_from_z"], ids=lambda c: f"{c['D']}m")
+def test_teos10_pressure(case):
+    p = soundspeed.teos10_pressure(case["D"], case["lat"])
+    assert p == pytest.approx(case["P_dbar"], abs=1e-4)
+    # the note's claim: Saunders and TEOS-10 agree to < 0.1 %
+    assert soundspeed.saunders_pressure(case["D"], case["lat"]) == pytest.approx(p, rel=1e-3)
 
 
 def test_harmonic_mean_speed():
@@ -74,6 +88,11 @@ def test_thorp(case):
     assert absorption.thorp(case["f_khz"]) == pytest.approx(case["alpha"], abs=1e-4)
 
 
+@_cases(P["absorption"]["thorp_coa_variant"])
+def test_thorp_coa(case):
+    assert absorption.thorp_coa(case["f_khz"]) == pytest.approx(case["alpha"], abs=1e-5)
+
+
 @_cases(P["absorption"]["francois_garrison_1982"])
 def test_francois_garrison(case):
     alpha = absorption.francois_garrison(case["f_khz"], case["T"], case["S"], case["D"], case["pH"])
@@ -84,6 +103,10 @@ def test_francois_garrison_uses_high_branch_at_20_degrees():
     case = P["absorption"]["francois_garrison_1982"]["boundary_T20"]
     alpha = absorption.francois_garrison(case["f_khz"], case["T"], case["S"], case["D"], case["pH"])
     assert alpha == pytest.approx(case["alpha_high_branch"], abs=1e-6)
+    # just below 20 deg C the low-temperature pure-water term applies; it meets the boundary
+    # value of that form
+    args = (case["f_khz"], case["T"] - 1e-9, case["S"], case["D"], case["pH"])
+    assert absorption.francois_garrison(*args) == pytest.approx(case["alpha_low_branch"], abs=1e-6)
 
 
 def _alpha(spec: str, f_khz: float) -> float:
@@ -345,3 +368,70 @@ def test_reception_interval():
     interval = timing.reception_interval(ex["t_start"], ex["owtt"], ex["duration"])
     assert interval.start == pytest.approx(ex["arrival"], abs=1e-9)
     assert interval.end == pytest.approx(ex["reception_end"], abs=1e-9)
+
+
+# -- every block of the vector file has a test above ---------------------------------------------
+
+CHECKED_BLOCKS = {
+    "sound_speed": {
+        "mackenzie_1981/cases",
+        "medwin_1975/cases",
+        "unesco_1983_chen_millero/cases",
+        "unesco_1983_chen_millero/its90_cases",
+        "teos10_gsw/cases",
+    },
+    "depth_to_pressure": {"saunders_1981", "gsw_p_from_z"},
+    "absorption": {
+        "thorp/cases",
+        "thorp_coa_variant/cases",
+        "francois_garrison_1982/cases",
+        "francois_garrison_1982/boundary_T20",
+    },
+    "transmission_loss": {"cases"},
+    "ambient_noise_stojanovic_2007": {"psd_cases", "band_levels"},
+    "snr": {"cases"},
+    "sinr": {"cases"},
+    "packet_error": {
+        *(
+            f"table_ros_acomms/tables/{rate}/{column}"
+            for rate in (1, 3, 5)
+            for column in ("snr_db", "frame_error")
+        ),
+        "table_ros_acomms/checks",
+        *(f"logistic/fitted_to_ros_acomms/{rate}" for rate in (1, 3, 5)),
+        "logistic/checks",
+        "threshold/cases",
+        "ber_to_per/cases",
+        "ber_to_per/ebn0_from_snr",
+        "netsim_udp_range_table/table",
+        "netsim_udp_range_table/checks",
+        "netsim_udp_mpp/checks",
+        "unetstack_protocol_model/defaults",
+        "unetstack_protocol_model/checks",
+    },
+    "geometry_and_delay": {"geodesic_wgs84", "owtt_cases"},
+    "moving_receiver": {"cases"},
+    "dead_reckoning": {"cases"},
+    "doppler": {"cases"},
+    "ranging": {"two_way", "synchronous"},
+    "timing_rules": {"overlap_cases", "half_duplex_cases", "duration_example"},
+}
+
+
+def _data_blocks(node: dict, path: str = ""):
+    """Paths of the lists and flat records in the vector file (notes and formulas are strings)."""
+    for key, value in node.items():
+        here = f"{path}{key}"
+        if isinstance(value, list):
+            yield here
+        elif isinstance(value, dict):
+            if any(isinstance(v, (dict, list)) for v in value.values()):
+                yield from _data_blocks(value, here + "/")
+            else:
+                yield here
+
+
+def test_every_vector_block_is_checked():
+    checked = {f"{top}/{block}" for top, blocks in CHECKED_BLOCKS.items() for block in blocks}
+    in_file = set(_data_blocks({k: v for k, v in P.items() if k != "units"}))
+    assert in_file == checked

@@ -13,6 +13,15 @@ def thorp(f_khz: float) -> float:
     return 0.002 + 0.11 * f2 / (1 + f2) + 0.011 * f2
 
 
+def thorp_coa(f_khz: float) -> float:
+    """Thorp, in the form of Jensen et al., "Computational Ocean Acoustics" (one branch).
+
+    A different published fit from `thorp` (6.12073 against 6.10481 dB/km at 25 kHz): pick one.
+    """
+    f2 = f_khz * f_khz
+    return 3.3e-3 + 0.11 * f2 / (1 + f2) + 44 * f2 / (4100 + f2) + 3.0e-4 * f2
+
+
 def francois_garrison(f_khz: float, T: float, S: float, D: float, pH: float = 8.0) -> float:
     """Francois & Garrison (1982): boric acid + magnesium sulphate + pure water terms."""
     f2 = f_khz * f_khz

@@ -1,12 +1,15 @@
 """Sound speed in sea water and depth -> pressure (spec netsim.md §7.3).
 
 Units: T in deg C, S in ppt (PSU), D depth in metres (positive down), P in dbar, c in m/s.
+TEOS-10 functions take Absolute Salinity SA (g/kg) and Conservative Temperature CT (deg C).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
+
+import gsw
 
 SoundSpeedProfile = Callable[[float], float]  # depth (m) -> sound speed (m/s)
 
@@ -71,10 +74,23 @@ def unesco_1983(S: float, T68: float, P_dbar: float) -> float:
     )
 
 
+def teos10(SA: float, CT: float, P_dbar: float) -> float:
+    """TEOS-10 (IOC, SCOR & IAPSO 2010), the 75-term Gibbs function, via `gsw.sound_speed`."""
+    return float(gsw.sound_speed(SA, CT, P_dbar))
+
+
 def saunders_pressure(depth: float, lat: float) -> float:
     """Saunders (1981): pressure in dbar at `depth` metres and latitude `lat` degrees."""
     c1 = 5.92e-3 + 5.25e-3 * math.sin(math.radians(lat)) ** 2
     return ((1 - c1) - math.sqrt((1 - c1) ** 2 - 8.84e-6 * depth)) / 4.42e-6
+
+
+def teos10_pressure(depth: float, lat: float) -> float:
+    """TEOS-10 `gsw.p_from_z` (dbar) at `depth` metres below the sea surface and latitude `lat`.
+
+    gsw counts height positive up, so z = -depth; the dynamic-height terms are left at zero.
+    """
+    return float(gsw.p_from_z(-depth, lat))
 
 
 def harmonic_mean_speed(profile: SoundSpeedProfile, z1: float, z2: float, steps: int = 16) -> float:
