@@ -27,6 +27,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.set_defaults(func=run)
 
+    s = subparsers.add_parser(
+        "store_server",
+        help="goby_store_server: ModemTransmission mailbox kept in SQLite",
+        description="Store server for DRIVER_STORE_SERVER clients (RUDICS packets over TCP).",
+    )
+    s.add_argument("--port", type=int, default=11244, help="TCP port (default %(default)s)")
+    s.add_argument("--host", default="0.0.0.0", help="address to bind (default %(default)s)")
+    s.add_argument("--db", default="goby_store_server.db", help="SQLite file (default %(default)s)")
+    s.add_argument("--max-lookback", type=float, default=3600.0,
+                   help="seconds of history a new client receives (default %(default)s)")  # fmt: skip
+    s.set_defaults(func=run_store_server)
+
 
 def run(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
@@ -55,3 +67,24 @@ async def _serve(args: argparse.Namespace) -> None:
     finally:
         await server.close()
         channel.close()
+
+
+def run_store_server(args: argparse.Namespace) -> int:
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    with contextlib.suppress(KeyboardInterrupt):
+        asyncio.run(_serve_store(args))
+    return 0
+
+
+async def _serve_store(args: argparse.Namespace) -> None:
+    from pygoby.acomms.store_server import StoreServer, TransmissionStore, serve_store
+
+    store = TransmissionStore(args.db, args.max_lookback)
+    server = await serve_store(StoreServer(store), args.host, args.port)
+    port = server.sockets[0].getsockname()[1]
+    print(f"store_server listening on {args.host}:{port} (database {args.db})", flush=True)
+    try:
+        await asyncio.Future()
+    finally:
+        server.close()
+        store.close()

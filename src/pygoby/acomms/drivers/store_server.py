@@ -1,0 +1,137 @@
+"""Store-server driver (DRIVER_STORE_SERVER, spec acomms.md §11): polls a goby_store_server.
+
+Every `query_interval_seconds` (when no reply is pending) it sends a StoreServerRequest with the
+pending outbox over its line link (TCP client, CR-delimited RUDICS packets); each response's
+inbox is delivered, acknowledged and polls are turned into local data requests. No reply within
+`reset_interval_seconds` closes and reopens the link.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from google.protobuf.message import DecodeError
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.rudics import RudicsPacketError, parse_rudics_packet, serialize_rudics_packet
+
+log = logging.getLogger(__name__)
+
+DEFAULT_PORT = 11244
+POLL = 1  # store_server.protobuf.Transmission.STORE_SERVER_DRIVER_POLL
+
+
+class StoreServerDriver(ModemDriverBase):
+    DEFAULT_LINE_DELIMITER = "\r"
+
+    def __init__(self, clock=None, link=None) -> None:
+        super().__init__(clock, link)
+        self.ss_cfg = m.StoreServerConfig()
+        self._outbox: list = []
+        self._request_id = 0
+        self._waiting_since: float | None = None
+        self._last_query = 0.0
+        self._frame_counter = 0
+        self._running = False
+
+    def startup(self, cfg) -> None:
+        cfg_copy = m.DriverConfig()
+        cfg_copy.CopyFrom(cfg)
+        cfg = cfg_copy
+        if not cfg.HasField("tcp_port"):
+            cfg.tcp_port = DEFAULT_PORT
+        if not cfg.HasField("connection_type"):
+            cfg.connection_type = m.DriverConfig.CONNECTION_TCP_AS_CLIENT
+        self.ss_cfg = cfg.Extensions[m.STORE_SERVER_CONFIG]
+        self.modem_start(cfg)
+        self._running = True
+
+    def shutdown(self) -> None:
+        self._running = False
+        self.modem_close()
+
+    # ------------------------------------------------------------------ sending
+    def handle_initiate_transmission(self, transmission) -> None:
+        msg = m.ModemTransmission()
+        msg.CopyFrom(transmission)
+        self.signal_modify_transmission.emit(msg)
+        if msg.type != m.DATA:
+            log.warning("store-server driver only sends DATA transmissions")
+            return
+        if msg.src < 0:
+            msg.src = self.modem_id
+        if msg.src != self.modem_id:
+            poll = m.ModemTransmission(src=self.modem_id, dest=msg.src, type=m.DRIVER_SPECIFIC)
+            ext = poll.Extensions[m.STORE_SERVER_TRANSMISSION]
+            ext.type, ext.poll_src, ext.poll_dest = POLL, msg.src, msg.dest
+            self._outbox.append(poll)
+            return
+        rate = msg.rate
+        msg.frame_start = self._frame_counter
+        to_bytes, to_frames = self.ss_cfg.rate_to_bytes, self.ss_cfg.rate_to_frames
+        msg.max_frame_bytes = (
+            to_bytes[rate] if 0 <= rate < len(to_bytes) else self.ss_cfg.max_frame_size
+        )
+        if 0 <= rate < len(to_frames):
+            msg.max_num_frames = to_frames[rate]
+        if len(msg.frame) < msg.max_num_frames:
+            self.signal_data_request.emit(msg)
+        self._frame_counter += len(msg.frame)
+        if msg.frame and msg.frame[0]:
+            self._outbox.append(msg)
+            self.signal_transmit_result.emit(msg)
+
+    # ------------------------------------------------------------------ polling loop
+    def do_work(self) -> None:
+        if not self._running or self.link is None:
+            return
+        for line in self.modem_read():
+            self._handle_packet(line.encode("latin-1") + b"\r")
+        now = self.clock.now()
+        if (
+            self._waiting_since is not None
+            and now - self._waiting_since > self.ss_cfg.reset_interval_seconds
+        ):
+            log.warning("no reply from the store server: reconnecting")
+            self.link.close()
+            self.link.open()
+            self._waiting_since = None
+        if (
+            self._waiting_since is None
+            and self.link.is_open
+            and now - self._last_query >= self.ss_cfg.query_interval_seconds
+        ):
+            self._send_request(now)
+
+    def _send_request(self, now: float) -> None:
+        self._request_id += 1
+        request = m.StoreServerRequest(modem_id=self.modem_id, request_id=self._request_id)
+        request.outbox.extend(self._outbox)
+        packet = serialize_rudics_packet(request.SerializeToString())
+        self.modem_write(packet.decode("latin-1"))
+        self.emit_raw(False, packet)
+        self._outbox = []
+        self._waiting_since = now
+        self._last_query = now
+
+    def _handle_packet(self, packet: bytes) -> None:
+        self.emit_raw(True, packet)
+        try:
+            response = m.StoreServerResponse.FromString(parse_rudics_packet(packet))
+        except (RudicsPacketError, DecodeError) as exc:
+            log.warning("ignoring a bad store-server response: %s", exc)
+            return
+        self._waiting_since = None
+        for t in response.inbox:
+            ext = t.Extensions[m.STORE_SERVER_TRANSMISSION]
+            if t.type == m.DRIVER_SPECIFIC and ext.type == POLL:
+                if ext.poll_src == self.modem_id:
+                    request = m.ModemTransmission(src=ext.poll_src, dest=ext.poll_dest, type=m.DATA)
+                    self.handle_initiate_transmission(request)
+                continue
+            if t.type == m.DATA and t.dest == self.modem_id and t.ack_requested:
+                ack = m.ModemTransmission(type=m.ACK, src=t.dest, dest=t.src)
+                ack.acked_frame.extend(range(t.frame_start, t.frame_start + len(t.frame)))
+                self._outbox.append(ack)
+            self.signal_receive.emit(t)
