@@ -75,7 +75,8 @@ def unesco_1983(S: float, T68: float, P_dbar: float) -> float:
 
 
 def teos10(SA: float, CT: float, P_dbar: float) -> float:
-    """TEOS-10 (IOC, SCOR & IAPSO 2010), the 75-term Gibbs function, via `gsw.sound_speed`."""
+    """TEOS-10 (IOC, SCOR & IAPSO 2010) via `gsw.sound_speed`, which uses the 75-term
+    specific-volume polynomial of Roquet et al. (2015); P is sea pressure in dbar."""
     return float(gsw.sound_speed(SA, CT, P_dbar))
 
 
