@@ -39,6 +39,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="seconds of history a new client receives (default %(default)s)")  # fmt: skip
     s.set_defaults(func=run_store_server)
 
+    a = subparsers.add_parser(
+        "abc_modem_simulator",
+        help="simulator for the ABC example modem (DRIVER_ABC_EXAMPLE_MODEM)",
+        description="Each TCP client is one ABC modem; no delay, no loss.",
+    )
+    a.add_argument("--port", type=int, required=True, help="TCP port to serve on")
+    a.add_argument("--host", default="127.0.0.1", help="address to bind (default %(default)s)")
+    a.set_defaults(func=run_abc_simulator)
+
 
 def run(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
@@ -88,3 +97,22 @@ async def _serve_store(args: argparse.Namespace) -> None:
     finally:
         server.close()
         store.close()
+
+
+def run_abc_simulator(args: argparse.Namespace) -> int:
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    with contextlib.suppress(KeyboardInterrupt):
+        asyncio.run(_serve_abc(args))
+    return 0
+
+
+async def _serve_abc(args: argparse.Namespace) -> None:
+    from pygoby.acomms.abc_simulator import ABCSimulator, serve_abc
+
+    server = await serve_abc(ABCSimulator(), args.host, args.port)
+    print(f"abc_modem_simulator listening on {args.host}:{server.sockets[0].getsockname()[1]}",
+          flush=True)  # fmt: skip
+    try:
+        await asyncio.Future()
+    finally:
+        server.close()

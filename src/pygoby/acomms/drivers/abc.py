@@ -1,0 +1,93 @@
+"""ABC example modem driver (DRIVER_ABC_EXAMPLE_MODEM, spec acomms.md §9.2). A teaching toy."""
+
+from __future__ import annotations
+
+import logging
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.abc_protocol import ABCParseError, format_abc, parse_abc
+from pygoby.acomms.driver_base import ModemDriverBase
+
+log = logging.getLogger(__name__)
+
+MAX_FRAME_BYTES = 500
+BITRATE = (100, 1000, 10000, 10000, 10000, 10000)
+
+
+class ABCDriver(ModemDriverBase):
+    DEFAULT_SERIAL_BAUD = 4800
+
+    def __init__(self, clock=None, link=None) -> None:
+        super().__init__(clock, link)
+        self._last_sent_frames: list[int] = []
+        self._running = False
+        self._configured = False  # CONF lines sent on the current connection
+
+    def startup(self, cfg) -> None:
+        self.modem_start(cfg)
+        self._running = True
+        self._configured = False
+
+    def _configure(self) -> None:
+        # on every (re)connection: the simulator registers modems per connection
+        abc = self.cfg.Extensions[m.ABC_CONFIG]
+        self._write(format_abc("CONF", MAC=self.cfg.modem_id))
+        self._write(format_abc("CONF", FOO=int(abc.enable_foo)))
+        self._write(format_abc("CONF", BAR=int(abc.enable_bar)))
+        self._configured = True
+
+    def shutdown(self) -> None:
+        self._running = False
+        self.modem_close()
+
+    def _write(self, text: str) -> None:
+        self.modem_write(text)
+        self.emit_raw(False, text.rstrip("\r\n"))
+
+    def handle_initiate_transmission(self, transmission) -> None:
+        msg = m.ModemTransmission()
+        msg.CopyFrom(transmission)
+        self.signal_modify_transmission.emit(msg)
+        msg.max_frame_bytes = MAX_FRAME_BYTES
+        if not msg.frame:
+            self.signal_data_request.emit(msg)
+        if not msg.frame or not msg.frame[0]:  # Quirk A8 (sane): nothing to send
+            return
+        rate = msg.rate if 0 <= msg.rate < len(BITRATE) else len(BITRATE) - 1
+        self._last_sent_frames = [msg.frame_start]  # only frame 0 is sent
+        self._write(format_abc(
+            "SEND", TO=msg.dest, FROM=msg.src, HEX=bytes(msg.frame[0]).hex(), BITRATE=BITRATE[rate],
+            ACK="TRUE",
+        ))  # fmt: skip
+
+    def do_work(self) -> None:
+        if not self._running or self.link is None:
+            return
+        if not self.link.is_open:
+            self._configured = False
+            return
+        if not self._configured:
+            self._configure()
+        for line in self.modem_read():
+            if not line.strip():
+                continue
+            self.emit_raw(True, line.strip())
+            try:
+                self._handle_line(line)
+            except (ABCParseError, ValueError, KeyError) as exc:
+                log.warning("ignoring bad ABC line %r: %s", line, exc)
+
+    def _handle_line(self, line: str) -> None:
+        key, fields = parse_abc(line)
+        now = m.now_us(self.clock.now())
+        if key == "RECV":
+            msg = m.ModemTransmission(type=m.DATA, src=int(fields["FROM"]), dest=int(fields["TO"]),
+                                      time=now)  # fmt: skip
+            msg.frame.append(bytes.fromhex(fields["HEX"]))
+        elif key == "ACKN":
+            msg = m.ModemTransmission(type=m.ACK, src=int(fields["FROM"]), dest=int(fields["TO"]),
+                                      time=now)  # fmt: skip
+            msg.acked_frame.extend(self._last_sent_frames)  # Quirk A9 (sane)
+        else:
+            msg = m.ModemTransmission(type=m.DATA, time=now)
+        self.signal_receive.emit(msg)

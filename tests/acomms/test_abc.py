@@ -1,0 +1,70 @@
+"""ABC example modem: protocol, simulator and driver end to end over TCP."""
+
+import asyncio
+
+import pytest
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.abc_protocol import ABCParseError, parse_abc
+from pygoby.acomms.abc_simulator import ABCSimulator, serve_abc
+from pygoby.acomms.bind import bind
+from pygoby.acomms.drivers.abc import ABCDriver
+from pygoby.util.clock import WallClock
+
+from .mm_e2e import run_until
+from .queue_helpers import entry, manager
+
+
+def test_parse_and_simulator_rules():
+    assert parse_abc("SEND,TO:2,FROM:1,HEX:0102abcd,BITRATE:100,ACK:TRUE\r\n") == (
+        "SEND", {"TO": "2", "FROM": "1", "HEX": "0102abcd", "BITRATE": "100", "ACK": "TRUE"})  # fmt: skip
+    with pytest.raises(ABCParseError):
+        parse_abc("SEND,TO2")
+    sim = ABCSimulator()
+    sim.handle("a", "CONF,MAC:1")
+    sim.handle("b", "CONF,MAC:2")
+    sim.handle("c", "CONF,MAC:3")
+    assert sim.handle("a", "SEND,TO:2,FROM:1,HEX:0102abcd,BITRATE:100,ACK:TRUE") == [
+        ("b", "RECV,FROM:1,TO:2,HEX:0102abcd,BITRATE:100\r\n"), ("a", "ACKN,FROM:2,TO:1\r\n")]  # fmt: skip
+    assert sorted(e for e, _ in sim.handle("a", "SEND,TO:0,FROM:1,HEX:00,BITRATE:100")) == [
+        "b",
+        "c",
+    ]
+    assert sim.handle("a", "SEND,TO:9,FROM:1,HEX:00,BITRATE:100") == []
+    assert sim.handle("a", "SEND,TO:2,FROM:1,BITRATE:100") == []
+
+
+def abc_cfg(modem_id, port):
+    return m.DriverConfig(driver_type=3, modem_id=modem_id, tcp_server="127.0.0.1", tcp_port=port,
+                          connection_type=m.DriverConfig.CONNECTION_TCP_AS_CLIENT)  # fmt: skip
+
+
+async def test_abc_driver_queue_to_queue_with_ack():
+    server = await serve_abc(ABCSimulator())
+    port = server.sockets[0].getsockname()[1]
+    clock = WallClock()
+    d1, d2 = ABCDriver(clock), ABCDriver(clock)
+    d1.startup(abc_cfg(1, port))
+    d2.startup(abc_cfg(2, port))
+    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
+    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
+    bind(d1, q1)
+    bind(d2, q2)
+    got, acked = [], []
+    q2.signal_receive.connect(got.append)
+    q1.signal_ack.connect(lambda ack, orig: acked.append(orig.value))
+    try:
+        await d1.link.wait_open()
+        await d2.link.wait_open()
+        d1.do_work()
+        d2.do_work()
+        await asyncio.sleep(0.05)  # let the CONF lines register both modems
+        q1.push_message(Status(src=1, dest=2, value=5))
+        await asyncio.sleep(0.01)
+        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        await run_until(lambda: bool(acked), [d1, d2], timeout=10)
+        assert [x.value for x in got] == [5] and acked == [5]
+    finally:
+        d1.shutdown()
+        d2.shutdown()
+        server.close()
