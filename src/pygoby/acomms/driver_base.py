@@ -42,11 +42,8 @@ def driver_name(cfg) -> str:
     if cfg.WhichOneof("driver") == "driver_name":
         kind = cfg.driver_name
     else:
-        kind = (
-            m.DriverConfig.DESCRIPTOR.enum_types_by_name["DriverType"]
-            .values_by_number[cfg.driver_type]
-            .name.removeprefix("DRIVER_")
-        )
+        driver_type = m.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
+        kind = driver_type.values_by_number[cfg.driver_type].name.removeprefix("DRIVER_")
     return f"{kind}::{cfg.modem_id}"
 
 

@@ -1,0 +1,145 @@
+"""uField simulation driver (DRIVER_UFIELD_SIM_DRIVER, spec acomms.md §10), MOOS-agnostic core.
+
+The driver tunnels hex-encoded ModemTransmissions through MOOS-IvP's uField toolbox. This core
+takes a `publish(variable, text)` callable for outgoing MOOS mail and is fed incoming mail with
+`handle_mail(variable, text)`; the MOOS client that connects the two is supplied by the
+application (pAcommsHandler opens one to `moos_server:moos_port`).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable
+
+from google.protobuf.message import DecodeError
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.moos.translator.modem_id import ModemIdLookup
+
+log = logging.getLogger(__name__)
+
+DEFAULT_FRAME_BYTES = 64
+SOUND_SPEED = 1500.0
+POLL = 1  # goby.moos.ufld.protobuf.Transmission.UFIELD_DRIVER_POLL
+
+
+def parse_moos_pairs(text: str) -> dict[str, str]:
+    pairs = {}
+    for part in text.split(","):
+        key, sep, value = part.partition("=")
+        if sep:
+            pairs[key.strip().lower()] = value.strip()
+    return pairs
+
+
+class UFldDriver(ModemDriverBase):
+    def __init__(self, clock=None, publish: Callable[[str, str], None] | None = None) -> None:
+        super().__init__(clock)
+        self.publish = publish if publish is not None else (lambda var, text: None)
+        self.ufld = m.UFldConfig()
+        self.lookup = ModemIdLookup()
+        self._ping_target: str | None = None
+
+    def startup(self, cfg) -> None:
+        self.cfg = cfg
+        self.ufld = cfg.Extensions[m.UFLD_CONFIG]
+        if self.ufld.modem_id_lookup_path:
+            self.lookup = ModemIdLookup.from_file(self.ufld.modem_id_lookup_path)
+
+    def shutdown(self) -> None:
+        pass
+
+    def do_work(self) -> None:
+        pass  # everything arrives as mail
+
+    @property
+    def subscriptions(self) -> list[str]:
+        """MOOS variables the client must register for."""
+        return [self.ufld.incoming_moos_var, self.ufld.micromodem_mimic.range_report_var]
+
+    def _name(self, modem_id: int) -> str:
+        return "all" if modem_id == m.BROADCAST_ID else self.lookup.name(modem_id)
+
+    # ------------------------------------------------------------------ sending
+    def handle_initiate_transmission(self, transmission) -> None:
+        msg = m.ModemTransmission()
+        msg.CopyFrom(transmission)
+        self.signal_modify_transmission.emit(msg)
+        mm_type = msg.Extensions[m.MM_TRANSMISSION].type
+        if msg.type == m.DATA and msg.src in (self.modem_id, m.QUERY_SOURCE_ID):
+            msg.src = self.modem_id
+            sizes = self.ufld.rate_to_bytes
+            msg.max_frame_bytes = (
+                sizes[msg.rate] if 0 <= msg.rate < len(sizes) else DEFAULT_FRAME_BYTES
+            )
+            if not msg.frame:
+                self.signal_data_request.emit(msg)
+            if msg.frame and msg.frame[0]:
+                self._send(msg)
+        elif msg.type == m.DATA:  # third party: ask that node to send
+            poll = m.ModemTransmission(type=m.DRIVER_SPECIFIC, src=self.modem_id, dest=msg.src)
+            ext = poll.Extensions[m.UFLD_TRANSMISSION]
+            ext.type, ext.poll_src, ext.poll_dest = POLL, msg.src, msg.dest
+            self._send(poll)
+        elif msg.type == m.DRIVER_SPECIFIC and mm_type == m.MICROMODEM_TWO_WAY_PING:
+            self.publish(
+                self.ufld.micromodem_mimic.range_request_var, f"name={self._name(self.modem_id)}"
+            )
+            self._ping_target = self._name(msg.dest)
+        else:
+            log.warning("uField driver ignores transmission type %d", msg.type)
+
+    def _send(self, msg) -> None:
+        text = msg.SerializeToString().hex()
+        self.publish(self.ufld.outgoing_moos_var, text)
+        node_message = (
+            f"src_node={self._name(msg.src)},dest_node={self._name(msg.dest)},"
+            f"var_name={self.ufld.incoming_moos_var},string_val={text}"
+        )
+        self.publish(self.ufld.ufield_outgoing_moos_var, node_message)
+        self.emit_raw(False, node_message)
+
+    # ------------------------------------------------------------------ receiving
+    def handle_mail(self, variable: str, text: str) -> None:
+        if variable == self.ufld.incoming_moos_var:
+            self._handle_incoming(text)
+        elif variable == self.ufld.micromodem_mimic.range_report_var:
+            self._handle_range_report(text)
+
+    def _handle_incoming(self, text: str) -> None:
+        self.emit_raw(True, text)
+        try:
+            msg = m.ModemTransmission.FromString(bytes.fromhex(text.strip()))
+        except (ValueError, DecodeError) as exc:
+            log.warning("ignoring bad %s: %s", self.ufld.incoming_moos_var, exc)
+            return
+        ext = msg.Extensions[m.UFLD_TRANSMISSION]
+        if msg.type == m.DRIVER_SPECIFIC and ext.type == POLL:
+            request = m.ModemTransmission(type=m.DATA, src=ext.poll_src, dest=ext.poll_dest)
+            self.handle_initiate_transmission(request)
+            return
+        if msg.type == m.DATA and msg.ack_requested and msg.dest != m.BROADCAST_ID:
+            ack = m.ModemTransmission(type=m.ACK, src=msg.dest, dest=msg.src)
+            ack.acked_frame.extend(range(len(msg.frame)))
+            self._send(ack)
+        self.signal_receive.emit(msg)
+
+    def _handle_range_report(self, text: str) -> None:
+        pairs = parse_moos_pairs(text)
+        if self._ping_target is None or pairs.get("target") != self._ping_target:
+            return
+        try:
+            owtt = float(pairs["range"]) / SOUND_SPEED
+            when = math.floor(float(pairs["time"]))  # Quirk A13 (faithful): whole seconds
+        except (KeyError, ValueError) as exc:
+            log.warning("ignoring bad range report %r: %s", text, exc)
+            return
+        msg = m.ModemTransmission(type=m.DRIVER_SPECIFIC, src=self.modem_id,
+                                  dest=self.lookup.modem_id(self._ping_target), time=when * 1_000_000)  # fmt: skip
+        ext = msg.Extensions[m.MM_TRANSMISSION]
+        ext.type = m.MICROMODEM_TWO_WAY_PING
+        ext.ranging_reply.one_way_travel_time.append(owtt)
+        self._ping_target = None
+        self.signal_receive.emit(msg)
