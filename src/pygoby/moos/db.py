@@ -82,6 +82,9 @@ class _Connection(asyncio.Protocol):
                     self.server._dispatch(self.server.core.process_packet(self.name, msgs))
         except p.ProtocolError as err:
             self._drop(f"protocol error: {err}")
+        except Exception:  # a bug must cost one connection, never the DB
+            log.exception("error while serving client %s", self.name)
+            self._drop("internal error")
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._closed = True
@@ -110,10 +113,10 @@ class _Connection(asyncio.Protocol):
         log.info("client %s connected from %s", self.name, self.peer)
         self.server._dispatch(self.server.core.collect_pushes(exclude=self.name))
 
-    def send(self, msgs: list[p.MOOSMessage]) -> None:
+    def send(self, msgs: list[p.MOOSMessage], cache: dict[int, bytes] | None = None) -> None:
         if self._closed or self.transport is None:
             return
-        self.transport.write(p.encode_packet(msgs))
+        self.transport.write(p.encode_packet(msgs, cache))
         if self.transport.get_write_buffer_size() > MAX_WRITE_BUFFER:
             self._drop("not reading its mail (write buffer full)")
 
@@ -216,10 +219,11 @@ class MOOSDB:
         await self.stop()
 
     def _dispatch(self, outgoing: dict[str, list[p.MOOSMessage]]) -> None:
+        cache: dict[int, bytes] = {}  # a notification routed to many clients is encoded once
         for name, msgs in outgoing.items():
             conn = self._clients.get(name)
             if conn is not None and msgs:
-                conn.send(msgs)
+                conn.send(msgs, cache)
 
     async def _sweep(self) -> None:
         loop = asyncio.get_running_loop()

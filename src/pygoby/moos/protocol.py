@@ -181,9 +181,20 @@ def encode_message(msg: MOOSMessage) -> bytes:
     return b"".join(out)
 
 
-def encode_packet(msgs: Iterable[MOOSMessage]) -> bytes:
-    """One packet holding `msgs` (never empty: an empty packet upsets C++ peers)."""
-    body = [encode_message(m) for m in msgs]
+def encode_packet(msgs: Iterable[MOOSMessage], cache: dict[int, bytes] | None = None) -> bytes:
+    """One packet holding `msgs` (never empty: an empty packet upsets C++ peers).
+
+    `cache` (keyed by id(message)) lets a caller that sends the same message objects to many
+    peers in one go encode each message once; the messages must stay alive meanwhile."""
+    if cache is None:
+        body = [encode_message(m) for m in msgs]
+    else:
+        body = []
+        for m in msgs:
+            raw = cache.get(id(m))
+            if raw is None:
+                raw = cache[id(m)] = encode_message(m)
+            body.append(raw)
     if not body:
         raise ValueError("a MOOS packet must hold at least one message")
     total = PACKET_HEADER_SIZE + sum(len(b) for b in body)
