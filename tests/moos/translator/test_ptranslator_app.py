@@ -1,0 +1,187 @@
+"""pTranslator end to end: embedded MOOSDB + pTranslator configured from a .moos file; inputs
+are poked and the translated variables read back with the MOOS client."""
+
+from __future__ import annotations
+
+import logging
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from pygoby.apps.ptranslator import pTranslator
+from pygoby.moos.appconfig import ConfigError
+from pygoby.moos.client import MOOSClient
+from pygoby.moos.db import MOOSDB
+from pygoby.moos.moosfile import MissionFile
+
+from .test_algorithms import LOOKUP
+
+PROTO = Path(__file__).resolve().parent / "protos" / "translator_test.proto"
+BNR = "pygoby.test.translator.BasicNodeReport"
+NODE_FORMAT = "NAME=%1%,X=%202%,Y=%3%,HEADING=%201%"
+
+
+def mission_text(port: int, lookup: Path, entries: str) -> str:
+    return f"""\
+ServerHost = localhost
+ServerPort = {port}
+Community  = alpha
+LatOrigin  = 42.35
+LongOrigin = -70.95
+modem_id_lookup_path = {lookup}
+
+ProcessConfig = pTranslator
+{{
+  common {{ log: false  app_tick: 20  verbosity: QUIET }}
+  load_proto_file: "{PROTO}"
+{entries}
+}}
+"""
+
+
+ENTRIES = f"""\
+  translator_entry {{
+    protobuf_name: "{BNR}"
+    trigger {{ type: TRIGGER_PUBLISH  moos_var: "NAV_HEADING" }}
+    create {{ technique: TECHNIQUE_FORMAT  moos_var: "NAV_X"  format: "%202%" }}
+    create {{ technique: TECHNIQUE_FORMAT  moos_var: "VEHICLE_NAME"  format: "%1%"
+             algorithm {{ name: "to_lower"  primary_field: 1 }} }}
+    create {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS  moos_var: "NAV_HEADING"
+             algorithm {{ name: "angle_0_360"  primary_field: 201 }} }}
+    create {{ technique: TECHNIQUE_FORMAT  moos_var: "NAV_Y"  format: "%3%" }}
+    publish {{ technique: TECHNIQUE_FORMAT  moos_var: "NODE_REPORT_%1%"
+              format: "{NODE_FORMAT};X+Y=%104%;ID=%102%"
+              algorithm {{ name: "add"  output_virtual_field: 104  primary_field: 202  reference_field: 3 }}
+              algorithm {{ name: "name2modem_id"  output_virtual_field: 102  primary_field: 1 }} }}
+    publish {{ technique: TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT  moos_var: "NODE_REPORT_PB" }}
+    publish {{ technique: TECHNIQUE_FORMAT  moos_var: "NODE_X"  format: "%202%" }}
+  }}
+  translator_entry {{
+    protobuf_name: "pygoby.test.translator.Deploy"
+    trigger {{ moos_var: "DEPLOY_CMD"  mandatory_content: "deploy" }}
+    create {{ technique: TECHNIQUE_PROTOBUF_TEXT_FORMAT  moos_var: "DEPLOY_TEXT" }}
+    create {{ technique: TECHNIQUE_FORMAT  moos_var: "DEPLOY_CMD"  format: "deploy %4%" }}
+    publish {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS  moos_var: "DEPLOY_KV" }}
+  }}
+"""
+OUTPUTS = ("NODE_REPORT_unicorn", "NODE_REPORT_PB", "NODE_X", "DEPLOY_KV")
+
+
+@pytest.fixture
+def lookup_file(tmp_path):
+    path = tmp_path / "modemidlookup.txt"
+    path.write_text(LOOKUP)
+    return path
+
+
+async def test_ptranslator_end_to_end(tmp_path, lookup_file, caplog):
+    async with (
+        MOOSDB(port=0, community="alpha") as db,
+        MOOSClient("tester", port=db.port) as tester,
+    ):
+        path = tmp_path / "mission.moos"
+        path.write_text(mission_text(db.port, lookup_file, ENTRIES))
+        app = pTranslator.from_mission(path, "pTranslator")
+        async with app:
+            for var in OUTPUTS:
+                tester.subscribe(var)
+            await tester.flush()
+            tester.publish("NAV_X", 550.0)
+            tester.publish("NAV_Y", 1023.5)
+            tester.publish("VEHICLE_NAME", "UNICORN")
+            tester.publish("NAV_HEADING", "heading=-120")
+            got = {}
+            while len(got) < 3:
+                msg = await tester.receive(3)
+                got[msg.key] = msg
+            assert got["NODE_REPORT_unicorn"].value == (
+                "NAME=unicorn,X=550,Y=1023.5,HEADING=240;X+Y=1573.5;ID=3"
+            )
+            assert got["NODE_REPORT_unicorn"].src_aux == f"{BNR}:TECHNIQUE_FORMAT"
+            assert got["NODE_REPORT_PB"].value == (
+                f'@PB[{BNR}] Name: "unicorn" y: 1023.5 heading: 240 x: 550 '
+            )
+            assert got["NODE_X"].is_double and got["NODE_X"].value == 550.0
+
+            # Malformed input: a warning, nothing half-built is posted, the app keeps going.
+            with caplog.at_level(logging.WARNING):
+                tester.publish("DEPLOY_TEXT", "destination: {")
+                tester.publish("DEPLOY_CMD", "deploy 7")
+                tester.publish("DEPLOY_CMD", "status")  # lacks the mandatory content
+                tester.publish("NAV_HEADING", "heading=10,colour=red")
+                keys = []
+                while len(keys) < 3:
+                    msg = await tester.receive(3)
+                    keys.append(msg.key)
+                    if msg.key == "NODE_REPORT_unicorn":
+                        assert msg.value == "NAME=unicorn,X=550,Y=1023.5,HEADING=10;X+Y=1573.5;ID=3"
+                assert keys == ["NODE_REPORT_PB", "NODE_REPORT_unicorn", "NODE_X"]  # by name
+                tester.publish("DEPLOY_TEXT", "mode: DEPLOY_MODE_STAY")
+                tester.publish("DEPLOY_CMD", "deploy 7")
+                while (msg := await tester.receive(3)).key != "DEPLOY_KV":
+                    assert msg.key in OUTPUTS
+            assert msg.value == "mode=DEPLOY_MODE_STAY,destination=7"
+            assert "cannot parse pygoby.test.translator.Deploy" in caplog.text
+            assert "unknown key(s) 'colour'" in caplog.text
+            assert app.connected
+
+
+async def test_time_trigger_and_datum_from_origin_mail(tmp_path, lookup_file):
+    entries = f"""\
+  translator_entry {{
+    protobuf_name: "{BNR}"
+    trigger {{ type: TRIGGER_TIME  period: 1 }}
+    create {{ technique: TECHNIQUE_FORMAT  moos_var: "NAV_Y"  format: "%3%" }}
+    publish {{ technique: TECHNIQUE_FORMAT  moos_var: "LAT"  format: "%100%"
+              algorithm {{ name: "utm_y2lat"  output_virtual_field: 100  primary_field: 3  reference_field: 202 }} }}
+  }}
+"""
+    async with (
+        MOOSDB(port=0, community="alpha") as db,
+        MOOSClient("tester", port=db.port) as tester,
+    ):
+        path = tmp_path / "mission.moos"
+        path.write_text(mission_text(db.port, lookup_file, entries))
+        async with pTranslator.from_mission(path, "pTranslator"):
+            tester.subscribe("LAT")
+            tester.publish("NAV_Y", 0.0)
+            msg = await tester.receive(3)
+            assert (msg.key, msg.value) == ("LAT", 42.35)
+            tester.publish("LAT_ORIGIN", 10.0)
+            tester.publish("LONG_ORIGIN", 20.0)
+            for _ in range(4):
+                msg = await tester.receive(3)
+                if msg.value == 10.0:
+                    break
+            assert msg.value == 10.0
+
+
+def test_configuration_errors(tmp_path, lookup_file):
+    bad = f'  translator_entry {{ protobuf_name: "{BNR}" publish {{ technique: TECHNIQUE_FORMAT moos_var: "X" format: "%1%" algorithm {{ name: "alg_nope" output_virtual_field: 90 primary_field: 1 }} }} }}'
+    mission = MissionFile.from_text(mission_text(9000, lookup_file, bad))
+    with pytest.raises(ConfigError, match="unknown algorithm 'alg_nope'"):
+        pTranslator(
+            pTranslator.read_config(mission, "pTranslator"), name="pTranslator", mission=mission
+        )
+    missing = '  translator_entry { protobuf_name: "no.Such" }'
+    mission = MissionFile.from_text(mission_text(9000, lookup_file, missing))
+    with pytest.raises(ConfigError, match="'no.Such' is not a loaded message type"):
+        pTranslator(
+            pTranslator.read_config(mission, "pTranslator"), name="pTranslator", mission=mission
+        )
+
+
+def test_example_config_command():
+    result = subprocess.run(
+        [sys.executable, "-m", "pygoby.apps.ptranslator", "--example_config"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
+    lines = result.stdout.splitlines()
+    assert lines[:2] == ["ProcessConfig = pTranslator", "{"] and lines[-1] == "}"
+    assert any(line.startswith("  translator_entry {") for line in lines)
+    assert any(line.startswith("  modem_id_lookup_path: ") for line in lines)
