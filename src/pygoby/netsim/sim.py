@@ -1,0 +1,355 @@
+"""A whole acoustic network in one process: emulators, physics, drivers, MAC and queues.
+
+`Simulation(scenario)` builds, for every node of a `pygoby.netsim.protobuf.Scenario`, the real
+stack a vehicle runs — a Micro-Modem emulator (`MicroModemModel`) on the netsim physics
+(`PhysicsChannel`), the Micro-Modem driver (`MMDriver`), the TDMA `MACManager` and a
+`QueueManager` with the vehicle's `NodeStatus` messages (DCCL) — and a `NetSimManager` that
+receives the scripted tracks as NavUpdates and feeds the channel its positions.
+
+Everything shares one Clock. `run_virtual()` drives a `VirtualClock` as a discrete-event
+simulation: the sans-I/O cores are connected in memory (`ModemLink`: the driver's sentences go
+straight into its emulator and the emulator's answers into the driver's buffer) and the clock
+jumps to the next thing that can happen — a reception's delivery, a MAC slot, a position update,
+periodic housekeeping — so a day of TDMA traffic runs in seconds. `pygoby.netsim.realtime` runs
+the same objects on the wall clock over TCP.
+
+Events go to `on_event` (`summary()` counts them): `tx` and `rx` from the channel (see
+`pygoby.netsim.physics_channel`), `app_rx` when a queue delivers a status message (port of the
+receiver, src), `range` when a driver reports a ranging reply (port, src, dest, owtt list).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from google.protobuf.message import Message
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.bind import bind
+from pygoby.acomms.drivers.micromodem import MMDriver
+from pygoby.acomms.mac import MACManager
+from pygoby.acomms.mmsim import MicroModemModel
+from pygoby.acomms.queue import QueueManager
+from pygoby.dccl import Codec
+from pygoby.netsim.channel import Channel, Position
+from pygoby.netsim.manager import NetSimManager
+from pygoby.netsim.physics_channel import PhysicsChannel
+from pygoby.netsim.protocol import request_class
+from pygoby.netsim.scenario import (
+    TrackFollower,
+    channel_config,
+    mac_config,
+    manager_config,
+    node_ports,
+    node_status_class,
+    start_time,
+)
+from pygoby.util.clock import Clock, VirtualClock
+from pygoby.util.linebased import LinkClosedError
+
+log = logging.getLogger(__name__)
+
+EventSink = Callable[[dict], None]
+DRIVER_WHOI_MICROMODEM = 2
+SLOT_EPSILON = 1e-3  # s: a MAC slot fires once the clock is past its start
+STARTUP_STEP = 0.01  # s: drivers set the modem clock just after a whole second
+STARTUP_LIMIT = 120.0  # s of simulated time for every driver to finish its start-up
+MAX_EXCHANGES = 10_000  # driver <-> emulator sentences at one instant before giving up
+LOCAL_IP = "127.0.0.1"
+
+
+class ModemLink:
+    """A LineLink straight into an emulator: what the driver writes is handled by the model at
+    once; what the model says is buffered until the driver reads it."""
+
+    def __init__(self, model: MicroModemModel) -> None:
+        self.model = model
+        self._open = False
+        self._lines: list[str] = []
+        model.on_output = self._heard
+
+    def _heard(self, text: str) -> None:
+        self._lines.append(text.strip())
+
+    @property
+    def is_open(self) -> bool:
+        return self._open
+
+    @property
+    def pending(self) -> bool:
+        return bool(self._lines)
+
+    def open(self) -> None:
+        self._open = True
+
+    def close(self) -> None:
+        self._open = False
+
+    def write(self, text: str) -> None:
+        if not self._open:
+            raise LinkClosedError("modem link is closed")
+        self.model.handle_line(text.strip())
+
+    def read_lines(self) -> list[str]:
+        lines, self._lines = self._lines, []
+        return lines
+
+
+def driver_config(modem_id: int, **link) -> Message:
+    cfg = m.DriverConfig(driver_type=DRIVER_WHOI_MICROMODEM, modem_id=modem_id, **link)
+    cfg.Extensions[m.MM_CONFIG].query_cfg_on_startup = False
+    return cfg
+
+
+def status_queue_entry(ack: bool) -> Message:
+    entry = m.QueuedMessageEntry(
+        protobuf_name="pygoby.netsim.protobuf.NodeStatus", ack=ack, max_queue=1, ttl=3600
+    )
+    Role = m.QueuedMessageEntry.Role
+    entry.role.add(type=Role.SOURCE_ID, field="src")
+    entry.role.add(type=Role.DESTINATION_ID, field="dest")
+    entry.role.add(type=Role.TIMESTAMP, field="time")
+    return entry
+
+
+@dataclass
+class SimNode:
+    """One vehicle: its emulator and (optionally) its in-process acomms stack."""
+
+    modem_id: int
+    port: int
+    model: MicroModemModel
+    track: TrackFollower | None = None
+    driver: MMDriver | None = None
+    mac: MACManager | None = None
+    queue: QueueManager | None = None
+    link: ModemLink | None = None
+    received: Counter = field(default_factory=Counter)  # status messages heard, by source
+
+
+@dataclass
+class RunSummary:
+    simulated_seconds: float
+    wall_seconds: float
+    events: Counter
+    outcomes: Counter
+    status_sent: int
+    status_received: int
+
+    @property
+    def speedup(self) -> float:
+        return self.simulated_seconds / self.wall_seconds if self.wall_seconds > 0 else 0.0
+
+    def lines(self) -> list[str]:
+        return [
+            f"simulated {self.simulated_seconds:.0f} s in {self.wall_seconds:.2f} s wall "
+            f"({self.speedup:,.0f}x real time)",
+            "events: " + ", ".join(f"{k} {v}" for k, v in sorted(self.events.items())),
+            "receptions: " + ", ".join(f"{k} {v}" for k, v in sorted(self.outcomes.items())),
+            f"status messages: {self.status_sent} queued, {self.status_received} delivered",
+        ]
+
+
+class Simulation:
+    def __init__(
+        self, scenario: Message, clock: Clock | None = None, on_event: EventSink | None = None
+    ) -> None:
+        self.scenario = scenario
+        self.start = start_time(scenario)
+        self.clock: Clock = clock if clock is not None else VirtualClock(self.start)
+        self.on_event = on_event
+        self.events: Counter = Counter()
+        self.outcomes: Counter = Counter()
+        self.status_sent = 0
+        self.manager = NetSimManager(manager_config(scenario))
+        self.channel = Channel(channel_config(scenario), seed=scenario.seed)
+        self.manager.on_nav(self.channel.on_environment_nav_update)
+        self.physics = PhysicsChannel(self.channel, self.clock, on_event=self._event)
+        self.codec = Codec(clock=self.clock)
+        self.status_class = node_status_class()
+        self.nodes: list[SimNode] = []
+        for node, port in zip(scenario.node, node_ports(scenario), strict=True):
+            track = TrackFollower(node.track, scenario) if node.HasField("track") else None
+            model = MicroModemModel(node.modem_id, self.clock, self.physics, name=str(port))
+            self.nodes.append(SimNode(node.modem_id, port, model, track))
+        self._request_id = 0
+        self._wall_start = 0.0
+
+    # -- building stacks -------------------------------------------------------------------------
+
+    def attach_stack(self, node: SimNode, driver: MMDriver) -> None:
+        """Give a node its driver (already linked to its emulator), MAC and status queue."""
+        node.driver = driver
+        node.mac = MACManager(self.clock)
+        traffic = self.scenario.traffic
+        if traffic.status:
+            node.queue = QueueManager(self.codec, self.clock)
+            node.queue.set_cfg(m.QueueManagerConfig(modem_id=node.modem_id))
+            node.queue.add_queue(status_queue_entry(traffic.ack), self.status_class)
+            node.queue.signal_receive.connect(lambda msg, n=node: self._status_heard(n, msg))
+            node.mac.signal_slot_start.connect(lambda slot, n=node: self._slot_started(n, slot))
+        bind(driver, node.queue, node.mac)
+        driver.signal_receive.connect(lambda msg, n=node: self._modem_heard(n, msg))
+
+    def start_macs(self) -> None:
+        for node in self.nodes:
+            if node.mac is not None:
+                node.mac.startup(mac_config(self.scenario, node.modem_id))
+                if node.queue is not None:
+                    self.queue_status(node)
+
+    # -- traffic -------------------------------------------------------------------------------
+
+    def queue_status(self, node: SimNode) -> None:
+        assert node.queue is not None
+        now = self.clock.now()
+        nav = self.manager.position(node.port)
+        if nav is None:
+            return
+        position = Position.from_nav(nav).at(now)
+        status = self.status_class(
+            src=node.modem_id, dest=self.scenario.traffic.status_dest, time=now,
+            lat=position.lat, lon=position.lon, depth=max(position.depth, 0.0),
+            speed=min(nav.speed, 10.0), heading=nav.heading % 360.0,
+        )  # fmt: skip
+        node.queue.push_message(status)
+        self.status_sent += 1
+
+    def _slot_started(self, node: SimNode, slot: Message) -> None:
+        if slot.src == node.modem_id:  # our slot has just taken the last status: queue the next
+            self.queue_status(node)
+
+    def _status_heard(self, node: SimNode, msg: Message) -> None:
+        node.received[msg.src] += 1
+        self._event({"event": "app_rx", "t": self.clock.now(), "port": node.port, "src": msg.src})
+
+    def _modem_heard(self, node: SimNode, msg: Message) -> None:
+        """Ranging results the driver reports (two-way pings) become `range` events."""
+        if msg.type != m.ModemTransmission.DRIVER_SPECIFIC:
+            return
+        owtt = msg.Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time
+        if owtt:
+            self._event(
+                {"event": "range", "t": self.clock.now(), "port": node.port, "src": msg.src,
+                 "dest": msg.dest, "owtt": list(owtt)}
+            )  # fmt: skip
+
+    def _event(self, event: dict) -> None:
+        self.events[event["event"]] += 1
+        if event["event"] == "rx":
+            self.outcomes[event["outcome"]] += 1
+        if self.on_event is not None:
+            self.on_event(event)
+
+    # -- positions -------------------------------------------------------------------------------
+
+    def post_positions(self) -> None:
+        """One NetSimManagerRequest with every tracked node's position now."""
+        now = self.clock.now()
+        request = request_class()(id=self._request_id)
+        self._request_id = (self._request_id + 1) % 2**31
+        for node in self.nodes:
+            if node.track is None:
+                continue
+            p = node.track.position(now - self.start, now)
+            request.nav.add(
+                modem_tcp_port=node.port, time=now, lat=p.lat, lon=p.lon, depth=p.depth,
+                speed=p.speed, heading=p.heading,
+            )  # fmt: skip
+        if request.nav:
+            outcome = self.manager.handle_request(request, LOCAL_IP)
+            if outcome.response.status != outcome.response.UPDATE_ACCEPTED:
+                log.warning("scripted positions refused: %s", outcome.response)
+
+    def summary(self) -> RunSummary:
+        return RunSummary(
+            simulated_seconds=self.clock.now() - self.start,
+            wall_seconds=time.perf_counter() - self._wall_start,
+            events=Counter(self.events),
+            outcomes=Counter(self.outcomes),
+            status_sent=self.status_sent,
+            status_received=sum(sum(n.received.values()) for n in self.nodes),
+        )
+
+    # -- discrete-event run ----------------------------------------------------------------------
+
+    def build_virtual(self) -> None:
+        """In-memory stacks for every node (drivers wired straight into their emulators)."""
+        for node in self.nodes:
+            node.link = ModemLink(node.model)
+            driver = MMDriver(self.clock, node.link)
+            driver.startup(driver_config(node.modem_id))
+            self.attach_stack(node, driver)
+
+    def run_virtual(self, until: float | None = None) -> RunSummary:
+        """Build, start and run to `until` (default: the scenario's duration) on the virtual
+        clock, jumping from event to event."""
+        if not isinstance(self.clock, VirtualClock):
+            raise TypeError("run_virtual needs a VirtualClock")
+        clock = self.clock
+        self._wall_start = time.perf_counter()
+        end = self.start + self.scenario.duration if until is None else until
+        self.post_positions()
+        self.build_virtual()
+        self._start_drivers(clock)
+        self.start_macs()
+        period = self.scenario.position_period
+        housekeeping = self.scenario.housekeeping_period
+        next_position = self.start + period
+        next_housekeeping = clock.now() + housekeeping
+        macs = [n.mac for n in self.nodes if n.mac is not None]
+        while True:
+            now = clock.now()
+            t = min(end, next_position, next_housekeeping)
+            delivery = self.physics.next_event_time()
+            if delivery is not None and delivery < t:
+                t = delivery
+            for mac in macs:
+                if mac.running and mac.next_slot_time + SLOT_EPSILON < t:
+                    t = mac.next_slot_time + SLOT_EPSILON
+            clock.set(max(t, now))
+            now = clock.now()
+            if now >= next_position:
+                self.post_positions()
+                next_position += period
+            self.physics.do_work()
+            every = now >= next_housekeeping
+            if every:
+                next_housekeeping += housekeeping
+            for node in self.nodes:
+                mac = node.mac
+                fired = mac is not None and mac.running and now > mac.next_slot_time
+                if fired:
+                    mac.do_work()
+                if every and node.queue is not None:
+                    node.queue.do_work()
+                if fired or every or (node.link is not None and node.link.pending):
+                    self._pump(node)
+            if now >= end:
+                return self.summary()
+
+    def _start_drivers(self, clock: VirtualClock) -> None:
+        deadline = clock.now() + STARTUP_LIMIT
+        while not all(n.driver is None or n.driver.startup_complete for n in self.nodes):
+            if clock.now() > deadline:
+                late = [n.modem_id for n in self.nodes if not n.driver.startup_complete]
+                raise RuntimeError(f"drivers of nodes {late} did not start")
+            for node in self.nodes:
+                self._pump(node)
+            clock.advance(STARTUP_STEP)
+
+    @staticmethod
+    def _pump(node: SimNode) -> None:
+        """Run the node's driver until its emulator has nothing more to say."""
+        driver, link = node.driver, node.link
+        if driver is None or link is None:
+            return
+        for _ in range(MAX_EXCHANGES):
+            driver.do_work()
+            if not link.pending:
+                return
+        log.warning("node %d: driver and emulator still talking; deferred", node.modem_id)
