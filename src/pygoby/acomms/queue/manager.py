@@ -36,6 +36,10 @@ class QueueManager:
         self.signal_expire = Signal()  # (original message)
         self.signal_queue_size_change = Signal()  # (QueueSize)
         self.signal_data_on_demand = Signal()  # (request ModemTransmission, message to fill)
+        # routing (pygoby.acomms.route): the router may rewrite an outgoing item's link dest;
+        # link packets for us are offered as (message, its bytes, its own dest, our id)
+        self.signal_out_route = Signal()  # (QueuedItem, modem_id)
+        self.signal_in_route = Signal()  # (message, encoded bytes, message dest, modem_id)
 
     @property
     def modem_id(self) -> int:
@@ -76,7 +80,9 @@ class QueueManager:
         self.signal_queue_size_change.emit(m.QueueSize(dccl_id=queue.dccl_id, size=len(queue)))
 
     # ------------------------------------------------------------------ push
-    def push_message(self, msg) -> None:
+    def push_message(self, msg, encoded: bytes | None = None) -> None:
+        """Queue a message. `encoded`: its DCCL bytes as received (a relayed message keeps
+        them untouched, so encrypted bodies pass through)."""
         queue = self._by_name.get(msg.DESCRIPTOR.full_name)
         if queue is None:
             raise QueueError(
@@ -84,28 +90,33 @@ class QueueManager:
             )
         if queue.has("LOOPBACK"):
             self.signal_receive.emit(msg)
-        if queue.has("NO_QUEUE"):
-            return
         src = self._role(queue, Role.SOURCE_ID, msg, 0)
         dest = self._role(queue, Role.DESTINATION_ID, msg, 0)
-        ack = queue.entry.ack and dest != m.BROADCAST_ID
-        if dest == self.modem_id:
+        item = QueuedItem(msg, b"", src, dest, 0, queue.entry.ack)
+        self.signal_out_route.emit(item, self.modem_id)
+        if queue.has("NO_QUEUE"):
+            return
+        if item.dest == self.modem_id:
             self.signal_receive.emit(msg)
             if queue.entry.ack:
                 now = m.now_us(self.clock.now())
-                ack_msg = m.ModemTransmission(src=dest, dest=dest, type=m.ACK, time=now)
+                ack_msg = m.ModemTransmission(src=item.dest, dest=item.dest, type=m.ACK, time=now)
                 self.signal_ack.emit(ack_msg, msg)
             return
+        item.ack_requested = queue.entry.ack and item.dest != m.BROADCAST_ID
         getter = queue.roles.get(Role.TIMESTAMP)
         when = timestamp_us(getter, msg) if getter is not None else None
-        encoded = self.codec.encode(msg)
-        if not encoded:
+        item.time = when if when is not None else m.now_us(self.clock.now())
+        item.encoded = encoded if encoded is not None else self.codec.encode(msg)
+        if not item.encoded:
             raise QueueError(f"{queue.name}: encoded size is 0; not queued")
-        item = QueuedItem(
-            msg, encoded, src, dest, when if when is not None else m.now_us(self.clock.now()), ack
-        )
         queue.push(item)
         self._size_changed(queue)
+
+    def message_dest(self, msg) -> int:
+        """A message's own destination (its DESTINATION_ID role; 0 without one)."""
+        queue = self._by_name.get(msg.DESCRIPTOR.full_name)
+        return 0 if queue is None else self._role(queue, Role.DESTINATION_ID, msg, 0)
 
     def _role(self, queue: MessageQueue, role: int, msg, default: int) -> int:
         getter = queue.roles.get(role)
@@ -233,8 +244,12 @@ class QueueManager:
         if transmission.type == m.ACK:
             self._handle_ack(transmission)
         elif transmission.type == m.DATA and not self.cfg.skip_decoding:
+            route = len(self.signal_in_route) > 0 and (
+                transmission.dest == self.modem_id
+                or transmission.dest in self.cfg.route_for_additional_modem_id
+            )
             for frame in transmission.frame:
-                self._decode_frame(bytes(frame))
+                self._decode_frame(bytes(frame), route)
 
     def _handle_ack(self, ack) -> None:
         if ack.dest != self.modem_id:
@@ -250,7 +265,7 @@ class QueueManager:
                     self._size_changed(queue)
                     self.signal_ack.emit(ack, item.msg)
 
-    def _decode_frame(self, data: bytes) -> None:
+    def _decode_frame(self, data: bytes, route: bool = False) -> None:
         offset = 0
         while offset < len(data):
             try:
@@ -259,6 +274,9 @@ class QueueManager:
                 where = "frame dropped" if offset == 0 else "rest of frame dropped"
                 log.warning("cannot decode DCCL message at byte %d (%s): %s", offset, where, exc)
                 return
+            if route:
+                encoded = data[offset : offset + used]
+                self.signal_in_route.emit(msg, encoded, self.message_dest(msg), self.modem_id)
             offset += max(used, 1)
             self._deliver(msg)
 

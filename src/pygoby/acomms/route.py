@@ -1,0 +1,74 @@
+"""Static routing between subnets of queue managers (spec acomms.md §12; experimental upstream).
+
+`bind_router(queue, router)` makes a QueueManager one of the router's subnets: outgoing items
+get the next hop as their link destination, and messages received on the link for us but
+addressed further on are pushed (with their original bytes) into the queue manager of the
+subnet that holds the next hop.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from pygoby.acomms import messages as m
+from pygoby.protobuf import default_loader
+
+log = logging.getLogger(__name__)
+
+default_loader().load_file("goby/acomms/protobuf/route.proto")
+RouteManagerConfig = default_loader().message_class("goby.acomms.protobuf.RouteManagerConfig")
+RouteCommand = default_loader().message_class("goby.acomms.protobuf.RouteCommand")
+
+NO_ROUTE = -1
+
+
+class RouteManager:
+    def __init__(self, cfg=None) -> None:
+        self.cfg = RouteManagerConfig()
+        if cfg is not None:
+            self.cfg.CopyFrom(cfg)
+        self.subnets: list = []  # QueueManagers
+
+    def set_route(self, route) -> None:
+        """Replace the hop list (RouteCommand.new_route)."""
+        self.cfg.route.CopyFrom(route)
+
+    def add_subnet_queue(self, queue) -> None:
+        if queue not in self.subnets:
+            self.subnets.append(queue)
+
+    def find_next_hop(self, us: int, dest: int) -> int:
+        hops = list(self.cfg.route.hop)
+        if us in hops and dest in hops:
+            i, j = hops.index(us), hops.index(dest)
+            return us if i == j else hops[i + 1] if j > i else hops[i - 1]
+        if self.cfg.HasField("default_gateway"):
+            return self.cfg.default_gateway
+        return NO_ROUTE
+
+    def handle_out(self, item, modem_id: int) -> None:
+        """Rewrite a queued item's link destination to the next hop (broadcasts untouched)."""
+        if item.dest == m.BROADCAST_ID:
+            return
+        hop = self.find_next_hop(modem_id, item.dest)
+        if hop != NO_ROUTE:
+            item.dest = hop
+
+    def handle_in(self, msg, encoded: bytes, dest: int, modem_id: int) -> None:
+        if dest in (modem_id, m.BROADCAST_ID):
+            return
+        hop = self.find_next_hop(modem_id, dest)
+        if hop == NO_ROUTE:
+            return
+        mask = self.cfg.subnet_mask
+        for queue in self.subnets:
+            if queue.modem_id & mask == hop & mask:
+                queue.push_message(msg, encoded=encoded)
+                return
+        log.debug("no subnet for next hop %d: message for %d not relayed", hop, dest)
+
+
+def bind_router(queue, router: RouteManager) -> None:
+    router.add_subnet_queue(queue)
+    queue.signal_out_route.connect(router.handle_out)
+    queue.signal_in_route.connect(router.handle_in)
