@@ -262,3 +262,19 @@ def test_fuzz_receive_never_raises(data):
 
 
 FUZZ = manager(VirtualClock(T0), modem_id=2, entries=[entry("Status"), entry("Bulk")])
+
+
+def test_network_acks_for_configured_sources(clock):
+    qm, (Status, *_) = manager(clock, entries=[entry("Status", ttl=60)],
+                               make_network_ack_for_src_id=[1])  # fmt: skip
+    got = []
+    qm.signal_receive.connect(got.append)
+    qm.push_message(Status(src=1, dest=2, value=1))
+    qm.push_message(Status(src=1, dest=2, value=2))
+    clock.advance(1)
+    fill(qm, max_bytes=7)
+    qm.handle_modem_receive(m.ModemTransmission(type=m.ACK, src=2, dest=1, acked_frame=[0]))
+    clock.advance(100)
+    qm.do_work()
+    kinds = [(a.ack_type, a.ack_src, a.message_src, a.message_dest, a.message_dccl_id) for a in got]
+    assert kinds == [(m.NetworkAck.ACK, 2, 1, 2, 20), (m.NetworkAck.EXPIRE, 1, 1, 2, 20)]

@@ -264,6 +264,7 @@ class QueueManager:
                     queue.remove(item)
                     self._size_changed(queue)
                     self.signal_ack.emit(ack, item.msg)
+                    self._network_ack(queue, item, m.NetworkAck.ACK, ack.src)
 
     def _decode_frame(self, data: bytes, route: bool = False) -> None:
         offset = 0
@@ -303,3 +304,20 @@ class QueueManager:
                 queue.remove(item)
                 self._size_changed(queue)
                 self.signal_expire.emit(item.msg)
+                self._network_ack(queue, item, m.NetworkAck.EXPIRE, self.modem_id)
+
+    def _network_ack(self, queue: MessageQueue, item: QueuedItem, kind: int, ack_src: int) -> None:
+        """NetworkAck for messages from `make_network_ack_for_src_id` sources (never for a
+        NetworkAck): delivered here if we sent the original, else offered to the router."""
+        if item.src not in self.cfg.make_network_ack_for_src_id:
+            return
+        if item.msg.DESCRIPTOR.full_name == m.NetworkAck.DESCRIPTOR.full_name:
+            return
+        ack = m.NetworkAck(
+            message_src=item.src, message_dest=self.message_dest(item.msg), message_time=item.time,
+            message_dccl_id=queue.dccl_id, ack_src=ack_src, ack_type=kind,
+        )  # fmt: skip
+        if item.src == self.modem_id:
+            self.signal_receive.emit(ack)
+        elif len(self.signal_in_route):
+            self.signal_in_route.emit(ack, self.codec.encode(ack), item.src, self.modem_id)
