@@ -30,6 +30,10 @@ Community  = alpha
 LatOrigin  = 42.35
 VehicleName = ship one
 {extra}
+ProcessConfig = pOther
+{{
+  LongOrigin = 5
+}}
 ProcessConfig = pTestApp
 {{
 {block}
@@ -42,7 +46,8 @@ BLOCK = """\
     log: false
     app_tick: 20
     verbosity: QUIET
-    lat_origin: 1.0   // the LatOrigin global wins (goby quirk Q2)
+    lat_origin: 1.0   // kept: globals fill only unset fields (quirk Q2, fixed)
+    server_host: "127.0.0.1"  // not "http://x" // a comment
     initializer { type: INI_DOUBLE  moos_var: "LAT_ORIGIN"  global_cfg_var: "LatOrigin" }
     initializer { type: INI_STRING  moos_var: "VEHICLE"  global_cfg_var: "VehicleName" }
     initializer { type: INI_STRING  moos_var: "GREETING"  sval: "  hi  " }
@@ -57,10 +62,10 @@ BLOCK = """\
 def test_configuration_globals_and_defaults():
     mission = MissionFile.from_text(_mission(9123, BLOCK))
     cfg = pTestApp.read_config(mission, "pTestApp")
-    assert cfg.common.lat_origin == 42.35
+    assert cfg.common.lat_origin == 1.0
     assert cfg.common.community == "alpha"
-    assert cfg.common.server_port == 9123 and cfg.common.server_host == "localhost"
-    assert not cfg.common.HasField("lon_origin")
+    assert cfg.common.server_port == 9123 and cfg.common.server_host == "127.0.0.1"
+    assert not cfg.common.HasField("lon_origin")  # LongOrigin inside pOther's block: not global
     assert cfg.gain == 2.0 and cfg.mode == cfg.SLOW
     assert cfg.common.app_tick == 20 and cfg.common.comm_tick == 10
 
@@ -72,11 +77,12 @@ def test_parse_error_names_line_and_field(tmp_path):
     with pytest.raises(ConfigError) as err:
         pTestApp.read_config(MissionFile.read(path), "pTestApp")
     line = text.splitlines().index("  gain: fast") + 1
+    assert line == 14
     assert f"m.moos:{line}:" in str(err.value) and "gain" in str(err.value)
     with pytest.raises(ConfigError, match='no field named "AppTick"'):
         pTestApp.read_config(MissionFile.from_text(_mission(9000, "  AppTick = 4")), "pTestApp")
-    with pytest.raises(ConfigError, match="no ProcessConfig block for pOther"):
-        pTestApp.read_config(MissionFile.from_text(_mission(9000, BLOCK)), "pOther")
+    with pytest.raises(ConfigError, match="no ProcessConfig block for pMissing"):
+        pTestApp.read_config(MissionFile.from_text(_mission(9000, BLOCK)), "pMissing")
     with pytest.raises(ConfigError, match="out_var"):
         pTestApp.read_config(MissionFile.from_text(_mission(9000, "  gain: 1")), "pTestApp")
 
@@ -92,7 +98,7 @@ def test_main_stops_on_config_error_before_connecting(tmp_path, capsys):
     path.write_text(_mission(1, "  common { app_tick: many }\n  out_var: \"X\""))
     assert pTestApp.main([str(path)], prog="pTestApp") == 1
     err = capsys.readouterr().err
-    assert "fatal configuration error" in err and 'field "app_tick"' in err and "m.moos:9:" in err
+    assert "fatal configuration error" in err and 'field "app_tick"' in err and "m.moos:13:" in err
 
 
 def test_example_config():

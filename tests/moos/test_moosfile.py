@@ -41,7 +41,9 @@ ProcessConfig = pHelmIvP          // a classic MOOS block
 ProcessConfig = pAcommsHandler
 {
   common { app_tick: 10  // a comment
-           verbosity: VERBOSE }
+           verbosity: VERBOSE
+           server_host: "http://a//b"  // quoted // kept }
+  }
   modem_id: 1
 }
 """
@@ -57,7 +59,9 @@ def test_globals():
     assert m.get_value("url") == "http://host//x"
     assert m.get_value("TargetDepth") == "12"
     assert m.get_bool("log") is True and m.get_bool("MOOSTimeWarp") is True
-    assert m.get_value("AppTick") == "4"  # globals match inside blocks too (quirk)
+    assert m.get_value("AppTick") == "4"  # MOOS globals match inside blocks too
+    assert m.get_value("AppTick", outside_blocks=True) is None
+    assert m.get_value("Community", outside_blocks=True) == "myship"
     assert m.get_value("Missing") is None
 
 
@@ -75,6 +79,7 @@ def test_goby_block_text_and_lines():
     block = m.goby_block("pAcommsHandler")
     assert block is not None
     assert "common { app_tick: 10  # a comment" in block.text
+    assert 'server_host: "http://a//b"  # quoted # kept }' in block.text
     assert block.text.strip().endswith("modem_id: 1")
     lines = MISSION.splitlines()
     assert lines[block.file_line(2) - 1].strip().startswith("common {")

@@ -315,7 +315,8 @@ class GobyMOOSApp:
         kinds = type(self.common).Initializer
         for ini in self.common.initializer:
             if ini.HasField("global_cfg_var"):
-                raw = self.mission.get_value(ini.global_cfg_var) if self.mission else None
+                mission = self.mission
+                raw = mission.get_value(ini.global_cfg_var, outside_blocks=True) if mission else None
                 if raw is None:
                     self.log.warning("initializer: global %s not found; %s not posted",
                                      ini.global_cfg_var, ini.moos_var)  # fmt: skip

@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 import functools
+import logging
 import re
 from collections.abc import Sequence
 
@@ -20,8 +21,10 @@ from google.protobuf import text_format
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
-from pygoby.moos.moosfile import MissionFile
+from pygoby.moos.moosfile import MissionFile, parse_number
 from pygoby.protobuf import builtin_class
+
+log = logging.getLogger(__name__)
 
 GOBY_FIELD_EXTENSION = 1009
 EXAMPLE_WIDTH = 66
@@ -106,8 +109,10 @@ def parse_block(config: Message, text: str, first_line: int, source: str) -> Non
 
 
 def apply_moos_globals(config: Message, mission: MissionFile) -> None:
-    """Set every non-repeated, non-oneof field that names a MOOS global found in the mission
-    file (recursively through non-repeated sub-messages); the global wins over the block."""
+    """Fill every non-repeated, non-oneof field that names a MOOS global (recursively through
+    non-repeated sub-messages) from the mission file's globals (lines outside ProcessConfig
+    blocks). A field already set in the block keeps its value: goby3 lets the global win, its
+    documentation says globals apply only to empty fields (quirks Q2, Q3: fixed as documented)."""
     for field in config.DESCRIPTOR.fields:
         if field.is_repeated or field.containing_oneof is not None:
             continue
@@ -121,22 +126,24 @@ def apply_moos_globals(config: Message, mission: MissionFile) -> None:
         name = goby_field_options(field).moos_global
         if not name:
             continue
-        value = mission.get_value(name)
+        value = mission.get_value(name, outside_blocks=True)
         if value is None:
             continue
-        _set_from_global(config, field, name, value, mission)
+        if config.HasField(field.name):
+            log.info("MOOS global %s=%s ignored: %s is set in the ProcessConfig block",
+                     name, value, field.full_name)  # fmt: skip
+            continue
+        _set_from_global(config, field, name, value)
 
 
-def _set_from_global(
-    config: Message, field: FieldDescriptor, name: str, value: str, mission: MissionFile
-) -> None:
+def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: str) -> None:
     kind = field.type
     if kind == FieldDescriptor.TYPE_STRING:
         setattr(config, field.name, value)
     elif kind == FieldDescriptor.TYPE_BOOL:
         if value.upper() in ("TRUE", "FALSE"):
             setattr(config, field.name, value.upper() == "TRUE")
-        elif (number := mission.get_float(name)) is not None:
+        elif (number := parse_number(value)) is not None:
             setattr(config, field.name, number > 0)
     elif kind == FieldDescriptor.TYPE_ENUM:
         enum_value = field.enum_type.values_by_name.get(value)
@@ -144,9 +151,9 @@ def _set_from_global(
             raise ConfigError(f'invalid enumeration "{value}" for {field.name} (MOOS global {name})')
         setattr(config, field.name, enum_value.number)
     elif kind in (FieldDescriptor.TYPE_DOUBLE, FieldDescriptor.TYPE_FLOAT):
-        if (number := mission.get_float(name)) is not None:
+        if (number := parse_number(value)) is not None:
             setattr(config, field.name, number)
-    elif (number := mission.get_float(name)) is not None:
+    elif (number := parse_number(value)) is not None:
         try:
             setattr(config, field.name, int(number))
         except ValueError:

@@ -3,6 +3,7 @@ and the Goby TextFormat block (goby-moos-apps.md 2.2).
 
     mission = MissionFile.read("alpha.moos")
     mission.get_value("ServerPort")          # "9000": first match anywhere, white space removed
+    mission.get_value("LatOrigin", outside_blocks=True)   # only lines outside ProcessConfig blocks
     mission.get_float("LatOrigin")           # None unless numeric
     mission.process_config("pHelmIvP")       # [(name, value), ...] in file order (or None)
     mission.goby_block("pAcommsHandler")     # GobyBlock(text, first_line) for TextFormat parsing
@@ -43,6 +44,41 @@ def strip_comment(line: str) -> str:
     return before + inside + (after if cut < 0 else after[:cut])
 
 
+def parse_number(value: str) -> float | None:
+    """MOOS's numeric rule: only `0-9 . e E + -` characters, then converted; else None."""
+    if not _NUMERIC.fullmatch(value):
+        return None
+    try:
+        return float(value)
+    except ValueError:
+        return None
+
+
+def _strip_textformat_comments(line: str) -> str:
+    """`//` becomes `#` only outside quoted strings (goby-moos-apps.md quirk Q1, fixed)."""
+    out = []
+    quote = ""
+    i = 0
+    while i < len(line):
+        c = line[i]
+        if quote:
+            if c == "\\":
+                out.append(line[i : i + 2])
+                i += 2
+                continue
+            if c == quote:
+                quote = ""
+        elif c in "\"'":
+            quote = c
+        elif line.startswith("//", i):
+            out.append("#")
+            i += 2
+            continue
+        out.append(c)
+        i += 1
+    return "".join(out)
+
+
 def _no_space(text: str) -> str:
     return text.replace(" ", "").replace("\t", "").replace("\r", "")
 
@@ -78,6 +114,7 @@ class MissionFile:
         self.path = path
         self.raw_lines = raw_lines
         self.lines = self._preprocess(raw_lines)  # comments removed, macros expanded
+        self._in_block = self._block_mask(self.lines)
 
     @classmethod
     def read(cls, path: str | os.PathLike[str]) -> MissionFile:
@@ -108,26 +145,36 @@ class MissionFile:
             out.append(strip_comment(line))
         return out
 
+    @staticmethod
+    def _block_mask(lines: list[str]) -> list[bool]:
+        mask = []
+        inside = False
+        for line in lines:
+            if _no_space(line).upper().startswith("PROCESSCONFIG="):
+                inside = True
+            mask.append(inside)
+            if inside and line.strip().startswith("}"):
+                inside = False
+        return mask
+
     # -- globals (moos.md 17.2) ----------------------------------------------------------------
 
-    def get_value(self, name: str) -> str | None:
+    def get_value(self, name: str, outside_blocks: bool = False) -> str | None:
         """The value of the first `name = value` line anywhere in the file (case-insensitive
-        name), with all white space removed."""
+        name), with all white space removed, as MOOS's GetValue does. With `outside_blocks`,
+        lines inside ProcessConfig blocks are skipped (goby-moos-apps.md quirk Q3, fixed)."""
         wanted = name.lower()
-        for line in self.lines:
+        for line, in_block in zip(self.lines, self._in_block, strict=True):
+            if outside_blocks and in_block:
+                continue
             key, sep, value = _no_space(line).partition("=")
             if sep and key.lower() == wanted:
                 return value
         return None
 
-    def get_float(self, name: str) -> float | None:
-        value = self.get_value(name)
-        if value is None or not _NUMERIC.fullmatch(value):
-            return None
-        try:
-            return float(value)
-        except ValueError:
-            return None
+    def get_float(self, name: str, outside_blocks: bool = False) -> float | None:
+        value = self.get_value(name, outside_blocks)
+        return None if value is None else parse_number(value)
 
     def get_int(self, name: str) -> int | None:
         number = self.get_float(name)
@@ -192,9 +239,10 @@ class MissionFile:
     # -- Goby TextFormat blocks (goby-moos-apps.md 2.2) ----------------------------------------
 
     def goby_block(self, app: str) -> GobyBlock | None:
-        """The text between the first `{` and the last `}` of the app's block, `//` replaced by
-        `#` (Goby's reader: header matched with spaces removed, no trailing comment allowed; the
-        block ends at the next line containing PROCESSCONFIG)."""
+        """The text between the first `{` and the last `}` of the app's block, with `//`
+        comments turned into `#` outside quoted strings (Goby's reader: header matched with
+        spaces removed, no trailing comment allowed; the block ends at the next line containing
+        PROCESSCONFIG)."""
         header = f"processconfig={app}".lower()
         raw = self.raw_lines
         start = next((i for i, ln in enumerate(raw) if ln.replace(" ", "").lower() == header), None)
@@ -208,7 +256,8 @@ class MissionFile:
         if open_at < 0 or close_at < open_at:
             return GobyBlock("", start + 1)
         first_line = start + 1 + text.count("\n", 0, open_at)
-        return GobyBlock(text[open_at + 1 : close_at].replace("//", "#"), first_line)
+        body = text[open_at + 1 : close_at]
+        return GobyBlock("\n".join(map(_strip_textformat_comments, body.split("\n"))), first_line)
 
     # -- pAntler (moos.md 19) ------------------------------------------------------------------
 
