@@ -3,6 +3,7 @@ are poked and the translated variables read back with the MOOS client."""
 
 from __future__ import annotations
 
+import asyncio
 import logging
 import subprocess
 import sys
@@ -81,6 +82,8 @@ async def test_ptranslator_end_to_end(tmp_path, lookup_file, caplog):
         MOOSDB(port=0, community="alpha") as db,
         MOOSClient("tester", port=db.port) as tester,
     ):
+        tester.publish("NAV_HEADING", "heading=5")  # before the app starts: must not trigger
+        await tester.flush()
         path = tmp_path / "mission.moos"
         path.write_text(mission_text(db.port, lookup_file, ENTRIES))
         app = pTranslator.from_mission(path, "pTranslator")
@@ -88,6 +91,7 @@ async def test_ptranslator_end_to_end(tmp_path, lookup_file, caplog):
             for var in OUTPUTS:
                 tester.subscribe(var)
             await tester.flush()
+            await asyncio.sleep(0.2)
             tester.publish("NAV_X", 550.0)
             tester.publish("NAV_Y", 1023.5)
             tester.publish("VEHICLE_NAME", "UNICORN")
@@ -95,6 +99,7 @@ async def test_ptranslator_end_to_end(tmp_path, lookup_file, caplog):
             got = {}
             while len(got) < 3:
                 msg = await tester.receive(3)
+                assert msg.key not in got, f"{msg.key} posted twice (stale trigger?)"
                 got[msg.key] = msg
             assert got["NODE_REPORT_unicorn"].value == (
                 "NAME=unicorn,X=550,Y=1023.5,HEADING=240;X+Y=1573.5;ID=3"
@@ -185,3 +190,42 @@ def test_example_config_command():
     assert lines[:2] == ["ProcessConfig = pTranslator", "{"] and lines[-1] == "}"
     assert any(line.startswith("  translator_entry {") for line in lines)
     assert any(line.startswith("  modem_id_lookup_path: ") for line in lines)
+
+
+async def test_shared_library_and_multiplexed_commands(tmp_path, lookup_file):
+    from grpc_tools import protoc
+
+    assert protoc.main(["protoc", f"-I{PROTO.parent}", f"--python_out={tmp_path}", str(PROTO)]) == 0
+    generated = tmp_path / "translator_test_pb2.py"
+    entries = """\
+  multiplex_create_moos_var: "MUX"
+  translator_entry {
+    protobuf_name: "pygoby.test.translator.Deploy"
+    trigger { moos_var: "DEPLOY_KV_IN" }
+    create { technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS  moos_var: "DEPLOY_KV_IN" }
+    publish { technique: TECHNIQUE_FORMAT  moos_var: "DEPLOY_OUT"  format: "%2%/%4%" }
+  }
+"""
+    text = mission_text(0, lookup_file, entries).replace(
+        f'  load_proto_file: "{PROTO}"', f'  load_shared_library: "{generated}"'
+    )
+    async with (
+        MOOSDB(port=0, community="alpha") as db,
+        MOOSClient("tester", port=db.port) as tester,
+    ):
+        path = tmp_path / "mission.moos"
+        path.write_text(text.replace("ServerPort = 0", f"ServerPort = {db.port}"))
+        async with pTranslator.from_mission(path, "pTranslator"):
+            tester.subscribe("DEPLOY_OUT")
+            tester.subscribe("DEPLOY_KV_IN")
+            await tester.flush()
+            tester.publish(
+                "MUX", "@PB[pygoby.test.translator.Deploy] mode: DEPLOY_MODE_STAY destination: 4"
+            )
+            tester.publish("MUX", "@PB[unknown.Type] x: 1")  # warned about and ignored
+            got = {}
+            while len(got) < 2:
+                msg = await tester.receive(3)
+                got[msg.key] = msg
+            assert got["DEPLOY_KV_IN"].value == "mode=DEPLOY_MODE_STAY,destination=4"
+            assert got["DEPLOY_OUT"].value == "DEPLOY_MODE_STAY/4"
