@@ -59,7 +59,7 @@ class pTranslator(GobyMOOSApp):  # noqa: N801 - the program's name
                 _import_generated_module(module)
             for path in cfg.load_proto_file:
                 self.loader.load_file(path)
-        except (ImportError, ProtoError, OSError) as err:
+        except (ImportError, ProtoError, OSError, SyntaxError, TypeError) as err:
             raise ConfigError(f"cannot load message definitions: {err}") from None
         modem_ids = (
             ModemIdLookup.from_file(cfg.modem_id_lookup_path) if cfg.modem_id_lookup_path else None

@@ -229,3 +229,15 @@ async def test_shared_library_and_multiplexed_commands(tmp_path, lookup_file):
                 got[msg.key] = msg
             assert got["DEPLOY_KV_IN"].value == "mode=DEPLOY_MODE_STAY,destination=4"
             assert got["DEPLOY_OUT"].value == "DEPLOY_MODE_STAY/4"
+
+
+def test_unloadable_message_definitions_are_config_errors(tmp_path, lookup_file):
+    broken = tmp_path / "broken.proto"
+    broken.write_text('syntax = "proto2"; message X { optional nonsense y = 1; }')
+    for line in (f'  load_proto_file: "{broken}"', '  load_shared_library: "no_such_module_pb2"'):
+        text = mission_text(9000, lookup_file, "").replace(f'  load_proto_file: "{PROTO}"', line)
+        mission = MissionFile.from_text(text)
+        with pytest.raises(ConfigError, match="cannot load message definitions"):
+            pTranslator(
+                pTranslator.read_config(mission, "pTranslator"), name="pTranslator", mission=mission
+            )
