@@ -214,3 +214,16 @@ def test_subclass_without_config_is_an_error():
 
     with pytest.raises(TypeError, match="config_class or config_proto"):
         Bare.load_config_class()
+
+
+async def test_log_file_named_after_app_and_community(tmp_path):
+    block = BLOCK.replace("log: false", f'log: true log_path: "{tmp_path}"')
+    mission = MissionFile.from_text(_mission(1, block))
+    app = pTestApp(pTestApp.read_config(mission, "pTestApp"), name="pTestApp", mission=mission)
+    await app.start()  # no DB on port 1: the app keeps trying, logging works regardless
+    app.log.warning("hello log")
+    await app.stop()
+    files = sorted(p.name for p in tmp_path.iterdir())
+    assert len(files) == 2 and files[1] == "pTestApp_alpha_latest.txt"
+    assert files[0].startswith("pTestApp_alpha_2") and files[0].endswith(".txt")
+    assert "hello log" in (tmp_path / files[1]).read_text()

@@ -7,6 +7,8 @@ import json
 import socket
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from pygoby.moos import protocol as p
 from pygoby.moos.dbcore import DBCore
@@ -199,3 +201,30 @@ def test_db_variables_refresh_every_two_seconds(core):
     out = _pkt(core, "a", p.timing_message(core.clock.now()), p.notify("X", 1, time=0, src="a"))
     assert [m.key for m in out["a"]] == ["_async_timing", "DB_CLIENTS"]
     assert out["a"][1].string == "a," and out["a"][1].src == "MOOSDB_alpha"
+
+
+_names = st.sampled_from(["a", "b", "", "ghost"])
+_keys = st.sampled_from(["X", "Y", "DB_TIME", "", "ALL", "VAR_SUMMARY", "PROC_SUMMARY", "DB_CLEAR"])
+_messages = st.builds(
+    p.MOOSMessage,
+    msg_type=st.sampled_from("NRU*/QT.iWKCZ"), data_type=st.sampled_from("DSB~?"), key=_keys,
+    time=st.floats(allow_nan=True), dval=st.floats(allow_nan=True), dval2=st.floats(),
+    sval=st.one_of(st.binary(max_size=20), st.just(p.wildcard_sval("*", "*", 0.1))),
+    src=_names, id=st.integers(-3, 3),
+)  # fmt: skip
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(["a", "b"]), st.lists(_messages, max_size=4)), max_size=12))
+def test_fuzz_core_never_crashes(packets):
+    clock = VirtualClock(1000.0)
+    core = DBCore("fz", clock)
+    core.connect(p.handshake_message("a", 0.0))
+    core.connect(p.handshake_message("b", 0.0, asynchronous=False))
+    for name, msgs in packets:
+        clock.advance(0.7)
+        out = core.process_packet(name, msgs)
+        assert all(out.values())  # never an empty packet
+    core.disconnect("a")
+    core.disconnect("b")
+    assert not core.clients

@@ -1,1 +1,18 @@
-"""pygoby.moos"""
+"""MOOS for pygoby: the V10 wire protocol, an asyncio client, an embedded MOOSDB, .moos files,
+the pAntler-style launcher and the Goby MOOS application base.
+
+    from pygoby.moos import MOOSClient, MOOSDB, MOOSMessage
+    from pygoby.moos.app import GobyMOOSApp        # base class of Goby MOOS applications
+
+Modules: protocol (sans-I/O codec and handshake), dbcore (sans-I/O DB semantics), db (asyncio
+server), client (asyncio client), timewarp (MOOS time), moosfile (.moos reader), appconfig and
+app (GobyMOOSApp), antler (launcher), cli (`pygoby moosdb|moos|antler`).
+"""
+
+from pygoby.moos.client import MOOSClient, MOOSRefused
+from pygoby.moos.db import MOOSDB
+from pygoby.moos.moosfile import MissionFile
+from pygoby.moos.protocol import MOOSMessage, ProtocolError
+from pygoby.moos.timewarp import moos_clock
+
+__all__ = ["MOOSDB", "MOOSClient", "MOOSMessage", "MOOSRefused", "MissionFile", "ProtocolError", "moos_clock"]

@@ -14,6 +14,7 @@ disconnect.
 from __future__ import annotations
 
 import logging
+import math
 import time as _time
 from dataclasses import dataclass, field
 
@@ -140,7 +141,8 @@ class DBCore:
                 had_notify = True
                 self._on_notify(msg)
             elif kind == p.REGISTER:
-                self._on_register(msg.src, msg.key, max(msg.dval, 0.0))
+                interval = msg.dval if math.isfinite(msg.dval) and msg.dval > 0 else 0.0
+                self._on_register(msg.src, msg.key, interval)
             elif kind == p.UNREGISTER:
                 var = self.variables.get(msg.key)
                 if var is not None:
