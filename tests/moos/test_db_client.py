@@ -273,3 +273,60 @@ async def test_cpp_client_bytes_replayed_over_a_socket(vectors_dir):
     assert kinds[-1] == [("N", "FOO"), ("N", "BAR")]  # pushed back to the publisher
     assert received[-1][0].dval == 3.5 and received[-1][1].value == "hello"
     assert received[0][0].src_aux == f"hostname={socket.gethostname()}"
+
+
+async def _scripted_db(units: list[dict]):
+    """A server that answers any client with the recorded DB-to-client packets of one conn."""
+    packets = [bytes.fromhex(u["hex"]) for u in units if u["unit"] == "packet"]
+
+    async def serve(reader, writer):
+        await reader.readexactly(p.PROTOCOL_STRING_SIZE)
+        header = await reader.readexactly(9)
+        total, _ = p.parse_packet_header(header)
+        await reader.readexactly(total - 9)
+        for packet in packets:
+            writer.write(packet)
+            await writer.drain()
+            await asyncio.sleep(0.01)
+        await asyncio.sleep(0.5)
+        writer.close()
+
+    return await asyncio.start_server(serve, "127.0.0.1", 0)
+
+
+async def test_client_against_recorded_cpp_db(vectors_dir):
+    text = (vectors_dir / "moos" / "sessions.jsonl").read_text()
+    units = [json.loads(line) for line in text.splitlines()]
+    listener = [u for u in units if u["conn"] == 3 and u["dir"] == "db_to_client"]
+    server = await _scripted_db(listener)
+    port = server.sockets[0].getsockname()[1]
+    expected = [
+        m for u in listener if u["unit"] == "packet" for m in p.decode_packet(bytes.fromhex(u["hex"]))
+        if m.msg_type not in (p.WELCOME, p.TIMING)
+    ]  # fmt: skip
+    got: list[p.MOOSMessage] = []
+    client = MOOSClient("nav_listener", port=port, on_message=got.append, reconnect_interval=5)
+    try:
+        await client.connect()
+        assert client.community == "alpha" and client.db_hostname == "localhost"
+        async with asyncio.timeout(5):
+            while len(got) < len(expected):
+                await asyncio.sleep(0.01)
+        assert got == expected  # T echoes dropped, every N delivered in order
+        assert client.skew.skew != 0.0  # the echoes fed the skew filter
+    finally:
+        await client.close()
+        server.close()
+
+
+async def test_client_raises_on_recorded_poison(vectors_dir):
+    text = (vectors_dir / "moos" / "sessions.jsonl").read_text()
+    units = [json.loads(line) for line in text.splitlines()]
+    server = await _scripted_db([u for u in units if u["seq"] == 110])
+    client = MOOSClient("dup", port=server.sockets[0].getsockname()[1])
+    try:
+        with pytest.raises(MOOSRefused, match='A client of this name \\("dup"\\) already exists'):
+            await client.connect()
+    finally:
+        await client.close()
+        server.close()
