@@ -252,3 +252,16 @@ def test_rev_init_resets_clock():
     h.clock.advance(2.5)
     h.clock.set(int(h.clock.now()) + 1.06)
     assert h.work()[0].startswith("$CCCLK")
+
+
+def test_bad_rate_is_refused_and_raw_log_written(tmp_path):
+    h = Harness()
+    h.cfg.raw_log = str(tmp_path / "raw_%1%.log")
+    h.start()
+    h.driver.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=9))
+    assert h.work() == []  # Quirk A4: rates above 5 are refused
+    h.driver.shutdown()
+    (log_file,) = tmp_path.glob("raw_*.log")
+    assert log_file.name == "raw_20231114T221320.log"
+    lines = log_file.read_text().splitlines()
+    assert lines[0] == "[tx] $CCCFG,CST,1*37" and "[rx] $CACFG,CST,1" in lines[1]

@@ -85,3 +85,40 @@ def test_datagram_is_plain_protobuf_and_garbage_is_skipped(caplog):
     finally:
         d.shutdown()
         listener.close()
+
+
+def test_multicast_queue_to_queue_with_ack():
+    import random
+
+    from pygoby.acomms.drivers import make_driver
+    from pygoby.protobuf import default_loader
+
+    ext = default_loader().pool.FindExtensionByName("goby.acomms.udp_multicast.protobuf.config")
+    port = random.randint(40000, 60000)
+    clock = VirtualClock(1_700_000_000.0)
+    drivers = []
+    for i in (1, 2):
+        cfg = m.DriverConfig(driver_type=11, modem_id=i)
+        cfg.Extensions[ext].listen_address = "127.0.0.1"
+        cfg.Extensions[ext].multicast_address = "239.255.42.97"
+        cfg.Extensions[ext].multicast_port = port
+        d = make_driver(cfg, clock)
+        d.startup(cfg)
+        drivers.append(d)
+    d1, d2 = drivers
+    try:
+        q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
+        q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
+        bind(d1, q1)
+        bind(d2, q2)
+        got, acked = [], []
+        q2.signal_receive.connect(got.append)
+        q1.signal_ack.connect(lambda ack, orig: acked.append(orig.value))
+        q1.push_message(Status(src=1, dest=2, value=8))
+        clock.advance(1)
+        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        pump(drivers)
+        assert [x.value for x in got] == [8] and acked == [8]
+    finally:
+        for d in drivers:
+            d.shutdown()

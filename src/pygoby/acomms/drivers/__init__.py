@@ -14,6 +14,7 @@ DRIVER_CLASSES = {
     4: "pygoby.acomms.drivers.ufield:UFldDriver",
     5: "pygoby.acomms.drivers.store_server:StoreServerDriver",
     6: "pygoby.acomms.drivers.udp:UDPDriver",
+    11: "pygoby.acomms.drivers.udp_multicast:UDPMulticastDriver",
 }
 
 

@@ -344,7 +344,11 @@ class MMDriver(ModemDriverBase):
 
     # ------------------------------------------------------------------ data transmission
     def _initiate_data(self, msg) -> None:
-        check_rate(msg.rate)
+        try:
+            check_rate(msg.rate)
+        except ValueError as exc:
+            log.warning("not sending: %s", exc)
+            return
         msg.max_num_frames = RATE_NUM_FRAMES[msg.rate]
         msg.max_frame_bytes = RATE_FRAME_BYTES[msg.rate]
         if msg.src < 0:
