@@ -135,6 +135,11 @@ def test_unknown_keys_warn(msgs, caplog):
         in caplog.text
     )
     assert "1 segment(s) without '=' ignored" in caplog.text
+    caplog.clear()
+    with caplog.at_level(logging.WARNING):
+        keyvalue.parse("x=2,colour=blue,size=3", msgs.BasicNodeReport(), where="NODE")
+    assert "'colour'" not in caplog.text  # reported once per variable and key
+    assert "unknown key(s) 'size'" in caplog.text
 
 
 @pytest.mark.parametrize(

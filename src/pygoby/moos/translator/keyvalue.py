@@ -170,6 +170,12 @@ def _top_level_keys(text: str) -> list[str | None]:
     return keys
 
 
+# Unknown keys are reported once per (variable, type, key): feeds such as MOOS-IvP's
+# NODE_REPORT routinely carry keys a mission does not map, and arrive several times a second.
+_REPORTED_LIMIT = 10_000
+_reported: set[tuple[str, str, str]] = set()
+
+
 def _warn_unknown_keys(lower: str, msg: Message, where: str) -> None:
     known = set()
     for field in msg.DESCRIPTOR.fields:
@@ -177,17 +183,26 @@ def _warn_unknown_keys(lower: str, msg: Message, where: str) -> None:
         if is_message(field):
             known.update(f"{field.name}_{sub.name}".lower() for sub in field.message_type.fields)
     keys = _top_level_keys(lower)
+    type_name = msg.DESCRIPTOR.full_name
     unknown = [k for k in keys if k is not None and k not in known and "(" not in k]
-    malformed = keys.count(None)
+    new = [k for k in unknown if (where, type_name, k) not in _reported]
     prefix = f"{where}: " if where else ""
-    if unknown:
+    if new:
+        if len(_reported) < _REPORTED_LIMIT:
+            _reported.update((where, type_name, k) for k in new)
         log.warning(
-            "%sunknown key(s) %s ignored for %s",
+            "%sunknown key(s) %s ignored for %s (reported once)",
             prefix,
-            ", ".join(repr(k) for k in unknown),
-            msg.DESCRIPTOR.full_name,
+            ", ".join(repr(k) for k in new),
+            type_name,
         )
+    elif unknown:
+        log.debug("%sunknown key(s) ignored for %s", prefix, type_name)
+    malformed = keys.count(None)
     if malformed:
         log.warning(
-            "%s%d segment(s) without '=' ignored in key=value string %r", prefix, malformed, lower
+            "%s%d segment(s) without '=' ignored in key=value string %.80r",
+            prefix,
+            malformed,
+            lower,
         )
