@@ -4,7 +4,7 @@ The contest visits queues, not messages, so a data request costs the same with 1
 messages waiting; push costs one DCCL encode.
 """
 
-import sys
+import importlib.util
 from pathlib import Path
 
 import pytest
@@ -12,8 +12,13 @@ import pytest
 from pygoby.acomms import messages as m
 from pygoby.util.clock import VirtualClock
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from acomms.queue_helpers import entry, manager  # noqa: E402
+# the test DCCL types and queue set-up shared with tests/acomms (loaded by path: the test
+# folder's package name would clash with the PyPI `acomms` package)
+_HELPERS = Path(__file__).resolve().parents[1] / "tests" / "acomms" / "queue_helpers.py"
+_spec = importlib.util.spec_from_file_location("acomms_queue_helpers", _HELPERS)
+_helpers = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(_helpers)
+entry, manager = _helpers.entry, _helpers.manager
 
 QUEUED = 100_000
 

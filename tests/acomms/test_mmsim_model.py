@@ -67,3 +67,43 @@ async def test_pygoby_mmsim_command_answers_over_tcp():
     finally:
         proc.terminate()
         await proc.wait()
+
+
+async def test_two_mmsim_processes_hear_each_other():
+    import random
+
+    group = f"239.255.42.96:{random.randint(40000, 60000)}"
+    procs, ports = [], []
+    try:
+        for modem_id in (1, 2):
+            proc = await asyncio.create_subprocess_exec(
+                sys.executable, "-m", "pygoby.cli", "mmsim", "--port", "0", "--id", str(modem_id),
+                "--channel-group", group,
+                stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.DEVNULL,
+            )  # fmt: skip
+            procs.append(proc)
+            line = (await asyncio.wait_for(proc.stdout.readline(), 20)).decode()
+            ports.append(int(line.rsplit(":", 1)[1]))
+        (r1, w1), (r2, w2) = [await asyncio.open_connection("127.0.0.1", p) for p in ports]
+
+        def send(writer, body):
+            writer.write((NMEASentence.parse(body).message() + "\r\n").encode())
+
+        async def until(reader, prefix):
+            async with asyncio.timeout(10):
+                while not (line := (await reader.readline()).decode()).startswith(prefix):
+                    pass
+            return NMEASentence.parse(line)
+
+        send(w1, "$CCCYC,0,1,2,1,0,1")
+        drq = await until(r1, "$CADRQ")
+        assert drq.fields[2:6] == ("1", "2", "0", "64")
+        send(w1, "$CCTXD,1,2,0,c0ffee")
+        rxd = await until(r2, "$CARXD")
+        assert rxd.fields[1:] == ("1", "2", "0", "1", "c0ffee")
+        for w in (w1, w2):
+            w.close()
+    finally:
+        for proc in procs:
+            proc.terminate()
+            await proc.wait()
