@@ -278,3 +278,20 @@ def test_network_acks_for_configured_sources(clock):
     qm.do_work()
     kinds = [(a.ack_type, a.ack_src, a.message_src, a.message_dest, a.message_dccl_id) for a in got]
     assert kinds == [(m.NetworkAck.ACK, 2, 1, 2, 20), (m.NetworkAck.EXPIRE, 1, 1, 2, 20)]
+
+
+def test_encrypt_rules_per_peer(clock):
+    rule = m.QueueManagerConfig.EncryptRule
+    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")],
+                               encrypt_rule=[rule(id=2, crypto_passphrase="two")])  # fmt: skip
+    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")],
+                    encrypt_rule=[rule(id=1, crypto_passphrase="two")])  # fmt: skip
+    q2_wrong, _ = manager(clock, modem_id=2, entries=[entry("Status")],
+                          encrypt_rule=[rule(id=1, crypto_passphrase="other")])  # fmt: skip
+    msg = Status(src=1, dest=2, value=321)
+    q1.push_message(msg)
+    clock.advance(1)
+    frame = bytes(fill(q1).frame[0])
+    assert frame != q1.codec.encode(msg)  # the body is encrypted for peer 2
+    assert [x.value for x in decoded(q2, frame)] == [321]
+    assert [x.value for x in decoded(q2_wrong, frame)] != [321]

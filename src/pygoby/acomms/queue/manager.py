@@ -27,6 +27,7 @@ class QueueManager:
     def __init__(self, codec, clock: Clock | None = None) -> None:
         """`codec` is a pygoby.dccl.Codec (types are loaded into it as queues are added)."""
         self.codec = codec
+        self._peer_codecs: dict[int, object] = {}  # encrypt_rule: peer id -> Codec
         self.clock: Clock = clock if clock is not None else WallClock()
         self.cfg = m.QueueManagerConfig()
         self.queues: dict[int, MessageQueue] = {}  # by DCCL id, kept in ascending order
@@ -49,6 +50,15 @@ class QueueManager:
     def set_cfg(self, cfg) -> None:
         self.cfg = m.QueueManagerConfig()
         self.cfg.CopyFrom(cfg)
+        self._peer_codecs = {
+            rule.id: type(self.codec)(
+                passphrase=rule.crypto_passphrase, clock=self.clock, loader=self.codec.loader
+            )
+            for rule in cfg.encrypt_rule
+        }
+        for loaded in self.codec.loaded():
+            for peer in self._peer_codecs.values():
+                peer.load(loaded)
         for entry in cfg.message_entry:
             self.add_queue(entry)
 
@@ -59,6 +69,8 @@ class QueueManager:
         if message_class is None:
             message_class = self.codec.loader.message_class(entry.protobuf_name)
         self.codec.load(message_class)
+        for peer in self._peer_codecs.values():
+            peer.load(message_class)
         compiled = self.codec.compiled(message_class)
         if compiled.id is None:
             raise QueueError(f"{entry.protobuf_name} has no DCCL id")
@@ -107,7 +119,9 @@ class QueueManager:
         getter = queue.roles.get(Role.TIMESTAMP)
         when = timestamp_us(getter, msg) if getter is not None else None
         item.time = when if when is not None else m.now_us(self.clock.now())
-        item.encoded = encoded if encoded is not None else self.codec.encode(msg)
+        if encoded is None:  # encrypt_rule: the passphrase of the message's destination
+            encoded = self._peer_codecs.get(dest, self.codec).encode(msg)
+        item.encoded = encoded
         if not item.encoded:
             raise QueueError(f"{queue.name}: encoded size is 0; not queued")
         queue.push(item)
@@ -270,7 +284,8 @@ class QueueManager:
         offset = 0
         while offset < len(data):
             try:
-                msg, used = self.codec.decode_prefix(data[offset:])
+                codec = self._codec_for_source(data[offset:])
+                msg, used = codec.decode_prefix(data[offset:])
             except Exception as exc:  # any DCCL failure: keep what was decoded
                 where = "frame dropped" if offset == 0 else "rest of frame dropped"
                 log.warning("cannot decode DCCL message at byte %d (%s): %s", offset, where, exc)
@@ -280,6 +295,22 @@ class QueueManager:
                 self.signal_in_route.emit(msg, encoded, self.message_dest(msg), self.modem_id)
             offset += max(used, 1)
             self._deliver(msg)
+
+    def _codec_for_source(self, data: bytes):
+        """encrypt_rule on receipt: the passphrase of the sender, read from the clear header."""
+        if not self._peer_codecs:
+            return self.codec
+        compiled = self.codec.compiled(self.codec.type_of(data))
+        header = compiled.cls()
+        head_bytes = compiled.head_bytes
+        if len(data) < head_bytes:
+            return self.codec
+        compiled.decode_head(
+            header, int.from_bytes(data[:head_bytes], "little"), compiled.id_bits, head_bytes * 8
+        )
+        queue = self._by_name.get(compiled.name)
+        src = self._role(queue, Role.SOURCE_ID, header, 0) if queue is not None else 0
+        return self._peer_codecs.get(src, self.codec)
 
     def _deliver(self, msg) -> None:
         queue = self._by_name.get(msg.DESCRIPTOR.full_name)
