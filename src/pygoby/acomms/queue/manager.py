@@ -14,6 +14,7 @@ from pygoby.acomms import messages as m
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
 from pygoby.acomms.signals import Signal
+from pygoby.dccl import DcclError
 from pygoby.util.clock import Clock, WallClock
 
 log = logging.getLogger(__name__)
@@ -286,7 +287,7 @@ class QueueManager:
             try:
                 codec = self._codec_for_source(data[offset:])
                 msg, used = codec.decode_prefix(data[offset:])
-            except Exception as exc:  # any DCCL failure: keep what was decoded
+            except DcclError as exc:  # keep the messages decoded so far
                 where = "frame dropped" if offset == 0 else "rest of frame dropped"
                 log.warning("cannot decode DCCL message at byte %d (%s): %s", offset, where, exc)
                 return
