@@ -15,6 +15,7 @@ from pygoby.moos.translator.conversions import lexical_double
 from pygoby.moos.translator.errors import TranslatorConfigError
 from pygoby.moos.translator.geodesy import UTMGeodesy
 from pygoby.moos.translator.modem_id import ModemIdLookup
+from pygoby.util.ocean import mackenzie_1981
 
 
 def numeric(text: str) -> float:
@@ -87,17 +88,7 @@ def mackenzie_soundspeed(t: float, s: float, d: float) -> float:
     """Mackenzie (1981) sound speed (m/s); NaN outside T in [-2, 30], S in [25, 40], D in [0, 8000]."""
     if not (-2 <= t <= 30 and 25 <= s <= 40 and 0 <= d <= 8000):
         return math.nan
-    return (
-        1448.96
-        + 4.591 * t
-        - 5.304e-2 * t**2
-        + 2.374e-4 * t**3
-        + 1.340 * (s - 35)
-        + 1.630e-2 * d
-        + 1.675e-7 * d**2
-        - 1.025e-2 * t * (s - 35)
-        - 7.139e-13 * t * d**3
-    )
+    return mackenzie_1981(t, s, d)
 
 
 def _round_decimals(value: float, decimals: int) -> float:

@@ -9,24 +9,9 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-import gsw
+from pygoby.util.ocean import mackenzie_1981  # noqa: F401  (re-exported: one of the formulas here)
 
 SoundSpeedProfile = Callable[[float], float]  # depth (m) -> sound speed (m/s)
-
-
-def mackenzie_1981(T: float, S: float, D: float) -> float:
-    """Mackenzie (1981); valid 2..30 deg C, 25..40 ppt, 0..8000 m."""
-    return (
-        1448.96
-        + 4.591 * T
-        - 5.304e-2 * T**2
-        + 2.374e-4 * T**3
-        + 1.340 * (S - 35)
-        + 1.630e-2 * D
-        + 1.675e-7 * D**2
-        - 1.025e-2 * T * (S - 35)
-        - 7.139e-13 * T * D**3
-    )
 
 
 def medwin_1975(T: float, S: float, D: float) -> float:
@@ -77,6 +62,8 @@ def unesco_1983(S: float, T68: float, P_dbar: float) -> float:
 def teos10(SA: float, CT: float, P_dbar: float) -> float:
     """TEOS-10 (IOC, SCOR & IAPSO 2010) via `gsw.sound_speed`, which uses the 75-term
     specific-volume polynomial of Roquet et al. (2015); P is sea pressure in dbar."""
+    import gsw  # numpy-based: loaded only when TEOS-10 is used
+
     return float(gsw.sound_speed(SA, CT, P_dbar))
 
 
@@ -91,6 +78,8 @@ def teos10_pressure(depth: float, lat: float) -> float:
 
     gsw counts height positive up, so z = -depth; the dynamic-height terms are left at zero.
     """
+    import gsw
+
     return float(gsw.p_from_z(-depth, lat))
 
 
