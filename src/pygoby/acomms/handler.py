@@ -1,0 +1,401 @@
+"""AcommsHandler: modem drivers, MAC, priority queue and DCCL wired together as pAcommsHandler
+wires them (spec goby-moos-apps.md §4.2-4.3, §4.8-4.9; acomms.md §2), without any MOOS.
+
+    handler = AcommsHandler(cfg, clock, loader)     # cfg: pAcommsHandlerConfig (or any message
+                                                    # with the same acomms fields)
+    handler.configure_queue(resolve)                # after the message types are loaded
+    handler.start()                                 # drivers start at the next do_work, MAC runs
+    handler.queue.push_message(msg)                 # outgoing DCCL messages
+    handler.do_work()                               # >= 5 Hz, inside a running asyncio loop
+
+`cfg.modem_id` is copied into the queue, the MAC and every driver configuration without its
+own id. Every driver (primary and listen) is bound to the queue; only the primary is bound to
+the MAC and has its informational signals re-emitted (`signal_raw_incoming`,
+`signal_raw_outgoing`, `signal_modem_receive`, `signal_modem_transmit`). A driver exception
+from `startup()` or `do_work()` shuts the driver down and applies `driver_failure_approach`.
+The queue's and the MAC's own signals are used directly (`handler.queue.signal_receive`, ...).
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import logging
+import os
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from google.protobuf.message import Message
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.bind import bind, unbind
+from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException, driver_name
+from pygoby.acomms.mac import MACManager
+from pygoby.acomms.queue import QueueError, QueueManager
+from pygoby.acomms.signals import Signal
+from pygoby.dccl import Codec, DcclError
+from pygoby.protobuf import ProtoLoader
+from pygoby.util.clock import Clock
+
+log = logging.getLogger(__name__)
+
+Status = m.ModemDriverStatus
+DriverType = m.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type.values_by_name
+DRIVER_NONE = DriverType["DRIVER_NONE"].number
+
+# Built-in drivers: DriverType name -> "module:class" (imported when first used).
+BUILTIN_DRIVERS = {
+    "DRIVER_WHOI_MICROMODEM": "pygoby.acomms.drivers.micromodem:MMDriver",
+    "DRIVER_UDP": "pygoby.acomms.drivers.udp:UDPDriver",
+    "DRIVER_STORE_SERVER": "pygoby.acomms.drivers.store_server:StoreServerDriver",
+}
+PLUGINS_ENV = "PACOMMSHANDLER_PLUGINS"
+
+CONTINUALLY_RESTART_DRIVER = 1
+MOVE_LISTEN_DRIVER_TO_PRIMARY = 2
+DISABLE_AND_MOVE_LISTEN_DRIVER_TO_PRIMARY = 3
+
+
+class HandlerError(Exception):
+    """The configuration cannot be used, or a failure the handler cannot recover from."""
+
+
+# --------------------------------------------------------------------------------------------
+# Drivers
+
+
+def _import_object(spec: str):
+    module, _, name = spec.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def import_module_or_file(name: str):
+    """A Python module given by importable name or by the path of a .py file (driver plugins,
+    and `load_shared_library` modules of generated message code)."""
+    path = Path(name)
+    if path.suffix == ".py":
+        spec = importlib.util.spec_from_file_location(f"pygoby_loaded_{path.stem}", path)
+        if spec is None or spec.loader is None:
+            raise ImportError(f"cannot load {name}")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+    return importlib.import_module(name)
+
+
+def plugin_driver_factory(driver_name: str) -> Callable[[Clock], ModemDriverBase]:
+    """`goby_make_driver` of the plugin (listed in $PACOMMSHANDLER_PLUGINS, separated by any of
+    `;`, `:`, `,`) whose `goby_driver_name()` is `driver_name`."""
+    listed = [p for p in re.split(r"[;:,]", os.environ.get(PLUGINS_ENV, "")) if p.strip()]
+    for name in listed:
+        try:
+            module = import_module_or_file(name.strip())
+        except (ImportError, OSError, SyntaxError) as exc:
+            raise HandlerError(f"cannot load driver plugin {name!r}: {exc}") from None
+        namer = getattr(module, "goby_driver_name", None)
+        if namer is None or namer() != driver_name:
+            continue
+        factory = getattr(module, "goby_make_driver", None)
+        if factory is None:
+            raise HandlerError(f"driver plugin {name!r} has no goby_make_driver()")
+        return factory
+    raise HandlerError(
+        f"no driver plugin named {driver_name!r} in ${PLUGINS_ENV} ({', '.join(listed) or 'empty'})"
+    )
+
+
+def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
+    """The driver selected by `cfg` (DriverConfig), or None for DRIVER_NONE."""
+    if cfg.WhichOneof("driver") == "driver_name":
+        factory = plugin_driver_factory(cfg.driver_name)
+        try:
+            return factory(clock)
+        except TypeError:
+            return factory()
+    if cfg.driver_type == DRIVER_NONE:
+        return None
+    type_name = (
+        m.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"]
+        .enum_type.values_by_number[cfg.driver_type]
+        .name
+    )
+    spec = BUILTIN_DRIVERS.get(type_name)
+    if spec is None:
+        raise HandlerError(f"driver_type {type_name} is not implemented in pygoby")
+    return _import_object(spec)(clock)
+
+
+@dataclass(eq=False)
+class DriverSlot:
+    """One configured driver and its run state (`restart_at` is None while it runs)."""
+
+    driver: ModemDriverBase
+    cfg: object  # DriverConfig
+    restart_at: float | None = 0.0
+    failures: int = 0
+
+    @property
+    def running(self) -> bool:
+        return self.restart_at is None
+
+
+# --------------------------------------------------------------------------------------------
+
+
+class AcommsHandler:
+    def __init__(
+        self,
+        cfg,
+        clock: Clock,
+        loader: ProtoLoader | None = None,
+        driver_factory: Callable[[object, Clock], ModemDriverBase | None] = make_driver,
+    ) -> None:
+        if cfg.modem_id == m.BROADCAST_ID:
+            raise HandlerError("modem_id 0 is the broadcast address; set a modem_id of 1 or more")
+        self.clock = clock
+        self.modem_id = cfg.modem_id
+        self.failure = type(cfg.driver_failure_approach)()
+        self.failure.CopyFrom(cfg.driver_failure_approach)
+
+        # Drivers first (as upstream): a bad driver configuration fails before anything runs.
+        self.slots: list[DriverSlot] = []
+        self.primary: DriverSlot | None = None
+        self.signal_raw_incoming = Signal()  # (ModemRaw) of the primary driver
+        self.signal_raw_outgoing = Signal()
+        self.signal_modem_receive = Signal()  # (ModemTransmission) received by the primary
+        self.signal_modem_transmit = Signal()  # (ModemTransmission) transmit result
+        primary_cfg = m.DriverConfig()
+        primary_cfg.CopyFrom(cfg.driver_cfg)
+        if primary_cfg.WhichOneof("driver") is None and cfg.HasField("driver_type"):
+            primary_cfg.driver_type = cfg.driver_type  # Goby 2 style top-level driver_type
+        for index, driver_cfg in enumerate([primary_cfg, *cfg.listen_driver_cfg]):
+            own = m.DriverConfig()
+            own.CopyFrom(driver_cfg)
+            if not own.HasField("modem_id"):
+                own.modem_id = self.modem_id
+            try:
+                driver = driver_factory(own, clock)
+            except ModemDriverException as exc:
+                raise HandlerError(f"driver configuration: {exc}") from None
+            if driver is None:
+                continue
+            slot = DriverSlot(driver, own)
+            self.slots.append(slot)
+            if index == 0:
+                self.primary = slot
+            self._forward_informational(slot)
+
+        self.codec = Codec(
+            passphrase=cfg.dccl_cfg.crypto_passphrase or None,
+            clock=clock,
+            do_not_encrypt_ids=cfg.dccl_cfg.skip_crypto_for_id,
+            loader=loader,
+        )
+        if cfg.dccl_cfg.id_codec:
+            log.warning("dccl_cfg.id_codec %r: custom id codecs are not supported; using the "
+                        "default id codec", cfg.dccl_cfg.id_codec)  # fmt: skip
+
+        self.queue_cfg = m.QueueManagerConfig()
+        self.queue_cfg.CopyFrom(cfg.queue_cfg)
+        self.queue_cfg.modem_id = self.modem_id
+        self.queue = QueueManager(self.codec, clock)
+        for slot in self.slots:
+            bind(slot.driver, self.queue)
+
+        self.mac_cfg = m.MACConfig()
+        self.mac_cfg.CopyFrom(cfg.mac_cfg)
+        self.mac_cfg.modem_id = self.modem_id
+        self.mac = MACManager(clock)
+        if self.primary is not None:
+            self.mac.signal_initiate_transmission.connect(self._initiate_on_primary)
+            self.primary.driver.signal_receive.connect(self.mac.handle_modem_receive)
+
+        self.route_cfg = type(cfg.route_cfg)()
+        self.route_cfg.CopyFrom(cfg.route_cfg)
+        if cfg.route_cfg.route.hop:
+            log.warning("route_cfg: static routing is not available yet; the route is kept "
+                        "(and replaced by RouteCommand) but messages are not relayed")  # fmt: skip
+
+    # ------------------------------------------------------------------ start-up
+    def configure_queue(self, resolve: Callable[[str], type[Message]]) -> list[str]:
+        """Create one queue per `queue_cfg.message_entry` whose type `resolve` knows; the
+        others are skipped (as upstream) and their names returned."""
+        entries = list(self.queue_cfg.message_entry)
+        base = m.QueueManagerConfig()
+        base.CopyFrom(self.queue_cfg)
+        del base.message_entry[:]
+        self.queue.set_cfg(base)
+        skipped = []
+        for entry in entries:
+            try:
+                cls = resolve(entry.protobuf_name)
+            except Exception:
+                log.debug("queue_cfg: %s is not a loaded type; no queue", entry.protobuf_name)
+                skipped.append(entry.protobuf_name)
+                continue
+            try:
+                self.queue.add_queue(entry, cls)
+            except (QueueError, DcclError, ValueError) as exc:
+                raise HandlerError(
+                    f"queue_cfg message_entry {entry.protobuf_name}: {exc}"
+                ) from None
+        return skipped
+
+    def start(self) -> None:
+        """Drivers start at the next `do_work`; the MAC starts its cycle now."""
+        for slot in self.slots:
+            slot.restart_at = 0.0
+        self.mac.startup(self.mac_cfg)
+
+    def shutdown(self) -> None:
+        self.mac.shutdown()
+        for slot in self.slots:
+            if slot.running:
+                self._shutdown_driver(slot)
+            slot.restart_at = 0.0
+
+    # ------------------------------------------------------------------ main loop (§4.9 3-6)
+    def do_work(self) -> None:
+        now = self.clock.now()
+        for slot in list(self.slots):
+            if not slot.running and slot.restart_at is not None and now >= slot.restart_at:
+                self._start_driver(slot)
+        for slot in list(self.slots):
+            if slot.running and slot in self.slots:
+                try:
+                    slot.driver.do_work()
+                except Exception as exc:  # any driver failure, including bugs: never fatal
+                    self._driver_failed(
+                        slot, _status_of(exc, Status.CONNECTION_TO_MODEM_FAILED), exc
+                    )
+        if self.primary is None or self.primary.running:
+            self.mac.do_work()
+        self.queue.do_work()
+
+    # ------------------------------------------------------------------ external requests
+    def initiate_transmission(self, transmission) -> None:
+        """A transmission requested from outside the MAC (e.g. an ad-hoc ping)."""
+        if self.primary is None:
+            log.warning("no primary driver: transmission request ignored")
+            return
+        self.primary.driver.handle_initiate_transmission(transmission)
+
+    def inject_receive(self, transmission) -> None:
+        """Treat `transmission` as received by a driver (queue only)."""
+        self.queue.handle_modem_receive(transmission)
+
+    def apply_mac_update(self, update) -> None:
+        """MACUpdate addressed to this node (§4.8); silences/restores Micro-Modems."""
+        state = self.mac.apply_update(update)
+        if state is None:
+            return
+        for slot in self.slots:
+            set_silent = getattr(slot.driver, "set_silent", None)
+            if set_silent is not None and slot.running:
+                set_silent(not state)
+
+    def update_driver_cfg(self, cfg) -> None:
+        """DriverConfig update for every running driver with the same modem_id."""
+        for slot in self.slots:
+            if slot.running and slot.cfg.modem_id == cfg.modem_id:
+                slot.driver.update_cfg(cfg)
+
+    def reset_primary(self) -> None:
+        """Manual reset (ACOMMS_DRIVER_RESET): shut down, then the failure approach."""
+        if self.primary is None:
+            log.warning("driver reset requested but there is no primary driver")
+            return
+        self._driver_failed(self.primary, Status.MANUAL_RESET, "manual reset")
+
+    def replace_route(self, route) -> None:
+        self.route_cfg.route.CopyFrom(route)
+        log.info("route replaced: %s", list(route.hop))
+
+    # ------------------------------------------------------------------ internals
+    def _initiate_on_primary(self, transmission) -> None:
+        if self.primary is not None and self.primary.running:
+            self.primary.driver.handle_initiate_transmission(transmission)
+
+    def _forward_informational(self, slot: DriverSlot) -> None:
+        driver = slot.driver
+
+        def forward(signal: Signal) -> Callable[[object], None]:
+            def emit(msg) -> None:
+                if self.primary is slot:
+                    signal.emit(msg)
+
+            return emit
+
+        driver.signal_raw_incoming.connect(forward(self.signal_raw_incoming))
+        driver.signal_raw_outgoing.connect(forward(self.signal_raw_outgoing))
+        driver.signal_receive.connect(forward(self.signal_modem_receive))
+        driver.signal_transmit_result.connect(forward(self.signal_modem_transmit))
+
+    def _start_driver(self, slot: DriverSlot) -> None:
+        log.info("starting driver %s", _name(slot))
+        try:
+            slot.driver.startup(slot.cfg)
+        except Exception as exc:
+            self._driver_failed(slot, _status_of(exc, Status.STARTUP_FAILED), exc, started=False)
+            return
+        slot.restart_at = None
+
+    def _shutdown_driver(self, slot: DriverSlot) -> None:
+        try:
+            slot.driver.shutdown()
+        except Exception:
+            log.exception("driver %s failed to shut down cleanly", _name(slot))
+
+    def _driver_failed(self, slot: DriverSlot, status: int, why, started: bool = True) -> None:
+        slot.failures += 1
+        log.warning("driver %s failed (%s): %s", _name(slot), Status.Status.Name(status), why)
+        self.signal_driver_status.emit(
+            Status(
+                src=max(1, min(slot.cfg.modem_id, 32)),
+                time=self.clock.now(),
+                status=status,
+                n_resets=min(slot.failures, 255),
+            )  # fmt: skip
+        )
+        if started or slot.running:
+            self._shutdown_driver(slot)
+        now = self.clock.now()
+        technique = self.failure.technique
+        if technique == CONTINUALLY_RESTART_DRIVER or slot is not self.primary:
+            slot.restart_at = now + self.failure.driver_backoff_sec
+            return
+        if len(self.slots) < 2:
+            raise HandlerError(
+                f"primary driver {_name(slot)} failed and there is no listen driver to replace it"
+            )
+        index = self.slots.index(slot)
+        new = self.slots[(index + 1) % len(self.slots)]
+        new.cfg.modem_id, slot.cfg.modem_id = slot.cfg.modem_id, new.cfg.modem_id
+        self._make_primary(new)
+        if new.running:
+            self._shutdown_driver(new)
+        new.restart_at = now + self.failure.new_driver_backoff_sec
+        if technique == DISABLE_AND_MOVE_LISTEN_DRIVER_TO_PRIMARY:
+            unbind(slot.driver, self.queue)
+            self.slots.remove(slot)
+            slot.restart_at = None
+            log.warning("driver %s disabled", _name(slot))
+        else:
+            slot.restart_at = now + self.failure.driver_backoff_sec
+        log.warning("driver %s is now the primary driver", _name(new))
+
+    def _make_primary(self, new: DriverSlot) -> None:
+        if self.primary is not None:
+            self.primary.driver.signal_receive.disconnect(self.mac.handle_modem_receive)
+        self.primary = new
+        new.driver.signal_receive.connect(self.mac.handle_modem_receive)
+
+
+def _status_of(exc: BaseException, default: int) -> int:
+    return exc.status if isinstance(exc, ModemDriverException) else default
+
+
+def _name(slot: DriverSlot) -> str:
+    return driver_name(slot.cfg)

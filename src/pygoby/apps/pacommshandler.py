@@ -1,0 +1,335 @@
+"""pAcommsHandler: goby-acomms on a MOOS community (spec goby-moos-apps.md §4).
+
+Translator entries create DCCL messages from MOOS variables and push them into the priority
+queue; the MAC opens the slots, the driver asks the queue for frames; messages received over
+the link are published through the same entries' publish rules and posted on
+ACOMMS_QUEUE_RECEIVE. Every ACOMMS_* variable of the spec's table is published or handled.
+The acomms wiring itself is `pygoby.acomms.handler.AcommsHandler`; this module maps the
+configuration, the translator and the MOOS variables onto it.
+
+    pAcommsHandler mission.moos [AppName]
+    pAcommsHandler --example_config
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import functools
+
+from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+from google.protobuf.message import Message
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.handler import AcommsHandler, HandlerError, import_module_or_file
+from pygoby.acomms.queue import QueueError
+from pygoby.dccl import DcclError
+from pygoby.moos.app import GobyMOOSApp
+from pygoby.moos.appconfig import ConfigError
+from pygoby.moos.protocol import MOOSMessage
+from pygoby.moos.translator import (
+    LAT_ORIGIN_VAR,
+    LONG_ORIGIN_VAR,
+    ModemIdLookup,
+    MoosValues,
+    Post,
+    Translator,
+    TranslatorError,
+    TranslatorRunner,
+    moos_technique_from_config,
+    parse_for_moos,
+    post_for_moos,
+)
+from pygoby.protobuf import ProtoError, ProtoLoader, builtin_class, default_loader
+
+ROUTE_COMMAND = "goby.acomms.protobuf.RouteCommand"
+ROUTE_PROTO = "goby/acomms/protobuf/route.proto"
+INTERFACE_DATA = "goby.middleware.frontseat.protobuf.InterfaceData"
+FRONTSEAT_PROTO = "goby/middleware/protobuf/frontseat.proto"
+
+
+@functools.cache
+def interface_data_class() -> type[Message]:
+    """iFrontSeat's InterfaceData; if pygoby has no frontseat messages, a stand-in with the one
+    field used here (`dccl_message` = 3) under the same type name, so readers parse it."""
+    try:
+        return builtin_class(FRONTSEAT_PROTO, INTERFACE_DATA)
+    except ProtoError:
+        file_proto = descriptor_pb2.FileDescriptorProto(
+            name="pygoby/apps/interface_data_stand_in.proto",
+            package="goby.middleware.frontseat.protobuf",
+            syntax="proto2",
+        )
+        msg = file_proto.message_type.add(name="InterfaceData")
+        msg.field.add(name="dccl_message", number=3, type=descriptor_pb2.FieldDescriptorProto.TYPE_BYTES,
+                      label=descriptor_pb2.FieldDescriptorProto.LABEL_OPTIONAL)  # fmt: skip
+        pool = descriptor_pool.DescriptorPool()
+        pool.Add(file_proto)
+        return message_factory.GetMessageClass(pool.FindMessageTypeByName(INTERFACE_DATA))
+
+
+def _raw_value(raw: bytes) -> str | bytes:
+    """Driver traffic as a MOOS string when it is text (NMEA), else as a binary string."""
+    try:
+        text = raw.decode("ascii")
+    except UnicodeDecodeError:
+        return raw
+    return text if text.isprintable() else raw
+
+
+class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
+    config_proto = (
+        "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
+        "goby.apps.moos.protobuf.pAcommsHandlerConfig",
+    )
+    default_name = "pAcommsHandler"
+
+    def __init__(self, cfg: Message, **kwargs) -> None:
+        super().__init__(cfg, **kwargs)
+        names = cfg.moos_var
+        self.var = {f.name: names.prefix + getattr(names, f.name)
+                    for f in names.DESCRIPTOR.fields if f.name not in ("prefix", "ifrontseat_data_out")}  # fmt: skip
+        self.ifs_data_out = names.ifrontseat_data_out
+        self.loader = ProtoLoader()
+        try:
+            self.moos_technique = moos_technique_from_config(self.common)
+            self.acomms = AcommsHandler(cfg, self.clock, self.loader)
+        except (HandlerError, TranslatorError) as err:
+            raise ConfigError(str(err)) from None
+        self.queue = self.acomms.queue
+        self.publish("MODEM_ID", float(cfg.modem_id))
+        self.publish("VEHICLE_ID", float(cfg.modem_id))
+        try:
+            for module in cfg.load_shared_library:
+                import_module_or_file(module)
+            for path in cfg.load_proto_file:
+                self.loader.load_file(path)
+        except (ImportError, ProtoError, OSError, SyntaxError) as err:
+            raise ConfigError(f"cannot load message definitions: {err}") from None
+        self._connect_signals()
+        try:
+            skipped = self.acomms.configure_queue(self._message_class)
+        except HandlerError as err:
+            raise ConfigError(str(err)) from None
+        for name in skipped:
+            self.log.debug("queue_cfg: no queue for %s (type not loaded)", name)
+        self.acomms.start()
+        modem_ids = (
+            ModemIdLookup.from_file(cfg.modem_id_lookup_path) if cfg.modem_id_lookup_path else None
+        )
+        try:
+            self.translator = Translator(
+                cfg.translator_entry,
+                self._message_class,
+                lat_origin=self.common.lat_origin,
+                lon_origin=self.common.lon_origin,
+                modem_ids=modem_ids,
+            )
+        except TranslatorError as err:
+            raise ConfigError(str(err)) from None
+        self.runner: TranslatorRunner | None = None
+        self._subscribe_all()
+        self.frontseat_forward = set()
+        for name in cfg.dccl_frontseat_forward_name:
+            try:
+                self._message_class(name)
+            except Exception:
+                raise ConfigError(
+                    f"dccl_frontseat_forward_name {name!r} is not a loaded type"
+                ) from None
+            self.frontseat_forward.add(name)
+
+    def _message_class(self, name: str) -> type[Message]:
+        """Message types: the app's .proto files, then load_shared_library modules (protobuf's
+        default pool), then goby's own messages (MACUpdate, RouteCommand, NetworkAck, ...)."""
+        try:
+            return self.loader.message_class(name)
+        except ProtoError:
+            pass
+        with contextlib.suppress(KeyError):
+            descriptor = descriptor_pool.Default().FindMessageTypeByName(name)
+            return message_factory.GetMessageClass(descriptor)
+        goby = default_loader()
+        goby.load_file(ROUTE_PROTO)
+        return goby.message_class(name)
+
+    # ------------------------------------------------------------------ wiring
+    def _connect_signals(self) -> None:
+        acomms, queue, mac = self.acomms, self.acomms.queue, self.acomms.mac
+        acomms.signal_raw_incoming.connect(functools.partial(self._post_raw, True))
+        acomms.signal_raw_outgoing.connect(functools.partial(self._post_raw, False))
+        acomms.signal_modem_receive.connect(functools.partial(self._post_pb, "driver_receive"))
+        acomms.signal_modem_transmit.connect(functools.partial(self._post_pb, "driver_transmit"))
+        mac.signal_initiate_transmission.connect(
+            functools.partial(self._post_pb, "mac_initiate_transmission")
+        )
+        mac.signal_slot_start.connect(functools.partial(self._post_pb, "mac_slot_start"))
+        queue.signal_receive.connect(self._on_queue_receive)
+        queue.signal_ack.connect(self._on_ack)
+        queue.signal_expire.connect(functools.partial(self._post_pb, "queue_expire"))
+        queue.signal_queue_size_change.connect(functools.partial(self._post_pb, "queue_size"))
+        queue.signal_data_on_demand.connect(self._on_data_on_demand)
+
+    def _subscribe_all(self) -> None:
+        handlers = {
+            "driver_receive": self._on_external_receive,
+            "mac_initiate_transmission": self._on_external_initiate,
+            "mac_cycle_update": self._on_mac_update,
+            "queue_flush": self._on_flush,
+            "config_file_request": self._on_config_request,
+            "driver_reset": self._on_driver_reset,
+            "driver_cfg_update": self._on_driver_cfg_update,
+        }
+        for key, handler in handlers.items():
+            self.subscribe(self.var[key], handler)
+        triggers = set()
+        for entry in self.translator.entries.values():
+            if entry.HasField("trigger") and entry.trigger.type == entry.trigger.TRIGGER_PUBLISH:
+                triggers.add(entry.trigger.moos_var)
+        handled = {*triggers, LAT_ORIGIN_VAR, LONG_ORIGIN_VAR}
+        for var in sorted(handled):
+            self.subscribe(var, self._on_translator_mail)
+        for var in self.translator.subscriptions():
+            if var not in handled:
+                self.subscribe(var)  # keeps dynamic_vars fresh for the create rules
+        for var in self.cfg.multiplex_create_moos_var:
+            self.subscribe(var, self._on_multiplex)
+
+    # ------------------------------------------------------------------ running
+    def on_start(self) -> None:
+        self.runner = TranslatorRunner(
+            self.translator,
+            start_time=self.start_time,
+            multiplex_vars=self.cfg.multiplex_create_moos_var,
+            variables=MoosValues(self.dynamic_vars),
+        )
+
+    def on_stop(self) -> None:
+        self.acomms.shutdown()
+
+    def loop(self) -> None:
+        if self.runner is not None:
+            self._push_created(self.runner.tick(self.clock.now()))
+        try:
+            self.acomms.do_work()
+        except HandlerError as err:
+            self.log.critical("%s; stopping", err)
+            self.request_stop()
+
+    # ------------------------------------------------------------------ MOOS -> acomms
+    def _on_translator_mail(self, msg: MOOSMessage) -> None:
+        if self.runner is not None:
+            self._push_created(self.runner.on_mail(msg.key, msg.value))
+
+    def _on_multiplex(self, msg: MOOSMessage) -> None:
+        if self.runner is None:
+            return
+        try:
+            posts = self.runner.on_multiplex(msg.value, self.moos_technique)
+        except TranslatorError as err:
+            self.log.warning("multiplexed message on %s not posted: %s", msg.key, err)
+            return
+        self._post(posts)
+
+    def _push_created(self, messages: list[Message]) -> None:
+        for message in messages:
+            try:
+                self.queue.push_message(message)
+            except (QueueError, DcclError, ValueError) as err:
+                self.log.warning("%s not queued: %s", message.DESCRIPTOR.full_name, err)
+
+    def _on_data_on_demand(self, request, message: Message) -> None:
+        try:
+            message.CopyFrom(
+                self.translator.create(message.DESCRIPTOR.full_name, MoosValues(self.dynamic_vars))
+            )
+        except TranslatorError as err:
+            self.log.warning("on-demand %s not created: %s", message.DESCRIPTOR.full_name, err)
+
+    def _parse(self, msg: MOOSMessage, cls: type[Message]) -> Message | None:
+        out = cls()
+        try:
+            parse_for_moos(msg.value, out, self.moos_technique)
+        except TranslatorError as err:
+            self.log.warning("cannot parse %s as %s: %s", msg.key, cls.DESCRIPTOR.full_name, err)
+            return None
+        return out
+
+    def _from_others(self, msg: MOOSMessage) -> bool:
+        return msg.src != self.name
+
+    def _on_external_receive(self, msg: MOOSMessage) -> None:
+        if self._from_others(msg) and (transmission := self._parse(msg, m.ModemTransmission)):
+            self.acomms.inject_receive(transmission)
+
+    def _on_external_initiate(self, msg: MOOSMessage) -> None:
+        if self._from_others(msg) and (transmission := self._parse(msg, m.ModemTransmission)):
+            self.acomms.initiate_transmission(transmission)
+
+    def _on_mac_update(self, msg: MOOSMessage) -> None:
+        if (update := self._parse(msg, m.MACUpdate)) is not None:
+            self.acomms.apply_mac_update(update)
+
+    def _on_flush(self, msg: MOOSMessage) -> None:
+        if (flush := self._parse(msg, m.QueueFlush)) is not None:
+            self.queue.flush_queue(flush)
+
+    def _on_config_request(self, msg: MOOSMessage) -> None:
+        self.publish(
+            self.var["config_file"], base64.b64encode(self.cfg.SerializeToString()).decode()
+        )
+
+    def _on_driver_reset(self, msg: MOOSMessage) -> None:
+        try:
+            self.acomms.reset_primary()
+        except HandlerError as err:
+            self.log.critical("%s; stopping", err)
+            self.request_stop()
+
+    def _on_driver_cfg_update(self, msg: MOOSMessage) -> None:
+        if (cfg := self._parse(msg, m.DriverConfig)) is not None:
+            self.acomms.update_driver_cfg(cfg)
+
+    # ------------------------------------------------------------------ acomms -> MOOS
+    def _post(self, posts: list[Post]) -> None:
+        for post in posts:
+            self.publish(post.var, post.value, src_aux=post.source_aux)
+
+    def _post_pb(self, key: str, message: Message) -> None:
+        self._post([post_for_moos(self.var[key], message, self.moos_technique)])
+
+    def _post_raw(self, incoming: bool, raw) -> None:
+        self.publish(
+            self.var["driver_raw_in" if incoming else "driver_raw_out"], _raw_value(raw.raw)
+        )
+        self._post_pb("driver_raw_msg_in" if incoming else "driver_raw_msg_out", raw)
+
+    def _on_ack(self, ack, original: Message) -> None:
+        self._post_pb("queue_ack_transmission", ack)
+        self._post_pb("queue_ack_original_msg", original)
+
+    def _on_queue_receive(self, message: Message) -> None:
+        name = message.DESCRIPTOR.full_name
+        try:
+            self._post(self.translator.publish(message))
+        except TranslatorError as err:
+            self.log.warning("Failed to translate received message %s: %s", name, err)
+        if name in self.frontseat_forward:
+            try:
+                data = self.acomms.codec.encode(message)
+            except DcclError as err:
+                self.log.warning("cannot forward %s to the frontseat: %s", name, err)
+            else:
+                self._post([post_for_moos(self.ifs_data_out, interface_data_class()(dccl_message=data),
+                                          self.moos_technique)])  # fmt: skip
+        if name == ROUTE_COMMAND and self.acomms.route_cfg.route.hop:
+            self.acomms.replace_route(message.new_route)
+        self._post_pb("queue_receive", message)
+
+
+def main(argv=None) -> int:
+    return pAcommsHandler.main(argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,192 @@
+"""Two pAcommsHandler communities for end-to-end tests: embedded MOOSDBs, Micro-Modem emulators
+on real loopback TCP (one perfect acoustic channel), and a MOOS client per community that
+records everything it sees."""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+from collections.abc import Callable
+from pathlib import Path
+
+from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
+from pygoby.acomms.mmsim.server import MMSimServer
+from pygoby.apps.pacommshandler import pAcommsHandler
+from pygoby.moos.client import MOOSClient
+from pygoby.moos.db import MOOSDB
+from pygoby.moos.protocol import MOOSMessage
+from pygoby.util.clock import WallClock
+
+PROTO = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / "two_vehicles.proto"
+STATUS = "pygoby.examples.SimpleStatus"
+COMMAND = "pygoby.examples.Command"
+SLOT_SECONDS = 1.5
+
+QUEUE_ENTRIES = f"""\
+  queue_cfg {{
+    message_entry {{
+      protobuf_name: "{STATUS}"  ack: false  max_queue: 1  ttl: 120
+      role {{ type: SOURCE_ID field: "src" }}
+      role {{ type: DESTINATION_ID field: "dest" }}
+      role {{ type: TIMESTAMP field: "time" }}
+    }}
+    message_entry {{
+      protobuf_name: "{COMMAND}"  ack: true  value_base: 5  ttl: 600
+      role {{ type: SOURCE_ID field: "src" }}
+      role {{ type: DESTINATION_ID field: "dest" }}
+      role {{ type: TIMESTAMP field: "time" }}
+    }}
+  }}
+"""
+
+TRANSLATOR_ENTRIES = f"""\
+  translator_entry {{
+    protobuf_name: "{STATUS}"
+    trigger {{ type: TRIGGER_PUBLISH moos_var: "SEND_STATUS" }}
+    create {{ technique: TECHNIQUE_FORMAT moos_var: "DB_TIME" format: "%1%" }}
+    create {{ technique: TECHNIQUE_FORMAT moos_var: "MODEM_ID" format: "%2%" }}
+    create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_X" format: "%10%" }}
+    create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_Y" format: "%11%" }}
+    create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_SPEED" format: "%12%" }}
+    create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_HEADING" format: "%13%"
+             algorithm {{ name: "angle_0_360" primary_field: 13 }} }}
+    create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_DEPTH" format: "%14%" }}
+    publish {{ technique: TECHNIQUE_FORMAT moos_var: "STATUS_REPORT_IN"
+              format: "src=%2%,x=%10%,y=%11%,speed=%12%,heading=%13%,depth=%14%" }}
+  }}
+  translator_entry {{
+    protobuf_name: "{COMMAND}"
+    trigger {{ type: TRIGGER_PUBLISH moos_var: "COMMAND_OUT" }}
+    create {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS moos_var: "COMMAND_OUT" }}
+    create {{ technique: TECHNIQUE_FORMAT moos_var: "DB_TIME" format: "%1%" }}
+    create {{ technique: TECHNIQUE_FORMAT moos_var: "MODEM_ID" format: "%2%" }}
+    publish {{ technique: TECHNIQUE_FORMAT moos_var: "DESIRED_HEADING" format: "%10%" }}
+    publish {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS moos_var: "COMMAND_IN" }}
+  }}
+"""
+
+
+def mission_text(
+    modem_id: int, db_port: int, modem_port: int, extra: str = "", slots: str | None = None
+) -> str:
+    if slots is None:
+        slots = "".join(
+            f"    slot {{ src: {src} dest: -1 rate: 0 type: DATA slot_seconds: {SLOT_SECONDS} }}\n"
+            for src in (1, 2)
+        )
+    return f"""\
+ServerHost = localhost
+ServerPort = {db_port}
+Community  = vehicle{modem_id}
+
+ProcessConfig = pAcommsHandler
+{{
+  common {{ log: false  app_tick: 20  verbosity: WARN }}
+  modem_id: {modem_id}
+  driver_cfg {{
+    driver_type: DRIVER_WHOI_MICROMODEM
+    connection_type: CONNECTION_TCP_AS_CLIENT
+    tcp_server: "127.0.0.1"
+    tcp_port: {modem_port}
+    reconnect_interval: 1
+    [goby.acomms.micromodem.protobuf.config] {{ query_cfg_on_startup: false }}
+  }}
+  mac_cfg {{
+    type: MAC_FIXED_DECENTRALIZED
+{slots}  }}
+  load_proto_file: "{PROTO}"
+{QUEUE_ENTRIES}{TRANSLATOR_ENTRIES}{extra}
+}}
+"""
+
+
+class Recorder:
+    """A MOOS client that keeps every notification it receives, by variable."""
+
+    def __init__(self, name: str, port: int) -> None:
+        self.client = MOOSClient(name, port=port)
+        self.seen: dict[str, list[MOOSMessage]] = {}
+        self._task: asyncio.Task | None = None
+
+    async def start(self, variables: list[str]) -> None:
+        await self.client.connect()
+        for var in variables:
+            self.client.subscribe(var)
+        await self.client.flush()
+        self._task = asyncio.create_task(self._collect())
+
+    async def _collect(self) -> None:
+        async for msg in self.client:
+            self.seen.setdefault(msg.key, []).append(msg)
+
+    def values(self, var: str) -> list:
+        return [msg.value for msg in self.seen.get(var, [])]
+
+    async def wait_for(
+        self, var: str, predicate: Callable[[object], bool] = lambda v: True, timeout: float = 20
+    ) -> object:
+        async with asyncio.timeout(timeout):
+            while True:
+                for value in self.values(var):
+                    if predicate(value):
+                        return value
+                await asyncio.sleep(0.02)
+
+    async def close(self) -> None:
+        if self._task is not None:
+            self._task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await self._task
+        await self.client.close()
+
+
+WATCHED = [
+    "STATUS_REPORT_IN", "DESIRED_HEADING", "COMMAND_IN", "MODEM_ID", "VEHICLE_ID",
+    "ACOMMS_NMEA_IN", "ACOMMS_NMEA_OUT", "ACOMMS_RAW_INCOMING", "ACOMMS_RAW_OUTGOING",
+    "ACOMMS_MODEM_RECEIVE", "ACOMMS_MODEM_TRANSMIT", "ACOMMS_QUEUE_RECEIVE", "ACOMMS_ACK",
+    "ACOMMS_ACK_ORIGINAL", "ACOMMS_EXPIRE", "ACOMMS_QSIZE", "ACOMMS_MAC_INITIATE_TRANSMISSION",
+    "ACOMMS_MAC_SLOT_START", "ACOMMS_CONFIG",
+]  # fmt: skip
+
+
+class TwoCommunities:
+    """Emulators + DBs + pAcommsHandlers + recorders; `extra` adds config to both apps."""
+
+    def __init__(self, tmp_path: Path, extra: str = "", slots: str | None = None) -> None:
+        self.tmp_path, self.extra, self.slots = tmp_path, extra, slots
+        self.stack = contextlib.AsyncExitStack()
+
+    async def __aenter__(self) -> TwoCommunities:
+        channel = LoopbackChannel()
+        clock = WallClock()
+        self.sims, self.dbs, self.apps, self.recorders = [], [], [], []
+        for modem_id in (1, 2):
+            sim = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
+            await sim.start()
+            self.stack.push_async_callback(sim.close)
+            db = MOOSDB(port=0, community=f"vehicle{modem_id}")
+            await self.stack.enter_async_context(db)
+            path = self.tmp_path / f"vehicle{modem_id}.moos"
+            path.write_text(mission_text(modem_id, db.port, sim.port, self.extra, self.slots))
+            app = pAcommsHandler.from_mission(path, "pAcommsHandler")
+            recorder = Recorder(f"recorder{modem_id}", db.port)
+            await recorder.start(WATCHED)
+            self.stack.push_async_callback(recorder.close)
+            await self.stack.enter_async_context(app)
+            self.sims.append(sim)
+            self.dbs.append(db)
+            self.apps.append(app)
+            self.recorders.append(recorder)
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        await self.stack.aclose()
+
+    async def ready(self, timeout: float = 20) -> None:
+        """Both drivers started and both apps have DB_TIME (the messages' time source)."""
+        async with asyncio.timeout(timeout):
+            while not all(
+                app.acomms.primary.driver.startup_complete and "DB_TIME" in app.dynamic_vars
+                for app in self.apps
+            ):
+                await asyncio.sleep(0.05)

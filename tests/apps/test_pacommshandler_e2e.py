@@ -1,0 +1,79 @@
+"""pAcommsHandler end to end: two communities (embedded MOOSDB + pAcommsHandler each) talking
+through emulated Micro-Modems over real loopback TCP, with TDMA slots."""
+
+from __future__ import annotations
+
+import asyncio
+
+from pygoby.acomms import messages as m
+from pygoby.moos.translator import parse_for_moos
+
+from .acomms_mission import COMMAND, STATUS, TwoCommunities
+
+NAV = {"NAV_X": 100.0, "NAV_Y": -50.0, "NAV_SPEED": 1.5, "NAV_HEADING": -90.0, "NAV_DEPTH": 10.0}
+
+
+def parsed(cls, text):
+    msg = cls()
+    parse_for_moos(text, msg)
+    return msg
+
+
+async def test_status_and_acked_command_between_two_vehicles(tmp_path):
+    async with TwoCommunities(tmp_path) as net:
+        (r1, r2), (app1, _) = net.recorders, net.apps
+        await net.ready()
+        assert r1.values("MODEM_ID") == [1.0] and r1.values("VEHICLE_ID") == [1.0]
+        for var, value in NAV.items():
+            r1.client.publish(var, value)
+        await r1.wait_for("ACOMMS_QSIZE")  # queues announced at creation
+        r1.client.publish("SEND_STATUS", "now")
+        report = await r2.wait_for("STATUS_REPORT_IN")
+        assert report == "src=1,x=100,y=-50,speed=1.5,heading=270,depth=10"
+        received = await r2.wait_for("ACOMMS_QUEUE_RECEIVE")
+        assert received.startswith(f"@PB[{STATUS}] ")
+
+        r1.client.publish("COMMAND_OUT", "dest=2,command_id=7,heading=90,speed=1.5,depth=20")
+        assert await r2.wait_for("DESIRED_HEADING") == 90.0
+        assert "command_id=7" in await r2.wait_for("COMMAND_IN")
+        ack = parsed(m.ModemTransmission, await r1.wait_for("ACOMMS_ACK"))
+        assert (ack.type, ack.src, ack.dest) == (m.ACK, 2, 1)
+        original = await r1.wait_for("ACOMMS_ACK_ORIGINAL")
+        assert original.startswith(f"@PB[{COMMAND}] ") and "command_id: 7" in original
+
+        # The informational variables of the primary driver, the MAC and the queue.
+        assert any(v.startswith("$CCCYC") for v in r1.values("ACOMMS_NMEA_OUT"))
+        assert any(v.startswith("$CARXD") for v in r2.values("ACOMMS_NMEA_IN"))
+        raw = parsed(m.ModemRaw, r2.values("ACOMMS_RAW_INCOMING")[0])
+        assert raw.raw.startswith(b"$CA") or raw.raw.startswith(b"$SN")
+        assert r1.values("ACOMMS_RAW_OUTGOING")
+        sent = [parsed(m.ModemTransmission, v) for v in r1.values("ACOMMS_MODEM_TRANSMIT")]
+        assert any(t.src == 1 and t.frame for t in sent)
+        heard = [parsed(m.ModemTransmission, v) for v in r2.values("ACOMMS_MODEM_RECEIVE")]
+        assert any(t.src == 1 and t.type == m.DATA and t.frame for t in heard)
+        starts = [parsed(m.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_SLOT_START")]
+        assert {s.src for s in starts} == {1, 2}  # every slot, own or not
+        initiated = [parsed(m.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_INITIATE_TRANSMISSION")]
+        assert initiated and {s.src for s in initiated} == {1}  # own slots only
+        sizes = [parsed(m.QueueSize, v) for v in r1.values("ACOMMS_QSIZE")]
+        assert {(s.dccl_id, s.size) for s in sizes} >= {(20, 0), (20, 1), (21, 0), (21, 1)}
+        assert app1.queue.size(21) == 0
+
+
+async def test_acked_command_survives_a_modem_link_outage(tmp_path):
+    async with TwoCommunities(tmp_path) as net:
+        (r1, r2), (app1, _) = net.recorders, net.apps
+        await net.ready()
+        driver = app1.acomms.primary.driver
+        net.sims[0].drop_clients()  # the modem's TCP link drops ...
+        async with asyncio.timeout(10):
+            while driver.link.is_open:
+                await asyncio.sleep(0.01)
+        r1.client.publish("COMMAND_OUT", "dest=2,command_id=9,heading=45,speed=1,depth=5")
+        await r1.wait_for("ACOMMS_QSIZE", lambda v: "dccl_id: 21 size: 1" in v)
+        # ... the driver reconnects (1 s) and the queued command goes out and is acknowledged.
+        assert await r2.wait_for("DESIRED_HEADING", timeout=30) == 45.0
+        original = await r1.wait_for("ACOMMS_ACK_ORIGINAL", timeout=30)
+        assert "command_id: 9" in original
+        assert r2.values("DESIRED_HEADING") == [45.0]  # delivered once
+        assert app1.queue.size(21) == 0
