@@ -12,6 +12,7 @@ SUBCOMMAND_MODULES = [
     "pygoby.dccl.cli",
     "pygoby.acomms.cli",
     "pygoby.moos.cli",
+    "pygoby.netsim.sim_cli",
 ]
 
 

@@ -26,6 +26,7 @@ virtual clock repeats exactly for the same seed.
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -88,6 +89,7 @@ class PhysicsChannel:
         self.on_event = on_event
         self._endpoints: dict[int, ChannelEndpoint] = {}
         self._answering: tuple[int, float] | None = None  # (port, owtt) of a ping being heard
+        self._last_poll = -math.inf
 
     # -- the mmsim Channel interface -----------------------------------------------------------
 
@@ -125,7 +127,8 @@ class PhysicsChannel:
         data = packet.kind is ModemPacketKind.DATA
         tx = Transmission(
             source=port,
-            start=self.clock.now(),
+            # never before the last poll (a wall clock stepped back must not break the channel)
+            start=max(self.clock.now(), self._last_poll),
             rate=packet.rate if data else self.control_rate,
             frames=max(1, len(packet.frames)) if data else 1,
             kind=PHYSICAL_KIND[packet.kind],
@@ -151,7 +154,9 @@ class PhysicsChannel:
             )
 
     def do_work(self) -> None:
-        for reception in self.channel.poll(self.clock.now()):
+        now = max(self.clock.now(), self._last_poll)
+        self._last_poll = now
+        for reception in self.channel.poll(now):
             self._deliver(reception)
 
     def next_event_time(self) -> float | None:

@@ -1,0 +1,133 @@
+"""`pygoby netsim run SCENARIO` and `pygoby netsim report LOG -o DIR`.
+
+`run` reads a Scenario (TextFormat, src/pygoby/protobuf/pygoby/netsim/scenario.proto), runs it
+— speed "max": everything in process on a virtual clock; a number: in real time (times that
+factor) with the netsim_manager and the Micro-Modem emulators on TCP — writes the event log
+(JSON lines) and prints a summary. `report` draws PNG plots from an event log.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import logging
+import sys
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "netsim",
+        help="acoustic network simulation: run a scenario, plot its event log",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_subcommands(parser.add_subparsers(dest="netsim_command", required=True, metavar="ACTION"))
+
+
+def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
+    run = subparsers.add_parser("run", help="run a simulation scenario (.pb.cfg)")
+    run.add_argument("scenario", help="scenario file (protobuf TextFormat)")
+    run.add_argument("--event-log", help="override the scenario's event_log path")
+    run.add_argument("--speed", help='override the scenario\'s speed ("max" or a factor)')
+    run.add_argument("--duration", type=float, help="override the duration (simulated s)")
+    run.add_argument("--seed", type=int, help="override the random seed")
+    run.add_argument("-v", "--verbose", action="count", default=0)
+    run.set_defaults(func=run_command)
+    report = subparsers.add_parser("report", help="plot an event log to PNG files")
+    report.add_argument("log", help="event log (JSON lines) written by `netsim run`")
+    report.add_argument("-o", "--output", default="netsim_report", help="output directory")
+    report.add_argument(
+        "--window", help="timeline window START:END in seconds after the first event "
+        "(default 0:3600)",
+    )  # fmt: skip
+    report.set_defaults(func=report_command)
+
+
+def run_command(args: argparse.Namespace) -> int:
+    from pygoby.netsim.eventlog import EventLogWriter
+    from pygoby.netsim.scenario import ScenarioError, check_scenario, load_scenario, speed_factor
+
+    level = logging.WARNING - 10 * args.verbose
+    logging.basicConfig(level=level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    try:
+        scenario = load_scenario(args.scenario)
+        if args.event_log is not None:
+            scenario.event_log = args.event_log
+        if args.speed is not None:
+            scenario.speed = args.speed
+        if args.duration is not None:
+            scenario.duration = args.duration
+        if args.seed is not None:
+            scenario.seed = args.seed
+        check_scenario(scenario)
+        factor = speed_factor(scenario)
+    except ScenarioError as exc:
+        print(f"pygoby netsim run: {exc}", file=sys.stderr)
+        return 1
+    try:
+        log = EventLogWriter(scenario.event_log)
+    except OSError as exc:
+        print(f"pygoby netsim run: cannot write the event log: {exc}", file=sys.stderr)
+        return 1
+    with log:
+        if factor is None:
+            from pygoby.netsim.sim import Simulation
+
+            summary = Simulation(scenario, on_event=log).run_virtual()
+        else:
+            summary = asyncio.run(_run_real_time(scenario, log))
+    for line in summary.lines():
+        print(line)
+    print(f"event log: {scenario.event_log} ({log.count} events)")
+    return 0
+
+
+async def _run_real_time(scenario, log):
+    from pygoby.netsim.realtime import RealTimeRun
+
+    run = RealTimeRun(scenario, on_event=log)
+    async with run:
+        print(f"netsim_manager on {run.host}:{run.manager_port}", flush=True)
+        for node in run.sim.nodes:
+            print(
+                f"Micro-Modem emulator id {node.modem_id} (netsim port {node.port}) on "
+                f"{run.host}:{run.emulator_port(node.modem_id)}"
+                + (" with in-process driver/MAC/queue" if node.driver is not None else ""),
+                flush=True,
+            )
+        task = asyncio.ensure_future(run.run())
+        try:
+            return await task
+        except asyncio.CancelledError:
+            run.request_stop()
+            with contextlib.suppress(asyncio.CancelledError):
+                return await task
+            raise
+
+
+def report_command(args: argparse.Namespace) -> int:
+    from pygoby.netsim.eventlog import read_events
+    from pygoby.netsim.report import summary_lines, write_report
+
+    window = None
+    if args.window:
+        try:
+            start, end = (float(x) for x in args.window.split(":"))
+        except ValueError:
+            print("pygoby netsim report: --window must be START:END seconds", file=sys.stderr)
+            return 2
+        window = (start, end)
+    try:
+        events = read_events(args.log)
+    except OSError as exc:
+        print(f"pygoby netsim report: {exc}", file=sys.stderr)
+        return 1
+    if not events:
+        print(f"pygoby netsim report: no events in {args.log}", file=sys.stderr)
+        return 1
+    for line in summary_lines(events):
+        print(line)
+    for path in write_report(events, args.output, window):
+        print(f"wrote {path}")
+    return 0
