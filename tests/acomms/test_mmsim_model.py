@@ -107,3 +107,17 @@ async def test_two_mmsim_processes_hear_each_other():
         for proc in procs:
             proc.terminate()
             await proc.wait()
+
+
+def test_channel_statistics_reach_cacst():
+    from pygoby.acomms.mmsim import AcousticPacket, PacketKind, Reception
+
+    model = MicroModemModel(2, VirtualClock(1e9))
+    packet = AcousticPacket(PacketKind.DATA, 1, 2, rate=1, frames=[b"a", b"b"])
+    model.receive(packet, Reception(1e9 + 0.25, frame_ok=[True, False],
+                                    stats={"snr_in": 7.6, "doppler": -0.4, "bogus": 1}))  # fmt: skip
+    lines = [NMEASentence.parse(x) for x in model.take_output()]
+    assert [s.sentence_id for s in lines] == ["RXP", "CYC", "RXD", "MSG", "CST"]
+    cst = lines[-1]
+    assert cst[1] == "1" and cst[21] == "8" and cst[26] == "-0.4"  # BAD_CRC mode, snr_in, doppler
+    assert cst[2].endswith(".2500")  # time of arrival

@@ -285,8 +285,13 @@ class MicroModemModel:
             data_quality_factor=200, doppler=0.0, stddev_noise=50, carrier_freq=25000,
             bandwidth=5000,
         )  # fmt: skip
+        fields = stat.DESCRIPTOR.fields_by_name
         for key, value in r.stats.items():
-            setattr(stat, key, value)
+            if key not in fields:
+                log.warning("%s: unknown $CACST statistic %r from the channel", self.name, key)
+                continue
+            is_float = fields[key].cpp_type == fields[key].CPPTYPE_DOUBLE
+            setattr(stat, key, float(value) if is_float else int(round(value)))
         self._say(*_sentence_parts(format_cst(stat)))
 
 
