@@ -70,6 +70,16 @@ def test_configuration_globals_and_defaults():
     assert cfg.common.app_tick == 20 and cfg.common.comm_tick == 10
 
 
+def test_command_line_overrides():
+    mission = MissionFile.from_text(_mission(9123, BLOCK))
+    cfg = pTestApp.read_config(mission, "pTestApp", [("gain", "4"), ("common", "app_tick: 5"),
+                                                      ("out_var", 'say "hi"')])  # fmt: skip
+    assert cfg.gain == 4 and cfg.common.app_tick == 5 and cfg.out_var == 'say "hi"'
+    assert cfg.common.verbosity == 1 and not cfg.common.log  # merged into the block's common
+    with pytest.raises(ConfigError, match="unknown option --nope"):
+        pTestApp.read_config(mission, "pTestApp", [("nope", "1")])
+
+
 def test_parse_error_names_line_and_field(tmp_path):
     text = _mission(9000, "  common { log: false }\n  gain: fast\n  out_var: \"X\"")
     path = tmp_path / "m.moos"

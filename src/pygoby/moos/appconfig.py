@@ -161,7 +161,8 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
 
 
 def apply_overrides(config: Message, overrides: Sequence[tuple[str, str]]) -> None:
-    """`--field value` pairs for top-level fields; message fields take TextFormat text."""
+    """`--field value` pairs for top-level fields: a scalar replaces the configured value; a
+    message field's TextFormat text is merged into it; a repeated field gets one more entry."""
     for name, value in overrides:
         field = config.DESCRIPTOR.fields_by_name.get(name)
         if field is None:
@@ -172,7 +173,7 @@ def apply_overrides(config: Message, overrides: Sequence[tuple[str, str]]) -> No
             text = f"{name}: {_quote(value)}"
         else:
             text = f"{name}: {value}"
-        if not field.is_repeated:
+        if not field.is_repeated and field.type != FieldDescriptor.TYPE_MESSAGE:
             config.ClearField(name)
         parse_block(config, text, 1, f"command line --{name}")
 
