@@ -209,10 +209,11 @@ class MOOSClient:
                 self._requests.remove(future)
 
     async def flush(self, timeout: float = 5.0) -> None:
-        """Wait until the outbox has been handed to the socket (connected) or `timeout`."""
+        """Wait until the outbox has been handed to the socket, or `timeout`. Returns at once
+        when disconnected (the outbox then waits for the next connection)."""
         loop = asyncio.get_running_loop()
         deadline = loop.time() + timeout
-        while self._outbox and loop.time() < deadline:
+        while self._outbox and self.connected and loop.time() < deadline:
             await asyncio.sleep(0.001)
         if self._writer is not None:
             with contextlib.suppress(ConnectionError):
