@@ -38,8 +38,8 @@ class UDPMulticastDriver(ModemDriverBase):
         self.mc_cfg = c = cfg.Extensions[_CONFIG]
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        if hasattr(socket, "SO_REUSEPORT"):
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+        # SO_REUSEADDR only: with SO_REUSEPORT Linux hands each group datagram to just one
+        # socket of the group instead of to every listener
         try:
             # A socket bound to a unicast address never sees group traffic (Linux), so bind the
             # port on every address and use listen_address as the multicast interface.

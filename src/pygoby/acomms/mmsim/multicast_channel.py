@@ -63,8 +63,8 @@ class MulticastChannel(LoopbackChannel):
     def open(self) -> None:
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        if hasattr(socket, "SO_REUSEPORT"):
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+        # SO_REUSEADDR only: with SO_REUSEPORT Linux hands each group datagram to just one
+        # socket of the group instead of to every listener
         sock.bind(("", self.port))
         loopback = socket.inet_aton("127.0.0.1")
         sock.setsockopt(
