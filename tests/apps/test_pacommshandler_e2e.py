@@ -53,7 +53,9 @@ async def test_status_and_acked_command_between_two_vehicles(tmp_path):
         assert any(t.src == 1 and t.type == m.DATA and t.frame for t in heard)
         starts = [parsed(m.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_SLOT_START")]
         assert {s.src for s in starts} == {1, 2}  # every slot, own or not
-        initiated = [parsed(m.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_INITIATE_TRANSMISSION")]
+        initiated = [
+            parsed(m.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_INITIATE_TRANSMISSION")
+        ]
         assert initiated and {s.src for s in initiated} == {1}  # own slots only
         sizes = [parsed(m.QueueSize, v) for v in r1.values("ACOMMS_QSIZE")]
         assert {(s.dccl_id, s.size) for s in sizes} >= {(20, 0), (20, 1), (21, 0), (21, 1)}

@@ -16,6 +16,7 @@ from __future__ import annotations
 import base64
 import contextlib
 import functools
+from pathlib import Path
 
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 from google.protobuf.message import Message
@@ -101,9 +102,9 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.publish("VEHICLE_ID", float(cfg.modem_id))
         try:
             for module in cfg.load_shared_library:
-                import_module_or_file(module)
+                import_module_or_file(self._find(module))
             for path in cfg.load_proto_file:
-                self.loader.load_file(path)
+                self.loader.load_file(self._find(path))
         except (ImportError, ProtoError, OSError, SyntaxError) as err:
             raise ConfigError(f"cannot load message definitions: {err}") from None
         self._connect_signals()
@@ -115,7 +116,9 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.log.debug("queue_cfg: no queue for %s (type not loaded)", name)
         self.acomms.start()
         modem_ids = (
-            ModemIdLookup.from_file(cfg.modem_id_lookup_path) if cfg.modem_id_lookup_path else None
+            ModemIdLookup.from_file(self._find(cfg.modem_id_lookup_path))
+            if cfg.modem_id_lookup_path
+            else None
         )
         try:
             self.translator = Translator(
@@ -138,6 +141,15 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
                     f"dccl_frontseat_forward_name {name!r} is not a loaded type"
                 ) from None
             self.frontseat_forward.add(name)
+
+    def _find(self, path: str) -> str:
+        """A relative path that does not exist from the working directory is looked up next to
+        the mission file (so that missions can be run from anywhere)."""
+        given = Path(path)
+        if given.is_absolute() or given.exists() or self.mission is None or not self.mission.path:
+            return path
+        beside = Path(self.mission.path).parent / given
+        return str(beside) if beside.exists() else path
 
     def _message_class(self, name: str) -> type[Message]:
         """Message types: the app's .proto files, then load_shared_library modules (protobuf's
