@@ -159,26 +159,20 @@ def notify(
 # Encoding
 
 
-def _put_str(out: list[bytes], raw: bytes) -> None:
-    out.append(_INT.pack(len(raw)))
-    out.append(raw)
-
-
 def encode_message(msg: MOOSMessage) -> bytes:
-    src = encode_text(msg.src)
-    aux = encode_text(msg.src_aux)
-    com = encode_text(msg.community)
-    key = encode_text(msg.key)
-    size = MESSAGE_FIXED_SIZE + len(src) + len(aux) + len(com) + len(key) + len(msg.sval)
-    out = [
-        _INT.pack(size),
-        _ID_TYPES.pack(msg.id, msg.msg_type.encode("latin-1"), msg.data_type.encode("latin-1")),
-    ]
-    for raw in (src, aux, com, key):
-        _put_str(out, raw)
-    out.append(_DOUBLES.pack(msg.time, msg.dval, msg.dval2))
-    _put_str(out, msg.sval)
-    return b"".join(out)
+    src = msg.src.encode("utf-8", "surrogateescape")
+    aux = msg.src_aux.encode("utf-8", "surrogateescape")
+    com = msg.community.encode("utf-8", "surrogateescape")
+    key = msg.key.encode("utf-8", "surrogateescape")
+    sval = msg.sval
+    a, b, c, k, v = len(src), len(aux), len(com), len(key), len(sval)
+    # one pack call with the lengths in the format: the hot path of the DB and the client
+    return struct.pack(
+        f"<iicci{a}si{b}si{c}si{k}sdddi{v}s",
+        MESSAGE_FIXED_SIZE + a + b + c + k + v, msg.id, msg.msg_type.encode("latin-1"),
+        msg.data_type.encode("latin-1"), a, src, b, aux, c, com, k, key,
+        msg.time, msg.dval, msg.dval2, v, sval,
+    )  # fmt: skip
 
 
 def encode_packet(msgs: Iterable[MOOSMessage], cache: dict[int, bytes] | None = None) -> bytes:
