@@ -9,6 +9,8 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import ConfigError
@@ -237,3 +239,13 @@ async def test_log_file_named_after_app_and_community(tmp_path):
     assert len(files) == 2 and files[1] == "pTestApp_alpha_latest.txt"
     assert files[0].startswith("pTestApp_alpha_2") and files[0].endswith(".txt")
     assert "hello log" in (tmp_path / files[1]).read_text()
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(alphabet=st.sampled_from('abc_:{}"#/ \n0123.-=common gain out_var'), max_size=120))
+def test_fuzz_config_block_gives_config_errors_only(text):
+    mission = MissionFile.from_text(f"ProcessConfig = pTestApp\n{{\n{text}\n}}\n")
+    try:
+        pTestApp.read_config(mission, "pTestApp")
+    except ConfigError as err:
+        assert str(err)
