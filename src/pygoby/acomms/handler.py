@@ -23,6 +23,8 @@ import importlib.util
 import logging
 import os
 import re
+import sys
+import zlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -73,16 +75,21 @@ def _import_object(spec: str):
 
 def import_module_or_file(name: str):
     """A Python module given by importable name or by the path of a .py file (driver plugins,
-    and `load_shared_library` modules of generated message code)."""
+    and `load_shared_library` modules of generated message code); each is loaded once."""
     path = Path(name)
-    if path.suffix == ".py":
-        spec = importlib.util.spec_from_file_location(f"pygoby_loaded_{path.stem}", path)
-        if spec is None or spec.loader is None:
-            raise ImportError(f"cannot load {name}")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        return module
-    return importlib.import_module(name)
+    if path.suffix != ".py":
+        return importlib.import_module(name)
+    resolved = path.resolve()
+    module_name = f"pygoby_loaded_{resolved.stem}_{zlib.crc32(str(resolved).encode()):08x}"
+    if module_name in sys.modules:
+        return sys.modules[module_name]
+    spec = importlib.util.spec_from_file_location(module_name, resolved)
+    if spec is None or spec.loader is None:
+        raise ImportError(f"cannot load {name}")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    sys.modules[module_name] = module
+    return module
 
 
 def plugin_driver_factory(driver_name: str) -> Callable[[Clock], ModemDriverBase]:
@@ -351,14 +358,6 @@ class AcommsHandler:
     def _driver_failed(self, slot: DriverSlot, status: int, why, started: bool = True) -> None:
         slot.failures += 1
         log.warning("driver %s failed (%s): %s", _name(slot), Status.Status.Name(status), why)
-        self.signal_driver_status.emit(
-            Status(
-                src=max(1, min(slot.cfg.modem_id, 32)),
-                time=self.clock.now(),
-                status=status,
-                n_resets=min(slot.failures, 255),
-            )  # fmt: skip
-        )
         if started or slot.running:
             self._shutdown_driver(slot)
         now = self.clock.now()

@@ -1,0 +1,53 @@
+"""A pAcommsHandler driver plugin for tests (loaded through $PACOMMSHANDLER_PLUGINS).
+
+Its behaviour is steered through class attributes: `fail_startups` (how many startups fail
+before one succeeds) and, per instance, `fail_next_work` (the next do_work raises)."""
+
+from __future__ import annotations
+
+from pygoby.acomms import messages as m
+from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+
+
+class ScriptedDriver(ModemDriverBase):
+    fail_startups = 0
+    instances: list[ScriptedDriver] = []
+
+    def __init__(self, clock=None) -> None:
+        super().__init__(clock)
+        self.started = 0
+        self.stopped = 0
+        self.fail_next_work = False
+        self.initiated: list = []
+        self.cfg_updates: list = []
+        ScriptedDriver.instances.append(self)
+
+    def startup(self, cfg) -> None:
+        self.cfg = cfg
+        if ScriptedDriver.fail_startups > 0:
+            ScriptedDriver.fail_startups -= 1
+            raise ModemDriverException("modem absent", m.ModemDriverStatus.STARTUP_FAILED)
+        self.started += 1
+
+    def shutdown(self) -> None:
+        self.stopped += 1
+
+    def do_work(self) -> None:
+        if self.fail_next_work:
+            self.fail_next_work = False
+            raise ModemDriverException("modem silent", m.ModemDriverStatus.MODEM_NOT_RESPONDING)
+
+    def handle_initiate_transmission(self, transmission) -> None:
+        self.initiated.append(transmission)
+        self.signal_data_request.emit(transmission)
+
+    def update_cfg(self, cfg) -> None:
+        self.cfg_updates.append(cfg)
+
+
+def goby_driver_name() -> str:
+    return "SCRIPTED"
+
+
+def goby_make_driver(clock=None) -> ScriptedDriver:
+    return ScriptedDriver(clock)
