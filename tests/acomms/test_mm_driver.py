@@ -265,3 +265,61 @@ def test_bad_rate_is_refused_and_raw_log_written(tmp_path):
     assert log_file.name == "raw_20231114T221320.log"
     lines = log_file.read_text().splitlines()
     assert lines[0] == "[tx] $CCCFG,CST,1*37" and "[rx] $CACFG,CST,1" in lines[1]
+
+
+def special(kind, **fields):
+    msg = m.ModemTransmission(src=1, dest=2, type=m.DRIVER_SPECIFIC)
+    ext = msg.Extensions[m.MM_TRANSMISSION]
+    ext.type = kind
+    for name, value in fields.items():
+        getattr(ext, name).CopyFrom(value)
+    return msg
+
+
+def test_lbl_pings_and_travel_times():
+    h = Harness().start()
+    h.driver.handle_initiate_transmission(special(m.MICROMODEM_REMUS_LBL_RANGING))
+    assert h.work() == [cs("$CCCFG,TAT,50")]  # TAT unknown: set it first
+    assert h.modem("$CACFG,TAT,50") == [cs("$CCPDT,1,2,0,0,1383,1,1,1,1")]  # 1000 m*2/1500 + 50 ms
+    h.modem("$SNPDT,1,2,0,0,1383,1,1,1,1", "$SNTTA,0.5,1.25,,2,221320.50")
+    (r,) = h.received
+    ext = r.Extensions[m.MM_TRANSMISSION]
+    assert ext.type == m.MICROMODEM_REMUS_LBL_RANGING and r.src == 1
+    assert list(ext.ranging_reply.one_way_travel_time) == [0.5, 1.25, 0.0, 2.0]
+    assert r.time == int((T0 + 0.5) * 1e6) and r.time_source == m.ModemTransmission.MODEM_TIME
+    nb = m.MMConfig().narrowband_lbl
+    nb.transmit_freq, nb.transmit_ping_ms, nb.receive_ping_ms, nb.turnaround_ms = 26000, 5, 5, 50
+    nb.receive_freq.extend([25000, 25500])
+    h.driver.handle_initiate_transmission(special(3, narrowband_lbl=nb))
+    assert h.work() == [cs("$CCPNT,26000,5,5,2716,25000,25500,0,0,1")]
+
+
+def test_hardware_control_sweep_and_m_sequence_commands():
+    h = Harness().start()
+    hw = m.MMTransmission().hw_ctl
+    hw.line, hw.mode, hw.arg = 5, 1, 1
+    h.driver.handle_initiate_transmission(special(6, hw_ctl=hw))
+    assert h.work() == [cs("$CCMEC,1,2,5,1,1")]
+    h.modem("$CAMEC,1,2,5,1,1", "$CAMER,2,1,5,1,1")
+    (r,) = h.received
+    assert r.Extensions[m.MM_TRANSMISSION].hw_ctl.line == 5 and (r.src, r.dest) == (2, 1)
+    sweep = m.MMTransmission().fm_sweep
+    sweep.start_freq, sweep.stop_freq, sweep.duration_ms = 25000.5, 26000, 100
+    h.driver.handle_initiate_transmission(special(9, fm_sweep=sweep))
+    assert h.work() == [cs("$CCSWP,250005,260000,999,1000,1,10000")]
+    h.modem("$CASWP,250005,260000,999,1000,1,10000")
+    seq = m.MMTransmission().m_sequence
+    seq.seqlen_bits, seq.number_repetitions, seq.carrier_cycles_per_chip, seq.carrier_freq = (
+        1023, 3, 4, 25000)  # fmt: skip
+    h.driver.handle_initiate_transmission(special(10, m_sequence=seq))
+    assert h.work() == [cs("$CCMSQ,1023,3,4,25000")]
+
+
+def test_hydroid_gateway_prefixes_strips_and_requests_gps():
+    h = Harness(hydroid_gateway_id=1, reset_nvram=True)
+    h.driver.startup(h.cfg)
+    assert h.work() == ["#G1", "#M1" + cs("$CCCFG,CST,1")]  # never CFG,ALL,0 on a buoy
+    h.link.feed("#M1" + cs("$CACFG,CST,1") + "\r")
+    assert h.work() == ["#M1" + cs("$CCCFG,SRC,1")]
+    h.clock.advance(30)
+    assert "#G1" in h.work()

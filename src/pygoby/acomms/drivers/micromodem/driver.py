@@ -29,6 +29,7 @@ MULTI_REPLY_QUIET = 2.0  # s of silence that ends a CFQ,ALL / CFQ,TOP burst
 DEFAULT_BAUD = 19200
 REVINIT_PAUSE = 2.0
 MM2_BITFIELD_CLOCK_REVISION = (2, 0, 26038)
+HYDROID_GPS_REQUEST_INTERVAL = 30.0
 
 Status = m.ModemDriverStatus
 
@@ -64,6 +65,7 @@ class MMDriver(ModemDriverBase):
         self._last_rx_at = self.clock.now()
         self._clock_set = False
         self._link_was_open = False
+        self._last_gps_request = float("-inf")
         # transmission state
         self._cached = m.ModemTransmission()
         self._frame_counter = 0
@@ -129,6 +131,7 @@ class MMDriver(ModemDriverBase):
         if not link_open:
             return  # a dead link is the link's business (it reconnects); do not count failures
         now = self.clock.now()
+        self._hydroid_gps_request(now)
         self._check_multi_reply(now)
         self._advance_startup(now)
         self._check_timeout(now)
@@ -151,8 +154,8 @@ class MMDriver(ModemDriverBase):
                 self._push("$CCMPC", msg.src if msg.src >= 0 else self.modem_id, msg.dest)
             elif kind == m.MICROMODEM_MINI_DATA:
                 self._initiate_mini(msg)
-            elif kind == m.MICROMODEM_REMUS_LBL_RANGING:
-                self._initiate_remus_lbl(msg)
+            elif kind in self._SIMPLE_COMMANDS:
+                getattr(self, self._SIMPLE_COMMANDS[kind])(msg)
             else:
                 log.warning("Micro-Modem transmission type %d is not supported", kind)
         else:
@@ -197,6 +200,12 @@ class MMDriver(ModemDriverBase):
             self._pop_front()
         else:
             self._written_at = None  # resend
+
+    def _hydroid_gps_request(self, now: float) -> None:
+        buoy = self.mm_cfg.hydroid_gateway_id
+        if buoy and now - self._last_gps_request >= HYDROID_GPS_REQUEST_INTERVAL:
+            self.modem_write(f"#G{buoy}\r\n")
+            self._last_gps_request = now
 
     def _check_timeout(self, now: float) -> None:
         if self._written_at is not None and now - self._written_at > MODEM_WAIT:
@@ -545,18 +554,75 @@ class MMDriver(ModemDriverBase):
         msg.frame.append(bytes.fromhex(s[3]))
         self.signal_receive.emit(msg)
 
-    def _initiate_remus_lbl(self, msg) -> None:
-        params = m.MMConfig().remus_lbl
-        params.CopyFrom(self.mm_cfg.remus_lbl)
-        params.MergeFrom(msg.Extensions[m.MM_TRANSMISSION].remus_lbl)
+    _SIMPLE_COMMANDS = {
+        m.MICROMODEM_REMUS_LBL_RANGING: "_initiate_remus_lbl",
+        m.MICROMODEM_NARROWBAND_LBL_RANGING: "_initiate_narrowband_lbl",
+        8: "_initiate_generic_lbl",  # MICROMODEM_GENERIC_LBL_RANGING
+        6: "_initiate_hardware_control",  # MICROMODEM_HARDWARE_CONTROL
+        9: "_initiate_fm_sweep",  # MICROMODEM_FM_SWEEP
+        10: "_initiate_m_sequence",  # MICROMODEM_M_SEQUENCE
+    }
+
+    def _lbl_params(self, msg, name: str):
+        """Configured LBL parameters merged with the request's own (§7.4)."""
+        params = type(getattr(self.mm_cfg, name))()
+        params.CopyFrom(getattr(self.mm_cfg, name))
+        params.MergeFrom(getattr(msg.Extensions[m.MM_TRANSMISSION], name))
         if self.nvram.get("TAT") != params.turnaround_ms:
             self._push("$CCCFG", "TAT", params.turnaround_ms)
-        timeout = int(params.lbl_max_range * 2 / 1500 * 1000 + params.turnaround_ms)
+        return params, int(params.lbl_max_range * 2 / 1500 * 1000 + params.turnaround_ms)
+
+    def _initiate_remus_lbl(self, msg) -> None:
+        params, timeout = self._lbl_params(msg, "remus_lbl")
         bits = params.enable_beacons
         self._last_lbl_type = m.MICROMODEM_REMUS_LBL_RANGING
         self._push(
             "$CCPDT", 1, self.modem_id % 4 + 1, 0, 0, timeout, *((bits >> i) & 1 for i in range(4))
         )
+
+    def _initiate_narrowband_lbl(self, msg) -> None:
+        p, timeout = self._lbl_params(msg, "narrowband_lbl")
+        freqs = [*list(p.receive_freq)[:4], 0, 0, 0, 0][:4]
+        self._last_lbl_type = m.MICROMODEM_NARROWBAND_LBL_RANGING
+        self._push("$CCPNT", p.transmit_freq, p.transmit_ping_ms, p.receive_ping_ms, timeout,
+                   *freqs, int(p.transmit_flag))  # fmt: skip
+
+    def _initiate_generic_lbl(self, msg) -> None:
+        p, timeout = self._lbl_params(msg, "generic_lbl")
+        codes = [*list(p.receive_seq_code)[:4], 0, 0, 0, 0][:4]
+        self._last_lbl_type = 8
+        self._push("$CCPGT", p.transmit_freq, p.n_bits, p.transmit_seq_code, timeout,
+                   p.receive_freq, *codes, p.bandwidth, 0)  # fmt: skip
+
+    def _initiate_hardware_control(self, msg) -> None:
+        hw = msg.Extensions[m.MM_TRANSMISSION].hw_ctl
+        src = msg.src if msg.src >= 0 else self.modem_id
+        self._push("$CCMEC", src, msg.dest, hw.line, hw.mode, hw.arg)
+
+    def _initiate_fm_sweep(self, msg) -> None:
+        p = m.MMConfig().fm_sweep
+        p.CopyFrom(self.mm_cfg.fm_sweep)
+        p.MergeFrom(msg.Extensions[m.MM_TRANSMISSION].fm_sweep)
+        self._push("$CCSWP", int(p.start_freq * 10), int(p.stop_freq * 10),
+                   int(abs(p.start_freq - p.stop_freq)), int(p.duration_ms * 10),
+                   p.number_repetitions, int(p.repetition_period_ms * 10))  # fmt: skip
+
+    def _initiate_m_sequence(self, msg) -> None:
+        p = m.MMConfig().m_sequence
+        p.CopyFrom(self.mm_cfg.m_sequence)
+        p.MergeFrom(msg.Extensions[m.MM_TRANSMISSION].m_sequence)
+        self._push("$CCMSQ", p.seqlen_bits, p.number_repetitions, p.carrier_cycles_per_chip,
+                   p.carrier_freq)  # fmt: skip
+
+    def _on_mer(self, s: NMEASentence) -> None:
+        src, dest = s.as_int(1), s.as_int(2)
+        major, minor, patch = self.revision
+        if major == 2 and minor == 0 and patch < 18307:  # these firmwares swap src and dest
+            src, dest = dest, src
+        msg = self._ping_result(src, dest, 7)  # MICROMODEM_HARDWARE_CONTROL_REPLY
+        hw = msg.Extensions[m.MM_TRANSMISSION].hw_ctl
+        hw.line, hw.mode, hw.arg = s.as_int(3), s.as_int(4), s.as_int(5)
+        self.signal_receive.emit(msg)
 
     def _on_tta(self, s: NMEASentence) -> None:
         msg = self._ping_result(self.modem_id, -1, self._last_lbl_type)
