@@ -124,6 +124,7 @@ def test_example_config():
     assert "  mode: SLOW  #  (FAST, SLOW) (optional) (default=SLOW)" in lines
     assert any(ln.startswith('  out_var: "OUT"  # Variable to publish (required)') for ln in lines)
     assert "hidden" not in text  # cfg.action NEVER
+    assert any(ln.startswith("  [pygoby.test.extra_gain]:   # An extension field") for ln in lines)
     assert "(INI_DOUBLE, " in text and "(repeated)" in text
     # the example parses back as a configuration (once the enum without a value gets one)
     body = "\n".join(lines[2:-1]).replace("type:   #", "type: INI_DOUBLE  #")

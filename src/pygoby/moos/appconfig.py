@@ -251,16 +251,26 @@ def _wrap_words(comment: str, width: int) -> list[str]:
     return lines
 
 
+def _extensions(descriptor: Descriptor) -> list[FieldDescriptor]:
+    """Extensions of `descriptor` loaded into its pool (e.g. driver configurations)."""
+    try:
+        found = descriptor.file.pool.FindAllExtensions(descriptor)
+    except (AttributeError, KeyError):
+        return []
+    return sorted(found, key=lambda f: f.number)
+
+
 def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
     out: list[str] = []
     indent = "  " * depth
-    for field in descriptor.fields:
+    for field in [*descriptor.fields, *_extensions(descriptor)]:
         opts = goby_field_options(field)
         if opts.HasField("cfg") and opts.cfg.action != opts.cfg.ALWAYS:
             continue
         comment = "# " + opts.description
+        name = f"[{field.full_name}]" if field.is_extension else field.name
         if field.type == FieldDescriptor.TYPE_MESSAGE:
-            out.extend(_wrap(f"{indent}{field.name} {{  ", comment + _label(field)))
+            out.extend(_wrap(f"{indent}{name} {{  ", comment + _label(field)))
             out.extend(_describe_fields(field.message_type, depth + 1))
             out.append(f"{indent}}}")
             continue
@@ -279,7 +289,7 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
             comment += f" (default={_format_scalar(field, field.default_value)})"
         if opts.moos_global:
             comment += f' (can also set MOOS global "{opts.moos_global}=")'
-        out.extend(_wrap(f"{indent}{field.name}: {value}  ", comment))
+        out.extend(_wrap(f"{indent}{name}: {value}  ", comment))
     return out
 
 
