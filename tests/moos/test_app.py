@@ -128,6 +128,7 @@ def test_example_config():
     assert "(INI_DOUBLE, " in text and "(repeated)" in text
     # the example parses back as a configuration (once the enum without a value gets one)
     body = "\n".join(lines[2:-1]).replace("type:   #", "type: INI_DOUBLE  #")
+    body = body.replace("extra_gain]:   #", "extra_gain]: 2  #")
     pTestApp.read_config(MissionFile.from_text(f"ProcessConfig = pTestApp\n{{\n{body}\n}}"), "pTestApp")
 
 
