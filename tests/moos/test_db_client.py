@@ -330,3 +330,31 @@ async def test_client_raises_on_recorded_poison(vectors_dir):
     finally:
         await client.close()
         server.close()
+
+
+async def test_legacy_synchronous_client_is_polled_not_pushed():
+    async with MOOSDB(port=0) as db, MOOSClient("pub", port=db.port) as pub:
+        reader, writer = await asyncio.open_connection("127.0.0.1", db.port)
+        hs = p.handshake_message("old", 0.0, asynchronous=False)
+        writer.write(p.PROTOCOL_STRING + p.encode_packet([hs]))
+        framer = p.PacketFramer()
+
+        async def next_packet(timeout=2.0):
+            while True:
+                packets = list(framer.packets())
+                if packets:
+                    return p.decode_packet(packets[0])
+                framer.feed(await asyncio.wait_for(reader.read(4096), timeout))
+
+        assert (await next_packet())[0].msg_type == p.WELCOME
+        writer.write(p.encode_packet([p.MOOSMessage(p.REGISTER, p.DOUBLE, "V", dval=0, src="old")]))
+        assert [m.msg_type for m in await next_packet()] == [p.NULL]
+        pub.publish("V", 1.0)
+        await pub.flush()
+        with pytest.raises(TimeoutError):
+            await next_packet(timeout=0.3)  # never pushed to a polling client
+        writer.write(p.encode_packet([p.MOOSMessage(p.NULL, src="old")]))
+        reply = await next_packet()
+        assert [(m.msg_type, m.key) for m in reply] == [(p.NULL, ""), (p.NOTIFY, "V")]
+        assert reply[0].time == -1.0 and reply[0].dval > 1e9  # the DB clock for the skew
+        writer.close()
