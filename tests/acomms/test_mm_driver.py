@@ -323,3 +323,24 @@ def test_hydroid_gateway_prefixes_strips_and_requests_gps():
     assert h.work() == ["#M1" + cs("$CCCFG,SRC,1")]
     h.clock.advance(30)
     assert "#G1" in h.work()
+
+
+def test_flexible_data_protocol_send_and_receive():
+    h = Harness().start()
+    h.modem("$CAREV,000000,AUV,2.0.30000")  # MM2 firmware with the odd-length bug
+    requests = []
+
+    def fill(msg):
+        requests.append(msg.max_frame_bytes)
+        msg.frame.append(b"abc")
+
+    h.driver.signal_data_request.connect(fill)
+    h.driver.handle_initiate_transmission(special(m.MICROMODEM_FLEXIBLE_DATA))
+    assert requests == [100] and h.work() == [cs("$CCTDP,2,0,0,0,61626300")]
+    h.modem("$CATDP,2,0,0,0,61626300")
+    h.modem("$CARDP,2,1,5,0,0,1;2;0102,1;3;aabbcc")
+    h.modem("$CARDP,2,1,5,0,0,1;2;0102,0;3;aabbcc")
+    good, bad = h.received
+    assert list(good.frame) == [b"\x01\x02\xaa\xbb\xcc"] and good.rate == 5
+    assert list(bad.frame) == [b""]
+    assert list(bad.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc) == [0]

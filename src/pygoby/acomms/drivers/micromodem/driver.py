@@ -8,6 +8,8 @@ driver is fully sans-I/O: feed lines, advance a VirtualClock, read what it wrote
 
 from __future__ import annotations
 
+import base64
+import binascii
 import contextlib
 import datetime as dt
 import logging
@@ -30,6 +32,7 @@ DEFAULT_BAUD = 19200
 REVINIT_PAUSE = 2.0
 MM2_BITFIELD_CLOCK_REVISION = (2, 0, 26038)
 HYDROID_GPS_REQUEST_INTERVAL = 30.0
+FDP_MAX_FRAME_BYTES = 100
 
 Status = m.ModemDriverStatus
 
@@ -154,6 +157,8 @@ class MMDriver(ModemDriverBase):
                 self._push("$CCMPC", msg.src if msg.src >= 0 else self.modem_id, msg.dest)
             elif kind == m.MICROMODEM_MINI_DATA:
                 self._initiate_mini(msg)
+            elif kind == m.MICROMODEM_FLEXIBLE_DATA:
+                self._initiate_fdp(msg)
             elif kind in self._SIMPLE_COMMANDS:
                 getattr(self, self._SIMPLE_COMMANDS[kind])(msg)
             else:
@@ -304,7 +309,7 @@ class MMDriver(ModemDriverBase):
         self._last_rx_at = self.clock.now()
         try:
             self._dispatch(sentence)
-        except (NMEAError, ValueError, IndexError) as exc:
+        except (NMEAError, ValueError, IndexError, binascii.Error) as exc:
             log.warning("ignoring malformed %s: %s", sentence.message(), exc)
         self._acknowledge(sentence)
 
@@ -549,6 +554,45 @@ class MMDriver(ModemDriverBase):
             data[0] &= 0x1F
         self._push("$CCMUC", msg.src, msg.dest, data.hex().upper())
 
+    def _initiate_fdp(self, msg) -> None:
+        msg.max_num_frames = 1
+        if not msg.HasField("max_frame_bytes"):
+            msg.max_frame_bytes = FDP_MAX_FRAME_BYTES
+        if msg.src < 0:
+            msg.src = self.modem_id
+        if not msg.frame:
+            self.signal_data_request.emit(msg)
+        if not msg.frame or not msg.frame[0]:
+            return
+        if msg.ack_requested and not self.mm_cfg.use_application_acks:
+            log.warning("FDP has no firmware acks; sending without one")
+        data = bytes(msg.frame[0])
+        major, minor, patch = self.revision
+        if (major, minor) == (2, 0) and patch < 35490 and len(data) % 2:
+            data += b"\0"  # these firmwares drop an odd final byte
+        self._push("$CCTDP", msg.dest, msg.rate, 0, 0, data.hex())
+
+    def _on_rdp(self, s: NMEASentence) -> None:
+        msg = self._ping_result(s.as_int(1), s.as_int(2), m.MICROMODEM_FLEXIBLE_DATA)
+        msg.rate = s.as_int(3)
+        frame, good = b"", True
+        for part in s.fields[6:8]:
+            triple = part.split(";")
+            if len(triple) < 3 or not part:
+                continue
+            crc_ok, payload = triple[0] == "1", triple[2]
+            good &= crc_ok
+            if self.mm_cfg.use_base64_fdp:
+                frame += base64.b64decode(payload)
+            else:
+                frame += bytes.fromhex(payload)
+        if good:
+            msg.frame.append(frame)
+        else:
+            msg.frame.append(b"")
+            msg.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc.append(0)
+        self.signal_receive.emit(msg)
+
     def _on_mua(self, s: NMEASentence) -> None:
         msg = self._ping_result(s.as_int(1), s.as_int(2), m.MICROMODEM_MINI_DATA)
         msg.frame.append(bytes.fromhex(s[3]))
@@ -557,10 +601,10 @@ class MMDriver(ModemDriverBase):
     _SIMPLE_COMMANDS = {
         m.MICROMODEM_REMUS_LBL_RANGING: "_initiate_remus_lbl",
         m.MICROMODEM_NARROWBAND_LBL_RANGING: "_initiate_narrowband_lbl",
-        8: "_initiate_generic_lbl",  # MICROMODEM_GENERIC_LBL_RANGING
-        6: "_initiate_hardware_control",  # MICROMODEM_HARDWARE_CONTROL
-        9: "_initiate_fm_sweep",  # MICROMODEM_FM_SWEEP
-        10: "_initiate_m_sequence",  # MICROMODEM_M_SEQUENCE
+        m.MICROMODEM_GENERIC_LBL_RANGING: "_initiate_generic_lbl",
+        m.MICROMODEM_HARDWARE_CONTROL: "_initiate_hardware_control",
+        m.MICROMODEM_FM_SWEEP: "_initiate_fm_sweep",
+        m.MICROMODEM_M_SEQUENCE: "_initiate_m_sequence",
     }
 
     def _lbl_params(self, msg, name: str):
@@ -590,7 +634,7 @@ class MMDriver(ModemDriverBase):
     def _initiate_generic_lbl(self, msg) -> None:
         p, timeout = self._lbl_params(msg, "generic_lbl")
         codes = [*list(p.receive_seq_code)[:4], 0, 0, 0, 0][:4]
-        self._last_lbl_type = 8
+        self._last_lbl_type = m.MICROMODEM_GENERIC_LBL_RANGING
         self._push("$CCPGT", p.transmit_freq, p.n_bits, p.transmit_seq_code, timeout,
                    p.receive_freq, *codes, p.bandwidth, 0)  # fmt: skip
 
@@ -619,7 +663,7 @@ class MMDriver(ModemDriverBase):
         major, minor, patch = self.revision
         if major == 2 and minor == 0 and patch < 18307:  # these firmwares swap src and dest
             src, dest = dest, src
-        msg = self._ping_result(src, dest, 7)  # MICROMODEM_HARDWARE_CONTROL_REPLY
+        msg = self._ping_result(src, dest, m.MICROMODEM_HARDWARE_CONTROL_REPLY)
         hw = msg.Extensions[m.MM_TRANSMISSION].hw_ctl
         hw.line, hw.mode, hw.arg = s.as_int(3), s.as_int(4), s.as_int(5)
         self.signal_receive.emit(msg)
