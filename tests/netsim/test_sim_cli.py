@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import struct
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.cli import main
@@ -15,7 +18,7 @@ from pygoby.netsim.eventlog import read_events
 from pygoby.netsim.protocol import LineDecoder, encode_line, request_class, response_names
 from pygoby.netsim.realtime import RealTimeRun
 from pygoby.netsim.report import bin_success
-from pygoby.netsim.scenario import parse_scenario
+from pygoby.netsim.scenario import ScenarioError, parse_scenario
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "netsim" / "tdma8.pb.cfg"
 
@@ -120,3 +123,21 @@ async def test_real_time_run_over_tcp():
 def test_real_time_needs_a_speed_factor():
     with pytest.raises(ValueError, match="virtual clock"):
         RealTimeRun(parse_scenario(SMALL))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(max_size=200))
+def test_fuzz_scenario_parser_only_raises_scenario_error(text):
+    with contextlib.suppress(ScenarioError):
+        parse_scenario(text)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.one_of(st.text(max_size=60), st.dictionaries(st.text(max_size=5),
+                                                                 st.integers(), max_size=3))))
+def test_fuzz_event_log_reader_skips_what_is_not_an_event(tmp_path_factory, lines):
+    path = tmp_path_factory.mktemp("log") / "events.jsonl"
+    text = "\n".join(json.dumps(x) if isinstance(x, dict) else x.replace("\n", " ") for x in lines)
+    path.write_text(text, encoding="utf-8")
+    events = read_events(path)
+    assert all(isinstance(e, dict) and isinstance(e.get("event"), str) for e in events)
