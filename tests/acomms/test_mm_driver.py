@@ -344,3 +344,28 @@ def test_flexible_data_protocol_send_and_receive():
     assert list(good.frame) == [b"\x01\x02\xaa\xbb\xcc"] and good.rate == 5
     assert list(bad.frame) == [b""]
     assert list(bad.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc) == [0]
+
+
+def test_application_ack_numbering_and_bitmasks():
+    from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
+
+    sender, receiver = ApplicationAcks({1}), ApplicationAcks({2})
+    sender.frame_counter = 30
+    msg = m.ModemTransmission(src=1, dest=2, max_num_frames=3, ack_requested=True)
+    size = sender.prepare(msg)
+    assert msg.frame_start == 0  # 30 + 3 > 32: numbering starts again
+    msg.frame[0] = bytes(msg.frame[0]) + b"x"
+    msg.frame.extend([b"y", b""])
+    assert sender.finish(msg, size) and sender.frame_counter == 3
+    heard = m.ModemTransmission()
+    heard.CopyFrom(msg)
+    heard.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc.append(2)
+    assert receiver.strip(heard) == [] and list(heard.frame) == [b"x", b"y", b""]
+    assert receiver.owed == {1: 0b011}
+    reply = m.ModemTransmission(src=2, dest=-1, max_num_frames=1)
+    size = receiver.prepare(reply)
+    assert receiver.finish(reply, size) and reply.dest == 0  # ack-only packet, broadcast
+    acks = sender.strip(reply)
+    assert [(a.src, a.dest, list(a.acked_frame)) for a in acks] == [(2, 1, [0]), (2, 1, [1])]
+    empty = m.ModemTransmission(src=2, dest=-1, max_num_frames=1)
+    assert not receiver.finish(empty, receiver.prepare(empty))  # nothing owed, no data

@@ -145,3 +145,35 @@ async def test_acked_message_queued_during_link_outage_is_delivered_after_reconn
             d.shutdown()
         for s in (sim1, sim2):
             await s.close()
+
+
+async def test_application_acks_over_tcp():
+    from pygoby.acomms.bind import bind
+
+    from .queue_helpers import entry, manager
+
+    channel, (sim1, sim2) = await start_emulators([1, 2])
+    d1 = await started_driver(1, sim1.port, use_application_acks=True)
+    d2 = await started_driver(2, sim2.port, use_application_acks=True)
+    clock = WallClock()
+    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
+    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
+    bind(d1, q1)
+    bind(d2, q2)
+    got, acked = [], []
+    q2.signal_receive.connect(got.append)
+    q1.signal_ack.connect(lambda ack, original: acked.append(original.value))
+    try:
+        q1.push_message(Status(src=1, dest=2, value=77))
+        await asyncio.sleep(0.01)
+        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=1))
+        await run_until(lambda: bool(got), [d1, d2])
+        assert [x.value for x in got] == [77] and acked == []  # the ack is owed, not sent yet
+        d2.handle_initiate_transmission(m.ModemTransmission(src=2, dest=-1, rate=1))  # no data
+        await run_until(lambda: bool(acked), [d1, d2])  # the ack-only packet acknowledges
+        assert acked == [77] and q1.size(20) == 0
+    finally:
+        for d in (d1, d2):
+            d.shutdown()
+        for s in (sim1, sim2):
+            await s.close()

@@ -18,6 +18,7 @@ from enum import Enum, auto
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
 from pygoby.acomms.drivers.micromodem.statistics import parse_cst, parse_toa, parse_xst
 from pygoby.util.nmea import NMEAError, NMEASentence
@@ -53,6 +54,7 @@ class MMDriver(ModemDriverBase):
         super().__init__(clock, link)
         self.mm_cfg = m.MMConfig()
         self.phase = Phase.STOPPED
+        self.app_acks: ApplicationAcks | None = None
         self.nvram: dict[str, int] = {}
         self.revision: tuple[int, int, int] = (0, 0, 0)
         self._reset_state()
@@ -96,6 +98,10 @@ class MMDriver(ModemDriverBase):
         self._reset_state()
         self.mm_cfg = cfg.Extensions[m.MM_CONFIG]
         self.modem_start(cfg)
+        self.app_acks = None
+        if self.mm_cfg.use_application_acks:
+            ids = {cfg.modem_id, *self.mm_cfg.additional_application_ack_modem_id}
+            self.app_acks = ApplicationAcks(ids)
         c = self.mm_cfg
         if c.reset_nvram and not c.hydroid_gateway_id:
             self._push("$CCCFG", "ALL", 0)
@@ -374,23 +380,29 @@ class MMDriver(ModemDriverBase):
                 return
             self._push("$CCCYC", 0, msg.src, msg.dest, msg.rate, 1, msg.max_num_frames)
             return
-        self._request_data(msg)
-        if not self._cached.frame or not self._cached.frame[0]:
+        if not self._request_data(msg):
             log.debug("no data to send; no cycle started")
             return
         c = self._cached
         self._expected_xst = 2 if c.rate == 0 else 1
         self._transmit = m.ModemTransmission()
         self._transmit.CopyFrom(c)
-        self._push("$CCCYC", 0, c.src, c.dest, c.rate, c.ack_requested, len(c.frame))
+        firmware_ack = c.ack_requested and self.app_acks is None
+        self._push("$CCCYC", 0, c.src, c.dest, c.rate, firmware_ack, len(c.frame))
 
-    def _request_data(self, msg) -> None:
+    def _request_data(self, msg) -> bool:
+        """Fill `msg` from the queue (with the application ack if enabled) and cache it;
+        False if there is nothing to send."""
         self._expected_acks.clear()
         self._frame_counter = 0
+        placeholder = self.app_acks.prepare(msg) if self.app_acks is not None else 0
         self.signal_data_request.emit(msg)
+        if self.app_acks is not None and not self.app_acks.finish(msg, placeholder):
+            msg.ClearField("frame")
         if msg.dest < 0:
             msg.dest = m.BROADCAST_ID
         self._cached = msg
+        return bool(msg.frame) and bool(msg.frame[0])
 
     def _on_cyc(self, s: NMEASentence) -> None:
         src, dest, rate, ack, nframes = (s.as_int(i) for i in range(2, 7))
@@ -521,7 +533,15 @@ class MMDriver(ModemDriverBase):
         self._expected_frames.clear()
         self._expected_cst = 0
         if rx is not None:
-            self.signal_receive.emit(rx)
+            self._emit_data(rx)
+
+    def _emit_data(self, rx) -> None:
+        """Deliver a data reception (after taking out an application ack, if enabled)."""
+        if self.app_acks is not None:
+            for ack in self.app_acks.strip(rx):
+                ack.time = m.now_us(self.clock.now())
+                self.signal_receive.emit(ack)
+        self.signal_receive.emit(rx)
 
     # ------------------------------------------------------------------ ranging, mini-packets
     def _on_mpr(self, s: NMEASentence) -> None:
@@ -560,11 +580,14 @@ class MMDriver(ModemDriverBase):
             msg.max_frame_bytes = FDP_MAX_FRAME_BYTES
         if msg.src < 0:
             msg.src = self.modem_id
-        if not msg.frame:
+        if self.app_acks is not None:
+            if not self._request_data(msg):
+                return
+        elif not msg.frame:
             self.signal_data_request.emit(msg)
         if not msg.frame or not msg.frame[0]:
             return
-        if msg.ack_requested and not self.mm_cfg.use_application_acks:
+        if msg.ack_requested and self.app_acks is None:
             log.warning("FDP has no firmware acks; sending without one")
         data = bytes(msg.frame[0])
         major, minor, patch = self.revision
@@ -591,7 +614,7 @@ class MMDriver(ModemDriverBase):
         else:
             msg.frame.append(b"")
             msg.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc.append(0)
-        self.signal_receive.emit(msg)
+        self._emit_data(msg)
 
     def _on_mua(self, s: NMEASentence) -> None:
         msg = self._ping_result(s.as_int(1), s.as_int(2), m.MICROMODEM_MINI_DATA)
