@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.cli import main
+from pygoby.moos.timewarp import moos_clock
 from pygoby.netsim.eventlog import read_events
 from pygoby.netsim.protocol import LineDecoder, encode_line, request_class, response_names
 from pygoby.netsim.realtime import RealTimeRun
@@ -120,9 +121,13 @@ async def test_real_time_run_over_tcp():
     assert any(e["event"] == "rx" and e["port"] == 62002 for e in events)
 
 
-def test_real_time_needs_a_speed_factor():
+def test_real_time_needs_a_speed_factor_or_a_clock():
     with pytest.raises(ValueError, match="virtual clock"):
         RealTimeRun(parse_scenario(SMALL))
+    clock = moos_clock(25)  # e.g. sharing a MOOS time-warp clock with the apps of a mission
+    run = RealTimeRun(parse_scenario(SMALL), clock=clock)
+    assert run.clock is clock and run.sim.physics.clock is clock
+    assert run.sim.start == pytest.approx(clock.now(), abs=5)
 
 
 @settings(max_examples=200, deadline=None)

@@ -7,7 +7,7 @@ netsim_tool), and one Micro-Modem emulator per node on its modem port (62000 + i
 get the real driver (over TCP to their emulator), MAC and status queue in this process; the
 others wait for an external driver. Scripted tracks are posted to the manager every
 `position_period`. The clock is the wall clock times the scenario's speed factor (external
-programs must run with the same MOOS time warp).
+programs must run with the same MOOS time warp), or a clock given by the caller.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.netsim.scenario import speed_factor
 from pygoby.netsim.server import ManagerServer
 from pygoby.netsim.sim import EventSink, RunSummary, Simulation, driver_config
-from pygoby.util.clock import WallClock
+from pygoby.util.clock import Clock, WallClock
 
 log = logging.getLogger(__name__)
 
@@ -34,14 +34,19 @@ STARTUP_TIMEOUT = 30.0  # wall seconds for the in-process drivers to start
 
 
 class RealTimeRun:
-    def __init__(self, scenario: Message, on_event: EventSink | None = None) -> None:
-        factor = speed_factor(scenario)
-        if factor is None:
-            raise ValueError('speed "max" runs on the virtual clock (Simulation.run_virtual)')
-        self.clock = WallClock(factor)
+    def __init__(
+        self, scenario: Message, on_event: EventSink | None = None, clock: Clock | None = None
+    ) -> None:
+        """`clock`: share another program's clock (e.g. a MOOS time-warp clock) instead of
+        the wall clock times the scenario's speed."""
+        if clock is None:
+            factor = speed_factor(scenario)
+            if factor is None:
+                raise ValueError('speed "max" runs on the virtual clock (Simulation.run_virtual)')
+            clock = WallClock(factor)
+        self.clock = clock
         self.sim = Simulation(scenario, clock=self.clock, on_event=on_event)
         self.sim.start = self.clock.now()
-        self.factor = factor
         rt = scenario.real_time
         self.host = rt.listen_address
         self.manager_server = ManagerServer(
