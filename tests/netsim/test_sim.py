@@ -6,6 +6,7 @@ from __future__ import annotations
 import pytest
 
 from pygoby.netsim.eventlog import EventLogWriter, read_events
+from pygoby.netsim.report import summary_lines
 from pygoby.netsim.scenario import ScenarioError, parse_scenario
 from pygoby.netsim.sim import Simulation
 
@@ -87,6 +88,7 @@ def test_overlapping_slots_collide():
     outcomes = {e["outcome"] for e in events if e["event"] == "rx"}
     assert {"half_duplex", "receiver_busy"} & outcomes
     assert any(e["collision"] for e in events if e["event"] == "rx")
+    assert any(line.startswith("collisions: ") for line in summary_lines(events))
 
 
 MARGINAL = f"""duration: 900 {ORIGIN} channel {{ noise_level: 110 }} mac {{ slot_seconds: 8 rate: 1 }}

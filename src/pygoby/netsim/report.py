@@ -176,4 +176,11 @@ def summary_lines(events: list[dict]) -> list[str]:
     ]
     if rx:
         lines.append(f"data packets: {good}/{len(rx)} received whole ({good / len(rx):.1%})")
+    overlapped = [e for e in events if e["event"] == "rx" and e.get("collision")]
+    if overlapped:
+        lost = sum(e["outcome"] != "good" for e in overlapped)
+        lines.append(f"collisions: {len(overlapped)} receptions overlapped by another, {lost} lost")
+    ranges = [e for e in events if e["event"] == "range"]
+    if ranges:
+        lines.append(f"ranging replies: {len(ranges)}")
     return lines
