@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import re
@@ -12,6 +13,8 @@ import time
 from pathlib import Path
 
 import pytest
+
+from pygoby.moos.client import MOOSClient
 
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))
 
@@ -33,6 +36,19 @@ def moosdb(tmp_path):
     yield int(match.group(2))
     proc.send_signal(signal.SIGINT)
     assert proc.wait(10) == 0
+
+
+def _wait_for_client(port: int, prefix: str, timeout: float = 10.0) -> None:
+    async def connected() -> bool:
+        async with MOOSClient("probe_watch", port=port) as probe:
+            replies = await probe.server_request("PROC_SUMMARY")
+        return any(m.string.startswith(prefix) for m in replies)
+
+    deadline = time.monotonic() + timeout
+    while not asyncio.run(connected()):
+        assert time.monotonic() < deadline, f"no client {prefix}* connected"
+        time.sleep(0.1)
+    time.sleep(0.2)  # its registrations follow its handshake
 
 
 def test_poke_then_get(moosdb):
@@ -58,7 +74,7 @@ def test_watch_streams_wildcard_notifications(moosdb):
         [PYGOBY, "moos", "watch", "--port", port, "--secs", "6", "--json", "NAV_*"],
         stdout=subprocess.PIPE, text=True,
     )  # fmt: skip
-    time.sleep(1.0)  # let it connect and register
+    _wait_for_client(moosdb, "pygoby_watch_")  # connected (and so registered)
     assert _pygoby("moos", "poke", "--port", port, "NAV_X=1", "OTHER=2", "NAV_Y=3").returncode == 0
     lines = []
     while len(lines) < 2:

@@ -153,8 +153,9 @@ async def test_reconnect_resubscribe_and_queue_while_away():
     app.subscribe("CMD")
     await app.flush()
     await db.stop()
-    await asyncio.sleep(0.3)
-    assert not app.connected
+    async with asyncio.timeout(3):
+        while app.connected:
+            await asyncio.sleep(0.01)
     app.publish("STATUS", "while-away")  # queued on the app's side
     db2 = MOOSDB(port=port)
     await db2.start()
