@@ -123,11 +123,16 @@ class Recorder:
         return [msg.value for msg in self.seen.get(var, [])]
 
     async def wait_for(
-        self, var: str, predicate: Callable[[object], bool] = lambda v: True, timeout: float = 20
+        self,
+        var: str,
+        predicate: Callable[[object], bool] = lambda v: True,
+        timeout: float = 20,
+        start: int = 0,
     ) -> object:
+        """The first value (from the `start`-th on) that satisfies `predicate`."""
         async with asyncio.timeout(timeout):
             while True:
-                for value in self.values(var):
+                for value in self.values(var)[start:]:
                     if predicate(value):
                         return value
                 await asyncio.sleep(0.02)
