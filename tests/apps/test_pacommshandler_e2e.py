@@ -6,7 +6,7 @@ from __future__ import annotations
 import asyncio
 
 from pygoby.acomms import messages as m
-from pygoby.moos.translator import parse_for_moos
+from pygoby.moos.translator import parse_for_moos, serialize_for_moos
 
 from .acomms_mission import COMMAND, STATUS, TwoCommunities
 
@@ -60,6 +60,19 @@ async def test_status_and_acked_command_between_two_vehicles(tmp_path):
         sizes = [parsed(m.QueueSize, v) for v in r1.values("ACOMMS_QSIZE")]
         assert {(s.dccl_id, s.size) for s in sizes} >= {(20, 0), (20, 1), (21, 0), (21, 1)}
         assert app1.queue.size(21) == 0
+
+        # Another process asks for a ping through ACOMMS_MAC_INITIATE_TRANSMISSION.
+        ping = m.ModemTransmission(src=1, dest=2, type=m.DRIVER_SPECIFIC)
+        ping.Extensions[m.MM_TRANSMISSION].type = m.MICROMODEM_TWO_WAY_PING
+        r1.client.publish("ACOMMS_MAC_INITIATE_TRANSMISSION", serialize_for_moos(ping))
+        reply = await r1.wait_for("ACOMMS_MODEM_RECEIVE", lambda v: "ranging_reply" in v)
+        assert "one_way_travel_time" in reply
+
+        # MACUpdate with cycle_state STOPPED: the MAC stops and the Micro-Modem goes silent.
+        stop = m.MACUpdate(src=2, dest=2, cycle_state=m.MACUpdate.STOPPED)
+        r2.client.publish("ACOMMS_MAC_CYCLE_UPDATE", serialize_for_moos(stop))
+        await r2.wait_for("ACOMMS_NMEA_OUT", lambda v: v.startswith("$CCCFG,SRC,0*"))
+        assert not net.apps[1].acomms.mac.running
 
 
 async def test_acked_command_survives_a_modem_link_outage(tmp_path):
