@@ -1,0 +1,168 @@
+"""What every Goby MOOS app with translator_entry blocks shares (pTranslator, pAcommsHandler).
+
+* `MessageTypes`: the app's message definitions: `load_shared_library` modules of generated code
+  (protobuf's default pool) and `load_proto_file` files (compiled at start-up), looked up by name.
+* `TranslatorBinding`: a `Translator` wired to a `GobyMOOSApp`: it subscribes the triggers, the
+  datum variables and the multiplex variables, runs the `TranslatorRunner`, hands each created
+  message to the app's callback, and posts publications.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+import importlib.util
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+from google.protobuf import descriptor_pool, message_factory
+from google.protobuf.message import Message
+
+from pygoby.moos.app import GobyMOOSApp
+from pygoby.moos.appconfig import ConfigError
+from pygoby.moos.protocol import MOOSMessage
+from pygoby.moos.translator import (
+    LAT_ORIGIN_VAR,
+    LONG_ORIGIN_VAR,
+    ModemIdLookup,
+    MoosValues,
+    Post,
+    Translator,
+    TranslatorError,
+    TranslatorRunner,
+    moos_technique_from_config,
+)
+from pygoby.protobuf import ProtoError, ProtoLoader
+
+
+def import_generated_module(name: str) -> None:
+    """load_shared_library: a module of generated _pb2 code, by module name or file path."""
+    path = Path(name)
+    if path.suffix == ".py" and path.is_file():
+        spec = importlib.util.spec_from_file_location(path.stem, path)
+        if spec is None or spec.loader is None:
+            raise ImportError(f"cannot load {name}")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    else:
+        importlib.import_module(name)
+
+
+class MessageTypes:
+    """Message classes by full name: .proto files first, then generated modules, then fallbacks
+    (e.g. pygoby's own messages)."""
+
+    def __init__(
+        self,
+        proto_files: Iterable[str] = (),
+        shared_libraries: Iterable[str] = (),
+        fallback: Callable[[str], type[Message]] | None = None,
+    ) -> None:
+        self.loader = ProtoLoader()
+        self._fallback = fallback
+        try:
+            for module in shared_libraries:
+                import_generated_module(module)
+            for path in proto_files:
+                self.loader.load_file(path)
+        except (ImportError, ProtoError, OSError, SyntaxError, TypeError) as err:
+            raise ConfigError(f"cannot load message definitions: {err}") from None
+
+    def __call__(self, name: str) -> type[Message]:
+        with contextlib.suppress(ProtoError):
+            return self.loader.message_class(name)
+        with contextlib.suppress(KeyError):
+            descriptor = descriptor_pool.Default().FindMessageTypeByName(name)
+            return message_factory.GetMessageClass(descriptor)
+        if self._fallback is not None:
+            return self._fallback(name)
+        raise ProtoError(f"unknown message type {name!r}")
+
+
+class TranslatorBinding:
+    """Runs an app's translator_entry blocks on the app's MOOS mail."""
+
+    def __init__(
+        self,
+        app: GobyMOOSApp,
+        entries: Iterable[Message],
+        resolve: Callable[[str], type[Message]],
+        on_created: Callable[[Message], None],
+        multiplex_vars: Iterable[str] = (),
+        modem_id_lookup_path: str = "",
+    ) -> None:
+        self.app = app
+        self.on_created = on_created
+        self.multiplex_vars = list(multiplex_vars)
+        modem_ids = ModemIdLookup.from_file(modem_id_lookup_path) if modem_id_lookup_path else None
+        try:
+            self.translator = Translator(
+                entries,
+                resolve,
+                lat_origin=app.common.lat_origin,
+                lon_origin=app.common.lon_origin,
+                modem_ids=modem_ids,
+            )
+            self.moos_technique = moos_technique_from_config(app.common)
+        except TranslatorError as err:
+            raise ConfigError(str(err)) from None
+        self.runner: TranslatorRunner | None = None
+
+    def subscribe_all(self) -> None:
+        triggers = set()
+        for entry in self.translator.entries.values():
+            if entry.HasField("trigger") and entry.trigger.type == entry.trigger.TRIGGER_PUBLISH:
+                triggers.add(entry.trigger.moos_var)
+        handled = {*triggers, LAT_ORIGIN_VAR, LONG_ORIGIN_VAR}
+        for var in sorted(handled):
+            self.app.subscribe(var, self._on_mail)
+        for var in self.translator.subscriptions():
+            if var not in handled:
+                self.app.subscribe(var)  # keeps dynamic_vars fresh for the create rules
+        for var in self.multiplex_vars:
+            self.app.subscribe(var, self._on_multiplex)
+
+    def start(self) -> None:
+        """Call from the app's on_start: the runner ignores mail older than the app's start."""
+        self.runner = TranslatorRunner(
+            self.translator,
+            start_time=self.app.start_time,
+            multiplex_vars=self.multiplex_vars,
+            variables=MoosValues(self.app.dynamic_vars),
+        )
+
+    def tick(self, now: float) -> None:
+        """Call from the app's loop: time triggers and pending datum changes."""
+        if self.runner is not None:
+            self._created(self.runner.tick(now))
+
+    def publish(self, message: Message) -> None:
+        """Post a message through its entry's publish rules (warns instead of posting part)."""
+        try:
+            posts = self.translator.publish(message)
+        except TranslatorError as err:
+            self.app.log.warning("cannot publish %s: %s", message.DESCRIPTOR.full_name, err)
+            return
+        self.post(posts)
+
+    def post(self, posts: Iterable[Post]) -> None:
+        for post in posts:
+            self.app.publish(post.var, post.value, src_aux=post.source_aux)
+
+    def _created(self, messages: list[Message]) -> None:
+        for message in messages:
+            self.on_created(message)
+
+    def _on_mail(self, msg: MOOSMessage) -> None:
+        if self.runner is not None:
+            self._created(self.runner.on_mail(msg.key, msg.value))
+
+    def _on_multiplex(self, msg: MOOSMessage) -> None:
+        if self.runner is None:
+            return
+        try:
+            posts = self.runner.on_multiplex(msg.value, self.moos_technique)
+        except TranslatorError as err:
+            self.app.log.warning("multiplexed message on %s not posted: %s", msg.key, err)
+            return
+        self.post(posts)
