@@ -95,6 +95,8 @@ async def test_two_mmsim_processes_hear_each_other():
                     pass
             return NMEASentence.parse(line)
 
+        send(w2, "$CCCFQ,SRC")  # a round trip: emulator 2 has registered this client
+        await until(r2, "$CACFG")
         send(w1, "$CCCYC,0,1,2,1,0,1")
         drq = await until(r1, "$CADRQ")
         assert drq.fields[2:6] == ("1", "2", "0", "64")
