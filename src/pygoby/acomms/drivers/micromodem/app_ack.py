@@ -16,7 +16,7 @@ from pygoby.dccl import Codec, DcclError
 log = logging.getLogger(__name__)
 
 MAX_FRAME_NUMBER = 32
-MMApplicationAck = m._cls("goby.acomms.micromodem.protobuf.MMApplicationAck")
+MMApplicationAck = m.MMApplicationAck
 
 
 class ApplicationAcks:
