@@ -295,3 +295,25 @@ def test_encrypt_rules_per_peer(clock):
     assert frame != q1.codec.encode(msg)  # the body is encrypted for peer 2
     assert [x.value for x in decoded(q2, frame)] == [321]
     assert [x.value for x in decoded(q2_wrong, frame)] != [321]
+
+
+def test_loopback_as_sent_minimum_ack_wait_and_flush(clock):
+    Manip = m.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+    e = entry("Status")
+    e.manipulator.append(Manip["LOOPBACK_AS_SENT"].number)
+    qm, (Status, *_) = manager(clock, entries=[e], minimum_ack_wait_seconds=10)
+    looped = []
+    qm.signal_receive.connect(looped.append)
+    qm.push_message(Status(src=1, dest=2, value=1))
+    assert looped == []
+    clock.advance(1)
+    first = fill(qm, frame_start=0)
+    assert [x.value for x in looped] == [1]
+    clock.advance(5)
+    assert fill(qm, frame_start=1).frame[0] == b""  # still waiting: sent 5 s < 10 s ago
+    clock.advance(6)
+    assert fill(qm, frame_start=2).frame[0] == first.frame[0]  # released after 10 s
+    sizes = []
+    qm.signal_queue_size_change.connect(lambda qs: sizes.append((qs.dccl_id, qs.size)))
+    qm.flush_queue(m.QueueFlush(dccl_id=20))
+    assert sizes == [(20, 0)] and qm.size(20) == 0
