@@ -249,3 +249,11 @@ def test_generated_python_classes_load(tmp_path: Path, monkeypatch) -> None:
     assert data.hex() == "042501"
     assert codec.decode(data) == example_pb2.Tiny(a=5, b=3, c=True)
     assert "example.Tiny" in codec.analyze(example_pb2.Tiny)
+
+
+def test_in_head_inside_a_body_message_is_dropped_with_a_warning(caplog) -> None:
+    """Spec §5.2 (vector ih.M4): the reference silently never sends such fields; we say so."""
+    cls = message_class("inhead.proto", "ih.M4")
+    with caplog.at_level("WARNING", logger="pygoby.dccl"):
+        Codec().load(cls)
+    assert "is in_head inside a sub-message that is not in the header" in caplog.text

@@ -7,6 +7,7 @@ tree of items in wire order; sizes, header validation, `analyze` and the code ge
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
@@ -17,6 +18,8 @@ from pygoby.dccl.codecs.base import FieldCodec, FieldInfo, field_category
 from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_options, message_options
 from pygoby.dccl.registry import CodecRegistry, DefaultMessageCodec
+
+log = logging.getLogger("pygoby.dccl")
 
 
 class Part(Enum):
@@ -241,6 +244,12 @@ class Planner:
         resolved, entry = self.registry.resolve(name, self.root.version, category)
         v2_message = isinstance(entry, DefaultMessageCodec) and entry.version == 2
         if not self._included(f, fopts, part, forced, version, v2_message):
+            if part is Part.BODY and forced is None and version >= 3 and fopts.in_head and stack[1:]:
+                log.warning(
+                    "%s is in_head inside a sub-message that is not in the header: it is never"
+                    " sent (as in DCCL); mark the message field in_head to send it",
+                    where,
+                )
             return None
         repeated = f.is_repeated
         if isinstance(entry, DefaultMessageCodec):
