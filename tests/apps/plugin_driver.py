@@ -1,4 +1,5 @@
-"""A pAcommsHandler driver plugin for tests (loaded through $PACOMMSHANDLER_PLUGINS).
+"""A pAcommsHandler driver plugin for tests (loaded through $PACOMMSHANDLER_PLUGINS): it
+"transmits" by asking the queue for data and reporting the filled transmission as sent.
 
 Its behaviour is steered through class attributes: `fail_startups` (how many startups fail
 before one succeeds) and, per instance, `fail_next_work` (the next do_work raises)."""
@@ -40,6 +41,7 @@ class ScriptedDriver(ModemDriverBase):
     def handle_initiate_transmission(self, transmission) -> None:
         self.initiated.append(transmission)
         self.signal_data_request.emit(transmission)
+        self.signal_transmit_result.emit(transmission)
 
     def update_cfg(self, cfg) -> None:
         self.cfg_updates.append(cfg)

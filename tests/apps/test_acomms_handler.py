@@ -155,3 +155,17 @@ def test_driver_cfg_update_goes_to_running_drivers_with_that_id(plugins):
     )
     handler.update_driver_cfg(m.DriverConfig(modem_id=7))
     assert [len(s.driver.cfg_updates) for s in handler.slots] == [0, 1]
+
+
+def test_a_transmission_the_driver_rejects_costs_only_that_slot(plugins, caplog):
+    clock = VirtualClock(1000.0)
+    handler = started(f"modem_id: 3 driver_cfg {{ {SCRIPTED} }} {SLOT}", clock)
+    driver = handler.primary.driver
+
+    def reject(transmission):
+        raise ValueError("rate 9 is not a Micro-Modem rate")
+
+    driver.signal_data_request.connect(reject)
+    run(handler, clock, 31)  # three slots: each one fails alone, the MAC keeps its schedule
+    assert len(driver.initiated) == 3 and handler.primary.running
+    assert caplog.text.count("cannot start the transmission") == 3

@@ -169,3 +169,49 @@ async def test_renamed_variables(tmp_path):
         finally:
             await app.stop()
             await r.close()
+
+
+ON_DEMAND = f"""\
+ServerHost = localhost
+ServerPort = @PORT@
+ProcessConfig = pAcommsHandler
+{{
+  common {{ log: false  app_tick: 20  verbosity: QUIET }}
+  modem_id: 1
+  driver_cfg {{ driver_name: "SCRIPTED" }}
+  mac_cfg {{ type: MAC_FIXED_DECENTRALIZED  slot {{ src: 1 slot_seconds: 1 max_frame_bytes: 32 }} }}
+  queue_cfg {{
+    message_entry {{ protobuf_name: "{STATUS}" ack: false  manipulator: ON_DEMAND
+                     role {{ type: SOURCE_ID field: "src" }} role {{ type: DESTINATION_ID field: "dest" }} }}
+  }}
+  load_proto_file: "{PROTO}"
+{TRANSLATOR_ENTRIES}
+}}
+"""
+
+
+async def test_on_demand_messages_are_created_at_each_data_request(tmp_path, monkeypatch):
+    monkeypatch.setenv("PACOMMSHANDLER_PLUGINS", "tests.apps.plugin_driver")
+    async with MOOSDB(port=0) as db:
+        path = tmp_path / "on_demand.moos"
+        path.write_text(ON_DEMAND.replace("@PORT@", str(db.port)))
+        r = Recorder("tester", db.port)
+        await r.start(["ACOMMS_MODEM_TRANSMIT"])
+        app = pAcommsHandler.from_mission(path)
+        await app.start(connect_timeout=5)
+        try:
+            for value, var in enumerate(("NAV_X", "NAV_Y", "NAV_SPEED", "NAV_HEADING", "NAV_DEPTH")):
+                r.client.publish(var, float(value + 1))
+            codec = Codec()
+            status_cls = codec.load_proto(PROTO, STATUS)
+
+            def carries_nav(text):
+                tx = m.ModemTransmission()
+                parse_for_moos(text, tx)
+                return tx.frame and tx.frame[0] and codec.decode(tx.frame[0]).nav_x == 1.0
+
+            await r.wait_for("ACOMMS_MODEM_TRANSMIT", carries_nav, timeout=15)
+            assert status_cls  # created from the newest NAV_* values, never triggered
+        finally:
+            await app.stop()
+            await r.close()

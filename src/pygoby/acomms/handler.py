@@ -29,6 +29,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from google.protobuf import text_format
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as m
@@ -287,7 +288,7 @@ class AcommsHandler:
         if self.primary is None:
             log.warning("no primary driver: transmission request ignored")
             return
-        self.primary.driver.handle_initiate_transmission(transmission)
+        self._initiate_on_primary(transmission)
 
     def inject_receive(self, transmission) -> None:
         """Treat `transmission` as received by a driver (queue only)."""
@@ -322,8 +323,13 @@ class AcommsHandler:
 
     # ------------------------------------------------------------------ internals
     def _initiate_on_primary(self, transmission) -> None:
-        if self.primary is not None and self.primary.running:
+        if self.primary is None or not self.primary.running:
+            return
+        try:
             self.primary.driver.handle_initiate_transmission(transmission)
+        except Exception:  # e.g. a slot with a rate the modem lacks: this slot only
+            log.exception("%s cannot start the transmission %s", _name(self.primary),
+                          text_format.MessageToString(transmission, as_one_line=True))  # fmt: skip
 
     def _forward_informational(self, slot: DriverSlot) -> None:
         driver = slot.driver

@@ -167,20 +167,38 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     # ------------------------------------------------------------------ wiring
     def _connect_signals(self) -> None:
+        """Map the acomms signals to MOOS posts. The slots run inside the driver's and the MAC's
+        work, so a failing slot is logged and contained (it must not look like a driver
+        failure or break a slot)."""
         acomms, queue, mac = self.acomms, self.acomms.queue, self.acomms.mac
-        acomms.signal_raw_incoming.connect(functools.partial(self._post_raw, True))
-        acomms.signal_raw_outgoing.connect(functools.partial(self._post_raw, False))
-        acomms.signal_modem_receive.connect(functools.partial(self._post_pb, "driver_receive"))
-        acomms.signal_modem_transmit.connect(functools.partial(self._post_pb, "driver_transmit"))
-        mac.signal_initiate_transmission.connect(
-            functools.partial(self._post_pb, "mac_initiate_transmission")
-        )
-        mac.signal_slot_start.connect(functools.partial(self._post_pb, "mac_slot_start"))
-        queue.signal_receive.connect(self._on_queue_receive)
-        queue.signal_ack.connect(self._on_ack)
-        queue.signal_expire.connect(functools.partial(self._post_pb, "queue_expire"))
-        queue.signal_queue_size_change.connect(functools.partial(self._post_pb, "queue_size"))
-        queue.signal_data_on_demand.connect(self._on_data_on_demand)
+        post = self._post_pb
+        connections = [
+            (acomms.signal_raw_incoming, functools.partial(self._post_raw, True)),
+            (acomms.signal_raw_outgoing, functools.partial(self._post_raw, False)),
+            (acomms.signal_modem_receive, functools.partial(post, "driver_receive")),
+            (acomms.signal_modem_transmit, functools.partial(post, "driver_transmit")),
+            (
+                mac.signal_initiate_transmission,
+                functools.partial(post, "mac_initiate_transmission"),
+            ),
+            (mac.signal_slot_start, functools.partial(post, "mac_slot_start")),
+            (queue.signal_receive, self._on_queue_receive),
+            (queue.signal_ack, self._on_ack),
+            (queue.signal_expire, functools.partial(post, "queue_expire")),
+            (queue.signal_queue_size_change, functools.partial(post, "queue_size")),
+            (queue.signal_data_on_demand, self._on_data_on_demand),
+        ]
+        for signal, slot in connections:
+            signal.connect(self._contained(slot))
+
+    def _contained(self, slot):
+        def run(*args) -> None:
+            try:
+                slot(*args)
+            except Exception:
+                self.log.exception("pAcommsHandler failed to handle an acomms event")
+
+        return run
 
     def _subscribe_all(self) -> None:
         handlers = {
@@ -251,12 +269,15 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
                 self.log.warning("%s not queued: %s", message.DESCRIPTOR.full_name, err)
 
     def _on_data_on_demand(self, request, message: Message) -> None:
+        """ON_DEMAND: a fresh message from the current variables, queued here (so a bad one is
+        logged and skipped); `message` is left empty so the queue does not push it again."""
+        name = message.DESCRIPTOR.full_name
         try:
-            message.CopyFrom(
-                self.translator.create(message.DESCRIPTOR.full_name, MoosValues(self.dynamic_vars))
-            )
+            created = self.translator.create(name, MoosValues(self.dynamic_vars))
         except TranslatorError as err:
-            self.log.warning("on-demand %s not created: %s", message.DESCRIPTOR.full_name, err)
+            self.log.warning("on-demand %s not created: %s", name, err)
+            return
+        self._push_created([created])
 
     def _parse(self, msg: MOOSMessage, cls: type[Message]) -> Message | None:
         out = cls()
