@@ -17,7 +17,7 @@ from pygoby.demo import run_mission
 SIMULATED_SECONDS = 900.0
 
 
-@pytest.mark.parametrize("warp", [25, 50])
+@pytest.mark.parametrize("warp", [25, 100])
 def test_two_vehicle_mission_messages_per_simulated_hour(benchmark, warp):
     def run():
         return asyncio.run(run_mission(warp, SIMULATED_SECONDS, say=lambda text: None))
