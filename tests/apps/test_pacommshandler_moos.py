@@ -200,7 +200,9 @@ async def test_on_demand_messages_are_created_at_each_data_request(tmp_path, mon
         app = pAcommsHandler.from_mission(path)
         await app.start(connect_timeout=5)
         try:
-            for value, var in enumerate(("NAV_X", "NAV_Y", "NAV_SPEED", "NAV_HEADING", "NAV_DEPTH")):
+            for value, var in enumerate(
+                ("NAV_X", "NAV_Y", "NAV_SPEED", "NAV_HEADING", "NAV_DEPTH")
+            ):
                 r.client.publish(var, float(value + 1))
             codec = Codec()
             status_cls = codec.load_proto(PROTO, STATUS)
@@ -212,6 +214,27 @@ async def test_on_demand_messages_are_created_at_each_data_request(tmp_path, mon
 
             await r.wait_for("ACOMMS_MODEM_TRANSMIT", carries_nav, timeout=15)
             assert status_cls  # created from the newest NAV_* values, never triggered
+        finally:
+            await app.stop()
+            await r.close()
+
+
+async def test_received_route_command_replaces_the_route(tmp_path):
+    route_cfg = """  route_cfg { route { hop: 1 hop: 3 } }
+  queue_cfg { message_entry { protobuf_name: "goby.acomms.protobuf.RouteCommand" } }"""
+    async with MOOSDB(port=0) as db:
+        app, r = await start(tmp_path, db, extra=route_cfg)
+        try:
+            assert 514 in app.queue.queues
+            command_cls = app._message_class("goby.acomms.protobuf.RouteCommand")
+            command = command_cls(src=3, dest=1, time=int(1.8e15))
+            command.new_route.hop.extend([1, 2, 3])
+            frame = app.acomms.codec.encode(command)
+            rx = m.ModemTransmission(src=3, dest=1, type=m.DATA, frame=[frame])
+            r.client.publish("ACOMMS_MODEM_RECEIVE", serialize_for_moos(rx))
+            async with asyncio.timeout(5):
+                while list(app.acomms.route_cfg.route.hop) != [1, 2, 3]:
+                    await asyncio.sleep(0.02)
         finally:
             await app.stop()
             await r.close()
