@@ -71,6 +71,8 @@ def test_spec_example_configures_every_layer(tmp_path):
     assert type(acomms.primary.driver).__name__ == "MMDriver"
     assert acomms.primary.cfg.modem_id == 1 and acomms.primary.cfg.serial_port == "/dev/ttyUSB0"
     assert acomms.primary.cfg.Extensions[m.MM_CONFIG].nvram_cfg == ["DQF,1"]
+    assert len(acomms.mac_cfg.slot) == 2 and acomms.mac_cfg.modem_id == 1
+    app.on_start()
     assert acomms.mac.running and len(acomms.mac.slots) == 2 and acomms.mac.cfg.modem_id == 1
     assert acomms.queue.modem_id == 1 and list(acomms.queue.queues) == [20]
     assert acomms.queue.queues[20].entry.blackout_time == 10

@@ -114,7 +114,6 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             raise ConfigError(str(err)) from None
         for name in skipped:
             self.log.debug("queue_cfg: no queue for %s (type not loaded)", name)
-        self.acomms.start()
         modem_ids = (
             ModemIdLookup.from_file(self._find(cfg.modem_id_lookup_path))
             if cfg.modem_id_lookup_path
@@ -233,6 +232,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             multiplex_vars=self.cfg.multiplex_create_moos_var,
             variables=MoosValues(self.dynamic_vars),
         )
+        self.acomms.start()  # drivers start at the first loop(); the MAC joins the cycle now
 
     def on_stop(self) -> None:
         self.acomms.shutdown()
