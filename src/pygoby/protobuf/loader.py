@@ -45,6 +45,9 @@ class ProtoLoader:
     ) -> None:
         self.include_dirs: list[Path] = [Path(d).resolve() for d in include_dirs]
         self.pool = pool if pool is not None else descriptor_pool.DescriptorPool()
+        # What we added, as compiled: a descriptor copied back out of the pool is not always
+        # byte-identical (e.g. an aliased enum default comes back under its other name).
+        self._added: dict[str, bytes] = {}
 
     def add_include_dir(self, directory: str | os.PathLike[str]) -> None:
         resolved = Path(directory).resolve()
@@ -110,16 +113,15 @@ class ProtoLoader:
         return list(fds.file)
 
     def _add(self, file_proto: descriptor_pb2.FileDescriptorProto) -> None:
+        compiled = file_proto.SerializeToString(deterministic=True)
         try:
-            existing = self.pool.FindFileByName(file_proto.name)
+            self.pool.FindFileByName(file_proto.name)
         except KeyError:
             self.pool.Add(file_proto)
+            self._added[file_proto.name] = compiled
             return
-        known = descriptor_pb2.FileDescriptorProto()
-        existing.CopyToProto(known)
-        if known.SerializeToString(deterministic=True) != file_proto.SerializeToString(
-            deterministic=True
-        ) and file_proto.name != "google/protobuf/descriptor.proto":
+        known = self._added.get(file_proto.name)
+        if known is not None and known != compiled:
             raise ProtoError(f"{file_proto.name} is already loaded with a different definition")
 
     def find_descriptor(self, full_name: str) -> Descriptor:
