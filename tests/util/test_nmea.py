@@ -74,3 +74,39 @@ def test_fuzz_parse_only_raises_nmea_errors(text):
 def test_fuzz_round_trip(token, values):
     s = NMEASentence.build(token, values)
     assert NMEASentence.parse(s.message()) == s
+
+
+FIELD_VALUES = st.one_of(
+    st.integers(),
+    st.booleans(),
+    st.binary(max_size=8),
+    st.floats(allow_nan=False),
+    st.text(alphabet="0123456789abcdefXYZ.-:T ", max_size=12),
+)
+
+
+def reference_field_text(value) -> str:
+    """The documented field rule: booleans 1/0, bytes as hex, anything else str()."""
+    if isinstance(value, bool):
+        return "1" if value else "0"
+    if isinstance(value, bytes):
+        return value.hex()
+    return str(value)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(FIELD_VALUES, max_size=10))
+def test_build_formats_every_kind_of_value_by_the_field_rule(values):
+    s = NMEASentence.build("$CCTXD", values)
+    assert s.fields == ("$CCTXD", *map(reference_field_text, values))
+    body = ",".join(s.fields)
+    cs = 0
+    for ch in body[1:]:
+        cs ^= ord(ch)
+    assert s.message() == f"{body}*{cs:02X}"
+
+
+@pytest.mark.parametrize("bad", ["a*b", "a\rb", "a\nb", "*"])
+def test_build_refuses_reserved_characters_in_any_field(bad):
+    with pytest.raises(NMEAFormatError, match="reserved"):
+        NMEASentence.build("$CCTXD", [1, bad, 2])

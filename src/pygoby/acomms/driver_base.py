@@ -167,11 +167,14 @@ class ModemDriverBase(ABC):
             self._raw_log.flush()
 
     def emit_raw(self, incoming: bool, raw: bytes | str, description: str = "") -> None:
+        signal = self.signal_raw_incoming if incoming else self.signal_raw_outgoing
+        if not signal:
+            return  # nobody listens: skip building a ModemRaw for every line
         data = raw.encode("latin-1") if isinstance(raw, str) else raw
         msg = m.ModemRaw(raw=data)
         if description:
             msg.description = description
-        (self.signal_raw_incoming if incoming else self.signal_raw_outgoing).emit(msg)
+        signal.emit(msg)
 
 
 class NoDriver(ModemDriverBase):

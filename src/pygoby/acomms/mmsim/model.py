@@ -74,7 +74,10 @@ class MicroModemModel:
 
     # ------------------------------------------------------------------ output
     def _say(self, token: str, *values: object) -> None:
-        line = NMEASentence.build(token, values).message()
+        self._say_sentence(NMEASentence.build(token, values))
+
+    def _say_sentence(self, sentence: NMEASentence) -> None:
+        line = sentence.message()
         if self.on_output is not None:
             self.on_output(line + "\r\n")
         else:
@@ -200,9 +203,7 @@ class MicroModemModel:
     def _transmitted(self, rate, src, dest, ack, frames, nbytes) -> None:
         self._say("$CATXP", nbytes)
         self._say("$CATXF", nbytes)
-        self._say(
-            *_sentence_parts(format_xst(self.modem_time(), rate, src, dest, ack, frames, nbytes))
-        )
+        self._say_sentence(format_xst(self.modem_time(), rate, src, dest, ack, frames, nbytes))
 
     def _cmd_mpc(self, s: NMEASentence) -> None:
         src, dest = s.as_int(1), s.as_int(2)
@@ -275,7 +276,7 @@ class MicroModemModel:
     def _cst(self, p: AcousticPacket, r: Reception, frames: int, bad: int) -> None:
         if not self.nvram.get("CST", 1):
             return
-        stat = m.ReceiveStatistics(
+        values = dict(
             mode=1 if bad else 0, time=m.now_us(r.arrival_time + self._clock_offset),
             clock_mode=0, mfd_peak=1000, mfd_power=20, mfd_ratio=150, spl=150, shf_agn=250,
             shf_ainpshift=0, shf_ainshift=0, shf_mfdshift=0, shf_p2bshift=0, rate=p.rate,
@@ -285,15 +286,16 @@ class MicroModemModel:
             data_quality_factor=200, doppler=0.0, stddev_noise=50, carrier_freq=25000,
             bandwidth=5000,
         )  # fmt: skip
-        fields = stat.DESCRIPTOR.fields_by_name
         for key, value in r.stats.items():
-            if key not in fields:
+            if key not in _STATISTICS:
                 log.warning("%s: unknown $CACST statistic %r from the channel", self.name, key)
                 continue
-            is_float = fields[key].cpp_type == fields[key].CPPTYPE_DOUBLE
-            setattr(stat, key, float(value) if is_float else int(round(value)))
-        self._say(*_sentence_parts(format_cst(stat)))
+            values[key] = float(value) if key in _DECIMAL_STATISTICS else int(round(value))
+        # one constructor call with every field: much faster than setting them one by one
+        self._say_sentence(format_cst(m.ReceiveStatistics(**values)))
 
 
-def _sentence_parts(sentence: NMEASentence) -> tuple[str, ...]:
-    return sentence.fields
+_STATISTICS = m.ReceiveStatistics.DESCRIPTOR.fields_by_name
+_DECIMAL_STATISTICS = {
+    name for name, f in _STATISTICS.items() if f.cpp_type == f.CPPTYPE_DOUBLE
+}  # fmt: skip

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
+import operator
 
 from pygoby.acomms import messages as m
 from pygoby.util.nmea import NMEAFormatError, NMEASentence
@@ -17,8 +18,10 @@ _CST_INT_FIELDS = (
     "number_frames", "number_bad_frames", "snr_rss", "snr_in", "snr_out", "snr_symbols",
     "mse_equalizer", "data_quality_factor", "doppler", "stddev_noise", "carrier_freq", "bandwidth",
 )  # fmt: skip
-_ENUM_RANGES = {"mode": (0, 2), "psk_error_code": (0, 6), "packet_type": (1, 5)}
-_INVALID = {"mode": -1, "psk_error_code": -1, "packet_type": -1, "clock_mode": -1}
+_DOPPLER = _CST_INT_FIELDS.index("doppler")  # the one decimal among them
+_cst_values = operator.attrgetter(*_CST_INT_FIELDS)  # all of them at once, in order
+# enum fields among them whose out-of-range values become -1 (the enums' INVALID value)
+_CST_ENUM_RANGES = {"psk_error_code": (0, 6), "packet_type": (1, 5)}
 
 
 def parse_toa(text: str, today: dt.date) -> int:
@@ -52,36 +55,58 @@ def clock_mode_from_field(value: int, new_bitfield: bool) -> int:
 def parse_cst(sentence: NMEASentence, today: dt.date, new_clock_bitfield: bool = False):
     """A $CACST sentence -> ReceiveStatistics (fields up to a short sentence's end)."""
     version, off = cst_offset(sentence)
-    stat = m.ReceiveStatistics(version=version)
     mode = sentence.as_int(1 + off)
-    stat.mode = mode if 0 <= mode <= 2 else -1
-    stat.time = parse_toa(sentence[2 + off], today)
-    stat.clock_mode = clock_mode_from_field(sentence.as_int(3 + off), new_clock_bitfield)
-    for i, name in enumerate(_CST_INT_FIELDS):
-        index = 4 + off + i
-        if index >= len(sentence):
-            log.warning("short $CACST (%d fields): stopped at %s", len(sentence), name)
-            break
-        if name == "doppler":
-            setattr(stat, name, sentence.as_float(index))
-            continue
-        value = sentence.as_int(index)
-        lo_hi = _ENUM_RANGES.get(name)
-        if lo_hi is not None and not lo_hi[0] <= value <= lo_hi[1]:
-            value = _INVALID[name]
-        setattr(stat, name, value)
-    return stat
+    time = parse_toa(sentence[2 + off], today)
+    clock_mode = clock_mode_from_field(sentence.as_int(3 + off), new_clock_bitfield)
+    start = 4 + off
+    texts = sentence.fields[start : start + len(_CST_INT_FIELDS)]
+    values = dict(zip(_CST_INT_FIELDS, _cst_numbers(sentence, start, texts), strict=False))
+    for name, (lo, hi) in _CST_ENUM_RANGES.items():
+        value = values.get(name)
+        if value is not None and not lo <= value <= hi:
+            values[name] = -1
+    if len(texts) < len(_CST_INT_FIELDS):
+        log.warning(
+            "short $CACST (%d fields): stopped at %s", len(sentence), _CST_INT_FIELDS[len(texts)]
+        )
+    # one constructor call with every field: much faster than setting them one by one
+    return m.ReceiveStatistics(
+        version=version, mode=mode if 0 <= mode <= 2 else -1, time=time, clock_mode=clock_mode,
+        **values,
+    )  # fmt: skip
+
+
+def _cst_numbers(sentence: NMEASentence, start: int, texts: tuple[str, ...]) -> list:
+    """`texts` (the fields from index `start`) as numbers: integers, but a decimal doppler."""
+    try:
+        return [
+            *map(int, texts[:_DOPPLER]),
+            *map(float, texts[_DOPPLER : _DOPPLER + 1]),
+            *map(int, texts[_DOPPLER + 1 :]),
+        ]
+    except ValueError:
+        # the error as_int / as_float give, naming the first field that is not a number
+        for i in range(len(texts)):
+            (sentence.as_float if i == _DOPPLER else sentence.as_int)(start + i)
+        raise
 
 
 def format_cst(stat, version: int = 0) -> NMEASentence:
     """ReceiveStatistics -> $CACST (used by the emulator)."""
     toa = dt.datetime.fromtimestamp(stat.time / 1e6, dt.UTC)
-    values: list[object] = [version] if version >= 6 else []
-    values += [stat.mode, f"{toa:%H%M%S}.{toa.microsecond // 100:04d}", stat.clock_mode]
-    for name in _CST_INT_FIELDS:
-        v = getattr(stat, name)
-        values.append(f"{v:.1f}" if name == "doppler" else int(v))
-    return NMEASentence.build("$CACST", values)
+    numbers = _cst_values(stat)
+    return NMEASentence.build(
+        "$CACST",
+        [
+            *([version] if version >= 6 else []),
+            stat.mode,
+            f"{toa.hour:02d}{toa.minute:02d}{toa.second:02d}.{toa.microsecond // 100:04d}",
+            stat.clock_mode,
+            *map(int, numbers[:_DOPPLER]),
+            f"{numbers[_DOPPLER]:.1f}",
+            *map(int, numbers[_DOPPLER + 1 :]),
+        ],
+    )
 
 
 # $CAXST v0 field order after date and time
