@@ -23,11 +23,8 @@ import importlib.util
 import logging
 import os
 import re
-import sys
-import zlib
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 
 from google.protobuf import text_format
 from google.protobuf.message import Message
@@ -41,6 +38,7 @@ from pygoby.acomms.signals import Signal
 from pygoby.dccl import Codec, DcclError
 from pygoby.protobuf import ProtoLoader
 from pygoby.util.clock import Clock
+from pygoby.util.modules import import_module_or_file
 
 log = logging.getLogger(__name__)
 
@@ -72,25 +70,6 @@ class HandlerError(Exception):
 def _import_object(spec: str):
     module, _, name = spec.partition(":")
     return getattr(importlib.import_module(module), name)
-
-
-def import_module_or_file(name: str):
-    """A Python module given by importable name or by the path of a .py file (driver plugins,
-    and `load_shared_library` modules of generated message code); each is loaded once."""
-    path = Path(name)
-    if path.suffix != ".py":
-        return importlib.import_module(name)
-    resolved = path.resolve()
-    module_name = f"pygoby_loaded_{resolved.stem}_{zlib.crc32(str(resolved).encode()):08x}"
-    if module_name in sys.modules:
-        return sys.modules[module_name]
-    spec = importlib.util.spec_from_file_location(module_name, resolved)
-    if spec is None or spec.loader is None:
-        raise ImportError(f"cannot load {name}")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    sys.modules[module_name] = module
-    return module
 
 
 def plugin_driver_factory(driver_name: str) -> Callable[[Clock], ModemDriverBase]:

@@ -14,7 +14,6 @@ configuration, the translator and the MOOS variables onto it.
 from __future__ import annotations
 
 import base64
-import contextlib
 import functools
 from pathlib import Path
 
@@ -22,25 +21,19 @@ from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.handler import AcommsHandler, HandlerError, import_module_or_file
+from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.acomms.queue import QueueError
 from pygoby.dccl import DcclError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import ConfigError
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import (
-    LAT_ORIGIN_VAR,
-    LONG_ORIGIN_VAR,
-    ModemIdLookup,
     MoosValues,
-    Post,
-    Translator,
     TranslatorError,
-    TranslatorRunner,
-    moos_technique_from_config,
     parse_for_moos,
     post_for_moos,
 )
+from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
 from pygoby.protobuf import ProtoError, ProtoLoader, builtin_class, default_loader
 
 ROUTE_COMMAND = "goby.acomms.protobuf.RouteCommand"
@@ -69,6 +62,13 @@ def interface_data_class() -> type[Message]:
         return message_factory.GetMessageClass(pool.FindMessageTypeByName(INTERFACE_DATA))
 
 
+def _goby_message_class(name: str) -> type[Message]:
+    """pygoby's own messages a mission may name (MACUpdate, RouteCommand, NetworkAck, ...)."""
+    goby = default_loader()
+    goby.load_file(ROUTE_PROTO)
+    return goby.message_class(name)
+
+
 def _raw_value(raw: bytes) -> str | bytes:
     """Driver traffic as a MOOS string when it is text (NMEA), else as a binary string."""
     try:
@@ -93,20 +93,30 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.ifs_data_out = names.ifrontseat_data_out
         self.loader = ProtoLoader()
         try:
-            self.moos_technique = moos_technique_from_config(self.common)
             self.acomms = AcommsHandler(cfg, self.clock, self.loader)
-        except (HandlerError, TranslatorError) as err:
+        except HandlerError as err:
             raise ConfigError(str(err)) from None
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
-        try:
-            for module in cfg.load_shared_library:
-                import_module_or_file(self._find(module))
-            for path in cfg.load_proto_file:
-                self.loader.load_file(self._find(path))
-        except (ImportError, ProtoError, OSError, SyntaxError) as err:
-            raise ConfigError(f"cannot load message definitions: {err}") from None
+        self._message_class = MessageTypes(
+            [self._find(path) for path in cfg.load_proto_file],
+            [self._find(module) for module in cfg.load_shared_library],
+            fallback=_goby_message_class,
+            loader=self.loader,
+        )
+        self.binding = TranslatorBinding(
+            self,
+            cfg.translator_entry,
+            self._message_class,
+            on_created=self._push,
+            multiplex_vars=cfg.multiplex_create_moos_var,
+            modem_id_lookup_path=self._find(cfg.modem_id_lookup_path)
+            if cfg.modem_id_lookup_path
+            else "",
+        )
+        self.translator = self.binding.translator
+        self.moos_technique = self.binding.moos_technique
         self._connect_signals()
         try:
             skipped = self.acomms.configure_queue(self._message_class)
@@ -114,22 +124,6 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             raise ConfigError(str(err)) from None
         for name in skipped:
             self.log.debug("queue_cfg: no queue for %s (type not loaded)", name)
-        modem_ids = (
-            ModemIdLookup.from_file(self._find(cfg.modem_id_lookup_path))
-            if cfg.modem_id_lookup_path
-            else None
-        )
-        try:
-            self.translator = Translator(
-                cfg.translator_entry,
-                self._message_class,
-                lat_origin=self.common.lat_origin,
-                lon_origin=self.common.lon_origin,
-                modem_ids=modem_ids,
-            )
-        except TranslatorError as err:
-            raise ConfigError(str(err)) from None
-        self.runner: TranslatorRunner | None = None
         self._subscribe_all()
         self.frontseat_forward = set()
         for name in cfg.dccl_frontseat_forward_name:
@@ -149,20 +143,6 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             return path
         beside = Path(self.mission.path).parent / given
         return str(beside) if beside.exists() else path
-
-    def _message_class(self, name: str) -> type[Message]:
-        """Message types: the app's .proto files, then load_shared_library modules (protobuf's
-        default pool), then goby's own messages (MACUpdate, RouteCommand, NetworkAck, ...)."""
-        try:
-            return self.loader.message_class(name)
-        except ProtoError:
-            pass
-        with contextlib.suppress(KeyError):
-            descriptor = descriptor_pool.Default().FindMessageTypeByName(name)
-            return message_factory.GetMessageClass(descriptor)
-        goby = default_loader()
-        goby.load_file(ROUTE_PROTO)
-        return goby.message_class(name)
 
     # ------------------------------------------------------------------ wiring
     def _connect_signals(self) -> None:
@@ -211,35 +191,18 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         }
         for key, handler in handlers.items():
             self.subscribe(self.var[key], handler)
-        triggers = set()
-        for entry in self.translator.entries.values():
-            if entry.HasField("trigger") and entry.trigger.type == entry.trigger.TRIGGER_PUBLISH:
-                triggers.add(entry.trigger.moos_var)
-        handled = {*triggers, LAT_ORIGIN_VAR, LONG_ORIGIN_VAR}
-        for var in sorted(handled):
-            self.subscribe(var, self._on_translator_mail)
-        for var in self.translator.subscriptions():
-            if var not in handled:
-                self.subscribe(var)  # keeps dynamic_vars fresh for the create rules
-        for var in self.cfg.multiplex_create_moos_var:
-            self.subscribe(var, self._on_multiplex)
+        self.binding.subscribe_all()
 
     # ------------------------------------------------------------------ running
     def on_start(self) -> None:
-        self.runner = TranslatorRunner(
-            self.translator,
-            start_time=self.start_time,
-            multiplex_vars=self.cfg.multiplex_create_moos_var,
-            variables=MoosValues(self.dynamic_vars),
-        )
+        self.binding.start()
         self.acomms.start()  # drivers start at the first loop(); the MAC joins the cycle now
 
     def on_stop(self) -> None:
         self.acomms.shutdown()
 
     def loop(self) -> None:
-        if self.runner is not None:
-            self._push_created(self.runner.tick(self.clock.now()))
+        self.binding.tick(self.clock.now())
         try:
             self.acomms.do_work()
         except HandlerError as err:
@@ -247,26 +210,11 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.request_stop()
 
     # ------------------------------------------------------------------ MOOS -> acomms
-    def _on_translator_mail(self, msg: MOOSMessage) -> None:
-        if self.runner is not None:
-            self._push_created(self.runner.on_mail(msg.key, msg.value))
-
-    def _on_multiplex(self, msg: MOOSMessage) -> None:
-        if self.runner is None:
-            return
+    def _push(self, message: Message) -> None:
         try:
-            posts = self.runner.on_multiplex(msg.value, self.moos_technique)
-        except TranslatorError as err:
-            self.log.warning("multiplexed message on %s not posted: %s", msg.key, err)
-            return
-        self._post(posts)
-
-    def _push_created(self, messages: list[Message]) -> None:
-        for message in messages:
-            try:
-                self.queue.push_message(message)
-            except (QueueError, DcclError, ValueError) as err:
-                self.log.warning("%s not queued: %s", message.DESCRIPTOR.full_name, err)
+            self.queue.push_message(message)
+        except (QueueError, DcclError, ValueError) as err:
+            self.log.warning("%s not queued: %s", message.DESCRIPTOR.full_name, err)
 
     def _on_data_on_demand(self, request, message: Message) -> None:
         """ON_DEMAND: a fresh message from the current variables, queued here (so a bad one is
@@ -277,7 +225,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         except TranslatorError as err:
             self.log.warning("on-demand %s not created: %s", name, err)
             return
-        self._push_created([created])
+        self._push(created)
 
     def _parse(self, msg: MOOSMessage, cls: type[Message]) -> Message | None:
         out = cls()
@@ -324,12 +272,8 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.acomms.update_driver_cfg(cfg)
 
     # ------------------------------------------------------------------ acomms -> MOOS
-    def _post(self, posts: list[Post]) -> None:
-        for post in posts:
-            self.publish(post.var, post.value, src_aux=post.source_aux)
-
     def _post_pb(self, key: str, message: Message) -> None:
-        self._post([post_for_moos(self.var[key], message, self.moos_technique)])
+        self.binding.post([post_for_moos(self.var[key], message, self.moos_technique)])
 
     def _post_raw(self, incoming: bool, raw) -> None:
         self.publish(
@@ -343,17 +287,14 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def _on_queue_receive(self, message: Message) -> None:
         name = message.DESCRIPTOR.full_name
-        try:
-            self._post(self.translator.publish(message))
-        except TranslatorError as err:
-            self.log.warning("Failed to translate received message %s: %s", name, err)
+        self.binding.publish(message)
         if name in self.frontseat_forward:
             try:
                 data = self.acomms.codec.encode(message)
             except DcclError as err:
                 self.log.warning("cannot forward %s to the frontseat: %s", name, err)
             else:
-                self._post([post_for_moos(self.ifs_data_out, interface_data_class()(dccl_message=data),
+                self.binding.post([post_for_moos(self.ifs_data_out, interface_data_class()(dccl_message=data),
                                           self.moos_technique)])  # fmt: skip
         if name == ROUTE_COMMAND and self.acomms.route_cfg.route.hop:
             self.acomms.replace_route(message.new_route)

@@ -10,10 +10,7 @@
 from __future__ import annotations
 
 import contextlib
-import importlib
-import importlib.util
 from collections.abc import Callable, Iterable
-from pathlib import Path
 
 from google.protobuf import descriptor_pool, message_factory
 from google.protobuf.message import Message
@@ -33,19 +30,7 @@ from pygoby.moos.translator import (
     moos_technique_from_config,
 )
 from pygoby.protobuf import ProtoError, ProtoLoader
-
-
-def import_generated_module(name: str) -> None:
-    """load_shared_library: a module of generated _pb2 code, by module name or file path."""
-    path = Path(name)
-    if path.suffix == ".py" and path.is_file():
-        spec = importlib.util.spec_from_file_location(path.stem, path)
-        if spec is None or spec.loader is None:
-            raise ImportError(f"cannot load {name}")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    else:
-        importlib.import_module(name)
+from pygoby.util.modules import import_module_or_file
 
 
 class MessageTypes:
@@ -57,12 +42,13 @@ class MessageTypes:
         proto_files: Iterable[str] = (),
         shared_libraries: Iterable[str] = (),
         fallback: Callable[[str], type[Message]] | None = None,
+        loader: ProtoLoader | None = None,
     ) -> None:
-        self.loader = ProtoLoader()
+        self.loader = loader if loader is not None else ProtoLoader()
         self._fallback = fallback
         try:
             for module in shared_libraries:
-                import_generated_module(module)
+                import_module_or_file(module)
             for path in proto_files:
                 self.loader.load_file(path)
         except (ImportError, ProtoError, OSError, SyntaxError, TypeError) as err:
