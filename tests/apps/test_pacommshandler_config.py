@@ -136,3 +136,29 @@ def test_example_config_command_line():
                    "translator_entry {", "multiplex_create_moos_var:", "modem_id_lookup_path:",
                    "driver_failure_approach {", "load_proto_file:"):  # fmt: skip
         assert needle in out, needle
+
+
+def test_route_cfg_gives_outgoing_messages_their_next_hop(tmp_path):
+    """route_cfg hops 1 -> 2 -> 3: a command for 3 leaves vehicle 1 addressed to 2 on the link."""
+    from .acomms_mission import COMMAND, QUEUE_ENTRIES
+
+    mission = f"""\
+ProcessConfig = pAcommsHandler
+{{
+  common {{ log: false }}
+  modem_id: 1
+  driver_cfg {{ driver_type: DRIVER_NONE }}
+{QUEUE_ENTRIES}
+  route_cfg {{ route {{ hop: 1 hop: 2 hop: 3 }} subnet_mask: 0xFFFFFF00 }}
+  load_proto_file: "@PROTO@"
+}}
+"""
+    app = pAcommsHandler.from_mission(write(tmp_path, mission))
+    command = app._message_class(COMMAND)(
+        time=float(int(time.time())), src=1, dest=3, command_id=7, heading=90, speed=1, depth=5
+    )
+    app.acomms.queue.push_message(command)
+    request = m.ModemTransmission(src=1, dest=m.QUERY_DESTINATION_ID, type=m.DATA, max_frame_bytes=32)
+    app.acomms.queue.handle_modem_data_request(request)
+    assert request.dest == 2
+    assert list(request.frame)  # the command is in the frame

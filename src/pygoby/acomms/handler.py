@@ -34,6 +34,7 @@ from pygoby.acomms.bind import bind, unbind
 from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException, driver_name
 from pygoby.acomms.mac import MACManager
 from pygoby.acomms.queue import QueueError, QueueManager
+from pygoby.acomms.route import RouteManager, bind_router
 from pygoby.acomms.signals import Signal
 from pygoby.dccl import Codec, DcclError
 from pygoby.protobuf import ProtoLoader
@@ -199,11 +200,9 @@ class AcommsHandler:
             self.mac.signal_initiate_transmission.connect(self._initiate_on_primary)
             self.primary.driver.signal_receive.connect(self.mac.handle_modem_receive)
 
-        self.route_cfg = type(cfg.route_cfg)()
-        self.route_cfg.CopyFrom(cfg.route_cfg)
-        if cfg.route_cfg.route.hop:
-            log.warning("route_cfg: static routing is not available yet; the route is kept "
-                        "(and replaced by RouteCommand) but messages are not relayed")  # fmt: skip
+        # Static routing (spec acomms.md §12): the queue is the router's one subnet here.
+        self.router = RouteManager(cfg.route_cfg)
+        bind_router(self.queue, self.router)
 
     # ------------------------------------------------------------------ start-up
     def configure_queue(self, resolve: Callable[[str], type[Message]]) -> list[str]:
@@ -296,8 +295,12 @@ class AcommsHandler:
             return
         self._driver_failed(self.primary, Status.MANUAL_RESET, "manual reset")
 
+    @property
+    def route_cfg(self):
+        return self.router.cfg
+
     def replace_route(self, route) -> None:
-        self.route_cfg.route.CopyFrom(route)
+        self.router.set_route(route)
         log.info("route replaced: %s", list(route.hop))
 
     # ------------------------------------------------------------------ internals
