@@ -47,6 +47,7 @@ from __future__ import annotations
 import enum
 import math
 import random
+from collections import defaultdict
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
@@ -248,7 +249,9 @@ class Channel:
             if not tx_band.overlaps(self.config.band_of(port)):
                 continue
             c = self.sound_speed(source.depth, receiver.depth)
-            if self.config.moving_receivers:
+            # a receiver that does not move is where it is: the fixed point of arrival_delay is
+            # its first guess (same value, one geodesic instead of five)
+            if self.config.moving_receivers and receiver.speed != 0:
                 delay = arrival_delay(
                     lambda tau, rx=receiver: slant_range(source, rx.at(tx.start + tau)), c
                 )
@@ -291,18 +294,25 @@ class Channel:
         self._pending = [p for p in self._pending if id(p) not in due_ids]
         self._finished.extend(due)  # before finishing: they interfere with each other
         due.sort(key=lambda p: (p.interval.end, p.receiver, p.sequence))
-        results = [self._finish(p) for p in due]
+        at_receiver = self._receptions_by_receiver()
+        results = [self._finish(p, at_receiver[p.receiver]) for p in due]
         self._prune(now)
         return results
 
     # -- internals -------------------------------------------------------------------------
 
-    def _receptions_at(self, port: int) -> list[_Pending]:
-        return [p for p in (*self._finished, *self._pending) if p.receiver == port]
+    def _receptions_by_receiver(self) -> defaultdict[int, list[_Pending]]:
+        """Every finished and pending reception, by receiver: one pass instead of one per
+        reception (in the same order as the lists: interference sums depend on it)."""
+        by_receiver: defaultdict[int, list[_Pending]] = defaultdict(list)
+        for p in (*self._finished, *self._pending):
+            by_receiver[p.receiver].append(p)
+        return by_receiver
 
     def _decide_locks(self, now: float) -> None:
         """Detection and receiver lock for every reception that has started by `now`, in
         arrival order (all earlier arrivals are known by then)."""
+        at_receiver = None
         for p in self._pending:  # sorted by arrival
             if p.interval.start > now:
                 break
@@ -311,9 +321,11 @@ class Channel:
             if self.config.protocol_model is not None:  # decided in _protocol_outcome
                 p.detected = p.locked = True
                 continue
+            if at_receiver is None:
+                at_receiver = self._receptions_by_receiver()
             others = [
                 q.received_level
-                for q in self._receptions_at(p.receiver)
+                for q in at_receiver[p.receiver]
                 if q is not p and q.interval.start <= p.interval.start < q.interval.end
             ]
             level = sinr(
@@ -332,12 +344,11 @@ class Channel:
             if p.locked:
                 self._locked_until[p.receiver] = p.interval.end
 
-    def _finish(self, p: _Pending) -> Reception:
+    def _finish(self, p: _Pending, at_receiver: list[_Pending]) -> Reception:
+        """`at_receiver`: every finished and pending reception at p's receiver."""
         noise = self.noise_level(self.config.band_of(p.receiver))
         interferers = [
-            q.received_level
-            for q in self._receptions_at(p.receiver)
-            if q is not p and q.interval.overlaps(p.interval)
+            q.received_level for q in at_receiver if q is not p and q.interval.overlaps(p.interval)
         ]
         level = sinr(p.received_level, noise, interferers)
         frames_ok: tuple[bool, ...] = ()
@@ -393,7 +404,10 @@ class Channel:
 
     def _prune(self, now: float) -> None:
         longest = max(self.config.durations.values(), default=0.0)
-        longest = max([longest, *(self.duration_of(p.transmission) for p in self._pending)])
+        # a pending reception outlasts these only with its own (explicit) duration
+        longest = max(
+            [longest, *(d for p in self._pending if (d := p.transmission.duration) is not None)]
+        )
         horizon = now - self.config.decode_latency - longest
         self._finished = [p for p in self._finished if p.interval.end > horizon]
         for port, intervals in self._own_tx.items():
