@@ -42,6 +42,8 @@ def test_format_then_parse_gives_the_statistics_back(
         **dict(zip(INTS, ints, strict=True)),
     )  # fmt: skip
     sentence = format_cst(stat, version)
+    as_mapping = {field.name: value for field, value in stat.ListFields()}
+    assert format_cst(as_mapping, version) == sentence
     assert sentence.fields[:2] == (("$CACST", str(version)) if version else ("$CACST", str(mode)))
     assert parse_cst(NMEASentence.parse(sentence.message()), DAY) == stat
 

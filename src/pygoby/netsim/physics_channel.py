@@ -34,7 +34,7 @@ from pygoby.acomms.mmsim.channel import AcousticPacket, ChannelEndpoint
 from pygoby.acomms.mmsim.channel import PacketKind as ModemPacketKind
 from pygoby.acomms.mmsim.channel import Reception as ModemReception
 from pygoby.netsim.channel import Channel, Outcome, PacketKind, Reception, Transmission
-from pygoby.netsim.channel.stats import receive_statistics
+from pygoby.netsim.channel.stats import receive_statistics_fields
 from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
@@ -200,7 +200,7 @@ class PhysicsChannel:
 
     def _stats(self, r: Reception, packet: AcousticPacket) -> dict[str, float]:
         band = self.channel.config.band_of(r.receiver)
-        stat = receive_statistics(
+        stat = receive_statistics_fields(
             r,
             source_id=packet.src,
             dest_id=packet.dest,
@@ -209,7 +209,7 @@ class PhysicsChannel:
         )
         if stat is None:
             return {}
-        return {name: getattr(stat, name) for name in STATS_FIELDS}
+        return {name: stat[name] for name in STATS_FIELDS}
 
     def _log_reception(self, r: Reception, sent: _Sent, delivered: bool, owtt: float) -> None:
         assert self.on_event is not None

@@ -43,7 +43,13 @@ class NMEASentence:
         """From a token (`"$CCCYC"`, or `"CCCYC"`, which gets a `$`) and field values."""
         if not token.startswith(("$", "!")):
             token = "$" + token
-        sentence = cls((token, *map(_field_text, values)))
+        # str and int values are nearly all of them: converted inline, without a call per field
+        # (`type(v) is int` is False for bool, which _field_text prints as 1/0)
+        fields = [
+            v if (kind := type(v)) is str else str(v) if kind is int else _field_text(v)
+            for v in values
+        ]
+        sentence = cls((token, *fields))
         sentence._validate(",".join(sentence.fields))
         return sentence
 
@@ -125,12 +131,6 @@ class NMEASentence:
 
 
 def _field_text(value: object) -> str:
-    # exact-type checks first: str and int are nearly every field (bool is not `int` here)
-    kind = type(value)
-    if kind is str:
-        return value  # type: ignore[return-value]
-    if kind is int:
-        return str(value)
     if isinstance(value, bool):
         return "1" if value else "0"
     if isinstance(value, bytes):

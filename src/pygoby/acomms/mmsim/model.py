@@ -291,8 +291,7 @@ class MicroModemModel:
                 log.warning("%s: unknown $CACST statistic %r from the channel", self.name, key)
                 continue
             values[key] = float(value) if key in _DECIMAL_STATISTICS else int(round(value))
-        # one constructor call with every field: much faster than setting them one by one
-        self._say_sentence(format_cst(m.ReceiveStatistics(**values)))
+        self._say_sentence(format_cst(values))
 
 
 _STATISTICS = m.ReceiveStatistics.DESCRIPTOR.fields_by_name

@@ -37,6 +37,26 @@ def receive_statistics(
 ) -> Message | None:
     """The $CACST a modem would report for this reception, or None if it reports nothing
     (the packet was never detected, or the receiver was busy with another one)."""
+    fields = receive_statistics_fields(
+        reception, source_id=source_id, dest_id=dest_id, carrier_hz=carrier_hz,
+        bandwidth_hz=bandwidth_hz, clock_mode=clock_mode,
+        flexible_data_packet=flexible_data_packet,
+    )  # fmt: skip
+    return None if fields is None else receive_statistics_class()(**fields)
+
+
+def receive_statistics_fields(
+    reception: Reception,
+    *,
+    source_id: int,
+    dest_id: int,
+    carrier_hz: float = 25000.0,
+    bandwidth_hz: float = 5000.0,
+    clock_mode: str = "NO_SYNC_TO_PPS_AND_CCCLK_GOOD",
+    flexible_data_packet: bool = False,
+) -> dict | None:
+    """`receive_statistics` as a dict of its fields (enums by name), for callers that only read
+    some of them: no message to build and read back."""
     if reception.outcome in (Outcome.NOT_DETECTED, Outcome.RECEIVER_BUSY):
         return None
     tx = reception.transmission
@@ -53,7 +73,7 @@ def receive_statistics(
     else:
         packet_type = "FSK" if tx.rate == 0 else "PSK"
     snr = reception.sinr
-    return receive_statistics_class()(
+    return dict(
         mode=mode,
         time=int(round(reception.arrival * 1e6)),
         clock_mode=clock_mode,

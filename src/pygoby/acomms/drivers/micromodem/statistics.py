@@ -5,6 +5,7 @@ from __future__ import annotations
 import datetime as dt
 import logging
 import operator
+from collections.abc import Mapping
 
 from pygoby.acomms import messages as m
 from pygoby.util.nmea import NMEAFormatError, NMEASentence
@@ -19,7 +20,10 @@ _CST_INT_FIELDS = (
     "mse_equalizer", "data_quality_factor", "doppler", "stddev_noise", "carrier_freq", "bandwidth",
 )  # fmt: skip
 _DOPPLER = _CST_INT_FIELDS.index("doppler")  # the one decimal among them
-_cst_values = operator.attrgetter(*_CST_INT_FIELDS)  # all of them at once, in order
+# every field format_cst prints, read at once from a ReceiveStatistics or from a mapping
+_CST_PRINTED = ("mode", "time", "clock_mode", *_CST_INT_FIELDS)
+_cst_attributes = operator.attrgetter(*_CST_PRINTED)
+_cst_items = operator.itemgetter(*_CST_PRINTED)
 # enum fields among them whose out-of-range values become -1 (the enums' INVALID value)
 _CST_ENUM_RANGES = {"psk_error_code": (0, 6), "packet_type": (1, 5)}
 
@@ -92,16 +96,18 @@ def _cst_numbers(sentence: NMEASentence, start: int, texts: tuple[str, ...]) -> 
 
 
 def format_cst(stat, version: int = 0) -> NMEASentence:
-    """ReceiveStatistics -> $CACST (used by the emulator)."""
-    toa = dt.datetime.fromtimestamp(stat.time / 1e6, dt.UTC)
-    numbers = _cst_values(stat)
+    """ReceiveStatistics -> $CACST (used by the emulator). `stat` may also be a mapping of
+    the field names to values (what the emulator has: no message to build and read back)."""
+    get = _cst_items if isinstance(stat, Mapping) else _cst_attributes
+    mode, time, clock_mode, *numbers = get(stat)
+    toa = dt.datetime.fromtimestamp(time / 1e6, dt.UTC)
     return NMEASentence.build(
         "$CACST",
         [
             *([version] if version >= 6 else []),
-            stat.mode,
+            mode,
             f"{toa.hour:02d}{toa.minute:02d}{toa.second:02d}.{toa.microsecond // 100:04d}",
-            stat.clock_mode,
+            clock_mode,
             *map(int, numbers[:_DOPPLER]),
             f"{numbers[_DOPPLER]:.1f}",
             *map(int, numbers[_DOPPLER + 1 :]),
