@@ -10,25 +10,21 @@ from __future__ import annotations
 import logging
 import socket
 
-from google.protobuf.message import DecodeError
-
 from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms.driver_base import ModemDriverException
+from pygoby.acomms.drivers.datagram import DatagramDriverBase
 
 log = logging.getLogger(__name__)
 
-MAX_DATAGRAM = 65507
 Status = m.ModemDriverStatus
 
 
-class UDPDriver(ModemDriverBase):
+class UDPDriver(DatagramDriverBase):
     def __init__(self, clock=None) -> None:
         super().__init__(clock)
         self.udp_cfg = m.UDPConfig()
-        self._sock: socket.socket | None = None
         self._remotes: dict[int, list[tuple[str, int]]] = {}
         self._ack_ids: set[int] = set()
-        self._frame_counter = 0
 
     @property
     def local_port(self) -> int:
@@ -62,24 +58,8 @@ class UDPDriver(ModemDriverBase):
             self._remotes.setdefault(remote.modem_id, []).append(info[0][4][:2])
         self._ack_ids = {cfg.modem_id, *self.udp_cfg.additional_application_ack_modem_id}
 
-    def shutdown(self) -> None:
-        if self._sock is not None:
-            self._sock.close()
-            self._sock = None
-
-    def handle_initiate_transmission(self, transmission) -> None:
-        msg = m.ModemTransmission()
-        msg.CopyFrom(transmission)
-        self.signal_modify_transmission.emit(msg)
-        if not msg.HasField("frame_start"):
-            msg.frame_start = self._frame_counter
-        if not msg.HasField("max_frame_bytes"):
-            msg.max_frame_bytes = self.udp_cfg.max_frame_size
-        self.signal_data_request.emit(msg)
-        self._frame_counter += len(msg.frame)
-        if msg.frame and msg.frame[0]:
-            self._send(msg)
-            self.signal_transmit_result.emit(msg)
+    def _max_frame_bytes(self, msg) -> int:
+        return self.udp_cfg.max_frame_size
 
     def _send(self, msg) -> None:
         if self._sock is None:
@@ -97,27 +77,8 @@ class UDPDriver(ModemDriverBase):
                 log.warning("UDP send to %s failed: %s", address, exc)
         self.emit_raw(False, data)
 
-    def do_work(self) -> None:
-        if self._sock is None:
-            return
-        while True:
-            try:
-                data, _ = self._sock.recvfrom(MAX_DATAGRAM)
-            except (BlockingIOError, InterruptedError):
-                return
-            except OSError as exc:  # e.g. ICMP port unreachable reported on a later call
-                log.debug("UDP receive error: %s", exc)
-                continue
-            self._handle_datagram(data)
-
-    def _handle_datagram(self, data: bytes) -> None:
+    def _handle_transmission(self, msg, data: bytes) -> None:
         self.emit_raw(True, data)
-        msg = m.ModemTransmission()
-        try:
-            msg.ParseFromString(data)
-        except DecodeError as exc:
-            log.warning("ignoring a datagram that is not a ModemTransmission: %s", exc)
-            return
         if msg.type != m.ACK and msg.ack_requested and msg.dest in self._ack_ids:
             ack = m.ModemTransmission(
                 type=m.ACK, time=m.now_us(self.clock.now()), src=msg.dest, dest=msg.src

@@ -11,25 +11,21 @@ import logging
 import socket
 import struct
 
-from google.protobuf.message import DecodeError
-
 from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms.driver_base import ModemDriverException
+from pygoby.acomms.drivers.datagram import DatagramDriverBase
 from pygoby.protobuf import default_loader
 
 log = logging.getLogger(__name__)
 
-MAX_DATAGRAM = 65507
 Status = m.ModemDriverStatus
 _CONFIG = default_loader().pool.FindExtensionByName("goby.acomms.udp_multicast.protobuf.config")
 
 
-class UDPMulticastDriver(ModemDriverBase):
+class UDPMulticastDriver(DatagramDriverBase):
     def __init__(self, clock=None) -> None:
         super().__init__(clock)
         self.mc_cfg = None
-        self._sock: socket.socket | None = None
-        self._frame_counter = 0
 
     def startup(self, cfg) -> None:
         if not cfg.HasField("modem_id"):
@@ -56,25 +52,9 @@ class UDPMulticastDriver(ModemDriverBase):
         sock.setblocking(False)
         self._sock = sock
 
-    def shutdown(self) -> None:
-        if self._sock is not None:
-            self._sock.close()
-            self._sock = None
-
-    def handle_initiate_transmission(self, transmission) -> None:
-        msg = m.ModemTransmission()
-        msg.CopyFrom(transmission)
-        self.signal_modify_transmission.emit(msg)
-        if not msg.HasField("frame_start"):
-            msg.frame_start = self._frame_counter
-        if not msg.HasField("max_frame_bytes"):
-            sizes = {rb.rate: rb.bytes for rb in self.mc_cfg.rate_to_bytes}
-            msg.max_frame_bytes = sizes.get(msg.rate, self.mc_cfg.max_frame_size)
-        self.signal_data_request.emit(msg)
-        self._frame_counter += len(msg.frame)
-        if msg.frame and msg.frame[0]:
-            self._send(msg)
-            self.signal_transmit_result.emit(msg)
+    def _max_frame_bytes(self, msg) -> int:
+        sizes = {rb.rate: rb.bytes for rb in self.mc_cfg.rate_to_bytes}
+        return sizes.get(msg.rate, self.mc_cfg.max_frame_size)
 
     def _send(self, msg) -> None:
         if self._sock is None:
@@ -86,28 +66,12 @@ class UDPMulticastDriver(ModemDriverBase):
             log.warning("multicast send failed: %s", exc)
         self.emit_raw(False, data)
 
-    def do_work(self) -> None:
-        if self._sock is None:
-            return
-        while True:
-            try:
-                data, _ = self._sock.recvfrom(MAX_DATAGRAM)
-            except (BlockingIOError, InterruptedError):
-                return
-            except OSError as exc:
-                log.debug("multicast receive error: %s", exc)
-                continue
-            msg = m.ModemTransmission()
-            try:
-                msg.ParseFromString(data)
-            except DecodeError as exc:
-                log.warning("ignoring a datagram that is not a ModemTransmission: %s", exc)
-                continue
-            if msg.src == self.modem_id:
-                continue  # our own transmission looped back
-            self.emit_raw(True, data)
-            if msg.type == m.DATA and msg.ack_requested and msg.dest == self.modem_id:
-                ack = m.ModemTransmission(type=m.ACK, src=self.modem_id, dest=msg.src)
-                ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
-                self._send(ack)
-            self.signal_receive.emit(msg)
+    def _handle_transmission(self, msg, data: bytes) -> None:
+        if msg.src == self.modem_id:
+            return  # our own transmission looped back
+        self.emit_raw(True, data)
+        if msg.type == m.DATA and msg.ack_requested and msg.dest == self.modem_id:
+            ack = m.ModemTransmission(type=m.ACK, src=self.modem_id, dest=msg.src)
+            ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
+            self._send(ack)
+        self.signal_receive.emit(msg)
