@@ -34,3 +34,20 @@ def manager(clock, modem_id=1, entries=(), **cfg):
     for e in entries:
         qm.add_queue(e)
     return qm, types
+
+
+def status_link(clock, d1, d2):
+    """Drivers d1 (modem 1) and d2 (modem 2), each bound to a queue manager with a Status queue.
+
+    Returns (q1, q2, Status, got, acked): `got` collects what q2 receives, `acked` the `value`
+    of each of q1's messages that was acknowledged."""
+    from pygoby.acomms.bind import bind
+
+    q1, (status_cls, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
+    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
+    bind(d1, q1)
+    bind(d2, q2)
+    got, acked = [], []
+    q2.signal_receive.connect(got.append)
+    q1.signal_ack.connect(lambda ack, original: acked.append(original.value))
+    return q1, q2, status_cls, got, acked

@@ -7,12 +7,11 @@ import pytest
 from pygoby.acomms import messages as m
 from pygoby.acomms.abc_protocol import ABCParseError, parse_abc
 from pygoby.acomms.abc_simulator import ABCSimulator, serve_abc
-from pygoby.acomms.bind import bind
 from pygoby.acomms.drivers.abc import ABCDriver
 from pygoby.util.clock import WallClock
 
 from .mm_e2e import run_until
-from .queue_helpers import entry, manager
+from .queue_helpers import status_link
 
 
 def test_parse_and_simulator_rules():
@@ -46,13 +45,7 @@ async def test_abc_driver_queue_to_queue_with_ack():
     d1, d2 = ABCDriver(clock), ABCDriver(clock)
     d1.startup(abc_cfg(1, port))
     d2.startup(abc_cfg(2, port))
-    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
-    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
-    bind(d1, q1)
-    bind(d2, q2)
-    got, acked = [], []
-    q2.signal_receive.connect(got.append)
-    q1.signal_ack.connect(lambda ack, orig: acked.append(orig.value))
+    q1, q2, Status, got, acked = status_link(clock, d1, d2)
     try:
         await d1.link.wait_open()
         await d2.link.wait_open()

@@ -9,6 +9,7 @@ from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.util.clock import WallClock
 
 from .mm_e2e import run_until, start_emulators, started_driver
+from .queue_helpers import status_link
 
 
 async def test_data_with_ack_and_ranging_over_tcp():
@@ -148,21 +149,11 @@ async def test_acked_message_queued_during_link_outage_is_delivered_after_reconn
 
 
 async def test_application_acks_over_tcp():
-    from pygoby.acomms.bind import bind
-
-    from .queue_helpers import entry, manager
-
     channel, (sim1, sim2) = await start_emulators([1, 2])
     d1 = await started_driver(1, sim1.port, use_application_acks=True)
     d2 = await started_driver(2, sim2.port, use_application_acks=True)
     clock = WallClock()
-    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
-    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
-    bind(d1, q1)
-    bind(d2, q2)
-    got, acked = [], []
-    q2.signal_receive.connect(got.append)
-    q1.signal_ack.connect(lambda ack, original: acked.append(original.value))
+    q1, q2, Status, got, acked = status_link(clock, d1, d2)
     try:
         q1.push_message(Status(src=1, dest=2, value=77))
         await asyncio.sleep(0.01)

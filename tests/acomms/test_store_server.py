@@ -7,14 +7,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.bind import bind
 from pygoby.acomms.drivers.store_server import StoreServerDriver
 from pygoby.acomms.rudics import RudicsPacketError, parse_rudics_packet, serialize_rudics_packet
 from pygoby.acomms.store_server import StoreServer, TransmissionStore, serve_store
 from pygoby.util.clock import WallClock
 
 from .mm_e2e import run_until
-from .queue_helpers import entry, manager
+from .queue_helpers import status_link
 
 
 @settings(max_examples=200, deadline=None)
@@ -71,13 +70,7 @@ async def test_driver_to_driver_through_store_server_with_ack(tmp_path):
     d1, d2 = StoreServerDriver(clock), StoreServerDriver(clock)
     d1.startup(store_cfg(1, port))
     d2.startup(store_cfg(2, port))
-    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
-    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
-    bind(d1, q1)
-    bind(d2, q2)
-    got, acked = [], []
-    q2.signal_receive.connect(got.append)
-    q1.signal_ack.connect(lambda ack, orig: acked.append(orig.value))
+    q1, q2, Status, got, acked = status_link(clock, d1, d2)
     try:
         await d1.link.wait_open()
         q1.push_message(Status(src=1, dest=2, value=33))

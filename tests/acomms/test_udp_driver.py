@@ -8,7 +8,7 @@ from pygoby.acomms.bind import bind
 from pygoby.acomms.drivers.udp import UDPDriver
 from pygoby.util.clock import VirtualClock
 
-from .queue_helpers import entry, manager
+from .queue_helpers import entry, manager, status_link
 
 DRIVER_UDP = 6
 
@@ -107,13 +107,7 @@ def test_multicast_queue_to_queue_with_ack():
         drivers.append(d)
     d1, d2 = drivers
     try:
-        q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
-        q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
-        bind(d1, q1)
-        bind(d2, q2)
-        got, acked = [], []
-        q2.signal_receive.connect(got.append)
-        q1.signal_ack.connect(lambda ack, orig: acked.append(orig.value))
+        q1, q2, Status, got, acked = status_link(clock, d1, d2)
         q1.push_message(Status(src=1, dest=2, value=8))
         clock.advance(1)
         d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))

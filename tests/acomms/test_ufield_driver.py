@@ -1,11 +1,10 @@
 """uField driver core: two nodes joined by a stand-in for uFldNodeComms + uFldMessageHandler."""
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.bind import bind
 from pygoby.acomms.drivers.ufield import UFldDriver, parse_moos_pairs
 from pygoby.util.clock import VirtualClock
 
-from .queue_helpers import entry, manager
+from .queue_helpers import status_link
 
 
 class Shoreside:
@@ -42,13 +41,7 @@ def test_data_ack_and_poll_through_ufield(tmp_path):
     shore = Shoreside()
     d1, d2 = make_node(shore, tmp_path, 1, "alpha"), make_node(shore, tmp_path, 2, "bravo")
     clock = d1.clock
-    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
-    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
-    bind(d1, q1)
-    bind(d2, q2)
-    got, acked = [], []
-    q2.signal_receive.connect(got.append)
-    q1.signal_ack.connect(lambda ack, orig: acked.append(orig.value))
+    q1, q2, Status, got, acked = status_link(clock, d1, d2)
     q1.push_message(Status(src=1, dest=2, value=3))
     d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
     assert [x.value for x in got] == [3] and acked == [3]
