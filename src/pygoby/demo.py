@@ -5,11 +5,14 @@
 2. A two-vehicle acoustic-communications mission, time-warped: the missions of
    examples/two_vehicles/ (a topside and an AUV, each a MOOS community with its own embedded
    MOOSDB, pAcommsHandler and uSimVehicle) run in this process, each pAcommsHandler talking to an
-   emulated WHOI Micro-Modem over loopback TCP, with TDMA slots. The vehicles broadcast DCCL
-   status reports; the topside sends acknowledged commands that steer the AUV. A monitor client
-   on each MOOSDB prints what happens, slot by slot.
+   emulated WHOI Micro-Modem over loopback TCP, with TDMA slots. The emulators hear each other
+   through netsim's acoustic physics (`PhysicsChannel`), at the vehicles' positions. The vehicles
+   broadcast DCCL status reports; the topside sends acknowledged commands that send the AUV away,
+   so travel times grow with range until packets are lost. A monitor client on each MOOSDB prints
+   what happens, slot by slot; every acoustic transmission and reception goes to an event log
+   (`pygoby netsim report LOG` plots it).
 
-    python -m pygoby.demo [--warp 25] [--duration 400] [--quiet]
+    python -m pygoby.demo [--warp 25] [--duration 720] [--event-log PATH] [--skip-dccl]
 
 `run_mission()` is the reusable part (benchmarks/test_acomms_handler_bench.py uses it).
 """
@@ -20,6 +23,7 @@ import argparse
 import asyncio
 import contextlib
 import logging
+import tempfile
 import time
 from collections import Counter
 from dataclasses import dataclass, field
@@ -33,11 +37,23 @@ from pygoby.dccl.analyze import describe
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 MISSION_DIR = EXAMPLES / "two_vehicles"
 VEHICLES = (("topside", 1), ("unicorn", 2))
+# The missions' emulator ports (their `pygoby mmsim --port` lines): the nodes' identities in the
+# acoustic channel and its event log.
+MODEM_PORTS = {"topside": 62101, "unicorn": 62102}
+NAV = ("NAV_X", "NAV_Y", "NAV_DEPTH", "NAV_SPEED", "NAV_HEADING")
 SHORT_NAMES = {"pygoby.examples.SimpleStatus": "status", "pygoby.examples.Command": "command"}
 WATCHED = (
     "ACOMMS_MAC_SLOT_START", "ACOMMS_MODEM_TRANSMIT", "ACOMMS_QUEUE_RECEIVE", "ACOMMS_ACK_ORIGINAL",
-    "ACOMMS_QSIZE", "STATUS_REPORT_IN", "COMMAND_IN", "COMMAND_OUT",
+    "ACOMMS_QSIZE", "STATUS_REPORT_IN", "COMMAND_IN", "COMMAND_OUT", *NAV,
 )  # fmt: skip
+# The acoustic environment: spherical spreading and a noisy harbour (100 dB re 1 uPa of ambient
+# noise in the modem's band), so that rate-0 packets fail beyond 2-3.5 km, within reach of the AUV
+# in a demo of minutes (netsim's default channel carries them to about 9.5 km). The channel has no
+# fading, so rate 0 (the data and every control packet here) gets a wide frame-error curve in its
+# place: losses grow over a kilometre of range instead of all at once.
+CHANNEL_SETTINGS = {"spreading": 2.0, "noise_level": 100.0}
+RATE0_FRAME_ERRORS = {"snr50_db": 0.0, "width_db": 1.5}  # logistic: 1% at 7 dB, 99% at -7 dB
+PHYSICS_SEED = 1
 
 
 def dccl_demo() -> None:
@@ -76,6 +92,31 @@ class VehicleStats:
     acked: Counter = field(default_factory=Counter)
     queued: dict[str, int] = field(default_factory=dict)
     last_report: str = ""
+    # acoustic packets that reached this vehicle's modem, and those it could not decode
+    packets_in: int = 0
+    packets_lost: int = 0
+    last_range_m: float | None = None  # of the newest packet that reached it
+    last_owtt: float | None = None  # its one-way travel time, s
+
+
+class AcousticTally:
+    """An `on_event` sink for `PhysicsChannel`: counts each vehicle's receptions in its
+    VehicleStats and passes every event on to `sink` (the event log)."""
+
+    def __init__(self, by_port: dict[int, VehicleStats], sink=None) -> None:
+        self.by_port, self.sink = by_port, sink
+        self.newest: VehicleStats | None = None  # the receiver of the newest reception
+
+    def __call__(self, event: dict) -> None:
+        if self.sink is not None:
+            self.sink(event)
+        receiver = self.by_port.get(event["port"]) if event["event"] == "rx" else None
+        if receiver is None:
+            return
+        receiver.packets_in += 1
+        receiver.packets_lost += event["outcome"] != "good"
+        receiver.last_range_m, receiver.last_owtt = event["range_m"], event["owtt"]
+        self.newest = receiver
 
 
 @dataclass
@@ -111,10 +152,13 @@ def _field(value: str, name: str) -> str:
 class Monitor:
     """A MOOS client on one community that turns ACOMMS_* mail into VehicleStats and events."""
 
-    def __init__(self, stats: VehicleStats, codec: Codec, clock, port: int, say) -> None:
+    def __init__(self, stats: VehicleStats, codec: Codec, clock, port: int, say, on_nav) -> None:
+        """`on_nav(nav, t)`: the vehicle's NAV_* values (by name) at MOOS time t, on every
+        NAV_* post once each has been seen."""
         from pygoby.moos.client import MOOSClient
 
-        self.stats, self.codec, self.say = stats, codec, say
+        self.stats, self.codec, self.say, self.on_nav = stats, codec, say, on_nav
+        self.nav: dict[str, float] = {}
         self.id_names = {codec.compiled(cls).id: SHORT_NAMES[cls.DESCRIPTOR.full_name]
                          for cls in codec.loaded()}  # fmt: skip
         self.client = MOOSClient(f"uDemoMonitor_{stats.name}", port=port, clock=clock,
@@ -141,7 +185,13 @@ class Monitor:
         from pygoby.acomms import messages as m
 
         s, value = self.stats, msg.value
-        if msg.key == "ACOMMS_MAC_SLOT_START" and (slot := self._parse(m.ModemTransmission, value)):
+        if msg.key in NAV and msg.is_double:
+            self.nav[msg.key] = msg.dval
+            if len(self.nav) == len(NAV):
+                self.on_nav(self.nav, msg.time)
+        elif msg.key == "ACOMMS_MAC_SLOT_START" and (
+            slot := self._parse(m.ModemTransmission, value)
+        ):
             self.slot = (slot.slot_index, slot.src)
         elif msg.key == "ACOMMS_MODEM_TRANSMIT" and (tx := self._parse(m.ModemTransmission, value)):
             for frame in tx.frame:
@@ -182,54 +232,103 @@ def _counts(counter: Counter) -> str:
     return "/".join(str(counter[name]) for name in SHORT_NAMES.values())
 
 
-def summary_line(t: float, slot: tuple[int, int] | None, vehicles: list[VehicleStats]) -> str:
+def _link(v: VehicleStats | None) -> str:
+    if v is None or v.last_range_m is None or v.last_owtt is None:
+        return "range    - km  owtt    - s"
+    return f"range {v.last_range_m / 1000:4.2f} km  owtt {v.last_owtt:4.2f} s"
+
+
+def summary_line(
+    t: float,
+    slot: tuple[int, int] | None,
+    vehicles: list[VehicleStats],
+    newest: VehicleStats | None = None,
+) -> str:
+    """One line: time, slot owner, range and one-way travel time of the newest acoustic
+    reception (`newest` heard it), then per vehicle its message counts and lost packets."""
     names = {modem_id: name for name, modem_id in VEHICLES}
     owner = f"slot {slot[0]} ({names.get(slot[1], slot[1])})" if slot else "slot -"
-    parts = [f"t={t:6.0f} s  {owner:<17}"]
+    parts = [f"t={t:4.0f} s  {owner:<17} {_link(newest)}"]
     for v in vehicles:
         queued = "/".join(str(v.queued.get(name, 0)) for name in SHORT_NAMES.values())
         parts.append(f"{v.name}: sent {_counts(v.sent)} rcvd {_counts(v.received)} "
-                     f"acked {v.acked['command']} queue {queued}")  # fmt: skip
+                     f"acked {v.acked['command']} queue {queued} "
+                     f"lost {v.packets_lost}/{v.packets_in}")  # fmt: skip
     return " | ".join(parts)
+
+
+def _channel_config():
+    from pygoby.netsim.channel import ChannelConfig, LogisticModel, RateErrorModels
+    from pygoby.netsim.channel.errors import DEFAULT_RATE_MODELS
+
+    rate0 = LogisticModel(**RATE0_FRAME_ERRORS)
+    errors = RateErrorModels(by_rate={**DEFAULT_RATE_MODELS, 0: rate0})
+    return ChannelConfig(**CHANNEL_SETTINGS, error_models=errors)
+
+
+def _geodesy(mission):
+    from pygoby.moos.translator.geodesy import UTMGeodesy
+
+    lat, lon = mission.get_float("LatOrigin"), mission.get_float("LongOrigin")
+    if lat is None or lon is None:
+        raise ValueError(f"{mission.path}: the demo needs LatOrigin and LongOrigin")
+    return UTMGeodesy(lat, lon)
 
 
 async def run_mission(
     warp: int = 25,
-    duration: float = 400.0,
+    duration: float = 720.0,
     say=print,
     mission_dir: Path = MISSION_DIR,
+    event_log: Path | None = None,
 ) -> MissionResult:
     """Run the two missions of `mission_dir` in this process for `duration` simulated seconds at
-    MOOS time warp `warp` (embedded MOOSDBs, emulated Micro-Modems on ephemeral loopback ports),
-    printing a summary line at every TDMA slot, and events, through `say`."""
-    from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
+    MOOS time warp `warp` (embedded MOOSDBs, emulated Micro-Modems on ephemeral loopback ports
+    hearing each other through netsim's physics at the vehicles' NAV_* positions), printing a
+    summary line at every TDMA slot, and events, through `say`; the channel's events go to
+    `event_log` (JSON lines) if given."""
+    from pygoby.acomms.mmsim import MicroModemModel
     from pygoby.acomms.mmsim.server import MMSimServer
     from pygoby.apps.pacommshandler import pAcommsHandler
     from pygoby.apps.usimvehicle import uSimVehicle
     from pygoby.moos.db import MOOSDB
     from pygoby.moos.moosfile import MissionFile
     from pygoby.moos.timewarp import moos_clock
+    from pygoby.netsim.channel import Channel
+    from pygoby.netsim.eventlog import EventLogWriter
+    from pygoby.netsim.physics_channel import PhysicsChannel
 
     clock = moos_clock(warp)
-    channel = LoopbackChannel()
     codec = Codec(clock=clock)
     for name in SHORT_NAMES:
         codec.load_proto(mission_dir / "two_vehicles.proto", name)
-    stats, monitors = [], []
+    stats = [VehicleStats(name, modem_id) for name, modem_id in VEHICLES]
+    monitors = []
     real_start = time.monotonic()
     async with contextlib.AsyncExitStack() as stack:
-        for name, modem_id in VEHICLES:
+        writer = None
+        if event_log is not None:
+            writer = stack.enter_context(EventLogWriter(event_log))
+        tally = AcousticTally({MODEM_PORTS[v.name]: v for v in stats}, writer)
+        channel = PhysicsChannel(
+            Channel(_channel_config(), seed=PHYSICS_SEED), clock,
+            ports=MODEM_PORTS, on_event=tally,
+        )  # fmt: skip
+        for vehicle_stats in stats:
+            name, modem_id = vehicle_stats.name, vehicle_stats.modem_id
             mission = MissionFile.read(mission_dir / f"{name}.moos")
             db = MOOSDB(port=0, community=name, clock=clock)
             await stack.enter_async_context(db)
-            sim = MMSimServer(MicroModemModel(modem_id, clock, channel, name=name), channel)
+            # the channel polled every 5 ms (1/8 simulated s at warp 25): deliveries on time
+            sim = MMSimServer(
+                MicroModemModel(modem_id, clock, channel, name=name), channel, work_period=0.005
+            )
             await sim.start()
             stack.push_async_callback(sim.close)
-            vehicle_stats = VehicleStats(name, modem_id)
-            monitor = Monitor(vehicle_stats, codec, clock, db.port, say)
+            on_nav = _position_feed(channel, MODEM_PORTS[name], _geodesy(mission))
+            monitor = Monitor(vehicle_stats, codec, clock, db.port, say, on_nav)
             await monitor.start()
             stack.push_async_callback(monitor.client.close)
-            stats.append(vehicle_stats)
             monitors.append(monitor)
             for app_class in (pAcommsHandler, uSimVehicle):
                 cfg = app_class.read_config(mission, app_class.default_name)
@@ -244,12 +343,39 @@ async def run_mission(
         while (now := clock.now()) < start + duration:
             slot = monitors[0].slot
             if slot is not None and slot != reported:  # one line per TDMA slot
-                say(summary_line(now - start, slot, stats))
+                say(summary_line(now - start, slot, stats, tally.newest))
                 reported = slot
             await asyncio.sleep(0.02)
         simulated = clock.now() - start
-        say(summary_line(simulated, monitors[0].slot, stats))
+        say(summary_line(simulated, monitors[0].slot, stats, tally.newest))
     return MissionResult(simulated, time.monotonic() - real_start, stats)
+
+
+def _position_feed(channel, port: int, geodesy):
+    """A Monitor's `on_nav`: the vehicle's position (local x/y to lat/lon about the mission's
+    origin), with speed and heading for dead reckoning, to the acoustic channel."""
+    from pygoby.netsim.channel import Position
+
+    def update(nav: dict[str, float], t: float) -> None:
+        lat, lon = geodesy.to_geo(nav["NAV_X"], nav["NAV_Y"])
+        channel.channel.update_position(
+            port,
+            Position(lat, lon, nav["NAV_DEPTH"], t, nav["NAV_SPEED"], nav["NAV_HEADING"]),
+        )
+
+    return update
+
+
+MISSION_INTRO = """\
+topside (modem 1) holds station; unicorn (modem 2) is an AUV the topside's commands send
+north-east at 5 m/s. Each runs MOOSDB + pAcommsHandler + uSimVehicle. Their modems hear each
+other through netsim's acoustic physics in a noisy harbour (spreading factor {spreading:g}, ambient
+noise {noise_level:g} dB re 1 uPa in band, half the packets lost at {snr50_db:g} dB SNR), in 10 s TDMA
+slots. Per slot:
+  range, owtt: distance and one-way travel time of the newest acoustic packet
+  sent/rcvd: status/command DCCL messages; queue: messages waiting to be sent
+  lost: acoustic packets that reached the vehicle's modem but could not be decoded / all of them
+"""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -257,24 +383,33 @@ def main(argv: list[str] | None = None) -> int:
         prog="python -m pygoby.demo", description=__doc__.split("\n\n")[0]
     )
     parser.add_argument("--warp", type=int, default=25, help="MOOS time warp (default %(default)s)")
-    parser.add_argument("--duration", type=float, default=400.0,
+    parser.add_argument("--duration", type=float, default=720.0,
                         help="simulated seconds of the mission (default %(default)s)")  # fmt: skip
+    parser.add_argument("--event-log", type=Path,
+                        help="acoustic event log to write (default: in a new temporary folder)")  # fmt: skip
     parser.add_argument("--skip-dccl", action="store_true", help="skip the DCCL part")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR, format="%(name)s: %(message)s")
+    event_log = (
+        args.event_log or Path(tempfile.mkdtemp(prefix="pygoby-demo-")) / "netsim_events.jsonl"
+    )
     if not args.skip_dccl:
         print("== pygoby demo 1/2: DCCL ==\n")
         dccl_demo()
     print(f"\n== pygoby demo 2/2: two vehicles, pAcommsHandler + Micro-Modem emulators + TDMA "
           f"(time warp {args.warp:g}) ==")  # fmt: skip
-    print("topside (modem 1) and unicorn (modem 2): MOOSDB + pAcommsHandler + uSimVehicle each;")
-    print("10 s TDMA slots; counts are status/command DCCL messages; queue = messages waiting\n")
-    result = asyncio.run(run_mission(args.warp, args.duration, say=_say))
+    print(MISSION_INTRO.format(**CHANNEL_SETTINGS, **RATE0_FRAME_ERRORS))
+    result = asyncio.run(run_mission(args.warp, args.duration, say=_say, event_log=event_log))
     print(f"\n{result.simulated_seconds:.0f} simulated seconds in {result.real_seconds:.1f} s: "
           f"{result.delivered} messages delivered end to end "
           f"({result.per_simulated_hour:.0f} per simulated hour)")  # fmt: skip
     for v in result.vehicles:
-        print(f"  {v.name}: last status heard: {v.last_report or '-'}")
+        print(f"  {v.name}: decoded {v.packets_in - v.packets_lost} of {v.packets_in} acoustic "
+              f"packets; the last one: {_link(v)}")  # fmt: skip
+        print(f"  {'':{len(v.name)}}  last status heard: {v.last_report or '-'}")
+    print(f"acoustic event log: {event_log}\n"
+          f"  plot it (success vs range and SNR, timeline): "
+          f"pygoby netsim report {event_log} -o DIR")  # fmt: skip
     topside, unicorn = result.vehicles
     ok = (
         topside.received["status"] > 0
