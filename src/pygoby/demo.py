@@ -369,9 +369,8 @@ def _position_feed(channel, port: int, geodesy):
 MISSION_INTRO = """\
 topside (modem 1) holds station; unicorn (modem 2) is an AUV the topside's commands send
 north-east at 5 m/s. Each runs MOOSDB + pAcommsHandler + uSimVehicle. Their modems hear each
-other through netsim's acoustic physics in a noisy harbour (spreading factor {spreading:g}, ambient
-noise {noise_level:g} dB re 1 uPa in band, half the packets lost at {snr50_db:g} dB SNR), in 10 s TDMA
-slots. Per slot:
+other through netsim's acoustic physics in a noisy harbour (spreading factor {spreading:g}, ambient noise
+{noise_level:g} dB re 1 uPa in band, half the packets lost at {snr50_db:g} dB SNR), in 10 s TDMA slots. Per slot:
   range, owtt: distance and one-way travel time of the newest acoustic packet
   sent/rcvd: status/command DCCL messages; queue: messages waiting to be sent
   lost: acoustic packets that reached the vehicle's modem but could not be decoded / all of them
