@@ -4,7 +4,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.util.nmea import NMEAChecksumError, NMEAError, NMEAFormatError, NMEASentence
+from pygoby.util.nmea import (
+    NMEAChecksumError,
+    NMEAError,
+    NMEAFormatError,
+    NMEASentence,
+    checksum,
+)
 
 SPEC_EXAMPLES = [
     "$CCCFG,SRC,1*31", "$CCCYC,0,1,2,0,1,1*5A", "$CCTMS,2019-12-02T03:02:37Z,0*7A",
@@ -110,3 +116,12 @@ def test_build_formats_every_kind_of_value_by_the_field_rule(values):
 def test_build_refuses_reserved_characters_in_any_field(bad):
     with pytest.raises(NMEAFormatError, match="reserved"):
         NMEASentence.build("$CCTXD", [1, bad, 2])
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(alphabet=st.characters(max_codepoint=127), max_size=300))
+def test_checksum_is_the_xor_of_every_character(body):
+    expected = 0
+    for ch in body:
+        expected ^= ord(ch)
+    assert checksum(body) == expected

@@ -78,6 +78,12 @@ class NetSimManager:
         self._nav_listeners: list[NavListener] = []
         self._stats_listeners: list[StatsListener] = []
         self._response_cls = message_class("NetSimManagerResponse")
+        # the status values, looked up once (each enum attribute access is a Python __getattr__)
+        status = status_enum()
+        self._accepted = status.UPDATE_ACCEPTED
+        self._invalid_port = status.UPDATE_FAILED_INVALID_MODEM_TCP_PORT
+        self._invalid_source = status.UPDATE_FAILED_INVALID_SOURCE_ADDRESS
+        self._out_of_region = status.UPDATE_FAILED_OUT_OF_DEFINED_REGION
         self._env_nav_cls = message_class("EnvironmentNavUpdate")
 
     # -- queries -------------------------------------------------------------------------
@@ -102,14 +108,13 @@ class NetSimManager:
     # -- processing ----------------------------------------------------------------------
 
     def handle_request(self, request: Message, peer_ip: str) -> RequestOutcome:
-        status = status_enum()
         outcome = RequestOutcome(self._response_cls(request_id=request.id))
-        result = status.UPDATE_ACCEPTED
+        result = self._accepted
         for nav in request.nav:
             result = self._check_nav(nav, peer_ip)
-            if result != status.UPDATE_ACCEPTED:
+            if result != self._accepted:
                 break
-            if all(nav.HasField(name) for name in NAV_FIELDS):
+            if all(map(nav.HasField, NAV_FIELDS)):
                 update = self._env_nav_cls(
                     environment_id=self._pairs[nav.modem_tcp_port].environment_id
                 )
@@ -130,18 +135,17 @@ class NetSimManager:
         return outcome
 
     def _check_nav(self, nav: Message, peer_ip: str) -> int:
-        status = status_enum()
         pair = self._pairs.get(nav.modem_tcp_port)
         if pair is None:
-            return status.UPDATE_FAILED_INVALID_MODEM_TCP_PORT
+            return self._invalid_port
         if peer_ip != pair.endpoint_ip_address:
-            return status.UPDATE_FAILED_INVALID_SOURCE_ADDRESS
+            return self._invalid_source
         bounds = self._bounds[pair.environment_id]
         lat, lon, depth = nav.lat, nav.lon, nav.depth
-        if self.config.reject_nonfinite_position and not all(
-            math.isfinite(v) for v in (lat, lon, depth)
+        if self.config.reject_nonfinite_position and not (
+            math.isfinite(lat) and math.isfinite(lon) and math.isfinite(depth)
         ):
-            return status.UPDATE_FAILED_OUT_OF_DEFINED_REGION
+            return self._out_of_region
         if (
             lat < bounds.lat_min
             or lat > bounds.lat_max
@@ -150,8 +154,8 @@ class NetSimManager:
             or depth < bounds.depth_min
             or depth > bounds.depth_max
         ):
-            return status.UPDATE_FAILED_OUT_OF_DEFINED_REGION
-        return status.UPDATE_ACCEPTED
+            return self._out_of_region
+        return self._accepted
 
     def connection(self, peer_address: str) -> ManagerConnection:
         return ManagerConnection(self, peer_address)
