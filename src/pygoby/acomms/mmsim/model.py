@@ -290,7 +290,10 @@ class MicroModemModel:
             if key not in _STATISTICS:
                 log.warning("%s: unknown $CACST statistic %r from the channel", self.name, key)
                 continue
-            values[key] = float(value) if key in _DECIMAL_STATISTICS else int(round(value))
+            if key in _DECIMAL_STATISTICS:
+                values[key] = float(value)
+            else:  # (an int is already what int(round()) would make of it)
+                values[key] = value if type(value) is int else int(round(value))
         self._say_sentence(format_cst(values))
 
 

@@ -103,21 +103,19 @@ def format_cst(stat, version: int = 0) -> NMEASentence:
     the field names to values (what the emulator has: no message to build and read back)."""
     get = _cst_items if isinstance(stat, Mapping) else _cst_attributes
     mode, time, clock_mode, *numbers = get(stat)
-    numbers[:_DOPPLER] = map(int, numbers[:_DOPPLER])
-    numbers[_DOPPLER + 1 :] = map(int, numbers[_DOPPLER + 1 :])
     toa = dt.datetime.fromtimestamp(time / 1e6, dt.UTC)
-    # one format call for the whole text, then read back as a sentence: much faster than
-    # building the sentence field by field
-    text = (
-        (f"$CACST,{version:d}," if version >= 6 else "$CACST,")
-        + f"{mode:d},{toa.hour:02d}{toa.minute:02d}{toa.second:02d}.{toa.microsecond // 100:04d},"
-        + f"{clock_mode:d},"
-        + _CST_NUMBERS_TEXT.format(*numbers)
-    )
+    # the whole text in one %-format (%d prints int(value)), then read back as a sentence:
+    # much faster than building the sentence field by field
+    text = _CST_TEXT % (
+        f"{version:d}," if version >= 6 else "", mode,
+        toa.hour, toa.minute, toa.second, toa.microsecond // 100, clock_mode, *numbers,
+    )  # fmt: skip
     return NMEASentence.parse(text)
 
 
-_CST_NUMBERS_TEXT = ",".join("{:.1f}" if n == "doppler" else "{:d}" for n in _CST_INT_FIELDS)
+_CST_TEXT = "$CACST,%s%d,%02d%02d%02d.%04d,%d," + ",".join(
+    "%.1f" if name == "doppler" else "%d" for name in _CST_INT_FIELDS
+)
 
 
 # $CAXST v0 field order after date and time
