@@ -88,7 +88,8 @@ class MicroModemModel:
         return out
 
     def _hhmmss(self) -> str:
-        return f"{dt.datetime.fromtimestamp(self.modem_time(), dt.UTC):%H%M%S}"
+        t = dt.datetime.fromtimestamp(self.modem_time(), dt.UTC)
+        return f"{t.hour:02d}{t.minute:02d}{t.second:02d}"  # %H%M%S, faster than strftime
 
     def _error(self, module: str, code: int, text: str) -> None:
         self._say("$CAERR", self._hhmmss(), module, code, text)

@@ -154,8 +154,10 @@ def format_xst(
 ) -> NMEASentence:
     t = dt.datetime.fromtimestamp(when, dt.UTC)
     packet_type = 1 if rate == 0 else 3
+    # (what %Y%m%d and %H%M%S print, several times faster than strftime)
     return NMEASentence.build(
         "$CAXST",
-        [f"{t:%Y%m%d}", f"{t:%H%M%S}.{t.microsecond // 100:04d}", 0, 0, 0, 5000, 25000, rate,
-         src, dest, ack, frames, frames, packet_type, nbytes],
+        [f"{t.year}{t.month:02d}{t.day:02d}",
+         f"{t.hour:02d}{t.minute:02d}{t.second:02d}.{t.microsecond // 100:04d}",
+         0, 0, 0, 5000, 25000, rate, src, dest, ack, frames, frames, packet_type, nbytes],
     )  # fmt: skip
