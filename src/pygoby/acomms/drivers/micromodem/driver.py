@@ -14,6 +14,7 @@ import contextlib
 import datetime as dt
 import logging
 from collections import deque
+from collections.abc import Callable
 from enum import Enum, auto
 
 from pygoby.acomms import messages as m
@@ -57,6 +58,7 @@ class MMDriver(ModemDriverBase):
         self.app_acks: ApplicationAcks | None = None
         self.nvram: dict[str, int] = {}
         self.revision: tuple[int, int, int] = (0, 0, 0)
+        self._handlers: dict[str, Callable[[NMEASentence], None]] = {}  # by sentence id
         self._reset_state()
 
     def _reset_state(self) -> None:
@@ -303,9 +305,10 @@ class MMDriver(ModemDriverBase):
     def _handle_line(self, line: str) -> None:
         if self.mm_cfg.hydroid_gateway_id:
             line = line[3:]
-        if not line.strip():
+        text = line.strip()
+        if not text:
             return
-        self.emit_raw(True, line.strip())
+        self.emit_raw(True, text)
         try:
             sentence = NMEASentence.parse(line)
         except NMEAError as exc:
@@ -320,9 +323,14 @@ class MMDriver(ModemDriverBase):
         self._acknowledge(sentence)
 
     def _dispatch(self, s: NMEASentence) -> None:
-        handler = getattr(self, "_on_" + s.sentence_id.lower(), None)
-        if handler is not None:
-            handler(s)
+        sentence_id = s.sentence_id
+        handler = self._handlers.get(sentence_id)
+        if handler is None:
+            handler = getattr(self, "_on_" + sentence_id.lower(), None)
+            if handler is None:
+                return
+            self._handlers[sentence_id] = handler  # only real handlers: garbage ids stay out
+        handler(s)
 
     def _on_rev(self, s: NMEASentence) -> None:
         if s[2] == "INIT":
