@@ -125,3 +125,12 @@ def test_checksum_is_the_xor_of_every_character(body):
     for ch in body:
         expected ^= ord(ch)
     assert checksum(body) == expected
+
+
+def test_a_recurring_line_parses_the_same_and_a_bad_one_fails_every_time():
+    first = NMEASentence.parse("$CARXP,0*44\r\n")
+    assert NMEASentence.parse("$CARXP,0*44\r\n") == first == NMEASentence.parse(" $CARXP,0*44")
+    assert first.fields == ("$CARXP", "0")
+    for _ in range(3):
+        with pytest.raises(NMEAChecksumError):
+            NMEASentence.parse("$CARXP,0*45")

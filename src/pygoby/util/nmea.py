@@ -8,6 +8,7 @@ parsing accepts a sentence without one, but a checksum that is present must matc
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -70,6 +71,10 @@ class NMEASentence:
     @classmethod
     def parse(cls, line: str) -> NMEASentence:
         """Parse one line (surrounding whitespace ignored). Raises an NMEAError subclass."""
+        return _parse_recurring(cls, line)
+
+    @classmethod
+    def _parse(cls, line: str) -> NMEASentence:
         text = line.strip()
         if not text.startswith(("$", "!")):
             raise NMEAFormatError(f"NMEA sentence must start with '$' or '!': {line!r}")
@@ -142,6 +147,14 @@ class NMEASentence:
         """The sentence with its checksum, without a line terminator."""
         body = self.message_no_cs()
         return f"{body}*{checksum(body[1:]):02X}"
+
+
+# Sentences are immutable and many lines recur verbatim (`$CARXP,0`, `$CACYC,...` for each
+# source, keep-alive `$CCCFQ,SRC` and its `$CACFG` reply): each is parsed once, then shared.
+# Errors are not cached (a bad line raises every time).
+@functools.lru_cache(maxsize=1024)
+def _parse_recurring(cls: type[NMEASentence], line: str) -> NMEASentence:
+    return cls._parse(line)
 
 
 def _field_text(value: object) -> str:
