@@ -223,6 +223,8 @@ class TrackFollower:
         fixes = self.fixes
         if len(fixes) == 1:
             f = fixes[0]
+            if not self.speed:  # a fixed node: what dead-reckoning below gives, in one step
+                return Position(f.lat, f.lon, f.depth, now, self.speed, self.heading)
             start = Position(f.lat, f.lon, f.depth, now - elapsed + f.t, self.speed, self.heading)
             return start.at(now)
         i = bisect.bisect_right(self._times, elapsed)

@@ -145,7 +145,7 @@ class NMEASentence:
 
     def message(self) -> str:
         """The sentence with its checksum, without a line terminator."""
-        body = self.message_no_cs()
+        body = ",".join(self.fields)  # (message_no_cs, without a call: this is a hot path)
         return f"{body}*{checksum(body[1:]):02X}"
 
 

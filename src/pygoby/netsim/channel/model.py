@@ -185,6 +185,7 @@ class Channel:
         self._locked_until: dict[int, float] = {}
         self._sequence = 0
         self._horizon = -math.inf  # last poll time
+        self._pruned_at = -math.inf
         self._noise_cache: dict[Band, float] = {}
 
     # -- positions -------------------------------------------------------------------------
@@ -213,11 +214,12 @@ class Channel:
     def noise_level(self, band: Band) -> float:
         if self.config.noise_level is not None:
             return self.config.noise_level
-        if band not in self._noise_cache:
-            self._noise_cache[band] = noise_level_integrated(
+        level = self._noise_cache.get(band)
+        if level is None:
+            level = self._noise_cache[band] = noise_level_integrated(
                 band.carrier_hz / 1000, band.bandwidth_hz, self.config.shipping, self.config.wind
             )
-        return self._noise_cache[band]
+        return level
 
     def sound_speed(self, depth_a: float, depth_b: float) -> float:
         c = self.config.sound_speed
@@ -403,7 +405,13 @@ class Channel:
         )
 
     def _prune(self, now: float) -> None:
+        """Forget receptions and own transmissions that can no longer overlap anything."""
         longest = max(self.config.durations.values(), default=0.0)
+        # Pruning later than possible changes nothing (what it would have dropped overlaps
+        # nothing still to come), so prune about once per packet length, not at every poll.
+        if now - self._pruned_at < longest:
+            return
+        self._pruned_at = now
         # a pending reception outlasts these only with its own (explicit) duration
         longest = max(
             [longest, *(d for p in self._pending if (d := p.transmission.duration) is not None)]

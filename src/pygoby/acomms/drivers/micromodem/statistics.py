@@ -101,7 +101,8 @@ def _cst_numbers(sentence: NMEASentence, start: int, texts: tuple[str, ...]) -> 
 def format_cst(stat, version: int = 0) -> NMEASentence:
     """ReceiveStatistics -> $CACST (used by the emulator). `stat` may also be a mapping of
     the field names to values (what the emulator has: no message to build and read back)."""
-    get = _cst_items if isinstance(stat, Mapping) else _cst_attributes
+    # (dict first: it matches at once, where the Mapping ABC check is slow)
+    get = _cst_items if isinstance(stat, (dict, Mapping)) else _cst_attributes
     mode, time, clock_mode, *numbers = get(stat)
     toa = dt.datetime.fromtimestamp(time / 1e6, dt.UTC)
     # the whole text in one %-format (%d prints int(value)), then read back as a sentence:
