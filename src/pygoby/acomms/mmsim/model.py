@@ -10,6 +10,7 @@ MUC/MUA. Anything else gets `$CAERR,…,NMEA,…`. Rates, frame counts and sizes
 from __future__ import annotations
 
 import datetime as dt
+import functools
 import logging
 import math
 from collections.abc import Callable
@@ -74,14 +75,16 @@ class MicroModemModel:
 
     # ------------------------------------------------------------------ output
     def _say(self, token: str, *values: object) -> None:
-        self._say_sentence(NMEASentence.build(token, values))
+        self._output(_sentence_line(token, *values))
 
     def _say_sentence(self, sentence: NMEASentence) -> None:
-        line = sentence.message()
+        self._output(sentence.message() + "\r\n")
+
+    def _output(self, line: str) -> None:
         if self.on_output is not None:
-            self.on_output(line + "\r\n")
+            self.on_output(line)
         else:
-            self._outbox.append(line + "\r\n")
+            self._outbox.append(line)
 
     def take_output(self) -> list[str]:
         out, self._outbox = self._outbox, []
@@ -296,6 +299,13 @@ class MicroModemModel:
             else:  # (an int is already what int(round()) would make of it)
                 values[key] = value if type(value) is int else int(round(value))
         self._say_sentence(format_cst(values))
+
+
+# Many of the modem's sentences recur verbatim ($CARXP,0, $CACYC for each source, $CACFG
+# answers to keep-alives): their text is built once. `typed`: 1, 1.0 and True print differently.
+@functools.lru_cache(maxsize=1024, typed=True)
+def _sentence_line(token: str, *values: object) -> str:
+    return NMEASentence.build(token, values).message() + "\r\n"
 
 
 _STATISTICS = m.ReceiveStatistics.DESCRIPTOR.fields_by_name
