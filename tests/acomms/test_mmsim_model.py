@@ -123,3 +123,12 @@ def test_channel_statistics_reach_cacst():
     cst = lines[-1]
     assert cst[1] == "1" and cst[21] == "8" and cst[26] == "-0.4"  # BAD_CRC mode, snr_in, doppler
     assert cst[2].endswith(".2500")  # time of arrival
+
+
+def test_recurring_sentence_text_depends_on_the_value_types():
+    from pygoby.acomms.mmsim.model import _sentence_line
+
+    values = [1, 1.0, True, 1, 1.0]
+    lines = [_sentence_line("$CACFG", "X", v) for v in values]
+    assert lines == [NMEASentence.build("$CACFG", ["X", v]).message() + "\r\n" for v in values]
+    assert [NMEASentence.parse(line)[2] for line in lines[:3]] == ["1", "1.0", "1"]
