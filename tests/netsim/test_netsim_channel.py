@@ -216,7 +216,7 @@ def test_channel_follows_manager_positions():
 
 
 def test_synthesized_receive_statistics():
-    from pygoby.netsim.channel.stats import receive_statistics
+    from pygoby.netsim.channel.stats import link_statistics, receive_statistics
 
     ch = channel({1: at(-1500), 2: at(1000), 3: at(0, speed=2.0, heading=270.0)})
     ch.transmit(Transmission(1, T0, rate=5, frames=8))
@@ -231,6 +231,10 @@ def test_synthesized_receive_statistics():
     assert stats.doppler == pytest.approx(2.0, abs=0.05)  # receiver heading west towards 1
     assert stats.packet_type == 3  # PSK
     assert receive_statistics(at3[2], source_id=2, dest_id=3) is None  # receiver was busy
+    link = link_statistics(at3[1])  # what the emulators take from the physics
+    assert link == {name: getattr(stats, name) for name in link}
+    assert {"snr_in", "doppler", "spl", "carrier_freq"} <= set(link)
+    assert link_statistics(at3[2]) is None
     # It fits a ReceiveStats push to the manager.
     push = message_class("ReceiveStats")(
         modem_tcp_port=3, tx_modem_tcp_port=1, packet_success=False, mm_stats=stats

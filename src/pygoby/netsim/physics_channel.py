@@ -34,7 +34,7 @@ from pygoby.acomms.mmsim.channel import AcousticPacket, ChannelEndpoint
 from pygoby.acomms.mmsim.channel import PacketKind as ModemPacketKind
 from pygoby.acomms.mmsim.channel import Reception as ModemReception
 from pygoby.netsim.channel import Channel, Outcome, PacketKind, Reception, Transmission
-from pygoby.netsim.channel.stats import receive_statistics_fields
+from pygoby.netsim.channel.stats import link_statistics
 from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
@@ -51,12 +51,6 @@ PHYSICAL_KIND = {
     ModemPacketKind.PING: PacketKind.PING,
     ModemPacketKind.PING_REPLY: PacketKind.PING,
 }
-
-# $CACST fields taken from the physics (the emulator fills the rest).
-STATS_FIELDS = (
-    "mfd_power", "mfd_ratio", "spl", "snr_rss", "snr_in", "snr_out", "snr_symbols",
-    "mse_equalizer", "data_quality_factor", "doppler", "stddev_noise", "carrier_freq", "bandwidth",
-)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -182,7 +176,7 @@ class PhysicsChannel:
             arrival_time=r.arrival,
             frame_ok=None if r.outcome is Outcome.GOOD else list(r.frames_ok),
             travel_time=travel_time,
-            stats=self._stats(r, packet),
+            stats=self._stats(r),
         )
         self._answering = (r.receiver, r.owtt) if packet.kind is ModemPacketKind.PING else None
         try:
@@ -198,18 +192,10 @@ class PhysicsChannel:
         # with its only frame bad is never noticed by the host.
         return r.outcome is Outcome.BAD_FRAMES and packet.kind is ModemPacketKind.DATA
 
-    def _stats(self, r: Reception, packet: AcousticPacket) -> dict[str, float]:
+    def _stats(self, r: Reception) -> dict[str, float]:
+        """The $CACST fields taken from the physics (the emulator fills the rest)."""
         band = self.channel.config.band_of(r.receiver)
-        stat = receive_statistics_fields(
-            r,
-            source_id=packet.src,
-            dest_id=packet.dest,
-            carrier_hz=band.carrier_hz,
-            bandwidth_hz=band.bandwidth_hz,
-        )
-        if stat is None:
-            return {}
-        return {name: stat[name] for name in STATS_FIELDS}
+        return link_statistics(r, band.carrier_hz, band.bandwidth_hz) or {}
 
     def _log_reception(self, r: Reception, sent: _Sent, delivered: bool, owtt: float) -> None:
         assert self.on_event is not None

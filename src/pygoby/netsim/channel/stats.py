@@ -37,27 +37,8 @@ def receive_statistics(
 ) -> Message | None:
     """The $CACST a modem would report for this reception, or None if it reports nothing
     (the packet was never detected, or the receiver was busy with another one)."""
-    fields = receive_statistics_fields(
-        reception, source_id=source_id, dest_id=dest_id, carrier_hz=carrier_hz,
-        bandwidth_hz=bandwidth_hz, clock_mode=clock_mode,
-        flexible_data_packet=flexible_data_packet,
-    )  # fmt: skip
-    return None if fields is None else receive_statistics_class()(**fields)
-
-
-def receive_statistics_fields(
-    reception: Reception,
-    *,
-    source_id: int,
-    dest_id: int,
-    carrier_hz: float = 25000.0,
-    bandwidth_hz: float = 5000.0,
-    clock_mode: str = "NO_SYNC_TO_PPS_AND_CCCLK_GOOD",
-    flexible_data_packet: bool = False,
-) -> dict | None:
-    """`receive_statistics` as a dict of its fields (enums by name), for callers that only read
-    some of them: no message to build and read back."""
-    if reception.outcome in (Outcome.NOT_DETECTED, Outcome.RECEIVER_BUSY):
+    link = link_statistics(reception, carrier_hz, bandwidth_hz)
+    if link is None:
         return None
     tx = reception.transmission
     if reception.outcome is Outcome.HALF_DUPLEX:
@@ -72,14 +53,10 @@ def receive_statistics_fields(
         packet_type = "FSK_MINI" if tx.rate == 0 else "PSK_MINI"
     else:
         packet_type = "FSK" if tx.rate == 0 else "PSK"
-    snr = reception.sinr
-    return dict(
+    return receive_statistics_class()(
         mode=mode,
         time=int(round(reception.arrival * 1e6)),
         clock_mode=clock_mode,
-        mfd_power=_clamp(snr / 2, -30, 40),
-        mfd_ratio=_clamp(10 ** (min(snr, 40) / 10) * 10, 0, 16383),
-        spl=round(reception.received_level),
         shf_agn=250,
         rate=_clamp(tx.rate, -1, 6),
         source=_clamp(source_id, 0, 127),
@@ -88,6 +65,23 @@ def receive_statistics_fields(
         packet_type=packet_type,
         number_frames=_clamp(tx.frames, 0, 8),
         number_bad_frames=_clamp(reception.bad_frames, 0, 8),
+        version=6,
+        **link,
+    )
+
+
+def link_statistics(
+    reception: Reception, carrier_hz: float = 25000.0, bandwidth_hz: float = 5000.0
+) -> dict[str, float] | None:
+    """The $CACST fields the physics decides (levels, SNRs, Doppler, band) for a reception, or
+    None if the modem reports nothing for it (see `receive_statistics`)."""
+    if reception.outcome in (Outcome.NOT_DETECTED, Outcome.RECEIVER_BUSY):
+        return None
+    snr = reception.sinr
+    return dict(
+        mfd_power=_clamp(snr / 2, -30, 40),
+        mfd_ratio=_clamp(10 ** (min(snr, 40) / 10) * 10, 0, 16383),
+        spl=round(reception.received_level),
         snr_rss=_clamp(reception.received_level - reception.noise_level, 0, 255),
         snr_in=_clamp(snr, -10, 30),
         snr_out=_clamp(snr + 10, 0, 25),
@@ -98,5 +92,4 @@ def receive_statistics_fields(
         stddev_noise=_clamp(reception.noise_level - 40, 0, 255),
         carrier_freq=_clamp(carrier_hz, 100, 30000),
         bandwidth=_clamp(bandwidth_hz, 1000, 5000),
-        version=6,
     )
