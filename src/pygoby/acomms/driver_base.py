@@ -141,8 +141,9 @@ class ModemDriverBase(ABC):
         if self.link is None:
             return []
         lines = self.link.read_lines()
-        for line in lines:
-            self._log_raw("[rx] ", line)
+        if self._raw_log is not None:
+            for line in lines:
+                self._log_raw("[rx] ", line)
         return lines
 
     def modem_write(self, text: str) -> None:

@@ -356,7 +356,7 @@ class MMDriver(ModemDriverBase):
 
     def _on_clk(self, s: NMEASentence) -> None:
         if self._outstanding("CLK"):
-            t = dt.datetime(*(s.as_int(i) for i in range(1, 7)), tzinfo=dt.UTC)
+            t = dt.datetime(*map(s.as_int, range(1, 7)), tzinfo=dt.UTC)
             self._check_clock(t.timestamp(), whole_seconds=True)
 
     def _on_tms(self, s: NMEASentence) -> None:
@@ -413,7 +413,7 @@ class MMDriver(ModemDriverBase):
         return bool(msg.frame) and bool(msg.frame[0])
 
     def _on_cyc(self, s: NMEASentence) -> None:
-        src, dest, rate, ack, nframes = (s.as_int(i) for i in range(2, 7))
+        src, dest, rate, ack, nframes = map(s.as_int, range(2, 7))
         if self._outstanding("CYC") and tuple(self._out[0].fields[2:5]) == tuple(s.fields[2:5]):
             return  # the modem's echo of our own $CCCYC
         if src == self.modem_id:
@@ -435,7 +435,7 @@ class MMDriver(ModemDriverBase):
         self._receive = None
 
     def _on_drq(self, s: NMEASentence) -> None:
-        src, dest, ack, nbytes, frame_no = (s.as_int(i) for i in range(2, 7))
+        src, dest, ack, nbytes, frame_no = map(s.as_int, range(2, 7))
         index = frame_no - 1
         if 0 <= index < len(self._cached.frame) and self._cached.frame[index]:
             data = bytes(self._cached.frame[index])
@@ -489,7 +489,7 @@ class MMDriver(ModemDriverBase):
         return self._receive
 
     def _on_rxd(self, s: NMEASentence) -> None:
-        src, dest, ack, frame_no = (s.as_int(i) for i in range(1, 5))
+        src, dest, ack, frame_no = map(s.as_int, range(1, 5))
         data = bytes.fromhex(s[5]) if len(s) > 5 else b""
         rx = self._receiving()
         if frame_no == 1:
