@@ -10,6 +10,8 @@ from pygoby.util.nmea import (
     NMEAFormatError,
     NMEASentence,
     checksum,
+    parse_int,
+    parse_ints,
 )
 
 SPEC_EXAMPLES = [
@@ -134,3 +136,35 @@ def test_a_recurring_line_parses_the_same_and_a_bad_one_fails_every_time():
     for _ in range(3):
         with pytest.raises(NMEAChecksumError):
             NMEASentence.parse("$CARXP,0*45")
+
+
+INT_TEXTS = st.one_of(
+    st.integers(-(10**12), 10**12).map(str),
+    st.sampled_from(["0", "-0", "+5", "007", " 3 ", "1_000", "٣", "", "x", "1.5", "0x10"]),
+    st.text(max_size=6),
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(INT_TEXTS, max_size=8))
+def test_parse_int_and_parse_ints_are_int_with_a_memory(texts):
+    def reference(text):
+        try:
+            return int(text)
+        except ValueError:
+            return ValueError
+
+    def ours(text):
+        try:
+            return parse_int(text)
+        except ValueError:
+            return ValueError
+
+    for _ in range(2):  # the second time through the memory
+        assert [ours(t) for t in texts] == [reference(t) for t in texts]
+        expected = [reference(t) for t in texts]
+        if ValueError in expected:
+            with pytest.raises(ValueError):
+                parse_ints(texts)
+        else:
+            assert parse_ints(texts) == expected

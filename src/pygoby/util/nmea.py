@@ -9,7 +9,7 @@ parsing accepts a sentence without one, but a checksum that is present must matc
 from __future__ import annotations
 
 import functools
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 
@@ -128,7 +128,7 @@ class NMEASentence:
     def as_int(self, index: int) -> int:
         """Field `index` as an integer; NMEAFormatError if missing or not a number."""
         try:
-            return int(self.fields[index])
+            return parse_int(self.fields[index])
         except (IndexError, ValueError):
             raise NMEAFormatError(
                 f"field {index} of {self.message()!r} is not an integer"
@@ -155,6 +155,29 @@ class NMEASentence:
 @functools.lru_cache(maxsize=1024)
 def _parse_recurring(cls: type[NMEASentence], line: str) -> NMEASentence:
     return cls._parse(line)
+
+
+def parse_int(text: str) -> int:
+    """`int(text)`, remembering the texts it has seen: int() of a str is slow (it normalises
+    Unicode digits and spaces first) and sentences repeat the same few numbers."""
+    value = _INT_TEXTS.get(text)
+    if value is None:
+        value = int(text)
+        if len(_INT_TEXTS) < _INT_TEXTS_LIMIT:
+            _INT_TEXTS[text] = value
+    return value
+
+
+def parse_ints(texts: Sequence[str]) -> list[int]:
+    """`[int(t) for t in texts]`, through the memory of parse_int."""
+    try:
+        return list(map(_INT_TEXTS.__getitem__, texts))  # one C-level pass if all are known
+    except KeyError:
+        return list(map(parse_int, texts))
+
+
+_INT_TEXTS: dict[str, int] = {}
+_INT_TEXTS_LIMIT = 65536  # texts remembered at most
 
 
 def _field_text(value: object) -> str:

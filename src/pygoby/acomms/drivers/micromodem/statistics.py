@@ -8,7 +8,7 @@ import operator
 from collections.abc import Mapping
 
 from pygoby.acomms import messages as m
-from pygoby.util.nmea import NMEAFormatError, NMEASentence
+from pygoby.util.nmea import NMEAFormatError, NMEASentence, parse_int, parse_ints
 
 log = logging.getLogger(__name__)
 
@@ -33,7 +33,7 @@ def parse_toa(text: str, today: dt.date) -> int:
     whole, _, frac = text.partition(".")
     if len(whole) != 6 or not whole.isdigit() or (frac and not frac.isdigit()):
         raise NMEAFormatError(f"bad time of arrival {text!r}")
-    hour, minute, second = int(whole[:2]), int(whole[2:4]), int(whole[4:6])
+    hour, minute, second = parse_int(whole[:2]), parse_int(whole[2:4]), parse_int(whole[4:6])
     dt.time(hour, minute, second)  # the range checks (ValueError) of a datetime, without one
     day = today.toordinal() - _EPOCH_ORDINAL
     seconds = day * 86400 + hour * 3600 + minute * 60 + second
@@ -87,9 +87,9 @@ def _cst_numbers(sentence: NMEASentence, start: int, texts: tuple[str, ...]) -> 
     """`texts` (the fields from index `start`) as numbers: integers, but a decimal doppler."""
     try:
         return [
-            *map(int, texts[:_DOPPLER]),
+            *parse_ints(texts[:_DOPPLER]),
             *map(float, texts[_DOPPLER : _DOPPLER + 1]),
-            *map(int, texts[_DOPPLER + 1 :]),
+            *parse_ints(texts[_DOPPLER + 1 :]),
         ]
     except ValueError:
         # the error as_int / as_float give, naming the first field that is not a number
