@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.drivers.micromodem.statistics import format_cst, parse_cst
-from pygoby.util.nmea import NMEAFormatError, NMEASentence
+from pygoby.acomms.drivers.micromodem.statistics import cst_text, format_cst, parse_cst
+from pygoby.util.nmea import NMEAFormatError, NMEASentence, with_checksum
 
 DAY = dt.date(2023, 11, 14)
 MIDNIGHT_US = int(dt.datetime(2023, 11, 14, tzinfo=dt.UTC).timestamp()) * 1_000_000
@@ -44,6 +44,7 @@ def test_format_then_parse_gives_the_statistics_back(
     sentence = format_cst(stat, version)
     as_mapping = {field.name: value for field, value in stat.ListFields()}
     assert format_cst(as_mapping, version) == sentence
+    assert with_checksum(cst_text(as_mapping, version)) == sentence.message()
     assert sentence.fields[:2] == (("$CACST", str(version)) if version else ("$CACST", str(mode)))
     assert parse_cst(NMEASentence.parse(sentence.message()), DAY) == stat
 

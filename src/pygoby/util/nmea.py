@@ -145,8 +145,7 @@ class NMEASentence:
 
     def message(self) -> str:
         """The sentence with its checksum, without a line terminator."""
-        body = ",".join(self.fields)  # (message_no_cs, without a call: this is a hot path)
-        return f"{body}*{checksum(body[1:]):02X}"
+        return with_checksum(",".join(self.fields))
 
 
 # Sentences are immutable and many lines recur verbatim (`$CARXP,0`, `$CACYC,...` for each
@@ -155,6 +154,11 @@ class NMEASentence:
 @functools.lru_cache(maxsize=1024)
 def _parse_recurring(cls: type[NMEASentence], line: str) -> NMEASentence:
     return cls._parse(line)
+
+
+def with_checksum(text: str) -> str:
+    """Sentence text (`$CCCYC,...`) -> the same with its `*HH` checksum (no line terminator)."""
+    return f"{text}*{checksum(text[1:]):02X}"
 
 
 def parse_int(text: str) -> int:

@@ -18,10 +18,10 @@ from dataclasses import dataclass, field
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES
-from pygoby.acomms.drivers.micromodem.statistics import format_cst, format_xst
+from pygoby.acomms.drivers.micromodem.statistics import cst_text, format_xst
 from pygoby.acomms.mmsim.channel import AcousticPacket, Channel, PacketKind, Reception
 from pygoby.util.clock import Clock
-from pygoby.util.nmea import NMEAError, NMEASentence
+from pygoby.util.nmea import NMEAError, NMEASentence, with_checksum
 
 log = logging.getLogger(__name__)
 
@@ -298,7 +298,7 @@ class MicroModemModel:
                 values[key] = float(value)
             else:  # (an int is already what int(round()) would make of it)
                 values[key] = value if type(value) is int else int(round(value))
-        self._say_sentence(format_cst(values))
+        self._output(with_checksum(cst_text(values)) + "\r\n")
 
 
 # Many of the modem's sentences recur verbatim ($CARXP,0, $CACYC for each source, $CACFG

@@ -101,17 +101,22 @@ def _cst_numbers(sentence: NMEASentence, start: int, texts: tuple[str, ...]) -> 
 def format_cst(stat, version: int = 0) -> NMEASentence:
     """ReceiveStatistics -> $CACST (used by the emulator). `stat` may also be a mapping of
     the field names to values (what the emulator has: no message to build and read back)."""
+    return NMEASentence.parse(cst_text(stat, version))
+
+
+def cst_text(stat, version: int = 0) -> str:
+    """The text of `format_cst` (without checksum), for a caller that only prints it: numbers
+    only, so there is nothing to validate."""
     # (dict first: it matches at once, where the Mapping ABC check is slow)
     get = _cst_items if isinstance(stat, (dict, Mapping)) else _cst_attributes
     mode, time, clock_mode, *numbers = get(stat)
     toa = dt.datetime.fromtimestamp(time / 1e6, dt.UTC)
-    # the whole text in one %-format (%d prints int(value)), then read back as a sentence:
-    # much faster than building the sentence field by field
-    text = _CST_TEXT % (
+    # the whole text in one %-format (%d prints int(value)): much faster than building the
+    # sentence field by field
+    return _CST_TEXT % (
         f"{version:d}," if version >= 6 else "", mode,
         toa.hour, toa.minute, toa.second, toa.microsecond // 100, clock_mode, *numbers,
     )  # fmt: skip
-    return NMEASentence.parse(text)
 
 
 _CST_TEXT = "$CACST,%s%d,%02d%02d%02d.%04d,%d," + ",".join(
