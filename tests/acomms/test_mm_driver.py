@@ -174,6 +174,19 @@ def test_reception_rate0_two_csts_and_bad_crc():
     assert list(rx.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc) == [1]
 
 
+def test_cst_with_an_out_of_range_value_is_ignored(caplog):
+    h = Harness(modem_id=2).start()
+    fields = CST_GOOD.split(",")
+    fields[4] = "8589934592"  # mfd_peak beyond int32
+    h.modem("$CARXP,0", "$CACYC,0,1,2,1,0,1", ",".join(fields))  # before any frame
+    h.modem("$CARXD,1,2,0,1,0102", ",".join(fields))
+    assert h.received == [] and "ignoring malformed $CACST" in caplog.text
+    h.modem(CST_GOOD)
+    (rx,) = h.received
+    assert list(rx.frame) == [b"\x01\x02"]
+    assert len(rx.Extensions[m.MM_TRANSMISSION].receive_stat) == 1
+
+
 def test_polled_node_answers_poll_from_its_queue():
     h = Harness(modem_id=2).start()
     h.driver.signal_data_request.connect(lambda msg: msg.frame.append(b"\x10\x20"))

@@ -61,26 +61,33 @@ def clock_mode_from_field(value: int, new_bitfield: bool) -> int:
 
 def parse_cst(sentence: NMEASentence, today: dt.date, new_clock_bitfield: bool = False):
     """A $CACST sentence -> ReceiveStatistics (fields up to a short sentence's end)."""
+    return m.ReceiveStatistics(**cst_fields(sentence, today, new_clock_bitfield))
+
+
+def cst_fields(sentence: NMEASentence, today: dt.date, new_clock_bitfield: bool = False) -> dict:
+    """The fields of `parse_cst`'s ReceiveStatistics by name: `repeated.add(**fields)` adds
+    them to a message without building and copying one (one constructor call with every field
+    is also much faster than setting them one by one)."""
     version, off = cst_offset(sentence)
     mode = sentence.as_int(1 + off)
-    time = parse_toa(sentence[2 + off], today)
-    clock_mode = clock_mode_from_field(sentence.as_int(3 + off), new_clock_bitfield)
+    fields = {
+        "version": version,
+        "mode": mode if 0 <= mode <= 2 else -1,
+        "time": parse_toa(sentence[2 + off], today),
+        "clock_mode": clock_mode_from_field(sentence.as_int(3 + off), new_clock_bitfield),
+    }
     start = 4 + off
     texts = sentence.fields[start : start + len(_CST_INT_FIELDS)]
-    values = dict(zip(_CST_INT_FIELDS, _cst_numbers(sentence, start, texts), strict=False))
+    fields.update(zip(_CST_INT_FIELDS, _cst_numbers(sentence, start, texts), strict=False))
     for name, (lo, hi) in _CST_ENUM_RANGES.items():
-        value = values.get(name)
+        value = fields.get(name)
         if value is not None and not lo <= value <= hi:
-            values[name] = -1
+            fields[name] = -1
     if len(texts) < len(_CST_INT_FIELDS):
         log.warning(
             "short $CACST (%d fields): stopped at %s", len(sentence), _CST_INT_FIELDS[len(texts)]
         )
-    # one constructor call with every field: much faster than setting them one by one
-    return m.ReceiveStatistics(
-        version=version, mode=mode if 0 <= mode <= 2 else -1, time=time, clock_mode=clock_mode,
-        **values,
-    )  # fmt: skip
+    return fields
 
 
 def _cst_numbers(sentence: NMEASentence, start: int, texts: tuple[str, ...]) -> list:
