@@ -251,6 +251,7 @@ class Channel:
             if not tx_band.overlaps(self.config.band_of(port)):
                 continue
             c = self.sound_speed(source.depth, receiver.depth)
+            receiver_now = receiver.at(tx.start)
             # a receiver that does not move is where it is: the fixed point of arrival_delay is
             # its first guess (same value, one geodesic instead of five)
             if self.config.moving_receivers and receiver.speed != 0:
@@ -258,7 +259,7 @@ class Channel:
                     lambda tau, rx=receiver: slant_range(source, rx.at(tx.start + tau)), c
                 )
             else:
-                delay = slant_range(source, receiver.at(tx.start)) / c
+                delay = slant_range(source, receiver_now) / c
             arrival = tx.start + delay
             range_m = delay * c
             protocol = self.config.protocol_model
@@ -273,7 +274,7 @@ class Channel:
                 range_m=range_m,
                 received_level=self.config.source_level
                 - transmission_loss(range_m, alpha, self.config.spreading),
-                closing_speed=closing_speed(source, receiver.at(tx.start)),
+                closing_speed=closing_speed(source, receiver_now),
             )
             self._pending.append(pending)
             planned.append((port, arrival))
