@@ -15,6 +15,7 @@ from collections.abc import Callable
 from google.protobuf.message import Message
 
 from pygoby.util.clock import Clock
+from pygoby.util.nmea import with_checksum
 
 log = logging.getLogger(__name__)
 
@@ -29,13 +30,6 @@ def _degrees_minutes(value: float, degree_digits: int) -> str:
     whole = math.floor(minutes)
     fraction = math.floor((minutes - whole) * 10000)
     return f"{degrees:0{degree_digits}d}{whole:02d}.{fraction:04d}"
-
-
-def nmea_checksum(body: str) -> str:
-    checksum = 0
-    for char in body:
-        checksum ^= ord(char)
-    return f"{checksum:02X}"
 
 
 def gprmc_sentence(nav: Message, utc_seconds: float) -> str:
@@ -57,7 +51,7 @@ def gprmc_sentence(nav: Message, utc_seconds: float) -> str:
             "E",
         )
     )
-    return f"${body}*{nmea_checksum(body)}\r\n"
+    return with_checksum(f"${body}") + "\r\n"
 
 
 class GpsOutputs:
