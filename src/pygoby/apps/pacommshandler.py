@@ -17,7 +17,6 @@ import base64
 import functools
 from pathlib import Path
 
-from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as m
@@ -34,7 +33,7 @@ from pygoby.moos.translator import (
     post_for_moos,
 )
 from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
-from pygoby.protobuf import ProtoError, ProtoLoader, builtin_class, default_loader
+from pygoby.protobuf import ProtoLoader, builtin_class, default_loader
 
 ROUTE_COMMAND = "goby.acomms.protobuf.RouteCommand"
 ROUTE_PROTO = "goby/acomms/protobuf/route.proto"
@@ -44,22 +43,8 @@ FRONTSEAT_PROTO = "goby/middleware/protobuf/frontseat.proto"
 
 @functools.cache
 def interface_data_class() -> type[Message]:
-    """iFrontSeat's InterfaceData; if pygoby has no frontseat messages, a stand-in with the one
-    field used here (`dccl_message` = 3) under the same type name, so readers parse it."""
-    try:
-        return builtin_class(FRONTSEAT_PROTO, INTERFACE_DATA)
-    except ProtoError:
-        file_proto = descriptor_pb2.FileDescriptorProto(
-            name="pygoby/apps/interface_data_stand_in.proto",
-            package="goby.middleware.frontseat.protobuf",
-            syntax="proto2",
-        )
-        msg = file_proto.message_type.add(name="InterfaceData")
-        msg.field.add(name="dccl_message", number=3, type=descriptor_pb2.FieldDescriptorProto.TYPE_BYTES,
-                      label=descriptor_pb2.FieldDescriptorProto.LABEL_OPTIONAL)  # fmt: skip
-        pool = descriptor_pool.DescriptorPool()
-        pool.Add(file_proto)
-        return message_factory.GetMessageClass(pool.FindMessageTypeByName(INTERFACE_DATA))
+    """iFrontSeat's InterfaceData, the type of IFS_DATA_OUT posts for forwarded messages."""
+    return builtin_class(FRONTSEAT_PROTO, INTERFACE_DATA)
 
 
 def _goby_message_class(name: str) -> type[Message]:
