@@ -91,3 +91,43 @@ def test_example_config_channel_block():
     assert seed == 1
     assert config.error_models.model(5) == LogisticModel(4.22, 0.12)
     assert config.error_models.model(0).frame_error(-8.5) == pytest.approx(0.75)
+
+
+@pytest.mark.parametrize(
+    ("formula", "expected"),
+    [
+        # spec netsim.md 7.3 check values at T 10 deg C, S 35, 100 m
+        ("MACKENZIE_1981", 1491.4351),
+        ("MEDWIN_1975", 1491.59),
+        # Chen & Millero at Saunders' 100.751 dbar (lat 30): 1491.46887 at 100 dbar + ~0.0164/dbar
+        ("UNESCO_1983", 1491.4898),
+        # gsw from SP 35 / t 10 at 100 m, lat 30, lon -70 (spec's SA/CT check: 1491.5205 at 100 dbar)
+        ("TEOS_10", 1491.4541),
+    ],
+)
+def test_sound_speed_formula_is_selectable(formula, expected):
+    water = f"temperature: 10 salinity: 35 latitude: 30 longitude: -70 sound_speed_formula: {formula}"
+    text = BOUNDS + f"environment_channel {{ environment_id: 0 channel {{ water {{ {water} }} }} }}"
+    config, _ = environment_channel_configs(parse_config(text))[0]
+    assert config.sound_speed(100) == pytest.approx(expected, abs=1e-4)
+
+
+def test_unesco_profile_uses_saunders_pressure_and_t68():
+    from pygoby.netsim.channel.soundspeed import (
+        saunders_pressure,
+        t68_from_t90,
+        unesco_1983,
+        water_profile,
+    )
+
+    profile = water_profile("UNESCO_1983", 12, 34, lat=60)
+    assert profile(2500) == unesco_1983(34, t68_from_t90(12), saunders_pressure(2500, 60))
+
+
+def test_thorp_variant_is_selectable():
+    from pygoby.netsim.channel.absorption import thorp_coa
+
+    text = BOUNDS + "environment_channel { environment_id: 0 channel { absorption: THORP_COA } }"
+    config, _ = environment_channel_configs(parse_config(text))[0]
+    assert config.absorption is thorp_coa
+    assert config.absorption(25) == pytest.approx(6.12073, abs=1e-5)  # spec 7.5's variant check

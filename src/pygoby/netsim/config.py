@@ -40,8 +40,10 @@ max_line_length: 1048576         # longer NETSIM lines are discarded
 environment_channel {
   environment_id: 0
   channel {
-    sound_speed: 1500              # or water { temperature: 10 salinity: 35 } for Mackenzie
-    absorption: THORP              # or FRANCOIS_GARRISON (uses water { ... })
+    sound_speed: 1500              # or water { temperature: 10 salinity: 35 } for Mackenzie;
+                                   # water { sound_speed_formula: MEDWIN_1975 | UNESCO_1983 |
+                                   #   TEOS_10  latitude: 41.5  longitude: -70.7 } for the others
+    absorption: THORP              # or THORP_COA, or FRANCOIS_GARRISON (uses water { ... })
     source_level: 185  spreading: 1.5
     shipping: 0.5  wind_speed: 5   # Stojanovic noise; or a fixed noise_level: 60
     carrier_hz: 25000  bandwidth_hz: 5000

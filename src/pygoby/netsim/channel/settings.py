@@ -7,7 +7,7 @@ import functools
 
 from google.protobuf.message import Message
 
-from pygoby.netsim.channel.absorption import francois_garrison, thorp
+from pygoby.netsim.channel.absorption import francois_garrison, thorp, thorp_coa
 from pygoby.netsim.channel.errors import (
     DEFAULT_RATE_MODELS,
     FrameErrorModel,
@@ -18,7 +18,7 @@ from pygoby.netsim.channel.errors import (
     ThresholdModel,
 )
 from pygoby.netsim.channel.model import Band, ChannelConfig, PacketKind
-from pygoby.netsim.channel.soundspeed import mackenzie_1981
+from pygoby.netsim.channel.soundspeed import water_profile
 from pygoby.protobuf import builtin_class
 
 
@@ -44,9 +44,10 @@ def _rate_model(entry: Message) -> FrameErrorModel:
 
 def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
     """(ChannelConfig, seed) for a ChannelModelConfig message. Raises ValueError."""
-    water = settings.water if settings.HasField("water") else None
-    if water is not None:
-        sound_speed = functools.partial(mackenzie_1981, water.temperature, water.salinity)
+    if settings.HasField("water"):
+        w = settings.water
+        formula = w.SoundSpeedFormula.Name(w.sound_speed_formula)
+        sound_speed = water_profile(formula, w.temperature, w.salinity, w.latitude, w.longitude)
     else:
         sound_speed = settings.sound_speed
     if settings.absorption == settings.FRANCOIS_GARRISON:
@@ -54,6 +55,8 @@ def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
         absorption = functools.partial(
             francois_garrison, T=w.temperature, S=w.salinity, D=w.absorption_depth, pH=w.ph
         )
+    elif settings.absorption == settings.THORP_COA:
+        absorption = thorp_coa
     else:
         absorption = thorp
     by_rate = dict(DEFAULT_RATE_MODELS)

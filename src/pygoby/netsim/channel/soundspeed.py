@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from pygoby.util.ocean import mackenzie_1981  # noqa: F401  (re-exported: one of the formulas here)
+from pygoby.util.ocean import mackenzie_1981
 
 SoundSpeedProfile = Callable[[float], float]  # depth (m) -> sound speed (m/s)
 
@@ -95,3 +95,31 @@ def harmonic_mean_speed(profile: SoundSpeedProfile, z1: float, z2: float, steps:
     for i in range(1, steps):
         total += (4 if i % 2 else 2) / profile(z1 + i * h)
     return (z2 - z1) / (total * h / 3)
+
+
+def teos10_in_situ(T: float, SP: float, depth: float, lat: float, lon: float) -> float:
+    """TEOS-10 sound speed from the practical salinity and in-situ temperature a user knows:
+    pressure from depth (`gsw.p_from_z`), then Absolute Salinity and Conservative Temperature."""
+    import gsw
+
+    p = teos10_pressure(depth, lat)
+    SA = gsw.SA_from_SP(SP, p, lon, lat)
+    return teos10(float(SA), float(gsw.CT_from_t(SA, T, p)), p)
+
+
+def water_profile(
+    formula: str, T: float, S: float, lat: float = 0.0, lon: float = 0.0
+) -> SoundSpeedProfile:
+    """c(depth) for water of temperature T (deg C, ITS-90) and practical salinity S by the named
+    formula: MACKENZIE_1981, MEDWIN_1975, UNESCO_1983 or TEOS_10 (the last two need the
+    latitude for pressure; TEOS-10 also the longitude for Absolute Salinity)."""
+    if formula == "MACKENZIE_1981":
+        return lambda depth: mackenzie_1981(T, S, depth)
+    if formula == "MEDWIN_1975":
+        return lambda depth: medwin_1975(T, S, depth)
+    if formula == "UNESCO_1983":
+        T68 = t68_from_t90(T)
+        return lambda depth: unesco_1983(S, T68, saunders_pressure(depth, lat))
+    if formula == "TEOS_10":
+        return lambda depth: teos10_in_situ(T, S, depth, lat, lon)
+    raise ValueError(f"unknown sound speed formula {formula!r}")
