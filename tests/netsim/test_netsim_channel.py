@@ -156,6 +156,19 @@ def test_stale_and_unknown_positions_are_absent():
     assert ch.transmit(Transmission(99, T0 + 1)) == []
 
 
+def test_a_stale_position_is_logged_once_per_position(caplog):
+    ch = channel({1: at(0), 2: at(1000, time=T0 - 61)})
+    with caplog.at_level("WARNING", logger="pygoby.netsim.channel.model"):
+        ch.transmit(Transmission(1, T0))
+        ch.transmit(Transmission(1, T0 + 10))
+        assert [r.getMessage()[:29] for r in caplog.records] == ["node 2 is absent from the cha"]
+        ch.update_position(2, at(1000, time=T0 - 61 + 1))  # a newer, still stale position
+        ch.transmit(Transmission(1, T0 + 20))
+        ch.update_position(2, at(1000, time=T0 + 25))  # fresh again: heard, nothing logged
+        assert [port for port, _ in ch.transmit(Transmission(1, T0 + 30))] == [2]
+    assert len(caplog.records) == 2 and "position_staleness = 60 s" in caplog.records[1].getMessage()
+
+
 def test_transmission_in_the_past_of_a_poll_is_refused():
     ch = channel({1: at(0), 2: at(1000)})
     ch.poll(T0 + 5)

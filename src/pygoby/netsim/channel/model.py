@@ -45,6 +45,7 @@ when `poll` is called.
 from __future__ import annotations
 
 import enum
+import logging
 import math
 import random
 from collections import defaultdict
@@ -57,6 +58,8 @@ from pygoby.netsim.channel.geometry import Position, arrival_delay, closing_spee
 from pygoby.netsim.channel.levels import noise_level_integrated, sinr, transmission_loss
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, harmonic_mean_speed
 from pygoby.netsim.channel.timing import Interval
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -187,6 +190,8 @@ class Channel:
         self._horizon = -math.inf  # last poll time
         self._pruned_at = -math.inf
         self._noise_cache: dict[Band, float] = {}
+        # The stale position last reported per node, so each one is logged once.
+        self._stale_reported: dict[int, Position] = {}
 
     # -- positions -------------------------------------------------------------------------
 
@@ -202,7 +207,16 @@ class Channel:
 
     def _fresh_position(self, port: int, t: float) -> Position | None:
         position = self._positions.get(port)
-        if position is None or t - position.time > self.config.position_staleness:
+        if position is None:
+            return None
+        if t - position.time > self.config.position_staleness:
+            if self._stale_reported.get(port) is not position:
+                self._stale_reported[port] = position
+                log.warning(
+                    "node %d is absent from the channel: its last position (t=%.3f) is more than "
+                    "position_staleness = %g s old at t=%.3f",
+                    port, position.time, self.config.position_staleness, t,
+                )  # fmt: skip
             return None
         return position
 
