@@ -246,6 +246,21 @@ def test_role_validation(clock):
         qm.add_queue(static)
 
 
+@pytest.mark.parametrize("bad_time", [float("nan"), float("inf")])
+def test_non_finite_timestamp_is_a_role_error_and_keeps_the_queue(clock, bad_time):
+    timed = entry("Status")
+    timed.role.add(type=Role.TIMESTAMP, field="time")
+    qm, (Status, *_) = manager(clock, entries=[timed])
+    qm.push_message(Status(src=1, dest=2, time=T0, value=1))
+    with pytest.raises(RoleError, match=r"TIMESTAMP field time is (nan|inf), not a time"):
+        qm.push_message(Status(src=1, dest=2, time=bad_time, value=2))
+    assert [x.value for x in decoded(qm_peer(clock), bytes(fill(qm).frame[0]))] == [1]
+
+
+def qm_peer(clock):
+    return manager(clock, modem_id=2, entries=[entry("Status")])[0]
+
+
 def test_garbage_frames_are_logged_not_fatal(clock, caplog):
     qm, (Status, *_) = manager(clock, modem_id=2, entries=[entry("Status")])
     good = qm.codec.encode(Status(src=1, dest=2, value=9))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as dt
+import math
 from dataclasses import dataclass
 
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
@@ -79,8 +80,15 @@ def timestamp_us(getter: RoleGetter, msg) -> int | None:
     if getter.kind == FieldDescriptor.TYPE_UINT64:
         return int(value)
     if getter.kind == FieldDescriptor.TYPE_DOUBLE:
+        if not math.isfinite(value):
+            raise RoleError(f"TIMESTAMP field {'.'.join(getter.path or ())} is {value}, not a time")
         return int(round(value * 1e6))  # Quirk A10 (sane): keep sub-second precision
-    parsed = dt.datetime.fromisoformat(str(value).replace("Z", "+00:00"))
+    try:
+        parsed = dt.datetime.fromisoformat(str(value).replace("Z", "+00:00"))
+    except ValueError:
+        raise RoleError(
+            f"TIMESTAMP field {'.'.join(getter.path or ())} is {value!r}, not an ISO 8601 time"
+        ) from None
     if parsed.tzinfo is None:
         parsed = parsed.replace(tzinfo=dt.UTC)
     return int(round(parsed.timestamp() * 1e6))
