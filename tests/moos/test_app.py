@@ -174,7 +174,7 @@ async def test_app_runs_against_embedded_db():
             assert "NEVER" not in got
 
 
-async def test_app_reconnects_reposts_initializers_and_keeps_queued_posts():
+async def test_app_reconnects_reposts_initializers_and_keeps_queued_posts(caplog):
     db = MOOSDB(port=0)
     await db.start()
     port = db.port
@@ -183,6 +183,7 @@ async def test_app_reconnects_reposts_initializers_and_keeps_queued_posts():
     await app.start(connect_timeout=3)
     await db.stop()
     await _wait_for(lambda: not app.connected)
+    assert "lost the connection to the MOOSDB" in caplog.text
     app.publish("WHILE_AWAY", 1.0)
     db = MOOSDB(port=port)
     await db.start()
@@ -198,6 +199,17 @@ async def test_app_reconnects_reposts_initializers_and_keeps_queued_posts():
     finally:
         await app.stop()
         await db.stop()
+
+
+async def test_a_clean_stop_is_not_reported_as_a_lost_connection(caplog):
+    async with MOOSDB(port=0) as db:
+        mission = MissionFile.from_text(_mission(db.port, BLOCK))
+        app = pTestApp(pTestApp.read_config(mission, "pTestApp"), name="pTestApp", mission=mission)
+        await app.start(connect_timeout=3)
+        with caplog.at_level("INFO", logger="pygoby.app.pTestApp"):
+            await app.stop()
+        assert "disconnected from the MOOSDB" in caplog.text
+        assert "lost the connection" not in caplog.text
 
 
 async def test_command_line_and_example_config_as_a_program(tmp_path):

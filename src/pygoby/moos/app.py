@@ -196,6 +196,7 @@ class GobyMOOSApp:
         self._published: set[str] = set()
         self._task: asyncio.Task[None] | None = None
         self._stop_requested: asyncio.Event | None = None
+        self._stopping = False  # a disconnect during stop() is expected, not a lost connection
         self._log_handlers: list[logging.Handler] = []
         self._last_status = -math.inf
         self._last_cpu = (_time.process_time(), _time.monotonic())
@@ -254,6 +255,7 @@ class GobyMOOSApp:
         first connection (TimeoutError otherwise); without, carry on and keep trying."""
         self._setup_logging()
         self._stop_requested = asyncio.Event()
+        self._stopping = False
         self.start_time = self.clock.now()
         self.on_start()
         self.client.start()
@@ -262,6 +264,7 @@ class GobyMOOSApp:
             await self.client.wait_connected(connect_timeout)
 
     async def stop(self) -> None:
+        self._stopping = True
         if self._task is not None:
             self._task.cancel()
             with contextlib.suppress(asyncio.CancelledError):
@@ -305,7 +308,10 @@ class GobyMOOSApp:
             self.log.exception("on_connect failed")
 
     def _disconnected(self) -> None:
-        self.log.warning("lost the connection to the MOOSDB; reconnecting")
+        if self._stopping:
+            self.log.info("disconnected from the MOOSDB")
+        else:
+            self.log.warning("lost the connection to the MOOSDB; reconnecting")
         try:
             self.on_disconnect()
         except Exception:
