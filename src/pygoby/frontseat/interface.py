@@ -1,0 +1,338 @@
+"""The frontseat interface base class: the iFrontSeat state machine shared by every driver.
+
+A driver (one vehicle's frontseat protocol) subclasses `InterfaceBase` and implements the
+abstract hooks; the application calls `do_work()` once per tick, `set_helm_state()` from the
+helm's posts, and forwards commands/data only in the states that allow them (spec
+goby-moos-apps.md 5.3, 5.7). Sans-I/O: time comes from the given Clock.
+
+State machine (spec 5.3), run by `do_work()` before the driver's `loop()`:
+
+* STANDBY -> LISTEN when the frontseat provides data (T1), else error check E1-E3 (T2);
+* LISTEN -> COMMAND when the frontseat accepts commands and the helm drives (or the helm is not
+  required) (T3), else error check E1-E4 (T4);
+* COMMAND -> LISTEN when the frontseat is IDLE or IN_CONTROL, whatever the helm (T5), else error
+  check E1-E4 with the helm rule applied without its start-up grace period (T6);
+* HELM_ERROR -> STANDBY when the helm drives (T7); FS_ERROR -> STANDBY when the condition behind
+  the last frontseat error is gone (T8); an IGNORING_COMMANDS error has no automatic exit;
+* a driver raising `FrontSeatException` from `loop()` forces the matching error state (T9).
+
+When the transition check enters an error state, `loop()` is skipped for that tick. Each error
+code is kept until its own exit (T7 clears the helm error, T8 the frontseat error), as goby3 does:
+so after a T9 jump from one error state to the other, `status()` can carry both codes.
+"""
+
+from __future__ import annotations
+
+import abc
+import logging
+from collections.abc import Callable
+from typing import Any
+
+from google.protobuf import text_format
+
+from pygoby.acomms.signals import Signal as _SlotList
+from pygoby.frontseat.messages import (
+    ERROR_FRONTSEAT_NONE,
+    ERROR_FRONTSEAT_NOT_CONNECTED,
+    ERROR_FRONTSEAT_NOT_PROVIDING_DATA,
+    ERROR_HELM_NONE,
+    ERROR_HELM_NOT_RUNNING,
+    ERROR_HELM_PARKED,
+    ERROR_STATES,
+    FRONTSEAT_ACCEPTING_COMMANDS,
+    FRONTSEAT_IDLE,
+    FRONTSEAT_IN_CONTROL,
+    FRONTSEAT_NOT_CONNECTED,
+    HELM_DRIVE,
+    HELM_NOT_RUNNING,
+    HELM_PARK,
+    INTERFACE_COMMAND,
+    INTERFACE_FS_ERROR,
+    INTERFACE_HELM_ERROR,
+    INTERFACE_LISTEN,
+    INTERFACE_STANDBY,
+    FrontSeatError,
+    HelmError,
+    InterfaceState,
+    InterfaceStatus,
+)
+from pygoby.util.clock import Clock, WallClock
+
+_log = logging.getLogger(__name__)
+
+
+class FrontSeatException(Exception):
+    """A driver raises it from loop() to force an error state (T9).
+
+    Carries at most one of a HelmError (-> INTERFACE_HELM_ERROR) or a FrontSeatError
+    (-> INTERFACE_FS_ERROR); one with neither is not a state change and propagates out of
+    `do_work()`.
+    """
+
+    def __init__(
+        self,
+        *,
+        helm_error: int | None = None,
+        frontseat_error: int | None = None,
+        message: str = "",
+    ) -> None:
+        if helm_error is not None and frontseat_error is not None:
+            raise ValueError(
+                "a FrontSeatException carries a helm error or a frontseat error, not both"
+            )
+        self.helm_error = helm_error
+        self.frontseat_error = frontseat_error
+        self.message = message
+        if helm_error is not None:
+            what = (
+                HelmError.Name(helm_error) if helm_error in HelmError.values() else str(helm_error)
+            )
+        elif frontseat_error is not None:
+            what = (
+                FrontSeatError.Name(frontseat_error)
+                if frontseat_error in FrontSeatError.values()
+                else str(frontseat_error)
+            )
+        else:
+            what = ""
+        super().__init__(": ".join(part for part in (what, message) if part))
+
+    @property
+    def is_helm_error(self) -> bool:
+        return self.helm_error is not None
+
+    @property
+    def is_fs_error(self) -> bool:
+        return self.frontseat_error is not None
+
+
+class FrontSeatFatalError(RuntimeError):
+    """Raised by do_work() in an error state when `exit_on_error` is set (the app exits 1)."""
+
+    def __init__(self, status: Any) -> None:
+        self.status = status
+        super().__init__(
+            f"error state {InterfaceState.Name(status.state)} with exit_on_error: true "
+            f"({_short(status)})"
+        )
+
+
+class Signal(_SlotList):
+    """Callback list: `sig.connect(cb)`; `sig(arg)` (or `sig.emit(arg)`) calls every cb(arg) in
+    order. A raising callback is logged and does not stop the others (a subscriber's bug must not
+    stop the interface's tick)."""
+
+    def emit(self, *args: Any) -> None:
+        for slot in list(self._slots):
+            try:
+                slot(*args)
+            except Exception:
+                _log.exception("frontseat signal callback %s raised", _slot_name(slot))
+
+    __call__ = emit
+
+
+def _slot_name(slot: Callable[..., Any]) -> str:
+    return getattr(slot, "__qualname__", repr(slot))
+
+
+def _short(status: Any) -> str:
+    return text_format.MessageToString(status, as_one_line=True)
+
+
+class InterfaceBase(abc.ABC):
+    """Base of every frontseat driver: state machine, signals and data helpers.
+
+    `cfg` is a goby.middleware.frontseat.protobuf.Config (copied; the driver reads its own
+    extension from `self.cfg`). `start_time` (construction time on `clock`) is the origin of the
+    helm and frontseat start-up grace periods.
+    """
+
+    def __init__(self, cfg: Any, clock: Clock | None = None) -> None:
+        self.cfg = type(cfg)()
+        self.cfg.CopyFrom(cfg)
+        self.clock: Clock = clock if clock is not None else WallClock()
+        self.start_time = self.clock.now()
+        self.log = logging.getLogger(f"{__name__}.{type(self).__name__}")
+
+        self._state: int = INTERFACE_STANDBY
+        self._helm_state: int = HELM_NOT_RUNNING
+        self._last_helm_error: int = ERROR_HELM_NONE
+        self._last_frontseat_error: int = ERROR_FRONTSEAT_NONE
+
+        self.signal_data_from_frontseat = Signal()
+        self.signal_command_response = Signal()
+        self.signal_raw_from_frontseat = Signal()
+        self.signal_raw_to_frontseat = Signal()
+        self.signal_state_change = Signal()
+
+    # --- driver hooks ---------------------------------------------------------------------
+
+    @abc.abstractmethod
+    def send_command_to_frontseat(self, command: Any) -> None:
+        """Pass a CommandRequest to the frontseat (called only in INTERFACE_COMMAND)."""
+
+    @abc.abstractmethod
+    def send_data_to_frontseat(self, data: Any) -> None:
+        """Pass InterfaceData to the frontseat (called in LISTEN and COMMAND)."""
+
+    @abc.abstractmethod
+    def send_raw_to_frontseat(self, raw: Any) -> None:
+        """Write a Raw message from another process to the frontseat (may be ignored)."""
+
+    @abc.abstractmethod
+    def frontseat_state(self) -> int:
+        """The driver's belief of the frontseat's command state (FrontSeatState)."""
+
+    @abc.abstractmethod
+    def frontseat_providing_data(self) -> bool:
+        """True while the required data (at least navigation) arrive recently enough."""
+
+    @abc.abstractmethod
+    def loop(self) -> None:
+        """Non-blocking work every tick after the state check: read, emit signals, age data."""
+
+    async def start(self) -> None:  # noqa: B027 (optional hook, a no-op by default)
+        """Open the driver's I/O (default: nothing to open)."""
+
+    async def stop(self) -> None:  # noqa: B027 (optional hook, a no-op by default)
+        """Close the driver's I/O (default: nothing to close)."""
+
+    # --- state ----------------------------------------------------------------------------
+
+    @property
+    def state(self) -> int:
+        return self._state
+
+    @property
+    def helm_state(self) -> int:
+        return self._helm_state
+
+    def set_helm_state(self, state: int) -> None:
+        self._helm_state = state
+
+    def status(self) -> Any:
+        status = InterfaceStatus(
+            state=self._state, frontseat_state=self.frontseat_state(), helm_state=self._helm_state
+        )
+        if self._last_helm_error != ERROR_HELM_NONE:
+            status.helm_error = self._last_helm_error
+        if self._last_frontseat_error != ERROR_FRONTSEAT_NONE:
+            status.frontseat_error = self._last_frontseat_error
+        return status
+
+    def do_work(self) -> None:
+        """One tick: the transition check, then the driver's loop() unless the check has just
+        entered an error state. Raises FrontSeatFatalError in an error state if
+        `exit_on_error` is set (after the state change was signalled)."""
+        if not self._check_change_state():
+            try:
+                self.loop()
+            except FrontSeatException as exc:
+                if not (exc.is_helm_error or exc.is_fs_error):
+                    raise
+                self.log.warning("driver reported an error: %s", exc)
+                self._enter_error(exc.helm_error, exc.frontseat_error)
+        if self.cfg.exit_on_error and self._state in ERROR_STATES:
+            raise FrontSeatFatalError(self.status())
+
+    def _check_change_state(self) -> bool:
+        """Applies T1-T8; True when it has just entered an error state (loop() is skipped)."""
+        state = self._state
+        if state in (INTERFACE_STANDBY, INTERFACE_LISTEN, INTERFACE_COMMAND):
+            target = self._normal_transition(state)
+            if target is None:
+                error = self._error_check()
+                if error is not None:
+                    self._enter_error(*error)
+                    return True
+                return False
+        elif state == INTERFACE_HELM_ERROR:
+            target = self._helm_error_exit()
+        else:
+            target = self._frontseat_error_exit()
+        if target is not None:
+            self._change_state(target)
+        return False
+
+    def _normal_transition(self, state: int) -> int | None:
+        if state == INTERFACE_STANDBY:
+            return INTERFACE_LISTEN if self.frontseat_providing_data() else None  # T1
+        if state == INTERFACE_LISTEN:  # T3
+            helm_ok = self._helm_state == HELM_DRIVE or not self.cfg.require_helm
+            accepting = self.frontseat_state() == FRONTSEAT_ACCEPTING_COMMANDS
+            return INTERFACE_COMMAND if accepting and helm_ok else None
+        # COMMAND (T5): the helm is not consulted
+        if self.frontseat_state() in (FRONTSEAT_IN_CONTROL, FRONTSEAT_IDLE):
+            return INTERFACE_LISTEN
+        return None
+
+    def _error_check(self) -> tuple[int | None, int | None] | None:
+        """E1-E4 in order (used from STANDBY, LISTEN, COMMAND): (helm error, frontseat error)
+        of the first rule that fires, or None."""
+        now = self.clock.now()
+        helm = self._helm_state
+        if helm == HELM_PARK:  # E1
+            return ERROR_HELM_PARKED, None
+        if (
+            self.cfg.require_helm
+            and helm == HELM_NOT_RUNNING
+            and (
+                self._state == INTERFACE_COMMAND
+                or now > self.start_time + self.cfg.helm_running_timeout
+            )
+        ):  # E2
+            return ERROR_HELM_NOT_RUNNING, None
+        if self.frontseat_state() == FRONTSEAT_NOT_CONNECTED and (
+            self._state != INTERFACE_STANDBY
+            or now > self.start_time + self.cfg.frontseat_connected_timeout
+        ):  # E3
+            return None, ERROR_FRONTSEAT_NOT_CONNECTED
+        if not self.frontseat_providing_data() and self._state != INTERFACE_STANDBY:  # E4
+            return None, ERROR_FRONTSEAT_NOT_PROVIDING_DATA
+        return None
+
+    def _helm_error_exit(self) -> int | None:
+        if self._helm_state == HELM_DRIVE:  # T7
+            self._last_helm_error = ERROR_HELM_NONE
+            return INTERFACE_STANDBY
+        return None
+
+    def _frontseat_error_exit(self) -> int | None:
+        error = self._last_frontseat_error
+        cleared = (
+            error == ERROR_FRONTSEAT_NOT_CONNECTED
+            and self.frontseat_state() != FRONTSEAT_NOT_CONNECTED
+        ) or (error == ERROR_FRONTSEAT_NOT_PROVIDING_DATA and self.frontseat_providing_data())
+        if cleared:  # T8
+            self._last_frontseat_error = ERROR_FRONTSEAT_NONE
+            return INTERFACE_STANDBY
+        return None
+
+    def _enter_error(self, helm_error: int | None, frontseat_error: int | None) -> None:
+        """Error entry (from the E rules or T9). Signals even when the state stays the same
+        (a T9 report while already in that error state), as goby3 does."""
+        if helm_error is not None:
+            self._last_helm_error = helm_error
+            target = INTERFACE_HELM_ERROR
+        else:
+            assert frontseat_error is not None
+            self._last_frontseat_error = frontseat_error
+            target = INTERFACE_FS_ERROR
+        self._set_state(target)
+
+    def _change_state(self, target: int) -> None:
+        if target != self._state:
+            self._set_state(target)
+
+    def _set_state(self, target: int) -> None:
+        previous, self._state = self._state, target
+        status = self.status()
+        log = self.log.warning if target in ERROR_STATES else self.log.info
+        log(
+            "interface state %s -> %s (%s)",
+            InterfaceState.Name(previous),
+            InterfaceState.Name(target),
+            _short(status),
+        )
+        self.signal_state_change(status)
