@@ -267,7 +267,7 @@ def _channel_config():
 
 
 def _geodesy(mission):
-    from pygoby.moos.translator.geodesy import UTMGeodesy
+    from pygoby.util.geodesy import UTMGeodesy
 
     lat, lon = mission.get_float("LatOrigin"), mission.get_float("LongOrigin")
     if lat is None or lon is None:

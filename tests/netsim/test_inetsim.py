@@ -13,11 +13,11 @@ from pygoby.apps.inetsimmanager import iNetSimManager
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.translator import serialize_for_moos
-from pygoby.moos.translator.geodesy import UTMGeodesy
 from pygoby.netsim.config import parse_config
 from pygoby.netsim.manager import NetSimManager
 from pygoby.netsim.navreporter import NavReporter
 from pygoby.netsim.server import ManagerServer
+from pygoby.util.geodesy import UTMGeodesy
 
 MANAGER = """
 sim_env_pair { modem_tcp_port: 62000 endpoint_ip_address: "127.0.0.1" environment_id: 0 }

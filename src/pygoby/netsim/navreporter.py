@@ -17,8 +17,8 @@ from collections.abc import Mapping
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as m
-from pygoby.moos.translator.geodesy import UTMGeodesy
 from pygoby.netsim.protocol import message_class
+from pygoby.util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)
 

@@ -23,7 +23,6 @@
 
 from pygoby.moos.translator.algorithms import AlgorithmRegistry, render_double
 from pygoby.moos.translator.errors import TranslatorConfigError, TranslatorError
-from pygoby.moos.translator.geodesy import UTMGeodesy
 from pygoby.moos.translator.modem_id import ModemIdLookup
 from pygoby.moos.translator.techniques import (
     MAGIC_PROTOBUF_HEADER,
@@ -46,6 +45,7 @@ from pygoby.moos.translator.translator import (
     make_post,
     post_for_moos,
 )
+from pygoby.util.geodesy import UTMGeodesy
 
 TRANSLATOR_PROTO = "goby/moos/protobuf/translator.proto"
 
