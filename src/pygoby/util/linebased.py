@@ -237,18 +237,29 @@ class TCPServerLink(_StreamLinkBase):
             self._task = asyncio.get_running_loop().create_task(self._serve())
 
     async def wait_listening(self, timeout: float = 10.0) -> int:
-        await asyncio.wait_for(self._listening.wait(), timeout)
+        """The port once listening; raises the server's own error (e.g. port in use) if it failed."""
+        listening = asyncio.ensure_future(self._listening.wait())
+        waiting = {listening} if self._task is None else {listening, self._task}
+        try:
+            await asyncio.wait(waiting, timeout=timeout, return_when=asyncio.FIRST_COMPLETED)
+        finally:
+            listening.cancel()
+        if self._task is not None and self._task.done() and not self._task.cancelled():
+            self._task.result()  # raises the error that ended the server
+        if not self._listening.is_set():
+            raise TimeoutError(f"{self.describe()}: not listening after {timeout} s")
         return self.port
 
     async def _serve(self) -> None:
         loop = asyncio.get_running_loop()
-        self._server = await loop.create_server(lambda: _Protocol(self), self.host, self.port)
-        self.port = self._server.sockets[0].getsockname()[1]
+        server = await loop.create_server(lambda: _Protocol(self), self.host, self.port)
+        self._server = server
+        self.port = server.sockets[0].getsockname()[1]
         self._listening.set()
         try:
             await asyncio.Future()  # serve until cancelled
         finally:
-            self._server.close()
+            server.close()  # close() may already have dropped self._server
 
     def close(self) -> None:
         if self._server is not None:

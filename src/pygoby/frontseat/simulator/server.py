@@ -1,0 +1,123 @@
+"""`basic_frontseat_simulator PORT` (alias `abc_frontseat_simulator`): the simulator on TCP.
+
+A TCP server (any number of clients; lines from all of them are handled in arrival order,
+every reply and NAV goes to every client, "\\r\\n" line endings) around the sans-I/O
+`BasicFrontSeatSimulator`. The simulator ticks every 1/(FREQ*WARP) wall seconds on a steady
+schedule; received lines are handled within `poll_interval` of their arrival, between ticks.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import logging
+import signal
+import sys
+
+from pygoby.frontseat.simulator.core import BasicFrontSeatSimulator
+from pygoby.util.linebased import LinkClosedError, TCPServerLink
+
+log = logging.getLogger(__name__)
+
+DEFAULT_POLL_INTERVAL = 0.01  # s between checks for received lines
+
+
+class SimulatorServer:
+    """Serves one `BasicFrontSeatSimulator` on `port` (0 = ephemeral; see `port` once listening)."""
+
+    def __init__(
+        self,
+        port: int,
+        host: str = "0.0.0.0",
+        simulator: BasicFrontSeatSimulator | None = None,
+        poll_interval: float = DEFAULT_POLL_INTERVAL,
+    ) -> None:
+        self.simulator = simulator if simulator is not None else BasicFrontSeatSimulator()
+        self.link = TCPServerLink(port, host=host)
+        self.poll_interval = poll_interval
+
+    @property
+    def port(self) -> int:
+        return self.link.port
+
+    async def start(self) -> int:
+        """Listen; returns the port."""
+        self.link.open()
+        return await self.link.wait_listening()
+
+    def close(self) -> None:
+        self.link.close()
+
+    async def serve(self) -> None:
+        """Listen (if not yet) and run the simulator until cancelled."""
+        await self.start()
+        log.info("basic frontseat simulator listening on %s:%d", self.link.host, self.port)
+        loop = asyncio.get_running_loop()
+        last_tick = loop.time()
+        try:
+            while True:
+                self._handle_input()
+                now = loop.time()
+                due = last_tick + self.simulator.period  # the period changes with START
+                if now >= due:
+                    self._send(self.simulator.tick())
+                    # keep a steady schedule, but never burst to catch up a long stall
+                    last_tick = due if now - due < self.simulator.period else now
+                    due = last_tick + self.simulator.period
+                await asyncio.sleep(max(0.0, min(due - now, self.poll_interval)))
+        finally:
+            self.close()
+
+    def _handle_input(self) -> None:
+        for line in self.link.read_lines():
+            self._send(self.simulator.handle_line(line))
+
+    def _send(self, lines: list[str]) -> None:
+        for line in lines:
+            log.debug("> %s", line)
+            # nobody connected: the line is for no one, as upstream
+            with contextlib.suppress(LinkClosedError):
+                self.link.write(line + "\r\n")
+
+
+def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=prog,
+        description="Basic (ABC) frontseat simulator: a TCP server speaking START/CTRL/NAV/CMD "
+        "lines (goby3 basic_frontseat_simulator).",
+    )
+    parser.add_argument("port", type=int, help="TCP port to listen on (0 = any free port)")
+    parser.add_argument("--bind", default="0.0.0.0", help="address to listen on (default: all)")
+    parser.add_argument(
+        "-v", "--verbose", action="count", default=0, help="more log output (-v: every line sent)"
+    )
+    return parser
+
+
+async def _run(server: SimulatorServer) -> None:
+    loop = asyncio.get_running_loop()
+    serving = asyncio.ensure_future(server.serve())
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        loop.add_signal_handler(signum, serving.cancel)
+    with contextlib.suppress(asyncio.CancelledError):
+        await serving
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(
+        level=logging.DEBUG if args.verbose else logging.INFO,
+        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
+    )
+    try:
+        asyncio.run(_run(SimulatorServer(args.port, host=args.bind)))
+    except OSError as exc:
+        print(f"{parser.prog}: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
