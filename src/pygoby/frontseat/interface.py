@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import abc
 import logging
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -57,6 +58,7 @@ from pygoby.frontseat.messages import (
     InterfaceStatus,
 )
 from pygoby.util.clock import Clock, WallClock
+from pygoby.util.geodesy import UTMGeodesy
 
 _log = logging.getLogger(__name__)
 
@@ -166,6 +168,16 @@ class InterfaceBase(abc.ABC):
         self.signal_raw_to_frontseat = Signal()
         self.signal_state_change = Signal()
 
+        self._geodesy: UTMGeodesy | None = None
+        origin = self.cfg.origin
+        if self.cfg.HasField("origin") and math.isfinite(origin.lat) and math.isfinite(origin.lon):
+            self.update_utm_datum(origin.lat, origin.lon)
+        else:
+            self.log.warning(
+                "no valid datum (cfg.origin, from LatOrigin/LongOrigin): compute_missing cannot "
+                "convert between global and local fixes until update_utm_datum()"
+            )
+
     # --- driver hooks ---------------------------------------------------------------------
 
     @abc.abstractmethod
@@ -220,6 +232,58 @@ class InterfaceBase(abc.ABC):
         if self._last_frontseat_error != ERROR_FRONTSEAT_NONE:
             status.frontseat_error = self._last_frontseat_error
         return status
+
+    # --- data helpers (spec 5.7) ---------------------------------------------------------------
+
+    def update_utm_datum(self, lat: float, lon: float) -> None:
+        """Re-centre the local grid used by compute_missing on (lat, lon) degrees."""
+        if not (math.isfinite(lat) and math.isfinite(lon)):
+            raise ValueError(f"invalid UTM datum ({lat}, {lon})")
+        self._geodesy = UTMGeodesy(lat, lon)
+
+    @property
+    def geodesy(self) -> UTMGeodesy | None:
+        """The local grid of the current datum (None until one is known)."""
+        return self._geodesy
+
+    def compute_missing(self, node_status: Any) -> None:
+        """Fill in what a driver's NodeStatus lacks, in place: `name`/`type` from the config,
+        `time` = now, and the global fix from the local fix (lat/lon by the UTM inverse,
+        depth = -z) or the other way round (x/y by UTM forward, z = -depth). Depth and z are
+        carried over only when set. With neither fix: a warning, nothing else changed."""
+        if not node_status.HasField("name") and self.cfg.HasField("name"):
+            node_status.name = self.cfg.name
+        if not node_status.HasField("type"):
+            node_status.type = self.cfg.type
+        if not node_status.HasField("time"):
+            node_status.time = self.clock.now()
+
+        has_global = node_status.HasField("global_fix")
+        has_local = node_status.HasField("local_fix")
+        if has_global == has_local:
+            if not has_global:
+                self.log.warning(
+                    "compute_missing: NodeStatus has neither global_fix nor local_fix "
+                    "(no position to compute from)"
+                )
+            return
+        if self._geodesy is None:
+            self.log.warning("compute_missing: no UTM datum, cannot convert the position fix")
+            return
+        if has_local:
+            local = node_status.local_fix
+            lat, lon = self._geodesy.to_geo(local.x, local.y)
+            fix = node_status.global_fix
+            fix.lat, fix.lon = lat, lon
+            if local.HasField("z"):
+                fix.depth = -local.z
+        else:
+            fix = node_status.global_fix
+            x, y = self._geodesy.to_local(fix.lat, fix.lon)
+            local = node_status.local_fix
+            local.x, local.y = x, y
+            if fix.HasField("depth"):
+                local.z = -fix.depth
 
     def do_work(self) -> None:
         """One tick: the transition check, then the driver's loop() unless the check has just
