@@ -32,6 +32,7 @@ from typing import Any
 from google.protobuf import text_format
 
 from pygoby.acomms.signals import Signal as _SlotList
+from pygoby.frontseat.ctd import compute_missing_ctd as _compute_missing_ctd
 from pygoby.frontseat.messages import (
     ERROR_FRONTSEAT_NONE,
     ERROR_FRONTSEAT_NOT_CONNECTED,
@@ -284,6 +285,11 @@ class InterfaceBase(abc.ABC):
             local.x, local.y = x, y
             if fix.HasField("depth"):
                 local.z = -fix.depth
+
+    def compute_missing_ctd(self, ctd: Any) -> None:
+        """Fill in a CTDSample's salinity, depth, sound speed and density where missing
+        (UNESCO algorithms; see pygoby.frontseat.ctd)."""
+        _compute_missing_ctd(ctd, self.log)
 
     def do_work(self) -> None:
         """One tick: the transition check, then the driver's loop() unless the check has just
