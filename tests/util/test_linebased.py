@@ -62,6 +62,7 @@ async def test_tcp_client_reconnects_after_server_restart():
     client = TCPClientLink("127.0.0.1", port, reconnect_interval=0.2)
     client.open()
     await client.wait_open()
+    assert client.connections == 1
     server.close()
     async with asyncio.timeout(5):
         while client.is_open:
@@ -72,6 +73,7 @@ async def test_tcp_client_reconnects_after_server_restart():
     server2.open()
     await server2.wait_listening()
     await client.wait_open(timeout=5)
+    assert client.connections == 2  # tells a driver its peer may have restarted
     client.write("again\r\n")
     assert await lines_from(server2, 1) == ["again"]
     client.close()
@@ -91,3 +93,24 @@ async def test_serial_link_over_pty():
     finally:
         link.close()
         os.close(master)
+
+
+async def test_server_wait_listening_raises_the_bind_error():
+    first = TCPServerLink(0, host="127.0.0.1")
+    first.open()
+    port = await first.wait_listening()
+    second = TCPServerLink(port, host="127.0.0.1")
+    second.open()
+    with pytest.raises(OSError):
+        await second.wait_listening()
+    second.close()
+    first.close()
+
+
+def test_memory_link_counts_connections():
+    link = MemoryLink()
+    link.open()
+    link.open()
+    link.close()
+    link.open()
+    assert link.connections == 2

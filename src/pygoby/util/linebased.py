@@ -26,6 +26,9 @@ class LinkClosedError(ConnectionError):
 
 
 class LineLink(Protocol):
+    # connections made so far: a change tells a driver that its peer may have restarted
+    connections: int
+
     @property
     def is_open(self) -> bool: ...
 
@@ -70,12 +73,15 @@ class MemoryLink:
         self._lines: deque[str] = deque()
         self.written: list[str] = []
         self._open = False
+        self.connections = 0
 
     @property
     def is_open(self) -> bool:
         return self._open
 
     def open(self) -> None:
+        if not self._open:
+            self.connections += 1
         self._open = True
 
     def close(self) -> None:
@@ -109,6 +115,7 @@ class _StreamLinkBase:
         self._task: asyncio.Task | None = None
         self._closing = False
         self._open_event = asyncio.Event()
+        self.connections = 0
 
     @property
     def is_open(self) -> bool:
@@ -145,6 +152,7 @@ class _StreamLinkBase:
     # protocol callbacks
     def _made(self, transport: asyncio.BaseTransport) -> None:
         self._transports[transport] = LineSplitter(self.delimiter)
+        self.connections += 1
         self._open_event.set()
         log.info("%s: connection made", self.describe())
 

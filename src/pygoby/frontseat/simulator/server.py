@@ -51,11 +51,11 @@ class SimulatorServer:
 
     async def serve(self) -> None:
         """Listen (if not yet) and run the simulator until cancelled."""
-        await self.start()
-        log.info("basic frontseat simulator listening on %s:%d", self.link.host, self.port)
-        loop = asyncio.get_running_loop()
-        last_tick = loop.time()
         try:
+            await self.start()
+            log.info("basic frontseat simulator listening on %s:%d", self.link.host, self.port)
+            loop = asyncio.get_running_loop()
+            last_tick = loop.time()
             while True:
                 self._handle_input()
                 now = loop.time()

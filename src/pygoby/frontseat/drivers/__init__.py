@@ -1,0 +1,1 @@
+"""Frontseat drivers shipped with pygoby (loaded through pygoby.frontseat.plugins)."""
