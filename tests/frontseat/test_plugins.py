@@ -18,6 +18,7 @@ from pygoby.frontseat.plugins import (
     available_drivers,
     canonical_name,
     driver_name_from,
+    find_driver,
     load_driver,
 )
 from pygoby.util.clock import VirtualClock
@@ -98,6 +99,16 @@ def test_load_by_module_path_and_attribute() -> None:
     driver = load_driver(f"{TEST_MODULE}:ScriptedFrontSeat", cfg(), VirtualClock(1.0))
     assert isinstance(driver, ScriptedFrontSeat)
     assert driver.start_time == 1.0
+
+
+def test_find_driver_imports_without_constructing(scripted_entry_point) -> None:
+    from . import scripted_driver
+
+    assert find_driver("scripted") is scripted_driver.frontseat_driver_load
+    assert find_driver("libgoby_frontseat_scripted.so.30") is scripted_driver.frontseat_driver_load
+    assert find_driver(f"{TEST_MODULE}:not_a_driver") is scripted_driver.not_a_driver
+    with pytest.raises(DriverLoadError, match="drivers found: .*abc"):
+        find_driver("libgoby_frontseat_bluefin.so.30")
 
 
 def test_factory_returning_no_driver() -> None:

@@ -110,6 +110,13 @@ def _resolve_factory(name: str) -> tuple[str, Callable[..., Any]]:
     raise DriverLoadError(f"unknown frontseat driver {name!r}; {_found()}")
 
 
+def find_driver(name: str) -> Callable[..., Any]:
+    """The factory of the driver called `name`, without making a driver. Importing a driver
+    loads its configuration extension, so iFrontSeat calls this before it reads its
+    configuration. DriverLoadError if there is no such driver."""
+    return _resolve_factory(name)[1]
+
+
 def load_driver(name: str, cfg: Any, clock: Clock | None = None) -> InterfaceBase:
     """Make the driver called `name` (entry point, upstream library name or module path) from
     the frontseat Config. Every failure is a DriverLoadError saying what went wrong."""
