@@ -8,7 +8,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.drivers.micromodem.statistics import cst_text, format_cst, parse_cst
+from pygoby.acomms.drivers.micromodem.statistics import (
+    add_cst,
+    cst_text,
+    format_cst,
+    parse_cst,
+)
 from pygoby.util.nmea import NMEAFormatError, NMEASentence, with_checksum
 
 DAY = dt.date(2023, 11, 14)
@@ -72,3 +77,49 @@ def test_a_field_that_is_not_a_number_is_named(index, text):
     fields[index] = text
     with pytest.raises(NMEAFormatError, match=f"field {index} of"):
         parse_cst(NMEASentence.parse(",".join(fields)), DAY)
+
+
+def test_add_cst_gives_parse_cst_for_recurring_statistics():
+    """The second sentence of a link (same fields, another time of arrival) comes from the
+    remembered parse of the first: the result must still be exactly parse_cst's."""
+    rx = m.ModemTransmission()
+    stats = rx.Extensions[m.MM_TRANSMISSION].receive_stat
+    second = CST.replace("221330.6675", "221407.0125")
+    for text in (CST, second, CST):
+        sentence = NMEASentence.parse(text)
+        assert add_cst(stats, sentence, DAY) == parse_cst(sentence, DAY)
+    assert [s.time for s in stats] == [
+        MIDNIGHT_US + (22 * 3600 + 13 * 60 + 30) * 1_000_000 + 667_500,
+        MIDNIGHT_US + (22 * 3600 + 14 * 60 + 7) * 1_000_000 + 12_500,
+        MIDNIGHT_US + (22 * 3600 + 13 * 60 + 30) * 1_000_000 + 667_500,
+    ]
+    other_day = dt.date(2024, 2, 29)
+    sentence = NMEASentence.parse(second)
+    assert add_cst(stats, sentence, other_day) == parse_cst(sentence, other_day)
+
+
+def test_add_cst_appends_nothing_for_a_bad_sentence():
+    rx = m.ModemTransmission()
+    stats = rx.Extensions[m.MM_TRANSMISSION].receive_stat
+    add_cst(stats, NMEASentence.parse(CST), DAY)  # remembered: only the TOA is read next
+    with pytest.raises(NMEAFormatError, match="bad time of arrival"):
+        add_cst(stats, NMEASentence.parse(CST.replace("221330.6675", "2213x0.6675")), DAY)
+    fields = CST.split(",")
+    fields[4] = "x"
+    with pytest.raises(NMEAFormatError, match="field 4 of"):
+        add_cst(stats, NMEASentence.parse(",".join(fields)), DAY)
+    fields[4] = str(2**40)  # a number, but out of the int32 field's range
+    with pytest.raises(ValueError):
+        add_cst(stats, NMEASentence.parse(",".join(fields)), DAY)
+    assert len(stats) == 1
+
+
+def test_add_cst_warns_about_every_short_sentence(caplog):
+    rx = m.ModemTransmission()
+    stats = rx.Extensions[m.MM_TRANSMISSION].receive_stat
+    short = NMEASentence.parse(",".join(CST.split(",")[:13]))
+    with caplog.at_level(logging.WARNING):
+        add_cst(stats, short, DAY)
+        add_cst(stats, short, DAY)
+    assert caplog.text.count("stopped at rate") == 2
+    assert stats[1] == parse_cst(short, DAY)

@@ -21,7 +21,7 @@ from pygoby.acomms import messages as m
 from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
 from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
-from pygoby.acomms.drivers.micromodem.statistics import cst_fields, parse_toa, parse_xst
+from pygoby.acomms.drivers.micromodem.statistics import add_cst, parse_toa, parse_xst
 from pygoby.util.nmea import NMEAError, NMEASentence
 
 log = logging.getLogger(__name__)
@@ -514,16 +514,16 @@ class MMDriver(ModemDriverBase):
 
     def _on_cst(self, s: NMEASentence) -> None:
         today = dt.datetime.fromtimestamp(self.clock.now(), dt.UTC).date()
-        fields = cst_fields(s, today, self.revision >= MM2_BITFIELD_CLOCK_REVISION)
+        new_clock = self.revision >= MM2_BITFIELD_CLOCK_REVISION
         if self._ack_msg is not None and self._receive is None and not self._expected_cst:
-            self._ack_msg.Extensions[m.MM_TRANSMISSION].receive_stat.add(**fields)
+            add_cst(self._ack_msg.Extensions[m.MM_TRANSMISSION].receive_stat, s, today, new_clock)
             self._flush_ack()
             return
-        # (what _receiving() gives, kept only once the statistics are in: add() refuses an
-        # out-of-range value before changing anything)
+        # (what _receiving() gives, kept only once the statistics are in: add_cst appends
+        # nothing when the sentence is bad)
         rx = self._receive if self._receive is not None else m.ModemTransmission(type=m.DATA)
         ext = rx.Extensions[m.MM_TRANSMISSION]
-        stat = ext.receive_stat.add(**fields)
+        stat = add_cst(ext.receive_stat, s, today, new_clock)
         self._receive = rx
         rx.time, rx.time_source = stat.time, m.ModemTransmission.MODEM_TIME
         if not rx.HasField("src"):

@@ -7,6 +7,8 @@ import logging
 import operator
 from collections.abc import Mapping
 
+from google.protobuf.message import Message
+
 from pygoby.acomms import messages as m
 from pygoby.util.nmea import NMEAFormatError, NMEASentence, parse_int, parse_ints
 
@@ -88,6 +90,37 @@ def cst_fields(sentence: NMEASentence, today: dt.date, new_clock_bitfield: bool 
             "short $CACST (%d fields): stopped at %s", len(sentence), _CST_INT_FIELDS[len(texts)]
         )
     return fields
+
+
+def add_cst(stats, sentence: NMEASentence, today: dt.date, new_clock_bitfield: bool = False):
+    """Append `parse_cst`'s ReceiveStatistics to the repeated field `stats` and return it.
+
+    A link's statistics recur: sentences that differ only in their time of arrival are parsed
+    once (the other fields are kept as a message, copied in C), then only the TOA is read.
+    Nothing is appended when the sentence is bad (the errors of `cst_fields`)."""
+    version, off = cst_offset(sentence)
+    fields = sentence.fields
+    key = (new_clock_bitfield, fields[: 2 + off], fields[3 + off :])
+    template = _cst_templates.get(key)
+    if template is None:
+        template = m.ReceiveStatistics(**cst_fields(sentence, today, new_clock_bitfield))
+        # (short sentences are not remembered: their warning is logged every time)
+        if len(fields) == 4 + off + len(_CST_INT_FIELDS):
+            if len(_cst_templates) >= _CST_TEMPLATES_LIMIT:
+                _cst_templates.clear()
+            _cst_templates[key] = template
+        time = template.time
+    else:
+        time = parse_toa(fields[2 + off], today)
+    stat = stats.add()
+    stat.CopyFrom(template)
+    stat.time = time
+    return stat
+
+
+# ReceiveStatistics without a meaningful time, by the other fields of their $CACST sentence
+_cst_templates: dict[tuple, Message] = {}
+_CST_TEMPLATES_LIMIT = 4096
 
 
 def _cst_numbers(sentence: NMEASentence, start: int, texts: tuple[str, ...]) -> list:
