@@ -53,6 +53,8 @@ The base provides
   `log` (a logging.Logger; terminal at `common.verbosity`, file log per `common.log`),
   `cfg` / `common`, `client` (the MOOSClient), `moos_time()`.
 * Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`.
+* `exit_status`: what `main` returns once the app has stopped (0; an app that stops itself on a
+  fatal error sets it, then calls `request_stop()`).
 * Mail older than the app's start time is stored in `dynamic_vars` but not handed to the
   subscription's handler (`ignore_stale = True`, Goby's rule; snapshots of old values
   therefore do not trigger handlers). Pattern handlers always run.
@@ -201,6 +203,7 @@ class GobyMOOSApp:
         self._last_status = -math.inf
         self._last_cpu = (_time.process_time(), _time.monotonic())
         self.iterations = 0
+        self.exit_status = 0
 
     # -- API for subclasses --------------------------------------------------------------------
 
@@ -529,4 +532,4 @@ def _run_until_signal(app: GobyMOOSApp) -> int:
         asyncio.run(runner())
     except KeyboardInterrupt:
         return 130
-    return 0
+    return app.exit_status

@@ -15,7 +15,7 @@ from __future__ import annotations
 import functools
 import logging
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from google.protobuf import text_format
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
@@ -187,7 +187,10 @@ def read_configuration(
     mission: MissionFile | None,
     app_name: str,
     overrides: Sequence[tuple[str, str]] = (),
+    complete: Callable[[Message], None] | None = None,
 ) -> Message:
+    """`complete(config)`, if given, runs after the overrides and before the check for required
+    fields (an app's own rewriting of older configuration forms)."""
     config = config_class()
     source = str(mission.path) if mission is not None and mission.path else "mission file"
     if mission is not None:
@@ -197,6 +200,8 @@ def read_configuration(
         parse_block(config, block.text, block.first_line, source)
         apply_moos_globals(config, mission)
     apply_overrides(config, overrides)
+    if complete is not None:
+        complete(config)
     missing = config.FindInitializationErrors()
     if missing:
         raise ConfigError(f"missing required configuration fields: {', '.join(missing)}")
