@@ -125,6 +125,39 @@ def test_channel_statistics_reach_cacst():
     assert cst[2].endswith(".2500")  # time of arrival
 
 
+def test_recurring_cacst_text_is_the_text_made_from_scratch():
+    """The emulator keeps the $CACST text after the time of arrival by link and statistics:
+    a remembered one must be what is made from scratch, and what format_cst prints."""
+    import datetime as dt
+
+    from pygoby.acomms.drivers.micromodem.statistics import format_cst, parse_cst
+    from pygoby.acomms.mmsim import AcousticPacket, PacketKind, Reception
+    from pygoby.acomms.mmsim import model as model_module
+
+    model = MicroModemModel(2, VirtualClock(1e9))
+    packet = AcousticPacket(PacketKind.DATA, 1, 2, rate=1, frames=[b"a", b"b"])
+
+    def cst(arrival, stats, frame_ok=None):
+        model.receive(packet, Reception(arrival, frame_ok=frame_ok, stats=stats))
+        return [x.strip() for x in model.take_output() if x.startswith("$CACST")]
+
+    as_ints = {"snr_in": 8, "doppler": 0, "spl": 151}
+    as_floats = {"snr_in": 8.0, "doppler": 0.0, "spl": 151.0}  # the same key: equal numbers
+    other = {"snr_in": 7.6, "doppler": -0.4, "spl": 151}
+    cases = [(1e9 + 0.25, as_ints), (1e9 + 3.5, as_floats), (1e9 + 7.125, other, [True, False])]
+    fresh = []
+    for case in cases:
+        model_module._cst_tails.clear()
+        fresh.append(cst(*case))
+    model_module._cst_tails.clear()
+    for _ in range(2):  # the second round is remembered
+        assert [cst(*case) for case in cases] == fresh
+    assert len(model_module._cst_tails) == 2
+    day = dt.datetime.fromtimestamp(1e9, dt.UTC).date()
+    for [line] in fresh:
+        assert format_cst(parse_cst(NMEASentence.parse(line), day)).message() == line
+
+
 def test_recurring_sentence_text_depends_on_the_value_types():
     from pygoby.acomms.mmsim.model import _sentence_line
 

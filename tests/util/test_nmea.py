@@ -12,6 +12,8 @@ from pygoby.util.nmea import (
     checksum,
     parse_int,
     parse_ints,
+    with_checksum,
+    with_checksum_of_parts,
 )
 
 SPEC_EXAMPLES = [
@@ -127,6 +129,16 @@ def test_checksum_is_the_xor_of_every_character(body):
     for ch in body:
         expected ^= ord(ch)
     assert checksum(body) == expected
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.text(alphabet=st.characters(min_codepoint=32, max_codepoint=126), max_size=60),
+    st.text(alphabet=st.characters(min_codepoint=32, max_codepoint=126), max_size=200),
+)
+def test_checksum_of_parts_is_the_checksum_of_the_whole(head, tail):
+    head = "$" + head
+    assert with_checksum_of_parts(head, tail, checksum(tail)) == with_checksum(head + tail)
 
 
 def test_a_recurring_line_parses_the_same_and_a_bad_one_fails_every_time():

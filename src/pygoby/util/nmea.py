@@ -161,6 +161,12 @@ def with_checksum(text: str) -> str:
     return f"{text}*{checksum(text[1:]):02X}"
 
 
+def with_checksum_of_parts(head: str, tail: str, tail_checksum: int) -> str:
+    """`with_checksum(head + tail)` for a caller that knows `checksum(tail)` (the checksum is an
+    XOR: the parts' checksums combine), e.g. because `tail` recurs."""
+    return f"{head}{tail}*{checksum(head[1:]) ^ tail_checksum:02X}"
+
+
 def parse_int(text: str) -> int:
     """`int(text)`, remembering the texts it has seen: int() of a str is slow (it normalises
     Unicode digits and spaces first) and sentences repeat the same few numbers."""

@@ -18,10 +18,10 @@ from dataclasses import dataclass, field
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES
-from pygoby.acomms.drivers.micromodem.statistics import cst_text, format_xst
+from pygoby.acomms.drivers.micromodem.statistics import cst_head, cst_tail, format_xst
 from pygoby.acomms.mmsim.channel import AcousticPacket, Channel, PacketKind, Reception
 from pygoby.util.clock import Clock
-from pygoby.util.nmea import NMEAError, NMEASentence, with_checksum
+from pygoby.util.nmea import NMEAError, NMEASentence, checksum, with_checksum_of_parts
 
 log = logging.getLogger(__name__)
 
@@ -280,8 +280,18 @@ class MicroModemModel:
     def _cst(self, p: AcousticPacket, r: Reception, frames: int, bad: int) -> None:
         if not self.nvram.get("CST", 1):
             return
+        # Everything after the time of arrival is the same for every packet of a link (the
+        # same statistics): that text and its checksum are made once.
+        key = (p.rate, p.src, p.dest, frames, bad, *r.stats.items())
+        tail = _cst_tails.get(key) or self._cst_tail(key, p, r, frames, bad)
+        head = cst_head(1 if bad else 0, m.now_us(r.arrival_time + self._clock_offset))
+        self._output(with_checksum_of_parts(head, *tail) + "\r\n")
+
+    def _cst_tail(
+        self, key: tuple, p: AcousticPacket, r: Reception, frames: int, bad: int
+    ) -> tuple[str, int]:
+        """The $CACST text after the time of arrival, and its checksum."""
         values = dict(
-            mode=1 if bad else 0, time=m.now_us(r.arrival_time + self._clock_offset),
             clock_mode=0, mfd_peak=1000, mfd_power=20, mfd_ratio=150, spl=150, shf_agn=250,
             shf_ainpshift=0, shf_ainshift=0, shf_mfdshift=0, shf_p2bshift=0, rate=p.rate,
             source=p.src, dest=p.dest, psk_error_code=3 if bad else 0,
@@ -290,15 +300,27 @@ class MicroModemModel:
             data_quality_factor=200, doppler=0.0, stddev_noise=50, carrier_freq=25000,
             bandwidth=5000,
         )  # fmt: skip
-        for key, value in r.stats.items():
-            if key not in _STATISTICS:
-                log.warning("%s: unknown $CACST statistic %r from the channel", self.name, key)
-                continue
-            if key in _DECIMAL_STATISTICS:
-                values[key] = float(value)
+        known = True
+        for name, value in r.stats.items():
+            if name not in _STATISTICS:
+                log.warning("%s: unknown $CACST statistic %r from the channel", self.name, name)
+                known = False  # (not remembered: warned about every time)
+            elif name in _DECIMAL_STATISTICS:
+                values[name] = float(value)
             else:  # (an int is already what int(round()) would make of it)
-                values[key] = value if type(value) is int else int(round(value))
-        self._output(with_checksum(cst_text(values)) + "\r\n")
+                values[name] = value if type(value) is int else int(round(value))
+        text = cst_tail(values)
+        tail = (text, checksum(text))
+        if known:
+            if len(_cst_tails) >= _CST_TAILS_LIMIT:
+                _cst_tails.clear()
+            _cst_tails[key] = tail
+        return tail
+
+
+# $CACST texts after the time of arrival, with their checksums, by link and statistics
+_cst_tails: dict[tuple, tuple[str, int]] = {}
+_CST_TAILS_LIMIT = 4096
 
 
 # Many of the modem's sentences recur verbatim ($CARXP,0, $CACYC for each source, $CACFG

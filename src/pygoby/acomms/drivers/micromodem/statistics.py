@@ -22,10 +22,11 @@ _CST_INT_FIELDS = (
     "mse_equalizer", "data_quality_factor", "doppler", "stddev_noise", "carrier_freq", "bandwidth",
 )  # fmt: skip
 _DOPPLER = _CST_INT_FIELDS.index("doppler")  # the one decimal among them
-# every field format_cst prints, read at once from a ReceiveStatistics or from a mapping
-_CST_PRINTED = ("mode", "time", "clock_mode", *_CST_INT_FIELDS)
-_cst_attributes = operator.attrgetter(*_CST_PRINTED)
-_cst_items = operator.itemgetter(*_CST_PRINTED)
+# the fields format_cst prints, read at once from a ReceiveStatistics or from a mapping
+_cst_head_attributes = operator.attrgetter("mode", "time")
+_cst_head_items = operator.itemgetter("mode", "time")
+_cst_tail_attributes = operator.attrgetter("clock_mode", *_CST_INT_FIELDS)
+_cst_tail_items = operator.itemgetter("clock_mode", *_CST_INT_FIELDS)
 # enum fields among them whose out-of-range values become -1 (the enums' INVALID value)
 _CST_ENUM_RANGES = {"psk_error_code": (0, 6), "packet_type": (1, 5)}
 
@@ -148,20 +149,32 @@ def cst_text(stat, version: int = 0) -> str:
     """The text of `format_cst` (without checksum), for a caller that only prints it: numbers
     only, so there is nothing to validate."""
     # (dict first: it matches at once, where the Mapping ABC check is slow)
-    get = _cst_items if isinstance(stat, (dict, Mapping)) else _cst_attributes
-    mode, time, clock_mode, *numbers = get(stat)
+    mapping = isinstance(stat, (dict, Mapping))
+    mode, time = (_cst_head_items if mapping else _cst_head_attributes)(stat)
+    return cst_head(mode, time, version) + cst_tail(stat)
+
+
+def cst_head(mode: int, time: int, version: int = 0) -> str:
+    """The start of a $CACST text, up to the comma after the time of arrival (`time`, in
+    microseconds since the epoch): the part that changes with every packet."""
     toa = dt.datetime.fromtimestamp(time / 1e6, dt.UTC)
-    # the whole text in one %-format (%d prints int(value)): much faster than building the
-    # sentence field by field
-    return _CST_TEXT % (
+    return _CST_HEAD % (
         f"{version:d}," if version >= 6 else "", mode,
-        toa.hour, toa.minute, toa.second, toa.microsecond // 100, clock_mode, *numbers,
+        toa.hour, toa.minute, toa.second, toa.microsecond // 100,
     )  # fmt: skip
 
 
-_CST_TEXT = "$CACST,%s%d,%02d%02d%02d.%04d,%d," + ",".join(
-    "%.1f" if name == "doppler" else "%d" for name in _CST_INT_FIELDS
-)
+def cst_tail(stat) -> str:
+    """The rest of the $CACST text after `cst_head` (clock mode, then the numbers from
+    mfd_peak to bandwidth), from a ReceiveStatistics or a mapping of the field names: a link's
+    statistics recur, so a caller may keep this part."""
+    # one %-format (%d prints int(value)): much faster than building the sentence field by field
+    get = _cst_tail_items if isinstance(stat, (dict, Mapping)) else _cst_tail_attributes
+    return _CST_TAIL % get(stat)
+
+
+_CST_HEAD = "$CACST,%s%d,%02d%02d%02d.%04d,"
+_CST_TAIL = "%d," + ",".join("%.1f" if name == "doppler" else "%d" for name in _CST_INT_FIELDS)
 
 
 # $CAXST v0 field order after date and time
