@@ -233,3 +233,41 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
         assert await r.wait_for("NAV_Y", lambda v: v < 0) < -1100
 
     assert driver.stopped == 1
+
+
+RENAMED = MISSION.replace(
+    "  legacy_cfg { publish_fs_bs_ready: true }",
+    """  moos_var { prefix: "FS_"  status: "STAT"  data_to_frontseat: "TO_VEHICLE" }
+  legacy_cfg { subscribe_ctd: true  publish_nav: false }""",
+).replace("status_period: 1", "status_period: 1  require_helm: false")
+
+
+async def test_renamed_variables_ctd_samples_and_no_helm_required(tmp_path):
+    async with Community(tmp_path, RENAMED) as c:
+        r, driver = c.recorder, c.driver
+        for var in ("FS_STAT", "FS_TO_VEHICLE", "FS_NODE_STATUS"):
+            r.client.subscribe(var)
+        # require_helm: false -> COMMAND without a helm.
+        status = await r.wait_for("FS_STAT", status_is(m.INTERFACE_COMMAND), timeout=10)
+        assert parsed(m.InterfaceStatus, status).helm_state == m.HELM_NOT_RUNNING
+        await r.wait_for("FS_NODE_STATUS")
+        assert r.values("IFS_STATUS") == [] and r.values("NAV_LAT") == []  # publish_nav: false
+
+        # CTD_*: each CTD_TEMPERATURE makes a sample at the last fix, completed, posted on
+        # the renamed data_to_frontseat variable, and (LISTEN/COMMAND) given to the driver.
+        for var, value in (("CTD_CONDUCTIVITY", 4.2914), ("CTD_PRESSURE", 100.0),
+                           ("CTD_TEMPERATURE", 15.0)):  # fmt: skip
+            c.post(var, value)
+        posted = m.InterfaceData()
+        parse_for_moos(await r.wait_for("FS_TO_VEHICLE"), posted)
+        sample = posted.ctd_sample
+        assert (sample.global_fix.lat, sample.global_fix.lon) == (42.51, -70.5)
+        assert sample.pressure == 100.0e4 and sample.temperature == 15.0
+        # 4.2914 S/m is C(35, 15 degC, 0 dbar); at 100 dbar it is a little less saline
+        assert 34.9 < sample.salinity < 35.0
+        assert 1500 < sample.sound_speed < 1520 and 1020 < sample.density < 1030
+        assert math.isclose(sample.global_fix.depth, 99.3, abs_tol=0.5)  # 100 dbar at 42.5 N
+        async with asyncio.timeout(5):
+            while not driver.data:
+                await asyncio.sleep(0.01)
+        assert driver.data[0] == posted
