@@ -102,6 +102,29 @@ def logged(tmp_path, text: str, name: str) -> list[dict]:
     return read_events(path)
 
 
+def test_positions_set_directly_are_what_the_manager_forwards(caplog):
+    """Discrete-event runs put the scripted positions straight into the channel; real-time runs
+    post them to the manager, which forwards them. Same positions, same refusals (the manager
+    stops at a node outside its region: deeper than 12000 m)."""
+    text = f"""duration: 60 {ORIGIN} {fixed(1, 0)}
+        node {{ modem_id: 2 track {{ waypoint {{ t: 0 x: 500 depth: 5 }}
+                                     waypoint {{ t: 100 x: 900 y: 70 depth: 25 }} }} }}
+        {fixed(3, 0, 300, depth=12500)} {fixed(4, 800)}"""
+    direct, posted = Simulation(parse_scenario(text)), Simulation(parse_scenario(text))
+    for sim in (direct, posted):
+        sim.clock.advance(42.5)
+    with caplog.at_level("WARNING"):
+        direct.set_positions()
+        posted.post_positions()
+    assert caplog.text.count("scripted positions refused") == 2
+    ports = [n.port for n in direct.nodes]
+    assert [direct.channel.position(p) for p in ports] == [
+        posted.channel.position(p) for p in ports
+    ]
+    assert direct.channel.position(ports[1]).speed > 0
+    assert direct.channel.position(ports[2]) is None and direct.channel.position(ports[3]) is None
+
+
 def test_same_seed_same_run_other_seed_other_run(tmp_path):
     first = logged(tmp_path, "seed: 5 " + MARGINAL, "a.jsonl")
     again = logged(tmp_path, "seed: 5 " + MARGINAL, "b.jsonl")

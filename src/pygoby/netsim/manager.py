@@ -80,7 +80,7 @@ class NetSimManager:
         self._response_cls = message_class("NetSimManagerResponse")
         # the status values, looked up once (each enum attribute access is a Python __getattr__)
         status = status_enum()
-        self._accepted = status.UPDATE_ACCEPTED
+        self.accepted = status.UPDATE_ACCEPTED
         self._invalid_port = status.UPDATE_FAILED_INVALID_MODEM_TCP_PORT
         self._invalid_source = status.UPDATE_FAILED_INVALID_SOURCE_ADDRESS
         self._out_of_region = status.UPDATE_FAILED_OUT_OF_DEFINED_REGION
@@ -109,10 +109,10 @@ class NetSimManager:
 
     def handle_request(self, request: Message, peer_ip: str) -> RequestOutcome:
         outcome = RequestOutcome(self._response_cls(request_id=request.id))
-        result = self._accepted
+        result = self.accepted
         for nav in request.nav:
             result = self._check_nav(nav, peer_ip)
-            if result != self._accepted:
+            if result != self.accepted:
                 break
             if all(map(nav.HasField, NAV_FIELDS)):
                 update = self._env_nav_cls(
@@ -135,13 +135,19 @@ class NetSimManager:
         return outcome
 
     def _check_nav(self, nav: Message, peer_ip: str) -> int:
-        pair = self._pairs.get(nav.modem_tcp_port)
+        return self.check_position(nav.modem_tcp_port, nav.lat, nav.lon, nav.depth, peer_ip)
+
+    def check_position(
+        self, modem_tcp_port: int, lat: float, lon: float, depth: float, peer_ip: str
+    ) -> int:
+        """The status a NavUpdate with these values from `peer_ip` gets (the checks of
+        `handle_request`, for a caller with positions that are not messages)."""
+        pair = self._pairs.get(modem_tcp_port)
         if pair is None:
             return self._invalid_port
         if peer_ip != pair.endpoint_ip_address:
             return self._invalid_source
         bounds = self._bounds[pair.environment_id]
-        lat, lon, depth = nav.lat, nav.lon, nav.depth
         if self.config.reject_nonfinite_position and not (
             math.isfinite(lat) and math.isfinite(lon) and math.isfinite(depth)
         ):
@@ -155,7 +161,7 @@ class NetSimManager:
             or depth > bounds.depth_max
         ):
             return self._out_of_region
-        return self._accepted
+        return self.accepted
 
     def connection(self, peer_address: str) -> ManagerConnection:
         return ManagerConnection(self, peer_address)

@@ -4,7 +4,9 @@
 stack a vehicle runs — a Micro-Modem emulator (`MicroModemModel`) on the netsim physics
 (`PhysicsChannel`), the Micro-Modem driver (`MMDriver`), the TDMA `MACManager` and a
 `QueueManager` with the vehicle's `NodeStatus` messages (DCCL) — and a `NetSimManager` that
-receives the scripted tracks as NavUpdates and feeds the channel its positions.
+feeds the channel the positions it accepts. Scripted tracks are posted to it as NavUpdates in
+real-time runs (`post_positions`); discrete-event runs, where nobody else talks to it, put them
+straight into the channel after the manager's checks (`set_positions`: same positions).
 
 Everything shares one Clock. `run_virtual()` drives a `VirtualClock` as a discrete-event
 simulation: the sans-I/O cores are connected in memory (`ModemLink`: the driver's sentences go
@@ -207,14 +209,16 @@ class Simulation:
     def queue_status(self, node: SimNode) -> None:
         assert node.queue is not None
         now = self.clock.now()
-        nav = self.manager.position(node.port)
-        if nav is None:
+        # (the channel's latest position: every position the manager accepts, scripted or
+        # from a vehicle simulator, goes there)
+        reported = self.channel.position(node.port)
+        if reported is None:
             return
-        position = Position.from_nav(nav).at(now)
+        position = reported.at(now)
         status = self.status_class(
             src=node.modem_id, dest=self.scenario.traffic.status_dest, time=now,
             lat=position.lat, lon=position.lon, depth=max(position.depth, 0.0),
-            speed=min(nav.speed, 10.0), heading=nav.heading % 360.0,
+            speed=min(reported.speed, 10.0), heading=reported.heading % 360.0,
         )  # fmt: skip
         node.queue.push_message(status)
         self.status_sent += 1
@@ -247,23 +251,37 @@ class Simulation:
 
     # -- positions -------------------------------------------------------------------------------
 
-    def post_positions(self) -> None:
-        """One NetSimManagerRequest with every tracked node's position now."""
+    def track_positions(self) -> list[tuple[int, Position]]:
+        """(modem port, position now) of every node with a scripted track."""
         now = self.clock.now()
+        elapsed = now - self.start
+        return [(n.port, n.track.position(elapsed, now)) for n in self.nodes if n.track is not None]
+
+    def post_positions(self) -> None:
+        """One NetSimManagerRequest with every tracked node's position now (what a vehicle
+        simulator sends: real-time runs, where others talk to the same manager)."""
         request = request_class()(id=self._request_id)
         self._request_id = (self._request_id + 1) % 2**31
-        for node in self.nodes:
-            if node.track is None:
-                continue
-            p = node.track.position(now - self.start, now)
+        for port, p in self.track_positions():
             request.nav.add(
-                modem_tcp_port=node.port, time=now, lat=p.lat, lon=p.lon, depth=p.depth,
+                modem_tcp_port=port, time=p.time, lat=p.lat, lon=p.lon, depth=p.depth,
                 speed=p.speed, heading=p.heading,
             )  # fmt: skip
         if request.nav:
             outcome = self.manager.handle_request(request, LOCAL_IP)
             if outcome.response.status != outcome.response.UPDATE_ACCEPTED:
                 log.warning("scripted positions refused: %s", outcome.response)
+
+    def set_positions(self) -> None:
+        """The positions `post_positions` sends, straight into the channel (discrete-event
+        runs, where nobody else talks to the manager): what the manager would forward to it,
+        after the manager's own checks and without the messages."""
+        for port, p in self.track_positions():
+            status = self.manager.check_position(port, p.lat, p.lon, p.depth, LOCAL_IP)
+            if status != self.manager.accepted:
+                log.warning("scripted positions refused: port %d: status %d", port, status)
+                return  # the manager stops at the first refused position of a request
+            self.channel.update_position(port, p)
 
     def summary(self) -> RunSummary:
         return RunSummary(
@@ -293,7 +311,7 @@ class Simulation:
         clock = self.clock
         self._wall_start = time.perf_counter()
         end = self.start + self.scenario.duration if until is None else until
-        self.post_positions()
+        self.set_positions()
         self.build_virtual()
         self._start_drivers(clock)
         self.start_macs()
@@ -314,7 +332,7 @@ class Simulation:
             clock.set(max(t, now))
             now = clock.now()
             if now >= next_position:
-                self.post_positions()
+                self.set_positions()
                 next_position += period
             self.physics.do_work()
             every = now >= next_housekeeping

@@ -202,6 +202,10 @@ class Channel:
         """Listener for `NetSimManager.on_nav` (an EnvironmentNavUpdate)."""
         self.update_position(update.nav.modem_tcp_port, Position.from_nav(update.nav))
 
+    def position(self, port: int) -> Position | None:
+        """The last position reported for a node, however old."""
+        return self._positions.get(port)
+
     def remove_node(self, port: int) -> None:
         self._positions.pop(port, None)
 
