@@ -150,3 +150,29 @@ async def test_exit_on_error_stops_the_process_with_status_1(tmp_path):
     assert b"INTERFACE_HELM_ERROR with exit_on_error: true" in output
     assert recorder.values("IFS_NODE_STATUS")  # it ran (LISTEN) before the helm timeout
     assert recorder.values("IFS_STATUS") == []
+
+
+def test_the_example_mission_reads():
+    cfg = iFrontSeat.read_config(MissionFile.read(REPO / "examples/frontseat/abc_auv.moos"),
+                                 "iFrontSeat")  # fmt: skip
+    assert cfg.driver_library == "abc" and cfg.legacy_cfg.publish_fs_bs_ready
+    sim = cfg.frontseat_cfg.Extensions[m.BASIC_SIMULATOR_CONFIG]
+    assert (sim.tcp_port, sim.start.lat) == (54321, 44.0888889)
+
+
+async def test_the_example_demo_converges():
+    process = await asyncio.create_subprocess_exec(
+        sys.executable, str(REPO / "examples/frontseat/run_demo.py"), "--warp", "10",
+        "--duration", "15", stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.STDOUT,
+    )  # fmt: skip
+    try:
+        async with asyncio.timeout(60):
+            output, _ = await process.communicate()
+    finally:
+        if process.returncode is None:
+            process.kill()
+    assert process.returncode == 0, output.decode()
+    last = output.decode().splitlines()[-1].split()
+    # "<t>s COMMAND 90 1.5 10.0  90.0 1.50 10.0  x y": on the helm's course, heading east
+    assert last[1:8] == ["COMMAND", "90", "1.5", "10.0", "90.0", "1.50", "10.0"]
+    assert float(last[8]) > 5.0

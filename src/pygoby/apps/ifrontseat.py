@@ -137,6 +137,8 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
             self.interface = load_driver(driver, self._frontseat_cfg(), self.clock)
         except (TranslatorError, DriverLoadError) as err:
             raise ConfigError(str(err)) from None
+        # the driver's log lines (state changes, link trouble) go to the app's log
+        self.interface.log = self.log.getChild(type(self.interface).__name__)
         self.log.info("frontseat driver %s (%s)", driver, type(self.interface).__name__)
         self.origin = (
             self.common.lat_origin if self.common.HasField("lat_origin") else math.nan,
