@@ -45,12 +45,20 @@ from pygoby.frontseat.legacy import (
     nav_posts,
     ready_posts,
 )
-from pygoby.frontseat.plugins import DriverLoadError, driver_name_from, find_driver, load_driver
+from pygoby.frontseat.plugins import (
+    DRIVER_ENV_VAR,
+    DriverLoadError,
+    driver_name_from,
+    find_driver,
+    load_driver,
+)
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import ConfigError, read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import (
+    LAT_ORIGIN_VAR,
+    LONG_ORIGIN_VAR,
     TranslatorError,
     moos_technique_from_config,
     parse_for_moos,
@@ -58,9 +66,7 @@ from pygoby.moos.translator import (
 )
 from pygoby.protobuf import default_loader
 
-DRIVER_ENV = "IFRONTSEAT_DRIVER_LIBRARY"
 HELM_STATE_VAR = "IVPHELM_STATE"
-LAT_ORIGIN_VAR, LONG_ORIGIN_VAR = "LAT_ORIGIN", "LONG_ORIGIN"
 LEGACY_BLACKOUT = 1.0  # s, goby3's registration interval for the DESIRED_* and CTD_* variables
 
 # The Goby 2 ABC driver's block, `[abc_config] { ... }` directly in the ProcessConfig.
@@ -88,7 +94,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
     def main(cls, argv: Sequence[str] | None = None, prog: str | None = None) -> int:
         """As goby3, the driver named in the environment is loaded before the options are
         read (its configuration extension then parses and shows in --example_config)."""
-        name = os.environ.get(DRIVER_ENV)
+        name = os.environ.get(DRIVER_ENV_VAR)
         if name:
             try:
                 find_driver(name)
