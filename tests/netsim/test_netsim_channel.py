@@ -166,7 +166,9 @@ def test_a_stale_position_is_logged_once_per_position(caplog):
         ch.transmit(Transmission(1, T0 + 20))
         ch.update_position(2, at(1000, time=T0 + 25))  # fresh again: heard, nothing logged
         assert [port for port, _ in ch.transmit(Transmission(1, T0 + 30))] == [2]
-    assert len(caplog.records) == 2 and "position_staleness = 60 s" in caplog.records[1].getMessage()
+    assert (
+        len(caplog.records) == 2 and "position_staleness = 60 s" in caplog.records[1].getMessage()
+    )
 
 
 def test_transmission_in_the_past_of_a_poll_is_refused():
@@ -253,6 +255,28 @@ def test_synthesized_receive_statistics():
         modem_tcp_port=3, tx_modem_tcp_port=1, packet_success=False, mm_stats=stats
     )
     assert push.IsInitialized()
+
+
+def test_link_statistics_of_recurring_levels_are_computed_the_same():
+    """The integer fields of a link's levels are remembered; the Doppler (which keeps the sign
+    of a zero) is not."""
+    from pygoby.netsim.channel import stats
+
+    ch = channel({1: at(0), 2: at(1000)})
+    ch.transmit(Transmission(1, T0))
+    (reception,) = ch.poll(T0 + 20)
+    stats._level_statistics.cache_clear()
+    first = stats.link_statistics(reception)
+    for closing in (0.0, -0.0, -0.04, 1.26, 7.0):
+        moving = dataclasses.replace(reception, closing_speed=closing)
+        again = stats.link_statistics(moving)
+        assert stats._level_statistics.cache_info().misses == 1
+        doppler = min(max(round(closing, 1), -3.0), 3.0)
+        assert again == {**first, "doppler": doppler}
+        assert list(again) == list(first)  # $CACST order
+        assert str(again["doppler"]) == str(doppler)  # -0.0 stays -0.0
+    again["snr_in"] = 99  # the caller's own dict
+    assert stats.link_statistics(reception) == first
 
 
 def test_protocol_model_ranges_and_collisions():

@@ -322,6 +322,18 @@ def test_position_dead_reckons_on_the_ellipsoid():
     assert azimuth % 360 == pytest.approx(200.0, abs=1e-3)
 
 
+def test_remembered_geodesics_are_the_geodesics():
+    a, b = geometry.Position(42.0, -70.0, 5.0), geometry.Position(42.01, -69.99, 30.0)
+    geometry._geodesics.clear()
+    azimuth, _, distance = geometry.WGS84.inv(a.lon, a.lat, b.lon, b.lat)
+    assert geometry.horizontal_range(a, b) == geometry.horizontal_range(a, b) == (distance, azimuth)
+    assert len(geometry._geodesics) == 1
+    # a zero coordinate is not remembered: -0.0 would share its key
+    on_equator = geometry.Position(0.0, -70.0, 5.0)
+    assert geometry.horizontal_range(a, on_equator)[0] > 0
+    assert len(geometry._geodesics) == 1
+
+
 @_cases(P["doppler"])
 def test_doppler(case):
     f = geometry.doppler_frequency(case["f_tx"], case["v_closing"], case["c"])

@@ -52,8 +52,23 @@ def dead_reckoning_offset(speed: float, heading_deg: float, dt: float) -> tuple[
 
 def horizontal_range(a: Position, b: Position) -> tuple[float, float]:
     """(distance m, azimuth deg from a to b) along the WGS-84 geodesic."""
-    azimuth, _, distance = WGS84.inv(a.lon, a.lat, b.lon, b.lat)
-    return distance, azimuth
+    ends = (a.lon, a.lat, b.lon, b.lat)
+    known = _geodesics.get(ends)
+    if known is not None:
+        return known
+    azimuth, _, distance = WGS84.inv(*ends)
+    result = (distance, azimuth)
+    # Fixed nodes ask for the same geodesics again and again: remembered (not with a zero
+    # coordinate, whose key would be shared by -0.0).
+    if 0.0 not in ends:
+        if len(_geodesics) >= _GEODESICS_LIMIT:
+            _geodesics.clear()
+        _geodesics[ends] = result
+    return result
+
+
+_geodesics: dict[tuple[float, float, float, float], tuple[float, float]] = {}
+_GEODESICS_LIMIT = 8192
 
 
 def slant_range(a: Position, b: Position) -> float:

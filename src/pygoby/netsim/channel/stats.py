@@ -6,7 +6,7 @@ These are modelling choices, not measured modem behaviour.
 
 from __future__ import annotations
 
-from functools import cache
+from functools import cache, lru_cache
 
 from google.protobuf.message import Message
 
@@ -77,19 +77,35 @@ def link_statistics(
     None if the modem reports nothing for it (see `receive_statistics`)."""
     if reception.outcome in (Outcome.NOT_DETECTED, Outcome.RECEIVER_BUSY):
         return None
-    snr = reception.sinr
+    fields = dict(
+        _level_statistics(
+            reception.sinr, reception.received_level, reception.noise_level, carrier_hz,
+            bandwidth_hz,
+        )
+    )  # fmt: skip
+    fields["doppler"] = min(max(round(reception.closing_speed, 1), -3.0), 3.0)
+    return fields
+
+
+# A link's levels recur (fixed nodes, steady noise): their integer fields are computed once.
+# (Every field here is rounded to an integer, so a key of -0.0 and 0.0 give the same values;
+# the Doppler, which keeps the sign of a zero, is computed every time.)
+@lru_cache(maxsize=4096)
+def _level_statistics(
+    snr: float, received_level: float, noise_level: float, carrier_hz: float, bandwidth_hz: float
+) -> dict[str, float]:
     return dict(
         mfd_power=_clamp(snr / 2, -30, 40),
         mfd_ratio=_clamp(10 ** (min(snr, 40) / 10) * 10, 0, 16383),
-        spl=round(reception.received_level),
-        snr_rss=_clamp(reception.received_level - reception.noise_level, 0, 255),
+        spl=round(received_level),
+        snr_rss=_clamp(received_level - noise_level, 0, 255),
         snr_in=_clamp(snr, -10, 30),
         snr_out=_clamp(snr + 10, 0, 25),
         snr_symbols=_clamp(snr + 10, 0, 30),
         mse_equalizer=_clamp(-snr, -30, 5),
         data_quality_factor=_clamp(snr * 10, 0, 255),
-        doppler=min(max(round(reception.closing_speed, 1), -3.0), 3.0),
-        stddev_noise=_clamp(reception.noise_level - 40, 0, 255),
+        doppler=0.0,  # (set by link_statistics: keeps the fields in $CACST order)
+        stddev_noise=_clamp(noise_level - 40, 0, 255),
         carrier_freq=_clamp(carrier_hz, 100, 30000),
         bandwidth=_clamp(bandwidth_hz, 1000, 5000),
     )
