@@ -5,9 +5,10 @@ goby-moos-apps.md 5.9 "typical session").
 The helm's DESIRED_* reach the simulator, whose vehicle converges on them, and its NAV comes
 back as NAV_* and IFS_NODE_STATUS. Faults: the simulator goes away (FS_ERROR, NOT_CONNECTED)
 and comes back (STANDBY -> LISTEN -> COMMAND); the mission ends and NAV stops (FS_ERROR,
-NOT_PROVIDING_DATA) until a new START; the helm parks or another process claims
-IVPHELM_STATE (HELM_ERROR); garbage from the simulator is skipped. The simulator's received
-lines show that no command is sent outside INTERFACE_COMMAND."""
+NOT_PROVIDING_DATA) until a new START; the helm parks, another process claims IVPHELM_STATE,
+or the helm falls silent past helm_state_timeout (HELM_ERROR); garbage from the simulator is
+skipped. The simulator's received lines show that no command is sent outside
+INTERFACE_COMMAND."""
 
 from __future__ import annotations
 
@@ -41,6 +42,7 @@ ProcessConfig = iFrontSeat
   driver_library: "basic_simulator"
   frontseat_cfg {{
     helm_running_timeout: 100
+    helm_state_timeout: 5
     status_period: 1
     [goby.middleware.frontseat.protobuf.basic_simulator_config] {{
       tcp_address: "127.0.0.1"
@@ -113,11 +115,15 @@ class ScriptedHelm:
                 self.client.publish(var, value)
             await asyncio.sleep(0.1)
 
-    async def close(self) -> None:
+    async def stop_posting(self) -> None:
         if self.task is not None:
             self.task.cancel()
             with contextlib.suppress(asyncio.CancelledError):
                 await self.task
+            self.task = None
+
+    async def close(self) -> None:
+        await self.stop_posting()
         await self.client.close()
 
 
@@ -214,6 +220,17 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
         await until(lambda: in_state(m.INTERFACE_HELM_ERROR))
         assert interface.status().helm_error == m.ERROR_HELM_NOT_RUNNING
         await until(lambda: in_state(m.INTERFACE_COMMAND))  # the helm's next post
+
+        # The helm hangs (no more posts): HELM_ERROR after helm_state_timeout (5 s warped), no
+        # command goes out meanwhile; when it posts again: back to COMMAND.
+        await helm.stop_posting()
+        sent = len(simulator.sim.commands())
+        await until(lambda: in_state(m.INTERFACE_HELM_ERROR))
+        assert interface.status().helm_error == m.ERROR_HELM_NOT_RUNNING
+        assert interface.helm_state == m.HELM_NOT_RUNNING
+        assert len(simulator.sim.commands()) == sent
+        helm.run()
+        await until(lambda: in_state(m.INTERFACE_COMMAND))
 
         # The simulator goes away: FS_ERROR (not connected); it comes back on the same port:
         # STANDBY -> LISTEN -> COMMAND, and the new vehicle is driven to the helm's course.

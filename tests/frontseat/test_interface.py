@@ -529,3 +529,32 @@ def test_random_sequences_respect_command_and_error_exits(require_helm, steps) -
             assert raised is not None  # only a driver report moves between error states
         assert driver.changes == [] or driver.changes[-1].state == after
         driver.changes.clear()
+
+
+def test_helm_state_timeout_off_by_default_keeps_a_silent_drive_helm() -> None:
+    driver = make()  # Q24 reproduced: no staleness without the pygoby option
+    bring_to(driver, "COMMAND")
+    tick(driver, at=3600)
+    assert (driver.state, driver.helm_state) == (COMMAND, DRIVE)
+
+
+def test_helm_state_timeout_turns_a_silent_helm_into_helm_error() -> None:
+    driver = make(helm_state_timeout=5)
+    bring_to(driver, "COMMAND")
+    driver.clock.set(START + 4)
+    tick(driver, helm=DRIVE)  # a post (same state) restarts the timeout
+    tick(driver, at=9)
+    assert (driver.state, driver.helm_state) == (COMMAND, DRIVE)
+    tick(driver, at=9.01)
+    assert (driver.state, driver.helm_state) == (HELM_ERROR, NOT_RUNNING)
+    assert errors(driver) == (HELM_NOT_RUNNING_ERR, None)
+    driver.clock.set(START + 10)
+    tick(driver, helm=DRIVE)  # the helm is back: T7
+    assert driver.state == STANDBY
+
+
+def test_helm_state_timeout_without_require_helm_only_forgets_the_state() -> None:
+    driver = make(helm_state_timeout=5, require_helm=False)
+    bring_to(driver, "COMMAND")
+    tick(driver, at=6)
+    assert (driver.state, driver.helm_state) == (COMMAND, NOT_RUNNING)

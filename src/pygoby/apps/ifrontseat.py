@@ -268,7 +268,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         if state != current:
             self.log.info("helm state %s -> %s (%s=%r from %s)", m.HelmState.Name(current),
                           m.HelmState.Name(state), msg.key, msg.string, msg.src)  # fmt: skip
-            self.interface.set_helm_state(state)
+        self.interface.set_helm_state(state)  # every post counts for helm_state_timeout
 
     def _on_origin(self, msg: MOOSMessage) -> None:
         if not msg.is_double or not math.isfinite(msg.dval):

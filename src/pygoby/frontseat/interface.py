@@ -16,6 +16,10 @@ State machine (spec 5.3), run by `do_work()` before the driver's `loop()`:
   the last frontseat error is gone (T8); an IGNORING_COMMANDS error has no automatic exit;
 * a driver raising `FrontSeatException` from `loop()` forces the matching error state (T9).
 
+goby3 keeps the helm's last reported state with no timeout (Quirk Q24, the default here too).
+The pygoby option `helm_state_timeout` (> 0) turns a helm that has not reported for that long
+into NOT_RUNNING before the check, so a helm that dies in DRIVE leads to HELM_ERROR (E2).
+
 When the transition check enters an error state, `loop()` is skipped for that tick. Each error
 code is kept until its own exit (T7 clears the helm error, T8 the frontseat error), as goby3 does:
 so after a T9 jump from one error state to the other, `status()` can carry both codes.
@@ -160,6 +164,7 @@ class InterfaceBase(abc.ABC):
 
         self._state: int = INTERFACE_STANDBY
         self._helm_state: int = HELM_NOT_RUNNING
+        self._helm_heard_at = self.start_time  # last set_helm_state(), for helm_state_timeout
         self._last_helm_error: int = ERROR_HELM_NONE
         self._last_frontseat_error: int = ERROR_FRONTSEAT_NONE
 
@@ -222,7 +227,10 @@ class InterfaceBase(abc.ABC):
         return self._helm_state
 
     def set_helm_state(self, state: int) -> None:
+        """The helm's state from its latest post; call it for every post, changed or not (each
+        one restarts the `helm_state_timeout` clock)."""
         self._helm_state = state
+        self._helm_heard_at = self.clock.now()
 
     def status(self) -> Any:
         status = InterfaceStatus(
@@ -295,6 +303,7 @@ class InterfaceBase(abc.ABC):
         """One tick: the transition check, then the driver's loop() unless the check has just
         entered an error state. Raises FrontSeatFatalError in an error state if
         `exit_on_error` is set (after the state change was signalled)."""
+        self._expire_helm_state()
         if not self._check_change_state():
             try:
                 self.loop()
@@ -305,6 +314,19 @@ class InterfaceBase(abc.ABC):
                 self._enter_error(exc.helm_error, exc.frontseat_error)
         if self.cfg.exit_on_error and self._state in ERROR_STATES:
             raise FrontSeatFatalError(self.status())
+
+    def _expire_helm_state(self) -> None:
+        timeout = self.cfg.helm_state_timeout
+        if (
+            timeout > 0
+            and self._helm_state != HELM_NOT_RUNNING
+            and self.clock.now() - self._helm_heard_at > timeout
+        ):
+            self.log.warning(
+                "no helm state for %g s (helm_state_timeout): the helm counts as not running",
+                self.clock.now() - self._helm_heard_at,
+            )
+            self._helm_state = HELM_NOT_RUNNING
 
     def _check_change_state(self) -> bool:
         """Applies T1-T8; True when it has just entered an error state (loop() is skipped)."""
