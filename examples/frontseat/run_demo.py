@@ -51,7 +51,9 @@ async def helm(client: MOOSClient, clock, start: float, period: float) -> None:
         await asyncio.sleep(period)
 
 
-async def demo(warp: float, duration: float) -> None:
+async def demo(warp: float, duration: float) -> bool:
+    """Runs the demo; True when the interface ends in COMMAND with the vehicle on the helm's
+    current course (what `make demo` checks)."""
     clock = moos_clock(warp)
     async with contextlib.AsyncExitStack() as stack:
         simulator = SimulatorServer(0, host="127.0.0.1")
@@ -94,15 +96,29 @@ async def demo(warp: float, duration: float) -> None:
                   f"{nav[0]:7.1f} {nav[1]:4.2f} {nav[2]:5.1f}   {nav[3]:8.1f} {nav[4]:8.1f}")  # fmt: skip
             await asyncio.sleep(3.0 / warp)
 
+        heading, speed, depth = leg_at(clock.now() - start)
+        on_course = (
+            abs(latest.get("NAV_HEADING", float("nan")) - heading) < 1.0
+            and abs(latest.get("NAV_SPEED", float("nan")) - speed) < 0.05
+            and abs(latest.get("NAV_DEPTH", float("nan")) - depth) < 0.5
+        )
+        in_command = app.interface.state == m.INTERFACE_COMMAND
+        print(
+            "iFrontSeat demo: "
+            + ("OK, the vehicle follows the helm in COMMAND" if in_command and on_course
+               else "FAILED: the vehicle is not on the helm's course in COMMAND")
+        )  # fmt: skip
+        return in_command and on_course
 
-def main() -> None:
+
+def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--warp", type=float, default=5.0, help="MOOS time warp (default 5)")
     parser.add_argument("--duration", type=float, default=90.0, help="warped seconds (default 90)")
     args = parser.parse_args()
     logging.basicConfig(level=logging.ERROR)  # the simulator's and links' chatter
-    asyncio.run(demo(args.warp, args.duration))
+    return 0 if asyncio.run(demo(args.warp, args.duration)) else 1
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -172,7 +172,9 @@ async def test_the_example_demo_converges():
         if process.returncode is None:
             process.kill()
     assert process.returncode == 0, output.decode()
-    last = output.decode().splitlines()[-1].split()
+    *table, verdict = output.decode().splitlines()
+    assert verdict == "iFrontSeat demo: OK, the vehicle follows the helm in COMMAND"
+    last = table[-1].split()
     # "<t>s COMMAND 90 1.5 10.0  90.0 1.50 10.0  x y": on the helm's course, heading east
     assert last[1:8] == ["COMMAND", "90", "1.5", "10.0", "90.0", "1.50", "10.0"]
     assert float(last[8]) > 5.0
