@@ -250,6 +250,19 @@ def test_malformed_and_bad_checksum_lines_are_logged_and_skipped(caplog):
     assert h.driver.startup_complete and h.received == []
 
 
+def test_sentences_without_a_handler_are_skipped_and_garbage_ids_stay_bounded():
+    h = Harness().start()
+    for i in range(300):  # sentence ids nobody handles, most of them garbage
+        h.modem(f"$CA{i:03d},1", "$CARXP,0", "$CATXF,0")
+    assert len(h.driver._handlers) <= 64
+    assert h.driver.startup_complete and h.received == []
+    h.modem("$CACYC,0,3,1,1,0,1", "$CARXD,3,1,0,1,c0ffee")  # handled ones still are
+    h.modem(
+        "$CACST,0,221330.6675,0,1000,29,16383,134,250,0,0,0,0,0,3,1,0,1,1,0,58,30,25,30,-30,255,0.0,36,25000,5000"
+    )
+    assert [bytes(f) for f in h.received[0].frame] == [bytes.fromhex("c0ffee")]
+
+
 def test_caerr_nmea_fails_outstanding_and_keep_alive():
     h = Harness().start()
     h.clock.advance(10.5)

@@ -10,9 +10,11 @@ from hypothesis import strategies as st
 from pygoby.acomms import messages as m
 from pygoby.acomms.drivers.micromodem.statistics import (
     add_cst,
+    cst_head,
     cst_text,
     format_cst,
     parse_cst,
+    parse_toa,
 )
 from pygoby.util.nmea import NMEAFormatError, NMEASentence, with_checksum
 
@@ -123,3 +125,20 @@ def test_add_cst_warns_about_every_short_sentence(caplog):
         add_cst(stats, short, DAY)
     assert caplog.text.count("stopped at rate") == 2
     assert stats[1] == parse_cst(short, DAY)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.one_of(st.integers(0, 2**33 * 10**6 - 1), st.integers(1_600_000_000 * 10**6, 2 * 10**15)))
+def test_cst_head_prints_the_utc_time_of_day(time_us):
+    toa = dt.datetime.fromtimestamp(time_us / 1e6, dt.UTC)
+    expected = f"$CACST,1,{toa:%H%M%S}.{toa.microsecond // 100:04d},"
+    assert cst_head(1, time_us) == expected
+    assert cst_head(1, float(time_us)) == expected  # (a float time takes the datetime path)
+    day = toa.date()
+    assert parse_toa(expected.split(",")[2], day) == time_us - time_us % 100
+
+
+@pytest.mark.parametrize("text", ["240000.0", "236000", "225960.5", "12345", "1234567", "12a456"])
+def test_parse_toa_refuses_what_is_not_a_time_of_day(text):
+    with pytest.raises(ValueError):
+        parse_toa(text, DAY)

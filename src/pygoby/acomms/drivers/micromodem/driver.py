@@ -37,6 +37,8 @@ HYDROID_GPS_REQUEST_INTERVAL = 30.0
 FDP_MAX_FRAME_BYTES = 100
 
 Status = m.ModemDriverStatus
+_UNKNOWN = object()  # a sentence id not looked up yet
+_MAX_REMEMBERED_IDS = 64  # sentence ids remembered with their handler (or lack of one)
 
 
 class Phase(Enum):
@@ -58,7 +60,7 @@ class MMDriver(ModemDriverBase):
         self.app_acks: ApplicationAcks | None = None
         self.nvram: dict[str, int] = {}
         self.revision: tuple[int, int, int] = (0, 0, 0)
-        self._handlers: dict[str, Callable[[NMEASentence], None]] = {}  # by sentence id
+        self._handlers: dict[str, Callable[[NMEASentence], None] | None] = {}  # by sentence id
         self._reset_state()
 
     def _reset_state(self) -> None:
@@ -324,13 +326,15 @@ class MMDriver(ModemDriverBase):
 
     def _dispatch(self, s: NMEASentence) -> None:
         sentence_id = s.sentence_id
-        handler = self._handlers.get(sentence_id)
-        if handler is None:
+        handler = self._handlers.get(sentence_id, _UNKNOWN)
+        if handler is _UNKNOWN:
             handler = getattr(self, "_on_" + sentence_id.lower(), None)
-            if handler is None:
-                return
-            self._handlers[sentence_id] = handler  # only real handlers: garbage ids stay out
-        handler(s)
+            # sentences without a handler ($CARXP, $CATXF, ...) are remembered too, up to a
+            # bound (so that garbage ids cannot grow the table)
+            if handler is not None or len(self._handlers) < _MAX_REMEMBERED_IDS:
+                self._handlers[sentence_id] = handler
+        if handler is not None:
+            handler(s)
 
     def _on_rev(self, s: NMEASentence) -> None:
         if s[2] == "INIT":

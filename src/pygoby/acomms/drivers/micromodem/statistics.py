@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as m
-from pygoby.util.nmea import NMEAFormatError, NMEASentence, parse_int, parse_ints
+from pygoby.util.nmea import NMEAFormatError, NMEASentence, parse_ints
 
 log = logging.getLogger(__name__)
 
@@ -36,8 +36,10 @@ def parse_toa(text: str, today: dt.date) -> int:
     whole, _, frac = text.partition(".")
     if len(whole) != 6 or not whole.isdigit() or (frac and not frac.isdigit()):
         raise NMEAFormatError(f"bad time of arrival {text!r}")
-    hour, minute, second = parse_int(whole[:2]), parse_int(whole[2:4]), parse_int(whole[4:6])
-    dt.time(hour, minute, second)  # the range checks (ValueError) of a datetime, without one
+    hour, minute_second = divmod(int(whole), 10000)  # (one int() instead of three)
+    minute, second = divmod(minute_second, 100)
+    if hour > 23 or minute > 59 or second > 59:
+        dt.time(hour, minute, second)  # the ValueError a datetime would raise
     day = today.toordinal() - _EPOCH_ORDINAL
     seconds = day * 86400 + hour * 3600 + minute * 60 + second
     micros = int(round(float("0." + frac) * 1e6)) if frac else 0
@@ -157,11 +159,22 @@ def cst_text(stat, version: int = 0) -> str:
 def cst_head(mode: int, time: int, version: int = 0) -> str:
     """The start of a $CACST text, up to the comma after the time of arrival (`time`, in
     microseconds since the epoch): the part that changes with every packet."""
-    toa = dt.datetime.fromtimestamp(time / 1e6, dt.UTC)
+    if type(time) is int and 0 <= time < _EXACT_TIME_LIMIT:
+        # what the datetime below gives, in integers (time / 1e6 is within 0.5 us of the
+        # exact value up to 2**33 s, so datetime's rounding gives back `time` exactly)
+        seconds, micros = divmod(time, 1_000_000)
+        minutes, second = divmod(seconds, 60)
+        hours, minute = divmod(minutes, 60)
+        hour = hours % 24
+    else:
+        toa = dt.datetime.fromtimestamp(time / 1e6, dt.UTC)
+        hour, minute, second, micros = toa.hour, toa.minute, toa.second, toa.microsecond
     return _CST_HEAD % (
-        f"{version:d}," if version >= 6 else "", mode,
-        toa.hour, toa.minute, toa.second, toa.microsecond // 100,
+        f"{version:d}," if version >= 6 else "", mode, hour, minute, second, micros // 100,
     )  # fmt: skip
+
+
+_EXACT_TIME_LIMIT = 2**33 * 1_000_000  # us (year 2242)
 
 
 def cst_tail(stat) -> str:
