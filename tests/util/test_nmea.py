@@ -141,6 +141,28 @@ def test_checksum_of_parts_is_the_checksum_of_the_whole(head, tail):
     assert with_checksum_of_parts(head, tail, checksum(tail)) == with_checksum(head + tail)
 
 
+@pytest.mark.parametrize(
+    "line, start, stop",
+    [("$CCCYC,0,1,2,x,1,1", 2, 7), ("$CCCYC,0,1,2", 2, 7), ("$CCCYC,0,1,2,3.5,1", 1, 5)],
+)
+def test_as_ints_gives_the_error_of_the_first_bad_field(line, start, stop):
+    sentence = NMEASentence.parse(line)
+    with pytest.raises(NMEAFormatError) as expected:
+        [sentence.as_int(i) for i in range(start, stop)]
+    with pytest.raises(
+        NMEAFormatError, match=str(expected.value).replace("$", r"\$").replace("*", r"\*")
+    ):
+        sentence.as_ints(start, stop)
+
+
+def test_as_ints_and_the_remembered_message():
+    sentence = NMEASentence.parse("$CCCYC,0,1,2,0,1,1")
+    assert sentence.as_ints(1, 7) == [0, 1, 2, 0, 1, 1] and sentence.as_ints(5, 5) == []
+    assert sentence.message() == sentence.message() == "$CCCYC,0,1,2,0,1,1*5A"  # spec example
+    assert sentence == NMEASentence.parse("$CCCYC,0,1,2,0,1,1*5A")  # the kept text is no field
+    assert hash(sentence) == hash(NMEASentence(sentence.fields))
+
+
 def test_a_recurring_line_parses_the_same_and_a_bad_one_fails_every_time():
     first = NMEASentence.parse("$CARXP,0*44\r\n")
     assert NMEASentence.parse("$CARXP,0*44\r\n") == first == NMEASentence.parse(" $CARXP,0*44")

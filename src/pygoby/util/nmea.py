@@ -134,6 +134,17 @@ class NMEASentence:
                 f"field {index} of {self.message()!r} is not an integer"
             ) from None
 
+    def as_ints(self, start: int, stop: int) -> list[int]:
+        """Fields `start` to `stop - 1` as integers, with the error `as_int` gives for the
+        first one that is missing or not a number (one C-level pass when all are known)."""
+        texts = self.fields[start:stop]
+        if len(texts) == stop - start:
+            try:
+                return parse_ints(texts)
+            except ValueError:
+                pass
+        return [self.as_int(i) for i in range(start, stop)]
+
     def as_float(self, index: int) -> float:
         try:
             return float(self.fields[index])
@@ -145,7 +156,12 @@ class NMEASentence:
 
     def message(self) -> str:
         """The sentence with its checksum, without a line terminator."""
-        return with_checksum(",".join(self.fields))
+        # made once per sentence (immutable; recurring ones are shared): kept beside the fields
+        # (in __dict__, so equality, hashing and repr do not see it)
+        text = self.__dict__.get("_message")
+        if text is None:
+            text = self.__dict__["_message"] = with_checksum(",".join(self.fields))
+        return text
 
 
 # Sentences are immutable and many lines recur verbatim (`$CARXP,0`, `$CACYC,...` for each

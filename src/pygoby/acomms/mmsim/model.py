@@ -140,7 +140,7 @@ class MicroModemModel:
         self._say("$CAMSC", s[1], s[2], s[3])
 
     def _cmd_clk(self, s: NMEASentence) -> None:
-        given = dt.datetime(*map(s.as_int, range(1, 7)), tzinfo=dt.UTC).timestamp()
+        given = dt.datetime(*s.as_ints(1, 7), tzinfo=dt.UTC).timestamp()
         self._clock_offset = given - math.ceil(self.clock.now())
         t = dt.datetime.fromtimestamp(self.modem_time(), dt.UTC)
         self._say("$CACLK", t.year, t.month, t.day, t.hour, t.minute, t.second)
@@ -158,7 +158,7 @@ class MicroModemModel:
         return f"{t:%Y-%m-%dT%H:%M:%S}.{t.microsecond // 100000}Z"
 
     def _cmd_cyc(self, s: NMEASentence) -> None:
-        adr1, adr2, rate, ack, nframes = map(s.as_int, range(2, 7))
+        adr1, adr2, rate, ack, nframes = s.as_ints(2, 7)
         if not 0 <= rate <= 5:
             self._error("CYC", 5, "Bad rate")
             return

@@ -12,6 +12,7 @@ import base64
 import binascii
 import contextlib
 import datetime as dt
+import functools
 import logging
 from collections import deque
 from collections.abc import Callable
@@ -182,7 +183,7 @@ class MMDriver(ModemDriverBase):
 
     # ------------------------------------------------------------------ outgoing FIFO
     def _push(self, token: str, *values: object) -> None:
-        self._out.append(NMEASentence.build(token, values))
+        self._out.append(_sentence(token, *values))
 
     def _try_write(self, now: float) -> None:
         if not self._out or self._written_at is not None or now < self._hold_until:
@@ -360,7 +361,7 @@ class MMDriver(ModemDriverBase):
 
     def _on_clk(self, s: NMEASentence) -> None:
         if self._outstanding("CLK"):
-            t = dt.datetime(*map(s.as_int, range(1, 7)), tzinfo=dt.UTC)
+            t = dt.datetime(*s.as_ints(1, 7), tzinfo=dt.UTC)
             self._check_clock(t.timestamp(), whole_seconds=True)
 
     def _on_tms(self, s: NMEASentence) -> None:
@@ -417,7 +418,7 @@ class MMDriver(ModemDriverBase):
         return bool(msg.frame) and bool(msg.frame[0])
 
     def _on_cyc(self, s: NMEASentence) -> None:
-        src, dest, rate, ack, nframes = map(s.as_int, range(2, 7))
+        src, dest, rate, ack, nframes = s.as_ints(2, 7)
         if self._outstanding("CYC") and tuple(self._out[0].fields[2:5]) == tuple(s.fields[2:5]):
             return  # the modem's echo of our own $CCCYC
         if src == self.modem_id:
@@ -439,7 +440,7 @@ class MMDriver(ModemDriverBase):
         self._receive = None
 
     def _on_drq(self, s: NMEASentence) -> None:
-        src, dest, ack, nbytes, frame_no = map(s.as_int, range(2, 7))
+        src, dest, ack, nbytes, frame_no = s.as_ints(2, 7)
         index = frame_no - 1
         if 0 <= index < len(self._cached.frame) and self._cached.frame[index]:
             data = bytes(self._cached.frame[index])
@@ -461,7 +462,7 @@ class MMDriver(ModemDriverBase):
             self._transmit = m.ModemTransmission()
 
     def _on_ack(self, s: NMEASentence) -> None:
-        src, dest, frame_no = s.as_int(1), s.as_int(2), s.as_int(3)
+        src, dest, frame_no = s.as_ints(1, 4)
         if dest != self.modem_id or src != self._expected_ack_src:
             return
         goby_frame = frame_no - 1
@@ -493,7 +494,7 @@ class MMDriver(ModemDriverBase):
         return self._receive
 
     def _on_rxd(self, s: NMEASentence) -> None:
-        src, dest, ack, frame_no = map(s.as_int, range(1, 5))
+        src, dest, ack, frame_no = s.as_ints(1, 5)
         data = bytes.fromhex(s[5]) if len(s) > 5 else b""
         rx = self._receiving()
         if frame_no == 1:
@@ -716,6 +717,13 @@ class MMDriver(ModemDriverBase):
         for i in range(1, 5):
             reply.one_way_travel_time.append(s.as_float(i) if s[i] else 0.0)
         self.signal_receive.emit(msg)
+
+
+# The driver sends the same few sentences again and again (keep-alives, cycle-inits, ...): each
+# is built once and shared (sentences are immutable). `typed`: 1, 1.0 and True print differently.
+@functools.lru_cache(maxsize=256, typed=True)
+def _sentence(token: str, *values: object) -> NMEASentence:
+    return NMEASentence.build(token, values)
 
 
 def _iso_time(text: str) -> float:
