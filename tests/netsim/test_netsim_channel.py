@@ -207,6 +207,31 @@ def test_seeded_runs_repeat_exactly_whatever_the_poll_pattern():
     assert _noisy_run(seed=6, poll_step=None) != once
 
 
+def test_frame_draws_come_from_the_documented_generator():
+    """Each reception draws from random.Random("seed:sequence:receiver") (one shared generator,
+    reseeded, must give the same stream), and next_delivery follows the pending receptions."""
+    import random
+
+    ch = channel({1: at(0), 2: at(3900), 3: at(0, 3950), 4: at(2000, 2000)}, seed=9)
+    config = ch.config
+    pending_ends = []
+    for k in range(24):
+        start = T0 + 2.1 * k
+        planned = ch.transmit(Transmission(1 + k % 4, start, rate=1, frames=3))
+        pending_ends += [arrival + 3.25 for _, arrival in planned]
+        assert ch.next_delivery() == pytest.approx(min(pending_ends), abs=1e-9)
+        polled = ch.poll(start)
+        assert len(polled) == sum(end <= start for end in pending_ends)
+        pending_ends = [end for end in pending_ends if end > start]
+        for r in polled:
+            if r.outcome in (Outcome.GOOD, Outcome.BAD_FRAMES):
+                fer = config.error_models.frame_error(r.transmission.rate, r.sinr)
+                rng = random.Random(f"9:{r.sequence}:{r.receiver}")
+                assert r.frames_ok == tuple(rng.random() > fer for _ in range(3))
+    assert ch.poll(T0 + 100)
+    assert ch.next_delivery() is None
+
+
 def test_decode_latency_delays_delivery():
     ch = channel({1: at(0), 2: at(1500)}, decode_latency=0.5)
     ch.transmit(Transmission(1, T0))

@@ -48,14 +48,18 @@ import enum
 import logging
 import math
 import random
-from collections import defaultdict
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from pygoby.netsim.channel.absorption import thorp
 from pygoby.netsim.channel.errors import ProtocolModel, RateErrorModels
 from pygoby.netsim.channel.geometry import Position, arrival_delay, closing_speed, slant_range
-from pygoby.netsim.channel.levels import noise_level_integrated, sinr, transmission_loss
+from pygoby.netsim.channel.levels import (
+    noise_level_integrated,
+    power_sum_db,
+    sinr,
+    transmission_loss,
+)
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, harmonic_mean_speed
 from pygoby.netsim.channel.timing import Interval
 
@@ -190,6 +194,10 @@ class Channel:
         self._horizon = -math.inf  # last poll time
         self._pruned_at = -math.inf
         self._noise_cache: dict[Band, float] = {}
+        self._quiet: dict[float, float] = {}  # noise level -> its power sum alone
+        self._noise_by_port: dict[int, float] = {}
+        self._rng = random.Random()
+        self._earliest_end: float | None = None  # of the pending receptions
         # The stale position last reported per node, so each one is logged once.
         self._stale_reported: dict[int, Position] = {}
 
@@ -259,28 +267,36 @@ class Channel:
         if source is None:
             return []
         source = source.at(tx.start)
-        tx_band = self.config.band_of(tx.source)
-        alpha = self.config.absorption(tx_band.carrier_hz / 1000)
+        config = self.config
+        tx_band = config.band_of(tx.source)
+        alpha = config.absorption(tx_band.carrier_hz / 1000)
+        protocol = config.protocol_model
         planned = []
         for port in sorted(self._positions):
+            if port == tx.source:
+                continue  # (its position was checked above)
             receiver = self._fresh_position(port, tx.start)
-            if port == tx.source or receiver is None:
+            if receiver is None:
                 continue
-            if not tx_band.overlaps(self.config.band_of(port)):
+            if not tx_band.overlaps(config.band_of(port)):
                 continue
             c = self.sound_speed(source.depth, receiver.depth)
-            receiver_now = receiver.at(tx.start)
-            # a receiver that does not move is where it is: the fixed point of arrival_delay is
-            # its first guess (same value, one geodesic instead of five)
-            if self.config.moving_receivers and receiver.speed != 0:
-                delay = arrival_delay(
-                    lambda tau, rx=receiver: slant_range(source, rx.at(tx.start + tau)), c
-                )
+            if receiver.speed != 0:
+                receiver_now = receiver.at(tx.start)
+                if config.moving_receivers:
+                    delay = arrival_delay(
+                        lambda tau, rx=receiver: slant_range(source, rx.at(tx.start + tau)), c
+                    )
+                else:
+                    delay = slant_range(source, receiver_now) / c
             else:
-                delay = slant_range(source, receiver_now) / c
+                # a receiver that does not move is where it is: its reported position gives the
+                # geodesic and closing speed of its dead-reckoned one (only lat, lon and depth
+                # count), and the fixed point of arrival_delay is its first guess
+                receiver_now = receiver
+                delay = slant_range(source, receiver) / c
             arrival = tx.start + delay
             range_m = delay * c
-            protocol = self.config.protocol_model
             if protocol is not None and not protocol.interferes(range_m):
                 continue
             pending = _Pending(
@@ -290,113 +306,156 @@ class Channel:
                 interval=Interval(arrival, arrival + duration),
                 owtt=delay,
                 range_m=range_m,
-                received_level=self.config.source_level
-                - transmission_loss(range_m, alpha, self.config.spreading),
+                received_level=config.source_level
+                - transmission_loss(range_m, alpha, config.spreading),
                 closing_speed=closing_speed(source, receiver_now),
             )
             self._pending.append(pending)
             planned.append((port, arrival))
         self._pending.sort(key=lambda p: (p.interval.start, p.receiver, p.sequence))
+        self._earliest_end = min([p.interval.end for p in self._pending], default=None)
         return planned
 
     def next_delivery(self) -> float | None:
-        if not self._pending:
+        if self._earliest_end is None:
             return None
-        return min(p.interval.end for p in self._pending) + self.config.decode_latency
+        return self._earliest_end + self.config.decode_latency
 
     def poll(self, now: float) -> list[Reception]:
         """Receptions delivered by `now` (no transmission may be registered before `now` later)."""
         self._horizon = max(self._horizon, now)
         self._decide_locks(now)
-        due = [p for p in self._pending if p.interval.end + self.config.decode_latency <= now]
+        latency = self.config.decode_latency
+        due, pending = [], []
+        for p in self._pending:
+            (due if p.interval.end + latency <= now else pending).append(p)
         if not due:
             return []
-        due_ids = {id(p) for p in due}
-        self._pending = [p for p in self._pending if id(p) not in due_ids]
+        self._pending = pending
+        self._earliest_end = min([p.interval.end for p in pending], default=None)
         self._finished.extend(due)  # before finishing: they interfere with each other
         due.sort(key=lambda p: (p.interval.end, p.receiver, p.sequence))
-        at_receiver = self._receptions_by_receiver()
-        results = [self._finish(p, at_receiver[p.receiver]) for p in due]
+        at_receiver: dict[int, list[_Pending]] = {}
+        results = []
+        for p in due:
+            receptions = at_receiver.get(p.receiver)
+            if receptions is None:
+                receptions = at_receiver[p.receiver] = self._receptions_at(p.receiver)
+            results.append(self._finish(p, receptions))
         self._prune(now)
         return results
 
     # -- internals -------------------------------------------------------------------------
 
-    def _receptions_by_receiver(self) -> defaultdict[int, list[_Pending]]:
-        """Every finished and pending reception, by receiver: one pass instead of one per
-        reception (in the same order as the lists: interference sums depend on it)."""
-        by_receiver: defaultdict[int, list[_Pending]] = defaultdict(list)
-        for p in (*self._finished, *self._pending):
-            by_receiver[p.receiver].append(p)
-        return by_receiver
+    def _receptions_at(self, receiver: int) -> list[_Pending]:
+        """Every finished and pending reception at a receiver, in the order of the lists
+        (interference sums depend on it)."""
+        return [p for p in self._finished if p.receiver == receiver] + [
+            p for p in self._pending if p.receiver == receiver
+        ]
+
+    def _noise_at(self, port: int) -> float:
+        """noise_level of the node's band, by port (the configuration is frozen; a Band's
+        hash is a Python call)."""
+        noise = self._noise_by_port.get(port)
+        if noise is None:
+            noise = self._noise_by_port[port] = self.noise_level(self.config.band_of(port))
+        return noise
+
+    def _quiet_level(self, noise: float) -> float:
+        """power_sum_db of the noise alone (what sinr subtracts without interferers), once per
+        noise level."""
+        level = self._quiet.get(noise)
+        if level is None:
+            level = self._quiet[noise] = power_sum_db((noise,))
+        return level
 
     def _decide_locks(self, now: float) -> None:
         """Detection and receiver lock for every reception that has started by `now`, in
         arrival order (all earlier arrivals are known by then)."""
-        at_receiver = None
+        config = self.config
+        at_receiver: dict[int, list[_Pending]] = {}  # (the lists do not change meanwhile)
         for p in self._pending:  # sorted by arrival
-            if p.interval.start > now:
+            start = p.interval.start
+            if start > now:
                 break
             if p.locked is not None:
                 continue
-            if self.config.protocol_model is not None:  # decided in _protocol_outcome
+            if config.protocol_model is not None:  # decided in _protocol_outcome
                 p.detected = p.locked = True
                 continue
-            if at_receiver is None:
-                at_receiver = self._receptions_by_receiver()
+            receptions = at_receiver.get(p.receiver)
+            if receptions is None:
+                receptions = at_receiver[p.receiver] = self._receptions_at(p.receiver)
             others = [
                 q.received_level
-                for q in at_receiver[p.receiver]
-                if q is not p and q.interval.start <= p.interval.start < q.interval.end
+                for q in receptions
+                if q is not p and q.interval.start <= start < q.interval.end
             ]
-            level = sinr(
-                p.received_level, self.noise_level(self.config.band_of(p.receiver)), others
-            )
-            threshold = self.config.error_models.detection_threshold(p.transmission.rate)
-            p.detected = level >= threshold or not self.config.receiver_lock
-            if not self.config.receiver_lock:
+            noise = self._noise_at(p.receiver)
+            if others:
+                level = sinr(p.received_level, noise, others)
+            else:
+                level = p.received_level - self._quiet_level(noise)
+            threshold = config.error_models.detection_threshold(p.transmission.rate)
+            p.detected = level >= threshold or not config.receiver_lock
+            if not config.receiver_lock:
                 p.locked = True
                 continue
-            free = self._locked_until.get(p.receiver, -math.inf) <= p.interval.start
-            transmitting = self.config.half_duplex and any(
-                own.start <= p.interval.start < own.end for own in self._own_tx.get(p.receiver, ())
-            )
+            free = self._locked_until.get(p.receiver, -math.inf) <= start
+            transmitting = False
+            if config.half_duplex:
+                for own in self._own_tx.get(p.receiver, ()):
+                    if own.start <= start < own.end:
+                        transmitting = True
+                        break
             p.locked = p.detected and free and not transmitting
             if p.locked:
                 self._locked_until[p.receiver] = p.interval.end
 
     def _finish(self, p: _Pending, at_receiver: list[_Pending]) -> Reception:
         """`at_receiver`: every finished and pending reception at p's receiver."""
-        noise = self.noise_level(self.config.band_of(p.receiver))
+        config = self.config
+        noise = self._noise_at(p.receiver)
+        start, end = p.interval.start, p.interval.end
         interferers = [
-            q.received_level for q in at_receiver if q is not p and q.interval.overlaps(p.interval)
+            q.received_level
+            for q in at_receiver
+            if q is not p and start < q.interval.end and end > q.interval.start  # overlaps
         ]
-        level = sinr(p.received_level, noise, interferers)
+        if interferers:
+            level = sinr(p.received_level, noise, interferers)
+        else:
+            level = p.received_level - self._quiet_level(noise)
         frames_ok: tuple[bool, ...] = ()
-        rng = random.Random(f"{self.seed}:{p.sequence}:{p.receiver}")
-        if self.config.half_duplex and any(
-            p.interval.overlaps(own) for own in self._own_tx.get(p.receiver, ())
-        ):
+        half_duplex = False
+        if config.half_duplex:
+            for own in self._own_tx.get(p.receiver, ()):
+                if own.start < end and own.end > start:  # overlaps
+                    half_duplex = True
+                    break
+        if half_duplex:
             outcome = Outcome.HALF_DUPLEX
-        elif self.config.protocol_model is not None:
+        elif config.protocol_model is not None:
             outcome, frames_ok = self._protocol_outcome(
-                p, self.config.protocol_model, rng, collided=bool(interferers)
+                p, config.protocol_model, self._random(p), collided=bool(interferers)
             )
         elif not p.detected:
             outcome = Outcome.NOT_DETECTED
         elif not p.locked:
             outcome = Outcome.RECEIVER_BUSY
         else:
-            fer = self.config.error_models.frame_error(p.transmission.rate, level)
-            frames_ok = tuple(rng.random() > fer for _ in range(p.transmission.frames))
+            fer = config.error_models.frame_error(p.transmission.rate, level)
+            draw = self._random(p).random
+            frames_ok = tuple([draw() > fer for _ in range(p.transmission.frames)])
             outcome = Outcome.GOOD if all(frames_ok) else Outcome.BAD_FRAMES
         return Reception(
             receiver=p.receiver,
             transmission=p.transmission,
             sequence=p.sequence,
-            arrival=p.interval.start,
-            end=p.interval.end,
-            deliver_at=p.interval.end + self.config.decode_latency,
+            arrival=start,
+            end=end,
+            deliver_at=end + config.decode_latency,
             owtt=p.owtt,
             range_m=p.range_m,
             received_level=p.received_level,
@@ -406,6 +465,13 @@ class Channel:
             outcome=outcome,
             frames_ok=frames_ok,
         )
+
+    def _random(self, p: _Pending) -> random.Random:
+        """The reception's own generator, seeded only when a draw decides something (one
+        generator object, reseeded: the same stream as a new one, without allocating its
+        state each time)."""
+        self._rng.seed(f"{self.seed}:{p.sequence}:{p.receiver}")
+        return self._rng
 
     @staticmethod
     def _protocol_outcome(
