@@ -14,7 +14,7 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	$(PY) -m pygoby.demo
-	$(PY) examples/frontseat/run_demo.py --warp 10 --duration 60
+	$(PY) examples/frontseat/run_demo.py --warp 10 --duration 50
 
 test: $(STAMP)
 	$(PY) -m ruff check src tests benchmarks
