@@ -23,6 +23,7 @@ receiver, src), `range` when a driver reports a ranging reply (port, src, dest, 
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections import Counter
 from collections.abc import Callable
@@ -66,16 +67,20 @@ LOCAL_IP = "127.0.0.1"
 
 class ModemLink:
     """A LineLink straight into an emulator: what the driver writes is handled by the model at
-    once; what the model says is buffered until the driver reads it."""
+    once; what the model says is buffered until the driver reads it. `waiting` (optional): a
+    set that holds `key` while lines wait (so a loop over many links need not ask each one)."""
 
-    def __init__(self, model: MicroModemModel) -> None:
+    def __init__(self, model: MicroModemModel, waiting: set | None = None, key=None) -> None:
         self.model = model
         self._open = False
         self._lines: list[str] = []
+        self._waiting = waiting if waiting is not None else set()
+        self._key = key
         model.on_output = self._heard
 
     def _heard(self, text: str) -> None:
         self._lines.append(text.strip())
+        self._waiting.add(self._key)
 
     @property
     def is_open(self) -> bool:
@@ -98,6 +103,7 @@ class ModemLink:
 
     def read_lines(self) -> list[str]:
         lines, self._lines = self._lines, []
+        self._waiting.discard(self._key)
         return lines
 
 
@@ -180,6 +186,7 @@ class Simulation:
             self.nodes.append(SimNode(node.modem_id, port, model, track))
         self._request_id = 0
         self._wall_start = 0.0
+        self._waiting: set[int] = set()  # indices of the nodes whose emulators have spoken
 
     # -- building stacks -------------------------------------------------------------------------
 
@@ -297,8 +304,8 @@ class Simulation:
 
     def build_virtual(self) -> None:
         """In-memory stacks for every node (drivers wired straight into their emulators)."""
-        for node in self.nodes:
-            node.link = ModemLink(node.model)
+        for index, node in enumerate(self.nodes):
+            node.link = ModemLink(node.model, self._waiting, index)
             driver = MMDriver(self.clock, node.link)
             driver.startup(driver_config(node.modem_id))
             self.attach_stack(node, driver)
@@ -320,15 +327,17 @@ class Simulation:
         next_position = self.start + period
         next_housekeeping = clock.now() + housekeeping
         macs = [n.mac for n in self.nodes if n.mac is not None]
+        nodes, waiting = self.nodes, self._waiting
         while True:
             now = clock.now()
             t = min(end, next_position, next_housekeeping)
             delivery = self.physics.next_event_time()
             if delivery is not None and delivery < t:
                 t = delivery
-            for mac in macs:
-                if mac.running and mac.next_slot_time + SLOT_EPSILON < t:
-                    t = mac.next_slot_time + SLOT_EPSILON
+            # (a MAC's next slot changes only when its own node works, below)
+            slot = min([mac.next_slot_time for mac in macs if mac.running], default=math.inf)
+            if slot + SLOT_EPSILON < t:
+                t = slot + SLOT_EPSILON
             clock.set(max(t, now))
             now = clock.now()
             if now >= next_position:
@@ -338,15 +347,19 @@ class Simulation:
             every = now >= next_housekeeping
             if every:
                 next_housekeeping += housekeeping
-            for node in self.nodes:
-                mac = node.mac
-                fired = mac is not None and mac.running and now > mac.next_slot_time
-                if fired:
-                    mac.do_work()
-                if every and node.queue is not None:
-                    node.queue.do_work()
-                if fired or every or (node.link is not None and node.link.pending):
-                    self._pump(node)
+            if every or now > slot:
+                for node in nodes:
+                    mac = node.mac
+                    fired = mac is not None and mac.running and now > mac.next_slot_time
+                    if fired:
+                        mac.do_work()
+                    if every and node.queue is not None:
+                        node.queue.do_work()
+                    if fired or every or (node.link is not None and node.link.pending):
+                        self._pump(node)
+            else:  # only deliveries: the nodes whose emulators have spoken, in node order
+                for index in sorted(waiting):
+                    self._pump(nodes[index])
             if now >= end:
                 return self.summary()
 
