@@ -138,7 +138,7 @@ class PhysicsChannel:
                     "port": port,
                     "src": packet.src,
                     "dest": packet.dest,
-                    "kind": packet.kind.value,
+                    "kind": packet.kind._value_,
                     "rate": packet.rate,
                     "frames": tx.frames,
                     "duration": self.channel.duration_of(tx),
@@ -198,6 +198,7 @@ class PhysicsChannel:
         return link_statistics(r, band.carrier_hz, band.bandwidth_hz) or {}
 
     def _log_reception(self, r: Reception, sent: _Sent, delivered: bool, owtt: float) -> None:
+        # (enum values read as `_value_`: the `value` property is a Python call per event)
         assert self.on_event is not None
         packet = sent.packet
         snr = r.received_level - r.noise_level
@@ -211,9 +212,9 @@ class PhysicsChannel:
                 "tx_port": sent.port,
                 "src": packet.src,
                 "dest": packet.dest,
-                "kind": packet.kind.value,
+                "kind": packet.kind._value_,
                 "rate": packet.rate,
-                "outcome": r.outcome.value,
+                "outcome": r.outcome._value_,
                 "delivered": delivered,
                 "frames": r.transmission.frames,
                 "good_frames": r.good_frames,

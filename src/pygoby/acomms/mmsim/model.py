@@ -229,7 +229,8 @@ class MicroModemModel:
 
     # ------------------------------------------------------------------ acoustic receptions
     def receive(self, packet: AcousticPacket, reception: Reception) -> None:
-        handler = getattr(self, "_heard_" + packet.kind.value)
+        # (`_value_`: the enum member's value without the `value` property's Python call)
+        handler = getattr(self, "_heard_" + packet.kind._value_)
         handler(packet, reception)
 
     def _heard_data(self, p: AcousticPacket, r: Reception) -> None:

@@ -145,12 +145,18 @@ class MMDriver(ModemDriverBase):
         if not link_open:
             return  # a dead link is the link's business (it reconnects); do not count failures
         now = self.clock.now()
-        self._hydroid_gps_request(now)
-        self._check_multi_reply(now)
-        self._advance_startup(now)
-        self._check_timeout(now)
+        # (each step's first test made here: do_work runs for every line batch and timer)
+        if self.mm_cfg.hydroid_gateway_id:
+            self._hydroid_gps_request(now)
+        if self._multi_reply:
+            self._check_multi_reply(now)
+        if self.phase is not Phase.READY or not self._clock_set:
+            self._advance_startup(now)
+        if self._written_at is not None:
+            self._check_timeout(now)
         self._keep_alive(now)
-        self._try_write(now)
+        if self._out:
+            self._try_write(now)
 
     def handle_initiate_transmission(self, transmission) -> None:
         if self.link is None or not self.link.is_open:
