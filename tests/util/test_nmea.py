@@ -12,6 +12,7 @@ from pygoby.util.nmea import (
     checksum,
     parse_int,
     parse_ints,
+    printed,
     with_checksum,
     with_checksum_of_parts,
 )
@@ -114,6 +115,44 @@ def test_build_formats_every_kind_of_value_by_the_field_rule(values):
     for ch in body[1:]:
         cs ^= ord(ch)
     assert s.message() == f"{body}*{cs:02X}"
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.sampled_from(["$CCTXD", "!AIVDM", "$CA", " $CARXD", "$CAöXD", "CCCFG"]),
+    st.lists(st.text(alphabet=st.characters(max_codepoint=300), max_size=6), max_size=6),
+)
+def test_a_printed_text_parses_to_what_parsing_it_gives(token, texts):
+    """`printed` remembers a text so that parsing it needs no work: the result (or the error)
+    must be exactly what parsing the text from scratch gives, whatever the fields (commas,
+    reserved characters, non-ASCII, a bad token, surrounding spaces)."""
+    sentence = NMEASentence((token, *texts))
+    try:
+        text = with_checksum(",".join(sentence.fields))
+    except UnicodeEncodeError:  # (a checksum is only defined for ASCII)
+        with pytest.raises(UnicodeEncodeError):
+            printed(sentence)
+        return
+    assert printed(sentence) == text
+    try:
+        expected = NMEASentence._parse(text)
+    except NMEAError as exc:
+        with pytest.raises(type(exc)):
+            NMEASentence.parse(text)
+        return
+    assert NMEASentence.parse(text) == expected
+    assert NMEASentence.parse(text) == expected  # (once more: now from the parse memory)
+
+
+def test_a_sentence_of_parts_is_the_sentence_of_its_fields():
+    tail = ("0", "1000", "-15", "0.0")
+    tail_text = ",".join(tail)
+    sentence = NMEASentence.of_parts(
+        ("$CACST", "1", "221523.4567"), tail, tail_text, checksum(tail_text)
+    )
+    whole = NMEASentence(("$CACST", "1", "221523.4567", *tail))
+    assert sentence == whole and sentence.message() == whole.message()
+    assert NMEASentence.parse(printed(sentence)) is sentence
 
 
 @pytest.mark.parametrize("bad", ["a*b", "a\rb", "a\nb", "*"])

@@ -71,7 +71,22 @@ class NMEASentence:
     @classmethod
     def parse(cls, line: str) -> NMEASentence:
         """Parse one line (surrounding whitespace ignored). Raises an NMEAError subclass."""
+        sentence = _printed.pop(line, None)
+        if sentence is not None and type(sentence) is cls:
+            return sentence  # printed here (see `printed`): nothing to parse
         return _parse_recurring(cls, line)
+
+    @classmethod
+    def of_parts(
+        cls, head: tuple[str, ...], tail: tuple[str, ...], tail_text: str, tail_checksum: int
+    ) -> NMEASentence:
+        """The sentence with fields `head + tail`, for a caller that keeps the text of a
+        recurring `tail` (`",".join(tail)`) and its checksum: only the head's part of the text
+        and checksum is made (see `message`)."""
+        sentence = cls((*head, *tail))
+        head_text = ",".join(head) + ","
+        sentence.__dict__["_message"] = with_checksum_of_parts(head_text, tail_text, tail_checksum)
+        return sentence
 
     @classmethod
     def _parse(cls, line: str) -> NMEASentence:
@@ -170,6 +185,34 @@ class NMEASentence:
 @functools.lru_cache(maxsize=1024)
 def _parse_recurring(cls: type[NMEASentence], line: str) -> NMEASentence:
     return cls._parse(line)
+
+
+def printed(sentence: NMEASentence) -> str:
+    """`sentence.message()`, for a caller that prints it. Parsing that very text later (the
+    other end of an in-process link) gives back `sentence` itself, without any work, when
+    parsing would give the same fields: only such texts are remembered (a bounded number)."""
+    text = sentence.message()
+    fields = sentence.fields
+    body = text[:-3]  # (without the *HH message() adds)
+    token = fields[0]
+    if (
+        len(token) == 6
+        and token[0] in "$!"
+        and text.isascii()
+        and body.count(",") == len(fields) - 1
+        and "*" not in body
+        and "\r" not in body
+        and "\n" not in body
+    ):
+        if len(_printed) >= _PRINTED_LIMIT:
+            _printed.clear()
+        _printed[text] = sentence
+    return text
+
+
+# Texts printed by this process, with their sentences, until parsed once (see `printed`).
+_printed: dict[str, NMEASentence] = {}
+_PRINTED_LIMIT = 4096
 
 
 def with_checksum(text: str) -> str:

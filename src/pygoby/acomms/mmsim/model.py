@@ -18,10 +18,10 @@ from dataclasses import dataclass, field
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES
-from pygoby.acomms.drivers.micromodem.statistics import cst_head, cst_tail, format_xst
+from pygoby.acomms.drivers.micromodem.statistics import cst_head_fields, cst_tail, format_xst
 from pygoby.acomms.mmsim.channel import AcousticPacket, Channel, PacketKind, Reception
 from pygoby.util.clock import Clock
-from pygoby.util.nmea import NMEAError, NMEASentence, checksum, with_checksum_of_parts
+from pygoby.util.nmea import NMEAError, NMEASentence, checksum, printed
 
 log = logging.getLogger(__name__)
 
@@ -78,7 +78,7 @@ class MicroModemModel:
         self._output(_sentence_line(token, *values))
 
     def _say_sentence(self, sentence: NMEASentence) -> None:
-        self._output(sentence.message() + "\r\n")
+        self._output(printed(sentence) + "\r\n")
 
     def _output(self, line: str) -> None:
         if self.on_output is not None:
@@ -285,13 +285,13 @@ class MicroModemModel:
         # same statistics): that text and its checksum are made once.
         key = (p.rate, p.src, p.dest, frames, bad, *r.stats.items())
         tail = _cst_tails.get(key) or self._cst_tail(key, p, r, frames, bad)
-        head = cst_head(1 if bad else 0, m.now_us(r.arrival_time + self._clock_offset))
-        self._output(with_checksum_of_parts(head, *tail) + "\r\n")
+        head = cst_head_fields(1 if bad else 0, m.now_us(r.arrival_time + self._clock_offset))
+        self._output(printed(NMEASentence.of_parts(head, *tail)) + "\r\n")
 
     def _cst_tail(
         self, key: tuple, p: AcousticPacket, r: Reception, frames: int, bad: int
-    ) -> tuple[str, int]:
-        """The $CACST text after the time of arrival, and its checksum."""
+    ) -> tuple[tuple[str, ...], str, int]:
+        """The $CACST fields after the time of arrival, their text and its checksum."""
         values = dict(
             clock_mode=0, mfd_peak=1000, mfd_power=20, mfd_ratio=150, spl=150, shf_agn=250,
             shf_ainpshift=0, shf_ainshift=0, shf_mfdshift=0, shf_p2bshift=0, rate=p.rate,
@@ -311,7 +311,7 @@ class MicroModemModel:
             else:  # (an int is already what int(round()) would make of it)
                 values[name] = value if type(value) is int else int(round(value))
         text = cst_tail(values)
-        tail = (text, checksum(text))
+        tail = (tuple(text.split(",")), text, checksum(text))
         if known:
             if len(_cst_tails) >= _CST_TAILS_LIMIT:
                 _cst_tails.clear()
@@ -319,8 +319,9 @@ class MicroModemModel:
         return tail
 
 
-# $CACST texts after the time of arrival, with their checksums, by link and statistics
-_cst_tails: dict[tuple, tuple[str, int]] = {}
+# $CACST fields after the time of arrival, with their text and its checksum, by link and
+# statistics
+_cst_tails: dict[tuple, tuple[tuple[str, ...], str, int]] = {}
 _CST_TAILS_LIMIT = 4096
 
 
@@ -328,7 +329,7 @@ _CST_TAILS_LIMIT = 4096
 # answers to keep-alives): their text is built once. `typed`: 1, 1.0 and True print differently.
 @functools.lru_cache(maxsize=1024, typed=True)
 def _sentence_line(token: str, *values: object) -> str:
-    return NMEASentence.build(token, values).message() + "\r\n"
+    return printed(NMEASentence.build(token, values)) + "\r\n"
 
 
 _STATISTICS = m.ReceiveStatistics.DESCRIPTOR.fields_by_name

@@ -23,7 +23,7 @@ from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
 from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
 from pygoby.acomms.drivers.micromodem.statistics import add_cst, parse_toa, parse_xst
-from pygoby.util.nmea import NMEAError, NMEASentence
+from pygoby.util.nmea import NMEAError, NMEASentence, printed
 
 log = logging.getLogger(__name__)
 
@@ -195,7 +195,7 @@ class MMDriver(ModemDriverBase):
         if not self._out or self._written_at is not None or now < self._hold_until:
             return
         sentence = self._out[0]
-        text = sentence.message()
+        text = printed(sentence)
         prefix = f"#M{self.mm_cfg.hydroid_gateway_id}" if self.mm_cfg.hydroid_gateway_id else ""
         self.modem_write(prefix + text + "\r\n")
         self.emit_raw(False, text)

@@ -159,6 +159,11 @@ def cst_text(stat, version: int = 0) -> str:
 def cst_head(mode: int, time: int, version: int = 0) -> str:
     """The start of a $CACST text, up to the comma after the time of arrival (`time`, in
     microseconds since the epoch): the part that changes with every packet."""
+    return ",".join(cst_head_fields(mode, time, version)) + ","
+
+
+def cst_head_fields(mode: int, time: int, version: int = 0) -> tuple[str, ...]:
+    """The fields of `cst_head`: token, version (from 6 on), mode, time of arrival."""
     if type(time) is int and 0 <= time < _EXACT_TIME_LIMIT:
         # what the datetime below gives, in integers (time / 1e6 is within 0.5 us of the
         # exact value up to 2**33 s, so datetime's rounding gives back `time` exactly)
@@ -169,9 +174,11 @@ def cst_head(mode: int, time: int, version: int = 0) -> str:
     else:
         toa = dt.datetime.fromtimestamp(time / 1e6, dt.UTC)
         hour, minute, second, micros = toa.hour, toa.minute, toa.second, toa.microsecond
-    return _CST_HEAD % (
-        f"{version:d}," if version >= 6 else "", mode, hour, minute, second, micros // 100,
-    )  # fmt: skip
+    toa_text = _TOA % (hour, minute, second, micros // 100)
+    mode_text = str(int(mode))  # (what %d prints, as in the tail)
+    if version >= 6:
+        return ("$CACST", f"{version:d}", mode_text, toa_text)
+    return ("$CACST", mode_text, toa_text)
 
 
 _EXACT_TIME_LIMIT = 2**33 * 1_000_000  # us (year 2242)
@@ -186,7 +193,7 @@ def cst_tail(stat) -> str:
     return _CST_TAIL % get(stat)
 
 
-_CST_HEAD = "$CACST,%s%d,%02d%02d%02d.%04d,"
+_TOA = "%02d%02d%02d.%04d"
 _CST_TAIL = "%d," + ",".join("%.1f" if name == "doppler" else "%d" for name in _CST_INT_FIELDS)
 
 
