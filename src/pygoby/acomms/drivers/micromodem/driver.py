@@ -524,7 +524,7 @@ class MMDriver(ModemDriverBase):
                 self._finish_receive()
 
     def _on_cst(self, s: NMEASentence) -> None:
-        today = dt.datetime.fromtimestamp(self.clock.now(), dt.UTC).date()
+        today = _utc_date(self.clock.now())
         new_clock = self.revision >= MM2_BITFIELD_CLOCK_REVISION
         if self._ack_msg is not None and self._receive is None and not self._expected_cst:
             add_cst(self._ack_msg.Extensions[m.MM_TRANSMISSION].receive_stat, s, today, new_clock)
@@ -717,7 +717,7 @@ class MMDriver(ModemDriverBase):
         msg = self._ping_result(self.modem_id, -1, self._last_lbl_type)
         msg.ClearField("dest")
         msg.time_source = m.ModemTransmission.MODEM_TIME
-        today = dt.datetime.fromtimestamp(self.clock.now(), dt.UTC).date()
+        today = _utc_date(self.clock.now())
         msg.time = parse_toa(s[5], today)
         reply = msg.Extensions[m.MM_TRANSMISSION].ranging_reply
         for i in range(1, 5):
@@ -730,6 +730,11 @@ class MMDriver(ModemDriverBase):
 @functools.lru_cache(maxsize=256, typed=True)
 def _sentence(token: str, *values: object) -> NMEASentence:
     return NMEASentence.build(token, values)
+
+
+@functools.lru_cache(maxsize=4)  # (a packet's statistics arrive at one instant)
+def _utc_date(seconds: float) -> dt.date:
+    return dt.datetime.fromtimestamp(seconds, dt.UTC).date()
 
 
 def _iso_time(text: str) -> float:

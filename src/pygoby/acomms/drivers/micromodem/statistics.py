@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as dt
+import functools
 import logging
 import operator
 from collections.abc import Mapping
@@ -31,6 +32,8 @@ _cst_tail_items = operator.itemgetter("clock_mode", *_CST_INT_FIELDS)
 _CST_ENUM_RANGES = {"psk_error_code": (0, 6), "packet_type": (1, 5)}
 
 
+# (the statistics of one packet repeat its time of arrival: remembered for a moment)
+@functools.lru_cache(maxsize=16)
 def parse_toa(text: str, today: dt.date) -> int:
     """`hhmmss.ffff` on `today` (UTC) -> microseconds since the epoch."""
     whole, _, frac = text.partition(".")
@@ -162,6 +165,7 @@ def cst_head(mode: int, time: int, version: int = 0) -> str:
     return ",".join(cst_head_fields(mode, time, version)) + ","
 
 
+@functools.lru_cache(maxsize=16, typed=True)  # (the statistics of one packet share a time)
 def cst_head_fields(mode: int, time: int, version: int = 0) -> tuple[str, ...]:
     """The fields of `cst_head`: token, version (from 6 on), mode, time of arrival."""
     if type(time) is int and 0 <= time < _EXACT_TIME_LIMIT:
