@@ -186,3 +186,28 @@ def test_modem_without_port_is_refused():
                                                                 ports={"alpha": 62005}),
                             name="alpha")  # fmt: skip
     assert model.channel.port_of(model) == 62005
+
+
+def test_rx_event_figures_are_rounded_the_same_when_remembered():
+    from pygoby.netsim import physics_channel
+
+    def fresh(range_m, owtt, rl, noise, sinr):
+        snr = rl - noise
+        return (
+            round(range_m, 3), round(owtt, 6), round(rl, 2), round(snr, 2), round(sinr, 2),
+            sinr < snr - 0.01,
+        )  # fmt: skip
+
+    physics_channel._figures.clear()
+    cases = [
+        (1234.56789, 0.8230452, 120.4449, 62.3, 58.1449),
+        (1234.56789, 0.8230452, 120.4449, 62.3, 50.0),  # a collision
+        (0.0, 0.0, 185.0, 62.3, -0.004),  # a zero: not remembered
+        (10.0, 0.0066, 62.3, 62.3, -0.0),  # -0.0 keeps its sign
+    ]
+    for _ in range(2):
+        for case in cases:
+            got = physics_channel._link_figures(*case)
+            assert got == fresh(*case)
+            assert [str(x) for x in got] == [str(x) for x in fresh(*case)]
+    assert len(physics_channel._figures) == 2

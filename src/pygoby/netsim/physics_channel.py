@@ -201,7 +201,9 @@ class PhysicsChannel:
         # (enum values read as `_value_`: the `value` property is a Python call per event)
         assert self.on_event is not None
         packet = sent.packet
-        snr = r.received_level - r.noise_level
+        range_m, owtt, rl, snr, sinr, collision = _link_figures(
+            r.range_m, owtt, r.received_level, r.noise_level, r.sinr
+        )
         self.on_event(
             {
                 "event": "rx",
@@ -218,11 +220,35 @@ class PhysicsChannel:
                 "delivered": delivered,
                 "frames": r.transmission.frames,
                 "good_frames": r.good_frames,
-                "range_m": round(r.range_m, 3),
-                "owtt": round(owtt, 6),
-                "rl": round(r.received_level, 2),
-                "snr": round(snr, 2),
-                "sinr": round(r.sinr, 2),
-                "collision": r.sinr < snr - 0.01,
+                "range_m": range_m,
+                "owtt": owtt,
+                "rl": rl,
+                "snr": snr,
+                "sinr": sinr,
+                "collision": collision,
             }  # fmt: skip
         )
+
+
+def _link_figures(
+    range_m: float, owtt: float, rl: float, noise: float, sinr: float
+) -> tuple[float, float, float, float, float, bool]:
+    """The rounded figures of an `rx` event (a link's recur: float rounding is slow, so they
+    are remembered; not with a zero among them, whose key would be shared by -0.0)."""
+    key = (range_m, owtt, rl, noise, sinr)
+    figures = _figures.get(key)
+    if figures is None:
+        snr = rl - noise
+        figures = (
+            round(range_m, 3), round(owtt, 6), round(rl, 2), round(snr, 2), round(sinr, 2),
+            sinr < snr - 0.01,
+        )  # fmt: skip
+        if 0.0 not in key:
+            if len(_figures) >= _FIGURES_LIMIT:
+                _figures.clear()
+            _figures[key] = figures
+    return figures
+
+
+_figures: dict[tuple[float, ...], tuple[float, float, float, float, float, bool]] = {}
+_FIGURES_LIMIT = 4096
