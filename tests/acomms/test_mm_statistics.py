@@ -15,6 +15,7 @@ from pygoby.acomms.drivers.micromodem.statistics import (
     format_cst,
     parse_cst,
     parse_toa,
+    parse_xst,
 )
 from pygoby.util.nmea import NMEAFormatError, NMEASentence, with_checksum
 
@@ -142,3 +143,25 @@ def test_cst_head_prints_the_utc_time_of_day(time_us):
 def test_parse_toa_refuses_what_is_not_a_time_of_day(text):
     with pytest.raises(ValueError):
         parse_toa(text, DAY)
+
+
+def test_parse_xst_fields_enum_ranges_and_short_sentences(caplog):
+    xst = parse_xst(
+        NMEASentence.parse("$CAXST,20231114,221930.0010,0,0,0,5000,25000,0,7,0,1,1,1,1,17")
+    )
+    assert (xst.version, xst.date, xst.time) == (0, "20231114", "221930.0010")
+    assert (xst.clock_mode, xst.mode, xst.probe_length, xst.bandwidth) == (0, 0, 0, 5000)
+    assert (xst.carrier_freq, xst.rate, xst.source, xst.dest) == (25000, 0, 7, 0)
+    assert xst.ack_requested is True and xst.number_bytes == 17
+    assert (xst.number_frames_expected, xst.number_frames_sent, xst.packet_type) == (1, 1, 1)
+    odd = parse_xst(
+        NMEASentence.parse("$CAXST,6,20231114,221930.0010,4,5,0,5000,25000,0,7,0,0,1,1,6,0")
+    )
+    assert odd.version == 6 and odd.date == "20231114"
+    assert (odd.clock_mode, odd.mode, odd.packet_type) == (-1, -1, -1)  # out of their ranges
+    with caplog.at_level(logging.WARNING):
+        short = parse_xst(NMEASentence.parse("$CAXST,20231114,221930.0010,0,2,0,5000"))
+    assert "stopped at carrier_freq" in caplog.text
+    assert short.mode == 2 and short.bandwidth == 5000 and not short.HasField("carrier_freq")
+    with pytest.raises(NMEAFormatError, match="field 5 of"):
+        parse_xst(NMEASentence.parse("$CAXST,20231114,221930.0010,0,2,x,5000,25000"))

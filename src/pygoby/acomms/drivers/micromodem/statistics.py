@@ -212,24 +212,25 @@ _XST_FIELDS = (
 def parse_xst(sentence: NMEASentence):
     first = sentence.as_int(1)
     version, off = (0, 0) if first > 19_700_000 else (first, 1)
-    stat = m.TransmitStatistics(version=version, date=sentence[1 + off], time=sentence[2 + off])
-    for i, name in enumerate(_XST_FIELDS):
-        index = 3 + off + i
-        if index >= len(sentence):
-            log.warning("short $CAXST (%d fields): stopped at %s", len(sentence), name)
-            break
-        value = sentence.as_int(index)
-        if name == "ack_requested":
-            stat.ack_requested = bool(value)
-        elif name == "mode":
-            stat.mode = value if 0 <= value <= 4 else -1
-        elif name == "clock_mode":
-            stat.clock_mode = value if 0 <= value <= 3 else -1
-        elif name == "packet_type":
-            stat.packet_type = value if 1 <= value <= 5 else -1
-        else:
-            setattr(stat, name, value)
+    date, time = sentence[1 + off], sentence[2 + off]
+    start = 3 + off
+    present = min(len(_XST_FIELDS), max(0, len(sentence) - start))
+    fields = dict(zip(_XST_FIELDS[:present], sentence.as_ints(start, start + present), strict=True))
+    for name, (lo, hi) in _XST_ENUM_RANGES.items():
+        value = fields.get(name)
+        if value is not None and not lo <= value <= hi:
+            fields[name] = -1
+    if "ack_requested" in fields:
+        fields["ack_requested"] = bool(fields["ack_requested"])
+    # (one constructor call: setting the fields one by one is several times slower)
+    stat = m.TransmitStatistics(version=version, date=date, time=time, **fields)
+    if present < len(_XST_FIELDS):
+        log.warning("short $CAXST (%d fields): stopped at %s", len(sentence), _XST_FIELDS[present])
     return stat
+
+
+# enum fields of $CAXST whose out-of-range values become -1 (the enums' INVALID value)
+_XST_ENUM_RANGES = {"mode": (0, 4), "clock_mode": (0, 3), "packet_type": (1, 5)}
 
 
 def format_xst(
