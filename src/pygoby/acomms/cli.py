@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import logging
+
+from pygoby.util.aiorun import run_until_signal
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -51,8 +52,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
-    with contextlib.suppress(KeyboardInterrupt):
-        asyncio.run(_serve(args))
+    run_until_signal(_serve(args))
     return 0
 
 
@@ -80,8 +80,7 @@ async def _serve(args: argparse.Namespace) -> None:
 
 def run_store_server(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
-    with contextlib.suppress(KeyboardInterrupt):
-        asyncio.run(_serve_store(args))
+    run_until_signal(_serve_store(args))
     return 0
 
 
@@ -101,8 +100,7 @@ async def _serve_store(args: argparse.Namespace) -> None:
 
 def run_abc_simulator(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
-    with contextlib.suppress(KeyboardInterrupt):
-        asyncio.run(_serve_abc(args))
+    run_until_signal(_serve_abc(args))
     return 0
 
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import logging
 import sys
 from pathlib import Path
@@ -17,6 +16,7 @@ from pathlib import Path
 from pygoby.netsim.config import EXAMPLE_CONFIG, ConfigError, parse_config
 from pygoby.netsim.gprmc import GpsOutputs
 from pygoby.netsim.manager import NetSimManager
+from pygoby.util.aiorun import run_until_signal
 from pygoby.util.clock import WallClock
 
 log = logging.getLogger(__name__)
@@ -127,8 +127,7 @@ def main(argv: list[str] | None = None) -> int:
     except (OSError, ConfigError) as exc:
         print(f"netsim_manager: {exc}", file=sys.stderr)
         return 1
-    with contextlib.suppress(KeyboardInterrupt):
-        asyncio.run(_run(manager, args.listen, args.port))
+    run_until_signal(_run(manager, args.listen, args.port))
     return 0
 
 

@@ -12,10 +12,10 @@ import argparse
 import asyncio
 import contextlib
 import logging
-import signal
 import sys
 
 from pygoby.frontseat.simulator.core import BasicFrontSeatSimulator
+from pygoby.util.aiorun import run_until_signal
 from pygoby.util.linebased import LinkClosedError, TCPServerLink
 
 log = logging.getLogger(__name__)
@@ -95,15 +95,6 @@ def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
-async def _run(server: SimulatorServer) -> None:
-    loop = asyncio.get_running_loop()
-    serving = asyncio.ensure_future(server.serve())
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        loop.add_signal_handler(signum, serving.cancel)
-    with contextlib.suppress(asyncio.CancelledError):
-        await serving
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -112,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
     )
     try:
-        asyncio.run(_run(SimulatorServer(args.port, host=args.bind)))
+        run_until_signal(SimulatorServer(args.port, host=args.bind).serve())
     except OSError as exc:
         print(f"{parser.prog}: {exc}", file=sys.stderr)
         return 1
