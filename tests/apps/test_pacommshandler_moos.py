@@ -148,9 +148,9 @@ async def test_moos_interface_without_a_modem(tmp_path, caplog):
 
 
 def pAcommsHandler_interface_data():  # noqa: N802
-    from pygoby.apps.pacommshandler import interface_data_class
+    from pygoby.frontseat.messages import InterfaceData
 
-    return interface_data_class()()
+    return InterfaceData()
 
 
 async def test_renamed_variables(tmp_path):

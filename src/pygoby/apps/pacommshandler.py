@@ -23,6 +23,7 @@ from pygoby.acomms import messages as m
 from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.acomms.queue import QueueError
 from pygoby.dccl import DcclError
+from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import ConfigError
 from pygoby.moos.protocol import MOOSMessage
@@ -33,18 +34,10 @@ from pygoby.moos.translator import (
     post_for_moos,
 )
 from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
-from pygoby.protobuf import ProtoLoader, builtin_class, default_loader
+from pygoby.protobuf import ProtoLoader, default_loader
 
 ROUTE_COMMAND = "goby.acomms.protobuf.RouteCommand"
 ROUTE_PROTO = "goby/acomms/protobuf/route.proto"
-INTERFACE_DATA = "goby.middleware.frontseat.protobuf.InterfaceData"
-FRONTSEAT_PROTO = "goby/middleware/protobuf/frontseat.proto"
-
-
-@functools.cache
-def interface_data_class() -> type[Message]:
-    """iFrontSeat's InterfaceData, the type of IFS_DATA_OUT posts for forwarded messages."""
-    return builtin_class(FRONTSEAT_PROTO, INTERFACE_DATA)
 
 
 def _goby_message_class(name: str) -> type[Message]:
@@ -279,7 +272,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             except DcclError as err:
                 self.log.warning("cannot forward %s to the frontseat: %s", name, err)
             else:
-                self.binding.post([post_for_moos(self.ifs_data_out, interface_data_class()(dccl_message=data),
+                self.binding.post([post_for_moos(self.ifs_data_out, InterfaceData(dccl_message=data),
                                           self.moos_technique)])  # fmt: skip
         if name == ROUTE_COMMAND and self.acomms.route_cfg.route.hop:
             self.acomms.replace_route(message.new_route)
