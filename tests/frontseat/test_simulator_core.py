@@ -9,9 +9,10 @@ import math
 import pytest
 from pyproj import Geod
 
-from pygoby.frontseat.simulator.core import BasicFrontSeatSimulator, wrap_heading
+from pygoby.frontseat.simulator.core import BasicFrontSeatSimulator
 from pygoby.frontseat.simulator.protocol import Nav, parse_line
 from pygoby.util.geodesy import UTMGeodesy
+from pygoby.util.kinematics import wrap_heading
 
 LAT, LON = 42.1234, -72.0
 START = f"START,LAT:{LAT},LON:{LON}"

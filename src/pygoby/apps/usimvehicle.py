@@ -17,12 +17,9 @@ from google.protobuf.message import Message
 
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
+from pygoby.util.kinematics import slew
 
 DESIRED = {"DESIRED_HEADING": "heading", "DESIRED_SPEED": "speed", "DESIRED_DEPTH": "depth"}
-
-
-def _approach(value: float, target: float, max_step: float) -> float:
-    return value + max(-max_step, min(max_step, target - value))
 
 
 @dataclass
@@ -49,9 +46,9 @@ class VehicleModel:
             self.heading += max(-self.turn_rate * dt, min(self.turn_rate * dt, error))
         self.heading %= 360.0
         if self.desired_speed is not None:
-            self.speed = _approach(self.speed, self.desired_speed, self.acceleration * dt)
+            self.speed = slew(self.speed, self.desired_speed, self.acceleration * dt)
         if self.desired_depth is not None:
-            self.depth = max(0.0, _approach(self.depth, self.desired_depth, self.dive_rate * dt))
+            self.depth = max(0.0, slew(self.depth, self.desired_depth, self.dive_rate * dt))
         radians = math.radians(self.heading)
         self.x += self.speed * math.sin(radians) * dt
         self.y += self.speed * math.cos(radians) * dt
