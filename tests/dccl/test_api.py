@@ -14,6 +14,7 @@ from pygoby.dccl import (
     DcclEncodeError,
     DcclLoadError,
     FixedWidthCodec,
+    register_codec,
 )
 from pygoby.dccl.registry import DEFAULT_REGISTRY
 from pygoby.util.clock import VirtualClock
@@ -206,25 +207,47 @@ class ParityCodec(FixedWidthCodec):
         self.from_raw = lambda raw: raw
 
 
+PARITY_USER = (
+    "message P { option (dccl.msg) = { id: 5 max_bytes: 4 codec_version: 4 };"
+    " required uint32 n = 1 [(dccl.field).codec = 'my.parity'];"
+    " required uint32 m = 2 [(dccl.field) = { min: 0 max: 7 }]; }"
+)
+
+
 def test_user_codec_selected_by_name(tmp_path: Path) -> None:
-    registry = CodecRegistry()
-    registry._entries = dict(DEFAULT_REGISTRY._entries)
-    registry.register("my.parity", ["uint32"], ParityCodec)
-    codec = Codec(registry=registry)
-    _, cls = load(
-        tmp_path,
-        "message P { option (dccl.msg) = { id: 5 max_bytes: 4 codec_version: 4 };"
-        " required uint32 n = 1 [(dccl.field).codec = 'my.parity'];"
-        " required uint32 m = 2 [(dccl.field) = { min: 0 max: 7 }]; }",
-        "P",
-        codec,
-    )
+    codec = Codec()
+    codec.registry.register("my.parity", ["uint32"], ParityCodec)
+    _, cls = load(tmp_path, PARITY_USER, "P", codec)
     data = codec.encode(cls(n=7, m=5))
     assert data.hex() == "0a0b"  # id 5; n parity 1 (bit 0), m 5 (bits 1-3)
     assert codec.decode(data) == cls(n=1, m=5)
+
+
+def test_a_codec_registered_on_one_codec_does_not_leak_into_another(tmp_path: Path) -> None:
+    first, second = Codec(), Codec()
+    first.registry.register("my.parity", ["uint32"], ParityCodec)
+    load(tmp_path, PARITY_USER, "P", first)
+    for other in (second, Codec()):  # made before and after the registration
+        with pytest.raises(DcclLoadError, match="no codec named 'my.parity'"):
+            load(tmp_path, PARITY_USER, "P", other)
     with pytest.raises(DcclLoadError, match="no codec named 'my.parity'"):
-        load(tmp_path, "message Q { option (dccl.msg) = { id: 6 max_bytes: 4 codec_version: 4 };"
-             " required uint32 n = 1 [(dccl.field).codec = 'my.parity']; }", "Q")
+        DEFAULT_REGISTRY.resolve("my.parity", 4, "uint32")
+
+
+def test_register_codec_adds_to_the_defaults_that_later_codecs_copy(tmp_path: Path) -> None:
+    earlier = Codec()
+    body = PARITY_USER.replace("my.parity", "test_api.global_parity")  # only this test uses it
+    register_codec("test_api.global_parity", ["uint32"], ParityCodec)
+    codec, cls = load(tmp_path, body, "P", Codec())
+    assert codec.encode(cls(n=7, m=5)).hex() == "0a0b"
+    with pytest.raises(DcclLoadError, match="no codec named 'test_api.global_parity'"):
+        load(tmp_path, body, "P", earlier)
+
+
+def test_a_codec_given_a_registry_uses_that_one(tmp_path: Path) -> None:
+    registry = CodecRegistry()
+    with pytest.raises(DcclLoadError, match="no codec named 'dccl.default4'"):
+        load(tmp_path, PARITY_USER, "P", Codec(registry=registry))
 
 
 def test_generated_python_classes_load(tmp_path: Path, monkeypatch) -> None:

@@ -36,14 +36,15 @@ def message_class(proto: str, name: str) -> type[Message]:
 class VectorCodecs:
     """One Codec per (proto file, passphrase), so IDs reused across files never clash."""
 
-    def __init__(self) -> None:
+    def __init__(self, trace: bool = False) -> None:
         self.clock = VirtualClock(0)
+        self.trace = trace
         self._codecs: dict[tuple[str, str | None], Codec] = {}
 
     def get(self, proto: str, passphrase: str | None) -> Codec:
         key = (proto, passphrase)
         if key not in self._codecs:
-            self._codecs[key] = Codec(passphrase=passphrase, clock=self.clock)
+            self._codecs[key] = Codec(passphrase=passphrase, clock=self.clock, trace=self.trace)
         return self._codecs[key]
 
 

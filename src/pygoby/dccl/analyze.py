@@ -1,10 +1,11 @@
-"""A readable description of a loaded message type: each field's codec and size, and totals."""
+"""A readable description of a loaded message type: each field's codec and size, and totals;
+and the Python generated for it."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pygoby.dccl.codec import CompiledType
+from pygoby.dccl.compiled import CompiledType
 from pygoby.dccl.plan import MessageItem, MessageNode, RepeatedItem, ScalarItem
 
 
@@ -85,3 +86,9 @@ def describe(compiled: CompiledType) -> str:
             f"  {r.path:<{widths[0]}}  {r.part:<4}  {r.codec:<{widths[1]}}  {bits:>9}  {r.detail}"
         )
     return "\n".join(lines)
+
+
+def generated_source(compiled: CompiledType) -> str:
+    """The generated Python of the type's encode/decode functions (head and body parts)."""
+    return "\n".join(compiled.source[name] for name in
+                     ("encode_head", "encode_body", "decode_head", "decode_body"))

@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 from collections.abc import Callable, Iterable
 
 from google.protobuf import text_format
 
-from pygoby.dccl.analyze import describe
+from pygoby.dccl.analyze import describe, generated_source
 from pygoby.dccl.codec import Codec
 from pygoby.dccl.errors import DcclError
+from pygoby.dccl.trace import log as trace_log
 
 
 def register(subparsers) -> None:
@@ -24,18 +26,28 @@ def register(subparsers) -> None:
     parser.add_argument("--passphrase", help="encrypt/decrypt the body with this passphrase")
     parser.add_argument("--strict", action="store_true",
                         help="refuse out-of-range values instead of degrading them")
+    parser.add_argument("--source", action="store_true",
+                        help="analyze: print the Python generated for the message, not the table")
+    parser.add_argument("--trace", action="store_true",
+                        help="encode/decode: print each field's value and bits to stderr")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    codec = Codec(passphrase=args.passphrase, strict=args.strict)
+    if args.trace:
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("%(message)s"))
+        trace_log.addHandler(handler)
+        trace_log.setLevel(logging.DEBUG)
+    codec = Codec(passphrase=args.passphrase, strict=args.strict, trace=args.trace)
     try:
         cls = codec.load_proto(args.proto, args.message, args.include)
     except DcclError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     if args.action == "analyze":
-        print(describe(codec.compiled(cls)))
+        show = generated_source if args.source else describe
+        print(show(codec.compiled(cls)))
         return 0
 
     def encode(line: str) -> str:

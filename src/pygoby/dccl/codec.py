@@ -5,16 +5,17 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
 
 from google.protobuf import message_factory
 from google.protobuf.descriptor import Descriptor
 from google.protobuf.message import Message
 
+from pygoby.dccl.analyze import describe
+from pygoby.dccl.compiled import CompiledType
 from pygoby.dccl.compiler import compile_decoder, compile_encoder
 from pygoby.dccl.crypto import BodyCipher
 from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError, DcclError, DcclLoadError
-from pygoby.dccl.plan import MessageNode, Part, Planner, root_options
+from pygoby.dccl.plan import Part, Planner, root_options
 from pygoby.dccl.registry import DEFAULT_REGISTRY, CodecRegistry
 from pygoby.protobuf import ProtoError, ProtoLoader
 from pygoby.util.clock import Clock
@@ -29,37 +30,16 @@ def id_width(dccl_id: int | None) -> int:
     return 8 if dccl_id < 128 else 16
 
 
-@dataclass
-class CompiledType:
-    """Everything needed to encode/decode one loaded root message type."""
-
-    cls: type[Message]
-    name: str
-    version: int
-    id: int | None
-    id_bits: int
-    max_bytes: int
-    head: MessageNode
-    body: MessageNode
-    head_bytes: int  # the header is fixed-size: ceil((id_bits + head bits) / 8)
-    encode_head: Callable
-    encode_body: Callable
-    decode_head: Callable
-    decode_body: Callable
-
-    def max_size(self) -> int:
-        return self.head_bytes + (self.body.max_size() + 7) // 8
-
-    def min_size(self) -> int:
-        return self.head_bytes + (self.body.min_size() + 7) // 8
-
-
 class Codec:
     """Encodes and decodes DCCL messages, byte-compatible with the C++ DCCL library.
 
     `strict`: out-of-range values, over-long strings and bad repeat counts raise instead of being
     degraded. `passphrase`: AES-256-CTR body encryption. `clock`: the receiver's clock for
-    `dccl.time` fields (defaults to the system clock).
+    `dccl.time` fields (defaults to the system clock). `registry`: the field codecs this Codec
+    can use; by default its own copy of the defaults (`register_codec` adds to the defaults that
+    Codecs made later copy; `codec.registry.register` adds to this Codec only). `trace`: log each
+    field's value and bits to the `pygoby.dccl.trace` logger at DEBUG while encoding and decoding
+    (types are compiled with trace hooks; without `trace` the generated code has none).
     """
 
     def __init__(
@@ -70,9 +50,11 @@ class Codec:
         registry: CodecRegistry | None = None,
         do_not_encrypt_ids: Iterable[int] = (),
         loader: ProtoLoader | None = None,
+        trace: bool = False,
     ) -> None:
         self.strict = strict
-        self.registry = registry if registry is not None else DEFAULT_REGISTRY
+        self.trace = trace
+        self.registry = registry if registry is not None else DEFAULT_REGISTRY.copy()
         self.loader = loader if loader is not None else ProtoLoader()
         self._now: Callable[[], float] = clock.now if clock is not None else time.time
         self._by_name: dict[str, CompiledType] = {}
@@ -142,6 +124,12 @@ class Codec:
                 f" max_bytes {root.max_bytes}"
             )
         id_raw = 0 if root.id is None else root.id << 1 | (1 if id_bits == 16 else 0)
+        generated = {
+            "encode_head": compile_encoder(head, root.name, Part.HEAD, id_raw, id_bits, self.trace),
+            "encode_body": compile_encoder(body, root.name, Part.BODY, 0, 0, self.trace),
+            "decode_head": compile_decoder(head, root.name, Part.HEAD, self.trace),
+            "decode_body": compile_decoder(body, root.name, Part.BODY, self.trace),
+        }
         return CompiledType(
             cls=cls,
             name=root.name,
@@ -152,10 +140,11 @@ class Codec:
             head=head,
             body=body,
             head_bytes=head_bytes,
-            encode_head=compile_encoder(head, "encode_head", id_raw, id_bits),
-            encode_body=compile_encoder(body, "encode_body", 0, 0),
-            decode_head=compile_decoder(head, "decode_head"),
-            decode_body=compile_decoder(body, "decode_body"),
+            encode_head=generated["encode_head"].function,
+            encode_body=generated["encode_body"].function,
+            decode_head=generated["decode_head"].function,
+            decode_body=generated["decode_body"].function,
+            source={name: g.source for name, g in generated.items()},
         )
 
     def compiled(self, message_type: type[Message] | Descriptor | str) -> CompiledType:
@@ -199,8 +188,6 @@ class Codec:
 
     def analyze(self, message_type: type[Message] | Descriptor | str) -> str:
         """A table of the type's fields: codec, part (head/body), bit sizes, and totals."""
-        from pygoby.dccl.analyze import describe
-
         return describe(self.compiled(message_type))
 
     def max_size(self, message_type: type[Message] | Descriptor | str) -> int:

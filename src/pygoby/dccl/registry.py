@@ -26,7 +26,10 @@ class DefaultMessageCodec:
 
 
 class CodecRegistry:
-    """Maps (name, type family) to a codec factory. Users add their own with `register`."""
+    """Maps (name, type family) to a codec factory. Users add their own with `register`.
+
+    Each Codec has its own (a copy of `DEFAULT_REGISTRY` unless given one), so a codec registered
+    for one application's messages cannot change how another Codec in the process encodes."""
 
     def __init__(self) -> None:
         self._entries: dict[tuple[str, str], CodecFactory | DefaultMessageCodec] = {}
@@ -109,6 +112,7 @@ DEFAULT_REGISTRY = _build_default_registry()
 def register_codec(
     name: str, categories: Iterable[str], factory: CodecFactory
 ) -> None:
-    """Register a user codec in the default registry (shared by every Codec not given a registry
-    of its own); a field selects it with `(dccl.field).codec = "name"`."""
+    """Register a user codec in the defaults, which each Codec created afterwards copies into its
+    own registry (a Codec that exists already is not changed: use `codec.registry.register` for
+    one Codec). A field selects it with `(dccl.field).codec = "name"`."""
     DEFAULT_REGISTRY.register(name, categories, factory)
