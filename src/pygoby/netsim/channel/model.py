@@ -15,6 +15,10 @@ API (what a modem emulator calls):
   HALF_DUPLEX (overlapped the receiver's own transmission). Lost ones are returned too, so the
   emulator can decide what a real modem would report.
 * ``channel.next_delivery()``: the earliest pending delivery time (for discrete-event loops).
+* ``channel.detections(now) -> list[Detection]``: the receptions whose start has reached their
+  receiver by `now` and that the receiver locked onto (a modem reports "packet detected" then),
+  each once, in arrival order; their outcome is only known at delivery. Call it before
+  ``poll(now)``: a poll forgets the detections nobody asked for.
 * ``pygoby.netsim.channel.stats.receive_statistics(reception, source_id=, dest_id=)``: the
   Micro-Modem ``$CACST`` (ReceiveStatistics) to report for a reception (None if none).
 * ``pygoby.netsim.channel.settings.environment_channel_configs(manager_config)``:
@@ -44,7 +48,9 @@ when `poll` is called.
 
 from __future__ import annotations
 
+import bisect
 import enum
+import heapq
 import logging
 import math
 import random
@@ -167,6 +173,15 @@ class Reception:
         return sum(not ok for ok in self.frames_ok)
 
 
+@dataclass(frozen=True)
+class Detection:
+    """A reception whose signal has started at `receiver` and locked it (see `detections`)."""
+
+    receiver: int
+    transmission: Transmission
+    arrival: float
+
+
 @dataclass
 class _Pending:
     receiver: int
@@ -180,24 +195,38 @@ class _Pending:
     locked: bool | None = None  # decided once every earlier arrival is known
     detected: bool = False
 
+    @property
+    def arrival_order(self) -> tuple[float, int, int]:
+        """The order in which arrivals are decided and receptions listed (and interference
+        summed): by arrival, receiver, transmission."""
+        return (self.interval.start, self.receiver, self.sequence)
+
+
+_arrival_order = _Pending.arrival_order.fget
+
 
 class Channel:
     def __init__(self, config: ChannelConfig | None = None, seed: int = 0) -> None:
         self.config = config if config is not None else ChannelConfig()
         self.seed = seed
         self._positions: dict[int, Position] = {}
-        self._pending: list[_Pending] = []  # by arrival
-        self._finished: list[_Pending] = []  # kept while they can still interfere
+        # Receptions at each receiver: finished ones (kept while they can still interfere), in
+        # the order they finished (batches in arrival order), then pending ones, by arrival.
+        self._finished_at: dict[int, list[_Pending]] = {}
+        self._pending_at: dict[int, list[_Pending]] = {}
+        self._undecided: list[tuple[tuple[float, int, int], _Pending]] = []  # heap, by arrival
+        self._ends: list[tuple[float, int, int, _Pending]] = []  # heap of pending ones, by end
         self._own_tx: dict[int, list[Interval]] = {}
         self._locked_until: dict[int, float] = {}
         self._sequence = 0
         self._horizon = -math.inf  # last poll time
         self._pruned_at = -math.inf
+        self._longest_configured = max(self.config.durations.values(), default=0.0)
         self._noise_cache: dict[Band, float] = {}
         self._quiet: dict[float, float] = {}  # noise level -> its power sum alone
         self._noise_by_port: dict[int, float] = {}
         self._rng = random.Random()
-        self._earliest_end: float | None = None  # of the pending receptions
+        self._detected: list[Detection] = []  # locked receptions not yet reported
         # The stale position last reported per node, so each one is logged once.
         self._stale_reported: dict[int, Position] = {}
 
@@ -310,30 +339,43 @@ class Channel:
                 - transmission_loss(range_m, alpha, config.spreading),
                 closing_speed=closing_speed(source, receiver_now),
             )
-            self._pending.append(pending)
+            order = pending.arrival_order
+            bisect.insort(self._pending_at.setdefault(port, []), pending, key=_arrival_order)
+            heapq.heappush(self._undecided, (order, pending))
+            heapq.heappush(self._ends, (pending.interval.end, sequence, port, pending))
             planned.append((port, arrival))
-        self._pending.sort(key=lambda p: (p.interval.start, p.receiver, p.sequence))
-        self._earliest_end = min([p.interval.end for p in self._pending], default=None)
         return planned
 
     def next_delivery(self) -> float | None:
-        if self._earliest_end is None:
+        if not self._ends:
             return None
-        return self._earliest_end + self.config.decode_latency
+        return self._ends[0][0] + self.config.decode_latency
+
+    def detections(self, now: float) -> list[Detection]:
+        """Receptions locked onto by `now` (see the module's documentation), each once. With
+        the protocol model, those within the detection range."""
+        self._horizon = max(self._horizon, now)
+        self._decide_locks(now)
+        detected, self._detected = self._detected, []
+        return detected
 
     def poll(self, now: float) -> list[Reception]:
         """Receptions delivered by `now` (no transmission may be registered before `now` later)."""
         self._horizon = max(self._horizon, now)
         self._decide_locks(now)
+        self._detected.clear()
         latency = self.config.decode_latency
-        due, pending = [], []
-        for p in self._pending:
-            (due if p.interval.end + latency <= now else pending).append(p)
+        ends = self._ends
+        due = []
+        while ends and ends[0][0] + latency <= now:
+            due.append(heapq.heappop(ends)[3])
         if not due:
             return []
-        self._pending = pending
-        self._earliest_end = min([p.interval.end for p in pending], default=None)
-        self._finished.extend(due)  # before finishing: they interfere with each other
+        # finished before finishing (they interfere with each other), in arrival order
+        due.sort(key=_arrival_order)
+        for p in due:
+            self._pending_at[p.receiver].remove(p)
+            self._finished_at.setdefault(p.receiver, []).append(p)
         due.sort(key=lambda p: (p.interval.end, p.receiver, p.sequence))
         at_receiver: dict[int, list[_Pending]] = {}
         results = []
@@ -348,11 +390,9 @@ class Channel:
     # -- internals -------------------------------------------------------------------------
 
     def _receptions_at(self, receiver: int) -> list[_Pending]:
-        """Every finished and pending reception at a receiver, in the order of the lists
-        (interference sums depend on it)."""
-        return [p for p in self._finished if p.receiver == receiver] + [
-            p for p in self._pending if p.receiver == receiver
-        ]
+        """Every finished and pending reception at a receiver, in that order (interference
+        sums depend on it)."""
+        return self._finished_at.get(receiver, []) + self._pending_at.get(receiver, [])
 
     def _noise_at(self, port: int) -> float:
         """noise_level of the node's band, by port (the configuration is frozen; a Band's
@@ -374,15 +414,15 @@ class Channel:
         """Detection and receiver lock for every reception that has started by `now`, in
         arrival order (all earlier arrivals are known by then)."""
         config = self.config
+        undecided = self._undecided
         at_receiver: dict[int, list[_Pending]] = {}  # (the lists do not change meanwhile)
-        for p in self._pending:  # sorted by arrival
+        while undecided and undecided[0][0][0] <= now:
+            p = heapq.heappop(undecided)[1]
             start = p.interval.start
-            if start > now:
-                break
-            if p.locked is not None:
-                continue
             if config.protocol_model is not None:  # decided in _protocol_outcome
                 p.detected = p.locked = True
+                if p.range_m <= config.protocol_model.detection_range:
+                    self._detected.append(Detection(p.receiver, p.transmission, start))
                 continue
             receptions = at_receiver.get(p.receiver)
             if receptions is None:
@@ -401,6 +441,8 @@ class Channel:
             p.detected = level >= threshold or not config.receiver_lock
             if not config.receiver_lock:
                 p.locked = True
+                if p.detected:
+                    self._detected.append(Detection(p.receiver, p.transmission, start))
                 continue
             free = self._locked_until.get(p.receiver, -math.inf) <= start
             transmitting = False
@@ -412,6 +454,7 @@ class Channel:
             p.locked = p.detected and free and not transmitting
             if p.locked:
                 self._locked_until[p.receiver] = p.interval.end
+                self._detected.append(Detection(p.receiver, p.transmission, start))
 
     def _finish(self, p: _Pending, at_receiver: list[_Pending]) -> Reception:
         """`at_receiver`: every finished and pending reception at p's receiver."""
@@ -491,7 +534,7 @@ class Channel:
 
     def _prune(self, now: float) -> None:
         """Forget receptions and own transmissions that can no longer overlap anything."""
-        longest = max(self.config.durations.values(), default=0.0)
+        longest = self._longest_configured
         # Pruning later than possible changes nothing (what it would have dropped overlaps
         # nothing still to come), so prune about once per packet length, not at every poll.
         if now - self._pruned_at < longest:
@@ -499,9 +542,10 @@ class Channel:
         self._pruned_at = now
         # a pending reception outlasts these only with its own (explicit) duration
         longest = max(
-            [longest, *(d for p in self._pending if (d := p.transmission.duration) is not None)]
+            [longest, *(d for *_, p in self._ends if (d := p.transmission.duration) is not None)]
         )
         horizon = now - self.config.decode_latency - longest
-        self._finished = [p for p in self._finished if p.interval.end > horizon]
+        for port, finished in self._finished_at.items():
+            self._finished_at[port] = [p for p in finished if p.interval.end > horizon]
         for port, intervals in self._own_tx.items():
             self._own_tx[port] = [i for i in intervals if i.end > horizon]
