@@ -9,6 +9,7 @@ from pygoby.acomms import messages as m
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
 from pygoby.acomms.mmsim.server import MMSimServer
+from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, ModemTiming, RateTiming
 from pygoby.util.clock import WallClock
 
 DRIVER_WHOI_MICROMODEM = 2
@@ -27,12 +28,25 @@ def mm_config(modem_id: int, port: int, **mm) -> object:
     return cfg
 
 
-async def start_emulators(ids, channel=None):
-    channel = channel if channel is not None else LoopbackChannel()
+# The modem's durations, ten times shorter: end-to-end tests of the driver and queue, not of
+# the timing (tests/acomms/test_mmsim_model.py and the pyacomms tests use the real ones).
+FAST = ModemTiming(
+    rates={
+        rate: RateTiming(t.frames, t.frame_bytes, t.lead / 10, t.per_frame / 10)
+        for rate, t in DEFAULT_TIMING.rates.items()
+    },
+    mini_packet=DEFAULT_TIMING.mini_packet / 10,
+    ping=DEFAULT_TIMING.ping / 10,
+)
+
+
+async def start_emulators(ids, range_m=0.0, timing=FAST):
     clock = WallClock()
+    channel = LoopbackChannel(clock, range_m)
     servers = []
     for modem_id in ids:
-        server = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
+        model = MicroModemModel(modem_id, clock, channel, timing=timing)
+        server = MMSimServer(model, channel)
         await server.start()
         servers.append(server)
     return channel, servers

@@ -9,15 +9,18 @@ from hypothesis import strategies as st
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.drivers.micromodem.statistics import (
+    CycleStatistics,
     add_cst,
-    cst_head,
-    cst_text,
+    cst_fields,
+    cycle_statistics,
     format_cst,
+    format_xst,
     parse_cst,
     parse_toa,
     parse_xst,
+    toa_text,
 )
-from pygoby.util.nmea import NMEAFormatError, NMEASentence, with_checksum
+from pygoby.util.nmea import NMEAFormatError, NMEASentence
 
 DAY = dt.date(2023, 11, 14)
 MIDNIGHT_US = int(dt.datetime(2023, 11, 14, tzinfo=dt.UTC).timestamp()) * 1_000_000
@@ -52,9 +55,14 @@ def test_format_then_parse_gives_the_statistics_back(
     sentence = format_cst(stat, version)
     as_mapping = {field.name: value for field, value in stat.ListFields()}
     assert format_cst(as_mapping, version) == sentence
-    assert with_checksum(cst_text(as_mapping, version)) == sentence.message()
     assert sentence.fields[:2] == (("$CACST", str(version)) if version else ("$CACST", str(mode)))
     assert parse_cst(NMEASentence.parse(sentence.message()), DAY) == stat
+    # the values a typed link carries read exactly as their text
+    typed = cycle_statistics(stat, version)
+    assert typed.message() == sentence.message()
+    other_day = dt.date(2001, 2, 3)  # (a version-0 time of day takes the reader's date)
+    for bitfield in (False, True):
+        assert cst_fields(typed, other_day, bitfield) == cst_fields(sentence, other_day, bitfield)
 
 
 def test_out_of_range_enum_values_become_invalid():
@@ -82,29 +90,10 @@ def test_a_field_that_is_not_a_number_is_named(index, text):
         parse_cst(NMEASentence.parse(",".join(fields)), DAY)
 
 
-def test_add_cst_gives_parse_cst_for_recurring_statistics():
-    """The second sentence of a link (same fields, another time of arrival) comes from the
-    remembered parse of the first: the result must still be exactly parse_cst's."""
-    rx = m.ModemTransmission()
-    stats = rx.Extensions[m.MM_TRANSMISSION].receive_stat
-    second = CST.replace("221330.6675", "221407.0125")
-    for text in (CST, second, CST):
-        sentence = NMEASentence.parse(text)
-        assert add_cst(stats, sentence, DAY) == parse_cst(sentence, DAY)
-    assert [s.time for s in stats] == [
-        MIDNIGHT_US + (22 * 3600 + 13 * 60 + 30) * 1_000_000 + 667_500,
-        MIDNIGHT_US + (22 * 3600 + 14 * 60 + 7) * 1_000_000 + 12_500,
-        MIDNIGHT_US + (22 * 3600 + 13 * 60 + 30) * 1_000_000 + 667_500,
-    ]
-    other_day = dt.date(2024, 2, 29)
-    sentence = NMEASentence.parse(second)
-    assert add_cst(stats, sentence, other_day) == parse_cst(sentence, other_day)
-
-
 def test_add_cst_appends_nothing_for_a_bad_sentence():
     rx = m.ModemTransmission()
     stats = rx.Extensions[m.MM_TRANSMISSION].receive_stat
-    add_cst(stats, NMEASentence.parse(CST), DAY)  # remembered: only the TOA is read next
+    add_cst(stats, NMEASentence.parse(CST), DAY)
     with pytest.raises(NMEAFormatError, match="bad time of arrival"):
         add_cst(stats, NMEASentence.parse(CST.replace("221330.6675", "2213x0.6675")), DAY)
     fields = CST.split(",")
@@ -129,17 +118,22 @@ def test_add_cst_warns_about_every_short_sentence(caplog):
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.one_of(st.integers(0, 2**33 * 10**6 - 1), st.integers(1_600_000_000 * 10**6, 2 * 10**15)))
-def test_cst_head_prints_the_utc_time_of_day(time_us):
-    toa = dt.datetime.fromtimestamp(time_us / 1e6, dt.UTC)
-    expected = f"$CACST,1,{toa:%H%M%S}.{toa.microsecond // 100:04d},"
-    assert cst_head(1, time_us) == expected
-    assert cst_head(1, float(time_us)) == expected  # (a float time takes the datetime path)
-    day = toa.date()
-    assert parse_toa(expected.split(",")[2], day) == time_us - time_us % 100
+@given(st.integers(0, 2**33 * 10**6 - 1), st.booleans())
+def test_toa_text_prints_the_utc_time_of_day_and_parse_toa_reads_it(time_us, with_date):
+    toa = dt.datetime.fromtimestamp(time_us // 100 * 100 / 1e6, dt.UTC)
+    expected = f"{toa:%H%M%S}.{toa.microsecond // 100:04d}"
+    if with_date:
+        expected = f"{toa:%Y%m%d}" + expected
+    assert toa_text(time_us, with_date) == expected
+    day = toa.date() if not with_date else dt.date(1999, 1, 1)  # (a dated time keeps its date)
+    assert parse_toa(expected, day) == time_us - time_us % 100
 
 
-@pytest.mark.parametrize("text", ["240000.0", "236000", "225960.5", "12345", "1234567", "12a456"])
+@pytest.mark.parametrize(
+    "text",
+    ["240000.0", "236000", "225960.5", "12345", "1234567", "12a456", "20231314221320.5",
+     "00000000221320", "20230229000000", "2023111422132"],
+)  # fmt: skip
 def test_parse_toa_refuses_what_is_not_a_time_of_day(text):
     with pytest.raises(ValueError):
         parse_toa(text, DAY)
@@ -165,3 +159,22 @@ def test_parse_xst_fields_enum_ranges_and_short_sentences(caplog):
     assert short.mode == 2 and short.bandwidth == 5000 and not short.HasField("carrier_freq")
     with pytest.raises(NMEAFormatError, match="field 5 of"):
         parse_xst(NMEASentence.parse("$CAXST,20231114,221930.0010,0,2,x,5000,25000"))
+
+
+def test_format_xst_prints_what_parse_xst_reads():
+    values = dict(clock_mode=1, mode=0, probe_length=0, bandwidth=5000, carrier_freq=25000,
+                  rate=5, source=1, dest=2, ack_requested=True, number_frames_expected=8,
+                  number_frames_sent=8, packet_type=3, number_bytes=2048)  # fmt: skip
+    for version in (0, 6):
+        xst = parse_xst(NMEASentence.parse(format_xst(1_700_000_000.25, values, version).message()))
+        assert (xst.version, xst.date, xst.time) == (version, "20231114", "221320.2500")
+        assert {k: getattr(xst, k) for k in values} == values
+
+
+def test_cycle_statistics_is_a_sentence_for_the_driver():
+    stat = parse_cst(NMEASentence.parse(CST), DAY)
+    typed = cycle_statistics(stat, 6)
+    assert isinstance(typed, CycleStatistics)
+    assert (typed.talker_id, typed.sentence_id) == ("CA", "CST")
+    assert typed.fields == NMEASentence.parse(typed.message()).fields
+    assert typed.toa == "20231114221330.6675"

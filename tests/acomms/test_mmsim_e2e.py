@@ -5,7 +5,7 @@ import asyncio
 from pygoby.acomms import messages as m
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
-from pygoby.acomms.mmsim.server import MMSimServer
+from pygoby.acomms.mmsim.server import ANONYMOUS_PTY, MMSimServer
 from pygoby.util.clock import WallClock
 
 from .mm_e2e import run_until, start_emulators, started_driver
@@ -13,7 +13,7 @@ from .queue_helpers import status_link
 
 
 async def test_data_with_ack_and_ranging_over_tcp():
-    channel, (sim1, sim2) = await start_emulators([1, 2], LoopbackChannel(travel_time=0.6667))
+    channel, (sim1, sim2) = await start_emulators([1, 2], range_m=1000.0)  # 0.6667 s away
     d1 = await started_driver(1, sim1.port)
     d2 = await started_driver(2, sim2.port, query=True)  # also exercises CFQ,ALL at start-up
     try:
@@ -45,7 +45,7 @@ async def test_data_with_ack_and_ranging_over_tcp():
         await run_until(lambda: any(t.type == m.DRIVER_SPECIFIC for t in got1), [d1, d2])
         reply = next(t for t in got1 if t.type == m.DRIVER_SPECIFIC)
         owtt = reply.Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time
-        assert list(owtt) == [0.6667] and (reply.src, reply.dest) == (2, 1)
+        assert list(owtt) == [0.6667] and (reply.src, reply.dest) == (2, 1)  # (exact: 4 digits)
         assert any(t.type == m.DRIVER_SPECIFIC and t.src == 1 for t in got2)  # $CAMPA heard
     finally:
         for d in (d1, d2):
@@ -98,7 +98,7 @@ async def test_driver_reconnects_after_link_drop_and_resumes():
 
 async def test_driver_over_serial_pty():
     channel = LoopbackChannel()
-    sim = MMSimServer(MicroModemModel(3, WallClock(), channel), channel, use_pty=True)
+    sim = MMSimServer(MicroModemModel(3, WallClock(), channel), channel, pty_path=ANONYMOUS_PTY)
     await sim.start()
     cfg = m.DriverConfig(driver_type=2, modem_id=3, serial_port=sim.pty_path, serial_baud=19200)
     cfg.Extensions[m.MM_CONFIG].query_cfg_on_startup = False
@@ -106,7 +106,7 @@ async def test_driver_over_serial_pty():
     driver.startup(cfg)
     try:
         await run_until(lambda: driver.startup_complete, [driver], timeout=15)
-        assert driver.revision == (0, 94, 0)
+        assert driver.revision == (2, 0, 40000)  # (the emulator is a Micro-Modem 2)
     finally:
         driver.shutdown()
         await sim.close()

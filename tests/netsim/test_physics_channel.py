@@ -10,6 +10,7 @@ import pytest
 
 from pygoby.acomms.drivers.micromodem.statistics import parse_cst
 from pygoby.acomms.mmsim import MicroModemModel
+from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.netsim.channel import Channel, ChannelConfig, Position
 from pygoby.netsim.channel.absorption import thorp
 from pygoby.netsim.channel.geometry import WGS84
@@ -18,6 +19,7 @@ from pygoby.netsim.eventlog import EventLogWriter, read_events
 from pygoby.netsim.physics_channel import PhysicsChannel
 from pygoby.util.clock import VirtualClock
 from pygoby.util.nmea import NMEASentence
+from pygoby.util.timeline import Timeline
 
 ORIGIN = (42.0, -70.0)
 T0 = 1_700_000_000.0
@@ -37,15 +39,16 @@ class Net:
         self.physics = PhysicsChannel(
             Channel(ChannelConfig(**config), seed=seed), self.clock, on_event=events
         )
+        self.timeline = Timeline(self.clock)
         self.modems: dict[int, MicroModemModel] = {}
         for i, (port, east) in enumerate(sorted(east_m.items()), 1):
             self.physics.channel.update_position(port, at(east))
-            self.modems[i] = MicroModemModel(i, self.clock, self.physics, name=str(port))
+            self.modems[i] = MicroModemModel(
+                i, self.clock, self.physics, name=str(port), timeline=self.timeline
+            )
 
-    def say(self, modem_id: int, body: str) -> list[str]:
-        model = self.modems[modem_id]
-        model.handle_line(NMEASentence.parse(body).message() + "\r\n")
-        return model.take_output()
+    def say(self, modem_id: int, body: str) -> None:
+        self.modems[modem_id].handle_line(NMEASentence.parse(body).message() + "\r\n")
 
     def send(self, src: int, dest: int, frames: list[bytes], rate: int = 1, ack: int = 0):
         self.say(src, f"$CCCYC,0,{src},{dest},{rate},{ack},{len(frames)}")
@@ -53,14 +56,19 @@ class Net:
             self.say(src, f"$CCTXD,{src},{dest},{ack},{frame.hex()}")
 
     def run_until(self, t: float) -> dict[int, list[NMEASentence]]:
-        """Advance through every delivery up to t; the sentences each modem printed."""
-        while (when := self.physics.next_event_time()) is not None and when <= t:
-            self.clock.set(when)
+        """Advance through every event up to t; the sentences each modem printed."""
+        while True:
+            times = [x for x in (self.physics.next_event_time(), self.timeline.next_time()) if x]
+            if not times or min(times) > t:
+                break
+            self.clock.set(max(min(times), self.clock.now()))
             self.physics.do_work()
+            self.timeline.run_due()
         self.clock.set(t)
         self.physics.do_work()
+        self.timeline.run_due()
         return {
-            i: [NMEASentence.parse(line) for line in model.take_output()]
+            i: [NMEASentence.parse(s.message()) for s in model.take_output()]
             for i, model in self.modems.items()
         }
 
@@ -72,19 +80,21 @@ def ids(sentences: list[NMEASentence], token: str) -> list[NMEASentence]:
 def test_data_arrives_at_end_of_reception_with_physics_stats_and_ack():
     net = Net({62000: 0.0, 62001: 1500.0})
     net.send(1, 2, [b"hello", b"world"], ack=1)
-    assert net.run_until(T0 + 4.2)[2] == []  # arrival T0 + 1.0, 3.25 s on air
-    out = net.run_until(T0 + 4.3)
+    air = DEFAULT_TIMING.data(1, 2)  # two rate-1 frames
+    assert ids(net.run_until(T0 + 1.05)[2], "CARXP")  # the start arrives after T0 + 1.0
+    assert net.run_until(T0 + 1.0 + air - 0.01)[2] == []
+    out = net.run_until(T0 + 1.0 + air + 0.01)
     rxd = ids(out[2], "CARXD")
     assert [bytes.fromhex(s[5]) for s in rxd] == [b"hello", b"world"]
     (cst,) = ids(out[2], "CACST")
-    stat = parse_cst(cst, dt.date(2023, 11, 14))
+    stat = parse_cst(cst, dt.date(2023, 11, 14), new_clock_bitfield=True)
     # SNR from the physics (185 dB source, 1.5 km), not the emulator's constant 15 dB
     assert stat.snr_in == 30  # clamped at its 30 dB maximum
     assert stat.spl == round(185 - transmission_loss(1500, thorp(25), 1.5))
     assert stat.time == pytest.approx((T0 + 1.0) * 1e6, abs=10)  # true time of arrival
-    # the ACK (a 1 s control packet) leaves at T0 + 4.25 and is heard at T0 + 6.25
-    assert ids(net.run_until(T0 + 6.2)[1], "CAACK") == []
-    acks = ids(net.run_until(T0 + 6.3)[1], "CAACK")
+    # the ACK (a 1 s mini-packet) leaves when the data has been heard, is heard 2 s later
+    assert ids(net.run_until(T0 + 3.0 + air - 0.01)[1], "CAACK") == []
+    acks = ids(net.run_until(T0 + 3.0 + air + 0.01)[1], "CAACK")
     assert [(s[1], s[2], s[3]) for s in acks] == [("2", "1", "1"), ("2", "1", "2")]
 
 
@@ -105,8 +115,9 @@ def test_ping_to_moving_vehicle_averages_both_legs():
     net.say(1, "$CCMPC,1,2")
     (mpr,) = ids(net.run_until(T0 + 10)[1], "CAMPR")
     first = 3000 / 1497  # receiver opening at 3 m/s
-    ping_done = T0 + first + 0.5  # ping is 0.5 s on air; the reply leaves when it is heard
-    second = (3000 + 3 * (ping_done - T0)) / 1500
+    # the ping is 0.5 s on air; the reply leaves 50 ms (NVRAM TAT) after it has been heard
+    reply_start = T0 + first + 0.5 + 0.05
+    second = (3000 + 3 * (reply_start - T0)) / 1500
     assert float(mpr[3]) == pytest.approx((first + second) / 2, abs=2e-4)
     assert float(mpr[3]) > 3000 / 1500
 
@@ -122,9 +133,9 @@ def test_three_modems_collision_receiver_locks_on_first_arrival():
 def test_half_duplex_transmitting_modem_misses_reception():
     events = []
     net = Net({62000: 0.0, 62001: 1500.0}, events=events.append)
-    net.send(1, 2, [b"lost"])
+    net.send(1, 2, [b"lost", b"2", b"3"])  # 3.25 s on the water
     net.clock.set(T0 + 2.0)  # node 2 starts transmitting while node 1's packet arrives
-    net.send(2, 1, [b"also lost"])
+    net.send(2, 1, [b"also lost", b"2", b"3"])
     out = net.run_until(T0 + 20)
     assert ids(out[1], "CARXD") == [] and ids(out[2], "CARXD") == []
     outcomes = [e["outcome"] for e in events if e["event"] == "rx"]
@@ -186,28 +197,3 @@ def test_modem_without_port_is_refused():
                                                                 ports={"alpha": 62005}),
                             name="alpha")  # fmt: skip
     assert model.channel.port_of(model) == 62005
-
-
-def test_rx_event_figures_are_rounded_the_same_when_remembered():
-    from pygoby.netsim import physics_channel
-
-    def fresh(range_m, owtt, rl, noise, sinr):
-        snr = rl - noise
-        return (
-            round(range_m, 3), round(owtt, 6), round(rl, 2), round(snr, 2), round(sinr, 2),
-            sinr < snr - 0.01,
-        )  # fmt: skip
-
-    physics_channel._figures.clear()
-    cases = [
-        (1234.56789, 0.8230452, 120.4449, 62.3, 58.1449),
-        (1234.56789, 0.8230452, 120.4449, 62.3, 50.0),  # a collision
-        (0.0, 0.0, 185.0, 62.3, -0.004),  # a zero: not remembered
-        (10.0, 0.0066, 62.3, 62.3, -0.0),  # -0.0 keeps its sign
-    ]
-    for _ in range(2):
-        for case in cases:
-            got = physics_channel._link_figures(*case)
-            assert got == fresh(*case)
-            assert [str(x) for x in got] == [str(x) for x in fresh(*case)]
-    assert len(physics_channel._figures) == 2

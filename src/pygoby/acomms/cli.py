@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import logging
+import sys
 
 from pygoby.util.aiorun import run_until_signal
 
@@ -13,19 +14,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "mmsim",
         help="WHOI Micro-Modem emulator (NMEA over TCP / pty)",
-        description="Emulated WHOI Micro-Modem. Emulators in other processes hear each other "
-        "through a perfect channel carried by UDP multicast on 127.0.0.1.",
+        description="Emulated WHOI Micro-Modem with the modem's timing (packets take their "
+        "time on the water, travel at the speed of sound over --range). Emulators in other "
+        "processes hear each other through a perfect channel carried by UDP multicast on "
+        "127.0.0.1.",
     )
     p.add_argument("--port", type=int, required=True, help="TCP port to serve NMEA on (0: any)")
     p.add_argument("--id", type=int, required=True, help="acoustic address (NVRAM SRC)")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
-    p.add_argument("--pty", action="store_true", help="also serve on a pseudo-terminal")
-    p.add_argument("--firmware", default="0.94.0.00", help="version in $CAREV (2.x = MM2)")
+    p.add_argument("--pty", nargs="?", const="", metavar="PATH",
+                   help="also serve on a pseudo-terminal, linked at PATH if given (e.g. "
+                   "/tmp/ttyLOOPA1, for a mission's serial_port)")  # fmt: skip
+    p.add_argument("--firmware", help="version in $CAREV: 2.x a Micro-Modem 2 (the default), "
+                   "0.x a Micro-Modem 1")  # fmt: skip
     p.add_argument("--channel-group", default="239.255.42.99:45454",
                    help="multicast group:port shared by emulators (default %(default)s)")  # fmt: skip
-    p.add_argument(
-        "--travel-time", type=float, default=0.0, help="one-way travel time for pings (s)"
-    )
+    p.add_argument("--range", type=float, default=0.0, metavar="METERS",
+                   help="distance between the emulated modems (travel time at --sound-speed)")
+    p.add_argument("--sound-speed", type=float, default=1500.0, help="m/s (default %(default)s)")
     p.set_defaults(func=run)
 
     s = subparsers.add_parser(
@@ -51,8 +57,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pygoby.util.pty import PtyError
+
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
-    run_until_signal(_serve(args))
+    try:
+        run_until_signal(_serve(args))
+    except (PtyError, ValueError) as exc:
+        print(f"mmsim: {exc}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -62,16 +74,18 @@ async def _serve(args: argparse.Namespace) -> None:
     from pygoby.acomms.mmsim.server import MMSimServer
     from pygoby.util.clock import WallClock
 
+    clock = WallClock()
     group, _, port = args.channel_group.rpartition(":")
-    channel = MulticastChannel(group, int(port), args.travel_time)
+    channel = MulticastChannel(group, int(port), clock, args.range, args.sound_speed)
     channel.open()
-    model = MicroModemModel(args.id, WallClock(), channel, firmware=args.firmware)
-    server = MMSimServer(model, channel, args.host, args.port, use_pty=args.pty)
-    port_used = await server.start()
-    print(f"mmsim id {args.id} listening on {args.host}:{port_used}", flush=True)
-    if server.pty_path:
-        print(f"mmsim id {args.id} serial pty {server.pty_path}", flush=True)
+    firmware = {"firmware": args.firmware} if args.firmware else {}
+    model = MicroModemModel(args.id, clock, channel, **firmware)
+    server = MMSimServer(model, channel, args.host, args.port, pty_path=args.pty)
     try:
+        port_used = await server.start()
+        print(f"mmsim id {args.id} listening on {args.host}:{port_used}", flush=True)
+        if server.pty_path:
+            print(f"mmsim id {args.id} serial pty {server.pty_path}", flush=True)
         await asyncio.Future()
     finally:
         await server.close()

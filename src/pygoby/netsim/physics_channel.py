@@ -8,14 +8,18 @@
 * positions are whatever the physics Channel knows: follow a NetSimManager with
   ``manager.on_nav(physics.channel.on_environment_nav_update)``, or feed scripted tracks with
   ``physics.channel.update_position(port, Position(...))``;
-* `transmit` registers the packet as a Transmission starting at the clock's now; `do_work`
-  polls the Channel at the clock's now and hands each reception to its receiver at its delivery
-  time (end of reception + decode latency) with the physics' outcome: all frames good, some
-  frames bad (the emulator reports those as BAD_CRC), or nothing at all (not detected, receiver
-  busy, half-duplex; a control packet — cycle-init, ACK, ping, mini-packet — with a bad frame);
-* `$CACST` numbers (SNR, SPL, Doppler, ...) come from `pygoby.netsim.channel.stats`;
-* a ping reply carries the true travel time: the mean of the two legs' one-way travel times, each
-  computed for the nodes' positions at the time (what the modem's `(round trip - TAT) / 2` gives);
+* `transmit` registers the packet as a Transmission starting at its `tx_time` and lasting its
+  `duration` (the emulator's duration table, pygoby.acomms.mmsim.timing); `do_work` asks the
+  Channel at the clock's now which receptions have locked their receivers (the emulator prints
+  `$CARXP`) and which have been delivered (end of reception + decode latency), and hands each
+  delivery to its receiver with the physics' outcome: all frames good, some frames bad (the
+  emulator reports those as BAD_CRC), or nothing at all (not detected, receiver busy,
+  half-duplex; a control packet — cycle-init, ACK, ping, mini-packet — with a bad frame);
+* `next_event_time` is the next delivery: in a discrete-event run a detection is reported at the
+  next event after its arrival (nothing in such a run depends on when `$CARXP` is printed), in
+  a real-time run at the next `do_work` (every few ms);
+* `$CACST` numbers (SNR, SPL, Doppler, ...) come from `pygoby.netsim.channel.stats`; ping replies
+  are timed by the emulators themselves (travel times from the arrival times the physics gives);
 * every transmission and reception is reported to `on_event` as a dict (JSON-ready), which
   `pygoby.netsim.eventlog` writes as the run's event log.
 
@@ -41,27 +45,29 @@ log = logging.getLogger(__name__)
 
 EventSink = Callable[[dict], None]
 
-# What each emulator packet is on the water: the cycle-init, ACK and mini-packets are short FSK
-# packets; pings and their replies are ranging pulses.
+# What each emulator packet is on the water: data and FDP packets carry frames at their rate; the
+# cycle-init, ACK, mini-packets and hardware-control packets are short FSK packets; pings,
+# their replies and the other signals (sweeps, navigation pings) are pulses.
 PHYSICAL_KIND = {
     ModemPacketKind.DATA: PacketKind.DATA,
+    ModemPacketKind.FDP: PacketKind.DATA,
     ModemPacketKind.CYCLE: PacketKind.MINI,
     ModemPacketKind.ACK: PacketKind.MINI,
     ModemPacketKind.MINI: PacketKind.MINI,
+    ModemPacketKind.HW_CONTROL: PacketKind.MINI,
     ModemPacketKind.PING: PacketKind.PING,
     ModemPacketKind.PING_REPLY: PacketKind.PING,
+    ModemPacketKind.SIGNAL: PacketKind.PING,
 }
 
 
 @dataclass(frozen=True)
 class _Sent:
-    """The payload of a Transmission: who sent which packet (and, for a ping reply, the
-    travel time of the ping it answers)."""
+    """The payload of a Transmission: who sent which packet."""
 
     sender: ChannelEndpoint
     packet: AcousticPacket
     port: int
-    first_leg_owtt: float | None = None
 
 
 class PhysicsChannel:
@@ -82,7 +88,6 @@ class PhysicsChannel:
         self.control_rate = control_rate
         self.on_event = on_event
         self._endpoints: dict[int, ChannelEndpoint] = {}
-        self._answering: tuple[int, float] | None = None  # (port, owtt) of a ping being heard
         self._last_poll = -math.inf
 
     # -- the mmsim Channel interface -----------------------------------------------------------
@@ -113,21 +118,21 @@ class PhysicsChannel:
 
     def transmit(self, sender: ChannelEndpoint, packet: AcousticPacket) -> None:
         port = self.port_of(sender)
-        first_leg = None
-        if packet.kind is ModemPacketKind.PING_REPLY and self._answering is not None:
-            answering_port, owtt = self._answering
-            if answering_port == port:
-                first_leg = owtt
-        data = packet.kind is ModemPacketKind.DATA
+        kind = packet.kind
+        if kind in _FRAMED:
+            rate, frames = packet.rate, max(1, len(packet.frames))
+        else:
+            rate, frames = self.control_rate, 1
         tx = Transmission(
             source=port,
             # never before the last poll (a wall clock stepped back must not break the channel)
-            start=max(self.clock.now(), self._last_poll),
-            rate=packet.rate if data else self.control_rate,
-            frames=max(1, len(packet.frames)) if data else 1,
-            kind=PHYSICAL_KIND[packet.kind],
+            start=max(packet.tx_time, self._last_poll),
+            rate=rate,
+            frames=frames,
+            kind=PHYSICAL_KIND[kind],
+            duration=packet.duration,
             dest=packet.dest,
-            payload=_Sent(sender, packet, port, first_leg),
+            payload=_Sent(sender, packet, port),
         )
         planned = self.channel.transmit(tx)
         if self.on_event is not None:
@@ -138,10 +143,10 @@ class PhysicsChannel:
                     "port": port,
                     "src": packet.src,
                     "dest": packet.dest,
-                    "kind": packet.kind._value_,
+                    "kind": kind._value_,
                     "rate": packet.rate,
                     "frames": tx.frames,
-                    "duration": self.channel.duration_of(tx),
+                    "duration": packet.duration,
                     "bytes": sum(len(f) for f in packet.frames),
                     "receivers": len(planned),
                 }  # fmt: skip
@@ -150,6 +155,10 @@ class PhysicsChannel:
     def do_work(self) -> None:
         now = max(self.clock.now(), self._last_poll)
         self._last_poll = now
+        for d in self.channel.detections(now):
+            endpoint = self._endpoints.get(d.receiver)
+            if endpoint is not None:
+                endpoint.detect(d.transmission.payload.packet, d.arrival)
         for reception in self.channel.poll(now):
             self._deliver(reception)
 
@@ -164,45 +173,37 @@ class PhysicsChannel:
         packet = sent.packet
         endpoint = self._endpoints.get(r.receiver)
         delivered = endpoint is not None and self._heard(r, packet)
-        travel_time = r.owtt
-        if packet.kind is ModemPacketKind.PING_REPLY and sent.first_leg_owtt is not None:
-            travel_time = (sent.first_leg_owtt + r.owtt) / 2
         if self.on_event is not None:
-            self._log_reception(r, sent, delivered, travel_time)
+            self._log_reception(r, sent, delivered)
         if not delivered:
             return
         assert endpoint is not None
         reception = ModemReception(
             arrival_time=r.arrival,
             frame_ok=None if r.outcome is Outcome.GOOD else list(r.frames_ok),
-            travel_time=travel_time,
             stats=self._stats(r),
         )
-        self._answering = (r.receiver, r.owtt) if packet.kind is ModemPacketKind.PING else None
-        try:
-            endpoint.receive(packet, reception)
-        finally:
-            self._answering = None
+        endpoint.receive(packet, reception)
 
     @staticmethod
     def _heard(r: Reception, packet: AcousticPacket) -> bool:
         if r.outcome is Outcome.GOOD:
             return True
-        # A data packet with bad frames is reported frame by frame (BAD_CRC); a control packet
+        # A data or FDP packet with bad frames is reported as such (BAD_CRC); a control packet
         # with its only frame bad is never noticed by the host.
-        return r.outcome is Outcome.BAD_FRAMES and packet.kind is ModemPacketKind.DATA
+        return r.outcome is Outcome.BAD_FRAMES and packet.kind in _FRAMED
 
     def _stats(self, r: Reception) -> dict[str, float]:
         """The $CACST fields taken from the physics (the emulator fills the rest)."""
         band = self.channel.config.band_of(r.receiver)
         return link_statistics(r, band.carrier_hz, band.bandwidth_hz) or {}
 
-    def _log_reception(self, r: Reception, sent: _Sent, delivered: bool, owtt: float) -> None:
+    def _log_reception(self, r: Reception, sent: _Sent, delivered: bool) -> None:
         # (enum values read as `_value_`: the `value` property is a Python call per event)
         assert self.on_event is not None
         packet = sent.packet
         range_m, owtt, rl, snr, sinr, collision = _link_figures(
-            r.range_m, owtt, r.received_level, r.noise_level, r.sinr
+            r.range_m, r.owtt, r.received_level, r.noise_level, r.sinr
         )
         self.on_event(
             {
@@ -230,25 +231,15 @@ class PhysicsChannel:
         )
 
 
+_FRAMED = (ModemPacketKind.DATA, ModemPacketKind.FDP)
+
+
 def _link_figures(
     range_m: float, owtt: float, rl: float, noise: float, sinr: float
 ) -> tuple[float, float, float, float, float, bool]:
-    """The rounded figures of an `rx` event (a link's recur: float rounding is slow, so they
-    are remembered; not with a zero among them, whose key would be shared by -0.0)."""
-    key = (range_m, owtt, rl, noise, sinr)
-    figures = _figures.get(key)
-    if figures is None:
-        snr = rl - noise
-        figures = (
-            round(range_m, 3), round(owtt, 6), round(rl, 2), round(snr, 2), round(sinr, 2),
-            sinr < snr - 0.01,
-        )  # fmt: skip
-        if 0.0 not in key:
-            if len(_figures) >= _FIGURES_LIMIT:
-                _figures.clear()
-            _figures[key] = figures
-    return figures
-
-
-_figures: dict[tuple[float, ...], tuple[float, float, float, float, float, bool]] = {}
-_FIGURES_LIMIT = 4096
+    """The rounded figures of an `rx` event."""
+    snr = rl - noise
+    return (
+        round(range_m, 3), round(owtt, 6), round(rl, 2), round(snr, 2), round(sinr, 2),
+        sinr < snr - 0.01,
+    )  # fmt: skip

@@ -8,10 +8,12 @@ feeds the channel the positions it accepts. Scripted tracks are posted to it as 
 real-time runs (`post_positions`); discrete-event runs, where nobody else talks to it, put them
 straight into the channel after the manager's checks (`set_positions`: same positions).
 
-Everything shares one Clock. `run_virtual()` drives a `VirtualClock` as a discrete-event
-simulation: the sans-I/O cores are connected in memory (`ModemLink`: the driver's sentences go
-straight into its emulator and the emulator's answers into the driver's buffer) and the clock
-jumps to the next thing that can happen — a reception's delivery, a MAC slot, a position update,
+Everything shares one Clock, and the emulators one Timeline (what they do later: the end of a
+transmission, a ping reply, a clock set). `run_virtual()` drives a `VirtualClock` as a
+discrete-event simulation: the sans-I/O cores are connected in memory
+(pygoby.acomms.mmsim.link.ModemLink: the driver's sentences go straight into its emulator and the
+emulator's answers, parsed, into the driver's buffer) and the clock jumps to the next thing that
+can happen — an emulator's timed event, a reception's delivery, a MAC slot, a position update,
 periodic housekeeping — so a day of TDMA traffic runs in seconds. `pygoby.netsim.realtime` runs
 the same objects on the wall clock over TCP.
 
@@ -36,6 +38,7 @@ from pygoby.acomms.bind import bind
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mac import MACManager
 from pygoby.acomms.mmsim import MicroModemModel
+from pygoby.acomms.mmsim.link import ModemLink
 from pygoby.acomms.queue import QueueManager
 from pygoby.dccl import Codec
 from pygoby.netsim.channel import Channel, Position
@@ -52,7 +55,7 @@ from pygoby.netsim.scenario import (
     start_time,
 )
 from pygoby.util.clock import Clock, VirtualClock
-from pygoby.util.linebased import LinkClosedError
+from pygoby.util.timeline import Timeline
 
 log = logging.getLogger(__name__)
 
@@ -63,48 +66,6 @@ STARTUP_STEP = 0.01  # s: drivers set the modem clock just after a whole second
 STARTUP_LIMIT = 120.0  # s of simulated time for every driver to finish its start-up
 MAX_EXCHANGES = 10_000  # driver <-> emulator sentences at one instant before giving up
 LOCAL_IP = "127.0.0.1"
-
-
-class ModemLink:
-    """A LineLink straight into an emulator: what the driver writes is handled by the model at
-    once; what the model says is buffered until the driver reads it. `waiting` (optional): a
-    set that holds `key` while lines wait (so a loop over many links need not ask each one)."""
-
-    def __init__(self, model: MicroModemModel, waiting: set | None = None, key=None) -> None:
-        self.model = model
-        self._open = False
-        self._lines: list[str] = []
-        self._waiting = waiting if waiting is not None else set()
-        self._key = key
-        model.on_output = self._heard
-
-    def _heard(self, text: str) -> None:
-        self._lines.append(text.strip())
-        self._waiting.add(self._key)
-
-    @property
-    def is_open(self) -> bool:
-        return self._open
-
-    @property
-    def pending(self) -> bool:
-        return bool(self._lines)
-
-    def open(self) -> None:
-        self._open = True
-
-    def close(self) -> None:
-        self._open = False
-
-    def write(self, text: str) -> None:
-        if not self._open:
-            raise LinkClosedError("modem link is closed")
-        self.model.handle_line(text.strip())
-
-    def read_lines(self) -> list[str]:
-        lines, self._lines = self._lines, []
-        self._waiting.discard(self._key)
-        return lines
 
 
 def driver_config(modem_id: int, **link) -> Message:
@@ -177,12 +138,15 @@ class Simulation:
         self.channel = Channel(channel_config(scenario), seed=scenario.seed)
         self.manager.on_nav(self.channel.on_environment_nav_update)
         self.physics = PhysicsChannel(self.channel, self.clock, on_event=self._event)
+        self.timeline = Timeline(self.clock)  # the emulators' timed events
         self.codec = Codec(clock=self.clock)
         self.status_class = node_status_class()
         self.nodes: list[SimNode] = []
         for node, port in zip(scenario.node, node_ports(scenario), strict=True):
             track = TrackFollower(node.track, scenario) if node.HasField("track") else None
-            model = MicroModemModel(node.modem_id, self.clock, self.physics, name=str(port))
+            model = MicroModemModel(
+                node.modem_id, self.clock, self.physics, name=str(port), timeline=self.timeline
+            )
             self.nodes.append(SimNode(node.modem_id, port, model, track))
         self._request_id = 0
         self._wall_start = 0.0
@@ -327,15 +291,18 @@ class Simulation:
         next_position = self.start + period
         next_housekeeping = clock.now() + housekeeping
         macs = [n.mac for n in self.nodes if n.mac is not None]
-        nodes, waiting = self.nodes, self._waiting
+        nodes, waiting, timeline = self.nodes, self._waiting, self.timeline
+        # (a MAC's next slot changes only when it works, below)
+        slot = min([mac.next_slot_time for mac in macs if mac.running], default=math.inf)
         while True:
             now = clock.now()
             t = min(end, next_position, next_housekeeping)
             delivery = self.physics.next_event_time()
             if delivery is not None and delivery < t:
                 t = delivery
-            # (a MAC's next slot changes only when its own node works, below)
-            slot = min([mac.next_slot_time for mac in macs if mac.running], default=math.inf)
+            timed = timeline.next_time()
+            if timed is not None and timed < t:
+                t = timed
             if slot + SLOT_EPSILON < t:
                 t = slot + SLOT_EPSILON
             clock.set(max(t, now))
@@ -344,6 +311,7 @@ class Simulation:
                 self.set_positions()
                 next_position += period
             self.physics.do_work()
+            timeline.run_due()
             every = now >= next_housekeeping
             if every:
                 next_housekeeping += housekeeping
@@ -357,6 +325,7 @@ class Simulation:
                         node.queue.do_work()
                     if fired or every or (node.link is not None and node.link.pending):
                         self._pump(node)
+                slot = min([mac.next_slot_time for mac in macs if mac.running], default=math.inf)
             else:  # only deliveries: the nodes whose emulators have spoken, in node order
                 for index in sorted(waiting):
                     self._pump(nodes[index])
@@ -369,6 +338,7 @@ class Simulation:
             if clock.now() > deadline:
                 late = [n.modem_id for n in self.nodes if not n.driver.startup_complete]
                 raise RuntimeError(f"drivers of nodes {late} did not start")
+            self.timeline.run_due()
             for node in self.nodes:
                 self._pump(node)
             clock.advance(STARTUP_STEP)

@@ -4,19 +4,21 @@ Interface (what a physics channel, e.g. in pygoby.netsim, implements):
 
 * `attach(endpoint)` / `detach(endpoint)`: a modem joins or leaves the water. An endpoint is a
   `ChannelEndpoint`: it has `modem_id` (its current acoustic address, may change at run time via
-  NVRAM `SRC`), `name` (stable, e.g. for looking up its position) and `receive(packet, reception)`.
-* `transmit(sender, packet)`: the sender starts an acoustic transmission now
-  (`packet.tx_time` is the sender's clock). The channel decides which endpoints hear it, when, and
-  how well, and calls `endpoint.receive(packet, reception)` for each of them — at once (as the
-  loopback channel does) or later from its own `do_work()` / event loop, at
-  `reception.arrival_time`. Every attached endpoint except the sender is a candidate: modems hear
-  packets whatever their destination (the modem itself decides what to do with them).
-* `do_work()`: called regularly by whoever runs the modems (the asyncio server calls it at
-  ~20 Hz); a channel that delivers later uses it to deliver due receptions. Optional work.
+  NVRAM `SRC`), `name` (stable, e.g. for looking up its position), `detect(packet, arrival)` and
+  `receive(packet, reception)`.
+* `transmit(sender, packet)`: the sender starts an acoustic transmission at `packet.tx_time`
+  lasting `packet.duration` (the emulator's duration table, pygoby.acomms.mmsim.timing). The
+  channel decides which endpoints hear it, when and how well. Every attached endpoint except the
+  sender is a candidate: modems hear packets whatever their destination.
+* For each endpoint that detects the packet: `detect(packet, arrival)` once the start of the
+  signal reaches it (the modem prints `$CARXP`), then `receive(packet, reception)` once the
+  signal has ended and is decoded (frames, statistics). A channel calls them from its own
+  `do_work()`, which whoever runs the modems calls regularly (a discrete-event loop at
+  `next_event_time()`); a late call is still made, with the true times in its arguments.
 
-`Reception` carries what the physics decided: arrival time, per-frame CRC outcome, the one-way
-travel time (used for ping replies) and optional `$CACST` statistics overrides (e.g. `snr_in`,
-`mse_equalizer`, `doppler`, `spl`: any ReceiveStatistics field name).
+`Reception` carries what the channel decided: the arrival time of the signal's start, per-frame
+CRC outcome and optional `$CACST` statistics overrides (any ReceiveStatistics field name, e.g.
+`snr_in`, `mse_equalizer`, `doppler`, `spl`).
 """
 
 from __future__ import annotations
@@ -25,14 +27,22 @@ import enum
 from dataclasses import dataclass, field
 from typing import Protocol
 
+from pygoby.util.clock import Clock, WallClock
+from pygoby.util.timeline import Timeline
+
+DEFAULT_SOUND_SPEED = 1500.0  # m/s
+
 
 class PacketKind(enum.Enum):
-    DATA = "data"  # cycle-init + data frames (a local transmission)
-    CYCLE = "cycle"  # a third-party cycle-init (poll) asking `src` to send to `dest`
+    DATA = "data"  # data frames at a rate (a PSK packet carries its cycle-init in its header)
+    CYCLE = "cycle"  # a cycle-init mini-packet: rate 0's own, or a third-party poll
     ACK = "ack"  # acoustic acknowledgement of frames
     PING = "ping"  # two-way ping request ($CCMPC)
     PING_REPLY = "ping_reply"
-    MINI = "mini"  # 13-bit mini-packet ($CCMUC)
+    MINI = "mini"  # 13-bit user mini-packet ($CCMUC)
+    FDP = "fdp"  # Micro-Modem 2 flexible data packet ($CCTDP)
+    HW_CONTROL = "hw_control"  # hardware line control command ($CCMEC) and its reply
+    SIGNAL = "signal"  # a sweep, sequence or navigation ping: heard by nobody here
 
 
 @dataclass
@@ -45,14 +55,16 @@ class AcousticPacket:
     frames: list[bytes] = field(default_factory=list)
     acked_frames: list[int] = field(default_factory=list)  # Micro-Modem numbering (1-based)
     num_frames: int = 0  # for CYCLE: frames requested
-    tx_time: float = 0.0
+    tx_time: float = 0.0  # start of the signal (sender's clock)
+    duration: float = 0.0  # s on the water
+    hw_control: tuple[int, int, int] | None = None  # (line, mode, arg) of HW_CONTROL
+    reply: bool = False  # HW_CONTROL: the answer to a command
 
 
 @dataclass
 class Reception:
-    arrival_time: float
+    arrival_time: float  # when the start of the signal reached the receiver
     frame_ok: list[bool] | None = None  # None: every frame good
-    travel_time: float = 0.0  # one-way travel time (s)
     stats: dict[str, float] = field(default_factory=dict)
 
     def frame_good(self, index: int) -> bool:
@@ -66,6 +78,8 @@ class ChannelEndpoint(Protocol):
     @property
     def name(self) -> str: ...
 
+    def detect(self, packet: AcousticPacket, arrival: float) -> None: ...
+
     def receive(self, packet: AcousticPacket, reception: Reception) -> None: ...
 
 
@@ -78,15 +92,27 @@ class Channel(Protocol):
 
     def do_work(self) -> None: ...
 
+    def next_event_time(self) -> float | None: ...
+
 
 class LoopbackChannel:
-    """A perfect channel: every other modem hears every packet at once, without errors.
-
-    `travel_time` (s) is only reported to ping replies (so ranging gives a fixed answer).
+    """A perfect channel: every other modem hears every packet, without errors, `range_m`
+    metres away (travel time `range_m / sound_speed`): the start of the signal is detected
+    after the travel time, the packet is decoded when its end has arrived. No half-duplex, no
+    collisions. `timeline`: share one with the modems (default: the channel's own on `clock`).
     """
 
-    def __init__(self, travel_time: float = 0.0) -> None:
-        self.travel_time = travel_time
+    def __init__(
+        self,
+        clock: Clock | None = None,
+        range_m: float = 0.0,
+        sound_speed: float = DEFAULT_SOUND_SPEED,
+        timeline: Timeline | None = None,
+    ) -> None:
+        if range_m < 0 or sound_speed <= 0:
+            raise ValueError("the range must not be negative and the sound speed must be positive")
+        self.timeline = timeline if timeline is not None else Timeline(clock or WallClock())
+        self.travel_time = range_m / sound_speed
         self.endpoints: list[ChannelEndpoint] = []
 
     def attach(self, endpoint: ChannelEndpoint) -> None:
@@ -98,12 +124,27 @@ class LoopbackChannel:
             self.endpoints.remove(endpoint)
 
     def transmit(self, sender: ChannelEndpoint, packet: AcousticPacket) -> None:
-        for endpoint in list(self.endpoints):
-            if endpoint is not sender:
-                endpoint.receive(
-                    packet,
-                    Reception(packet.tx_time + self.travel_time, travel_time=self.travel_time),
-                )
+        self.deliver(packet, [e for e in self.endpoints if e is not sender])
+
+    def deliver(self, packet: AcousticPacket, endpoints: list[ChannelEndpoint]) -> None:
+        """Schedule `packet`'s detection and reception at `endpoints`."""
+        arrival = packet.tx_time + self.travel_time
+        for endpoint in endpoints:
+            self.timeline.at(arrival, self._detect, endpoint, packet, arrival)
+            self.timeline.at(
+                arrival + packet.duration, self._receive, endpoint, packet, Reception(arrival)
+            )
+
+    def _detect(self, endpoint: ChannelEndpoint, packet: AcousticPacket, arrival: float) -> None:
+        if endpoint in self.endpoints:  # (still attached)
+            endpoint.detect(packet, arrival)
+
+    def _receive(self, endpoint: ChannelEndpoint, packet: AcousticPacket, r: Reception) -> None:
+        if endpoint in self.endpoints:
+            endpoint.receive(packet, r)
 
     def do_work(self) -> None:
-        pass
+        self.timeline.run_due()
+
+    def next_event_time(self) -> float | None:
+        return self.timeline.next_time()

@@ -1,8 +1,10 @@
 """A perfect channel between emulator processes: packets travel as UDP multicast datagrams.
 
-Each process attaches its local modems; a transmission is delivered at once to the other local
-modems and sent to the group, where the other processes deliver it to theirs. Same semantics as
-LoopbackChannel (no loss, no delay); it only spans processes.
+Each process attaches its local modems; a transmission is delivered to the other local modems
+and sent to the group, where the other processes deliver it to theirs: the LoopbackChannel's
+semantics (no loss, a fixed range), spanning processes. The socket is bound to the group address
+on the loopback interface and only datagrams sent from 127.0.0.1 count: a unicast datagram, or
+one from another host, is never taken for an acoustic packet.
 """
 
 from __future__ import annotations
@@ -16,46 +18,67 @@ import socket
 import struct
 
 from pygoby.acomms.mmsim.channel import (
+    DEFAULT_SOUND_SPEED,
     AcousticPacket,
     ChannelEndpoint,
     LoopbackChannel,
     PacketKind,
-    Reception,
 )
+from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
+
+LOOPBACK = "127.0.0.1"
+MAX_DATAGRAM = 16384
+MAX_FRAMES, MAX_FRAME_BYTES = 8, 256  # (the largest packet: rate 5)
 
 
 def packet_to_json(packet: AcousticPacket, sender: str) -> bytes:
     return json.dumps(
         {
-            "sender": sender,
-            "kind": packet.kind.value,
-            "src": packet.src,
-            "dest": packet.dest,
-            "rate": packet.rate,
-            "ack": packet.ack_requested,
+            "sender": sender, "kind": packet.kind.value, "src": packet.src, "dest": packet.dest,
+            "rate": packet.rate, "ack": packet.ack_requested,
             "frames": [base64.b64encode(f).decode() for f in packet.frames],
-            "acked": packet.acked_frames,
-            "num_frames": packet.num_frames,
-            "tx": packet.tx_time,
+            "acked": packet.acked_frames, "num_frames": packet.num_frames, "tx": packet.tx_time,
+            "duration": packet.duration, "hw": packet.hw_control, "reply": packet.reply,
         }  # fmt: skip
     ).encode()
 
 
 def packet_from_json(data: bytes) -> tuple[str, AcousticPacket]:
+    """ValueError (or KeyError, TypeError) if the datagram is not a packet this channel sent."""
     d = json.loads(data)
+    frames = [base64.b64decode(f, validate=True) for f in d["frames"]]
+    if len(frames) > MAX_FRAMES or any(len(f) > MAX_FRAME_BYTES for f in frames):
+        raise ValueError("more data than a packet carries")
+    hw = d["hw"]
     packet = AcousticPacket(
-        PacketKind(d["kind"]), int(d["src"]), int(d["dest"]), int(d["rate"]), bool(d["ack"]),
-        [base64.b64decode(f) for f in d["frames"]], [int(a) for a in d["acked"]],
-        int(d["num_frames"]), float(d["tx"]),
+        PacketKind(d["kind"]), _int(d["src"]), _int(d["dest"]), _int(d["rate"]), bool(d["ack"]),
+        frames, [_int(a) for a in d["acked"][:MAX_FRAMES]], _int(d["num_frames"]),
+        float(d["tx"]), float(d["duration"]), None if hw is None else tuple(map(_int, hw[:3])),
+        bool(d["reply"]),
     )  # fmt: skip
+    if not 0 <= packet.duration < 3600:
+        raise ValueError(f"bad duration {packet.duration}")
     return str(d["sender"]), packet
 
 
+def _int(value: object) -> int:
+    if type(value) is not int or not 0 <= value <= 255:
+        raise ValueError(f"not a small integer: {value!r}")
+    return value
+
+
 class MulticastChannel(LoopbackChannel):
-    def __init__(self, group: str = "239.255.42.99", port: int = 45454, travel_time: float = 0.0):
-        super().__init__(travel_time)
+    def __init__(
+        self,
+        group: str = "239.255.42.99",
+        port: int = 45454,
+        clock: Clock | None = None,
+        range_m: float = 0.0,
+        sound_speed: float = DEFAULT_SOUND_SPEED,
+    ) -> None:
+        super().__init__(clock, range_m, sound_speed)
         self.group, self.port = group, port
         self.token = f"{os.getpid()}-{id(self)}"
         self._sock: socket.socket | None = None
@@ -64,9 +87,10 @@ class MulticastChannel(LoopbackChannel):
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         # SO_REUSEADDR only: with SO_REUSEPORT Linux hands each group datagram to just one
-        # socket of the group instead of to every listener
-        sock.bind(("", self.port))
-        loopback = socket.inet_aton("127.0.0.1")
+        # socket of the group instead of to every listener. Bound to the group: only datagrams
+        # sent to it arrive.
+        sock.bind((self.group, self.port))
+        loopback = socket.inet_aton(LOOPBACK)
         sock.setsockopt(
             socket.IPPROTO_IP,
             socket.IP_ADD_MEMBERSHIP,
@@ -74,6 +98,7 @@ class MulticastChannel(LoopbackChannel):
         )
         sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, loopback)
         sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)  # never leaves the host
         sock.setblocking(False)
         self._sock = sock
         asyncio.get_running_loop().add_reader(sock.fileno(), self._readable)
@@ -92,13 +117,17 @@ class MulticastChannel(LoopbackChannel):
     def _readable(self) -> None:
         assert self._sock is not None
         try:
-            data, _ = self._sock.recvfrom(65536)
+            data, (address, _) = self._sock.recvfrom(MAX_DATAGRAM)
+        except OSError as exc:
+            log.warning("channel socket: %s", exc)
+            return
+        if address != LOOPBACK:
+            log.warning("ignoring a channel datagram from %s (not this host's loopback)", address)
+            return
+        try:
             sender, packet = packet_from_json(data)
-        except (OSError, ValueError, KeyError, TypeError) as exc:
+        except (ValueError, KeyError, TypeError, IndexError) as exc:
             log.warning("ignoring bad channel datagram: %s", exc)
             return
-        if sender == self.token:
-            return
-        for endpoint in list(self.endpoints):
-            endpoint.receive(packet, Reception(packet.tx_time + self.travel_time,
-                                               travel_time=self.travel_time))  # fmt: skip
+        if sender != self.token:
+            self.deliver(packet, list(self.endpoints))

@@ -1,9 +1,18 @@
-"""asyncio front ends for the modem model: a TCP server and a pseudo-terminal (serial)."""
+"""asyncio front ends for the modem model: a TCP server and a pseudo-terminal (serial line).
+
+Text is made here, at the edge: the model's sentences are printed with their checksum and CRLF;
+host lines (CR and/or LF) are parsed by the model. The model's timed events and the channel's
+deliveries run in one loop that wakes for the next of them (at most `work_period` apart).
+
+Output never waits for a reader: a TCP client that reads nothing is not read either once its
+pending output passes asyncio's high-water mark (so its own commands cannot grow it), and is
+disconnected when the modem's own output (receptions) passes `MAX_CLIENT_BACKLOG` bytes; the
+pseudo-terminal drops what its reader leaves unread.
+"""
 
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import logging
 import os
 import re
@@ -11,11 +20,14 @@ import re
 from pygoby.acomms.mmsim.channel import Channel
 from pygoby.acomms.mmsim.model import MicroModemModel
 from pygoby.util.linebased import open_pty_pair
+from pygoby.util.pty import PtyEnd
 
 log = logging.getLogger(__name__)
 
 _LINE_END = re.compile(rb"[\r\n]+")
-MAX_PENDING = 65536
+MAX_PENDING = 65536  # bytes of a host line without its end
+MAX_CLIENT_BACKLOG = 1 << 20  # bytes of unread output before a TCP client is dropped
+ANONYMOUS_PTY = ""  # `pty_path` value for a pty without a stable link
 
 
 class _HostLines:
@@ -33,7 +45,8 @@ class _HostLines:
 
 class MMSimServer:
     """Serves one emulated modem on TCP (every client sees the modem's output) and optionally
-    on a pty (`pty_path` after `start`). Runs `channel.do_work()` every `work_period` s."""
+    on a pty: `pty_path` a path to link it at (e.g. /tmp/ttyLOOPA1), or ANONYMOUS_PTY; after
+    `start`, `pty_path` is where a host opens it."""
 
     def __init__(
         self,
@@ -41,14 +54,15 @@ class MMSimServer:
         channel: Channel,
         host: str = "127.0.0.1",
         port: int = 0,
-        use_pty: bool = False,
-        work_period: float = 0.05,
+        pty_path: str | None = None,
+        work_period: float = 0.01,
     ) -> None:
         self.model, self.channel = model, channel
         self.host, self.port = host, port
-        self.use_pty = use_pty
+        self.pty_path = pty_path
         self.work_period = work_period
-        self.pty_path: str | None = None
+        self.pty_dropped = 0  # bytes the pty's reader left unread
+        self._pty: PtyEnd | None = None
         self._pty_master: int | None = None
         self._writers: set[asyncio.StreamWriter] = set()
         self._server: asyncio.Server | None = None
@@ -58,8 +72,13 @@ class MMSimServer:
     async def start(self) -> int:
         self._server = await asyncio.start_server(self._client, self.host, self.port)
         self.port = self._server.sockets[0].getsockname()[1]
-        if self.use_pty:
-            self._pty_master, self.pty_path = open_pty_pair()
+        if self.pty_path is not None:
+            if self.pty_path:
+                self._pty = PtyEnd(self.pty_path).open()
+                self._pty_master = self._pty.master
+            else:
+                self._pty_master, self.pty_path = open_pty_pair()
+                os.set_blocking(self._pty_master, False)
             asyncio.get_running_loop().add_reader(self._pty_master, self._pty_readable)
             self._pty_lines = _HostLines()
         self._tasks.append(asyncio.create_task(self._work()))
@@ -71,12 +90,13 @@ class MMSimServer:
             task.cancel()
         if self._server is not None:
             self._server.close()
-        for writer in list(self._writers):
-            writer.close()
-        self._writers.clear()
+        self.drop_clients()
         if self._pty_master is not None:
             asyncio.get_running_loop().remove_reader(self._pty_master)
-            os.close(self._pty_master)
+            if self._pty is not None:
+                self._pty.close()
+            else:
+                os.close(self._pty_master)
             self._pty_master = None
         self.channel.detach(self.model)
 
@@ -87,20 +107,33 @@ class MMSimServer:
         self._writers.clear()
 
     async def _work(self) -> None:
+        clock = self.model.clock
         while True:
+            self.model.do_work()
             self.channel.do_work()
-            await asyncio.sleep(self.work_period)
+            wait = self.work_period
+            for when in (self.model.next_event_time(), self.channel.next_event_time()):
+                if when is not None:
+                    wait = min(wait, max(0.0, when - clock.now()))
+            await asyncio.sleep(wait)
 
-    def _broadcast(self, text: str) -> None:
-        data = text.encode("latin-1")
+    def _broadcast(self, sentence) -> None:
+        data = (sentence.message() + "\r\n").encode("latin-1")
         for writer in list(self._writers):
             if writer.is_closing():
                 self._writers.discard(writer)
+            elif writer.transport.get_write_buffer_size() > MAX_CLIENT_BACKLOG:
+                log.warning("dropping a client that has not read %d bytes", MAX_CLIENT_BACKLOG)
+                self._writers.discard(writer)
+                writer.close()
             else:
                 writer.write(data)
         if self._pty_master is not None:
-            with contextlib.suppress(OSError):
-                os.write(self._pty_master, data)
+            try:
+                written = os.write(self._pty_master, data)
+            except OSError:  # (full, or nobody has the line open)
+                written = 0
+            self.pty_dropped += len(data) - written
 
     async def _client(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         self._writers.add(writer)
@@ -109,6 +142,7 @@ class MMSimServer:
             while data := await reader.read(4096):
                 for line in lines.feed(data):
                     self.model.handle_line(line)
+                await writer.drain()  # a client that does not read is not read either
         except ConnectionError:
             pass
         finally:

@@ -1,20 +1,24 @@
 """The WHOI Micro-Modem NMEA driver (spec acomms.md §7) as a state machine.
 
-Everything happens in `do_work()` (read lines, dispatch, run timers against the Clock) and in
+Everything happens in `do_work()` (read the modem, dispatch, run timers against the Clock) and in
 `handle_initiate_transmission()`; nothing blocks. Start-up (§7.3) is a sequence of phases
 advanced by `do_work`; `startup_complete` says when it is done. With an injected MemoryLink the
-driver is fully sans-I/O: feed lines, advance a VirtualClock, read what it wrote.
+driver is fully sans-I/O: feed lines, advance a VirtualClock, read what it wrote. A link with
+`read_sentences` / `write_sentence` (pygoby.acomms.mmsim.link.ModemLink: an emulator in the same
+process) carries parsed sentences instead of text.
+
+Every number the modem sends is range-checked against what a Micro-Modem can do (addresses,
+rates, frame counts and sizes, travel times) before it is used: a bad one makes the sentence
+"malformed" (logged and ignored), never a huge allocation or an overflow.
 """
 
 from __future__ import annotations
 
 import base64
-import binascii
+import contextlib
 import datetime as dt
-import functools
 import logging
 from collections import deque
-from collections.abc import Callable
 from enum import Enum, auto
 
 from pygoby.acomms import messages as m
@@ -22,7 +26,8 @@ from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
 from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
 from pygoby.acomms.drivers.micromodem.statistics import add_cst, parse_toa, parse_xst
-from pygoby.util.nmea import NMEAError, NMEASentence, printed
+from pygoby.util.linebased import LinkClosedError
+from pygoby.util.nmea import NMEAError, NMEASentence
 
 log = logging.getLogger(__name__)
 
@@ -35,10 +40,19 @@ REVINIT_PAUSE = 2.0
 MM2_BITFIELD_CLOCK_REVISION = (2, 0, 26038)
 HYDROID_GPS_REQUEST_INTERVAL = 30.0
 FDP_MAX_FRAME_BYTES = 100
+# what a Micro-Modem can do: the bounds of the numbers read from it
+MAX_ADDRESS = 127
+MAX_FRAMES = max(RATE_NUM_FRAMES)
+MAX_FRAME_BYTES = max(RATE_FRAME_BYTES)
+MAX_FDP_BYTES = 2048  # (the largest flexible data packet: rate 5, 8 x 256 bytes)
+MAX_TRAVEL_TIME = 30.0  # s (goby3's RangingReply bound)
+MAX_RATE = 6  # (the driver sends rates 0-5; another modem may use 6)
+MAX_NVRAM_KEYS = 1024  # NVRAM parameters remembered from $CACFG
+INT32 = (-(2**31), 2**31 - 1)
+CLOCK_FIELDS = ((1, 9999), (1, 12), (1, 31), (0, 23), (0, 59), (0, 60))  # $CACLK
+HW_LINE_BOUNDS = {3: (0, 255), 4: (0, 3), 5: (0, 7)}  # line, mode, arg
 
 Status = m.ModemDriverStatus
-_UNKNOWN = object()  # a sentence id not looked up yet
-_MAX_REMEMBERED_IDS = 64  # sentence ids remembered with their handler (or lack of one)
 
 
 class Phase(Enum):
@@ -60,7 +74,7 @@ class MMDriver(ModemDriverBase):
         self.app_acks: ApplicationAcks | None = None
         self.nvram: dict[str, int] = {}
         self.revision: tuple[int, int, int] = (0, 0, 0)
-        self._handlers: dict[str, Callable[[NMEASentence], None] | None] = {}  # by sentence id
+        self._typed = False  # the link carries sentences, not text
         self._reset_state()
 
     def _reset_state(self) -> None:
@@ -102,6 +116,7 @@ class MMDriver(ModemDriverBase):
         self._reset_state()
         self.mm_cfg = cfg.Extensions[m.MM_CONFIG]
         self.modem_start(cfg)
+        self._typed = hasattr(self.link, "read_sentences")
         self.app_acks = None
         if self.mm_cfg.use_application_acks:
             ids = {cfg.modem_id, *self.mm_cfg.additional_application_ack_modem_id}
@@ -110,11 +125,7 @@ class MMDriver(ModemDriverBase):
         if c.reset_nvram and not c.hydroid_gateway_id:
             self._push("$CCCFG", "ALL", 0)
         self._push("$CCCFG", "CST", 1)
-        for entry in c.nvram_cfg:
-            key, sep, value = entry.partition(",")
-            if sep and len(key) == 3:
-                entry = entry.upper()
-            self._out.append(NMEASentence.build("$CCCFG", entry.split(",")))
+        self._push_nvram_cfg(c.nvram_cfg)
         self._push("$CCCFG", "SRC", cfg.modem_id)
         if c.HasField("revision"):
             self.revision = (c.revision.mm_major, c.revision.mm_minor, c.revision.mm_patch)
@@ -126,6 +137,20 @@ class MMDriver(ModemDriverBase):
             self._push("$CCCFG", "recv.base64data", 1)
         self._push("$CCMSC", cfg.modem_id, cfg.modem_id, 0)
         self.phase = Phase.CONFIGURING
+
+    def _push_nvram_cfg(self, entries) -> None:
+        for entry in entries:
+            key, sep, _ = entry.partition(",")
+            if sep and len(key) == 3:
+                entry = entry.upper()
+            self._out.append(NMEASentence.build("$CCCFG", entry.split(",")))
+
+    def update_cfg(self, cfg) -> None:
+        """ACOMMS_DRIVER_CONFIG_UPDATE: send the update's Micro-Modem `nvram_cfg` entries (as at
+        start-up) and keep them in the configuration, so that a restart sends them too."""
+        entries = list(cfg.Extensions[m.MM_CONFIG].nvram_cfg)
+        self._push_nvram_cfg(entries)
+        self.mm_cfg.nvram_cfg.extend(entries)
 
     def shutdown(self) -> None:
         self.phase = Phase.STOPPED
@@ -139,8 +164,12 @@ class MMDriver(ModemDriverBase):
         if link_open and not self._link_was_open:
             self._written_at = None  # (re)connected: rewrite the outstanding sentence now
         self._link_was_open = link_open
-        for line in self.modem_read():
-            self._handle_line(line)
+        if self._typed:
+            for sentence in self.link.read_sentences():
+                self._handle_sentence(sentence)
+        else:
+            for line in self.modem_read():
+                self._handle_line(line)
         if not link_open:
             return  # a dead link is the link's business (it reconnects); do not count failures
         now = self.clock.now()
@@ -188,16 +217,25 @@ class MMDriver(ModemDriverBase):
 
     # ------------------------------------------------------------------ outgoing FIFO
     def _push(self, token: str, *values: object) -> None:
-        self._out.append(_sentence(token, *values))
+        self._out.append(NMEASentence.build(token, values))
 
     def _try_write(self, now: float) -> None:
         if not self._out or self._written_at is not None or now < self._hold_until:
             return
         sentence = self._out[0]
-        text = printed(sentence)
-        prefix = f"#M{self.mm_cfg.hydroid_gateway_id}" if self.mm_cfg.hydroid_gateway_id else ""
-        self.modem_write(prefix + text + "\r\n")
-        self.emit_raw(False, text)
+        if self._typed:
+            try:
+                self.link.write_sentence(sentence)
+            except LinkClosedError as exc:
+                raise ModemDriverException(str(exc), Status.CONNECTION_TO_MODEM_FAILED) from exc
+            if self.signal_raw_outgoing or self._raw_log is not None:
+                self._log_raw("[tx] ", sentence.message())
+                self.emit_raw(False, sentence.message())
+        else:
+            text = sentence.message()
+            buoy = self.mm_cfg.hydroid_gateway_id
+            self.modem_write((f"#M{buoy}" if buoy else "") + text + "\r\n")
+            self.emit_raw(False, text)
         self._written_at = now
         self._tries += 1
 
@@ -322,25 +360,25 @@ class MMDriver(ModemDriverBase):
         except NMEAError as exc:
             log.warning("ignoring invalid line from the modem: %s", exc)
             return
+        self._dispatch(sentence)
+
+    def _handle_sentence(self, sentence) -> None:
+        """A sentence from a typed link (parsed already; `$CACST` as its values)."""
+        if self.signal_raw_incoming or self._raw_log is not None:
+            self._log_raw("[rx] ", sentence.message())
+            self.emit_raw(True, sentence.message())
+        self._dispatch(sentence)
+
+    def _dispatch(self, sentence) -> None:
         self._fails = 0
         self._last_rx_at = self.clock.now()
-        try:
-            self._dispatch(sentence)
-        except (NMEAError, ValueError, IndexError, binascii.Error) as exc:
-            log.warning("ignoring malformed %s: %s", sentence.message(), exc)
-        self._acknowledge(sentence)
-
-    def _dispatch(self, s: NMEASentence) -> None:
-        sentence_id = s.sentence_id
-        handler = self._handlers.get(sentence_id, _UNKNOWN)
-        if handler is _UNKNOWN:
-            handler = getattr(self, "_on_" + sentence_id.lower(), None)
-            # sentences without a handler ($CARXP, $CATXF, ...) are remembered too, up to a
-            # bound (so that garbage ids cannot grow the table)
-            if handler is not None or len(self._handlers) < _MAX_REMEMBERED_IDS:
-                self._handlers[sentence_id] = handler
+        handler = _HANDLERS.get(sentence.sentence_id)
         if handler is not None:
-            handler(s)
+            try:
+                handler(self, sentence)
+            except (NMEAError, ValueError, IndexError) as exc:
+                log.warning("ignoring malformed %s: %s", sentence.message(), exc)
+        self._acknowledge(sentence)
 
     def _on_rev(self, s: NMEASentence) -> None:
         if s[2] == "INIT":
@@ -358,17 +396,17 @@ class MMDriver(ModemDriverBase):
             self._fail_front("$CAERR NMEA")
 
     def _on_cfg(self, s: NMEASentence) -> None:
-        if len(s) >= 3:
-            try:  # noqa: SIM105 (contextlib.suppress is slow: this answers every keep-alive)
-                self.nvram[s[1]] = int(s[2])
-            except ValueError:
-                pass
+        # integer parameters only (MM2 also has text ones), and a bounded number of them
+        if len(s) >= 3 and (s[1] in self.nvram or len(self.nvram) < MAX_NVRAM_KEYS):
+            with contextlib.suppress(NMEAError):
+                self.nvram[s[1]] = s.as_int(2, *INT32)
         if self._multi_reply:
             self._last_cfg_at = self.clock.now()
 
     def _on_clk(self, s: NMEASentence) -> None:
         if self._outstanding("CLK"):
-            t = dt.datetime(*s.as_ints(1, 7), tzinfo=dt.UTC)
+            t = dt.datetime(*(s.as_int(i, *bounds) for i, bounds in enumerate(CLOCK_FIELDS, 1)),
+                            tzinfo=dt.UTC)  # fmt: skip
             self._check_clock(t.timestamp(), whole_seconds=True)
 
     def _on_tms(self, s: NMEASentence) -> None:
@@ -425,7 +463,10 @@ class MMDriver(ModemDriverBase):
         return bool(msg.frame) and bool(msg.frame[0])
 
     def _on_cyc(self, s: NMEASentence) -> None:
-        src, dest, rate, ack, nframes = s.as_ints(2, 7)
+        src, dest, rate, ack, nframes = (
+            s.as_int(2, 0, MAX_ADDRESS), s.as_int(3, 0, MAX_ADDRESS), s.as_int(4, 0, MAX_RATE),
+            s.as_int(5, 0, 1), s.as_int(6, 0, MAX_FRAMES),
+        )  # fmt: skip
         if self._outstanding("CYC") and tuple(self._out[0].fields[2:5]) == tuple(s.fields[2:5]):
             return  # the modem's echo of our own $CCCYC
         if src == self.modem_id:
@@ -447,7 +488,10 @@ class MMDriver(ModemDriverBase):
         self._receive = None
 
     def _on_drq(self, s: NMEASentence) -> None:
-        src, dest, ack, nbytes, frame_no = s.as_ints(2, 7)
+        src, dest, ack, nbytes, frame_no = (
+            s.as_int(2, 0, MAX_ADDRESS), s.as_int(3, 0, MAX_ADDRESS), s.as_int(4, 0, 1),
+            s.as_int(5, 0, MAX_FRAME_BYTES), s.as_int(6, 1, MAX_FRAMES),
+        )  # fmt: skip
         index = frame_no - 1
         if 0 <= index < len(self._cached.frame) and self._cached.frame[index]:
             data = bytes(self._cached.frame[index])
@@ -469,7 +513,8 @@ class MMDriver(ModemDriverBase):
             self._transmit = m.ModemTransmission()
 
     def _on_ack(self, s: NMEASentence) -> None:
-        src, dest, frame_no = s.as_ints(1, 4)
+        src, dest = s.as_int(1, 0, MAX_ADDRESS), s.as_int(2, 0, MAX_ADDRESS)
+        frame_no = s.as_int(3, 1, MAX_FRAMES)
         if dest != self.modem_id or src != self._expected_ack_src:
             return
         goby_frame = frame_no - 1
@@ -501,8 +546,11 @@ class MMDriver(ModemDriverBase):
         return self._receive
 
     def _on_rxd(self, s: NMEASentence) -> None:
-        src, dest, ack, frame_no = s.as_ints(1, 5)
-        data = bytes.fromhex(s[5]) if len(s) > 5 else b""
+        src, dest, ack, frame_no = (
+            s.as_int(1, 0, MAX_ADDRESS), s.as_int(2, 0, MAX_ADDRESS), s.as_int(3, 0, 1),
+            s.as_int(4, 1, MAX_FRAMES),
+        )  # fmt: skip
+        data = _hex(s[5], MAX_FRAME_BYTES) if len(s) > 5 else b""
         rx = self._receiving()
         if frame_no == 1:
             rx.time = m.now_us(self.clock.now())
@@ -569,12 +617,13 @@ class MMDriver(ModemDriverBase):
     # ------------------------------------------------------------------ ranging, mini-packets
     def _on_mpr(self, s: NMEASentence) -> None:
         # Quirk A5 (faithful): src/dest copied as they appear in the sentence
-        msg = self._ping_result(s.as_int(1), s.as_int(2))
-        msg.Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time.append(s.as_float(3))
+        owtt = s.as_float(3, 0.0, MAX_TRAVEL_TIME)
+        msg = self._ping_result(*_addresses(s))
+        msg.Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time.append(owtt)
         self.signal_receive.emit(msg)
 
     def _on_mpa(self, s: NMEASentence) -> None:
-        self.signal_receive.emit(self._ping_result(s.as_int(1), s.as_int(2)))
+        self.signal_receive.emit(self._ping_result(*_addresses(s)))
 
     def _ping_result(self, src: int, dest: int, kind: int = m.MICROMODEM_TWO_WAY_PING):
         msg = m.ModemTransmission(
@@ -619,8 +668,8 @@ class MMDriver(ModemDriverBase):
         self._push("$CCTDP", msg.dest, msg.rate, 0, 0, data.hex())
 
     def _on_rdp(self, s: NMEASentence) -> None:
-        msg = self._ping_result(s.as_int(1), s.as_int(2), m.MICROMODEM_FLEXIBLE_DATA)
-        msg.rate = s.as_int(3)
+        msg = self._ping_result(*_addresses(s), m.MICROMODEM_FLEXIBLE_DATA)
+        msg.rate = s.as_int(3, 0, MAX_RATE)
         frame, good = b"", True
         for part in s.fields[6:8]:
             triple = part.split(";")
@@ -628,10 +677,11 @@ class MMDriver(ModemDriverBase):
                 continue
             crc_ok, payload = triple[0] == "1", triple[2]
             good &= crc_ok
-            if self.mm_cfg.use_base64_fdp:
-                frame += base64.b64decode(payload)
-            else:
-                frame += bytes.fromhex(payload)
+            if len(payload) > 4 * MAX_FDP_BYTES:  # (hex or base64 of more than the packet holds)
+                raise ValueError(f"a flexible data packet has at most {MAX_FDP_BYTES} bytes")
+            frame += base64.b64decode(payload) if self.mm_cfg.use_base64_fdp else bytes.fromhex(payload)
+            if len(frame) > MAX_FDP_BYTES:
+                raise ValueError(f"a flexible data packet has at most {MAX_FDP_BYTES} bytes")
         if good:
             msg.frame.append(frame)
         else:
@@ -640,8 +690,8 @@ class MMDriver(ModemDriverBase):
         self._emit_data(msg)
 
     def _on_mua(self, s: NMEASentence) -> None:
-        msg = self._ping_result(s.as_int(1), s.as_int(2), m.MICROMODEM_MINI_DATA)
-        msg.frame.append(bytes.fromhex(s[3]))
+        msg = self._ping_result(*_addresses(s), m.MICROMODEM_MINI_DATA)
+        msg.frame.append(_hex(s[3], 2))
         self.signal_receive.emit(msg)
 
     _SIMPLE_COMMANDS = {
@@ -705,13 +755,14 @@ class MMDriver(ModemDriverBase):
                    p.carrier_freq)  # fmt: skip
 
     def _on_mer(self, s: NMEASentence) -> None:
-        src, dest = s.as_int(1), s.as_int(2)
+        src, dest = _addresses(s)
+        line, mode, arg = (s.as_int(i, *HW_LINE_BOUNDS[i]) for i in (3, 4, 5))
         major, minor, patch = self.revision
         if major == 2 and minor == 0 and patch < 18307:  # these firmwares swap src and dest
             src, dest = dest, src
         msg = self._ping_result(src, dest, m.MICROMODEM_HARDWARE_CONTROL_REPLY)
         hw = msg.Extensions[m.MM_TRANSMISSION].hw_ctl
-        hw.line, hw.mode, hw.arg = s.as_int(3), s.as_int(4), s.as_int(5)
+        hw.line, hw.mode, hw.arg = line, mode, arg
         self.signal_receive.emit(msg)
 
     def _on_tta(self, s: NMEASentence) -> None:
@@ -722,21 +773,33 @@ class MMDriver(ModemDriverBase):
         msg.time = parse_toa(s[5], today)
         reply = msg.Extensions[m.MM_TRANSMISSION].ranging_reply
         for i in range(1, 5):
-            reply.one_way_travel_time.append(s.as_float(i) if s[i] else 0.0)
+            reply.one_way_travel_time.append(s.as_float(i, 0.0, MAX_TRAVEL_TIME) if s[i] else 0.0)
         self.signal_receive.emit(msg)
 
 
-# The driver sends the same few sentences again and again (keep-alives, cycle-inits, ...): each
-# is built once and shared (sentences are immutable). `typed`: 1, 1.0 and True print differently.
-@functools.lru_cache(maxsize=256, typed=True)
-def _sentence(token: str, *values: object) -> NMEASentence:
-    return NMEASentence.build(token, values)
-
-
-@functools.lru_cache(maxsize=4)  # (a packet's statistics arrive at one instant)
 def _utc_date(seconds: float) -> dt.date:
     return dt.datetime.fromtimestamp(seconds, dt.UTC).date()
 
 
 def _iso_time(text: str) -> float:
     return dt.datetime.fromisoformat(text.replace("Z", "+00:00")).timestamp()
+
+
+def _addresses(s: NMEASentence) -> tuple[int, int]:
+    """Fields 1 and 2: source and destination (0 .. 127)."""
+    return s.as_int(1, 0, MAX_ADDRESS), s.as_int(2, 0, MAX_ADDRESS)
+
+
+def _hex(text: str, max_bytes: int) -> bytes:
+    """Hex data of at most `max_bytes` bytes (ValueError otherwise)."""
+    if len(text) > 2 * max_bytes:
+        raise ValueError(f"more than {max_bytes} bytes of data")
+    return bytes.fromhex(text)
+
+
+# sentence id -> handler (`_on_xyz` handles `XYZ`, whatever the talker)
+_HANDLERS = {
+    name[4:].upper(): handler
+    for name, handler in vars(MMDriver).items()
+    if name.startswith("_on_") and callable(handler)
+}
