@@ -3,6 +3,8 @@
 import logging
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.driver_base import ModemDriverException
@@ -394,3 +396,80 @@ def test_application_ack_numbering_and_bitmasks():
     assert [(a.src, a.dest, list(a.acked_frame)) for a in acks] == [(2, 1, [0]), (2, 1, [1])]
     empty = m.ModemTransmission(src=2, dest=-1, max_num_frames=1)
     assert not receiver.finish(empty, receiver.prepare(empty))  # nothing owed, no data
+
+
+def test_sizes_from_the_modem_are_range_checked(caplog):
+    """Regressions (hardening issue): `$CACYC,...,40000000` allocated 2.25 GB; a `$CADRQ` with a
+    huge byte count built a 200 MB sentence; numbers beyond ssize_t raised OverflowError."""
+    import tracemalloc
+
+    h = Harness(modem_id=2, pad_partial_frames=True).start()
+    h.driver.signal_data_request.connect(lambda msg: msg.frame.append(b"\x10\x20"))
+    tracemalloc.start()
+    with caplog.at_level(logging.WARNING):
+        h.modem("$CACYC,0,1,2,1,1,4000000")  # frames: at most 8
+        h.modem("$CACYC,0,2,1,1,1,3")  # (polled: a frame to answer)
+        written = h.modem("$CADRQ,120000,2,1,1,200000000,1")  # bytes: at most 256
+        written += h.modem("$CADRQ,120000,2,1,1,99999999999999999999,1")
+        h.modem("$CAMPR,1,2,nan", "$CAMPR,1,2,1e999", "$CARXD,1,2,0,1," + "ab" * 257)
+        h.modem("$CARDP,1,2,5,0,0,1;3000;" + "ab" * 3000 + ",")
+        h.link.feed(cs("$CCCLK,2024,1,2,3,4,5") + "\r")  # (not outstanding: ignored anyway)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    assert peak < 5_000_000
+    assert written == [] and caplog.text.count("malformed") == 7
+    assert h.received == []
+    # the driver keeps working
+    assert h.modem("$CADRQ,120000,2,1,1,64,1") == [cs("$CCTXD,2,1,1,1020" + "00" * 62)]
+
+
+def test_clock_reply_beyond_any_date_is_malformed_not_a_crash(caplog):
+    h = Harness().start()
+    h.modem("$CAREV,000000,INIT,0.94.0.00")  # a reboot: the clock is set again
+    h.clock.advance(2.5)
+    h.clock.set(int(h.clock.now()) + 1.06)
+    assert h.work()[0].startswith("$CCCLK")
+    with caplog.at_level(logging.WARNING):
+        h.modem("$CACLK,99999999999999999999999,11,14,22,13,21")  # OverflowError before
+    assert "malformed" in caplog.text
+
+
+def test_nvram_remembered_from_the_modem_is_bounded():
+    h = Harness().start()
+    for i in range(3000):
+        h.link.feed(cs(f"$CACFG,key{i},{i}") + "\r")
+    h.work()
+    assert len(h.driver.nvram) <= 1024 and h.driver.nvram["CST"] == 1
+
+
+def test_update_cfg_sends_the_new_nvram_entries():
+    h = Harness().start()
+    update = m.DriverConfig()
+    update.Extensions[m.MM_CONFIG].nvram_cfg.extend(["agn,200", "psk.packet.mod_hdr_version,1"])
+    h.driver.update_cfg(update)
+    assert h.work() == [cs("$CCCFG,AGN,200")]
+    assert h.modem("$CACFG,AGN,200") == [cs("$CCCFG,psk.packet.mod_hdr_version,1")]
+    assert h.modem("$CACFG,psk.packet.mod_hdr_version,1") == []
+    assert list(h.driver.mm_cfg.nvram_cfg) == ["agn,200", "psk.packet.mod_hdr_version,1"]
+
+
+MODEM_IDS = ["REV", "ERR", "CFG", "CLK", "TMS", "TMQ", "CYC", "DRQ", "XST", "ACK", "RXD", "MSG",
+             "CST", "MPR", "MPA", "RDP", "MUA", "MER", "TTA", "RXP", "TXF", "XYZ"]  # fmt: skip
+FIELD = st.one_of(
+    st.integers(-(2**80), 2**80).map(str),
+    st.sampled_from(["", "0", "1", "6", "AUV", "INIT", "NMEA", "BAD_CRC", "1;2;0102", "nan",
+                     "221320.5", "20231114221320.5", "2023-11-14T22:13:20Z", "0.94.0.00"]),
+    st.text(alphabet="0123456789abcdef.;-:TZ ", max_size=30),
+)  # fmt: skip
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(MODEM_IDS), st.lists(FIELD, max_size=32)), max_size=8))
+def test_fuzz_modem_lines_never_raise(sentences):
+    """Whatever the modem says, the driver logs and carries on (no exception escapes)."""
+    h = Harness(modem_id=2).start()
+    h.driver.signal_data_request.connect(lambda msg: msg.frame.append(b"x"))
+    for sentence_id, fields in sentences:
+        h.link.feed(NMEASentence(("$CA" + sentence_id, *fields)).message() + "\r")
+        h.work()
+    assert h.driver.startup_complete

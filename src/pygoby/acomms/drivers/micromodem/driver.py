@@ -75,6 +75,8 @@ class MMDriver(ModemDriverBase):
         self.nvram: dict[str, int] = {}
         self.revision: tuple[int, int, int] = (0, 0, 0)
         self._typed = False  # the link carries sentences, not text
+        self._buoy = 0  # Hydroid gateway buoy id (prefixes)
+        self._keep_alive_seconds = 0
         self._reset_state()
 
     def _reset_state(self) -> None:
@@ -115,6 +117,8 @@ class MMDriver(ModemDriverBase):
     def startup(self, cfg) -> None:
         self._reset_state()
         self.mm_cfg = cfg.Extensions[m.MM_CONFIG]
+        self._buoy = self.mm_cfg.hydroid_gateway_id
+        self._keep_alive_seconds = self.mm_cfg.keep_alive_seconds
         self.modem_start(cfg)
         self._typed = hasattr(self.link, "read_sentences")
         self.app_acks = None
@@ -165,16 +169,17 @@ class MMDriver(ModemDriverBase):
             self._written_at = None  # (re)connected: rewrite the outstanding sentence now
         self._link_was_open = link_open
         if self._typed:
-            for sentence in self.link.read_sentences():
-                self._handle_sentence(sentence)
+            sentences = self.link.read_sentences()
+            if sentences:
+                self._handle_sentences(sentences)
         else:
             for line in self.modem_read():
                 self._handle_line(line)
         if not link_open:
             return  # a dead link is the link's business (it reconnects); do not count failures
         now = self.clock.now()
-        # (each step's first test made here: do_work runs for every line batch and timer)
-        if self.mm_cfg.hydroid_gateway_id:
+        # (each step's first test made here: do_work runs for every sentence batch and timer)
+        if self._buoy:
             self._hydroid_gps_request(now)
         if self._multi_reply:
             self._check_multi_reply(now)
@@ -182,8 +187,10 @@ class MMDriver(ModemDriverBase):
             self._advance_startup(now)
         if self._written_at is not None:
             self._check_timeout(now)
-        self._keep_alive(now)
-        if self._out:
+        if not self._out:
+            if now - self._last_rx_at > self._keep_alive_seconds and self.phase is Phase.READY:
+                self._keep_alive(now)
+        else:
             self._try_write(now)
 
     def handle_initiate_transmission(self, transmission) -> None:
@@ -233,7 +240,7 @@ class MMDriver(ModemDriverBase):
                 self.emit_raw(False, sentence.message())
         else:
             text = sentence.message()
-            buoy = self.mm_cfg.hydroid_gateway_id
+            buoy = self._buoy
             self.modem_write((f"#M{buoy}" if buoy else "") + text + "\r\n")
             self.emit_raw(False, text)
         self._written_at = now
@@ -271,14 +278,13 @@ class MMDriver(ModemDriverBase):
             self._fail_front("timeout")
 
     def _keep_alive(self, now: float) -> None:
-        if self.phase is not Phase.READY or self._out:
-            return
-        if now - self._last_rx_at > self.mm_cfg.keep_alive_seconds:
-            if self.is_mm2:
-                self._push("$CCTMQ", 0)
-            else:
-                self._push("$CCCFQ", "SRC")
-            self._last_rx_at = now
+        """Nothing heard for keep_alive_seconds: ask the modem something (and send it)."""
+        if self.is_mm2:
+            self._push("$CCTMQ", 0)
+        else:
+            self._push("$CCCFQ", "SRC")
+        self._last_rx_at = now
+        self._try_write(now)
 
     def _check_multi_reply(self, now: float) -> None:
         if self._multi_reply and self._last_cfg_at and now - self._last_cfg_at > MULTI_REPLY_QUIET:
@@ -289,7 +295,7 @@ class MMDriver(ModemDriverBase):
 
     def _acknowledge(self, sentence: NMEASentence) -> None:
         """Pop the outstanding sentence if `sentence` answers it (§7.2 table)."""
-        if not self._out or self._written_at is None:
+        if not self._out:
             return
         front = self._out[0]
         kind, got = front.sentence_id, sentence.sentence_id
@@ -349,7 +355,7 @@ class MMDriver(ModemDriverBase):
 
     # ------------------------------------------------------------------ incoming
     def _handle_line(self, line: str) -> None:
-        if self.mm_cfg.hydroid_gateway_id:
+        if self._buoy:
             line = line[3:]
         text = line.strip()
         if not text:
@@ -360,25 +366,30 @@ class MMDriver(ModemDriverBase):
         except NMEAError as exc:
             log.warning("ignoring invalid line from the modem: %s", exc)
             return
+        self._last_rx_at = self.clock.now()
         self._dispatch(sentence)
 
-    def _handle_sentence(self, sentence) -> None:
-        """A sentence from a typed link (parsed already; `$CACST` as its values)."""
-        if self.signal_raw_incoming or self._raw_log is not None:
-            self._log_raw("[rx] ", sentence.message())
-            self.emit_raw(True, sentence.message())
-        self._dispatch(sentence)
+    def _handle_sentences(self, sentences: list) -> None:
+        """Sentences from a typed link (parsed already; `$CACST` as its values)."""
+        self._last_rx_at = self.clock.now()
+        raw = self.signal_raw_incoming or self._raw_log is not None
+        for sentence in sentences:
+            if raw:
+                self._log_raw("[rx] ", sentence.message())
+                self.emit_raw(True, sentence.message())
+            self._dispatch(sentence)
 
     def _dispatch(self, sentence) -> None:
+        """Handle a valid sentence from the modem (received now)."""
         self._fails = 0
-        self._last_rx_at = self.clock.now()
         handler = _HANDLERS.get(sentence.sentence_id)
         if handler is not None:
             try:
                 handler(self, sentence)
             except (NMEAError, ValueError, IndexError) as exc:
                 log.warning("ignoring malformed %s: %s", sentence.message(), exc)
-        self._acknowledge(sentence)
+        if self._written_at is not None:
+            self._acknowledge(sentence)
 
     def _on_rev(self, s: NMEASentence) -> None:
         if s[2] == "INIT":
