@@ -177,4 +177,4 @@ def test_cycle_statistics_is_a_sentence_for_the_driver():
     assert isinstance(typed, CycleStatistics)
     assert (typed.talker_id, typed.sentence_id) == ("CA", "CST")
     assert typed.fields == NMEASentence.parse(typed.message()).fields
-    assert typed.toa == "20231114221330.6675"
+    assert typed.fields[3] == "20231114221330.6675" and typed.time_on(DAY) == stat.time

@@ -68,6 +68,11 @@ def ids(sentences) -> list[str]:
     return [s.fields[0] for s in sentences]
 
 
+def serial(body: str) -> float:
+    """Seconds a sentence takes on the modem's 19200-baud line (with *HH and CR LF)."""
+    return (len(body) + 5) * 10 / 19200
+
+
 def test_cfg_cfq_accept_only_the_modems_parameters():
     w = Water(ids=(4,))
     assert ids(w.say(4, "$CCCFG,SRC,7")) == ["$CACFG"] and w.modems[4].modem_id == 7
@@ -104,25 +109,29 @@ def on_air(w, modem_id):
 
 def test_rate0_cycle_init_then_data_with_their_air_times_and_travel_time():
     w = Water()  # 1500 m: one second of travel
-    assert ids(w.say(1, "$CCCYC,0,1,2,0,1,1")) == ["$CACYC", "$CATXP"]  # the FSK cycle-init
+    assert ids(w.say(1, "$CCCYC,0,1,2,0,1,1")) == ["$CACYC"]
+    ci = round(serial("$CCCYC,0,1,2,0,1,1"), 6)  # the FSK cycle-init leaves once it has come
     w.run(1.5)
     (drq_t, drq), = w.said(1, "DRQ")
-    assert drq_t == 1.0 and drq.fields[2:] == ("1", "2", "1", "32", "1")  # after the cycle-init
+    assert drq_t == ci + 1.0 and drq.fields[2:] == ("1", "2", "1", "32", "1")  # cycle-init sent
     w.say(1, "$CCTXD,1,2,1,0102030405")
     w.run(20)
-    assert on_air(w, 1) == [(0.0, 1.0), (1.5, 1.5 + 3.2)]  # 32 bytes at 80 bit/s: 3.2 s
+    data = round(1.5 + serial("$CCTXD,1,2,1,0102030405"), 6)  # (the DRQ was across by 1.5)
+    assert on_air(w, 1) == [(ci, ci + 1.0), (data, pytest.approx(data + 3.2))]  # 80 bit/s
     xst = [s for _, s in w.said(1, "XST")]
-    assert [s[3] for s in xst] == ["221320.0000", "221321.5000"]  # their start times
+    assert [s[3] for s in xst] == [f"221320.{int(ci * 1e4):04d}", f"221321.{int((data - 1) * 1e4):04d}"]
     heard = [(t, s.fields[0]) for t, s in w.heard[2]]
-    assert heard[:3] == [(1.0, "$CARXP"), (2.0, "$CACYC"), (2.0, "$CACST")]
-    assert heard[3:6] == [(2.5, "$CARXP"), (5.7, "$CARXD"), (5.7, "$CACST")]
+    assert heard[:3] == [(ci + 1.0, "$CARXP"), (ci + 2.0, "$CACYC"), (ci + 2.0, "$CACST")]
+    end = round(data + 4.2, 6)
+    assert heard[3:6] == [(data + 1.0, "$CARXP"), (end, "$CARXD"), (end, "$CACST")]
     csts = [parse_cst(s, None) for _, s in w.said(2, "CST")]
-    assert [c.time / 1e6 - T0 for c in csts] == [1.0, 2.5]  # times of arrival
+    toa = [c.time / 1e6 - T0 for c in csts]
+    assert toa == pytest.approx([ci + 1.0, data + 1.0], abs=1e-4)  # times of arrival (0.1 ms)
     assert [c.packet_type for c in csts] == [2, 1]  # FSK mini-packet, FSK
     # the receiver acknowledges (a mini-packet) once the data has been heard
-    assert on_air(w, 2) == [(5.7, 6.7)]
+    assert on_air(w, 2) == [(end, end + 1.0)]
     (ack_t, ack), = w.said(1, "ACK")
-    assert ack_t == 7.7 and ack.fields[1:] == ("2", "1", "1", "1")
+    assert ack_t == end + 2.0 and ack.fields[1:] == ("2", "1", "1", "1")
 
 
 @pytest.mark.parametrize(
@@ -132,14 +141,19 @@ def test_rate0_cycle_init_then_data_with_their_air_times_and_travel_time():
 )  # fmt: skip
 def test_psk_air_time_per_rate_and_frame_count(rate, frames, size, seconds):
     w = Water(range_m=0.0)
-    drqs = w.say(1, f"$CCCYC,0,1,2,{rate},0,{frames}")
+    cyc = f"$CCCYC,0,1,2,{rate},0,{frames}"
+    drqs = w.say(1, cyc)
     assert drqs[-1].fields[5:] == (str(size), "1")  # no cycle-init packet: asked for data at once
-    for _ in range(frames):
-        w.say(1, f"$CCTXD,1,2,0,{'ab' * size}")
+    line = serial(cyc)
+    for n in range(1, frames + 1):
+        txd = f"$CCTXD,1,2,0,{'ab' * size}"
+        line += serial(f"$CADRQ,221320,1,2,0,{size},{n}") + serial(txd)
+        w.say(1, txd)
     w.run(10)
     ((start, end),) = on_air(w, 1)
+    assert start == pytest.approx(line, abs=2e-6)  # once every frame has crossed the serial line
     assert end - start == pytest.approx(seconds)
-    assert len(w.said(2, "RXD")) == frames and w.said(2, "RXD")[0][0] == pytest.approx(seconds)
+    assert len(w.said(2, "RXD")) == frames and w.said(2, "RXD")[0][0] == pytest.approx(end)
     assert w.said(2, "CYC")[0][1].fields[1:] == ("0", "1", "2", str(rate), "0", str(frames))
 
 
@@ -171,8 +185,12 @@ def test_a_second_transmission_waits_for_the_transducer():
     w.say(1, "$CCTXD,1,2,0,aa")
     w.say(1, "$CCMUC,1,2,0123")  # while the data is on the water
     w.run(10)
-    assert on_air(w, 1) == [(0.0, pytest.approx(0.3 + 2.95 / 3)),
-                            (pytest.approx(0.3 + 2.95 / 3), pytest.approx(1.3 + 2.95 / 3))]  # fmt: skip
+    start = serial("$CCCYC,0,1,2,1,0,1") + serial("$CADRQ,221320,1,2,0,64,1") + serial(
+        "$CCTXD,1,2,0,aa"
+    )
+    end = start + 0.3 + 2.95 / 3
+    assert on_air(w, 1) == [(pytest.approx(start, abs=2e-6), pytest.approx(end, abs=2e-6)),
+                            (pytest.approx(end, abs=2e-6), pytest.approx(end + 1, abs=2e-6))]  # fmt: skip
     assert w.said(2, "MUA")[0][1].fields[1:] == ("1", "2", "0123")
 
 
@@ -181,13 +199,13 @@ def test_ping_reply_after_two_way_travel_and_turnaround(range_m, tat):
     w = Water(range_m=range_m, sound_speed=1490.0)
     for modem in w.modems.values():
         modem.nvram["TAT"] = tat
-    assert ids(w.say(1, "$CCMPC,1,2")) == ["$CAMPC", "$CATXP"]
+    assert ids(w.say(1, "$CCMPC,1,2")) == ["$CAMPC"]
     w.run(20)
-    owtt = range_m / 1490.0
+    owtt, start = range_m / 1490.0, serial("$CCMPC,1,2")
     (mpa_t, mpa), = w.said(2, "MPA")
-    assert mpa_t == pytest.approx(owtt + 0.5) and mpa.fields[1:] == ("1", "2")
+    assert mpa_t == pytest.approx(start + owtt + 0.5) and mpa.fields[1:] == ("1", "2")
     (mpr_t, mpr), = w.said(1, "MPR")
-    assert mpr_t == pytest.approx(2 * owtt + 2 * 0.5 + tat / 1000)
+    assert mpr_t == pytest.approx(start + 2 * owtt + 2 * 0.5 + tat / 1000)
     assert mpr.fields[1:3] == ("2", "1") and float(mpr[3]) == pytest.approx(owtt, abs=1e-4)
 
 
@@ -262,7 +280,8 @@ def test_navigation_pings_echo_and_report_no_transponders_at_the_timeout():
     assert w.say(1, "$CCPDT,1,2,0,0,1383,1,1,1,1")[0].fields[0] == "$SNPDT"
     w.run(3)
     (t, tta), = w.said(1, "TTA")
-    assert t == pytest.approx(1.383) and tta.fields[1:] == ("", "", "", "", "221320.00")
+    start = serial("$CCPDT,1,2,0,0,1383,1,1,1,1")  # the ping leaves once the command is in
+    assert t == pytest.approx(start + 1.383) and tta.fields[1:] == ("", "", "", "", "221320.01")
     assert w.say(1, "$CCPNT,26000,5,5,2716,25000,25500,0,0,1")[0].fields[0] == "$SNPNT"
     pgt = "$CCPGT,1,25000,28,abc,500,25500,28,a,b,c,d,5000,5000,0"  # pyacomms' 14 fields
     assert w.say(1, pgt)[0].fields[0] == "$SNPGT"

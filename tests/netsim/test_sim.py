@@ -151,3 +151,15 @@ def test_same_seed_same_run_other_seed_other_run(tmp_path):
 def test_bad_scenarios_are_refused_with_the_reason(text, reason):
     with pytest.raises(ScenarioError, match=reason):
         parse_scenario(text)
+
+
+def test_scenario_modem_timing_sets_the_emulators_durations():
+    text = f"""duration: 120 {ORIGIN} mac {{ slot_seconds: 10 rate: 1 }}
+        modem_timing {{ rate {{ rate: 1 lead: 2.0 per_frame: 0 }} mini_packet: 0.8 }}
+        {fixed(1, 0)} {fixed(2, 1500)}"""
+    sim, events = run(text)
+    data = [e for e in events if e["event"] == "tx" and e["kind"] == "data"]
+    assert data and {e["duration"] for e in data} == {2.0}
+    for bad in ("rate { rate: 9 lead: 1 }", "rate { rate: 1 lead: 0 per_frame: 0 }", "ping: -1"):
+        with pytest.raises(ScenarioError, match="modem_timing"):
+            parse_scenario(f"modem_timing {{ {bad} }} {fixed(1, 0)} {ORIGIN}")

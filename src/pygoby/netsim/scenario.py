@@ -10,6 +10,7 @@ The schema is documented in src/pygoby/protobuf/pygoby/netsim/scenario.proto.
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -20,6 +21,7 @@ from google.protobuf import text_format
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as m
+from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, ModemTiming
 from pygoby.netsim.channel import Band, ChannelConfig, Position
 from pygoby.netsim.channel.errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
@@ -92,6 +94,7 @@ def check_scenario(scenario: Message) -> None:
         raise ScenarioError("position_period and housekeeping_period must be positive")
     if scenario.channel.position_staleness <= scenario.position_period:
         raise ScenarioError("channel.position_staleness must exceed position_period")
+    modem_timing(scenario)  # raises on a bad duration table
 
 
 def speed_factor(scenario: Message) -> float | None:
@@ -144,6 +147,31 @@ def channel_config(scenario: Message) -> ChannelConfig:
         decode_latency=c.decode_latency,
         position_staleness=c.position_staleness,
     )
+
+
+def modem_timing(scenario: Message) -> ModemTiming:
+    """The emulators' duration table: the defaults with the scenario's `modem_timing` over them."""
+    t = scenario.modem_timing
+    rates = dict(DEFAULT_TIMING.rates)
+    for entry in t.rate:
+        spec = rates.get(entry.rate)
+        if spec is None:
+            raise ScenarioError(f"modem_timing: there is no Micro-Modem rate {entry.rate}")
+        lead = entry.lead if entry.HasField("lead") else spec.lead
+        per_frame = entry.per_frame if entry.HasField("per_frame") else spec.per_frame
+        if lead < 0 or per_frame < 0 or lead + per_frame <= 0:
+            raise ScenarioError(f"modem_timing: rate {entry.rate} needs a positive duration")
+        rates[entry.rate] = dataclasses.replace(spec, lead=lead, per_frame=per_frame)
+    others = {
+        name: getattr(t, name)
+        for name in ("mini_packet", "ping", "nav_ping", "tmq_reply")
+        if t.HasField(name)
+    }
+    if any(value <= 0 for value in others.values()):
+        raise ScenarioError(f"modem_timing: durations must be positive: {others}")
+    if t.HasField("baud"):
+        others["baud"] = t.baud
+    return dataclasses.replace(DEFAULT_TIMING, rates=rates, **others)
 
 
 def manager_config(scenario: Message, endpoint_ip: str = "127.0.0.1") -> Message:

@@ -50,6 +50,7 @@ from pygoby.netsim.scenario import (
     channel_config,
     mac_config,
     manager_config,
+    modem_timing,
     node_ports,
     node_status_class,
     start_time,
@@ -139,14 +140,16 @@ class Simulation:
         self.manager.on_nav(self.channel.on_environment_nav_update)
         self.physics = PhysicsChannel(self.channel, self.clock, on_event=self._event)
         self.timeline = Timeline(self.clock)  # the emulators' timed events
+        timing = modem_timing(scenario)
         self.codec = Codec(clock=self.clock)
         self.status_class = node_status_class()
         self.nodes: list[SimNode] = []
         for node, port in zip(scenario.node, node_ports(scenario), strict=True):
             track = TrackFollower(node.track, scenario) if node.HasField("track") else None
             model = MicroModemModel(
-                node.modem_id, self.clock, self.physics, name=str(port), timeline=self.timeline
-            )
+                node.modem_id, self.clock, self.physics, name=str(port), timing=timing,
+                timeline=self.timeline,
+            )  # fmt: skip
             self.nodes.append(SimNode(node.modem_id, port, model, track))
         self._request_id = 0
         self._wall_start = 0.0

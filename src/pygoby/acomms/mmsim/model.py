@@ -39,7 +39,6 @@ from pygoby.acomms.drivers.micromodem.statistics import (
     DOPPLER_INDEX,
     CycleStatistics,
     format_xst,
-    toa_text,
 )
 from pygoby.acomms.mmsim.channel import AcousticPacket, Channel, PacketKind, Reception
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, FDP_RATES, ModemTiming
@@ -124,6 +123,7 @@ class MicroModemModel:
         self._clock_source = "RTC"  # the modem's own clock until the host sets it
         self._tx: _Transmit | None = None
         self._air_free_at = -math.inf  # the transducer is busy until then
+        self._line_done = -math.inf  # host sentences have crossed the serial line by then
         self._pings: dict[int, float] = {}  # start of our last ping to each modem
         self._lines: dict[int, int] = {}  # hardware control lines
         self.channel = channel
@@ -173,6 +173,12 @@ class MicroModemModel:
         t = dt.datetime.fromtimestamp(modem_time, dt.UTC)
         return f"{t:%Y-%m-%dT%H:%M:%S}.{t.microsecond // 100000}Z"
 
+    def _serial_time(self, sentence: NMEASentence) -> float:
+        """Seconds a sentence takes on the modem's serial line (start, 8 data, stop bit per
+        character; with its checksum and CR LF)."""
+        baud = self.timing.baud
+        return (len(",".join(sentence.fields)) + 5) * 10 / baud if baud else 0.0
+
     def _error(self, module: str, code: int, text: str) -> None:
         self._say("$CAERR", self._hhmmss(), module, code, text)
 
@@ -198,6 +204,8 @@ class MicroModemModel:
         if command is None or (sentence_id in _MM2_COMMANDS and not self.mm2):
             self._error("NMEA", 2, f"Unknown command {s.fields[0][1:]}")
             return
+        # (the sentence has crossed the serial line when the modem acts on it)
+        self._line_done = max(self.clock.now(), self._line_done) + self._serial_time(s)
         try:
             command(self, s)
         except (NMEAError, ValueError, IndexError) as exc:
@@ -300,7 +308,7 @@ class MicroModemModel:
             self._start_transmit(_Transmit(adr1, adr2, rate, bool(ack), nframes))
         else:  # a third-party cycle-init: an acoustic poll asking adr1 to send
             cycle = AcousticPacket(PacketKind.CYCLE, adr1, adr2, rate, bool(ack), num_frames=nframes)
-            self._send(cycle, self.timing.mini_packet)
+            self._send(cycle, self.timing.mini_packet, at=self._line_done)
 
     def _start_transmit(self, tx: _Transmit) -> None:
         self._tx = tx
@@ -308,7 +316,9 @@ class MicroModemModel:
             cycle = AcousticPacket(
                 PacketKind.CYCLE, tx.src, tx.dest, 0, tx.ack, num_frames=tx.num_frames
             )
-            self._send(cycle, self.timing.mini_packet, lambda: self._request_frame(tx))
+            self._send(
+                cycle, self.timing.mini_packet, lambda: self._request_frame(tx), self._line_done
+            )
         else:
             self._request_frame(tx)
 
@@ -317,7 +327,11 @@ class MicroModemModel:
             return  # a newer cycle replaced it
         tx.requested = len(tx.frames) + 1
         nbytes = self.timing.rates[tx.rate].frame_bytes
-        self._say("$CADRQ", self._hhmmss(), tx.src, tx.dest, int(tx.ack), nbytes, tx.requested)
+        drq = NMEASentence.build(
+            "$CADRQ", (self._hhmmss(), tx.src, tx.dest, int(tx.ack), nbytes, tx.requested)
+        )
+        self._emit(drq)
+        self._line_done = max(self.clock.now(), self._line_done) + self._serial_time(drq)
         timeout = self.clock.now() + max(1, int(self.nvram["DTO"]))
         self.timeline.at(timeout, self._data_timeout, tx, tx.requested)
 
@@ -346,13 +360,13 @@ class MicroModemModel:
         tx.requested = 0
         if tx.frames:  # (nothing to send: nothing goes out)
             packet = AcousticPacket(PacketKind.DATA, tx.src, tx.dest, tx.rate, tx.ack, tx.frames)
-            self._send(packet, self.timing.data(tx.rate, len(tx.frames)))
+            self._send(packet, self.timing.data(tx.rate, len(tx.frames)), at=self._line_done)
 
     def _cmd_mpc(self, s: NMEASentence) -> None:
         src, dest = s.as_int(1, 0, MAX_ADDRESS), s.as_int(2, 0, MAX_ADDRESS)
         self._say("$CAMPC", src, dest)
         ping = AcousticPacket(PacketKind.PING, src, dest)
-        self._send(ping, self.timing.ping)
+        self._send(ping, self.timing.ping, at=self._line_done)
         self._pings[dest] = ping.tx_time
 
     def _cmd_muc(self, s: NMEASentence) -> None:
@@ -361,7 +375,8 @@ class MicroModemModel:
             self._error("MUC", 7, "Mini-packet data must be 13 bits")
             return
         self._say("$CAMUC", src, dest, s[3])
-        self._send(AcousticPacket(PacketKind.MINI, src, dest, frames=[data]), self.timing.mini_packet)
+        mini = AcousticPacket(PacketKind.MINI, src, dest, frames=[data])
+        self._send(mini, self.timing.mini_packet, at=self._line_done)
 
     def _cmd_tdp(self, s: NMEASentence) -> None:
         dest, rate = s.as_int(1, 0, MAX_ADDRESS), s.as_int(2)
@@ -374,7 +389,7 @@ class MicroModemModel:
         size = self.timing.rates[rate].frame_bytes  # (the payload goes in its rate's frames)
         frames = [data[i : i + size] for i in range(0, len(data), size)]
         packet = AcousticPacket(PacketKind.FDP, self.modem_id, dest, rate, bool(ack), frames)
-        self._send(packet, self.timing.data(rate, len(frames)))
+        self._send(packet, self.timing.data(rate, len(frames)), at=self._line_done)
 
     def _cmd_mec(self, s: NMEASentence) -> None:
         src, dest = s.as_int(1, 0, MAX_ADDRESS), s.as_int(2, 0, MAX_ADDRESS)
@@ -384,7 +399,7 @@ class MicroModemModel:
             return
         self._say("$CAMEC", src, dest, line, mode, arg)
         command = AcousticPacket(PacketKind.HW_CONTROL, src, dest, hw_control=(line, mode, arg))
-        self._send(command, self.timing.mini_packet)
+        self._send(command, self.timing.mini_packet, at=self._line_done)
 
     def _control_line(self, line: int, mode: int, arg: int) -> int:
         """Set or read a hardware line (modes: 0 read, 1 set, 2/3 toggle); its value after."""
@@ -409,8 +424,8 @@ class MicroModemModel:
     def _navigation_ping(self, s: NMEASentence, echo: str, timeout_field: int, length: float):
         timeout_ms = s.as_int(timeout_field, 0, 60_000)
         self._say(echo, *s.fields[1:])
-        start = max(self.clock.now(), self._air_free_at)
-        self._send(AcousticPacket(PacketKind.SIGNAL, self.modem_id, 0), length)
+        start = max(self._line_done, self._air_free_at)
+        self._send(AcousticPacket(PacketKind.SIGNAL, self.modem_id, 0), length, at=start)
         # no transponders answer: the travel times stay empty
         when = dt.datetime.fromtimestamp(start + self._clock_offset, dt.UTC)
         stamp = f"{when:%H%M%S}.{when.microsecond // 10000:02d}"
@@ -431,7 +446,7 @@ class MicroModemModel:
 
     def _signal(self, s: NMEASentence, echo: str, length: float) -> None:
         self._say(echo, *s.fields[1:])
-        self._send(AcousticPacket(PacketKind.SIGNAL, self.modem_id, 0), length)
+        self._send(AcousticPacket(PacketKind.SIGNAL, self.modem_id, 0), length, at=self._line_done)
 
     # ------------------------------------------------------------------ on the water
     def _send(
@@ -591,10 +606,10 @@ class MicroModemModel:
                 values[i] = round(value, 1)
             else:
                 values[i] = value if type(value) is int else int(round(value))
-        toa = toa_text(m.now_us(r.arrival_time + self._clock_offset), self.mm2)
         self._emit(
             CycleStatistics(
-                self.statistics_version, 1 if bad else 0, toa, self._clock_mode_field(),
+                self.statistics_version, 1 if bad else 0,
+                m.now_us(r.arrival_time + self._clock_offset), self._clock_mode_field(),
                 tuple(values),
             )  # fmt: skip
         )

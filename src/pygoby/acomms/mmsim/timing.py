@@ -20,6 +20,11 @@ Figures and their confidence (spec netsim.md §7.10 and the sources it cites):
 * LBL interrogation pings ($CCPDT, $CCPGT): 10 ms; $CCPNT gives its own length. ESTIMATE.
 * $CATMQ comes 0.5 s after $CCTMQ and reports the time at the query. KNOWN (goby3 driver: "the
   Micro-Modem takes 0.5 second to respond to TMQ").
+* the host's serial line: 19200 baud, 10 bits a character (goby3's default for the Micro-Modem;
+  NVRAM BR1 3). KNOWN. A packet goes on the water once the host's sentences that make it
+  ($CCCYC, each $CADRQ and $CCTXD, $CCMPC, ...) have crossed the line: a rate-0 frame's $CADRQ
+  and $CCTXD take about 60 ms, a full rate-5 packet's about 2.3 s. (The modem's own output is
+  not paced.)
 * the ping reply leaves the turnaround time TAT (NVRAM, default 50 ms) after the ping has been
   heard; the pinging modem reports ((reply arrival - ping start) - ping length - its own TAT) / 2.
   TAT default: ESTIMATE (goby's REMUS LBL default turnaround).
@@ -72,6 +77,7 @@ class ModemTiming:
     ping: float = 0.5
     nav_ping: float = 0.010
     tmq_reply: float = 0.5
+    baud: int = 19200  # (0: the host's sentences take no time)
 
     def data(self, rate: int, frames: int) -> float:
         return self.rates[rate].duration(frames)

@@ -48,8 +48,10 @@ when `poll` is called.
 
 from __future__ import annotations
 
+import _random
 import bisect
 import enum
+import hashlib
 import heapq
 import logging
 import math
@@ -489,8 +491,14 @@ class Channel:
             outcome = Outcome.RECEIVER_BUSY
         else:
             fer = config.error_models.frame_error(p.transmission.rate, level)
-            draw = self._random(p).random
-            frames_ok = tuple([draw() > fer for _ in range(p.transmission.frames)])
+            frames = p.transmission.frames
+            if fer >= 1.0:  # (random() < 1: every draw would fail)
+                frames_ok = (False,) * frames
+            elif fer <= 0.0:  # (every draw would succeed, but for one exactly 0.0: 2**-53)
+                frames_ok = (True,) * frames
+            else:
+                draw = self._random(p).random
+                frames_ok = tuple([draw() > fer for _ in range(frames)])
             outcome = Outcome.GOOD if all(frames_ok) else Outcome.BAD_FRAMES
         return Reception(
             receiver=p.receiver,
@@ -510,11 +518,15 @@ class Channel:
         )
 
     def _random(self, p: _Pending) -> random.Random:
-        """The reception's own generator, seeded only when a draw decides something (one
-        generator object, reseeded: the same stream as a new one, without allocating its
-        state each time)."""
-        self._rng.seed(f"{self.seed}:{p.sequence}:{p.receiver}")
-        return self._rng
+        """The reception's own generator, random.Random(f"{seed}:{sequence}:{receiver}"),
+        seeded only when a draw decides something: one generator object, reseeded the way
+        Random.seed seeds it from a str (version 2: the text and its SHA-512 as one integer),
+        without its Python wrapper and without allocating the state each time."""
+        key = f"{self.seed}:{p.sequence}:{p.receiver}".encode()
+        rng = self._rng
+        _random.Random.seed(rng, int.from_bytes(key + hashlib.sha512(key).digest()))
+        rng.gauss_next = None
+        return rng
 
     @staticmethod
     def _protocol_outcome(

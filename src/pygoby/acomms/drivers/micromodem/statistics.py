@@ -61,25 +61,31 @@ def clock_mode_from_field(value: int, new_bitfield: bool) -> int:
 
 class CycleStatistics:
     """A $CACST as the values it prints: what an emulator hands a driver on an in-process link
-    (the driver reads the values; the text is made only for a serial or TCP edge). `toa` and
-    `clock_mode` are as printed (the time of day, or date and time from version 6 on; the clock
-    field, a bit field on newer Micro-Modem 2 firmware): the driver interprets them as it does
-    the text. `values`: mfd_peak .. bandwidth in $CACST order, doppler to 0.1, the rest
-    integers (see `cycle_statistics`)."""
+    (the driver reads the values; the text is made only for a serial or TCP edge). The time of
+    arrival `toa_us` (microseconds since the epoch, to the 100 us the text carries) and
+    `clock_mode` (the field as printed: a bit field on newer Micro-Modem 2 firmware) are read as
+    the text is: a version-0 time is a time of day on the reader's date. `values`: mfd_peak ..
+    bandwidth in $CACST order, doppler to 0.1, the rest integers (see `cycle_statistics`)."""
 
-    __slots__ = ("version", "mode", "toa", "clock_mode", "values")
+    __slots__ = ("version", "mode", "toa_us", "clock_mode", "values")
     talker_id = "CA"
     sentence_id = "CST"
 
-    def __init__(self, version: int, mode: int, toa: str, clock_mode: int, values: tuple) -> None:
-        self.version, self.mode, self.toa, self.clock_mode = version, mode, toa, clock_mode
-        self.values = values
+    def __init__(self, version: int, mode: int, toa_us: int, clock_mode: int, values: tuple):
+        self.version, self.mode, self.clock_mode, self.values = version, mode, clock_mode, values
+        self.toa_us = toa_us - toa_us % 100
+
+    def time_on(self, today: dt.date) -> int:
+        """The time of arrival as the text's reader gets it (parse_toa(toa_text(...)))."""
+        if self.version >= 6:
+            return self.toa_us
+        return (today.toordinal() - _EPOCH_ORDINAL) * 86_400_000_000 + self.toa_us % 86_400_000_000
 
     def sentence(self) -> NMEASentence:
         head = (str(self.version),) if self.version >= 6 else ()
         return NMEASentence(
-            ("$CACST", *head, str(self.mode), self.toa, str(self.clock_mode),
-             *(_CST_TAIL % self.values).split(","))
+            ("$CACST", *head, str(self.mode), toa_text(self.toa_us, self.version >= 6),
+             str(self.clock_mode), *(_CST_TAIL % self.values).split(","))
         )  # fmt: skip
 
     @property
@@ -105,7 +111,7 @@ def cycle_statistics(stat: Mapping | object, version: int = 0) -> CycleStatistic
     6 on the sentence carries its version and the date of the time of arrival (Micro-Modem 2)."""
     get = stat.__getitem__ if isinstance(stat, Mapping) else stat.__getattribute__
     return CycleStatistics(
-        version, int(get("mode")), toa_text(get("time"), version >= 6), int(get("clock_mode")),
+        version, int(get("mode")), int(get("time")), int(get("clock_mode")),
         tuple(round(get(name), 1) if name == _DECIMAL else int(get(name)) for name in _CST_FIELDS),
     )  # fmt: skip
 
@@ -135,11 +141,12 @@ def cst_fields(
 ) -> dict:
     """The ReceiveStatistics fields of a $CACST, by name (up to a short sentence's end)."""
     if isinstance(sentence, CycleStatistics):
-        version, mode, toa, clock = sentence.version, sentence.mode, sentence.toa, sentence.clock_mode
+        version, mode, clock = sentence.version, sentence.mode, sentence.clock_mode
+        time = sentence.time_on(today)
         fields = dict(zip(_CST_FIELDS, sentence.values, strict=True))
     else:
         version, off = cst_offset(sentence)
-        mode, toa = sentence.as_int(1 + off), sentence[2 + off]
+        mode, time = sentence.as_int(1 + off), parse_toa(sentence[2 + off], today)
         clock = sentence.as_int(3 + off)
         start = 4 + off
         present = min(len(_CST_FIELDS), max(0, len(sentence) - start))
@@ -153,7 +160,7 @@ def cst_fields(
             )
     fields["version"] = version
     fields["mode"] = mode if 0 <= mode <= 2 else -1
-    fields["time"] = parse_toa(toa, today)
+    fields["time"] = time
     fields["clock_mode"] = clock_mode_from_field(clock, new_clock_bitfield)
     for name, (lo, hi) in _CST_ENUM_RANGES.items():
         if name in fields and not lo <= fields[name] <= hi:
@@ -179,7 +186,7 @@ def add_cst(
     if isinstance(sentence, CycleStatistics) and math.copysign(1, sentence.values[DOPPLER_INDEX]) > 0:
         # an emulated link's statistics recur: all but the time of arrival are converted once
         # (not with a Doppler of -0.0, which would share the memo's key with 0.0)
-        time = parse_toa(sentence.toa, today)
+        time = sentence.time_on(today)
         stats.append(
             _without_toa(sentence.version, sentence.mode, sentence.clock_mode, sentence.values,
                          new_clock_bitfield)
@@ -194,7 +201,7 @@ def add_cst(
 @functools.lru_cache(maxsize=4096)
 def _without_toa(version: int, mode: int, clock_mode: int, values: tuple, new_bitfield: bool):
     """parse_cst's ReceiveStatistics of a typed $CACST but its time (shared: copy it)."""
-    typed = CycleStatistics(version, mode, "000000", clock_mode, values)
+    typed = CycleStatistics(version, mode, 0, clock_mode, values)
     return parse_cst(typed, dt.date(1970, 1, 1), new_bitfield)
 
 
