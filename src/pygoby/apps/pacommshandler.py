@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import base64
 import functools
-from pathlib import Path
 
 from google.protobuf.message import Message
 
@@ -34,17 +33,9 @@ from pygoby.moos.translator import (
     post_for_moos,
 )
 from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
-from pygoby.protobuf import ProtoLoader, default_loader
+from pygoby.protobuf import ProtoLoader
 
 ROUTE_COMMAND = "goby.acomms.protobuf.RouteCommand"
-ROUTE_PROTO = "goby/acomms/protobuf/route.proto"
-
-
-def _goby_message_class(name: str) -> type[Message]:
-    """pygoby's own messages a mission may name (MACUpdate, RouteCommand, NetworkAck, ...)."""
-    goby = default_loader()
-    goby.load_file(ROUTE_PROTO)
-    return goby.message_class(name)
 
 
 def _raw_value(raw: bytes) -> str | bytes:
@@ -80,7 +71,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self._message_class = MessageTypes(
             [self._find(path) for path in cfg.load_proto_file],
             [self._find(module) for module in cfg.load_shared_library],
-            fallback=_goby_message_class,
+            fallback=m.goby_message_class,
             loader=self.loader,
         )
         self.binding = TranslatorBinding(
@@ -114,13 +105,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.frontseat_forward.add(name)
 
     def _find(self, path: str) -> str:
-        """A relative path that does not exist from the working directory is looked up next to
-        the mission file (so that missions can be run from anywhere)."""
-        given = Path(path)
-        if given.is_absolute() or given.exists() or self.mission is None or not self.mission.path:
-            return path
-        beside = Path(self.mission.path).parent / given
-        return str(beside) if beside.exists() else path
+        return self.mission.find_file(path) if self.mission is not None else path
 
     # ------------------------------------------------------------------ wiring
     def _connect_signals(self) -> None:

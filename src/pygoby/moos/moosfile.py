@@ -125,6 +125,15 @@ class MissionFile:
     def from_text(cls, text: str) -> MissionFile:
         return cls(text.splitlines())
 
+    def find_file(self, path: str) -> str:
+        """A relative path that does not exist from the working directory is looked up next to
+        the mission file (so that missions can be run from anywhere)."""
+        given = Path(path)
+        if given.is_absolute() or given.exists() or not self.path:
+            return path
+        beside = Path(self.path).parent / given
+        return str(beside) if beside.exists() else path
+
     @staticmethod
     def _preprocess(raw_lines: list[str]) -> list[str]:
         macros: dict[str, str] = {}

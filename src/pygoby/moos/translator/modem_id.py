@@ -84,5 +84,9 @@ class ModemIdLookup:
         found = self._by_name.get(name.lower())
         return found if found is not None else atoi(name)
 
+    def entries(self) -> list[ModemIdEntry]:
+        """Every entry, by modem id."""
+        return [self._by_id[modem_id] for modem_id in sorted(self._by_id)]
+
     def __len__(self) -> int:
         return len(self._by_id)
