@@ -103,6 +103,11 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
                     f"dccl_frontseat_forward_name {name!r} is not a loaded type"
                 ) from None
             self.frontseat_forward.add(name)
+        self.liaison = None
+        if cfg.HasField("liaison"):
+            from pygoby.apps.liaison import Liaison  # imported only when asked for (web stack)
+
+            self.liaison = Liaison.embedded(self)
 
     def _find(self, path: str) -> str:
         return self.mission.find_file(path) if self.mission is not None else path
@@ -163,6 +168,16 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def on_stop(self) -> None:
         self.acomms.shutdown()
+
+    async def start(self, connect_timeout: float | None = None) -> None:
+        await super().start(connect_timeout)
+        if self.liaison is not None:
+            await self.liaison.start()
+
+    async def stop(self) -> None:
+        if self.liaison is not None:
+            await self.liaison.stop()
+        await super().stop()
 
     def loop(self) -> None:
         self.binding.tick(self.clock.now())

@@ -134,8 +134,11 @@ class CommandSet:
         modem_ids: ModemIdLookup | None = None,
         lat_origin: float = 0.0,
         lon_origin: float = 0.0,
+        resolve: Callable[[str], type[Message]] | None = None,
     ) -> None:
         self.translator = translator
+        # every message type of the mission (queues without translator entries too)
+        self.resolve = resolve or translator.message_class
         self.queue_entries = queue_entries
         self.multiplex_var = multiplex_var
         self.variables = variables
@@ -150,16 +153,16 @@ class CommandSet:
 
     @classmethod
     def from_pacommshandler(
-        cls, cfg: Message, find: Callable[[str], str] = str, community_lookup: str = ""
+        cls, cfg: Message, find: Callable[[str], str] = str, modem_id_lookup_path: str = ""
     ) -> CommandSet:
         """From a pAcommsHandlerConfig; `find` resolves relative file names (e.g.
-        MissionFile.find_file). Raises ConfigError for files or entries that cannot be used."""
+        MissionFile.find_file); `modem_id_lookup_path` replaces the config's. Raises ConfigError for files or entries that cannot be used."""
         types = MessageTypes(
             [find(path) for path in cfg.load_proto_file],
             [find(module) for module in cfg.load_shared_library],
             fallback=acomms_messages.goby_message_class,
         )
-        lookup_path = cfg.modem_id_lookup_path or community_lookup
+        lookup_path = modem_id_lookup_path or cfg.modem_id_lookup_path
         modem_ids = ModemIdLookup.from_file(find(lookup_path)) if lookup_path else None
         translator = Translator(
             cfg.translator_entry,
@@ -176,6 +179,7 @@ class CommandSet:
             modem_ids=modem_ids,
             lat_origin=cfg.common.lat_origin,
             lon_origin=cfg.common.lon_origin,
+            resolve=types,
         )
 
     def __len__(self) -> int:
