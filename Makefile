@@ -6,6 +6,9 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: demo test bench lint clean
 
+# liaison's browser tests drive Debian's chromium (Playwright's own browser download is not used)
+CHROMIUM ?= /usr/bin/chromium
+
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
@@ -16,7 +19,10 @@ demo: $(STAMP)
 	$(PY) -m pygoby.demo
 	$(PY) examples/frontseat/run_demo.py --warp 10 --duration 50
 
-test: $(STAMP)
+$(CHROMIUM):
+	command -v apt-get >/dev/null && (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) || echo "install chromium for liaison's browser tests"
+
+test: $(STAMP) $(CHROMIUM)
 	$(PY) -m ruff check src tests benchmarks
 	$(PY) -m pytest -q
 

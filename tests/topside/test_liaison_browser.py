@@ -9,14 +9,13 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import playwright.async_api as playwright_api  # a dev dependency: these tests never skip
 import pytest
 
 from pygoby.apps.liaison import Liaison
 from tests.apps.acomms_mission import TwoCommunities
 
 from .mission import topside_mission
-
-playwright_api = pytest.importorskip("playwright.async_api")
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
