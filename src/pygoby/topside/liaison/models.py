@@ -5,6 +5,7 @@ commander core directly.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections import deque
@@ -117,6 +118,11 @@ class QueueState:
         return self.entry.value_base * (now - self.last_sent) / ttl
 
 
+def _enum_name(msg: Message, field: str) -> str:
+    enum = msg.DESCRIPTOR.fields_by_name[field].enum_type
+    return enum.values_by_number[getattr(msg, field)].name
+
+
 def _mm_extension(transmission: Message) -> Message | None:
     if transmission.HasExtension(am.MM_TRANSMISSION):
         return transmission.Extensions[am.MM_TRANSMISSION]
@@ -157,8 +163,8 @@ class AcommsModel:
         self._handlers = {
             self.var["queue_size"]: self._on_qsize,
             self.var["mac_slot_start"]: self._on_slot,
-            self.var["driver_transmit"]: self._on_transmit,
-            self.var["driver_receive"]: self._on_receive,
+            self.var["driver_transmit"]: functools.partial(self._on_modem, True),
+            self.var["driver_receive"]: functools.partial(self._on_modem, False),
             self.var["queue_ack_original_msg"]: self._on_ack,
             self.var["queue_expire"]: self._on_expire,
         }
@@ -208,46 +214,37 @@ class AcommsModel:
                 offset += max(used, 1)
         return names
 
-    def _transmission(self, transmission: Message, when: float) -> dict:
-        stamp = transmission.time / 1e6 if transmission.HasField("time") else when
-        return {
-            "time": stamp, "src": transmission.src, "dest": transmission.dest,
+    def _on_modem(self, sent: bool, value: MoosValue, when: float) -> None:
+        """ACOMMS_MODEM_TRANSMIT (sent) / ACOMMS_MODEM_RECEIVE: one row, with the modem's
+        statistics ($CAXST result, $CACST SNR, Doppler, bad frames) when it gives them."""
+        transmission = self._parse(am.ModemTransmission, value)
+        if transmission is None:
+            return
+        names = self._messages_in(transmission)
+        row = {
+            "time": transmission.time / 1e6 if transmission.HasField("time") else when,
+            "src": transmission.src, "dest": transmission.dest,
             "type": am.ModemTransmission.TransmissionType.Name(transmission.type),
             "rate": transmission.rate, "frames": len(transmission.frame),
-            "messages": [n.rsplit(".", 1)[-1] for n in self._messages_in(transmission)],
+            "messages": [n.rsplit(".", 1)[-1] for n in names],
         }  # fmt: skip
-
-    def _on_transmit(self, value: MoosValue, when: float) -> None:
-        transmission = self._parse(am.ModemTransmission, value)
-        if transmission is None:
-            return
-        row = self._transmission(transmission, when)
         mm = _mm_extension(transmission)
-        if mm is not None and mm.transmit_stat:
-            stat = mm.transmit_stat[-1]
-            row["mode"] = am.TransmitStatistics.DESCRIPTOR.fields_by_name["mode"].enum_type.values_by_number[stat.mode].name
-        for name in self._messages_in(transmission):
-            queue = self.queues.get(name)
-            if queue is not None:
-                queue.last_sent, queue.sent = row["time"], queue.sent + 1
-        self.tx.appendleft(row)
-        self.timeline.appendleft({"time": row["time"], "kind": "tx",
-                                  "text": f"sent {row['type']} {row['src']}->{row['dest']} {', '.join(row['messages'])}"})  # fmt: skip
-
-    def _on_receive(self, value: MoosValue, when: float) -> None:
-        transmission = self._parse(am.ModemTransmission, value)
-        if transmission is None:
-            return
-        row = self._transmission(transmission, when)
-        mm = _mm_extension(transmission)
-        if mm is not None and mm.receive_stat:
+        if sent:
+            if mm is not None and mm.transmit_stat:
+                row["mode"] = _enum_name(mm.transmit_stat[-1], "mode")
+            for name in names:
+                queue = self.queues.get(name)
+                if queue is not None:
+                    queue.last_sent, queue.sent = row["time"], queue.sent + 1
+        elif mm is not None and mm.receive_stat:
             stat = mm.receive_stat[-1]
             row.update(snr_in=stat.snr_in, snr_out=stat.snr_out, doppler=stat.doppler,
                        mse=stat.mse_equalizer, bad_frames=stat.number_bad_frames,
-                       psk_error=am.ReceiveStatistics.DESCRIPTOR.fields_by_name["psk_error_code"].enum_type.values_by_number[stat.psk_error_code].name)  # fmt: skip
-        self.rx.appendleft(row)
-        self.timeline.appendleft({"time": row["time"], "kind": "rx",
-                                  "text": f"heard {row['type']} {row['src']}->{row['dest']} {', '.join(row['messages'])}"})  # fmt: skip
+                       psk_error=_enum_name(stat, "psk_error_code"))  # fmt: skip
+        (self.tx if sent else self.rx).appendleft(row)
+        verb = "sent" if sent else "heard"
+        self.timeline.appendleft({"time": row["time"], "kind": "tx" if sent else "rx",
+                                  "text": f"{verb} {row['type']} {row['src']}->{row['dest']} {', '.join(row['messages'])}"})  # fmt: skip
 
     def _original(self, kind: str, value: MoosValue, when: float) -> None:
         original = dynamic_parse(value, self._resolve, _TEXT)
