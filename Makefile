@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test bench lint clean screenshots
 
 # liaison's browser tests drive Debian's chromium (Playwright's own browser download is not used)
 CHROMIUM ?= /usr/bin/chromium
@@ -25,6 +25,10 @@ $(CHROMIUM):
 test: $(STAMP) $(CHROMIUM)
 	$(PY) -m ruff check src tests benchmarks
 	$(PY) -m pytest -q
+
+# the README's liaison pictures, taken by the browser test against a real two-vehicle mission
+screenshots: $(STAMP) $(CHROMIUM)
+	PYGOBY_SCREENSHOTS=$(CURDIR)/docs/images $(PY) -m pytest -q tests/topside/test_liaison_browser.py
 
 bench: $(STAMP)
 	$(PY) -m pytest benchmarks -q -o addopts="" --benchmark-only --benchmark-columns=min,mean,ops,rounds

@@ -1,11 +1,12 @@
 """liaison in a real browser (headless Chromium driven by Playwright) against a real mission:
 two communities with embedded MOOSDBs, pAcommsHandlers and emulated Micro-Modems. A command
 composed in the page reaches the other vehicle and shows acknowledged; the scope shows a
-variable changing; the map shows both vehicles. Each page's screenshot goes to docs/images/
+variable changing; the map shows both vehicles. `make screenshots` writes each page to docs/images/
 (the README shows them)."""
 
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 
@@ -20,7 +21,9 @@ from .mission import topside_mission
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync"]  # fmt: skip
-SCREENSHOTS = Path(__file__).resolve().parents[2] / "docs" / "images"
+# `make screenshots` sets this to docs/images (the README's pictures); otherwise the shots go to
+# the test's tmp dir, so a test run leaves the work tree as it found it
+SCREENSHOTS_ENV = "PYGOBY_SCREENSHOTS"
 
 LIAISON = """
 ProcessConfig = liaison
@@ -49,9 +52,10 @@ async def browser(tmp_path):
         await browser.close()
 
 
-async def shot(page, name: str) -> None:
-    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
-    await page.screenshot(path=str(SCREENSHOTS / f"liaison-{name}.png"))
+async def shot(page, name: str, tmp_path: Path) -> None:
+    folder = Path(os.environ.get(SCREENSHOTS_ENV) or tmp_path / "screenshots")
+    folder.mkdir(parents=True, exist_ok=True)
+    await page.screenshot(path=str(folder / f"liaison-{name}.png"))
 
 
 @pytest.mark.timeout(180)
@@ -81,7 +85,7 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
                 r1.client.publish(var, value)
             await page.locator('#scope-table tr[data-key="NAV_X"]').click()
             await page.wait_for_timeout(500)
-            await shot(page, "scope")
+            await shot(page, "scope", tmp_path)
 
             # Commander: compose a command, a refused value, send; it arrives and is acked.
             await page.goto(f"{base}/commander")
@@ -107,7 +111,7 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
             await page.locator("#cmd-notices .notice").filter(has_text="Message acknowledged from queue: Command").wait_for()
             assert r1.values("COMMAND_OUT") == ["dest=2,command_id=7,heading=90,speed=1.5,depth=20"]
             assert "message::Command" in (tmp_path / "autosave.txt").read_text()
-            await shot(page, "commander")
+            await shot(page, "commander", tmp_path)
 
             # Map: vehicle 2 reports its position acoustically (STATUS_REPORT_IN at vehicle 1).
             for var, value in {"NAV_X": 300.0, "NAV_Y": 200.0, "NAV_SPEED": 1.5, "NAV_HEADING": 60.0, "NAV_DEPTH": 5.0}.items():
@@ -119,7 +123,7 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
             await page.locator('#map-svg g.node[data-name="vehicle1"]').wait_for()
             await page.locator('#map-svg g.node[data-name="vehicle2"]').wait_for()
             await page.locator('#map-svg line.link[data-from="vehicle2"][data-to="vehicle1"]').wait_for()
-            await shot(page, "map")
+            await shot(page, "map", tmp_path)
 
             # Acomms: queues, the MAC cycle, transmissions and receptions with statistics.
             await page.goto(f"{base}/acomms")
@@ -128,4 +132,4 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
             await page.locator("#acomms-rx tbody tr").first.wait_for()
             await page.locator("#acomms-timeline li.acknowledged").first.wait_for()
             await page.locator("#acomms-slots .slot.current").wait_for()
-            await shot(page, "acomms")
+            await shot(page, "acomms", tmp_path)
