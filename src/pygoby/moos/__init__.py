@@ -5,8 +5,10 @@ the pAntler-style launcher and the Goby MOOS application base.
     from pygoby.moos.app import GobyMOOSApp        # base class of Goby MOOS applications
 
 Modules: protocol (sans-I/O codec and handshake), dbcore (sans-I/O DB semantics), db (asyncio
-server), client (asyncio client), timewarp (MOOS time), moosfile (.moos reader), appconfig and
-app (GobyMOOSApp), antler (launcher), cli (`pygoby moosdb|moos|antler`).
+server), client (asyncio client), timewarp (MOOS time), moosfile (.moos reader), app
+(GobyMOOSApp: mail dispatch, ticks, timers, publish/subscribe) with appconfig (its
+configuration), appcli (its command line), applog (its log files) and appstatus (its
+<NAME>_STATUS posts), antler (launcher), cli (`pygoby moosdb|moos|antler`).
 """
 
 from pygoby.moos.client import MOOSClient, MOOSRefused

@@ -5,6 +5,7 @@
   named by `(goby.field).moos_global` options, then command-line overrides, then the check for
   required fields.
 * `example_config(config_class, app_name)`: the `--example_config` text.
+* `initializer_posts(common, mission)`: what `common.initializer` posts on every connect.
 * `goby_field_options(field)`: a field's `(goby.field)` options (description, example,
   moos_global, cfg.action), read from its serialized options so that it works for classes from
   any descriptor pool.
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import math
 import re
 from collections.abc import Callable, Sequence
 
@@ -301,3 +303,39 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
 def example_config(config_class: type[Message], app_name: str) -> str:
     lines = [f"ProcessConfig = {app_name}", "{", *_describe_fields(config_class.DESCRIPTOR, 1), "}"]
     return "\n".join(lines) + "\n"
+
+
+def initializer_posts(
+    common: Message, mission: MissionFile | None, log: logging.Logger = log
+) -> list[tuple[str, float | str]]:
+    """The (MOOS variable, value) posts of `common.initializer` (spec 2.5): a constant, or a
+    global of the mission file (a double that does not parse is NaN); a missing global is
+    warned about on `log` and not posted."""
+    posts = []
+    for ini in common.initializer:
+        value = _initializer_value(ini, common, mission, log)
+        if value is not None:
+            posts.append((ini.moos_var, value))
+    return posts
+
+
+def _initializer_value(
+    ini: Message, common: Message, mission: MissionFile | None, log: logging.Logger
+) -> float | str | None:
+    is_double = ini.type == type(common).Initializer.INI_DOUBLE
+    if not ini.HasField("global_cfg_var"):
+        if is_double:
+            return ini.dval
+        return ini.sval.strip() if ini.trim else ini.sval
+    raw = mission.get_value(ini.global_cfg_var, outside_blocks=True) if mission else None
+    if raw is None:
+        log.warning("initializer: global %s not found; %s not posted",
+                    ini.global_cfg_var, ini.moos_var)  # fmt: skip
+        return None
+    if not is_double:
+        return raw.strip() if ini.trim else raw
+    try:
+        return float(raw)
+    except ValueError:
+        return math.nan
+
