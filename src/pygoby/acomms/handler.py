@@ -34,7 +34,7 @@ from pygoby.acomms.bind import bind, unbind
 from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException, driver_name
 from pygoby.acomms.mac import MACManager
 from pygoby.acomms.queue import QueueError, QueueManager
-from pygoby.acomms.route import RouteManager, bind_router
+from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
 from pygoby.acomms.signals import Signal
 from pygoby.dccl import Codec, DcclError
 from pygoby.protobuf import ProtoLoader
@@ -54,6 +54,7 @@ BUILTIN_DRIVERS = {
     "DRIVER_STORE_SERVER": "pygoby.acomms.drivers.store_server:StoreServerDriver",
 }
 PLUGINS_ENV = "PACOMMSHANDLER_PLUGINS"
+ROUTE_COMMAND = RouteCommand.DESCRIPTOR.full_name
 
 CONTINUALLY_RESTART_DRIVER = 1
 MOVE_LISTEN_DRIVER_TO_PRIMARY = 2
@@ -302,6 +303,12 @@ class AcommsHandler:
     def replace_route(self, route) -> None:
         self.router.set_route(route)
         log.info("route replaced: %s", list(route.hop))
+
+    def apply_route_command(self, message: Message) -> None:
+        """A RouteCommand received over the link replaces the route when routing is configured
+        (pAcommsHandler's rule); any other message is left alone."""
+        if message.DESCRIPTOR.full_name == ROUTE_COMMAND and self.route_cfg.route.hop:
+            self.replace_route(message.new_route)
 
     # ------------------------------------------------------------------ internals
     def _initiate_on_primary(self, transmission) -> None:

@@ -53,17 +53,10 @@ from pygoby.frontseat.plugins import (
     load_driver,
 )
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError, read_configuration
+from pygoby.moos.appconfig import ConfigError, prefixed_var_names, read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.moos.translator import (
-    LAT_ORIGIN_VAR,
-    LONG_ORIGIN_VAR,
-    TranslatorError,
-    moos_technique_from_config,
-    parse_for_moos,
-    post_for_moos,
-)
+from pygoby.moos.translator import LAT_ORIGIN_VAR, LONG_ORIGIN_VAR
 from pygoby.protobuf import default_loader
 
 HELM_STATE_VAR = "IVPHELM_STATE"
@@ -131,17 +124,11 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
                     f"legacy_cfg {{ {option}: true }} needs goby3's Bluefin frontseat "
                     "extensions, which pygoby does not implement; remove the option"
                 )
-        names = cfg.moos_var
-        self.var = {
-            field.name: names.prefix + getattr(names, field.name)
-            for field in names.DESCRIPTOR.fields
-            if field.name != "prefix"
-        }
+        self.var = prefixed_var_names(cfg.moos_var)
         try:
-            self.technique = moos_technique_from_config(self.common)
             driver = driver_name_from(os.environ, cfg.driver_library or None)
             self.interface = load_driver(driver, self._frontseat_cfg(), self.clock)
-        except (TranslatorError, DriverLoadError) as err:
+        except DriverLoadError as err:
             raise ConfigError(str(err)) from None
         # the driver's log lines (state changes, link trouble) go to the app's log
         self.interface.log = self.log.getChild(type(self.interface).__name__)
@@ -173,13 +160,13 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         interface = self.interface
         interface.signal_data_from_frontseat.connect(self._on_data_from_frontseat)
         interface.signal_command_response.connect(
-            lambda response: self._post_pb(self.var["command_response"], response)
+            lambda response: self.publish_pb(self.var["command_response"], response)
         )
         interface.signal_raw_from_frontseat.connect(
-            lambda raw: self._post_pb(self.var["raw_in"], raw)
+            lambda raw: self.publish_pb(self.var["raw_in"], raw)
         )
         interface.signal_raw_to_frontseat.connect(
-            lambda raw: self._post_pb(self.var["raw_out"], raw)
+            lambda raw: self.publish_pb(self.var["raw_out"], raw)
         )
         if self.cfg.legacy_cfg.publish_fs_bs_ready:
             interface.signal_state_change.connect(lambda status: self._post(ready_posts(status)))
@@ -223,18 +210,9 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
             self.request_stop()
 
     def post_status(self) -> None:
-        self._post_pb(self.var["status"], self.interface.status())
+        self.publish_pb(self.var["status"], self.interface.status())
 
     # -- MOOS -> frontseat -----------------------------------------------------------------
-
-    def _parse(self, msg: MOOSMessage, cls: type[Message]) -> Message | None:
-        out = cls()
-        try:
-            parse_for_moos(msg.value, out, self.technique)
-        except TranslatorError as err:
-            self.log.warning("cannot parse %s as %s: %s", msg.key, cls.DESCRIPTOR.full_name, err)
-            return None
-        return out
 
     def _on_command_request(self, msg: MOOSMessage) -> None:
         state = self.interface.state
@@ -242,17 +220,17 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
             self.log.debug("%s not sent: the interface is in %s, not INTERFACE_COMMAND",
                            msg.key, m.InterfaceState.Name(state))  # fmt: skip
             return
-        if (command := self._parse(msg, m.CommandRequest)) is not None:
+        if (command := self.parse_pb(msg, m.CommandRequest)) is not None:
             self.interface.send_command_to_frontseat(command)
 
     def _on_data_to_frontseat(self, msg: MOOSMessage) -> None:
-        if self._may_send(msg) and (data := self._parse(msg, m.InterfaceData)) is not None:
+        if self._may_send(msg) and (data := self.parse_pb(msg, m.InterfaceData)) is not None:
             self.interface.send_data_to_frontseat(data)
 
     def _on_raw_out(self, msg: MOOSMessage) -> None:
         if msg.src == self.name:
             return  # our own post of what the driver sent
-        if self._may_send(msg) and (raw := self._parse(msg, m.Raw)) is not None:
+        if self._may_send(msg) and (raw := self.parse_pb(msg, m.Raw)) is not None:
             self.interface.send_raw_to_frontseat(raw)
 
     def _may_send(self, msg: MOOSMessage) -> bool:
@@ -288,7 +266,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         request = self.desired.update(msg.key, msg.dval, msg.time)
         if request is not None:
             # through the MOOSDB, so the state check of IFS_COMMAND_REQUEST applies to it too
-            self._post_pb(self.var["command_request"], request)
+            self.publish_pb(self.var["command_request"], request)
 
     def _on_ctd(self, msg: MOOSMessage) -> None:
         if not msg.is_double:
@@ -298,24 +276,20 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         sample = self.ctd.update(msg.key, msg.dval, msg.time)
         if sample is not None:
             self.interface.compute_missing_ctd(sample)
-            self._post_pb(self.var["data_to_frontseat"], m.InterfaceData(ctd_sample=sample))
+            self.publish_pb(self.var["data_to_frontseat"], m.InterfaceData(ctd_sample=sample))
 
     # -- frontseat -> MOOS -----------------------------------------------------------------
 
     def _on_data_from_frontseat(self, data: Message) -> None:
-        self._post_pb(self.var["data_from_frontseat"], data)
+        self.publish_pb(self.var["data_from_frontseat"], data)
         if not data.HasField("node_status"):
             return
         status = data.node_status
-        self._post_pb(self.var["node_status"], status)
+        self.publish_pb(self.var["node_status"], status)
         if self.cfg.legacy_cfg.publish_nav:
             self._post(nav_posts(status))
         if self.ctd is not None:
             self.ctd.update_position(status)
-
-    def _post_pb(self, var: str, message: Message) -> None:
-        post = post_for_moos(var, message, self.technique)
-        self.publish(post.var, post.value, src_aux=post.source_aux)
 
     def _post(self, posts: list[Post]) -> None:
         for var, value in posts:

@@ -52,6 +52,13 @@ The base provides
   epoch, checked each tick), `dynamic_vars` (newest message per variable), `start_time`,
   `log` (a logging.Logger; terminal at `common.verbosity`, file log per `common.log`,
   see pygoby.moos.applog), `cfg` / `common`, `client` (the MOOSClient), `moos_time()`.
+* Protobuf messages on MOOS variables in the app-internal technique (`moos_technique`, from
+  `common.moos_parser_technique` / `use_binary_protobuf`; `@PB[type] ...` by default):
+  `publish_pb(var, message)`, `parse_pb(msg, cls)` (None, with a warning, when the value does
+  not parse) and `subscribe_pb(var, cls, handler, ignore_own=False)` (`handler(message)` for
+  each value that parses).
+* `find_file(path)`: a relative path from the configuration, looked up next to the mission
+  file when it does not exist from the working directory.
 * Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`.
 * `exit_status`: what `main` returns once the app has stopped (0; an app that stops itself on a
   fatal error sets it, then calls `request_stop()`).
@@ -77,6 +84,7 @@ from google.protobuf.message import Message
 from pygoby.moos import appcli
 from pygoby.moos import protocol as p
 from pygoby.moos.appconfig import (
+    ConfigError,
     example_config,
     initializer_posts,
     read_configuration,
@@ -87,6 +95,13 @@ from pygoby.moos.client import MOOSClient
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.timewarp import clock_warp, moos_clock
+from pygoby.moos.translator import (
+    Technique,
+    TranslatorError,
+    moos_technique_from_config,
+    parse_for_moos,
+    post_for_moos,
+)
 from pygoby.protobuf import builtin_class
 from pygoby.util.clock import Clock
 
@@ -108,6 +123,13 @@ class _Timer:
             return False
         self.next = (math.floor(now / self.period) + 1) * self.period
         return True
+
+
+def _app_technique(common: Message) -> Technique:
+    try:
+        return moos_technique_from_config(common)
+    except TranslatorError as err:
+        raise ConfigError(str(err)) from None
 
 
 class GobyMOOSApp:
@@ -173,6 +195,7 @@ class GobyMOOSApp:
         self.common = cfg.common  # type: ignore[attr-defined]
         self.name = name or self.default_name or type(self).__name__
         self.mission = mission
+        self.moos_technique = _app_technique(self.common)
         warp = float(self.common.time_warp_multiplier or 1)
         self.clock = clock or moos_clock(warp)
         if host is None:
@@ -243,6 +266,46 @@ class GobyMOOSApp:
     @property
     def connected(self) -> bool:
         return self.client.connected
+
+    def find_file(self, path: str) -> str:
+        """`path` from the configuration, looked up next to the mission file when it is relative
+        and does not exist from the working directory (MissionFile.find_file)."""
+        return self.mission.find_file(path) if self.mission is not None else path
+
+    # -- protobuf messages on MOOS variables (the app-internal technique) ----------------------
+
+    def publish_pb(self, var: str, message: Message) -> None:
+        post = post_for_moos(var, message, self.moos_technique)
+        self.publish(post.var, post.value, src_aux=post.source_aux)
+
+    def parse_pb(self, msg: MOOSMessage, cls: type[Message]) -> Message | None:
+        """`msg`'s value as a `cls` message; None, with a warning, when it does not parse."""
+        out = cls()
+        try:
+            parse_for_moos(msg.value, out, self.moos_technique)
+        except TranslatorError as err:
+            self.log.warning("cannot parse %s as %s: %s", msg.key, cls.DESCRIPTOR.full_name, err)
+            return None
+        return out
+
+    def subscribe_pb(
+        self,
+        var: str,
+        cls: type[Message],
+        handler: Callable[[Message], None],
+        *,
+        ignore_own: bool = False,
+    ) -> None:
+        """`handler(message)` for each post of `var` that parses as `cls` (with `ignore_own`,
+        not for this app's own posts)."""
+
+        def on_mail(msg: MOOSMessage) -> None:
+            if ignore_own and msg.src == self.name:
+                return
+            if (message := self.parse_pb(msg, cls)) is not None:
+                handler(message)
+
+        self.subscribe(var, on_mail)
 
     # -- running -------------------------------------------------------------------------------
 

@@ -6,6 +6,7 @@
   required fields.
 * `example_config(config_class, app_name)`: the `--example_config` text.
 * `initializer_posts(common, mission)`: what `common.initializer` posts on every connect.
+* `prefixed_var_names(moos_var)`: an app's `moos_var { prefix: ... }` block as full names.
 * `goby_field_options(field)`: a field's `(goby.field)` options (description, example,
   moos_global, cfg.action), read from its serialized options so that it works for classes from
   any descriptor pool.
@@ -339,3 +340,12 @@ def _initializer_value(
     except ValueError:
         return math.nan
 
+
+def prefixed_var_names(names: Message, skip: Sequence[str] = ()) -> dict[str, str]:
+    """An app's `moos_var` block as {field name: prefix + variable}, for every field but
+    `prefix` and those in `skip`."""
+    return {
+        field.name: names.prefix + getattr(names, field.name)
+        for field in names.DESCRIPTOR.fields
+        if field.name != "prefix" and field.name not in skip
+    }
