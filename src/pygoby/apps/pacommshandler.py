@@ -67,10 +67,11 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             fallback=m.goby_message_class,
             loader=self.loader,
         )
+        lookup = cfg.modem_id_lookup_path
         self.binding = TranslatorBinding(
             self, cfg.translator_entry, self._message_class, on_created=self._push,
             multiplex_vars=cfg.multiplex_create_moos_var,
-            modem_id_lookup_path=self.find_file(cfg.modem_id_lookup_path) if cfg.modem_id_lookup_path else "",
+            modem_id_lookup_path=self.find_file(lookup) if lookup else "",
         )  # fmt: skip
         self.translator = self.binding.translator
         self._connect_signals()
@@ -95,7 +96,9 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         try:
             self._message_class(name)
         except Exception:
-            raise ConfigError(f"dccl_frontseat_forward_name {name!r} is not a loaded type") from None
+            raise ConfigError(
+                f"dccl_frontseat_forward_name {name!r} is not a loaded type"
+            ) from None
         return name
 
     # ------------------------------------------------------------------ wiring
@@ -221,10 +224,11 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def _forward_to_frontseat(self, message: Message) -> None:
         """`dccl_frontseat_forward_name`: the message's DCCL bytes to iFrontSeat."""
+        name = message.DESCRIPTOR.full_name
         try:
             data = self.acomms.codec.encode(message)
         except DcclError as err:
-            self.log.warning("cannot forward %s to the frontseat: %s", message.DESCRIPTOR.full_name, err)
+            self.log.warning("cannot forward %s to the frontseat: %s", name, err)
         else:
             self.publish_pb(self.ifs_data_out, InterfaceData(dccl_message=data))
 
