@@ -16,7 +16,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(PY) -m pygoby.demo
+	$(PY) examples/two_vehicles/run_demo.py
 	$(PY) examples/frontseat/run_demo.py --warp 10 --duration 50
 
 $(CHROMIUM):
