@@ -33,7 +33,7 @@ def acomms_config(app: GobyMOOSApp, block: str) -> Message:
 
 
 def command_set(app: GobyMOOSApp, cfg: Message, lookup_path: str) -> CommandSet:
-    find = app.mission.find_file if app.mission is not None else str
+    find = app.find_file
     return CommandSet.from_pacommshandler(cfg, find, find(lookup_path) if lookup_path else "")
 
 
