@@ -3,7 +3,7 @@
 import pytest
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverException, NoDriver, driver_name
+from pygoby.acomms.driver_base import ModemDriverError, NoDriver, driver_name
 from pygoby.acomms.drivers import make_driver
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.drivers.udp import UDPDriver
@@ -22,7 +22,7 @@ def test_factory_and_driver_none():
     assert requests == []
     assert isinstance(make_driver(m.DriverConfig(driver_type=2), clock), MMDriver)
     assert isinstance(make_driver(m.DriverConfig(driver_type=6), clock), UDPDriver)
-    with pytest.raises(ModemDriverException):
+    with pytest.raises(ModemDriverError):
         make_driver(m.DriverConfig(driver_type=8), clock)  # Iridium: not implemented
 
 
@@ -30,11 +30,11 @@ def test_driver_name_and_missing_settings():
     assert driver_name(m.DriverConfig(driver_type=2, modem_id=1)) == "WHOI_MICROMODEM::1"
     assert driver_name(m.DriverConfig(driver_name="my_plugin", modem_id=3)) == "my_plugin::3"
     d = MMDriver(VirtualClock(0))
-    with pytest.raises(ModemDriverException) as info:
+    with pytest.raises(ModemDriverError) as info:
         d.startup(m.DriverConfig(driver_type=2))  # no modem_id
     assert info.value.status == m.ModemDriverStatus.INVALID_CONFIGURATION
-    with pytest.raises(ModemDriverException):
+    with pytest.raises(ModemDriverError):
         d.startup(m.DriverConfig(driver_type=2, modem_id=1))  # SERIAL without serial_port
-    with pytest.raises(ModemDriverException):
+    with pytest.raises(ModemDriverError):
         d.startup(m.DriverConfig(driver_type=2, modem_id=1,
                                  connection_type=m.DriverConfig.CONNECTION_TCP_AS_CLIENT))  # fmt: skip

@@ -5,7 +5,7 @@ import logging
 import pytest
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverException
+from pygoby.acomms.driver_base import ModemDriverError
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.util.clock import VirtualClock
 from pygoby.util.linebased import MemoryLink
@@ -235,7 +235,7 @@ def test_resend_retries_and_death():
     h.clock.advance(5.1)
     h.work()
     h.clock.advance(5.1)
-    with pytest.raises(ModemDriverException) as info:
+    with pytest.raises(ModemDriverError) as info:
         h.work()
     assert info.value.status == m.ModemDriverStatus.MODEM_NOT_RESPONDING
 

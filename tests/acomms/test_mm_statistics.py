@@ -17,7 +17,8 @@ from pygoby.acomms.drivers.micromodem.statistics import (
     parse_toa,
     parse_xst,
 )
-from pygoby.util.nmea import NMEAFormatError, NMEASentence, with_checksum
+from pygoby.util.errors import NMEAFormatError
+from pygoby.util.nmea import NMEASentence, with_checksum
 
 DAY = dt.date(2023, 11, 14)
 MIDNIGHT_US = int(dt.datetime(2023, 11, 14, tzinfo=dt.UTC).timestamp()) * 1_000_000

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from pygoby.frontseat import messages as m
 from pygoby.frontseat.interface import (
-    FrontSeatException,
+    FrontSeatDriverError,
     FrontSeatFatalError,
     InterfaceBase,
     Signal,
@@ -78,7 +78,7 @@ def bring_to(driver: ScriptedFrontSeat, where: str) -> None:
             elif where == "FS_NOT_PROVIDING":
                 tick(driver, providing=False)
             elif where == "FS_IGNORING":
-                driver.raise_in_loop = FrontSeatException(frontseat_error=IGNORING_ERR)
+                driver.raise_in_loop = FrontSeatDriverError(frontseat_error=IGNORING_ERR)
                 tick(driver)
     expected = {
         "STANDBY": (STANDBY, None, None),
@@ -345,7 +345,7 @@ def test_a_full_session_signals_each_change_once() -> None:
 def test_t9_driver_exception_forces_error_state(where, exc_args, expect) -> None:
     driver = make()
     bring_to(driver, where)
-    driver.raise_in_loop = FrontSeatException(**exc_args, message="frontseat says no")
+    driver.raise_in_loop = FrontSeatDriverError(**exc_args, message="frontseat says no")
     driver.do_work()
     state, helm_error, fs_error = expect
     assert driver.state == state
@@ -363,7 +363,7 @@ def test_t9_keeps_the_other_error_code_until_its_own_exit() -> None:
     """goby3 clears each error only on its own exit (T7 / T8)."""
     driver = make()
     bring_to(driver, "FS_NOT_PROVIDING")
-    driver.raise_in_loop = FrontSeatException(helm_error=PARKED)
+    driver.raise_in_loop = FrontSeatDriverError(helm_error=PARKED)
     tick(driver)
     assert driver.state == HELM_ERROR
     assert errors(driver) == (PARKED, NOT_PROVIDING_ERR)
@@ -375,7 +375,7 @@ def test_t9_keeps_the_other_error_code_until_its_own_exit() -> None:
 def test_t9_after_a_transition_on_the_same_tick() -> None:
     driver = make()
     driver.fs_state, driver.providing = IDLE, True
-    driver.raise_in_loop = FrontSeatException(frontseat_error=IGNORING_ERR)
+    driver.raise_in_loop = FrontSeatDriverError(frontseat_error=IGNORING_ERR)
     driver.do_work()
     assert [s.state for s in driver.changes] == [LISTEN, FS_ERROR]
 
@@ -383,8 +383,8 @@ def test_t9_after_a_transition_on_the_same_tick() -> None:
 def test_exception_without_error_propagates() -> None:
     driver = make()
     bring_to(driver, "LISTEN")
-    driver.raise_in_loop = FrontSeatException(message="bad")
-    with pytest.raises(FrontSeatException, match="bad"):
+    driver.raise_in_loop = FrontSeatDriverError(message="bad")
+    with pytest.raises(FrontSeatDriverError, match="bad"):
         driver.do_work()
     assert driver.state == LISTEN
     driver.raise_in_loop = KeyError("bug")
@@ -395,11 +395,11 @@ def test_exception_without_error_propagates() -> None:
 
 def test_exception_carries_one_error() -> None:
     with pytest.raises(ValueError):
-        FrontSeatException(helm_error=PARKED, frontseat_error=IGNORING_ERR)
-    exc = FrontSeatException(frontseat_error=IGNORING_ERR, message="no ack")
+        FrontSeatDriverError(helm_error=PARKED, frontseat_error=IGNORING_ERR)
+    exc = FrontSeatDriverError(frontseat_error=IGNORING_ERR, message="no ack")
     assert exc.is_fs_error and not exc.is_helm_error
     assert str(exc) == "ERROR_FRONTSEAT_IGNORING_COMMANDS: no ack"
-    assert FrontSeatException(helm_error=PARKED).is_helm_error
+    assert FrontSeatDriverError(helm_error=PARKED).is_helm_error
 
 
 # --- exit_on_error ----------------------------------------------------------------------
@@ -419,7 +419,7 @@ def test_exit_on_error_raises_after_the_state_change() -> None:
 
 def test_exit_on_error_on_driver_exception() -> None:
     driver = make(exit_on_error=True)
-    driver.raise_in_loop = FrontSeatException(helm_error=PARKED)
+    driver.raise_in_loop = FrontSeatDriverError(helm_error=PARKED)
     with pytest.raises(FrontSeatFatalError):
         driver.do_work()
     assert driver.state == HELM_ERROR
@@ -505,7 +505,7 @@ def test_random_sequences_respect_command_and_error_exits(require_helm, steps) -
         if raised is not None:
             kind, code = raised
             key = "helm_error" if kind == "helm" else "frontseat_error"
-            driver.raise_in_loop = FrontSeatException(**{key: code})
+            driver.raise_in_loop = FrontSeatDriverError(**{key: code})
         before = driver.state
         last_fs_error = errors(driver)[1]
         loops = driver.loop_calls

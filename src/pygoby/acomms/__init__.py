@@ -21,3 +21,23 @@ are synchronous `pygoby.acomms.signals.Signal`s with `connect`/`disconnect`/`emi
 * `pygoby.acomms.bind.bind(driver, queue, mac)` wires them; `pygoby.acomms.route` routes.
 * `pygoby.acomms.mmsim`: the Micro-Modem emulator and its pluggable acoustic channel.
 """
+
+from pygoby.acomms.errors import (
+    ABCParseError,
+    AcommsError,
+    HandlerError,
+    ModemDriverError,
+    QueueError,
+    RoleError,
+    RudicsPacketError,
+)
+
+__all__ = [
+    "ABCParseError",
+    "AcommsError",
+    "HandlerError",
+    "ModemDriverError",
+    "QueueError",
+    "RoleError",
+    "RudicsPacketError",
+]

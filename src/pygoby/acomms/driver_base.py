@@ -14,27 +14,15 @@ from abc import ABC, abstractmethod
 from typing import IO
 
 from pygoby.acomms import messages as m
+from pygoby.acomms.errors import ModemDriverError
 from pygoby.acomms.signals import Signal
 from pygoby.util.clock import Clock, WallClock
-from pygoby.util.linebased import (
-    LineLink,
-    LinkClosedError,
-    SerialLink,
-    TCPClientLink,
-    TCPServerLink,
-)
+from pygoby.util.errors import LinkClosedError
+from pygoby.util.linebased import LineLink, SerialLink, TCPClientLink, TCPServerLink
 
 log = logging.getLogger(__name__)
 
 Status = m.ModemDriverStatus
-
-
-class ModemDriverException(Exception):
-    """A driver failure; `status` is a ModemDriverStatus.Status value."""
-
-    def __init__(self, message: str, status: int) -> None:
-        super().__init__(message)
-        self.status = status
 
 
 def driver_name(cfg) -> str:
@@ -99,13 +87,13 @@ class ModemDriverBase(ABC):
     def modem_start(self, cfg) -> None:
         """Validate the link settings, build (or reuse the injected) link and open it."""
         if not cfg.HasField("modem_id"):
-            raise ModemDriverException("modem_id is required", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
         self.cfg = cfg
         delimiter = self.line_delimiter(cfg)
         if not self._injected_link:
             self.link = self._make_link(cfg, delimiter)
         if self.link is None:
-            raise ModemDriverException("no link configured", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("no link configured", Status.INVALID_CONFIGURATION)
         if cfg.HasField("raw_log"):
             stamp = dt.datetime.fromtimestamp(self.clock.now(), dt.UTC).strftime("%Y%m%dT%H%M%S")
             self._raw_log = open(cfg.raw_log.replace("%1%", stamp), "a", encoding="latin-1")  # noqa: SIM115
@@ -122,19 +110,19 @@ class ModemDriverBase(ABC):
         kind = cfg.connection_type
         if kind == C.CONNECTION_SERIAL:
             if not cfg.HasField("serial_port"):
-                raise ModemDriverException("serial_port is required", Status.INVALID_CONFIGURATION)
+                raise ModemDriverError("serial_port is required", Status.INVALID_CONFIGURATION)
             baud = cfg.serial_baud if cfg.HasField("serial_baud") else self.DEFAULT_SERIAL_BAUD
             if baud is None:
-                raise ModemDriverException("serial_baud is required", Status.INVALID_CONFIGURATION)
+                raise ModemDriverError("serial_baud is required", Status.INVALID_CONFIGURATION)
             return SerialLink(cfg.serial_port, baud, delimiter)
         if kind == C.CONNECTION_TCP_AS_CLIENT:
             if not (cfg.HasField("tcp_server") and cfg.HasField("tcp_port")):
-                raise ModemDriverException(
+                raise ModemDriverError(
                     "tcp_server and tcp_port are required", Status.INVALID_CONFIGURATION
                 )
             return TCPClientLink(cfg.tcp_server, cfg.tcp_port, delimiter, cfg.reconnect_interval)
         if not cfg.HasField("tcp_port"):
-            raise ModemDriverException("tcp_port is required", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("tcp_port is required", Status.INVALID_CONFIGURATION)
         return TCPServerLink(cfg.tcp_port, delimiter=delimiter)
 
     def modem_read(self) -> list[str]:
@@ -148,11 +136,11 @@ class ModemDriverBase(ABC):
 
     def modem_write(self, text: str) -> None:
         if self.link is None:
-            raise ModemDriverException("no link", Status.CONNECTION_TO_MODEM_FAILED)
+            raise ModemDriverError("no link", Status.CONNECTION_TO_MODEM_FAILED)
         try:
             self.link.write(text)
         except LinkClosedError as exc:
-            raise ModemDriverException(str(exc), Status.CONNECTION_TO_MODEM_FAILED) from exc
+            raise ModemDriverError(str(exc), Status.CONNECTION_TO_MODEM_FAILED) from exc
         self._log_raw("[tx] ", text.rstrip("\r\n"))
 
     def modem_close(self) -> None:

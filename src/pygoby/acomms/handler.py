@@ -31,9 +31,10 @@ from google.protobuf.message import Message
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.bind import bind, unbind
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException, driver_name
+from pygoby.acomms.driver_base import ModemDriverBase, driver_name
+from pygoby.acomms.errors import HandlerError, ModemDriverError, QueueError
 from pygoby.acomms.mac import MACManager
-from pygoby.acomms.queue import QueueError, QueueManager
+from pygoby.acomms.queue import QueueManager
 from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
 from pygoby.acomms.signals import Signal
 from pygoby.dccl import Codec, DcclError
@@ -59,10 +60,6 @@ ROUTE_COMMAND = RouteCommand.DESCRIPTOR.full_name
 CONTINUALLY_RESTART_DRIVER = 1
 MOVE_LISTEN_DRIVER_TO_PRIMARY = 2
 DISABLE_AND_MOVE_LISTEN_DRIVER_TO_PRIMARY = 3
-
-
-class HandlerError(Exception):
-    """The configuration cannot be used, or a failure the handler cannot recover from."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -166,7 +163,7 @@ class AcommsHandler:
                 own.modem_id = self.modem_id
             try:
                 driver = driver_factory(own, clock)
-            except ModemDriverException as exc:
+            except ModemDriverError as exc:
                 raise HandlerError(f"driver configuration: {exc}") from None
             if driver is None:
                 continue
@@ -388,7 +385,7 @@ class AcommsHandler:
 
 
 def _status_of(exc: BaseException, default: int) -> int:
-    return exc.status if isinstance(exc, ModemDriverException) else default
+    return exc.status if isinstance(exc, ModemDriverError) else default
 
 
 def _name(slot: DriverSlot) -> str:

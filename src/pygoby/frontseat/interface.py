@@ -14,7 +14,7 @@ State machine (spec 5.3), run by `do_work()` before the driver's `loop()`:
   check E1-E4 with the helm rule applied without its start-up grace period (T6);
 * HELM_ERROR -> STANDBY when the helm drives (T7); FS_ERROR -> STANDBY when the condition behind
   the last frontseat error is gone (T8); an IGNORING_COMMANDS error has no automatic exit;
-* a driver raising `FrontSeatException` from `loop()` forces the matching error state (T9).
+* a driver raising `FrontSeatDriverError` from `loop()` forces the matching error state (T9).
 
 goby3 keeps the helm's last reported state with no timeout (Quirk Q24, the default here too).
 The pygoby option `helm_state_timeout` (> 0) turns a helm that has not reported for that long
@@ -37,6 +37,7 @@ from google.protobuf import text_format
 
 from pygoby.acomms.signals import Signal as _SlotList
 from pygoby.frontseat.ctd import compute_missing_ctd as _compute_missing_ctd
+from pygoby.frontseat.errors import FrontSeatDriverError, FrontSeatFatalError
 from pygoby.frontseat.messages import (
     ERROR_FRONTSEAT_NONE,
     ERROR_FRONTSEAT_NOT_CONNECTED,
@@ -57,8 +58,6 @@ from pygoby.frontseat.messages import (
     INTERFACE_HELM_ERROR,
     INTERFACE_LISTEN,
     INTERFACE_STANDBY,
-    FrontSeatError,
-    HelmError,
     InterfaceState,
     InterfaceStatus,
 )
@@ -66,62 +65,6 @@ from pygoby.util.clock import Clock, WallClock
 from pygoby.util.geodesy import UTMGeodesy
 
 _log = logging.getLogger(__name__)
-
-
-class FrontSeatException(Exception):
-    """A driver raises it from loop() to force an error state (T9).
-
-    Carries at most one of a HelmError (-> INTERFACE_HELM_ERROR) or a FrontSeatError
-    (-> INTERFACE_FS_ERROR); one with neither is not a state change and propagates out of
-    `do_work()`.
-    """
-
-    def __init__(
-        self,
-        *,
-        helm_error: int | None = None,
-        frontseat_error: int | None = None,
-        message: str = "",
-    ) -> None:
-        if helm_error is not None and frontseat_error is not None:
-            raise ValueError(
-                "a FrontSeatException carries a helm error or a frontseat error, not both"
-            )
-        self.helm_error = helm_error
-        self.frontseat_error = frontseat_error
-        self.message = message
-        if helm_error is not None:
-            what = (
-                HelmError.Name(helm_error) if helm_error in HelmError.values() else str(helm_error)
-            )
-        elif frontseat_error is not None:
-            what = (
-                FrontSeatError.Name(frontseat_error)
-                if frontseat_error in FrontSeatError.values()
-                else str(frontseat_error)
-            )
-        else:
-            what = ""
-        super().__init__(": ".join(part for part in (what, message) if part))
-
-    @property
-    def is_helm_error(self) -> bool:
-        return self.helm_error is not None
-
-    @property
-    def is_fs_error(self) -> bool:
-        return self.frontseat_error is not None
-
-
-class FrontSeatFatalError(RuntimeError):
-    """Raised by do_work() in an error state when `exit_on_error` is set (the app exits 1)."""
-
-    def __init__(self, status: Any) -> None:
-        self.status = status
-        super().__init__(
-            f"error state {InterfaceState.Name(status.state)} with exit_on_error: true "
-            f"({_short(status)})"
-        )
 
 
 class Signal(_SlotList):
@@ -307,7 +250,7 @@ class InterfaceBase(abc.ABC):
         if not self._check_change_state():
             try:
                 self.loop()
-            except FrontSeatException as exc:
+            except FrontSeatDriverError as exc:
                 if not (exc.is_helm_error or exc.is_fs_error):
                     raise
                 self.log.warning("driver reported an error: %s", exc)

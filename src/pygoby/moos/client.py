@@ -12,7 +12,7 @@ sync); everything queued is sent in one packet as soon as the event loop runs th
 client reconnects by itself (every `reconnect_interval` s) after a lost connection, sends its
 subscriptions again, calls the `on_connect` callbacks, then sends publications queued while it
 was away (bounded by `outbox_limit`; the oldest are dropped beyond it, with a warning). A `K`
-(name already in use) ends the client with `MOOSRefused`: no retry, as in C++.
+(name already in use) ends the client with `MoosRefusedError`: no retry, as in C++.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from collections import deque
 from collections.abc import AsyncIterator, Callable
 
 from pygoby.moos import protocol as p
+from pygoby.moos.errors import MoosProtocolError, MoosRefusedError
 from pygoby.moos.protocol import MOOSMessage, Value
 from pygoby.util.clock import Clock, WallClock
 
@@ -32,10 +33,6 @@ log = logging.getLogger(__name__)
 
 TIMING_PERIOD = 1.0
 MAX_PACKET_MESSAGES = 4096
-
-
-class MOOSRefused(Exception):
-    """The DB refused the handshake (poison message); carries the DB's reason."""
 
 
 class MOOSClient:
@@ -101,7 +98,7 @@ class MOOSClient:
             self._task = asyncio.create_task(self._run(), name=f"moos-client-{self.name}")
 
     async def connect(self, timeout: float | None = 5.0) -> None:
-        """Start and wait until connected (TimeoutError after `timeout`; MOOSRefused on K)."""
+        """Start and wait until connected (TimeoutError after `timeout`; MoosRefusedError on K)."""
         self.start()
         await self.wait_connected(timeout)
 
@@ -287,12 +284,12 @@ class MOOSClient:
                     continue
                 try:
                     await self._session(reader, writer)
-                except MOOSRefused as err:
+                except MoosRefusedError as err:
                     log.error("%s: %s", self.name, err)
                     self.failure = err
                     self._stopped.set()
                     return
-                except (OSError, EOFError, TimeoutError, p.ProtocolError) as err:
+                except (OSError, EOFError, TimeoutError, MoosProtocolError) as err:
                     log.warning("%s: connection to %s:%d lost: %s", self.name, self.host,
                                 self.port, err or type(err).__name__)  # fmt: skip
                 finally:
@@ -327,9 +324,9 @@ class MOOSClient:
         framer = p.PacketFramer(self.max_packet_size)
         welcome = await asyncio.wait_for(self._read_first_packet(reader, framer), 5.0)
         if welcome.msg_type == p.POISON:
-            raise MOOSRefused(f"MOOSDB refused {self.name!r}: {welcome.string}")
+            raise MoosRefusedError(f"MOOSDB refused {self.name!r}: {welcome.string}")
         if welcome.msg_type != p.WELCOME:
-            raise p.ProtocolError(f"expected a welcome, got message type {welcome.msg_type!r}")
+            raise MoosProtocolError(f"expected a welcome, got message type {welcome.msg_type!r}")
         self.community = welcome.community
         self.db_hostname = p.welcome_hostname(welcome)
         self.clock_correction = bool(self.db_hostname) and self.db_hostname != socket.gethostname()
@@ -401,7 +398,7 @@ class MOOSClient:
             if kind == p.NULL or (kind == p.NOTIFY and msg.id == p.SERVER_REQUEST_ID):
                 continue
             if kind in (p.WELCOME, p.POISON):
-                raise p.ProtocolError(f"unexpected {kind!r} message after the handshake")
+                raise MoosProtocolError(f"unexpected {kind!r} message after the handshake")
             self._deliver(msg)
 
     async def _write_loop(self, writer: asyncio.StreamWriter) -> None:

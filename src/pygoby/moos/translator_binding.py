@@ -15,8 +15,8 @@ from collections.abc import Callable, Iterable
 from google.protobuf import descriptor_pool, message_factory
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import (
     LAT_ORIGIN_VAR,

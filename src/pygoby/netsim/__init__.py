@@ -6,3 +6,21 @@
 * `client`: the vehicle side of the manager interface (asyncio, reconnecting).
 * `channel`: the packet-level acoustic channel the modem emulators use.
 """
+
+from pygoby.netsim.errors import (
+    LineError,
+    LineTooLongError,
+    MissingSeparatorError,
+    NetsimError,
+    ScenarioError,
+    UnknownNameError,
+)
+
+__all__ = [
+    "LineError",
+    "LineTooLongError",
+    "MissingSeparatorError",
+    "NetsimError",
+    "ScenarioError",
+    "UnknownNameError",
+]

@@ -24,11 +24,11 @@ from collections.abc import Callable, Iterable
 
 from google.protobuf.message import Message
 
+from pygoby.netsim.errors import LineError
 from pygoby.netsim.protocol import (
     LEGACY_REQUEST_NAME,
     REQUEST_NAME,
     LineDecoder,
-    LineError,
     encode_line,
     message_class,
     request_class,

@@ -26,11 +26,11 @@ from dataclasses import dataclass, field
 
 from google.protobuf.message import Message
 
+from pygoby.netsim.errors import LineError
 from pygoby.netsim.protocol import (
     LEGACY_RESPONSE_NAME,
     RESPONSE_NAME,
     LineDecoder,
-    LineError,
     encode_line,
     message_class,
     request_names,

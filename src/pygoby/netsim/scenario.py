@@ -24,6 +24,7 @@ from pygoby.netsim.channel import Band, ChannelConfig, Position
 from pygoby.netsim.channel.errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.config import config_class as manager_config_class
+from pygoby.netsim.errors import ScenarioError
 from pygoby.protobuf import builtin_class
 
 SCENARIO_PROTO = "pygoby/netsim/scenario.proto"
@@ -32,10 +33,6 @@ VIRTUAL_START = 1_700_000_000.0  # default start of a "max"-speed run (repeatabl
 MAC_FIXED_DECENTRALIZED = m.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name[
     "MAC_FIXED_DECENTRALIZED"
 ].number
-
-
-class ScenarioError(Exception):
-    """The scenario cannot be run (parse error or inconsistent settings)."""
 
 
 @cache
@@ -53,7 +50,10 @@ def load_scenario(path: str | Path) -> Message:
         text = Path(path).read_text()
     except OSError as exc:
         raise ScenarioError(f"cannot read scenario: {exc}") from exc
-    return parse_scenario(text)
+    try:
+        return parse_scenario(text)
+    except ScenarioError as exc:
+        raise exc.located(file=path) from None
 
 
 def parse_scenario(text: str) -> Message:
@@ -61,7 +61,7 @@ def parse_scenario(text: str) -> Message:
     try:
         text_format.Parse(text, scenario)
     except text_format.ParseError as exc:
-        raise ScenarioError(f"cannot parse scenario: {exc}") from exc
+        raise ScenarioError.from_parse_error(exc, "scenario") from exc
     check_scenario(scenario)
     return scenario
 

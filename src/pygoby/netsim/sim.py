@@ -52,7 +52,7 @@ from pygoby.netsim.scenario import (
     start_time,
 )
 from pygoby.util.clock import Clock, VirtualClock
-from pygoby.util.linebased import LinkClosedError
+from pygoby.util.errors import LinkClosedError
 
 log = logging.getLogger(__name__)
 

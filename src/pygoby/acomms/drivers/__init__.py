@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import importlib
 
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.errors import ModemDriverError
 
 # DriverType value -> "module:Class"
 DRIVER_CLASSES = {
@@ -25,7 +26,7 @@ def make_driver(cfg, clock=None, **kwargs) -> ModemDriverBase:
     if target is None:
         from pygoby.acomms import messages as m
 
-        raise ModemDriverException(
+        raise ModemDriverError(
             f"driver type {cfg.driver_type} is not implemented",
             m.ModemDriverStatus.INVALID_CONFIGURATION,
         )

@@ -5,8 +5,9 @@ from __future__ import annotations
 import logging
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.abc_protocol import ABCParseError, format_abc, parse_abc
+from pygoby.acomms.abc_protocol import format_abc, parse_abc
 from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.errors import ABCParseError
 
 log = logging.getLogger(__name__)
 

@@ -14,7 +14,8 @@ from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.driver_base import ModemDriverBase
-from pygoby.acomms.rudics import RudicsPacketError, parse_rudics_packet, serialize_rudics_packet
+from pygoby.acomms.errors import RudicsPacketError
+from pygoby.acomms.rudics import parse_rudics_packet, serialize_rudics_packet
 
 log = logging.getLogger(__name__)
 

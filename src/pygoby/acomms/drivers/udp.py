@@ -11,8 +11,8 @@ import logging
 import socket
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverException
 from pygoby.acomms.drivers.datagram import DatagramDriverBase
+from pygoby.acomms.errors import ModemDriverError
 
 log = logging.getLogger(__name__)
 
@@ -33,18 +33,18 @@ class UDPDriver(DatagramDriverBase):
 
     def startup(self, cfg) -> None:
         if not cfg.HasField("modem_id"):
-            raise ModemDriverException("modem_id is required", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
         self.cfg = cfg
         self.udp_cfg = cfg.Extensions[m.UDP_CONFIG]
         if not self.udp_cfg.HasField("local"):
-            raise ModemDriverException("UDP config needs local", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("UDP config needs local", Status.INVALID_CONFIGURATION)
         family = socket.AF_INET6 if self.udp_cfg.ipv6 else socket.AF_INET
         sock = socket.socket(family, socket.SOCK_DGRAM)
         try:
             sock.bind(("::" if self.udp_cfg.ipv6 else "0.0.0.0", self.udp_cfg.local.port))
         except OSError as exc:
             sock.close()
-            raise ModemDriverException(str(exc), Status.STARTUP_FAILED) from exc
+            raise ModemDriverError(str(exc), Status.STARTUP_FAILED) from exc
         sock.setblocking(False)
         self._sock = sock
         self._remotes = {}
@@ -52,7 +52,7 @@ class UDPDriver(DatagramDriverBase):
             try:
                 info = socket.getaddrinfo(remote.ip, remote.port, family, socket.SOCK_DGRAM)
             except OSError as exc:
-                raise ModemDriverException(
+                raise ModemDriverError(
                     f"cannot resolve {remote.ip}: {exc}", Status.INVALID_CONFIGURATION
                 ) from exc
             self._remotes.setdefault(remote.modem_id, []).append(info[0][4][:2])
@@ -63,7 +63,7 @@ class UDPDriver(DatagramDriverBase):
 
     def _send(self, msg) -> None:
         if self._sock is None:
-            raise ModemDriverException(
+            raise ModemDriverError(
                 "UDP driver is not started", Status.CONNECTION_TO_MODEM_FAILED
             )
         data = msg.SerializeToString()

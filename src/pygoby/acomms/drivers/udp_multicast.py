@@ -12,8 +12,8 @@ import socket
 import struct
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverException
 from pygoby.acomms.drivers.datagram import DatagramDriverBase
+from pygoby.acomms.errors import ModemDriverError
 from pygoby.protobuf import default_loader
 
 log = logging.getLogger(__name__)
@@ -29,7 +29,7 @@ class UDPMulticastDriver(DatagramDriverBase):
 
     def startup(self, cfg) -> None:
         if not cfg.HasField("modem_id"):
-            raise ModemDriverException("modem_id is required", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
         self.cfg = cfg
         self.mc_cfg = c = cfg.Extensions[_CONFIG]
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
@@ -48,7 +48,7 @@ class UDPMulticastDriver(DatagramDriverBase):
             sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
         except OSError as exc:
             sock.close()
-            raise ModemDriverException(str(exc), Status.STARTUP_FAILED) from exc
+            raise ModemDriverError(str(exc), Status.STARTUP_FAILED) from exc
         sock.setblocking(False)
         self._sock = sock
 
@@ -58,7 +58,7 @@ class UDPMulticastDriver(DatagramDriverBase):
 
     def _send(self, msg) -> None:
         if self._sock is None:
-            raise ModemDriverException("driver is not started", Status.CONNECTION_TO_MODEM_FAILED)
+            raise ModemDriverError("driver is not started", Status.CONNECTION_TO_MODEM_FAILED)
         data = msg.SerializeToString()
         try:
             self._sock.sendto(data, (self.mc_cfg.multicast_address, self.mc_cfg.multicast_port))

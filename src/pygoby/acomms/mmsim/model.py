@@ -21,7 +21,8 @@ from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FR
 from pygoby.acomms.drivers.micromodem.statistics import cst_head_fields, cst_tail, format_xst
 from pygoby.acomms.mmsim.channel import AcousticPacket, Channel, PacketKind, Reception
 from pygoby.util.clock import Clock
-from pygoby.util.nmea import NMEAError, NMEASentence, checksum, printed
+from pygoby.util.errors import NMEAError
+from pygoby.util.nmea import NMEASentence, checksum, printed
 
 log = logging.getLogger(__name__)
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 
 from pygoby.acomms import messages as m
+from pygoby.acomms.errors import QueueError
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
 from pygoby.acomms.signals import Signal
@@ -18,10 +19,6 @@ from pygoby.dccl import DcclError
 from pygoby.util.clock import Clock, WallClock
 
 log = logging.getLogger(__name__)
-
-
-class QueueError(Exception):
-    """A message cannot be queued (no queue for its type, empty encoding, bad config)."""
 
 
 class QueueManager:

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 
 from pygoby.acomms import messages as m
+from pygoby.acomms.errors import RoleError
 
 Role = m.QueuedMessageEntry.Role
 _INTEGER_TYPES = {
@@ -17,10 +18,6 @@ _INTEGER_TYPES = {
     FieldDescriptor.TYPE_FIXED32, FieldDescriptor.TYPE_FIXED64, FieldDescriptor.TYPE_SFIXED32,
     FieldDescriptor.TYPE_SFIXED64, FieldDescriptor.TYPE_ENUM,
 }  # fmt: skip
-
-
-class RoleError(ValueError):
-    """A role in the queue configuration is invalid for its message type."""
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,8 @@ import logging
 from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.rudics import RudicsPacketError, parse_rudics_packet, serialize_rudics_packet
+from pygoby.acomms.errors import RudicsPacketError
+from pygoby.acomms.rudics import parse_rudics_packet, serialize_rudics_packet
 from pygoby.acomms.store_server.store import TransmissionStore
 from pygoby.util.clock import Clock, WallClock
 

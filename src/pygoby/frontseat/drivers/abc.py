@@ -37,6 +37,7 @@ import asyncio
 from typing import Any
 
 from pygoby.frontseat import messages as m
+from pygoby.frontseat.errors import AbcConfigError, SimulatorProtocolError
 from pygoby.frontseat.interface import InterfaceBase
 from pygoby.frontseat.simulator.protocol import (
     KEY_CMD,
@@ -45,12 +46,12 @@ from pygoby.frontseat.simulator.protocol import (
     WHITESPACE,
     Command,
     Nav,
-    ProtocolError,
     Start,
     parse_line,
 )
 from pygoby.util.clock import Clock
-from pygoby.util.linebased import LineLink, LinkClosedError, TCPClientLink
+from pygoby.util.errors import LinkClosedError
+from pygoby.util.linebased import LineLink, TCPClientLink
 
 NAV_TIMEOUT = 10.0  # s without NAV before the frontseat counts as not providing data
 CONNECT_TIMEOUT = 10.0  # s start() waits for the first connection
@@ -62,20 +63,19 @@ _CTRL_STATES = {
 }
 
 
-class AbcConfigError(ValueError):
-    """The frontseat Config lacks a usable `basic_simulator_config`."""
-
-
 def start_params(cfg: Any) -> Start:
     """The START message a frontseat Config asks for."""
     if not cfg.HasExtension(m.BASIC_SIMULATOR_CONFIG):
         raise AbcConfigError(
-            "frontseat_cfg has no [goby.middleware.frontseat.protobuf.basic_simulator_config]"
+            "has no [goby.middleware.frontseat.protobuf.basic_simulator_config]",
+            field="frontseat_cfg",
         )
     sim = cfg.Extensions[m.BASIC_SIMULATOR_CONFIG]
     missing = sim.FindInitializationErrors()
     if missing:
-        raise AbcConfigError(f"basic_simulator_config lacks required {', '.join(missing)}")
+        raise AbcConfigError(
+            f"lacks required {', '.join(missing)}", field="basic_simulator_config"
+        )
     start = sim.start
     try:
         return Start(
@@ -88,8 +88,8 @@ def start_params(cfg: Any) -> Start:
             z_rate=start.vehicle.z_rate,
             warp=cfg.sim_warp_factor,
         )
-    except ProtocolError as exc:
-        raise AbcConfigError(f"basic_simulator_config: {exc}") from None
+    except SimulatorProtocolError as exc:
+        raise AbcConfigError(str(exc), field="basic_simulator_config") from None
 
 
 class AbcFrontSeat(InterfaceBase):
@@ -205,7 +205,7 @@ class AbcFrontSeat(InterfaceBase):
                 self._command_result(msg.fields.get("RESULT", ""))
             else:
                 self.log.info("unknown message from the frontseat: %r", line)
-        except ProtocolError as exc:
+        except SimulatorProtocolError as exc:
             self.log.warning("skipping bad line from the frontseat %r: %s", line, exc)
 
     def _navigation(self, nav: Nav) -> None:

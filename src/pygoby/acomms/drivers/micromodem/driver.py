@@ -18,11 +18,13 @@ from collections.abc import Callable
 from enum import Enum, auto
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms.driver_base import ModemDriverBase
 from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
 from pygoby.acomms.drivers.micromodem.statistics import add_cst, parse_toa, parse_xst
-from pygoby.util.nmea import NMEAError, NMEASentence, printed
+from pygoby.acomms.errors import ModemDriverError
+from pygoby.util.errors import NMEAError
+from pygoby.util.nmea import NMEASentence, printed
 
 log = logging.getLogger(__name__)
 
@@ -213,7 +215,7 @@ class MMDriver(ModemDriverBase):
         log.warning("no valid answer to %s (%s)", front, reason)
         if self._fails >= MAX_FAILS_BEFORE_DEAD:
             self.shutdown()
-            raise ModemDriverException(
+            raise ModemDriverError(
                 f"modem did not respond to {front}", Status.MODEM_NOT_RESPONDING
             )
         if self._tries >= RETRIES:

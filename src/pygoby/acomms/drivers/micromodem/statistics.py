@@ -11,7 +11,8 @@ from collections.abc import Mapping
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as m
-from pygoby.util.nmea import NMEAFormatError, NMEASentence, parse_ints
+from pygoby.util.errors import NMEAFormatError
+from pygoby.util.nmea import NMEASentence, parse_ints
 
 log = logging.getLogger(__name__)
 
