@@ -15,9 +15,9 @@ from pygoby.frontseat.interface import (
     FrontSeatDriverError,
     FrontSeatFatalError,
     InterfaceBase,
-    Signal,
 )
 from pygoby.util.clock import VirtualClock
+from pygoby.util.signal import Signal
 
 from .scripted_driver import ScriptedFrontSeat
 
@@ -436,7 +436,7 @@ def test_without_exit_on_error_error_states_do_not_raise() -> None:
 
 
 def test_signal_calls_every_callback_in_order_even_if_one_raises(caplog) -> None:
-    sig = Signal()
+    sig = Signal(contain_errors=True)  # (as the interface's signals are)
     seen: list = []
 
     def broken(value):

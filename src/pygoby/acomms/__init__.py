@@ -1,7 +1,7 @@
 """goby-acomms: moving DCCL messages over slow, lossy acoustic links (spec acomms.md).
 
 Layers (all sans-I/O cores advanced by `do_work()` against a pygoby.util.clock.Clock; signals
-are synchronous `pygoby.acomms.signals.Signal`s with `connect`/`disconnect`/`emit`):
+are synchronous `pygoby.util.signal.Signal`s with `connect`/`disconnect`/`emit`):
 
 * `pygoby.acomms.messages`: protobuf classes (ModemTransmission, DriverConfig, QueueManagerConfig,
   MACConfig, MACUpdate, NetworkAck, Micro-Modem / UDP / ABC / store-server / uField extensions as

@@ -15,10 +15,10 @@ from typing import IO
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.errors import ModemDriverError
-from pygoby.acomms.signals import Signal
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.errors import LinkClosedError
 from pygoby.util.linebased import LineLink, SerialLink, TCPClientLink, TCPServerLink
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 

@@ -36,11 +36,11 @@ from pygoby.acomms.errors import HandlerError, ModemDriverError, QueueError
 from pygoby.acomms.mac import MACManager
 from pygoby.acomms.queue import QueueManager
 from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
-from pygoby.acomms.signals import Signal
 from pygoby.dccl import Codec, DcclError
 from pygoby.protobuf import ProtoLoader
 from pygoby.util.clock import Clock
 from pygoby.util.modules import import_module_or_file
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 

@@ -13,8 +13,8 @@ import logging
 import math
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.signals import Signal
 from pygoby.util.clock import Clock
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 

@@ -121,16 +121,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             (queue.signal_data_on_demand, self._on_data_on_demand),
         ]
         for signal, slot in connections:
-            signal.connect(self._contained(slot))
-
-    def _contained(self, slot):
-        def run(*args) -> None:
-            try:
-                slot(*args)
-            except Exception:
-                self.log.exception("pAcommsHandler failed to handle an acomms event")
-
-        return run
+            signal.connect(slot, contain_errors=True, logger=self.log)
 
     def _subscribe_all(self) -> None:
         acomms = self.acomms

@@ -30,12 +30,10 @@ from __future__ import annotations
 import abc
 import logging
 import math
-from collections.abc import Callable
 from typing import Any
 
 from google.protobuf import text_format
 
-from pygoby.acomms.signals import Signal as _SlotList
 from pygoby.frontseat.ctd import compute_missing_ctd as _compute_missing_ctd
 from pygoby.frontseat.errors import FrontSeatDriverError, FrontSeatFatalError
 from pygoby.frontseat.messages import (
@@ -63,27 +61,9 @@ from pygoby.frontseat.messages import (
 )
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.geodesy import UTMGeodesy
+from pygoby.util.signal import Signal
 
 _log = logging.getLogger(__name__)
-
-
-class Signal(_SlotList):
-    """Callback list: `sig.connect(cb)`; `sig(arg)` (or `sig.emit(arg)`) calls every cb(arg) in
-    order. A raising callback is logged and does not stop the others (a subscriber's bug must not
-    stop the interface's tick)."""
-
-    def emit(self, *args: Any) -> None:
-        for slot in list(self._slots):
-            try:
-                slot(*args)
-            except Exception:
-                _log.exception("frontseat signal callback %s raised", _slot_name(slot))
-
-    __call__ = emit
-
-
-def _slot_name(slot: Callable[..., Any]) -> str:
-    return getattr(slot, "__qualname__", repr(slot))
 
 
 def _short(status: Any) -> str:
@@ -111,11 +91,12 @@ class InterfaceBase(abc.ABC):
         self._last_helm_error: int = ERROR_HELM_NONE
         self._last_frontseat_error: int = ERROR_FRONTSEAT_NONE
 
-        self.signal_data_from_frontseat = Signal()
-        self.signal_command_response = Signal()
-        self.signal_raw_from_frontseat = Signal()
-        self.signal_raw_to_frontseat = Signal()
-        self.signal_state_change = Signal()
+        # A raising subscriber is logged and does not stop the others (nor the interface's tick)
+        self.signal_data_from_frontseat = Signal(contain_errors=True, logger=_log)
+        self.signal_command_response = Signal(contain_errors=True, logger=_log)
+        self.signal_raw_from_frontseat = Signal(contain_errors=True, logger=_log)
+        self.signal_raw_to_frontseat = Signal(contain_errors=True, logger=_log)
+        self.signal_state_change = Signal(contain_errors=True, logger=_log)
 
         self._geodesy: UTMGeodesy | None = None
         origin = self.cfg.origin

@@ -10,7 +10,7 @@
 Behaviour: a `T` timing message leads a packet at least once a second (keep-alive and clock
 sync); everything queued is sent in one packet as soon as the event loop runs the writer. The
 client reconnects by itself (every `reconnect_interval` s) after a lost connection, sends its
-subscriptions again, calls the `on_connect` callbacks, then sends publications queued while it
+subscriptions again, emits `signal_connect`, then sends publications queued while it
 was away (bounded by `outbox_limit`; the oldest are dropped beyond it, with a warning). A `K`
 (name already in use) ends the client with `MoosRefusedError`: no retry, as in C++.
 """
@@ -28,6 +28,7 @@ from pygoby.moos import protocol as p
 from pygoby.moos.errors import MoosProtocolError, MoosRefusedError
 from pygoby.moos.protocol import MOOSMessage, Value
 from pygoby.util.clock import Clock, WallClock
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
@@ -42,6 +43,10 @@ class MOOSClient:
     `pygoby.moos.timewarp.moos_clock`), on_message (callback for every received message; when
     None, messages go to the inbox read by `receive()`), reconnect_interval (s), outbox_limit,
     inbox_limit (messages), max_packet_size (bytes accepted from the DB).
+
+    Signals (`pygoby.util.signal.Signal`, no arguments): `signal_connect` after each
+    (re)connection, once the subscriptions are sent again (a raising slot is logged);
+    `signal_disconnect` when a connection is lost.
     """
 
     def __init__(
@@ -64,8 +69,9 @@ class MOOSClient:
         self.port = port
         self.clock = clock or WallClock()
         self.on_message = on_message
-        self.on_connect: list[Callable[[], None]] = []
-        self.on_disconnect: list[Callable[[], None]] = []
+        # a failing connect slot is logged (the session goes on); disconnect slots' errors propagate
+        self.signal_connect = Signal(contain_errors=True, logger=log)
+        self.signal_disconnect = Signal()
         self.reconnect_interval = reconnect_interval
         self.outbox_limit = outbox_limit
         self.inbox_limit = inbox_limit
@@ -311,8 +317,7 @@ class MOOSClient:
         for future in self._requests:
             if not future.done():
                 future.set_result([])
-        for callback in self.on_disconnect:
-            callback()
+        self.signal_disconnect.emit()
 
     async def _session(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         sock = writer.get_extra_info("socket")
@@ -337,11 +342,7 @@ class MOOSClient:
         self.connections += 1
         self._connected.set()
         log.info("%s: connected to MOOSDB %s at %s:%d", self.name, self.community, self.host, self.port)
-        for callback in self.on_connect:
-            try:
-                callback()
-            except Exception:
-                log.exception("%s: on_connect callback failed", self.name)
+        self.signal_connect.emit()
         write_task = asyncio.create_task(self._write_loop(writer))
         try:
             await self._read_loop(reader, framer)

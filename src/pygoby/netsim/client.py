@@ -34,6 +34,7 @@ from pygoby.netsim.protocol import (
     request_class,
     response_names,
 )
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
@@ -111,7 +112,9 @@ class NetSimClient:
     ) -> None:
         self.host, self.port = host, port
         self.tracker = RequestTracker(legacy_names)
-        self._callbacks: list[ResponseCallback] = [on_response] if on_response else []
+        self.signal_response = Signal()  # every response received, in arrival order
+        if on_response is not None:
+            self.signal_response.connect(on_response)
         self.backoff_initial, self.backoff_max = backoff_initial, backoff_max
         self._writer: asyncio.StreamWriter | None = None
         self._connected = asyncio.Event()
@@ -122,9 +125,6 @@ class NetSimClient:
     @property
     def connected(self) -> bool:
         return self._writer is not None
-
-    def add_response_callback(self, callback: ResponseCallback) -> None:
-        self._callbacks.append(callback)
 
     async def start(self) -> None:
         if self._task is None:
@@ -198,8 +198,7 @@ class NetSimClient:
                         log.warning(
                             "netsim request %d: %s", response.request_id, status_name(response)
                         )
-                    for callback in self._callbacks:
-                        callback(response)
+                    self.signal_response.emit(response)
         except OSError as exc:
             log.info("netsim client: connection lost: %s", exc)
         finally:

@@ -53,6 +53,7 @@ from pygoby.netsim.scenario import (
 )
 from pygoby.util.clock import Clock, VirtualClock
 from pygoby.util.errors import LinkClosedError
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
@@ -169,7 +170,9 @@ class Simulation:
         self.scenario = scenario
         self.start = start_time(scenario)
         self.clock: Clock = clock if clock is not None else VirtualClock(self.start)
-        self.on_event = on_event
+        self.signal_event = Signal()  # every event (see the module's documentation)
+        if on_event is not None:
+            self.signal_event.connect(on_event)
         self.events: Counter = Counter()
         self.outcomes: Counter = Counter()
         self.status_sent = 0
@@ -253,8 +256,7 @@ class Simulation:
         self.events[event["event"]] += 1
         if event["event"] == "rx":
             self.outcomes[event["outcome"]] += 1
-        if self.on_event is not None:
-            self.on_event(event)
+        self.signal_event.emit(event)
 
     # -- positions -------------------------------------------------------------------------------
 

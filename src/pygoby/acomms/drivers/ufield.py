@@ -16,7 +16,7 @@ from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.driver_base import ModemDriverBase
-from pygoby.moos.translator.modem_id import ModemIdLookup
+from pygoby.util.modem_id import ModemIdLookup
 
 log = logging.getLogger(__name__)
 

@@ -14,9 +14,9 @@ from pygoby.acomms import messages as m
 from pygoby.acomms.errors import QueueError
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
-from pygoby.acomms.signals import Signal
 from pygoby.dccl import DcclError
 from pygoby.util.clock import Clock, WallClock
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 

@@ -27,7 +27,6 @@ from pygoby.moos.translator.errors import (
     TranslatorError,
     UnconvertibleError,
 )
-from pygoby.moos.translator.modem_id import ModemIdLookup
 from pygoby.moos.translator.techniques import (
     MAGIC_PROTOBUF_HEADER,
     MoosValue,
@@ -50,6 +49,7 @@ from pygoby.moos.translator.translator import (
     post_for_moos,
 )
 from pygoby.util.geodesy import UTMGeodesy
+from pygoby.util.modem_id import ModemIdLookup
 
 TRANSLATOR_PROTO = "goby/moos/protobuf/translator.proto"
 
