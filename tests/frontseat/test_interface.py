@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.interface import (
     FrontSeatDriverError,
     FrontSeatFatalError,
@@ -22,21 +22,21 @@ from pygoby.util.signal import Signal
 from .scripted_driver import ScriptedFrontSeat
 
 START = 1000.0
-ERRORS = (m.INTERFACE_HELM_ERROR, m.INTERFACE_FS_ERROR)
+ERRORS = (frontseat_pb.INTERFACE_HELM_ERROR, frontseat_pb.INTERFACE_FS_ERROR)
 
-STANDBY, LISTEN, COMMAND = m.INTERFACE_STANDBY, m.INTERFACE_LISTEN, m.INTERFACE_COMMAND
-HELM_ERROR, FS_ERROR = m.INTERFACE_HELM_ERROR, m.INTERFACE_FS_ERROR
-NOT_CONNECTED, IDLE = m.FRONTSEAT_NOT_CONNECTED, m.FRONTSEAT_IDLE
-ACCEPTING, IN_CONTROL = m.FRONTSEAT_ACCEPTING_COMMANDS, m.FRONTSEAT_IN_CONTROL
-NOT_RUNNING, DRIVE, PARK = m.HELM_NOT_RUNNING, m.HELM_DRIVE, m.HELM_PARK
-PARKED, HELM_NOT_RUNNING_ERR = m.ERROR_HELM_PARKED, m.ERROR_HELM_NOT_RUNNING
-FS_NOT_CONNECTED_ERR = m.ERROR_FRONTSEAT_NOT_CONNECTED
-NOT_PROVIDING_ERR = m.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
-IGNORING_ERR = m.ERROR_FRONTSEAT_IGNORING_COMMANDS
+STANDBY, LISTEN, COMMAND = frontseat_pb.INTERFACE_STANDBY, frontseat_pb.INTERFACE_LISTEN, frontseat_pb.INTERFACE_COMMAND
+HELM_ERROR, FS_ERROR = frontseat_pb.INTERFACE_HELM_ERROR, frontseat_pb.INTERFACE_FS_ERROR
+NOT_CONNECTED, IDLE = frontseat_pb.FRONTSEAT_NOT_CONNECTED, frontseat_pb.FRONTSEAT_IDLE
+ACCEPTING, IN_CONTROL = frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS, frontseat_pb.FRONTSEAT_IN_CONTROL
+NOT_RUNNING, DRIVE, PARK = frontseat_pb.HELM_NOT_RUNNING, frontseat_pb.HELM_DRIVE, frontseat_pb.HELM_PARK
+PARKED, HELM_NOT_RUNNING_ERR = frontseat_pb.ERROR_HELM_PARKED, frontseat_pb.ERROR_HELM_NOT_RUNNING
+FS_NOT_CONNECTED_ERR = frontseat_pb.ERROR_FRONTSEAT_NOT_CONNECTED
+NOT_PROVIDING_ERR = frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
+IGNORING_ERR = frontseat_pb.ERROR_FRONTSEAT_IGNORING_COMMANDS
 
 
 def make(start: float = START, **cfg_fields) -> ScriptedFrontSeat:
-    driver = ScriptedFrontSeat(m.Config(**cfg_fields), VirtualClock(start))
+    driver = ScriptedFrontSeat(frontseat_pb.Config(**cfg_fields), VirtualClock(start))
     driver.changes = []
     driver.signal_state_change.connect(driver.changes.append)
     return driver
@@ -222,7 +222,7 @@ def test_transition_table(row: Row) -> None:
 
     tick(driver, helm=row.helm, fs=row.fs, providing=row.providing, at=row.at)
 
-    assert driver.state == row.expect, m.InterfaceState.Name(driver.state)
+    assert driver.state == row.expect, frontseat_pb.InterfaceState.Name(driver.state)
     assert errors(driver) == (row.helm_error, row.fs_error)
     entered_error_by_check = row.expect in ERRORS and before not in ERRORS
     # loop() is skipped exactly on the tick the transition check enters an error state
@@ -254,7 +254,7 @@ def test_initial_state() -> None:
 def test_grace_periods_are_measured_from_construction() -> None:
     clock = VirtualClock(0.0)
     clock.advance(500)
-    driver = ScriptedFrontSeat(m.Config(), clock)
+    driver = ScriptedFrontSeat(frontseat_pb.Config(), clock)
     driver.fs_state = IDLE
     clock.set(510)
     driver.do_work()
@@ -319,7 +319,7 @@ def test_a_full_session_signals_each_change_once() -> None:
     tick(driver, providing=False, at=1)  # E4
     tick(driver, at=20)  # stays
     tick(driver, providing=True, at=21)  # T8
-    assert [m.InterfaceState.Name(s.state) for s in driver.changes] == [
+    assert [frontseat_pb.InterfaceState.Name(s.state) for s in driver.changes] == [
         "INTERFACE_LISTEN",
         "INTERFACE_COMMAND",
         "INTERFACE_LISTEN",
@@ -467,11 +467,11 @@ def test_driver_hooks_are_abstract() -> None:
             pass
 
     with pytest.raises(TypeError):
-        Incomplete(m.Config())
+        Incomplete(frontseat_pb.Config())
 
 
 def test_cfg_is_a_copy() -> None:
-    cfg = m.Config(name="auv1")
+    cfg = frontseat_pb.Config(name="auv1")
     driver = ScriptedFrontSeat(cfg, VirtualClock(0))
     cfg.name = "changed"
     assert driver.cfg.name == "auv1"

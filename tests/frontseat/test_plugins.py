@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat import plugins
 from pygoby.frontseat.plugins import (
     DRIVER_ENV_VAR,
@@ -29,7 +29,7 @@ TEST_MODULE = "tests.frontseat.scripted_driver"
 
 
 def cfg():
-    return m.Config(name="auv1", require_helm=False)
+    return frontseat_pb.Config(name="auv1", require_helm=False)
 
 
 @pytest.fixture
@@ -122,7 +122,7 @@ def test_module_without_factory() -> None:
     with pytest.raises(DriverLoadError, match="no 'missing' factory"):
         load_driver(f"{TEST_MODULE}:missing", cfg())
     with pytest.raises(DriverLoadError, match="not callable"):
-        load_driver(f"{TEST_MODULE}:m", cfg())  # the module's messages import
+        load_driver(f"{TEST_MODULE}:frontseat_pb", cfg())  # the module's messages import
 
 
 def test_factory_that_raises() -> None:
@@ -167,7 +167,7 @@ def test_basic_simulator_driver_loads_when_installed() -> None:
     """The real ABC / basic simulator driver through its entry point (once it exists)."""
     pytest.importorskip("pygoby.frontseat.drivers.abc")
     config = cfg()
-    sim = config.Extensions[m.BASIC_SIMULATOR_CONFIG]
+    sim = config.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
     sim.tcp_address, sim.start.lat, sim.start.lon = "127.0.0.1", 42.5, -70.5
     for name in ("basic_simulator", "abc", "libgoby_frontseat_basic_simulator.so.30"):
         driver = load_driver(name, config, VirtualClock(0.0))

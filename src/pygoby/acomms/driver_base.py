@@ -13,7 +13,7 @@ import logging
 from abc import ABC, abstractmethod
 from typing import IO
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import ModemDriverError
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.errors import LinkClosedError
@@ -22,7 +22,7 @@ from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
-Status = m.ModemDriverStatus
+Status = acomms_pb.ModemDriverStatus
 
 
 def driver_name(cfg) -> str:
@@ -30,7 +30,7 @@ def driver_name(cfg) -> str:
     if cfg.WhichOneof("driver") == "driver_name":
         kind = cfg.driver_name
     else:
-        driver_type = m.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
+        driver_type = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
         kind = driver_type.values_by_number[cfg.driver_type].name.removeprefix("DRIVER_")
     return f"{kind}::{cfg.modem_id}"
 
@@ -49,7 +49,7 @@ class ModemDriverBase(ABC):
         self.signal_modify_transmission = Signal()
         self.signal_raw_incoming = Signal()
         self.signal_raw_outgoing = Signal()
-        self.cfg = m.DriverConfig()
+        self.cfg = acomms_pb.DriverConfig()
         self.link: LineLink | None = link
         self._injected_link = link is not None
         self._raw_log: IO[str] | None = None
@@ -71,11 +71,11 @@ class ModemDriverBase(ABC):
         log.warning("%s: update_cfg is not implemented by this driver", type(self).__name__)
 
     def report(self):
-        report = m.ModemReport(modem_id=self.cfg.modem_id, time=m.now_us(self.clock.now()))
+        report = acomms_pb.ModemReport(modem_id=self.cfg.modem_id, time=acomms_pb.now_us(self.clock.now()))
         report.link_state = (
-            m.ModemReport.LINK_AVAILABLE
+            acomms_pb.ModemReport.LINK_AVAILABLE
             if self.link is not None and self.link.is_open
-            else m.ModemReport.LINK_NOT_AVAILABLE
+            else acomms_pb.ModemReport.LINK_NOT_AVAILABLE
         )
         return report
 
@@ -105,7 +105,7 @@ class ModemDriverBase(ABC):
         return cfg.line_delimiter
 
     def _make_link(self, cfg, delimiter: str) -> LineLink:
-        C = m.DriverConfig
+        C = acomms_pb.DriverConfig
         # Quirk A1 (sane): an implicit connection_type is the documented default, SERIAL.
         kind = cfg.connection_type
         if kind == C.CONNECTION_SERIAL:
@@ -160,7 +160,7 @@ class ModemDriverBase(ABC):
         if not signal:
             return  # nobody listens: skip building a ModemRaw for every line
         data = raw.encode("latin-1") if isinstance(raw, str) else raw
-        msg = m.ModemRaw(raw=data)
+        msg = acomms_pb.ModemRaw(raw=data)
         if description:
             msg.description = description
         signal.emit(msg)

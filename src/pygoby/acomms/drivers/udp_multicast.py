@@ -11,14 +11,14 @@ import logging
 import socket
 import struct
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.datagram import DatagramDriverBase
 from pygoby.acomms.errors import ModemDriverError
 from pygoby.protobuf import default_loader
 
 log = logging.getLogger(__name__)
 
-Status = m.ModemDriverStatus
+Status = acomms_pb.ModemDriverStatus
 _CONFIG = default_loader().pool.FindExtensionByName("goby.acomms.udp_multicast.protobuf.config")
 
 
@@ -70,8 +70,8 @@ class UDPMulticastDriver(DatagramDriverBase):
         if msg.src == self.modem_id:
             return  # our own transmission looped back
         self.emit_raw(True, data)
-        if msg.type == m.DATA and msg.ack_requested and msg.dest == self.modem_id:
-            ack = m.ModemTransmission(type=m.ACK, src=self.modem_id, dest=msg.src)
+        if msg.type == acomms_pb.DATA and msg.ack_requested and msg.dest == self.modem_id:
+            ack = acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=self.modem_id, dest=msg.src)
             ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
             self._send(ack)
         self.signal_receive.emit(msg)
