@@ -3,14 +3,13 @@ paths, and the errors for everything else."""
 
 from __future__ import annotations
 
-from importlib.metadata import EntryPoint
+from importlib.metadata import entry_points
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pygoby.frontseat import messages as frontseat_pb
-from pygoby.frontseat import plugins
 from pygoby.frontseat.plugins import (
     DRIVER_ENV_VAR,
     ENTRY_POINT_GROUP,
@@ -33,24 +32,24 @@ def cfg():
 
 
 @pytest.fixture
-def scripted_entry_point(monkeypatch):
-    """The installed entry points plus one for the test driver module."""
-    real = plugins._entry_points()
-    extra = EntryPoint(
-        name="scripted", value=f"{TEST_MODULE}:frontseat_driver_load", group=ENTRY_POINT_GROUP
+def scripted_entry_point(monkeypatch, tmp_path):
+    """The installed entry points plus two of a distribution installed for the test (found on
+    sys.path, as pip-installed driver packages are): the test driver module and a broken one."""
+    dist_info = tmp_path / "pygoby_test_drivers-1.0.dist-info"
+    dist_info.mkdir()
+    (dist_info / "METADATA").write_text("Metadata-Version: 2.1\nName: pygoby-test-drivers\nVersion: 1.0\n")
+    (dist_info / "entry_points.txt").write_text(
+        f"[{ENTRY_POINT_GROUP}]\n"
+        f"scripted = {TEST_MODULE}:frontseat_driver_load\n"
+        "broken = tests.frontseat.no_such_module:x\n"
     )
-    broken = EntryPoint(
-        name="broken", value="tests.frontseat.no_such_module:x", group=ENTRY_POINT_GROUP
-    )
-    monkeypatch.setattr(
-        plugins, "_entry_points", lambda: {**real, "scripted": extra, "broken": broken}
-    )
+    monkeypatch.syspath_prepend(str(tmp_path))
 
 
 def test_pygoby_registers_its_drivers() -> None:
     """pyproject's entry points are installed (pip install -e .)."""
     assert {"abc", "basic_simulator"} <= set(available_drivers())
-    found = plugins._entry_points()
+    found = {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
     for name in ("abc", "basic_simulator"):
         assert found[name].value == "pygoby.frontseat.drivers.abc:frontseat_driver_load"
 

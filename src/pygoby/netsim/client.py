@@ -48,11 +48,14 @@ def status_name(response: Message) -> str:
 
 
 class RequestTracker:
-    """Request numbering, encoding and response matching for one client."""
+    """Request numbering, encoding and response matching for one client. `first_id`: the id
+    of the first request (0, as upstream; another value continues a sequence)."""
 
-    def __init__(self, legacy_names: bool = False) -> None:
+    def __init__(self, legacy_names: bool = False, first_id: int = 0) -> None:
+        if not 0 <= first_id <= MAX_REQUEST_ID:
+            raise ValueError(f"a request id is within 0..{MAX_REQUEST_ID}, not {first_id}")
         self.request_name = LEGACY_REQUEST_NAME if legacy_names else REQUEST_NAME
-        self._next_id = 0
+        self._next_id = first_id
         self._decoder = LineDecoder(response_names())
         self._waiting: dict[int, asyncio.Future[Message]] = {}
 
