@@ -19,6 +19,7 @@ from pygoby.moos import MoosError
 from pygoby.moos.translator import TranslatorConfigError
 from pygoby.netsim import NetsimError, ScenarioError
 from pygoby.protobuf import ProtoError
+from pygoby.topside import TopsideError
 from pygoby.util import LinkClosedError, NMEAError
 
 # the root(s) every error class of a package derives from
@@ -29,6 +30,7 @@ PACKAGE_ROOTS: dict[str, tuple[type[BaseException], ...]] = {
     "pygoby.moos": (MoosError,),
     "pygoby.netsim": (NetsimError,),
     "pygoby.protobuf": (ProtoError,),
+    "pygoby.topside": (TopsideError,),
     "pygoby.util": (NMEAError, LinkClosedError),  # independent helpers: one root per kind
     "pygoby.errors": (PygobyError,),
 }

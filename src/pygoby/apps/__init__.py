@@ -1,3 +1,12 @@
 """The Goby MOOS applications, one module per console script (thin wiring of the libraries)."""
 
-__all__ = ["ifrontseat", "inetsimmanager", "pacommshandler", "ptranslator", "usimvehicle"]
+__all__ = [
+    "icommander",
+    "ifrontseat",
+    "inetsimmanager",
+    "liaison",
+    "pacommshandler",
+    "ptranslator",
+    "topside_cli",
+    "usimvehicle",
+]
