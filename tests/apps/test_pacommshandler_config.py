@@ -79,7 +79,7 @@ def test_spec_example_configures_every_layer(tmp_path):
     assert list(acomms.route_cfg.route.hop) == [1, 2]
     assert acomms.failure.driver_backoff_sec == 30
     assert app.var["queue_size"] == "AC_QSIZE" and app.ifs_data_out == "IFS_DATA_OUT"
-    status = app._message_class(STATUS)(
+    status = app.message_types(STATUS)(
         time=float(int(time.time())), src=1, nav_x=1, nav_y=2, speed=0, heading=0, depth=0
     )
     encrypted = acomms.codec.encode(status)
@@ -90,8 +90,8 @@ def test_spec_example_configures_every_layer(tmp_path):
 
 def test_goby_messages_resolve_for_translator_entries(tmp_path):
     app = pAcommsHandler.from_mission(write(tmp_path, EXAMPLE))
-    assert app._message_class("goby.acomms.protobuf.MACUpdate") is acomms_pb.MACUpdate
-    assert app._message_class("goby.acomms.protobuf.RouteCommand").DESCRIPTOR.name == "RouteCommand"
+    assert app.message_types("goby.acomms.protobuf.MACUpdate") is acomms_pb.MACUpdate
+    assert app.message_types("goby.acomms.protobuf.RouteCommand").DESCRIPTOR.name == "RouteCommand"
 
 
 @pytest.mark.parametrize(
@@ -154,7 +154,7 @@ ProcessConfig = pAcommsHandler
 }}
 """
     app = pAcommsHandler.from_mission(write(tmp_path, mission))
-    command = app._message_class(COMMAND)(
+    command = app.message_types(COMMAND)(
         time=float(int(time.time())), src=1, dest=3, command_id=7, heading=90, speed=1, depth=5
     )
     app.acomms.queue.push_message(command)

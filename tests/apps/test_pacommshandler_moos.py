@@ -226,7 +226,7 @@ async def test_received_route_command_replaces_the_route(tmp_path):
         app, r = await start(tmp_path, db, extra=route_cfg)
         try:
             assert 514 in app.queue.queues
-            command_cls = app._message_class("goby.acomms.protobuf.RouteCommand")
+            command_cls = app.message_types("goby.acomms.protobuf.RouteCommand")
             command = command_cls(src=3, dest=1, time=int(1.8e15))
             command.new_route.hop.extend([1, 2, 3])
             frame = app.acomms.codec.encode(command)

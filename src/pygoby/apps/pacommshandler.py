@@ -61,7 +61,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
-        self._message_class = MessageTypes(
+        self.message_types = MessageTypes(
             [self.find_file(path) for path in cfg.load_proto_file],
             [self.find_file(module) for module in cfg.load_shared_library],
             fallback=m.goby_message_class,
@@ -69,7 +69,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         )
         lookup = cfg.modem_id_lookup_path
         self.binding = TranslatorBinding(
-            self, cfg.translator_entry, self._message_class, on_created=self._push,
+            self, cfg.translator_entry, self.message_types, on_created=self._push,
             multiplex_vars=cfg.multiplex_create_moos_var,
             modem_id_lookup_path=self.find_file(lookup) if lookup else "",
         )  # fmt: skip
@@ -86,7 +86,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def _configure_queue(self) -> None:
         try:
-            skipped = self.acomms.configure_queue(self._message_class)
+            skipped = self.acomms.configure_queue(self.message_types)
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         for name in skipped:
@@ -94,7 +94,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def _loaded(self, name: str) -> str:
         try:
-            self._message_class(name)
+            self.message_types(name)
         except Exception:
             raise ConfigError(
                 f"dccl_frontseat_forward_name {name!r} is not a loaded type"
