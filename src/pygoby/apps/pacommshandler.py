@@ -18,13 +18,14 @@ import functools
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.acomms.queue import QueueError
 from pygoby.dccl import DcclError
+from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError, prefixed_var_names
+from pygoby.moos.appconfig import prefixed_var_names
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, TranslatorError
 from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
@@ -64,7 +65,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.message_types = MessageTypes(
             [self.find_file(path) for path in cfg.load_proto_file],
             [self.find_file(module) for module in cfg.load_shared_library],
-            fallback=m.goby_message_class,
+            fallback=acomms_pb.goby_message_class,
             loader=self.loader,
         )
         lookup = cfg.modem_id_lookup_path
@@ -128,12 +129,12 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         from_others = {"driver_receive": acomms.inject_receive,
                        "mac_initiate_transmission": acomms.initiate_transmission}  # fmt: skip
         for key, handler in from_others.items():
-            self.subscribe_pb(self.var[key], m.ModemTransmission, handler, ignore_own=True)
-        self.subscribe_pb(self.var["mac_cycle_update"], m.MACUpdate, acomms.apply_mac_update)
-        self.subscribe_pb(self.var["queue_flush"], m.QueueFlush, self.queue.flush_queue)
+            self.subscribe_pb(self.var[key], acomms_pb.ModemTransmission, handler, ignore_own=True)
+        self.subscribe_pb(self.var["mac_cycle_update"], acomms_pb.MACUpdate, acomms.apply_mac_update)
+        self.subscribe_pb(self.var["queue_flush"], acomms_pb.QueueFlush, self.queue.flush_queue)
         self.subscribe(self.var["config_file_request"], self._on_config_request)
         self.subscribe(self.var["driver_reset"], self._on_driver_reset)
-        self.subscribe_pb(self.var["driver_cfg_update"], m.DriverConfig, acomms.update_driver_cfg)
+        self.subscribe_pb(self.var["driver_cfg_update"], acomms_pb.DriverConfig, acomms.update_driver_cfg)
         self.binding.subscribe_all()
 
     # ------------------------------------------------------------------ running

@@ -81,14 +81,10 @@ from typing import ClassVar
 
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.moos import appcli
 from pygoby.moos import protocol as p
-from pygoby.moos.appconfig import (
-    ConfigError,
-    example_config,
-    initializer_posts,
-    read_configuration,
-)
+from pygoby.moos.appconfig import example_config, initializer_posts, read_configuration
 from pygoby.moos.applog import AppLogHandlers
 from pygoby.moos.appstatus import StatusReport
 from pygoby.moos.client import MOOSClient
