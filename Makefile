@@ -4,7 +4,10 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test bench lint clean screenshots
+
+# liaison's browser tests drive Debian's chromium (Playwright's own browser download is not used)
+CHROMIUM ?= /usr/bin/chromium
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -13,12 +16,19 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(PY) -m pygoby.demo
+	$(PY) examples/two_vehicles/run_demo.py
 	$(PY) examples/frontseat/run_demo.py --warp 10 --duration 50
 
-test: $(STAMP)
+$(CHROMIUM):
+	command -v apt-get >/dev/null && (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) || echo "install chromium for liaison's browser tests"
+
+test: $(STAMP) $(CHROMIUM)
 	$(PY) -m ruff check src tests benchmarks
 	$(PY) -m pytest -q
+
+# the README's liaison pictures, taken by the browser test against a real two-vehicle mission
+screenshots: $(STAMP) $(CHROMIUM)
+	PYGOBY_SCREENSHOTS=$(CURDIR)/docs/images $(PY) -m pytest -q tests/topside/test_liaison_browser.py
 
 bench: $(STAMP)
 	$(PY) -m pytest benchmarks -q -o addopts="" --benchmark-only --benchmark-columns=min,mean,ops,rounds

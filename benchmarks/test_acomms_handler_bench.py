@@ -1,20 +1,24 @@
 """End-to-end messages per simulated hour through the two-vehicle demo mission in fast mode.
 
-The mission of examples/two_vehicles (two MOOS communities, pAcommsHandler + uSimVehicle each,
-emulated Micro-Modems over loopback TCP hearing each other through netsim's physics, two 10 s
-TDMA slots) runs time-warped in this process, as `make demo` does. Each slot carries one rate-0
-packet (32 bytes), so the mission's design caps delivery near one message per slot (360 per
-simulated hour) plus packed commands; a warp the machine cannot keep up with shows as slots lost
-to "clock skew" and a lower figure. The run stops while the AUV is within ~2 km of the ship,
-before the demo's channel starts losing packets to range.
+The mission of examples/two_vehicles (`run_mission` of its run_demo.py: two MOOS communities,
+pAcommsHandler + uSimVehicle each, emulated Micro-Modems over loopback TCP hearing each other
+through netsim's physics, two 10 s TDMA slots) runs time-warped in this process, as `make demo`
+does. Each slot carries one rate-0 packet (32 bytes), so the mission's design caps delivery near
+one message per slot (360 per simulated hour) plus packed commands; a warp the machine cannot
+keep up with shows as slots lost to "clock skew" and a lower figure. The run stops while the AUV
+is within ~2 km of the ship, before the demo's channel starts losing packets to range.
 The figures go to the benchmark's extra_info; nothing about them is asserted.
 """
 
 import asyncio
+from pathlib import Path
 
 import pytest
 
-from pygoby.demo import run_mission
+from pygoby.util.modules import import_module_or_file
+
+DEMO = Path(__file__).resolve().parents[1] / "examples" / "two_vehicles" / "run_demo.py"
+run_mission = import_module_or_file(str(DEMO)).run_mission
 
 SIMULATED_SECONDS = 450.0
 

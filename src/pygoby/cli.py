@@ -13,6 +13,7 @@ SUBCOMMAND_MODULES = [
     "pygoby.acomms.cli",
     "pygoby.moos.cli",
     "pygoby.netsim.sim_cli",
+    "pygoby.apps.topside_cli",
 ]
 
 

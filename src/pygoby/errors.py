@@ -1,14 +1,33 @@
 """The root of pygoby's error family.
 
-Every error pygoby raises on purpose is a `PygobyError`. Each package has one root of its own
-(`DcclError`, `MoosError`, `AcommsError`, `NetsimError`, `FrontSeatError`, ...) so a caller
-catches one class per layer; every configuration problem, whichever package finds it, is a
-`ConfigError` that says where (file:line) and which field.
+Every error pygoby raises on purpose is a `PygobyError`. Each package has one root of its own,
+defined with the rest of its family in the package's `errors` module and exported by the
+package, so a caller catches one class per layer:
+
+    pygoby.dccl.DcclError          pygoby.moos.MoosError (translator errors under it)
+    pygoby.acomms.AcommsError      pygoby.netsim.NetsimError
+    pygoby.frontseat.FrontSeatError
+    pygoby.protobuf.ProtoError     (.proto files and message types)
+    pygoby.util.NMEAError, pygoby.util.LinkClosedError   (independent helpers: one per kind)
+
+Every configuration problem, whichever package finds it, is a `ConfigError` (or a subclass that
+is also under its package's root, e.g. `ScenarioError`, `TranslatorConfigError`) that says
+where (file:line) and which field. Standard mix-ins let callers catch the usual kinds:
+`ValueError` for bad values (ConfigError, decode errors), `ConnectionError` for closed links.
 """
 
 from __future__ import annotations
 
 from os import PathLike
+from typing import Protocol, Self
+
+
+class TextFormatParseError(Protocol):
+    """What `ConfigError.from_parse_error` reads of google.protobuf.text_format.ParseError."""
+
+    def GetLine(self) -> int | None: ...  # noqa: N802 - protobuf's name
+
+    def GetColumn(self) -> int | None: ...  # noqa: N802 - protobuf's name
 
 
 class PygobyError(Exception):
@@ -35,6 +54,25 @@ class ConfigError(PygobyError, ValueError):
         self.line = line
         self.field = field
         super().__init__(self._text())
+
+    @classmethod
+    def from_parse_error(
+        cls,
+        err: TextFormatParseError,
+        what: str,
+        *,
+        file: str | PathLike[str] | None = None,
+        first_line: int = 1,
+    ) -> Self:
+        """The error for a protobuf TextFormat ParseError in text that starts at `first_line` of
+        `file`: "file:line: cannot parse {what}: reason" (the reason without protobuf's own
+        `line:column : ` prefix)."""
+        line = err.GetLine()
+        reason = str(err)
+        if line is not None:
+            reason = reason.split(" : ", 1)[-1]
+            line += first_line - 1
+        return cls(f"cannot parse {what}: {reason}", file=file, line=line)
 
     def _text(self) -> str:
         where = ""

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.store_server import StoreServerDriver
 from pygoby.acomms.rudics import RudicsPacketError, parse_rudics_packet, serialize_rudics_packet
 from pygoby.acomms.store_server import StoreServer, TransmissionStore, serve_store
@@ -42,23 +42,23 @@ def test_rudics_known_layout_and_errors():
 def test_store_keeps_messages_across_restart(tmp_path):
     db = tmp_path / "store.db"
     store = TransmissionStore(db)
-    request = m.StoreServerRequest(modem_id=1, request_id=1)
+    request = acomms_pb.StoreServerRequest(modem_id=1, request_id=1)
     request.outbox.add(src=1, dest=2, frame=[b"kept"])
     assert list(store.exchange(request, 100.0).inbox) == []
     store.close()
     store = TransmissionStore(db)  # restart
-    reply = store.exchange(m.StoreServerRequest(modem_id=2, request_id=5), 101.0)
+    reply = store.exchange(acomms_pb.StoreServerRequest(modem_id=2, request_id=5), 101.0)
     assert [bytes(t.frame[0]) for t in reply.inbox] == [b"kept"] and reply.request_id == 5
-    assert list(store.exchange(m.StoreServerRequest(modem_id=2), 102.0).inbox) == []  # seen
+    assert list(store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 102.0).inbox) == []  # seen
     store.close()
     store = TransmissionStore(db)
-    assert list(store.exchange(m.StoreServerRequest(modem_id=2), 103.0).inbox) == []  # cursor kept
+    assert list(store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 103.0).inbox) == []  # cursor kept
 
 
 def store_cfg(modem_id, port):
-    cfg = m.DriverConfig(driver_type=5, modem_id=modem_id, tcp_server="127.0.0.1", tcp_port=port,
-                         connection_type=m.DriverConfig.CONNECTION_TCP_AS_CLIENT)  # fmt: skip
-    cfg.Extensions[m.STORE_SERVER_CONFIG].query_interval_seconds = 0.05
+    cfg = acomms_pb.DriverConfig(driver_type=5, modem_id=modem_id, tcp_server="127.0.0.1", tcp_port=port,
+                         connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT)  # fmt: skip
+    cfg.Extensions[acomms_pb.STORE_SERVER_CONFIG].query_interval_seconds = 0.05
     return cfg
 
 
@@ -75,14 +75,14 @@ async def test_driver_to_driver_through_store_server_with_ack(tmp_path):
         await d1.link.wait_open()
         q1.push_message(Status(src=1, dest=2, value=33))
         await asyncio.sleep(0.01)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=0))
         await run_until(lambda: bool(acked), [d1, d2, q1, q2], timeout=10)
         assert [x.value for x in got] == [33] and acked == [33] and q1.size(20) == 0
         # polling: node 1 asks node 2 for data through the store
         q2.push_message(Status(src=2, dest=1, value=44))
         back = []
         q1.signal_receive.connect(back.append)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=2, dest=1, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=2, dest=1, rate=0))
         await run_until(lambda: bool(back), [d1, d2, q1, q2], timeout=10)
         assert [x.value for x in back] == [44]
     finally:

@@ -1,13 +1,16 @@
-"""`make demo` (python -m pygoby.demo) runs the two-vehicle mission over netsim's acoustic
-physics: the AUV drives away, travel times and losses grow with range, and it exits 0."""
+"""`make demo` (examples/two_vehicles/run_demo.py) runs the two-vehicle mission over netsim's
+acoustic physics: the AUV drives away, travel times and losses grow with range, and it exits 0."""
 
 from __future__ import annotations
 
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 from pygoby.netsim.eventlog import read_events
+
+DEMO = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / "run_demo.py"
 
 SLOT_LINE = re.compile(
     r"^t=\s*(\d+) s .*range (\S+) km  owtt (\S+) s \| topside: .* lost (\d+)/(\d+) "
@@ -18,7 +21,7 @@ SLOT_LINE = re.compile(
 def test_demo_exits_zero_with_traffic_both_ways_and_range_effects(tmp_path):
     event_log = tmp_path / "events.jsonl"
     done = subprocess.run(
-        [sys.executable, "-m", "pygoby.demo", "--event-log", str(event_log)],
+        [sys.executable, str(DEMO), "--event-log", str(event_log)],
         capture_output=True,
         text=True,
         timeout=60,

@@ -4,6 +4,7 @@ half-duplex, losses growing with range, seeded repeatability."""
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as dt
 
 import pytest
@@ -201,3 +202,45 @@ def test_modem_without_port_is_refused():
                                                                 ports={"alpha": 62005}),
                             name="alpha")  # fmt: skip
     assert model.channel.port_of(model) == 62005
+
+
+def test_rx_event_figures_are_rounded():
+    """Every rx event carries the reception's figures rounded, a zero and the sign of a
+    negative zero included (links recur: the same figures each time)."""
+
+    def fresh(range_m, owtt, rl, noise, sinr):
+        snr = rl - noise
+        return (
+            round(range_m, 3), round(owtt, 6), round(rl, 2), round(snr, 2), round(sinr, 2),
+            sinr < snr - 0.01,
+        )  # fmt: skip
+
+    cases = [
+        (1234.56789, 0.8230452, 120.4449, 62.3, 58.1449),
+        (1234.56789, 0.8230452, 120.4449, 62.3, 50.0),  # a collision
+        (0.0, 0.0, 185.0, 62.3, -0.004),  # a zero: not remembered
+        (10.0, 0.0066, 62.3, 62.3, -0.0),  # -0.0 keeps its sign
+    ] * 2
+    events: list[dict] = []
+    net = Net({62000: 0.0, 62001: 1500.0}, events=events.append)
+    # the physics' receptions, with the levels of the cases in turn
+    physics_poll, scripted = net.physics.channel.poll, iter(cases)
+
+    def poll(now):
+        return [
+            dataclasses.replace(r, range_m=rng, owtt=owtt, received_level=rl, noise_level=noise,
+                                sinr=sinr)  # fmt: skip
+            for r in physics_poll(now)
+            for rng, owtt, rl, noise, sinr in [next(scripted)]
+        ]
+
+    net.physics.channel.poll = poll
+    for i in range(len(cases)):
+        net.send(1, 2, [b"x"])
+        net.run_until(T0 + 10 * (i + 1))
+    rx = [e for e in events if e["event"] == "rx"]
+    assert len(rx) == len(cases)
+    for event, case in zip(rx, cases, strict=True):
+        got = tuple(event[key] for key in ("range_m", "owtt", "rl", "snr", "sinr", "collision"))
+        assert got == fresh(*case)
+        assert [str(x) for x in got] == [str(x) for x in fresh(*case)]

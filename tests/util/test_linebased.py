@@ -5,9 +5,9 @@ import os
 
 import pytest
 
+from pygoby.util.errors import LinkClosedError
 from pygoby.util.linebased import (
     LineSplitter,
-    LinkClosedError,
     MemoryLink,
     SerialLink,
     TCPClientLink,

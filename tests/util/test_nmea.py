@@ -4,10 +4,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from pygoby.util.errors import NMEAChecksumError, NMEAError, NMEAFormatError
 from pygoby.util.nmea import (
-    NMEAChecksumError,
-    NMEAError,
-    NMEAFormatError,
     NMEASentence,
     checksum,
     with_checksum,

@@ -6,7 +6,8 @@ import asyncio
 import logging
 from collections.abc import Hashable
 
-from pygoby.acomms.abc_protocol import ABCParseError, format_abc, parse_abc
+from pygoby.acomms.abc_protocol import format_abc, parse_abc
+from pygoby.acomms.errors import ABCParseError
 
 log = logging.getLogger(__name__)
 

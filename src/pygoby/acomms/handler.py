@@ -29,22 +29,23 @@ from dataclasses import dataclass
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.bind import bind, unbind
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException, driver_name
+from pygoby.acomms.driver_base import ModemDriverBase, driver_name
+from pygoby.acomms.errors import HandlerError, ModemDriverError, QueueError
 from pygoby.acomms.mac import MACManager
-from pygoby.acomms.queue import QueueError, QueueManager
-from pygoby.acomms.route import RouteManager, bind_router
-from pygoby.acomms.signals import Signal
+from pygoby.acomms.queue import QueueManager
+from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
 from pygoby.dccl import Codec, DcclError
 from pygoby.protobuf import ProtoLoader
 from pygoby.util.clock import Clock
 from pygoby.util.modules import import_module_or_file
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
-Status = m.ModemDriverStatus
-DriverType = m.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type.values_by_name
+Status = acomms_pb.ModemDriverStatus
+DriverType = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type.values_by_name
 DRIVER_NONE = DriverType["DRIVER_NONE"].number
 
 # Built-in drivers: DriverType name -> "module:class" (imported when first used).
@@ -54,14 +55,11 @@ BUILTIN_DRIVERS = {
     "DRIVER_STORE_SERVER": "pygoby.acomms.drivers.store_server:StoreServerDriver",
 }
 PLUGINS_ENV = "PACOMMSHANDLER_PLUGINS"
+ROUTE_COMMAND = RouteCommand.DESCRIPTOR.full_name
 
 CONTINUALLY_RESTART_DRIVER = 1
 MOVE_LISTEN_DRIVER_TO_PRIMARY = 2
 DISABLE_AND_MOVE_LISTEN_DRIVER_TO_PRIMARY = 3
-
-
-class HandlerError(Exception):
-    """The configuration cannot be used, or a failure the handler cannot recover from."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -105,7 +103,7 @@ def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
     if cfg.driver_type == DRIVER_NONE:
         return None
     type_name = (
-        m.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"]
+        acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"]
         .enum_type.values_by_number[cfg.driver_type]
         .name
     )
@@ -140,7 +138,7 @@ class AcommsHandler:
         loader: ProtoLoader | None = None,
         driver_factory: Callable[[object, Clock], ModemDriverBase | None] = make_driver,
     ) -> None:
-        if cfg.modem_id == m.BROADCAST_ID:
+        if cfg.modem_id == acomms_pb.BROADCAST_ID:
             raise HandlerError("modem_id 0 is the broadcast address; set a modem_id of 1 or more")
         self.clock = clock
         self.modem_id = cfg.modem_id
@@ -154,18 +152,18 @@ class AcommsHandler:
         self.signal_raw_outgoing = Signal()
         self.signal_modem_receive = Signal()  # (ModemTransmission) received by the primary
         self.signal_modem_transmit = Signal()  # (ModemTransmission) transmit result
-        primary_cfg = m.DriverConfig()
+        primary_cfg = acomms_pb.DriverConfig()
         primary_cfg.CopyFrom(cfg.driver_cfg)
         if primary_cfg.WhichOneof("driver") is None and cfg.HasField("driver_type"):
             primary_cfg.driver_type = cfg.driver_type  # Goby 2 style top-level driver_type
         for index, driver_cfg in enumerate([primary_cfg, *cfg.listen_driver_cfg]):
-            own = m.DriverConfig()
+            own = acomms_pb.DriverConfig()
             own.CopyFrom(driver_cfg)
             if not own.HasField("modem_id"):
                 own.modem_id = self.modem_id
             try:
                 driver = driver_factory(own, clock)
-            except ModemDriverException as exc:
+            except ModemDriverError as exc:
                 raise HandlerError(f"driver configuration: {exc}") from None
             if driver is None:
                 continue
@@ -185,14 +183,14 @@ class AcommsHandler:
             log.warning("dccl_cfg.id_codec %r: custom id codecs are not supported; using the "
                         "default id codec", cfg.dccl_cfg.id_codec)  # fmt: skip
 
-        self.queue_cfg = m.QueueManagerConfig()
+        self.queue_cfg = acomms_pb.QueueManagerConfig()
         self.queue_cfg.CopyFrom(cfg.queue_cfg)
         self.queue_cfg.modem_id = self.modem_id
         self.queue = QueueManager(self.codec, clock)
         for slot in self.slots:
             bind(slot.driver, self.queue)
 
-        self.mac_cfg = m.MACConfig()
+        self.mac_cfg = acomms_pb.MACConfig()
         self.mac_cfg.CopyFrom(cfg.mac_cfg)
         self.mac_cfg.modem_id = self.modem_id
         self.mac = MACManager(clock)
@@ -209,7 +207,7 @@ class AcommsHandler:
         """Create one queue per `queue_cfg.message_entry` whose type `resolve` knows; the
         others are skipped (as upstream) and their names returned."""
         entries = list(self.queue_cfg.message_entry)
-        base = m.QueueManagerConfig()
+        base = acomms_pb.QueueManagerConfig()
         base.CopyFrom(self.queue_cfg)
         del base.message_entry[:]
         self.queue.set_cfg(base)
@@ -303,6 +301,12 @@ class AcommsHandler:
         self.router.set_route(route)
         log.info("route replaced: %s", list(route.hop))
 
+    def apply_route_command(self, message: Message) -> None:
+        """A RouteCommand received over the link replaces the route when routing is configured
+        (pAcommsHandler's rule); any other message is left alone."""
+        if message.DESCRIPTOR.full_name == ROUTE_COMMAND and self.route_cfg.route.hop:
+            self.replace_route(message.new_route)
+
     # ------------------------------------------------------------------ internals
     def _initiate_on_primary(self, transmission) -> None:
         if self.primary is None or not self.primary.running:
@@ -381,7 +385,7 @@ class AcommsHandler:
 
 
 def _status_of(exc: BaseException, default: int) -> int:
-    return exc.status if isinstance(exc, ModemDriverException) else default
+    return exc.status if isinstance(exc, ModemDriverError) else default
 
 
 def _name(slot: DriverSlot) -> str:

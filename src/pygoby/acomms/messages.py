@@ -40,6 +40,12 @@ def _cls(full_name: str):
     return _loader.message_class(full_name)
 
 
+def goby_message_class(full_name: str):
+    """pygoby's own messages a mission may name (MACUpdate, RouteCommand, NetworkAck, ...)."""
+    _loader.load_file("goby/acomms/protobuf/route.proto")
+    return _loader.message_class(full_name)
+
+
 def extension(full_name: str) -> FieldDescriptor:
     """An extension field by full name, for `msg.Extensions[...]`."""
     return _loader.pool.FindExtensionByName(full_name)

@@ -10,11 +10,9 @@ from __future__ import annotations
 
 import zlib
 
+from pygoby.acomms.errors import RudicsPacketError
+
 DEFAULT_RESERVED = b"\r"
-
-
-class RudicsPacketError(ValueError):
-    """A packet is too short or fails its CRC."""
 
 
 def _convert(data: bytes, source_base: int, sink_base: int) -> bytes:

@@ -12,10 +12,9 @@ from __future__ import annotations
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.moos.translator import TranslatorError, moos_technique_from_config, parse_for_moos
 from pygoby.netsim.client import NetSimClient, status_name
 from pygoby.netsim.navreporter import NavReporter
 
@@ -39,7 +38,6 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
             {p.modem_id: p.modem_tcp_port for p in cfg.modem_port},
             cfg.port_of_id_offset,
         )
-        self.technique = moos_technique_from_config(common)
         self.netsim = NetSimClient(cfg.manager_host, cfg.manager_port, on_response=self._answer)
         self.last_status: str | None = None
         names = {
@@ -48,7 +46,7 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
         }  # fmt: skip
         for var, name in names.items():
             self.subscribe(var, lambda msg, name=name: self._nav(name, msg))
-        self.subscribe(cfg.modem_receive_var, self._modem_receive)
+        self.subscribe_pb(cfg.modem_receive_var, acomms_pb.ModemTransmission, self._modem_receive)
         self.register_timer(cfg.nav_period, self.send_nav)
 
     async def start(self, connect_timeout: float | None = None) -> None:
@@ -70,13 +68,7 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
         if nav is not None:
             self.netsim.send_navs([nav])
 
-    def _modem_receive(self, msg: MOOSMessage) -> None:
-        transmission = m.ModemTransmission()
-        try:
-            parse_for_moos(msg.value, transmission, self.technique)
-        except TranslatorError as exc:
-            self.log.warning("cannot parse %s: %s", msg.key, exc)
-            return
+    def _modem_receive(self, transmission: Message) -> None:
         stats = self.reporter.receive_stats(transmission)
         if stats and self.netsim.send_stats(stats) is None:
             self.log.info("not connected to netsim_manager: %d receive stats dropped", len(stats))

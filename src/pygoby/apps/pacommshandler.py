@@ -15,36 +15,23 @@ from __future__ import annotations
 
 import base64
 import functools
-from pathlib import Path
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.acomms.queue import QueueError
 from pygoby.dccl import DcclError
+from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError
+from pygoby.moos.appconfig import prefixed_var_names
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.moos.translator import (
-    MoosValues,
-    TranslatorError,
-    parse_for_moos,
-    post_for_moos,
-)
+from pygoby.moos.translator import MoosValues, TranslatorError
 from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
-from pygoby.protobuf import ProtoLoader, default_loader
+from pygoby.protobuf import ProtoLoader
 
-ROUTE_COMMAND = "goby.acomms.protobuf.RouteCommand"
-ROUTE_PROTO = "goby/acomms/protobuf/route.proto"
-
-
-def _goby_message_class(name: str) -> type[Message]:
-    """pygoby's own messages a mission may name (MACUpdate, RouteCommand, NetworkAck, ...)."""
-    goby = default_loader()
-    goby.load_file(ROUTE_PROTO)
-    return goby.message_class(name)
+IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
 
 
 def _raw_value(raw: bytes) -> str | bytes:
@@ -65,10 +52,8 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def __init__(self, cfg: Message, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
-        names = cfg.moos_var
-        self.var = {f.name: names.prefix + getattr(names, f.name)
-                    for f in names.DESCRIPTOR.fields if f.name not in ("prefix", "ifrontseat_data_out")}  # fmt: skip
-        self.ifs_data_out = names.ifrontseat_data_out
+        self.var = prefixed_var_names(cfg.moos_var, skip=(IFS_DATA_OUT,))
+        self.ifs_data_out = getattr(cfg.moos_var, IFS_DATA_OUT)
         self.loader = ProtoLoader()
         try:
             self.acomms = AcommsHandler(cfg, self.clock, self.loader)
@@ -77,50 +62,45 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
-        self._message_class = MessageTypes(
-            [self._find(path) for path in cfg.load_proto_file],
-            [self._find(module) for module in cfg.load_shared_library],
-            fallback=_goby_message_class,
+        self.message_types = MessageTypes(
+            [self.find_file(path) for path in cfg.load_proto_file],
+            [self.find_file(module) for module in cfg.load_shared_library],
+            fallback=acomms_pb.goby_message_class,
             loader=self.loader,
         )
+        lookup = cfg.modem_id_lookup_path
         self.binding = TranslatorBinding(
-            self,
-            cfg.translator_entry,
-            self._message_class,
-            on_created=self._push,
+            self, cfg.translator_entry, self.message_types, on_created=self._push,
             multiplex_vars=cfg.multiplex_create_moos_var,
-            modem_id_lookup_path=self._find(cfg.modem_id_lookup_path)
-            if cfg.modem_id_lookup_path
-            else "",
-        )
+            modem_id_lookup_path=self.find_file(lookup) if lookup else "",
+        )  # fmt: skip
         self.translator = self.binding.translator
-        self.moos_technique = self.binding.moos_technique
         self._connect_signals()
+        self._configure_queue()
+        self._subscribe_all()
+        self.frontseat_forward = {self._loaded(name) for name in cfg.dccl_frontseat_forward_name}
+        self.liaison = None
+        if cfg.HasField("liaison"):
+            from pygoby.apps.liaison import Liaison  # imported only when asked for (web stack)
+
+            self.liaison = Liaison.embedded(self)
+
+    def _configure_queue(self) -> None:
         try:
-            skipped = self.acomms.configure_queue(self._message_class)
+            skipped = self.acomms.configure_queue(self.message_types)
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         for name in skipped:
             self.log.debug("queue_cfg: no queue for %s (type not loaded)", name)
-        self._subscribe_all()
-        self.frontseat_forward = set()
-        for name in cfg.dccl_frontseat_forward_name:
-            try:
-                self._message_class(name)
-            except Exception:
-                raise ConfigError(
-                    f"dccl_frontseat_forward_name {name!r} is not a loaded type"
-                ) from None
-            self.frontseat_forward.add(name)
 
-    def _find(self, path: str) -> str:
-        """A relative path that does not exist from the working directory is looked up next to
-        the mission file (so that missions can be run from anywhere)."""
-        given = Path(path)
-        if given.is_absolute() or given.exists() or self.mission is None or not self.mission.path:
-            return path
-        beside = Path(self.mission.path).parent / given
-        return str(beside) if beside.exists() else path
+    def _loaded(self, name: str) -> str:
+        try:
+            self.message_types(name)
+        except Exception:
+            raise ConfigError(
+                f"dccl_frontseat_forward_name {name!r} is not a loaded type"
+            ) from None
+        return name
 
     # ------------------------------------------------------------------ wiring
     def _connect_signals(self) -> None:
@@ -128,47 +108,33 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         work, so a failing slot is logged and contained (it must not look like a driver
         failure or break a slot)."""
         acomms, queue, mac = self.acomms, self.acomms.queue, self.acomms.mac
-        post = self._post_pb
         connections = [
             (acomms.signal_raw_incoming, functools.partial(self._post_raw, True)),
             (acomms.signal_raw_outgoing, functools.partial(self._post_raw, False)),
-            (acomms.signal_modem_receive, functools.partial(post, "driver_receive")),
-            (acomms.signal_modem_transmit, functools.partial(post, "driver_transmit")),
-            (
-                mac.signal_initiate_transmission,
-                functools.partial(post, "mac_initiate_transmission"),
-            ),
-            (mac.signal_slot_start, functools.partial(post, "mac_slot_start")),
+            (acomms.signal_modem_receive, self._poster("driver_receive")),
+            (acomms.signal_modem_transmit, self._poster("driver_transmit")),
+            (mac.signal_initiate_transmission, self._poster("mac_initiate_transmission")),
+            (mac.signal_slot_start, self._poster("mac_slot_start")),
             (queue.signal_receive, self._on_queue_receive),
             (queue.signal_ack, self._on_ack),
-            (queue.signal_expire, functools.partial(post, "queue_expire")),
-            (queue.signal_queue_size_change, functools.partial(post, "queue_size")),
+            (queue.signal_expire, self._poster("queue_expire")),
+            (queue.signal_queue_size_change, self._poster("queue_size")),
             (queue.signal_data_on_demand, self._on_data_on_demand),
         ]
         for signal, slot in connections:
-            signal.connect(self._contained(slot))
-
-    def _contained(self, slot):
-        def run(*args) -> None:
-            try:
-                slot(*args)
-            except Exception:
-                self.log.exception("pAcommsHandler failed to handle an acomms event")
-
-        return run
+            signal.connect(slot, contain_errors=True, logger=self.log)
 
     def _subscribe_all(self) -> None:
-        handlers = {
-            "driver_receive": self._on_external_receive,
-            "mac_initiate_transmission": self._on_external_initiate,
-            "mac_cycle_update": self._on_mac_update,
-            "queue_flush": self._on_flush,
-            "config_file_request": self._on_config_request,
-            "driver_reset": self._on_driver_reset,
-            "driver_cfg_update": self._on_driver_cfg_update,
-        }
-        for key, handler in handlers.items():
-            self.subscribe(self.var[key], handler)
+        acomms = self.acomms
+        from_others = {"driver_receive": acomms.inject_receive,
+                       "mac_initiate_transmission": acomms.initiate_transmission}  # fmt: skip
+        for key, handler in from_others.items():
+            self.subscribe_pb(self.var[key], acomms_pb.ModemTransmission, handler, ignore_own=True)
+        self.subscribe_pb(self.var["mac_cycle_update"], acomms_pb.MACUpdate, acomms.apply_mac_update)
+        self.subscribe_pb(self.var["queue_flush"], acomms_pb.QueueFlush, self.queue.flush_queue)
+        self.subscribe(self.var["config_file_request"], self._on_config_request)
+        self.subscribe(self.var["driver_reset"], self._on_driver_reset)
+        self.subscribe_pb(self.var["driver_cfg_update"], acomms_pb.DriverConfig, acomms.update_driver_cfg)
         self.binding.subscribe_all()
 
     # ------------------------------------------------------------------ running
@@ -179,10 +145,23 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
     def on_stop(self) -> None:
         self.acomms.shutdown()
 
+    async def start(self, connect_timeout: float | None = None) -> None:
+        await super().start(connect_timeout)
+        if self.liaison is not None:
+            await self.liaison.start()
+
+    async def stop(self) -> None:
+        if self.liaison is not None:
+            await self.liaison.stop()
+        await super().stop()
+
     def loop(self) -> None:
         self.binding.tick(self.clock.now())
+        self._stop_on_failure(self.acomms.do_work)
+
+    def _stop_on_failure(self, work) -> None:
         try:
-            self.acomms.do_work()
+            work()
         except HandlerError as err:
             self.log.critical("%s; stopping", err)
             self.request_stop()
@@ -205,78 +184,45 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             return
         self._push(created)
 
-    def _parse(self, msg: MOOSMessage, cls: type[Message]) -> Message | None:
-        out = cls()
-        try:
-            parse_for_moos(msg.value, out, self.moos_technique)
-        except TranslatorError as err:
-            self.log.warning("cannot parse %s as %s: %s", msg.key, cls.DESCRIPTOR.full_name, err)
-            return None
-        return out
-
-    def _from_others(self, msg: MOOSMessage) -> bool:
-        return msg.src != self.name
-
-    def _on_external_receive(self, msg: MOOSMessage) -> None:
-        if self._from_others(msg) and (transmission := self._parse(msg, m.ModemTransmission)):
-            self.acomms.inject_receive(transmission)
-
-    def _on_external_initiate(self, msg: MOOSMessage) -> None:
-        if self._from_others(msg) and (transmission := self._parse(msg, m.ModemTransmission)):
-            self.acomms.initiate_transmission(transmission)
-
-    def _on_mac_update(self, msg: MOOSMessage) -> None:
-        if (update := self._parse(msg, m.MACUpdate)) is not None:
-            self.acomms.apply_mac_update(update)
-
-    def _on_flush(self, msg: MOOSMessage) -> None:
-        if (flush := self._parse(msg, m.QueueFlush)) is not None:
-            self.queue.flush_queue(flush)
-
     def _on_config_request(self, msg: MOOSMessage) -> None:
         self.publish(
             self.var["config_file"], base64.b64encode(self.cfg.SerializeToString()).decode()
         )
 
     def _on_driver_reset(self, msg: MOOSMessage) -> None:
-        try:
-            self.acomms.reset_primary()
-        except HandlerError as err:
-            self.log.critical("%s; stopping", err)
-            self.request_stop()
-
-    def _on_driver_cfg_update(self, msg: MOOSMessage) -> None:
-        if (cfg := self._parse(msg, m.DriverConfig)) is not None:
-            self.acomms.update_driver_cfg(cfg)
+        self._stop_on_failure(self.acomms.reset_primary)
 
     # ------------------------------------------------------------------ acomms -> MOOS
-    def _post_pb(self, key: str, message: Message) -> None:
-        self.binding.post([post_for_moos(self.var[key], message, self.moos_technique)])
+    def _poster(self, key: str):
+        return functools.partial(self.publish_pb, self.var[key])
 
     def _post_raw(self, incoming: bool, raw) -> None:
         self.publish(
             self.var["driver_raw_in" if incoming else "driver_raw_out"], _raw_value(raw.raw)
         )
-        self._post_pb("driver_raw_msg_in" if incoming else "driver_raw_msg_out", raw)
+        self.publish_pb(self.var["driver_raw_msg_in" if incoming else "driver_raw_msg_out"], raw)
 
     def _on_ack(self, ack, original: Message) -> None:
-        self._post_pb("queue_ack_transmission", ack)
-        self._post_pb("queue_ack_original_msg", original)
+        self.publish_pb(self.var["queue_ack_transmission"], ack)
+        self.publish_pb(self.var["queue_ack_original_msg"], original)
 
     def _on_queue_receive(self, message: Message) -> None:
         name = message.DESCRIPTOR.full_name
         self.binding.publish(message)
         if name in self.frontseat_forward:
-            try:
-                data = self.acomms.codec.encode(message)
-            except DcclError as err:
-                self.log.warning("cannot forward %s to the frontseat: %s", name, err)
-            else:
-                self.binding.post([post_for_moos(self.ifs_data_out, InterfaceData(dccl_message=data),
-                                          self.moos_technique)])  # fmt: skip
-        if name == ROUTE_COMMAND and self.acomms.route_cfg.route.hop:
-            self.acomms.replace_route(message.new_route)
-        self._post_pb("queue_receive", message)
+            self._forward_to_frontseat(message)
+        self.acomms.apply_route_command(message)
+        self.publish_pb(self.var["queue_receive"], message)
+
+    def _forward_to_frontseat(self, message: Message) -> None:
+        """`dccl_frontseat_forward_name`: the message's DCCL bytes to iFrontSeat."""
+        name = message.DESCRIPTOR.full_name
+        try:
+            data = self.acomms.codec.encode(message)
+        except DcclError as err:
+            self.log.warning("cannot forward %s to the frontseat: %s", name, err)
+        else:
+            self.publish_pb(self.ifs_data_out, InterfaceData(dccl_message=data))
 
 
 def main(argv=None) -> int:

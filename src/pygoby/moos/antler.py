@@ -20,7 +20,8 @@ import sys
 import time
 from pathlib import Path
 
-from pygoby.moos.moosfile import AntlerRun, MissionFile, MissionFileError
+from pygoby.moos.errors import MissionFileError
+from pygoby.moos.moosfile import AntlerRun, MissionFile
 from pygoby.moos.protocol import DEFAULT_PORT
 
 log = logging.getLogger(__name__)

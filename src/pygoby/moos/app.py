@@ -33,7 +33,7 @@ Writing an application
 
 The base provides
 -----------------
-* `cls.main(argv=None) -> int`: the command line `APP [options] mission.moos [moos_name]`
+* `cls.main(argv=None) -> int`: the command line (pygoby.moos.appcli) `APP [options] mission.moos [moos_name]`
   (also `-c/--moos_file`, `-a/--moos_name`, `-e/--example_config`, `-V/--version`,
   `--<field> <value>` for any top-level config field). A configuration error prints one
   clear message naming the file line and the field and exits 1 before connecting.
@@ -50,8 +50,15 @@ The base provides
   handler)`, `publish(var, value, src_aux="", time=None)` (queued while disconnected, sent on
   reconnect), `register_timer(period, callback)` (fires on multiples of `period` since the
   epoch, checked each tick), `dynamic_vars` (newest message per variable), `start_time`,
-  `log` (a logging.Logger; terminal at `common.verbosity`, file log per `common.log`),
-  `cfg` / `common`, `client` (the MOOSClient), `moos_time()`.
+  `log` (a logging.Logger; terminal at `common.verbosity`, file log per `common.log`,
+  see pygoby.moos.applog), `cfg` / `common`, `client` (the MOOSClient), `moos_time()`.
+* Protobuf messages on MOOS variables in the app-internal technique (`moos_technique`, from
+  `common.moos_parser_technique` / `use_binary_protobuf`; `@PB[type] ...` by default):
+  `publish_pb(var, message)`, `parse_pb(msg, cls)` (None, with a warning, when the value does
+  not parse) and `subscribe_pb(var, cls, handler, ignore_own=False)` (`handler(message)` for
+  each value that parses).
+* `find_file(path)`: a relative path from the configuration, looked up next to the mission
+  file when it does not exist from the working directory.
 * Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`.
 * `exit_status`: what `main` returns once the app has stopped (0; an app that stops itself on a
   fatal error sets it, then calls `request_stop()`).
@@ -59,51 +66,44 @@ The base provides
   subscription's handler (`ignore_stale = True`, Goby's rule; snapshots of old values
   therefore do not trigger handlers). Pattern handlers always run.
 * On every (re)connect the client re-subscribes, then `common.initializer` entries are posted.
+* Every couple of seconds `<NAME>_STATUS` (pygoby.moos.appstatus) is posted.
 """
 
 from __future__ import annotations
 
-import argparse
 import asyncio
 import contextlib
 import logging
 import math
 import os
-import resource
-import sys
-import time as _time
 from collections.abc import Callable, Sequence
-from pathlib import Path
 from typing import ClassVar
 
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
+from pygoby.moos import appcli
 from pygoby.moos import protocol as p
-from pygoby.moos.appconfig import ConfigError, example_config, read_configuration
+from pygoby.moos.appconfig import example_config, initializer_posts, read_configuration
+from pygoby.moos.applog import AppLogHandlers
+from pygoby.moos.appstatus import StatusReport
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.timewarp import clock_warp, moos_clock
+from pygoby.moos.translator import (
+    Technique,
+    TranslatorError,
+    moos_technique_from_config,
+    parse_for_moos,
+    post_for_moos,
+)
 from pygoby.protobuf import builtin_class
 from pygoby.util.clock import Clock
 
 Handler = Callable[[MOOSMessage], None]
 
-STATUS_PERIOD = 2.0
-# goby.util.protobuf.GLogConfig.Verbosity -> logging level
-VERBOSITY_LEVELS = {1: logging.CRITICAL + 10, 2: logging.WARNING, 4: logging.INFO,
-                    5: logging.DEBUG, 6: logging.DEBUG, 7: logging.DEBUG}  # fmt: skip
-
 COMMON_PROTO = ("goby/moos/protobuf/goby_moos_app.proto", "goby.moos.protobuf.GobyMOOSAppConfig")
-
-
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("pygoby")
-    except PackageNotFoundError:
-        return "unknown"
 
 
 class _Timer:
@@ -119,6 +119,13 @@ class _Timer:
             return False
         self.next = (math.floor(now / self.period) + 1) * self.period
         return True
+
+
+def _app_technique(common: Message) -> Technique:
+    try:
+        return moos_technique_from_config(common)
+    except TranslatorError as err:
+        raise ConfigError(str(err)) from None
 
 
 class GobyMOOSApp:
@@ -163,6 +170,11 @@ class GobyMOOSApp:
     def example_config(cls, name: str | None = None) -> str:
         return example_config(cls.load_config_class(), name or cls.default_name or cls.__name__)
 
+    @classmethod
+    def main(cls, argv: Sequence[str] | None = None, prog: str | None = None) -> int:
+        """Run the app from the command line (pygoby.moos.appcli); returns the exit status."""
+        return appcli.run_app(cls, argv, prog)
+
     # -- construction --------------------------------------------------------------------------
 
     def __init__(
@@ -179,6 +191,7 @@ class GobyMOOSApp:
         self.common = cfg.common  # type: ignore[attr-defined]
         self.name = name or self.default_name or type(self).__name__
         self.mission = mission
+        self.moos_technique = _app_technique(self.common)
         warp = float(self.common.time_warp_multiplier or 1)
         self.clock = clock or moos_clock(warp)
         if host is None:
@@ -186,8 +199,8 @@ class GobyMOOSApp:
         if port is None:
             port = self.common.server_port if self.common.HasField("server_port") else p.DEFAULT_PORT
         self.client = MOOSClient(self.name, host, port, clock=self.clock, on_message=self._on_mail)
-        self.client.on_connect.append(self._connected)
-        self.client.on_disconnect.append(self._disconnected)
+        self.client.signal_connect.connect(self._connected)
+        self.client.signal_disconnect.connect(self._disconnected)
         self.log = logging.getLogger(f"pygoby.app.{self.name}")
         self.start_time = self.clock.now()
         self.dynamic_vars: dict[str, MOOSMessage] = {}
@@ -199,9 +212,8 @@ class GobyMOOSApp:
         self._task: asyncio.Task[None] | None = None
         self._stop_requested: asyncio.Event | None = None
         self._stopping = False  # a disconnect during stop() is expected, not a lost connection
-        self._log_handlers: list[logging.Handler] = []
-        self._last_status = -math.inf
-        self._last_cpu = (_time.process_time(), _time.monotonic())
+        self._log_handlers: AppLogHandlers | None = None
+        self._status = StatusReport()
         self.iterations = 0
         self.exit_status = 0
 
@@ -251,12 +263,52 @@ class GobyMOOSApp:
     def connected(self) -> bool:
         return self.client.connected
 
+    def find_file(self, path: str) -> str:
+        """`path` from the configuration, looked up next to the mission file when it is relative
+        and does not exist from the working directory (MissionFile.find_file)."""
+        return self.mission.find_file(path) if self.mission is not None else path
+
+    # -- protobuf messages on MOOS variables (the app-internal technique) ----------------------
+
+    def publish_pb(self, var: str, message: Message) -> None:
+        post = post_for_moos(var, message, self.moos_technique)
+        self.publish(post.var, post.value, src_aux=post.source_aux)
+
+    def parse_pb(self, msg: MOOSMessage, cls: type[Message]) -> Message | None:
+        """`msg`'s value as a `cls` message; None, with a warning, when it does not parse."""
+        out = cls()
+        try:
+            parse_for_moos(msg.value, out, self.moos_technique)
+        except TranslatorError as err:
+            self.log.warning("cannot parse %s as %s: %s", msg.key, cls.DESCRIPTOR.full_name, err)
+            return None
+        return out
+
+    def subscribe_pb(
+        self,
+        var: str,
+        cls: type[Message],
+        handler: Callable[[Message], None],
+        *,
+        ignore_own: bool = False,
+    ) -> None:
+        """`handler(message)` for each post of `var` that parses as `cls` (with `ignore_own`,
+        not for this app's own posts)."""
+
+        def on_mail(msg: MOOSMessage) -> None:
+            if ignore_own and msg.src == self.name:
+                return
+            if (message := self.parse_pb(msg, cls)) is not None:
+                handler(message)
+
+        self.subscribe(var, on_mail)
+
     # -- running -------------------------------------------------------------------------------
 
     async def start(self, connect_timeout: float | None = None) -> None:
         """Start logging, the comms and the tick loop. With `connect_timeout`, wait for the
         first connection (TimeoutError otherwise); without, carry on and keep trying."""
-        self._setup_logging()
+        self._log_handlers = AppLogHandlers.open(self.log, self.name, self.common)
         self._stop_requested = asyncio.Event()
         self._stopping = False
         self.start_time = self.clock.now()
@@ -277,7 +329,9 @@ class GobyMOOSApp:
         with contextlib.suppress(Exception):
             await self.client.flush(timeout=1.0)
         await self.client.close()
-        self._teardown_logging()
+        if self._log_handlers is not None:
+            self._log_handlers.close()
+            self._log_handlers = None
 
     def request_stop(self) -> None:
         if self._stop_requested is not None:
@@ -298,10 +352,7 @@ class GobyMOOSApp:
     async def __aexit__(self, *exc: object) -> None:
         await self.stop()
 
-    # -- internals -----------------------------------------------------------------------------
-
-    def _on_mail(self, msg: MOOSMessage) -> None:
-        self._mail.append(msg)
+    # -- connection events ---------------------------------------------------------------------
 
     def _connected(self) -> None:
         self._post_initializers()
@@ -321,51 +372,41 @@ class GobyMOOSApp:
             self.log.exception("on_disconnect failed")
 
     def _post_initializers(self) -> None:
-        kinds = type(self.common).Initializer
-        for ini in self.common.initializer:
-            if ini.HasField("global_cfg_var"):
-                mission = self.mission
-                raw = mission.get_value(ini.global_cfg_var, outside_blocks=True) if mission else None
-                if raw is None:
-                    self.log.warning("initializer: global %s not found; %s not posted",
-                                     ini.global_cfg_var, ini.moos_var)  # fmt: skip
-                    continue
-                if ini.type == kinds.INI_DOUBLE:
-                    try:
-                        value: p.Value = float(raw)
-                    except ValueError:
-                        value = math.nan
-                else:
-                    value = raw.strip() if ini.trim else raw
-            elif ini.type == kinds.INI_DOUBLE:
-                value = ini.dval
-            else:
-                value = ini.sval.strip() if ini.trim else ini.sval
-            self.publish(ini.moos_var, value)
+        for var, value in initializer_posts(self.common, self.mission, self.log):
+            self.publish(var, value)
+
+    # -- mail ----------------------------------------------------------------------------------
+
+    def _on_mail(self, msg: MOOSMessage) -> None:
+        self._mail.append(msg)
 
     def _handle_mail(self) -> None:
         mail, self._mail = self._mail, []
         mail.sort(key=lambda m: m.time)  # CMOOSApp's SortMailByTime
         for msg in mail:
-            if msg.msg_type != p.NOTIFY:
-                continue
-            self.dynamic_vars[msg.key] = msg
-            handlers = self._handlers.get(msg.key, ())
-            if handlers and self.ignore_stale and msg.time < self.start_time:
-                self.log.warning("ignoring stale message %s (time %.3f before the app started)",
-                                 msg.key, msg.time)  # fmt: skip
-            else:
-                for handler in handlers:
-                    self._call(handler, msg)
-            for var_pattern, app_pattern, handler in self._pattern_handlers:
-                if p.wildcard_match(var_pattern, msg.key) and p.wildcard_match(app_pattern, msg.src):
-                    self._call(handler, msg)
+            if msg.msg_type == p.NOTIFY:
+                self._dispatch(msg)
+
+    def _dispatch(self, msg: MOOSMessage) -> None:
+        self.dynamic_vars[msg.key] = msg
+        handlers = self._handlers.get(msg.key, ())
+        if handlers and self.ignore_stale and msg.time < self.start_time:
+            self.log.warning("ignoring stale message %s (time %.3f before the app started)",
+                             msg.key, msg.time)  # fmt: skip
+        else:
+            for handler in handlers:
+                self._call(handler, msg)
+        for var_pattern, app_pattern, handler in self._pattern_handlers:
+            if p.wildcard_match(var_pattern, msg.key) and p.wildcard_match(app_pattern, msg.src):
+                self._call(handler, msg)
 
     def _call(self, handler: Handler, msg: MOOSMessage) -> None:
         try:
             handler(msg)
         except Exception:
             self.log.exception("handler for %s failed", msg.key)
+
+    # -- ticks ---------------------------------------------------------------------------------
 
     async def _tick_loop(self) -> None:
         loop = asyncio.get_running_loop()
@@ -378,158 +419,33 @@ class GobyMOOSApp:
             await asyncio.sleep(max(next_tick - loop.time(), 0.0))
             if loop.time() - next_tick > 10 * max(period, 0.001):
                 next_tick = loop.time()  # fell far behind: do not try to catch up
-            self._handle_mail()
-            if not self.client.connected:
-                continue
-            self._post_status()
-            try:
-                self.loop()
-            except Exception:
-                self.log.exception("loop() failed")
-            self.iterations += 1
-            now = self.clock.now()
-            for timer in self._timers:
-                if timer.due(now):
-                    try:
-                        timer.callback()
-                    except Exception:
-                        self.log.exception("timer callback failed")
+            self._tick()
+
+    def _tick(self) -> None:
+        self._handle_mail()
+        if not self.client.connected:
+            return
+        self._post_status()
+        try:
+            self.loop()
+        except Exception:
+            self.log.exception("loop() failed")
+        self.iterations += 1
+        self._run_timers(self.clock.now())
+
+    def _run_timers(self, now: float) -> None:
+        for timer in self._timers:
+            if timer.due(now):
+                try:
+                    timer.callback()
+                except Exception:
+                    self.log.exception("timer callback failed")
 
     def _post_status(self) -> None:
         now = self.clock.now()
-        if now - self._last_status < STATUS_PERIOD:
+        if not self._status.due(now):
             return
-        self._last_status = now
-        usage = resource.getrusage(resource.RUSAGE_SELF)
-        cpu_now, wall_now = _time.process_time(), _time.monotonic()
-        cpu = 100.0 * (cpu_now - self._last_cpu[0]) / max(wall_now - self._last_cpu[1], 1e-6)
-        self._last_cpu = (cpu_now, wall_now)
-        subscribed = "".join(f"{v}," for v in sorted(self.client.subscriptions))
-        published = "".join(f"{v}," for v in sorted(self._published))
-        status = (f"AppErrorFlag=false,Uptime={now - self.start_time:g},cpuload={cpu:.4g},"
-                  f"memory_kb={usage.ru_maxrss},memory_max_kb={usage.ru_maxrss:.4g},"
-                  f'MOOSName={self.name},Publishing="{published}",Subscribing="{subscribed}"')  # fmt: skip
+        status = self._status.line(
+            self.name, now - self.start_time, self._published, self.client.subscriptions
+        )
         self.client.publish(f"{self.name.upper()}_STATUS", status)
-
-    # -- logging (spec 2.8) --------------------------------------------------------------------
-
-    def _setup_logging(self) -> None:
-        common = self.common
-        self.log.setLevel(logging.DEBUG)
-        self.log.propagate = False
-        terminal = logging.StreamHandler(sys.stdout)
-        terminal.setLevel(VERBOSITY_LEVELS.get(common.verbosity, logging.INFO))
-        terminal.setFormatter(logging.Formatter(f"{self.name} [%(asctime)s]: %(message)s"))
-        self._log_handlers.append(terminal)
-        if common.log:
-            path = self._open_log_file()
-            if path is not None:
-                handler = logging.FileHandler(path)
-                handler.setLevel(VERBOSITY_LEVELS.get(common.log_verbosity, logging.DEBUG))
-                handler.setFormatter(logging.Formatter("[ %(asctime)s ] {%(levelname)s}: %(message)s"))
-                self._log_handlers.append(handler)
-        for handler in self._log_handlers:
-            self.log.addHandler(handler)
-            logging.getLogger("pygoby.moos").addHandler(handler)
-
-    def _open_log_file(self) -> Path | None:
-        common = self.common
-        base = f"{self.name.replace('/', '_')}_{common.community}"
-        stamp = "" if common.log_omit_file_timestamp else "_" + _time.strftime("%Y%m%dT%H%M%S", _time.gmtime())
-        for directory in (Path(common.log_path), Path(".")):
-            path = directory / f"{base}{stamp}.txt"
-            try:
-                path.touch()
-            except OSError:
-                self.log.warning("cannot write a log file in %s; trying ./", directory)
-                continue
-            if not common.log_omit_latest_symlink and stamp:
-                latest = directory / f"{base}_latest.txt"
-                with contextlib.suppress(OSError):
-                    latest.unlink(missing_ok=True)
-                    latest.symlink_to(path.name)
-            return path
-        raise ConfigError(f"cannot open a log file in {common.log_path} or ./")
-
-    def _teardown_logging(self) -> None:
-        for handler in self._log_handlers:
-            self.log.removeHandler(handler)
-            logging.getLogger("pygoby.moos").removeHandler(handler)
-            handler.close()
-        self._log_handlers = []
-
-    # -- command line (spec 2.1) ---------------------------------------------------------------
-
-    @classmethod
-    def _program_name(cls, argv0: str) -> str:
-        base = Path(argv0).name
-        if not base or base.endswith(".py") or base in ("python", "python3", "-c"):
-            return cls.default_name or cls.__name__
-        return base
-
-    @classmethod
-    def main(cls, argv: Sequence[str] | None = None, prog: str | None = None) -> int:
-        """Run the app from the command line; returns the exit status."""
-        args_in = list(sys.argv[1:] if argv is None else argv)
-        program = prog or cls._program_name(sys.argv[0] if argv is None else "")
-        parser = argparse.ArgumentParser(prog=program, description=f"{program}: a Goby MOOS application")
-        parser.add_argument("mission", nargs="?", help=".moos mission file")
-        parser.add_argument("alias", nargs="?", help="name to use with the MOOSDB and ProcessConfig")
-        parser.add_argument("-c", "--moos_file", help="same as the mission positional")
-        parser.add_argument("-a", "--moos_name", help="same as the alias positional")
-        parser.add_argument("-e", "--example_config", action="store_true", help="print an example ProcessConfig block and exit")
-        parser.add_argument("-V", "--version", action="version", version=f"%(prog)s {_version()}")
-        known, rest = parser.parse_known_args(args_in)
-        name = known.moos_name or known.alias or program
-        if known.example_config:
-            sys.stdout.write(cls.example_config(name))
-            return 0
-        try:
-            overrides = _parse_overrides(rest)
-        except ValueError as err:
-            parser.error(str(err))
-        mission_path = known.moos_file or known.mission
-        mission = None
-        if mission_path:
-            try:
-                mission = MissionFile.read(mission_path)
-            except OSError as err:
-                print(f"{name}: warning: cannot open mission file {mission_path}: {err.strerror}", file=sys.stderr)
-        try:
-            cfg = cls.read_config(mission, name, overrides)
-            app = cls(cfg, name=name, mission=mission)
-        except ConfigError as err:
-            print(f"{name}: fatal configuration error: {err}", file=sys.stderr)
-            return 1
-        return _run_until_signal(app)
-
-
-def _parse_overrides(rest: list[str]) -> list[tuple[str, str]]:
-    out = []
-    items = iter(rest)
-    for item in items:
-        if not item.startswith("--"):
-            raise ValueError(f"unexpected argument {item!r}")
-        key, eq, value = item[2:].partition("=")
-        if not eq:
-            value = next(items, None)
-            if value is None:
-                raise ValueError(f"option --{key} needs a value")
-        out.append((key, value))
-    return out
-
-
-def _run_until_signal(app: GobyMOOSApp) -> int:
-    import signal
-
-    async def runner() -> None:
-        loop = asyncio.get_running_loop()
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            loop.add_signal_handler(sig, app.request_stop)
-        await app.run()
-
-    try:
-        asyncio.run(runner())
-    except KeyboardInterrupt:
-        return 130
-    return app.exit_status

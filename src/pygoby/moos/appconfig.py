@@ -1,10 +1,13 @@
 """Goby MOOS application configuration (spec goby-moos-apps.md 2.2-2.5), sans I/O.
 
 * `read_configuration(config_class, mission, app_name, overrides)`: the app's ProcessConfig block
-  parsed as protobuf TextFormat (errors name the file line and the field), then the MOOS globals
+  parsed as protobuf TextFormat, then the MOOS globals
   named by `(goby.field).moos_global` options, then command-line overrides, then the check for
-  required fields.
+  required fields. Every problem is a `pygoby.errors.ConfigError` naming the file, the line
+  and the field where they are known.
 * `example_config(config_class, app_name)`: the `--example_config` text.
+* `initializer_posts(common, mission)`: what `common.initializer` posts on every connect.
+* `prefixed_var_names(moos_var)`: an app's `moos_var { prefix: ... }` block as full names.
 * `goby_field_options(field)`: a field's `(goby.field)` options (description, example,
   moos_global, cfg.action), read from its serialized options so that it works for classes from
   any descriptor pool.
@@ -14,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import math
 import re
 from collections.abc import Callable, Sequence
 
@@ -21,6 +25,7 @@ from google.protobuf import text_format
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.moos.moosfile import MissionFile, parse_number
 from pygoby.protobuf import builtin_class
 
@@ -30,10 +35,6 @@ GOBY_FIELD_EXTENSION = 1009
 EXAMPLE_WIDTH = 66
 EXAMPLE_MIN_WIDTH = 20
 EXAMPLE_FALLBACK_INDENT = 46
-
-
-class ConfigError(Exception):
-    """The configuration could not be read; the message says where and why."""
 
 
 @functools.cache
@@ -94,7 +95,7 @@ def parse_block(config: Message, text: str, first_line: int, source: str) -> Non
     except text_format.ParseError as err:
         line, column = err.GetLine(), err.GetColumn()
         if line is None:
-            raise ConfigError(f"{source}: {err}") from None
+            raise ConfigError(str(err), file=source) from None
         lines = text.splitlines()
         line_text = lines[line - 1] if 0 < line <= len(lines) else ""
         detail = str(err).split(" : ", 1)[-1]
@@ -104,7 +105,7 @@ def parse_block(config: Message, text: str, first_line: int, source: str) -> Non
         field = _field_near(line_text, column or 0)
         where = f' in field "{field}"' if field and field not in detail else ""
         raise ConfigError(
-            f"{source}:{first_line + line - 1}: {detail}{where}\n    {line_text.strip()}"
+            f"{detail}{where}\n    {line_text.strip()}", file=source, line=first_line + line - 1
         ) from None
 
 
@@ -148,7 +149,9 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
     elif kind == FieldDescriptor.TYPE_ENUM:
         enum_value = field.enum_type.values_by_name.get(value)
         if enum_value is None:
-            raise ConfigError(f'invalid enumeration "{value}" for {field.name} (MOOS global {name})')
+            raise ConfigError(
+                f'invalid enumeration "{value}" (MOOS global {name})', field=field.name
+            )
         setattr(config, field.name, enum_value.number)
     elif kind in (FieldDescriptor.TYPE_DOUBLE, FieldDescriptor.TYPE_FLOAT):
         if (number := parse_number(value)) is not None:
@@ -157,7 +160,9 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
         try:
             setattr(config, field.name, int(number))
         except ValueError:
-            raise ConfigError(f"MOOS global {name}={value} is out of range for {field.name}") from None
+            raise ConfigError(
+                f"MOOS global {name}={value} is out of range", field=field.name
+            ) from None
 
 
 def apply_overrides(config: Message, overrides: Sequence[tuple[str, str]]) -> None:
@@ -166,7 +171,7 @@ def apply_overrides(config: Message, overrides: Sequence[tuple[str, str]]) -> No
     for name, value in overrides:
         field = config.DESCRIPTOR.fields_by_name.get(name)
         if field is None:
-            raise ConfigError(f"unknown option --{name}")
+            raise ConfigError(f"unknown option --{name}", file="command line")
         if field.type == FieldDescriptor.TYPE_MESSAGE:
             text = f"{name} {{ {value} }}"
         elif field.type == FieldDescriptor.TYPE_STRING:
@@ -196,9 +201,12 @@ def read_configuration(
     if mission is not None:
         block = mission.goby_block(app_name)
         if block is None:
-            raise ConfigError(f"no ProcessConfig block for {app_name} in {source}")
+            raise ConfigError(f"no ProcessConfig block for {app_name}", file=source)
         parse_block(config, block.text, block.first_line, source)
-        apply_moos_globals(config, mission)
+        try:
+            apply_moos_globals(config, mission)
+        except ConfigError as err:
+            raise err.located(file=source) from None
     apply_overrides(config, overrides)
     if complete is not None:
         complete(config)
@@ -301,3 +309,48 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
 def example_config(config_class: type[Message], app_name: str) -> str:
     lines = [f"ProcessConfig = {app_name}", "{", *_describe_fields(config_class.DESCRIPTOR, 1), "}"]
     return "\n".join(lines) + "\n"
+
+
+def initializer_posts(
+    common: Message, mission: MissionFile | None, log: logging.Logger = log
+) -> list[tuple[str, float | str]]:
+    """The (MOOS variable, value) posts of `common.initializer` (spec 2.5): a constant, or a
+    global of the mission file (a double that does not parse is NaN); a missing global is
+    warned about on `log` and not posted."""
+    posts = []
+    for ini in common.initializer:
+        value = _initializer_value(ini, common, mission, log)
+        if value is not None:
+            posts.append((ini.moos_var, value))
+    return posts
+
+
+def _initializer_value(
+    ini: Message, common: Message, mission: MissionFile | None, log: logging.Logger
+) -> float | str | None:
+    is_double = ini.type == type(common).Initializer.INI_DOUBLE
+    if not ini.HasField("global_cfg_var"):
+        if is_double:
+            return ini.dval
+        return ini.sval.strip() if ini.trim else ini.sval
+    raw = mission.get_value(ini.global_cfg_var, outside_blocks=True) if mission else None
+    if raw is None:
+        log.warning("initializer: global %s not found; %s not posted",
+                    ini.global_cfg_var, ini.moos_var)  # fmt: skip
+        return None
+    if not is_double:
+        return raw.strip() if ini.trim else raw
+    try:
+        return float(raw)
+    except ValueError:
+        return math.nan
+
+
+def prefixed_var_names(names: Message, skip: Sequence[str] = ()) -> dict[str, str]:
+    """An app's `moos_var` block as {field name: prefix + variable}, for every field but
+    `prefix` and those in `skip`."""
+    return {
+        field.name: names.prefix + getattr(names, field.name)
+        for field in names.DESCRIPTOR.fields
+        if field.name != "prefix" and field.name not in skip
+    }

@@ -17,12 +17,10 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from pygoby.moos.errors import MissionFileError
+
 _NUMERIC = re.compile(r"[0-9.eE+\-]+")
 _MACRO_USE = re.compile(r"\$\{([^}]*)\}")
-
-
-class MissionFileError(Exception):
-    pass
 
 
 def strip_comment(line: str) -> str:
@@ -124,6 +122,15 @@ class MissionFile:
     @classmethod
     def from_text(cls, text: str) -> MissionFile:
         return cls(text.splitlines())
+
+    def find_file(self, path: str) -> str:
+        """A relative path that does not exist from the working directory is looked up next to
+        the mission file (so that missions can be run from anywhere)."""
+        given = Path(path)
+        if given.is_absolute() or given.exists() or not self.path:
+            return path
+        beside = Path(self.path).parent / given
+        return str(beside) if beside.exists() else path
 
     @staticmethod
     def _preprocess(raw_lines: list[str]) -> list[str]:
@@ -264,7 +271,9 @@ class MissionFile:
     def antler(self) -> AntlerConfig:
         settings = self.process_config("ANTLER")
         if settings is None:
-            raise MissionFileError("no ProcessConfig = ANTLER block in the mission file")
+            raise MissionFileError(
+                "no ProcessConfig = ANTLER block in the mission file", file=self.path
+            )
         compact = [(_no_space(k), _no_space(v)) for k, v in settings]
         lookup = {k.lower(): v for k, v in reversed(compact)}  # first occurrence wins
         runs = []

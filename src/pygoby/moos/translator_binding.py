@@ -15,8 +15,8 @@ from collections.abc import Callable, Iterable
 from google.protobuf import descriptor_pool, message_factory
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import (
     LAT_ORIGIN_VAR,
@@ -27,7 +27,6 @@ from pygoby.moos.translator import (
     Translator,
     TranslatorError,
     TranslatorRunner,
-    moos_technique_from_config,
 )
 from pygoby.protobuf import ProtoError, ProtoLoader
 from pygoby.util.modules import import_module_or_file
@@ -89,9 +88,9 @@ class TranslatorBinding:
                 lon_origin=app.common.lon_origin,
                 modem_ids=modem_ids,
             )
-            self.moos_technique = moos_technique_from_config(app.common)
         except TranslatorError as err:
             raise ConfigError(str(err)) from None
+        self.moos_technique = app.moos_technique
         self.runner: TranslatorRunner | None = None
 
     def subscribe_all(self) -> None:

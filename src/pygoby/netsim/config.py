@@ -13,6 +13,7 @@ from functools import cache
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.netsim.channel.settings import environment_channel_configs
 from pygoby.protobuf import builtin_class
 
@@ -58,10 +59,6 @@ environment_channel {
 """
 
 
-class ConfigError(Exception):
-    """The configuration cannot be used (parse error or a fatal start-up check)."""
-
-
 @cache
 def config_class() -> type[Message]:
     return builtin_class(CONFIG_PROTO, CONFIG_TYPE)
@@ -81,7 +78,7 @@ def parse_config(text: str) -> Message:
     try:
         _Parser().ParseLines(text.split("\n"), config)
     except text_format.ParseError as exc:
-        raise ConfigError(f"cannot parse configuration: {exc}") from exc
+        raise ConfigError.from_parse_error(exc, "configuration") from exc
     validate_config(config)
     return config
 

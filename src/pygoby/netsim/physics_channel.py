@@ -20,8 +20,9 @@
   a real-time run at the next `do_work` (every few ms);
 * `$CACST` numbers (SNR, SPL, Doppler, ...) come from `pygoby.netsim.channel.stats`; ping replies
   are timed by the emulators themselves (travel times from the arrival times the physics gives);
-* every transmission and reception is reported to `on_event` as a dict (JSON-ready), which
-  `pygoby.netsim.eventlog` writes as the run's event log.
+* every transmission and reception is emitted by `signal_event` (the `on_event` argument is
+  connected to it) as a dict (JSON-ready), which `pygoby.netsim.eventlog` writes as the run's
+  event log.
 
 Randomness is the Channel's own (seeded per transmission and receiver), so a run driven by a
 virtual clock repeats exactly for the same seed.
@@ -40,6 +41,7 @@ from pygoby.acomms.mmsim.channel import Reception as ModemReception
 from pygoby.netsim.channel import Channel, Outcome, PacketKind, Reception, Transmission
 from pygoby.netsim.channel.stats import link_statistics
 from pygoby.util.clock import Clock
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
@@ -86,7 +88,9 @@ class PhysicsChannel:
         self.clock = clock
         self.ports = dict(ports or {})
         self.control_rate = control_rate
-        self.on_event = on_event
+        self.signal_event = Signal()
+        if on_event is not None:
+            self.signal_event.connect(on_event)
         self._endpoints: dict[int, ChannelEndpoint] = {}
         self._last_poll = -math.inf
 
@@ -135,8 +139,8 @@ class PhysicsChannel:
             payload=_Sent(sender, packet, port),
         )
         planned = self.channel.transmit(tx)
-        if self.on_event is not None:
-            self.on_event(
+        if self.signal_event:  # (the event is only made when someone listens)
+            self.signal_event.emit(
                 {
                     "event": "tx",
                     "t": tx.start,
@@ -173,7 +177,7 @@ class PhysicsChannel:
         packet = sent.packet
         endpoint = self._endpoints.get(r.receiver)
         delivered = endpoint is not None and self._heard(r, packet)
-        if self.on_event is not None:
+        if self.signal_event:
             self._log_reception(r, sent, delivered)
         if not delivered:
             return
@@ -200,12 +204,11 @@ class PhysicsChannel:
 
     def _log_reception(self, r: Reception, sent: _Sent, delivered: bool) -> None:
         # (enum values read as `_value_`: the `value` property is a Python call per event)
-        assert self.on_event is not None
         packet = sent.packet
         range_m, owtt, rl, snr, sinr, collision = _link_figures(
             r.range_m, r.owtt, r.received_level, r.noise_level, r.sinr
         )
-        self.on_event(
+        self.signal_event.emit(
             {
                 "event": "rx",
                 "t": r.deliver_at,

@@ -20,24 +20,21 @@ from pathlib import Path
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, ModemTiming
 from pygoby.netsim.channel import Band, ChannelConfig, Position
 from pygoby.netsim.channel.errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.config import config_class as manager_config_class
+from pygoby.netsim.errors import ScenarioError
 from pygoby.protobuf import builtin_class
 
 SCENARIO_PROTO = "pygoby/netsim/scenario.proto"
 FIRST_MODEM_PORT = 62000
 VIRTUAL_START = 1_700_000_000.0  # default start of a "max"-speed run (repeatable)
-MAC_FIXED_DECENTRALIZED = m.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name[
+MAC_FIXED_DECENTRALIZED = acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name[
     "MAC_FIXED_DECENTRALIZED"
 ].number
-
-
-class ScenarioError(Exception):
-    """The scenario cannot be run (parse error or inconsistent settings)."""
 
 
 @cache
@@ -55,7 +52,10 @@ def load_scenario(path: str | Path) -> Message:
         text = Path(path).read_text()
     except OSError as exc:
         raise ScenarioError(f"cannot read scenario: {exc}") from exc
-    return parse_scenario(text)
+    try:
+        return parse_scenario(text)
+    except ScenarioError as exc:
+        raise exc.located(file=path) from None
 
 
 def parse_scenario(text: str) -> Message:
@@ -63,7 +63,7 @@ def parse_scenario(text: str) -> Message:
     try:
         text_format.Parse(text, scenario)
     except text_format.ParseError as exc:
-        raise ScenarioError(f"cannot parse scenario: {exc}") from exc
+        raise ScenarioError.from_parse_error(exc, "scenario") from exc
     check_scenario(scenario)
     return scenario
 
@@ -191,7 +191,7 @@ def manager_config(scenario: Message, endpoint_ip: str = "127.0.0.1") -> Message
 
 def mac_config(scenario: Message, modem_id: int) -> Message:
     """The scenario's TDMA cycle for one node (the same slots at every node)."""
-    cfg = m.MACConfig()
+    cfg = acomms_pb.MACConfig()
     cfg.CopyFrom(scenario.mac)
     cfg.modem_id = modem_id
     if not scenario.mac.HasField("type"):
@@ -200,7 +200,7 @@ def mac_config(scenario: Message, modem_id: int) -> Message:
         for node in scenario.node:
             cfg.slot.add(
                 src=node.modem_id, dest=scenario.traffic.status_dest, rate=cfg.rate,
-                type=m.ModemTransmission.DATA, slot_seconds=cfg.slot_seconds,
+                type=acomms_pb.ModemTransmission.DATA, slot_seconds=cfg.slot_seconds,
                 ack_requested=scenario.traffic.ack,
             )  # fmt: skip
     return cfg

@@ -13,7 +13,8 @@ import logging
 import sys
 from pathlib import Path
 
-from pygoby.netsim.config import EXAMPLE_CONFIG, ConfigError, parse_config
+from pygoby.errors import ConfigError
+from pygoby.netsim.config import EXAMPLE_CONFIG, parse_config
 from pygoby.netsim.gprmc import GpsOutputs
 from pygoby.netsim.manager import NetSimManager
 from pygoby.util.aiorun import run_until_signal
@@ -124,7 +125,10 @@ def main(argv: list[str] | None = None) -> int:
         manager = NetSimManager(config)
         if config.gps_out:
             manager.on_nav(GpsOutputs.open_serial(config, WallClock()).on_nav_update)
-    except (OSError, ConfigError) as exc:
+    except ConfigError as exc:
+        print(f"netsim_manager: {exc.located(file=args.config)}", file=sys.stderr)
+        return 1
+    except OSError as exc:
         print(f"netsim_manager: {exc}", file=sys.stderr)
         return 1
     run_until_signal(_run(manager, args.listen, args.port))

@@ -11,18 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-
-class NMEAError(ValueError):
-    """A line is not a valid NMEA sentence."""
-
-
-class NMEAFormatError(NMEAError):
-    """Missing start character, bad token, non-ASCII text, a malformed checksum field, or a
-    field that is not the number a reader asked for."""
-
-
-class NMEAChecksumError(NMEAError):
-    """The `*HH` checksum does not match the sentence."""
+from pygoby.util.errors import NMEAChecksumError, NMEAFormatError
 
 
 def checksum(body: str) -> int:

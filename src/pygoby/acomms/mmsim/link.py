@@ -9,7 +9,7 @@ recognises this kind of link by its `read_sentences` / `write_sentence`.
 from __future__ import annotations
 
 from pygoby.acomms.mmsim.model import MicroModemModel
-from pygoby.util.linebased import LinkClosedError
+from pygoby.util.errors import LinkClosedError
 from pygoby.util.nmea import NMEASentence
 
 

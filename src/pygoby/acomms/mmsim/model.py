@@ -33,7 +33,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem.statistics import (
     CST_FIELD_INDEX,
     DOPPLER_INDEX,
@@ -43,7 +43,8 @@ from pygoby.acomms.drivers.micromodem.statistics import (
 from pygoby.acomms.mmsim.channel import AcousticPacket, Channel, PacketKind, Reception
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, FDP_RATES, ModemTiming
 from pygoby.util.clock import Clock
-from pygoby.util.nmea import NMEAError, NMEASentence
+from pygoby.util.errors import NMEAError
+from pygoby.util.nmea import NMEASentence
 from pygoby.util.timeline import Timeline
 
 log = logging.getLogger(__name__)
@@ -609,7 +610,7 @@ class MicroModemModel:
         self._emit(
             CycleStatistics(
                 self.statistics_version, 1 if bad else 0,
-                m.now_us(r.arrival_time + self._clock_offset), self._clock_mode_field(),
+                acomms_pb.now_us(r.arrival_time + self._clock_offset), self._clock_mode_field(),
                 tuple(values),
             )  # fmt: skip
         )

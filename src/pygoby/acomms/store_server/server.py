@@ -7,8 +7,9 @@ import logging
 
 from google.protobuf.message import DecodeError
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.rudics import RudicsPacketError, parse_rudics_packet, serialize_rudics_packet
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.errors import RudicsPacketError
+from pygoby.acomms.rudics import parse_rudics_packet, serialize_rudics_packet
 from pygoby.acomms.store_server.store import TransmissionStore
 from pygoby.util.clock import Clock, WallClock
 
@@ -27,7 +28,7 @@ class StoreServer:
 
     def handle_packet(self, packet: bytes) -> bytes | None:
         try:
-            request = m.StoreServerRequest.FromString(parse_rudics_packet(packet))
+            request = acomms_pb.StoreServerRequest.FromString(parse_rudics_packet(packet))
         except (RudicsPacketError, DecodeError) as exc:
             log.warning("ignoring a bad store-server request: %s", exc)
             return None

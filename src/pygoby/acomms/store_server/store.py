@@ -6,7 +6,7 @@ from __future__ import annotations
 import sqlite3
 from pathlib import Path
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS transmission (
@@ -58,7 +58,7 @@ class TransmissionStore:
                 "ON CONFLICT(modem_id) DO UPDATE SET last_id = excluded.last_id",
                 (request.modem_id, newest),
             )
-        response = m.StoreServerResponse(modem_id=request.modem_id)
+        response = acomms_pb.StoreServerResponse(modem_id=request.modem_id)
         if request.HasField("request_id"):
             response.request_id = request.request_id
         for _, data in rows:

@@ -226,6 +226,16 @@ def check_parse_format(descriptor: Descriptor, fmt: str) -> None:
         _field_spec(current, last)
 
 
+def parsed_fields(descriptor: Descriptor, fmt: str) -> set[int]:
+    """The numbers of the top-level fields a create format sets (for tools that show where a
+    field's value comes from)."""
+    return {
+        _field_spec(descriptor, spec.split(":")[0])[0].number
+        for kind, spec, _sep in _directives(fmt.lower())
+        if kind == "directive"
+    }
+
+
 def check_serialize_format(descriptor: Descriptor, fmt: str) -> None:
     """Reject publish formats that cannot render (bad sub-message paths, bad directives)."""
     probe = message_factory.GetMessageClass(descriptor)()

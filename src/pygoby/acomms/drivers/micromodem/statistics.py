@@ -8,8 +8,9 @@ import logging
 import math
 from collections.abc import Mapping
 
-from pygoby.acomms import messages as m
-from pygoby.util.nmea import NMEAFormatError, NMEASentence
+from pygoby.acomms import messages as acomms_pb
+from pygoby.util.errors import NMEAFormatError
+from pygoby.util.nmea import NMEASentence
 
 log = logging.getLogger(__name__)
 
@@ -172,7 +173,7 @@ def parse_cst(
     sentence: NMEASentence | CycleStatistics, today: dt.date, new_clock_bitfield: bool = False
 ):
     """A $CACST -> ReceiveStatistics. NMEAFormatError or ValueError if it is bad."""
-    return m.ReceiveStatistics(**cst_fields(sentence, today, new_clock_bitfield))
+    return acomms_pb.ReceiveStatistics(**cst_fields(sentence, today, new_clock_bitfield))
 
 
 def add_cst(
@@ -228,7 +229,7 @@ def parse_xst(sentence: NMEASentence):
             fields[name] = -1
     if "ack_requested" in fields:
         fields["ack_requested"] = bool(fields["ack_requested"])
-    stat = m.TransmitStatistics(version=version, date=date, time=time, **fields)
+    stat = acomms_pb.TransmitStatistics(version=version, date=date, time=time, **fields)
     if present < len(_XST_FIELDS):
         log.warning("short $CAXST (%d fields): stopped at %s", len(sentence), _XST_FIELDS[present])
     return stat

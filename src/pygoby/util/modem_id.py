@@ -1,4 +1,5 @@
-"""The modem-id lookup file: `modem_id, name, type[, location]` per line, `//` and `#` comments."""
+"""The modem-id lookup file: `modem_id, name, type[, location]` per line, `//` and `#` comments
+(goby's ModemIdConvert; shared by the MOOS translator's algorithms and the uField driver)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import os
 import re
 from dataclasses import dataclass
 
-log = logging.getLogger("pygoby.moos.translator")
+log = logging.getLogger(__name__)
 
 _LEADING_INT = re.compile(r"\s*([+-]?[0-9]+)")
 
@@ -83,6 +84,10 @@ class ModemIdLookup:
         instead of goby3's undefined int(NaN): Quirk Q12)."""
         found = self._by_name.get(name.lower())
         return found if found is not None else atoi(name)
+
+    def entries(self) -> list[ModemIdEntry]:
+        """Every entry, by modem id."""
+        return [self._by_id[modem_id] for modem_id in sorted(self._by_id)]
 
     def __len__(self) -> int:
         return len(self._by_id)

@@ -2,17 +2,18 @@
 
 1. DCCL: a vehicle status report encoded (clear and encrypted) and decoded: the same bytes the
    C++ DCCL library produces.
-2. A two-vehicle acoustic-communications mission, time-warped: the missions of
-   examples/two_vehicles/ (a topside and an AUV, each a MOOS community with its own embedded
-   MOOSDB, pAcommsHandler and uSimVehicle) run in this process, each pAcommsHandler talking to an
-   emulated WHOI Micro-Modem over loopback TCP, with TDMA slots. The emulators hear each other
-   through netsim's acoustic physics (`PhysicsChannel`), at the vehicles' positions. The vehicles
-   broadcast DCCL status reports; the topside sends acknowledged commands that send the AUV away,
-   so travel times grow with range until packets are lost. A monitor client on each MOOSDB prints
-   what happens, slot by slot; every acoustic transmission and reception goes to an event log
-   (`pygoby netsim report LOG` plots it).
+2. A two-vehicle acoustic-communications mission, time-warped: the missions next to this file
+   (topside.moos and unicorn.moos: a topside and an AUV, each a MOOS community with its own
+   embedded MOOSDB, pAcommsHandler and uSimVehicle) run in this process, each pAcommsHandler
+   talking to an emulated WHOI Micro-Modem over loopback TCP, with TDMA slots. The emulators
+   hear each other through netsim's acoustic physics (`PhysicsChannel`), at the vehicles'
+   positions. The vehicles broadcast DCCL status reports; the topside sends acknowledged
+   commands that send the AUV away, so travel times grow with range until packets are lost. A
+   monitor client on each MOOSDB prints what happens, slot by slot; every acoustic transmission
+   and reception goes to an event log (`pygoby netsim report LOG` plots it).
 
-    python -m pygoby.demo [--warp 25] [--duration 720] [--event-log PATH] [--skip-dccl]
+    python examples/two_vehicles/run_demo.py [--warp 25] [--duration 720] [--event-log PATH]
+                                             [--skip-dccl]
 
 `run_mission()` is the reusable part (benchmarks/test_acomms_handler_bench.py uses it).
 """
@@ -34,8 +35,8 @@ from google.protobuf import text_format
 from pygoby.dccl import Codec
 from pygoby.dccl.analyze import describe
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-MISSION_DIR = EXAMPLES / "two_vehicles"
+MISSION_DIR = Path(__file__).resolve().parent
+EXAMPLES = MISSION_DIR.parent
 VEHICLES = (("topside", 1), ("unicorn", 2))
 # The missions' emulator ports (their `pygoby mmsim --port` lines): the nodes' identities in the
 # acoustic channel and its event log.
@@ -182,7 +183,7 @@ class Monitor:
         return msg
 
     def _on_mail(self, msg) -> None:
-        from pygoby.acomms import messages as m
+        from pygoby.acomms import messages as acomms_pb
 
         s, value = self.stats, msg.value
         if msg.key in NAV and msg.is_double:
@@ -190,10 +191,10 @@ class Monitor:
             if len(self.nav) == len(NAV):
                 self.on_nav(self.nav, msg.time)
         elif msg.key == "ACOMMS_MAC_SLOT_START" and (
-            slot := self._parse(m.ModemTransmission, value)
+            slot := self._parse(acomms_pb.ModemTransmission, value)
         ):
             self.slot = (slot.slot_index, slot.src)
-        elif msg.key == "ACOMMS_MODEM_TRANSMIT" and (tx := self._parse(m.ModemTransmission, value)):
+        elif msg.key == "ACOMMS_MODEM_TRANSMIT" and (tx := self._parse(acomms_pb.ModemTransmission, value)):
             for frame in tx.frame:
                 s.sent.update(self._types_in(bytes(frame)))
         elif msg.key == "ACOMMS_QUEUE_RECEIVE" and isinstance(value, str):
@@ -203,7 +204,7 @@ class Monitor:
             self.say(
                 f"{s.name}: {_short(value)} {_field(value, 'command_id')} acknowledged by the receiving modem"
             )
-        elif msg.key == "ACOMMS_QSIZE" and (size := self._parse(m.QueueSize, value)):
+        elif msg.key == "ACOMMS_QSIZE" and (size := self._parse(acomms_pb.QueueSize, value)):
             s.queued[self.id_names.get(size.dccl_id, str(size.dccl_id))] = size.size
         elif msg.key == "STATUS_REPORT_IN":
             s.last_report = str(value)
@@ -378,9 +379,7 @@ other through netsim's acoustic physics in a noisy harbour (spreading factor {sp
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
-        prog="python -m pygoby.demo", description=__doc__.split("\n\n")[0]
-    )
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--warp", type=int, default=25, help="MOOS time warp (default %(default)s)")
     parser.add_argument("--duration", type=float, default=720.0,
                         help="simulated seconds of the mission (default %(default)s)")  # fmt: skip

@@ -1,0 +1,95 @@
+"""iCommander: compose and send command messages from a terminal (Goby 1.1, seed 003 §2.4).
+
+    iCommander mission.moos [AppName]
+    iCommander --example_config
+
+The messages are the ones the mission's pAcommsHandler creates on a publish trigger
+(`commander { pacommshandler_name }`, default "pAcommsHandler"). LatOrigin/LongOrigin give the
+datum of the local x/y special; modem_id_lookup_path the modem id picker. Runs over ssh (any
+terminal); Ctrl-C or Exit quits.
+"""
+
+from __future__ import annotations
+
+import asyncio
+
+from google.protobuf.message import Message
+
+from pygoby.apps.liaison import acomms_config, command_set
+from pygoby.errors import ConfigError
+from pygoby.moos.app import GobyMOOSApp
+from pygoby.moos.protocol import MOOSMessage
+from pygoby.moos.translator import Post
+from pygoby.topside.commander import KEY_VALUE, MULTIPLEX, Commander, CommanderError
+from pygoby.topside.icommander import ICommanderTUI
+
+SEND_MULTIPLEX = 2  # pygoby.apps.protobuf.SendStyle
+QUIET = 1  # goby.util.protobuf.GLogConfig.Verbosity
+
+
+class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
+    config_proto = ("pygoby/apps/topside_config.proto", "pygoby.apps.protobuf.iCommanderConfig")
+    default_name = "iCommander"
+
+    def __init__(self, cfg: Message, *, acomms_cfg: Message | None = None, **kwargs) -> None:
+        super().__init__(cfg, **kwargs)
+        if not (self.common.HasField("lat_origin") and self.common.HasField("lon_origin")):
+            raise ConfigError("LatOrigin and LongOrigin are required (local x/y -> lat/lon)",
+                              field="common.lat_origin")  # fmt: skip
+        options = cfg.commander
+        self.common.verbosity = QUIET  # the terminal belongs to the screens; the log file keeps all
+        if acomms_cfg is None:
+            acomms_cfg = acomms_config(self, options.pacommshandler_name)
+        try:
+            self.commander = Commander(
+                command_set(self, acomms_cfg, cfg.modem_id_lookup_path),
+                community=self.common.community, now=self.clock.now, publish=self._post,
+                style=MULTIPLEX if options.send_style == SEND_MULTIPLEX else KEY_VALUE,
+                force_xy_only=cfg.force_xy_only or options.force_xy_only,
+                autosave_path=options.autosave_path or None,
+            )  # fmt: skip
+        except CommanderError as err:
+            raise ConfigError(str(err), field="commander") from None
+        self.tui = ICommanderTUI(self.commander, list(cfg.show_variable), on_exit=self.request_stop)
+        for var in self.commander.watched_variables:
+            self.subscribe(var, self._on_ack_or_expire)
+        for var in cfg.show_variable:
+            self.subscribe(var, self._on_show)
+        self.load_warnings = []
+        for path in [*cfg.load, *options.load]:
+            self.load_warnings += self.commander.load(path)
+
+    def _post(self, post: Post) -> None:
+        self.publish(post.var, post.value, src_aux=post.source_aux)
+
+    def _on_ack_or_expire(self, msg: MOOSMessage) -> None:
+        for notice in self.commander.handle_mail(msg.key, msg.value, msg.time):
+            if self.tui.is_running:
+                self.tui.show_notice(notice)
+
+    def _on_show(self, msg: MOOSMessage) -> None:
+        if self.tui.is_running:
+            self.tui.show_variable(msg.key, msg.value)
+
+    async def run(self) -> None:
+        """The MOOS app and the terminal UI in one loop; either one ending stops both."""
+        await self.start()
+        ui = asyncio.create_task(self.tui.run_async())
+        assert self._stop_requested is not None
+        stop = asyncio.create_task(self._stop_requested.wait())
+        try:
+            await asyncio.wait({ui, stop}, return_when=asyncio.FIRST_COMPLETED)
+        finally:
+            if not ui.done():
+                self.tui.exit()
+                await ui
+            stop.cancel()
+            await self.stop()
+
+
+def main(argv=None) -> int:
+    return iCommander.main(argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

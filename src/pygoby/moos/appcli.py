@@ -1,0 +1,128 @@
+"""The command line of every Goby MOOS application (spec goby-moos-apps.md section 2.1).
+
+    APP [options] mission.moos [moos_name]
+
+`-c/--moos_file` and `-a/--moos_name` are the two positionals by name, `-e/--example_config`
+prints a ProcessConfig block, `-V/--version` the version, and `--<field> <value>` (or
+`--<field>=<value>`) overrides any top-level configuration field. `run_app(app_class, argv)` is
+what `GobyMOOSApp.main` does: read the configuration (a configuration error prints one clear
+message and exits 1 before connecting), then run the app until SIGINT/SIGTERM or until it stops
+itself, and return its exit status.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import signal
+import sys
+from collections.abc import Sequence
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from pygoby.errors import ConfigError
+from pygoby.moos.moosfile import MissionFile
+
+if TYPE_CHECKING:
+    from pygoby.moos.app import GobyMOOSApp
+
+Overrides = list[tuple[str, str]]
+
+
+def package_version() -> str:
+    try:
+        return version("pygoby")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def program_name(app_class: type[GobyMOOSApp], argv0: str) -> str:
+    """The name the program was started as; the app's default name when run from Python."""
+    base = Path(argv0).name
+    if not base or base.endswith(".py") or base in ("python", "python3", "-c"):
+        return app_class.default_name or app_class.__name__
+    return base
+
+
+def argument_parser(program: str) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=program, description=f"{program}: a Goby MOOS application")
+    parser.add_argument("mission", nargs="?", help=".moos mission file")
+    parser.add_argument("alias", nargs="?", help="name to use with the MOOSDB and ProcessConfig")
+    parser.add_argument("-c", "--moos_file", help="same as the mission positional")
+    parser.add_argument("-a", "--moos_name", help="same as the alias positional")
+    parser.add_argument("-e", "--example_config", action="store_true", help="print an example ProcessConfig block and exit")
+    parser.add_argument("-V", "--version", action="version", version=f"%(prog)s {package_version()}")
+    return parser
+
+
+def parse_overrides(rest: list[str]) -> Overrides:
+    """`--field value` / `--field=value` pairs; ValueError for anything else."""
+    out = []
+    items = iter(rest)
+    for item in items:
+        if not item.startswith("--"):
+            raise ValueError(f"unexpected argument {item!r}")
+        key, eq, value = item[2:].partition("=")
+        if not eq:
+            value = next(items, None)
+            if value is None:
+                raise ValueError(f"option --{key} needs a value")
+        out.append((key, value))
+    return out
+
+
+def read_mission(path: str | None, name: str) -> MissionFile | None:
+    """The mission file, or None (with a warning) when there is none or it cannot be opened:
+    the configuration may still be complete from defaults and options."""
+    if not path:
+        return None
+    try:
+        return MissionFile.read(path)
+    except OSError as err:
+        print(f"{name}: warning: cannot open mission file {path}: {err.strerror}", file=sys.stderr)
+        return None
+
+
+def run_app(
+    app_class: type[GobyMOOSApp], argv: Sequence[str] | None = None, prog: str | None = None
+) -> int:
+    """`app_class.main`: parse the command line (`sys.argv` without `argv`), build the app and
+    run it; returns the exit status."""
+    args_in = list(sys.argv[1:] if argv is None else argv)
+    program = prog or program_name(app_class, sys.argv[0] if argv is None else "")
+    parser = argument_parser(program)
+    known, rest = parser.parse_known_args(args_in)
+    name = known.moos_name or known.alias or program
+    if known.example_config:
+        sys.stdout.write(app_class.example_config(name))
+        return 0
+    try:
+        overrides = parse_overrides(rest)
+    except ValueError as err:
+        parser.error(str(err))
+    mission = read_mission(known.moos_file or known.mission, name)
+    try:
+        cfg = app_class.read_config(mission, name, overrides)
+        app = app_class(cfg, name=name, mission=mission)
+    except ConfigError as err:
+        print(f"{name}: fatal configuration error: {err}", file=sys.stderr)
+        return 1
+    return run_until_signal(app)
+
+
+def run_until_signal(app: GobyMOOSApp) -> int:
+    """Run `app` until SIGINT/SIGTERM asks it to stop (it stops cleanly) or it stops itself;
+    its exit status, 130 after a KeyboardInterrupt outside the loop."""
+
+    async def runner() -> None:
+        loop = asyncio.get_running_loop()
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            loop.add_signal_handler(sig, app.request_stop)
+        await app.run()
+
+    try:
+        asyncio.run(runner())
+    except KeyboardInterrupt:
+        return 130
+    return app.exit_status

@@ -1,0 +1,106 @@
+"""Everything liaison's pages show, fed with MOOS mail (no I/O): the Scope, Acomms and Map
+models and the commander core, with JSON-ready views for the web layer."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from google.protobuf.message import Message
+
+from pygoby.moos.protocol import MOOSMessage
+from pygoby.moos.translator import Post
+from pygoby.topside.commander import (
+    KEY_VALUE,
+    MULTIPLEX,
+    Commander,
+    CommandSet,
+    Draft,
+    Outgoing,
+    SentRecord,
+)
+from pygoby.topside.liaison.models import AcommsModel, MapModel, ScopeModel
+
+SEND_MULTIPLEX = 2  # pygoby.apps.protobuf.SendStyle
+
+
+def field_view(draft: Draft) -> list[dict]:
+    return [{
+        "name": spec.name, "kind": spec.kind, "type": spec.proto_type, "editable": spec.editable,
+        "required": spec.required, "describe": spec.describe(), "value": draft.value(spec.name),
+        "enum": list(spec.enum_values), "source": spec.source, "automatic": spec.automatic_from,
+    } for spec in draft.type.fields]  # fmt: skip
+
+
+def record_view(record: SentRecord) -> dict:
+    return {"id": record.record_id, "type": record.type.short_name, "time": record.time,
+            "status": record.status, "status_time": record.status_time, "text": record.text,
+            "posts": [f"{p.var}: {p.value}" for p in record.posts]}  # fmt: skip
+
+
+def outgoing_view(outgoing: Outgoing) -> dict:
+    return {"posts": outgoing.lines(), "warnings": outgoing.warnings}
+
+
+class LiaisonState:
+    """`handle(msg)` for every MOOS message; `page(name, now, **options)` for the pages."""
+
+    def __init__(
+        self,
+        cfg: Message,  # pygoby.apps.protobuf.LiaisonConfig
+        acomms_cfg: Message,  # pAcommsHandlerConfig of the community
+        commands: CommandSet,
+        *,
+        community: str,
+        now: Callable[[], float],
+        publish: Callable[[Post], None],
+        start_time: float,
+    ) -> None:
+        self.now = now
+        self.start_time = start_time
+        commander_cfg = cfg.commander
+        self.commander = Commander(
+            commands,
+            community=community,
+            now=now,
+            publish=publish,
+            style=MULTIPLEX if commander_cfg.send_style == SEND_MULTIPLEX else KEY_VALUE,
+            force_xy_only=commander_cfg.force_xy_only,
+            autosave_path=commander_cfg.autosave_path or None,
+        )
+        self.scope = ScopeModel(cfg.max_history_items, list(cfg.scope_subscription))
+        self.acomms = AcommsModel(acomms_cfg, commands.resolve, start_time)
+        names = acomms_cfg.moos_var
+        self.map = MapModel(
+            community, commands.geodesy, commands.modem_ids, list(cfg.node_report_var),
+            names.prefix + names.driver_receive, names.prefix + names.driver_transmit,
+            cfg.link_seconds, cfg.max_track_points,
+        )  # fmt: skip
+        self.load_warnings: list[str] = []
+        for path in commander_cfg.load:
+            self.load_warnings += self.commander.load(path)
+
+    def handle(self, msg: MOOSMessage) -> None:
+        self.scope.update(msg)
+        self.acomms.handle(msg)
+        self.map.handle(msg)
+        if msg.time >= self.start_time:  # older acks are not ours (Goby's stale-mail rule)
+            self.commander.handle_mail(msg.key, msg.value, msg.time)
+
+    def page(self, name: str, now: float, pattern: str = "") -> dict:
+        if name == "scope":
+            return {"rows": self.scope.snapshot(now, pattern)}
+        if name == "acomms":
+            return self.acomms.snapshot(now)
+        if name == "map":
+            return self.map.snapshot(now)
+        if name == "commander":
+            commander = self.commander
+            return {
+                "records": [record_view(r) for r in reversed(commander.records[-50:])],
+                "notices": [n.banner() for n in reversed(commander.notices[-20:])],
+            }
+        raise KeyError(name)
+
+    def commander_types(self) -> list[dict]:
+        return [{"name": t.name, "short": t.short_name, "ack": t.ack, "trigger": t.trigger_var}
+                for t in self.commander.commands.types.values()]  # fmt: skip

@@ -1,0 +1,276 @@
+// pygoby liaison: the four pages, fed by Server-Sent Events (/api/events) and JSON POSTs.
+"use strict";
+
+const page = (location.pathname.replace(/^\/+/, "") || "scope").split("/")[0];
+const $ = (selector) => document.querySelector(selector);
+const el = (tag, attrs = {}, ...children) => {
+  const node = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (k === "class") node.className = v;
+    else if (k.startsWith("data-")) node.setAttribute(k, v);
+    else node[k] = v;
+  }
+  for (const child of children) node.append(child);
+  return node;
+};
+const svg = (tag, attrs = {}) => {
+  const node = document.createElementNS("http://www.w3.org/2000/svg", tag);
+  for (const [k, v] of Object.entries(attrs)) node.setAttribute(k, v);
+  return node;
+};
+const clock = (t) => new Date(t * 1000).toISOString().substring(11, 19);
+
+async function post(body) {
+  const response = await fetch("/api/commander", {
+    method: "POST",
+    headers: { "Content-Type": "application/json", "X-Liaison": "1" },
+    body: JSON.stringify(body),
+  });
+  return response.json();
+}
+
+// ------------------------------------------------------------------------------ live updates
+let source = null;
+function listen(extra = "") {
+  if (source) source.close();
+  source = new EventSource(`/api/events?page=${page}${extra}`);
+  source.onmessage = (event) => {
+    $("#status").textContent = "live " + new Date().toLocaleTimeString();
+    $("#status").classList.remove("bad");
+    renderers[page](JSON.parse(event.data));
+  };
+  source.onerror = () => {
+    $("#status").textContent = "disconnected (retrying)";
+    $("#status").classList.add("bad");
+  };
+}
+
+// ------------------------------------------------------------------------------ Scope
+let historyKey = "";
+function renderScope(data) {
+  const body = $("#scope-table tbody");
+  body.replaceChildren(...data.rows.map((row) => {
+    const tr = el("tr", { "data-key": row.key, class: (row.numeric ? "numeric" : "") + (row.key === historyKey ? " selected" : "") },
+      el("td", { class: "key" }, row.key), el("td", { class: "value" }, row.value), el("td", {}, row.type),
+      el("td", {}, row.source), el("td", {}, row.community), el("td", { class: "age" }, row.age.toFixed(1)),
+      el("td", { class: "rate" }, row.rate.toFixed(2)));
+    if (row.numeric) tr.onclick = () => { historyKey = row.key; $("#history-key").textContent = row.key; };
+    return tr;
+  }));
+  $("#scope-count").textContent = `${data.rows.length} variables`;
+  if (historyKey) drawHistory();
+}
+
+async function drawHistory() {
+  const response = await fetch(`/api/scope/history?key=${encodeURIComponent(historyKey)}`);
+  const { points } = await response.json();
+  const canvas = $("#history-canvas");
+  const ctx = canvas.getContext("2d");
+  const [w, h, pad] = [canvas.width, canvas.height, 36];
+  ctx.clearRect(0, 0, w, h);
+  if (points.length === 0) return;
+  const ts = points.map((p) => p[0]), vs = points.map((p) => p[1]);
+  let [t0, t1, v0, v1] = [Math.min(...ts), Math.max(...ts), Math.min(...vs), Math.max(...vs)];
+  if (t1 === t0) t1 = t0 + 1;
+  if (v1 === v0) { v0 -= 1; v1 += 1; }
+  const x = (t) => pad + (t - t0) / (t1 - t0) * (w - 2 * pad);
+  const y = (v) => h - pad + (v0 - v) / (v1 - v0) * (h - 2 * pad);
+  ctx.strokeStyle = "#d7dde4"; ctx.fillStyle = "#6b7785"; ctx.font = "11px sans-serif";
+  ctx.strokeRect(pad, pad, w - 2 * pad, h - 2 * pad);
+  ctx.fillText(v1.toPrecision(6), 2, pad + 4); ctx.fillText(v0.toPrecision(6), 2, h - pad);
+  ctx.fillText(clock(t0), pad, h - 8); ctx.fillText(clock(t1), w - pad - 48, h - 8);
+  ctx.strokeStyle = "#e87722"; ctx.lineWidth = 2; ctx.beginPath();
+  points.forEach(([t, v], i) => (i ? ctx.lineTo(x(t), y(v)) : ctx.moveTo(x(t), y(v))));
+  ctx.stroke();
+}
+
+// ------------------------------------------------------------------------------ Commander
+let current = "";
+let modemIds = [];
+function showMessage(text, error = false) {
+  const box = $("#cmd-message");
+  box.textContent = text;
+  box.className = "message" + (error ? " error" : "");
+}
+
+function renderForm(fields) {
+  const body = $("#cmd-form tbody");
+  body.replaceChildren(...fields.map((f) => {
+    let input;
+    if (f.editable && (f.kind === "enum" || f.kind === "bool")) {
+      const options = f.kind === "bool" ? ["true", "false"] : f.enum;
+      input = el("select", { "data-field": f.name }, el("option", { value: "" }, ""),
+        ...options.map((o) => el("option", { value: o, selected: o === f.value }, o)));
+    } else {
+      input = el("input", { "data-field": f.name, value: f.value, disabled: !f.editable, size: 22 });
+    }
+    const error = el("div", { class: "error" });
+    input.addEventListener("input", async () => {
+      const r = await post({ action: "check", type: current, field: f.name, text: input.value, partial: true });
+      input.classList.toggle("invalid", !r.ok);
+      error.textContent = r.ok ? "" : r.error;
+    });
+    input.addEventListener("change", async () => {
+      const r = await post({ action: "set", type: current, field: f.name, text: input.value });
+      input.classList.toggle("invalid", !r.ok);
+      error.textContent = r.ok ? "" : r.error;
+    });
+    const specials = el("td", { class: "specials" });
+    if (f.editable && (f.kind === "int" || f.kind === "float")) {
+      specials.append(el("button", { title: "insert special: current time", onclick: () => special(f.name, "time") }, "t"));
+      if (/lat|lon/i.test(f.name)) specials.append(el("button", { title: "insert special: local X,Y to longitude,latitude", onclick: () => special(f.name, "xy") }, "x,y"));
+      if (modemIds.length) {
+        const pick = el("select", { title: "insert special: modem id" }, el("option", { value: "" }, "id…"),
+          ...modemIds.map(([id, name, type]) => el("option", { value: id }, `${id}: ${name} (${type})`)));
+        pick.onchange = () => pick.value !== "" && special(f.name, "modem_id", pick.value);
+        specials.append(pick);
+      }
+    }
+    if (f.editable && f.kind === "string") specials.append(el("button", { title: "insert special: community", onclick: () => special(f.name, "community") }, "community"));
+    return el("tr", { "data-field": f.name }, el("td", { class: "name" }, f.name),
+      el("td", {}, input, error), specials, el("td", { class: "info" }, f.describe));
+  }));
+}
+
+async function special(field, name, modemId) {
+  const r = await post({ action: "special", type: current, field, special: name, modem_id: modemId });
+  if (!r.ok) showMessage(r.error, true);
+  if (r.fields) renderForm(r.fields);
+}
+
+async function commanderAction(action, extra = {}) {
+  if (!current) { showMessage("choose a message first", true); return null; }
+  const r = await post({ action, type: current, ...extra });
+  if (!r.ok) { showMessage(r.error, true); return r; }
+  if (r.fields) renderForm(r.fields);
+  return r;
+}
+
+async function setupCommander() {
+  const info = await (await fetch("/api/commander/types")).json();
+  modemIds = info.modem_ids;
+  const select = $("#cmd-type");
+  for (const t of info.types) select.append(el("option", { value: t.name }, `${t.short}${t.ack ? " (ack)" : ""}`));
+  select.onchange = async () => {
+    current = select.value;
+    $("#cmd-preview-text").hidden = true;
+    showMessage("");
+    if (current) await commanderAction("open");
+    else $("#cmd-form tbody").replaceChildren();
+  };
+  $("#cmd-preview").onclick = async () => {
+    const r = await commanderAction("preview");
+    if (r && r.ok) {
+      const box = $("#cmd-preview-text");
+      box.hidden = false;
+      box.textContent = "Preview (nothing published):\n" + r.preview.posts.join("\n") +
+        (r.preview.warnings.length ? "\nWarnings: " + r.preview.warnings.join("; ") : "");
+    }
+  };
+  $("#cmd-send").onclick = async () => {
+    const r = await commanderAction("send");
+    if (r && r.ok) showMessage(`sent #${r.record.id} at ${clock(r.record.time)}: ${r.record.posts.join(" | ")}`);
+  };
+  $("#cmd-clear").onclick = () => commanderAction("clear");
+  $("#cmd-save").onclick = async () => {
+    const r = await commanderAction("save", { path: $("#cmd-path").value });
+    if (r && r.ok) showMessage("saved to " + $("#cmd-path").value);
+  };
+  $("#cmd-load").onclick = async () => {
+    const r = await commanderAction("load", { path: $("#cmd-path").value });
+    if (r && r.ok) showMessage("loaded " + $("#cmd-path").value + (r.warnings.length ? " (" + r.warnings.join("; ") + ")" : ""));
+  };
+}
+
+function renderCommander(data) {
+  $("#cmd-notices").replaceChildren(...data.notices.map((text) =>
+    el("div", { class: "notice" + (text.includes(" expired ") ? " expired" : "") }, text)));
+  $("#cmd-records tbody").replaceChildren(...data.records.map((r) =>
+    el("tr", { "data-id": r.id }, el("td", {}, String(r.id)), el("td", {}, r.type), el("td", {}, clock(r.time)),
+      el("td", { class: "status " + r.status.replace(" ", "-") }, r.status), el("td", { class: "value" }, r.text))));
+}
+
+// ------------------------------------------------------------------------------ Acomms
+function renderAcomms(data) {
+  $("#acomms-modem").textContent = data.modem_id;
+  $("#acomms-queues tbody").replaceChildren(...data.queues.map((q) =>
+    el("tr", { "data-queue": q.name }, el("td", {}, q.name), el("td", {}, q.dccl_id ?? "?"), el("td", { class: "size" }, String(q.size)),
+      el("td", {}, q.ack ? "yes" : "no"), el("td", {}, String(q.ttl)), el("td", {}, String(q.value_base)),
+      el("td", {}, q.priority.toFixed(2)), el("td", {}, String(q.sent)), el("td", {}, q.next ? "▶ next" : ""))));
+  const mac = data.mac;
+  $("#acomms-cycle").textContent = `${mac.slots.length} slots, ${mac.cycle_seconds} s` +
+    (mac.into_slot !== null ? `, ${mac.into_slot} s into slot ${mac.current}` : "");
+  $("#acomms-slots").replaceChildren(...mac.slots.map((s, i) =>
+    el("div", { class: "slot" + (i === mac.current ? " current" : "") }, `${s.src}→${s.dest < 0 ? "any" : s.dest} ${s.type} r${s.rate} ${s.seconds}s`)));
+  $("#acomms-tx tbody").replaceChildren(...data.tx.map((t) =>
+    el("tr", {}, el("td", {}, clock(t.time)), el("td", {}, `${t.src}→${t.dest}`), el("td", {}, t.type), el("td", {}, String(t.rate)),
+      el("td", {}, t.messages.join(", ")), el("td", {}, t.mode ?? ""))));
+  $("#acomms-rx tbody").replaceChildren(...data.rx.map((r) =>
+    el("tr", {}, el("td", {}, clock(r.time)), el("td", {}, `${r.src}→${r.dest}`), el("td", {}, r.type), el("td", {}, r.messages.join(", ")),
+      el("td", {}, r.snr_in ?? ""), el("td", {}, r.snr_out ?? ""), el("td", {}, r.doppler ?? ""), el("td", {}, r.mse ?? ""),
+      el("td", {}, r.bad_frames ?? ""))));
+  $("#acomms-timeline").replaceChildren(...data.timeline.map((e) =>
+    el("li", { class: e.kind }, `${clock(e.time)} ${e.text}`)));
+}
+
+// ------------------------------------------------------------------------------ Map
+const COLOURS = ["#1565c0", "#e87722", "#2e7d32", "#6a1b9a", "#c62828", "#00838f"];
+function renderMap(data) {
+  const map = $("#map-svg");
+  const [W, H, pad] = [900, 600, 50];
+  const xs = [], ys = [];
+  for (const n of data.nodes) { xs.push(n.x); ys.push(n.y); for (const [x, y] of n.track) { xs.push(x); ys.push(y); } }
+  if (xs.length === 0) { map.replaceChildren(); $("#map-info").textContent = "no positions yet"; return; }
+  let [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+  const span = Math.max(x1 - x0, y1 - y0, 50) * 1.15;
+  const [cx, cy] = [(x0 + x1) / 2, (y0 + y1) / 2];
+  const scale = Math.min(W - 2 * pad, H - 2 * pad) / span;
+  const px = (x) => W / 2 + (x - cx) * scale, py = (y) => H / 2 - (y - cy) * scale;
+  const children = [];
+  const step = Math.pow(10, Math.floor(Math.log10(span / 2)));
+  for (let g = Math.ceil((cx - span) / step) * step; g <= cx + span; g += step) {
+    children.push(svg("line", { class: "gridline", x1: px(g), x2: px(g), y1: 0, y2: H }));
+  }
+  for (let g = Math.ceil((cy - span) / step) * step; g <= cy + span; g += step) {
+    children.push(svg("line", { class: "gridline", y1: py(g), y2: py(g), x1: 0, x2: W }));
+  }
+  const where = Object.fromEntries(data.nodes.map((n) => [n.name, n]));
+  for (const link of data.links) {
+    const [a, b] = [where[link.from], where[link.to]];
+    if (!a || !b) continue;
+    const line = svg("line", { class: "link", x1: px(a.x), y1: py(a.y), x2: px(b.x), y2: py(b.y), "data-from": link.from, "data-to": link.to });
+    line.append(svg("title")); line.firstChild.textContent = `${link.from} → ${link.to}, ${link.age} s ago`;
+    children.push(line);
+  }
+  data.nodes.forEach((n, i) => {
+    const colour = COLOURS[i % COLOURS.length];
+    children.push(svg("polyline", { class: "track", stroke: colour, points: n.track.map(([x, y]) => `${px(x)},${py(y)}`).join(" ") }));
+    const g = svg("g", { class: "node", "data-name": n.name, transform: `translate(${px(n.x)},${py(n.y)})` });
+    const heading = n.heading ?? 0;
+    g.append(svg("path", { d: "M0,-11 L7,8 L0,4 L-7,8 Z", fill: colour, transform: `rotate(${heading})` }));
+    const label = svg("text", { x: 12, y: 4 }); label.textContent = `${n.name} (${n.x.toFixed(0)}, ${n.y.toFixed(0)})`;
+    g.append(label);
+    children.push(g);
+  });
+  const bar = step;
+  children.push(svg("line", { x1: 20, x2: 20 + bar * scale, y1: H - 20, y2: H - 20, stroke: "#1d2733", "stroke-width": 3 }));
+  const barLabel = svg("text", { x: 20, y: H - 28 }); barLabel.textContent = `${bar} m`; children.push(barLabel);
+  map.replaceChildren(...children);
+  $("#map-info").textContent = `${data.nodes.length} vehicles, ${data.links.length} links heard recently (local x/y about the datum; north up)`;
+}
+
+const renderers = { scope: renderScope, commander: renderCommander, acomms: renderAcomms, map: renderMap };
+
+// ------------------------------------------------------------------------------ start
+document.querySelectorAll("nav a").forEach((a) => a.classList.toggle("active", a.dataset.page === page));
+const section = document.getElementById(`page-${page}`);
+if (section) section.hidden = false;
+if (page === "scope") {
+  let timer = null;
+  $("#scope-filter").addEventListener("input", () => {
+    clearTimeout(timer);
+    timer = setTimeout(() => listen("&filter=" + encodeURIComponent($("#scope-filter").value)), 250);
+  });
+}
+if (page === "commander") setupCommander();
+if (renderers[page]) listen();

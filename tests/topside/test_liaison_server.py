@@ -1,0 +1,52 @@
+"""liaison's server without a browser: pAcommsHandler serving it from a `liaison` block, the
+access token off loopback, the POST header, the static files in the package."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import urllib.error
+import urllib.request
+
+import pytest
+
+from pygoby.topside.liaison import is_loopback
+from tests.apps.acomms_mission import TwoCommunities
+
+
+def fetch(url: str, body: dict | None = None, headers: dict | None = None) -> tuple[int, str]:
+    data = json.dumps(body).encode() if body is not None else None
+    request = urllib.request.Request(url, data=data, headers=headers or {})
+    try:
+        with urllib.request.urlopen(request, timeout=5) as response:
+            return response.status, response.read().decode()
+    except urllib.error.HTTPError as err:
+        return err.code, err.read().decode()
+
+
+def test_loopback_addresses():
+    assert is_loopback("127.0.0.1") and is_loopback("::1") and is_loopback("localhost")
+    assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.5") and not is_loopback("")
+
+
+@pytest.mark.timeout(60)
+async def test_pacommshandler_serves_liaison_with_a_token_off_loopback(tmp_path, capsys):
+    liaison = 'liaison { http_address: "0.0.0.0"  http_port: 0 }'
+    async with TwoCommunities(tmp_path, extra=liaison) as net:
+        web = net.apps[0].liaison.web
+        assert web.token and f"?token={web.token}" in capsys.readouterr().out  # printed at start-up
+        base = f"http://127.0.0.1:{web.port}"
+        assert (await asyncio.to_thread(fetch, f"{base}/scope"))[0] == 401
+        status, page = await asyncio.to_thread(fetch, f"{base}/scope?token={web.token}")
+        assert status == 200 and '<script src="/static/liaison.js">' in page
+        auth = {"Authorization": f"Bearer {web.token}"}
+        status, script = await asyncio.to_thread(fetch, f"{base}/static/liaison.js", None, auth)
+        assert status == 200 and "EventSource" in script  # shipped in the package, no CDN
+        types = json.loads((await asyncio.to_thread(fetch, f"{base}/api/commander/types", None, auth))[1])
+        assert {t["short"] for t in types["types"]} == {"Command", "SimpleStatus"}
+        body = {"action": "open", "type": "Command"}
+        assert (await asyncio.to_thread(fetch, f"{base}/api/commander", body, auth))[0] == 403
+        status, reply = await asyncio.to_thread(
+            fetch, f"{base}/api/commander", {**body, "action": "set", "field": "heading", "text": "999"},
+            {**auth, "X-Liaison": "1", "Content-Type": "application/json"})  # fmt: skip
+        assert status == 422 and "above the maximum 360" in json.loads(reply)["error"]
