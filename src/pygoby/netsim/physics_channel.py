@@ -22,7 +22,8 @@
   are timed by the emulators themselves (travel times from the arrival times the physics gives);
 * every transmission and reception is emitted by `signal_event` (the `on_event` argument is
   connected to it) as a dict (JSON-ready), which `pygoby.netsim.eventlog` writes as the run's
-  event log.
+  event log; an event is only made when someone listens, and `transmissions` and `outcomes`
+  (receptions by outcome) count them in any case.
 
 Randomness is the Channel's own (seeded per transmission and receiver), so a run driven by a
 virtual clock repeats exactly for the same seed.
@@ -32,6 +33,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -93,6 +95,8 @@ class PhysicsChannel:
             self.signal_event.connect(on_event)
         self._endpoints: dict[int, ChannelEndpoint] = {}
         self._last_poll = -math.inf
+        self.transmissions = 0
+        self.outcomes: Counter[str] = Counter()  # receptions by outcome
 
     # -- the mmsim Channel interface -----------------------------------------------------------
 
@@ -139,6 +143,7 @@ class PhysicsChannel:
             payload=_Sent(sender, packet, port),
         )
         planned = self.channel.transmit(tx)
+        self.transmissions += 1
         if self.signal_event:  # (the event is only made when someone listens)
             self.signal_event.emit(
                 {
@@ -177,6 +182,7 @@ class PhysicsChannel:
         packet = sent.packet
         endpoint = self._endpoints.get(r.receiver)
         delivered = endpoint is not None and self._heard(r, packet)
+        self.outcomes[r.outcome._value_] += 1
         if self.signal_event:
             self._log_reception(r, sent, delivered)
         if not delivered:

@@ -56,7 +56,6 @@ from pygoby.netsim.scenario import (
     start_time,
 )
 from pygoby.util.clock import Clock, VirtualClock
-from pygoby.util.signal import Signal
 from pygoby.util.timeline import Timeline
 
 log = logging.getLogger(__name__)
@@ -132,16 +131,15 @@ class Simulation:
         self.scenario = scenario
         self.start = start_time(scenario)
         self.clock: Clock = clock if clock is not None else VirtualClock(self.start)
-        self.signal_event = Signal()  # every event (see the module's documentation)
-        if on_event is not None:
-            self.signal_event.connect(on_event)
-        self.events: Counter = Counter()
-        self.outcomes: Counter = Counter()
+        self.events: Counter = Counter()  # this run's own events (the channel counts its own)
         self.status_sent = 0
         self.manager = NetSimManager(manager_config(scenario))
         self.channel = Channel(channel_config(scenario), seed=scenario.seed)
         self.manager.on_nav(self.channel.on_environment_nav_update)
-        self.physics = PhysicsChannel(self.channel, self.clock, on_event=self._event)
+        self.physics = PhysicsChannel(self.channel, self.clock, on_event=on_event)
+        # every event (see the module's documentation): the channel's, and the run's own on the
+        # same signal (an event is only made when someone listens)
+        self.signal_event = self.physics.signal_event
         self.timeline = Timeline(self.clock)  # the emulators' timed events
         timing = modem_timing(scenario)
         self.codec = Codec(clock=self.clock)
@@ -206,7 +204,7 @@ class Simulation:
 
     def _status_heard(self, node: SimNode, msg: Message) -> None:
         node.received[msg.src] += 1
-        self._event({"event": "app_rx", "t": self.clock.now(), "port": node.port, "src": msg.src})
+        self._event("app_rx", t=self.clock.now(), port=node.port, src=msg.src)
 
     def _modem_heard(self, node: SimNode, msg: Message) -> None:
         """Ranging results the driver reports (two-way pings) become `range` events."""
@@ -215,15 +213,14 @@ class Simulation:
         owtt = msg.Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply.one_way_travel_time
         if owtt:
             self._event(
-                {"event": "range", "t": self.clock.now(), "port": node.port, "src": msg.src,
-                 "dest": msg.dest, "owtt": list(owtt)}
+                "range", t=self.clock.now(), port=node.port, src=msg.src, dest=msg.dest,
+                owtt=list(owtt),
             )  # fmt: skip
 
-    def _event(self, event: dict) -> None:
-        self.events[event["event"]] += 1
-        if event["event"] == "rx":
-            self.outcomes[event["outcome"]] += 1
-        self.signal_event.emit(event)
+    def _event(self, kind: str, **fields) -> None:
+        self.events[kind] += 1
+        if self.signal_event:  # (made only when someone listens)
+            self.signal_event.emit({"event": kind, **fields})
 
     # -- positions -------------------------------------------------------------------------------
 
@@ -263,8 +260,10 @@ class Simulation:
         return RunSummary(
             simulated_seconds=self.clock.now() - self.start,
             wall_seconds=time.perf_counter() - self._wall_start,
-            events=Counter(self.events),
-            outcomes=Counter(self.outcomes),
+            events=self.events + Counter(
+                tx=self.physics.transmissions, rx=sum(self.physics.outcomes.values())
+            ),
+            outcomes=Counter(self.physics.outcomes),
             status_sent=self.status_sent,
             status_received=sum(sum(n.received.values()) for n in self.nodes),
         )
