@@ -15,9 +15,10 @@
   delivery to its receiver with the physics' outcome: all frames good, some frames bad (the
   emulator reports those as BAD_CRC), or nothing at all (not detected, receiver busy,
   half-duplex; a control packet — cycle-init, ACK, ping, mini-packet — with a bad frame);
-* `next_event_time` is the next delivery: in a discrete-event run a detection is reported at the
-  next event after its arrival (nothing in such a run depends on when `$CARXP` is printed), in
-  a real-time run at the next `do_work` (every few ms);
+* `next_event_time` is the next delivery. A detection is reported at the next `do_work` after
+  its arrival (a real-time run calls it every few ms), or, with `detections_with_receptions`
+  (discrete-event runs, where nothing depends on when `$CARXP` is printed), just before its
+  reception ends: the receiver's driver then wakes once for both;
 * `$CACST` numbers (SNR, SPL, Doppler, ...) come from `pygoby.netsim.channel.stats`; ping replies
   are timed by the emulators themselves (travel times from the arrival times the physics gives);
 * every transmission and reception is emitted by `signal_event` (the `on_event` argument is
@@ -83,6 +84,7 @@ class PhysicsChannel:
         *,
         control_rate: int = 0,
         on_event: EventSink | None = None,
+        detections_with_receptions: bool = False,
     ) -> None:
         """`control_rate`: the rate whose error model applies to cycle-inits, ACKs, pings and
         mini-packets (FSK on a Micro-Modem, so rate 0 by default)."""
@@ -95,6 +97,8 @@ class PhysicsChannel:
             self.signal_event.connect(on_event)
         self._endpoints: dict[int, ChannelEndpoint] = {}
         self._last_poll = -math.inf
+        # detections held until their receptions end: (receiver, transmission number) -> arrival
+        self._held: dict[tuple[int, int], float] | None = {} if detections_with_receptions else None
         self.transmissions = 0
         self.outcomes: Counter[str] = Counter()  # receptions by outcome
 
@@ -164,12 +168,23 @@ class PhysicsChannel:
     def do_work(self) -> None:
         now = max(self.clock.now(), self._last_poll)
         self._last_poll = now
+        held = self._held
         for d in self.channel.detections(now):
-            endpoint = self._endpoints.get(d.receiver)
-            if endpoint is not None:
-                endpoint.detect(d.transmission.payload.packet, d.arrival)
+            if held is not None:
+                held[d.receiver, d.sequence] = d.arrival
+            else:
+                self._detect(d.receiver, d.transmission, d.arrival)
         for reception in self.channel.poll(now):
+            if held is not None:
+                arrival = held.pop((reception.receiver, reception.sequence), None)
+                if arrival is not None:
+                    self._detect(reception.receiver, reception.transmission, arrival)
             self._deliver(reception)
+
+    def _detect(self, receiver: int, transmission: Transmission, arrival: float) -> None:
+        endpoint = self._endpoints.get(receiver)
+        if endpoint is not None:
+            endpoint.detect(transmission.payload.packet, arrival)
 
     def next_event_time(self) -> float | None:
         """When `do_work` next has something to deliver (for discrete-event loops)."""

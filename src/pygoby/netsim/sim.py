@@ -136,7 +136,11 @@ class Simulation:
         self.manager = NetSimManager(manager_config(scenario))
         self.channel = Channel(channel_config(scenario), seed=scenario.seed)
         self.manager.on_nav(self.channel.on_environment_nav_update)
-        self.physics = PhysicsChannel(self.channel, self.clock, on_event=on_event)
+        # (in a discrete-event run a driver wakes once for $CARXP and the packet)
+        self.physics = PhysicsChannel(
+            self.channel, self.clock, on_event=on_event,
+            detections_with_receptions=isinstance(self.clock, VirtualClock),
+        )  # fmt: skip
         # every event (see the module's documentation): the channel's, and the run's own on the
         # same signal (an event is only made when someone listens)
         self.signal_event = self.physics.signal_event

@@ -181,6 +181,7 @@ class Detection:
 
     receiver: int
     transmission: Transmission
+    sequence: int  # number of the transmission on this channel
     arrival: float
 
 
@@ -424,7 +425,7 @@ class Channel:
             if config.protocol_model is not None:  # decided in _protocol_outcome
                 p.detected = p.locked = True
                 if p.range_m <= config.protocol_model.detection_range:
-                    self._detected.append(Detection(p.receiver, p.transmission, start))
+                    self._detected.append(Detection(p.receiver, p.transmission, p.sequence, start))
                 continue
             receptions = at_receiver.get(p.receiver)
             if receptions is None:
@@ -444,7 +445,7 @@ class Channel:
             if not config.receiver_lock:
                 p.locked = True
                 if p.detected:
-                    self._detected.append(Detection(p.receiver, p.transmission, start))
+                    self._detected.append(Detection(p.receiver, p.transmission, p.sequence, start))
                 continue
             free = self._locked_until.get(p.receiver, -math.inf) <= start
             transmitting = False
@@ -456,7 +457,7 @@ class Channel:
             p.locked = p.detected and free and not transmitting
             if p.locked:
                 self._locked_until[p.receiver] = p.interval.end
-                self._detected.append(Detection(p.receiver, p.transmission, start))
+                self._detected.append(Detection(p.receiver, p.transmission, p.sequence, start))
 
     def _finish(self, p: _Pending, at_receiver: list[_Pending]) -> Reception:
         """`at_receiver`: every finished and pending reception at p's receiver."""
