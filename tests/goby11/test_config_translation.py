@@ -6,8 +6,9 @@ from __future__ import annotations
 import pytest
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
-from pygoby.moos.appconfig import ConfigError, read_configuration
+from pygoby.moos.appconfig import read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.protobuf import builtin_class
 from tests.goby11.seed_listings import EXAMPLES

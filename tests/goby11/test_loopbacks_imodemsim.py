@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from pygoby.apps.imodemsim import iModemSim
-from pygoby.moos.appconfig import ConfigError
+from pygoby.errors import ConfigError
 from pygoby.util.pty import PtyEnd, PtyError, PtyPair, is_live, open_serial, partner_of
 
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))

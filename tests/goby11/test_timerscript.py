@@ -12,7 +12,6 @@ from google.protobuf import text_format
 from pygoby.acomms import messages as acomms_pb
 from pygoby.apps.utimerscript import uTimerScript
 from pygoby.errors import ConfigError
-from pygoby.moos.appconfig import ConfigError as AppConfigError
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.logic import LogicCondition
@@ -146,6 +145,6 @@ async def test_app_posts_the_seed_script_on_the_embedded_moosdb(tmp_path):
 def test_app_configuration_error_names_the_mission(tmp_path):
     path = tmp_path / "bad.moos"
     path.write_text("ServerPort = 9000\nProcessConfig = uTimerScript\n{\n  EVENT = var=X\n}\n")
-    with pytest.raises(AppConfigError, match=r"bad\.moos: uTimerScript: EVENT 'var=X' has no val="):
+    with pytest.raises(ConfigError, match=r"bad\.moos: uTimerScript: EVENT 'var=X' has no val="):
         uTimerScript.from_mission(path)
     assert asyncio.iscoroutinefunction(uTimerScript.start)

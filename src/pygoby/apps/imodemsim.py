@@ -26,7 +26,7 @@ import logging
 from pygoby.acomms.mmsim.model import MicroModemModel
 from pygoby.acomms.mmsim.multicast_channel import BroadcastChannel, MulticastChannel
 from pygoby.acomms.mmsim.server import MMSimServer
-from pygoby.moos.appconfig import ConfigError
+from pygoby.errors import ConfigError
 from pygoby.moos.classic_app import ClassicMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.util.pty import PtyError, PtyPair, is_live, partner_of
@@ -81,8 +81,7 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
         self.server = MMSimServer(self.model, self.channel, port=None, serial_path=self.port_path)
 
     def _error(self, reason: str):
-        where = f"{self.mission.path}: " if self.mission and self.mission.path else ""
-        raise ConfigError(f"{where}{self.name}: {reason}")
+        raise ConfigError(f"{self.name}: {reason}", file=self.mission.path if self.mission else None)
 
     def _number(self, settings: dict[str, str], key: str, default: float) -> float:
         text = settings.get(key)

@@ -6,8 +6,7 @@ pygoby.moos.timerscript), so that missions run without MOOS-IvP installed.
 
 from __future__ import annotations
 
-from pygoby.errors import ConfigError as PygobyConfigError
-from pygoby.moos.appconfig import ConfigError
+from pygoby.errors import ConfigError
 from pygoby.moos.classic_app import ClassicMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.timerscript import TimerScript
@@ -23,9 +22,8 @@ class uTimerScript(ClassicMOOSApp):  # noqa: N801 - the program's name
         super().__init__(cfg, **kwargs)
         try:
             self.script = TimerScript(self.params)
-        except PygobyConfigError as err:
-            where = f"{self.mission.path}: " if self.mission and self.mission.path else ""
-            raise ConfigError(f"{where}{self.name}: {err}") from None
+        except ConfigError as err:
+            raise ConfigError(f"{self.name}: {err}", file=self.mission.path if self.mission else None) from None
         for warning in self.script.warnings:
             self.log.warning("%s", warning)
         for var in self.script.subscriptions():

@@ -21,8 +21,9 @@ from typing import ClassVar
 
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError, apply_moos_globals
+from pygoby.moos.appconfig import apply_moos_globals
 from pygoby.moos.moosfile import MissionFile, parse_number
 
 
@@ -35,7 +36,7 @@ class ClassicMOOSApp(GobyMOOSApp):
         cls, mission: MissionFile | None, name: str, overrides: Sequence[tuple[str, str]] = ()
     ) -> Message:
         if overrides:
-            raise ConfigError(f"{name} takes no --option overrides: set them in its ProcessConfig block")
+            raise ConfigError("takes no --option overrides: set them in its ProcessConfig block", field=name)
         cfg = cls.load_config_class()()
         cfg.common.log = False
         if mission is None:
@@ -47,7 +48,8 @@ class ClassicMOOSApp(GobyMOOSApp):
                 continue
             number = parse_number(value)
             if number is None or number <= 0:
-                raise ConfigError(f"{mission.path}: {name}: {key} must be a positive number, not {value!r}")
+                raise ConfigError(f"{key} must be a positive number, not {value!r}",
+                                  file=mission.path, field=name)  # fmt: skip
             setattr(cfg.common, field, max(1, math.ceil(number)))
         return cfg
 
