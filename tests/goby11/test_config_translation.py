@@ -121,7 +121,7 @@ def test_unparsable_text_is_left_to_protobuf():
 
 
 def test_goby11_mac_updates_become_todays():
-    from pygoby.apps.transitional import mac_update_from_goby11
+    from pygoby.apps.pacommshandler_goby11 import mac_update_from_goby11
 
     U = acomms_pb.MACUpdate.UpdateType
     current = [acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DATA, slot_seconds=10),

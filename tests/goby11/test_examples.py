@@ -145,3 +145,12 @@ async def test_ccl_and_dccl_simple_status_reaches_mm2(tmp_path):
     assert (node["NAME"], node["TYPE"], node["X"], node["Y"], node["HDG"]) == ("mm1", "topside", "100", "300", "150")
     assert float(node["LAT"]) == pytest.approx(lat, abs=1e-9) and float(node["LON"]) == pytest.approx(lon, abs=1e-9)
     assert any("pREMUSCodec is not available" in err for err in run_pair.stderr)
+
+
+def test_antler_block_of_the_seed_with_xconfig_and_geometry_lines():
+    from pygoby.moos.moosfile import MissionFile
+
+    config = MissionFile.read(EXAMPLES / "MOOS" / "ccl_and_dccl" / "mm1.moos").antler()
+    assert [(r.program, r.options.get("XConfig")) for r in config.runs] == [
+        ("MOOSDB", None), ("pREMUSCodec", "1"), ("pAcommsHandler", "2"), ("iModemSim", "3")]
+    assert config.ms_between_launches == 10

@@ -141,6 +141,8 @@ async def test_two_imodemsims_sharing_a_port_hear_each_other(tmp_path):
     """Seed 003's layout: both emulators on UDP port X with BroadcastAddr 127.0.0.1 (plain
     unicast would reach only one socket); each makes its /tmp/ttyLOOP pair itself."""
     udp = free_udp_port()
+    (tmp_path / "ttyLOOPA1").symlink_to("/dev/pts/999999")  # stale links of an earlier run
+    (tmp_path / "ttyLOOPA2").symlink_to("/dev/pts/999998")
     apps = [iModemSim.from_mission(imodemsim_mission(tmp_path, x, udp)) for x in "AB"]
     for app in apps:
         await app.start()

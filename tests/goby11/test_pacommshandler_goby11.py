@@ -136,3 +136,24 @@ def test_xml_error_stops_pacommshandler_with_file_and_line(tmp_path):
                             capture_output=True, text=True, timeout=60)  # fmt: skip
     assert result.returncode == 1
     assert f"fatal configuration error: {bad}:40: <max> must be a number, not 'fast'" in result.stderr
+
+
+def test_transitional_messages_expand_into_the_configuration(tmp_path):
+    from pygoby.acomms.transitional import TransitionalMessages
+    from pygoby.protobuf import ProtoLoader, builtin_class
+
+    cfg = builtin_class("goby/apps/moos/protobuf/pAcommsHandler_config.proto",
+                        "goby.apps.moos.protobuf.pAcommsHandlerConfig")(modem_id=3)  # fmt: skip
+    cfg.transitional_cfg.message_file.add(path=str(SIMPLE_STATUS), manipulator=[5])
+    cfg.transitional_cfg.generated_proto_dir = str(tmp_path / "proto")
+    loader = ProtoLoader()
+    messages = TransitionalMessages.expand(cfg, loader)
+    assert [e.protobuf_name for e in cfg.queue_cfg.message_entry] == ["SIMPLE_STATUS"]
+    assert list(cfg.queue_cfg.message_entry[0].manipulator) == [5]
+    assert [e.protobuf_name for e in cfg.translator_entry] == ["SIMPLE_STATUS"]
+    assert (tmp_path / "proto" / "simple_status.proto").read_text().startswith("// Converted from")
+    status = loader.message_class("SIMPLE_STATUS")(nav_x=5)
+    messages.complete(status, 1234.5, 3)
+    assert (status.Timestamp, status.Node) == (1234.5, 3)
+    given = loader.message_class("SIMPLE_STATUS")(Timestamp=1.0, Node=7)
+    assert messages.complete(given, 1234.5, 3) == given  # set fields are kept

@@ -21,7 +21,8 @@ from google.protobuf.message import Message
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.acomms.queue import QueueError
-from pygoby.apps.transitional import Goby11Variables, TransitionalMessages
+from pygoby.acomms.transitional import TransitionalMessages
+from pygoby.apps.pacommshandler_goby11 import Goby11Variables
 from pygoby.dccl import DcclError
 from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData

@@ -70,10 +70,6 @@ class Field:
         return out
 
 
-class _Unparsable(Exception):
-    """Not TextFormat we understand: the text is left for protobuf to report."""
-
-
 _TOKEN = re.compile(
     r"""(?P<space>[ \t\r\f\v]+)|(?P<newline>\n)|(?P<comment>\#[^\n]*)
       |(?P<string>"(?:[^"\\\n]|\\.)*"|'(?:[^'\\\n]|\\.)*')
@@ -89,7 +85,7 @@ def tokenize(text: str) -> list[Token]:
     while pos < len(text):
         match = _TOKEN.match(text, pos)
         if match is None:
-            raise _Unparsable(f"line {line}: unexpected {text[pos]!r}")
+            raise ValueError(f"line {line}: unexpected {text[pos]!r}")
         kind = match.lastgroup
         if kind == "newline":
             line += 1
@@ -109,7 +105,7 @@ class _Parser:
 
     def take(self) -> Token:
         if self.pos >= len(self.tokens):
-            raise _Unparsable("unexpected end of the block")
+            raise ValueError("unexpected end of the block")
         token = self.tokens[self.pos]
         self.pos += 1
         return token
@@ -123,7 +119,7 @@ class _Parser:
     def field(self) -> Field:
         name = self.take()
         if not (re.fullmatch(r"[A-Za-z_]\w*", name.text) or name.text.startswith("[")):
-            raise _Unparsable(f"line {name.line}: {name.text!r} is not a field name")
+            raise ValueError(f"line {name.line}: {name.text!r} is not a field name")
         result = Field(name)
         if self.peek() == ":":
             result.colon = self.take()
@@ -133,7 +129,7 @@ class _Parser:
             result.children = self.fields(closing)
             result.brackets = (opening, self.take())
         elif result.colon is None:
-            raise _Unparsable(f"line {name.line}: {name.text} needs ':' or a block")
+            raise ValueError(f"line {name.line}: {name.text} needs ':' or a block")
         elif self.peek() == "[":
             result.value.append(self.take())
             while self.peek() not in ("]", None):
@@ -308,7 +304,7 @@ def translate(text: str, descriptor: Descriptor) -> Translation:
     try:
         parser = _Parser(tokenize(text))
         fields = parser.fields(None)
-    except _Unparsable:
+    except ValueError:  # not TextFormat we understand: left for protobuf to report
         return Translation(text, [])
     notes: list[str] = []
     fields = _rewrite(fields, descriptor, notes)

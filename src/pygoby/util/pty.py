@@ -23,13 +23,11 @@ import os
 import tty
 from pathlib import Path
 
+from pygoby.util.errors import PtyError
+
 log = logging.getLogger(__name__)
 
 READ_SIZE = 4096
-
-
-class PtyError(OSError):
-    """A link cannot be made (in use by a live owner, or not a place we may write)."""
 
 
 def partner_of(path: str | os.PathLike[str]) -> Path | None:

@@ -1,22 +1,14 @@
-"""pAcommsHandler's Goby 1.1 side (spec goby-moos-apps.md §4.10, acomms.md §5.8, seed 003
-§2.3.5-2.3.7), kept out of the app's wiring:
+"""pAcommsHandler's wiring of the Goby 1.1 MOOS variables (seed 003 §2.3.6-2.3.7, spec
+acomms.md §5.8) that goby3 lacks or spells differently (the XML message sets themselves are
+pygoby.acomms.transitional):
 
-* `TransitionalMessages.expand(cfg, loader, find)`: the XML message files of
-  `transitional_cfg` (where Goby 1.1's dccl_cfg/queue_cfg `message_file`s land at load) become
-  DCCL types in the app's loader, `queue_cfg.message_entry`s and `translator_entry`s, as Goby 2
-  did at start-up; `complete(msg)` gives a created message Goby 1.1's header defaults (time =
-  now, source = our modem id).
-* `Goby11Variables`: the Goby 1.1 MOOS variables that goby3 lacks or spells differently: CCL
-  queues (`out_pubsub_var` -> queue, received frames -> `in_pubsub_var`), ACOMMS_INCOMING_DATA /
-  ACOMMS_OUTGOING_DATA (ModemDataTransmission text), ACOMMS_RANGE_COMMAND ->
-  ping, ACOMMS_RANGE_RESPONSE, ACOMMS_POLLER_UPDATE (a MACUpdate, 1.1 slots allowed).
+* `Goby11Variables`: CCL queues (`out_pubsub_var` -> queue, received frames ->
+  `in_pubsub_var`), ACOMMS_INCOMING_DATA / ACOMMS_OUTGOING_DATA (ModemDataTransmission text),
+  ACOMMS_RANGE_COMMAND -> ping, ACOMMS_RANGE_RESPONSE, ACOMMS_POLLER_UPDATE.
+* `mac_update_from_goby11`: a Goby 1.1 MACUpdate (ADD/REMOVE/REPLACE, SLOT_* slots) as today's.
 """
 
 from __future__ import annotations
-
-import logging
-from collections.abc import Callable
-from pathlib import Path
 
 from google.protobuf import text_format
 from google.protobuf.message import Message
@@ -24,14 +16,9 @@ from google.protobuf.message import Message
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.queue import QueueError
 from pygoby.acomms.queue.ccl import goby11_time
-from pygoby.dccl.xml import MessageSet, load_message_set
-from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import Technique, serialize_for_moos
-from pygoby.protobuf import ProtoLoader
-
-log = logging.getLogger(__name__)
 
 INCOMING_DATA = "ACOMMS_INCOMING_DATA"
 OUTGOING_DATA = "ACOMMS_OUTGOING_DATA"
@@ -90,57 +77,6 @@ def mac_update_from_goby11(value: str | bytes, current: list[Message], src: int)
     return update
 
 
-class TransitionalMessages:
-    """The XML message sets of a pAcommsHandler configuration."""
-
-    def __init__(self, sets: list[MessageSet], header_fields: dict[str, tuple[str, str]]) -> None:
-        self.sets = sets
-        self._header = header_fields  # message name -> (time field, source field)
-
-    @classmethod
-    def expand(
-        cls, cfg: Message, loader: ProtoLoader, find: Callable[[str], str] = str
-    ) -> TransitionalMessages:
-        """Load `cfg.transitional_cfg.message_file` (paths through `find`), register the types
-        in `loader` and append their queue and translator entries to `cfg`."""
-        sets: list[MessageSet] = []
-        header: dict[str, tuple[str, str]] = {}
-        seen: dict[str, Path] = {}
-        transitional = cfg.transitional_cfg
-        for message_file in transitional.message_file:
-            message_set = load_message_set(find(message_file.path), message_file.manipulator)
-            for name in message_set.names:
-                if name in seen:
-                    raise ConfigError(f"message {name} is defined in {seen[name]} too",
-                                      file=message_set.path)  # fmt: skip
-                seen[name] = message_set.path
-            message_set.register(loader)
-            cfg.queue_cfg.message_entry.extend(message_set.queue_entries())
-            cfg.translator_entry.extend(message_set.translator_entries())
-            if transitional.generated_proto_dir:
-                written = message_set.write_proto(transitional.generated_proto_dir)
-                log.info("wrote %s (converted from %s)", written, message_set.path)
-            for msg in message_set.messages:
-                header[msg.name] = (msg.header["time"].name, msg.header["src_id"].name)
-            sets.append(message_set)
-        return cls(sets, header)
-
-    @property
-    def warnings(self) -> list[str]:
-        return [w for s in self.sets for w in s.warnings]
-
-    def complete(self, message: Message, now: float, modem_id: int) -> Message:
-        """Goby 1.1's header defaults: an unset time is now, an unset source our modem id."""
-        fields = self._header.get(message.DESCRIPTOR.full_name)
-        if fields is not None:
-            time_field, source_field = fields
-            if not message.HasField(time_field):
-                setattr(message, time_field, now)
-            if not message.HasField(source_field):
-                setattr(message, source_field, modem_id)
-        return message
-
-
 class Goby11Variables:
     """The Goby 1.1 MOOS variables of a pAcommsHandler (see the module docstring).
 
@@ -152,18 +88,8 @@ class Goby11Variables:
         self.in_vars = {q.key.id: q.in_pubsub_var for q in queue_cfg.queue if q.in_pubsub_var}
         self.out_vars = {q.out_pubsub_var: q.key.id for q in queue_cfg.queue if q.out_pubsub_var}
         # these run inside the queue's and the driver's work: a failure is logged, not raised
-        acomms.queue.signal_receive_ccl.connect(self._contained(self._on_ccl_received))
-        acomms.signal_modem_receive.connect(self._contained(self._on_modem_receive))
-
-    def _contained(self, slot: Callable[[Message], None]) -> Callable[[Message], None]:
-        def run(message: Message) -> None:
-            try:
-                slot(message)
-            except Exception:
-                self.app.log.exception("cannot post the Goby 1.1 form of %s",
-                                       message.DESCRIPTOR.full_name)  # fmt: skip
-
-        return run
+        acomms.queue.signal_receive_ccl.connect(self._on_ccl_received, contain_errors=True, logger=app.log)
+        acomms.signal_modem_receive.connect(self._on_modem_receive, contain_errors=True, logger=app.log)
 
     def subscribe_all(self) -> None:
         for var in self.out_vars:
