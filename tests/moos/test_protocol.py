@@ -132,6 +132,31 @@ def test_wildcard_match(pattern, name, expected):
     assert p.wildcard_match(pattern, name) is expected
 
 
+def _reference_glob(pattern: str, name: str) -> bool:
+    """MOOSWildCmp's meaning by dynamic programming: can pattern[:i] match name[:j]?"""
+    row = [True] + [False] * len(name)
+    for c in pattern:
+        if c == "*":
+            row = [any(row[: j + 1]) for j in range(len(name) + 1)]
+        else:
+            row = [False] + [row[j] and c in ("?", name[j]) for j in range(len(name))]
+    return row[-1]
+
+
+@settings(max_examples=2000, deadline=None)
+@given(st.text("ab*?", max_size=8), st.text("abc", max_size=10))
+def test_glob_agrees_with_the_definition(pattern, name):
+    assert p.Glob(pattern).match(name) is _reference_glob(pattern, name)
+
+
+@pytest.mark.timeout(10)  # a backtracking matcher takes hours here (issue 16, item 1)
+def test_glob_has_no_catastrophic_backtracking():
+    name = "a" * 200
+    for pattern in ("*a*a*a*a*a*a*a*a*a*a*b", "*?a*?a*?a*?a*?a*?a*?a*?a*b", "a*" * 50 + "b"):
+        assert not p.Glob(pattern).match(name)
+    assert p.Glob("*a*a*a*a*a*a*a*a*a*a").match(name)
+
+
 def test_rejects_malformed_packets():
     good = p.encode_packet([p.notify("X", 1.0, time=1.0, src="a")])
     with pytest.raises(p.MoosProtocolError):

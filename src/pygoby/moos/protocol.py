@@ -386,19 +386,62 @@ def parse_wildcard_sval(sval: bytes) -> tuple[str, str, float]:
     return app, var, interval
 
 
-_WILDCARD_CACHE: dict[str, re.Pattern[str]] = {}
+class Glob:
+    """A MOOS glob, compiled once: `*` any sequence, `?` one character, everything else
+    literal, case-sensitive, whole name (unlike fnmatch, `[` and `]` are ordinary characters).
+
+    Matching never backtracks: the text between stars is placed at its leftmost possible
+    position, one piece after the other (which finds a match whenever there is one), so a test
+    costs at most len(name) x len(pattern) character comparisons whatever the pattern."""
+
+    __slots__ = ("pattern", "_pieces", "_min_len")
+
+    def __init__(self, pattern: str) -> None:
+        self.pattern = pattern
+        self._pieces = pattern.split("*")  # one piece: no star; else head, middles..., tail
+        self._min_len = len(pattern) - len(self._pieces) + 1
+
+    def match(self, name: str) -> bool:
+        pieces = self._pieces
+        if len(pieces) == 1:
+            return len(name) == self._min_len and _piece_at(pieces[0], name, 0)
+        if len(name) < self._min_len or not _piece_at(pieces[0], name, 0):
+            return False
+        tail_start = len(name) - len(pieces[-1])
+        pos = len(pieces[0])
+        for piece in pieces[1:-1]:
+            pos = _find_piece(piece, name, pos, tail_start)
+            if pos < 0:
+                return False
+            pos += len(piece)
+        return _piece_at(pieces[-1], name, tail_start)
+
+    def __repr__(self) -> str:
+        return f"Glob({self.pattern!r})"
+
+
+def _piece_at(piece: str, name: str, at: int) -> bool:
+    """Does the star-free `piece` (`?` = any character) match `name` at offset `at`?"""
+    if "?" not in piece:
+        return name.startswith(piece, at)
+    if at + len(piece) > len(name):
+        return False
+    return all(c == "?" or c == name[at + i] for i, c in enumerate(piece))
+
+
+def _find_piece(piece: str, name: str, start: int, stop: int) -> int:
+    """Leftmost offset >= start where `piece` matches and ends at or before `stop`; -1 if none."""
+    if "?" not in piece:
+        return name.find(piece, start, stop)
+    for at in range(start, stop - len(piece) + 1):
+        if _piece_at(piece, name, at):
+            return at
+    return -1
 
 
 def wildcard_match(pattern: str, name: str) -> bool:
-    """MOOS glob: `*` any sequence, `?` one character, everything else literal, case-sensitive,
-    whole name (unlike fnmatch, `[` and `]` are ordinary characters)."""
-    compiled = _WILDCARD_CACHE.get(pattern)
-    if compiled is None:
-        parts = [".*" if c == "*" else "." if c == "?" else re.escape(c) for c in pattern]
-        compiled = re.compile("".join(parts), re.DOTALL)
-        if len(_WILDCARD_CACHE) < 4096:
-            _WILDCARD_CACHE[pattern] = compiled
-    return compiled.fullmatch(name) is not None
+    """`Glob(pattern).match(name)`, for one-off tests."""
+    return Glob(pattern).match(name)
 
 
 @dataclass(slots=True)
