@@ -173,31 +173,26 @@ def encode_message(msg: MOOSMessage) -> bytes:
     )  # fmt: skip
 
 
-def encode_packet(msgs: Iterable[MOOSMessage], cache: dict[int, bytes] | None = None) -> bytes:
-    """One packet holding `msgs` (never empty: an empty packet upsets C++ peers).
+def encode_packet(msgs: Iterable[MOOSMessage]) -> bytes:
+    """One packet holding `msgs` (never empty: an empty packet upsets C++ peers)."""
+    return packet_of([encode_message(m) for m in msgs])
 
-    `cache` (keyed by id(message)) lets a caller that sends the same message objects to many
-    peers in one go encode each message once; the messages must stay alive meanwhile."""
-    if cache is None:
-        body = [encode_message(m) for m in msgs]
-    else:
-        body = []
-        for m in msgs:
-            raw = cache.get(id(m))
-            if raw is None:
-                raw = cache[id(m)] = encode_message(m)
-            body.append(raw)
-    if not body:
+
+def packet_of(encoded: list[bytes]) -> bytes:
+    """One packet of already encoded messages."""
+    if not encoded:
         raise ValueError("a MOOS packet must hold at least one message")
-    total = PACKET_HEADER_SIZE + sum(len(b) for b in body)
-    return _HEADER.pack(total, len(body), 0) + b"".join(body)
+    total = PACKET_HEADER_SIZE + sum(map(len, encoded))
+    return _HEADER.pack(total, len(encoded), 0) + b"".join(encoded)
 
 
 # ---------------------------------------------------------------------------------------------
 # Decoding
 
 
-def _get_str(data: bytes | memoryview, pos: int, end: int, what: str) -> tuple[bytes, int]:
+def read_str(data: bytes | memoryview, pos: int, end: int, what: str) -> tuple[bytes, int]:
+    """The MOOS string (int32 length + bytes) at `pos`, which must end by `end`; and the offset
+    after it."""
     if pos + 4 > end:
         raise MoosProtocolError(f"message truncated in the length of {what}")
     (n,) = _INT.unpack_from(data, pos)
@@ -220,14 +215,14 @@ def decode_message(data: bytes | memoryview, offset: int = 0, end: int | None = 
     stop = offset + msg_len
     msg_id, mtype, dtype = _ID_TYPES.unpack_from(data, offset + 4)
     pos = offset + 10
-    src, pos = _get_str(data, pos, stop, "src")
-    aux, pos = _get_str(data, pos, stop, "src_aux")
-    com, pos = _get_str(data, pos, stop, "community")
-    key, pos = _get_str(data, pos, stop, "key")
+    src, pos = read_str(data, pos, stop, "src")
+    aux, pos = read_str(data, pos, stop, "src_aux")
+    com, pos = read_str(data, pos, stop, "community")
+    key, pos = read_str(data, pos, stop, "key")
     if pos + 24 > stop:
         raise MoosProtocolError("message truncated in its time/dval/dval2 fields")
     time_, dval, dval2 = _DOUBLES.unpack_from(data, pos)
-    sval, pos = _get_str(data, pos + 24, stop, "sval")
+    sval, pos = read_str(data, pos + 24, stop, "sval")
     if pos != stop:
         raise MoosProtocolError(f"message has {stop - pos} bytes after sval inside its msg_len")
     msg = MOOSMessage(
