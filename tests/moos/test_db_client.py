@@ -132,7 +132,7 @@ async def test_server_requests():
         assert names == sorted(names, reverse=True) and "FOO" in names
         assert all(m.id == p.SERVER_REQUEST_ID for m in everything)
         assert await c.server_request("DB_CLEAR", timeout=0.3) == []
-        assert db.core.variables["FOO"].writes == 0
+        assert not db.core.variables["FOO"].written
 
 
 async def test_name_collision_is_refused():

@@ -57,18 +57,19 @@ class Subscription:
 class Variable:
     """One MOOS variable; its value is the last notification as forwarded (`raw`)."""
 
-    __slots__ = ("name", "key", "type_code", "raw", "community", "write_time", "writes",
-                 "write_rate", "subscribers", "every_update", "timed")  # fmt: skip
+    __slots__ = ("name", "key", "type_code", "accepts", "raw", "community", "write_time",
+                 "write_rate", "last_source", "subscribers", "every_update", "timed")  # fmt: skip
 
     def __init__(self, name: str) -> None:
         self.name = name
         self.key = p.encode_text(name)
         self.type_code = _NOT_SET
-        self.raw: bytes | None = None
+        self.accepts = -1  # the type code of the writes routed without further checks
+        self.raw: bytes | None = None  # None: never written (since the last DB_CLEAR)
         self.community = ""  # of a variable cleared by DB_CLEAR (the C++ DB keeps it)
         self.write_time = -1.0
-        self.writes = 0
         self.write_rate = 0.0
+        self.last_source: _Source | None = None  # whose publisher already lists this variable
         self.subscribers: dict[str, Subscription] = {}
         # routing tables derived from `subscribers` (rebuilt when they change): the held-mail
         # appenders of interval-0 subscribers, and the subscriptions with an interval
@@ -78,6 +79,10 @@ class Variable:
     @property
     def data_type(self) -> str:
         return chr(self.type_code)
+
+    @property
+    def written(self) -> bool:
+        return self.raw is not None
 
     def message(self) -> p.MOOSMessage:
         """The stored value as a message (an empty one with defaults when never written)."""
@@ -116,7 +121,8 @@ class Variable:
         if self.raw is not None:
             self.community = self.message().community
         self.raw = None
-        self.write_time, self.writes, self.write_rate = -1.0, 0, 0.0
+        self.accepts = -1
+        self.write_time, self.write_rate = -1.0, 0.0
 
 
 class ClientRecord:
@@ -309,6 +315,8 @@ class DBCore:
         read_int = _INT.unpack_from
         pack_int = _INT.pack
         source = self._source
+        head, head_len, forwarded, growth = (source.head, len(source.head), source.forwarded,
+                                             source.growth)  # fmt: skip
         had_notify = False
         for _ in range(count):
             if end - pos < p.MESSAGE_FIXED_SIZE:
@@ -323,10 +331,12 @@ class DBCore:
                 pos = stop
                 continue
             had_notify = True
-            key_at = pos + 10 + len(source.head)
-            if key_at > stop or not data.startswith(source.head, pos + 10):
+            key_at = pos + 10 + head_len
+            if key_at > stop or data[pos + 10 : key_at] != head:
                 source = self._source = _Source(self, data, pos + 10, stop)
-                key_at = pos + 10 + len(source.head)
+                head, head_len, forwarded, growth = (source.head, len(source.head),
+                                                     source.forwarded, source.growth)  # fmt: skip
+                key_at = pos + 10 + head_len
             (key_len,) = read_int(data, key_at)
             key_end = key_at + 4 + key_len
             if key_len < 0 or key_end + 28 > stop:
@@ -334,25 +344,26 @@ class DBCore:
             (sval_len,) = read_int(data, key_end + 24)
             if sval_len < 0 or key_end + 28 + sval_len != stop:
                 raise p.ProtocolError(f"sval length {sval_len} does not end the message")
-            key = data[key_at + 4 : key_end]
-            if source.forwarded is None:
+            if forwarded is None:
                 raw = data[pos:stop]
             else:
-                raw = b"".join((pack_int(msg_len + source.growth), data[pos + 4 : pos + 10],
-                                source.forwarded, data[key_at:stop]))  # fmt: skip
-            var = by_key.get(key)
-            if var is None or var.type_code != data_type or not var.writes:
-                var = self._first_or_mistyped_write(var, key, data_type, source.src)
+                raw = b"".join((pack_int(msg_len + growth), data[pos + 4 : pos + 10], forwarded,
+                                data[key_at:stop]))  # fmt: skip
+            var = by_key.get(data[key_at + 4 : key_end])
+            if var is None or var.accepts != data_type:
+                var = self._first_or_mistyped_write(var, data[key_at + 4 : key_end], data_type, source.src, now)
                 if var is None:
                     pos = stop
                     continue
-            if var.writes and now > var.write_time:
-                var.write_rate = 0.9 * var.write_rate + 0.1 / (now - var.write_time)
-            var.write_time = now
-            var.writes += 1
+            elif now != var.write_time:
+                if now > var.write_time:
+                    var.write_rate = 0.9 * var.write_rate + 0.1 / (now - var.write_time)
+                var.write_time = now
             var.raw = raw
-            if source.publisher is not None:
-                source.publisher.published.add(var.name)
+            if var.last_source is not source:
+                var.last_source = source
+                if source.publisher is not None:
+                    source.publisher.published.add(var.name)
             for append in var.every_update:
                 append(raw)
             for sub in var.timed:
@@ -365,13 +376,14 @@ class DBCore:
         return had_notify
 
     def _first_or_mistyped_write(
-        self, var: Variable | None, key: bytes, data_type: int, src: str
+        self, var: Variable | None, key: bytes, data_type: int, src: str, now: float
     ) -> Variable | None:
         """The variable a write of `data_type` goes to, or None when the type lock drops it."""
         if var is None:
             var = self._variable(p.decode_text(key))
-        if var.writes == 0:
-            var.type_code = data_type
+        if var.raw is None:
+            var.type_code = var.accepts = data_type
+            var.write_time = now  # no write rate from a first write
             self._apply_filters_on_creation(var, src)
             return var
         log.info('Attempting to update var "%s" which is type %s with data type %s by client %s',
@@ -421,7 +433,7 @@ class DBCore:
             return  # the subscriber is `src`; an empty or unknown one is ignored
         var = self._variable(key)
         sub = var.subscribe(client, interval)
-        if var.writes > 0:
+        if var.written:
             client.held.append(var.snapshot())
             sub.last_sent = now
 
@@ -456,7 +468,7 @@ class DBCore:
             for var in sorted(self.variables.values(), key=lambda v: v.name, reverse=True):
                 m = var.message()
                 is_double = var.type_code == _DOUBLE
-                rel = var.write_time - self.start_time if var.writes else -1.0
+                rel = var.write_time - self.start_time if var.written else -1.0
                 out.append(p.MOOSMessage(
                     p.NOTIFY, var.data_type, var.name, rel, m.dval if is_double else -1.0,
                     var.write_rate, b"" if is_double else m.sval, m.src, m.src_aux, m.community,
@@ -525,8 +537,8 @@ class DBCore:
         lines = []
         for var in sorted(self.variables.values(), key=lambda v: v.name):
             m = var.message()
-            when = _time.strftime("%H:%M:%S", _time.gmtime(var.write_time)) if var.writes else "-"
-            writer = m.src if var.writes else "(write pending)"
+            when = _time.strftime("%H:%M:%S", _time.gmtime(var.write_time)) if var.written else "-"
+            writer = m.src if var.written else "(write pending)"
             if var.type_code == _DOUBLE:
                 value = f"{m.dval:.1f}"
             elif var.data_type == p.BINARY:
