@@ -353,12 +353,17 @@ class MOOSDB:
         loop = self._loop
         while True:
             await asyncio.sleep(min(0.5, self.client_timeout / 4, self.packet_timeout / 4))
-            now = loop.time()
-            for conn in list(self._connections):
-                if conn.name is not None and conn.last_rx < now - self.client_timeout:
-                    conn._drop(f"silent for more than {self.client_timeout:g} s")
-                elif conn.packet_since is not None and conn.packet_since < now - self.packet_timeout:
-                    conn._drop(f"a packet took more than {self.packet_timeout:g} s to arrive")
-                elif conn.transport is not None and not conn.transport.is_closing():
-                    conn.update_unsent()
-            self._check_budget()
+            try:
+                self._enforce_deadlines(loop.time())
+            except Exception:  # the timeouts must outlive any bug
+                log.exception("error while checking client deadlines")
+
+    def _enforce_deadlines(self, now: float) -> None:
+        for conn in list(self._connections):
+            if conn.name is not None and conn.last_rx < now - self.client_timeout:
+                conn._drop(f"silent for more than {self.client_timeout:g} s")
+            elif conn.packet_since is not None and conn.packet_since < now - self.packet_timeout:
+                conn._drop(f"a packet took more than {self.packet_timeout:g} s to arrive")
+            elif conn.transport is not None and not conn.transport.is_closing():
+                conn.update_unsent()
+        self._check_budget()
