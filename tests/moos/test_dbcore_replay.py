@@ -3,6 +3,7 @@ answers with the C++ MOOSDB's, structurally (types, keys, ids, sources, values, 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import socket
 
@@ -272,3 +273,33 @@ def test_fuzz_core_never_crashes(packets):
     core.disconnect("a")
     core.disconnect("b")
     assert not core.clients
+
+
+_notifications = st.builds(
+    p.MOOSMessage,
+    msg_type=st.just(p.NOTIFY), data_type=st.sampled_from("DSB"), key=st.sampled_from("XYZ"),
+    time=st.floats(), dval=st.floats(), dval2=st.floats(), sval=st.binary(max_size=6),
+    src=st.sampled_from(["a", "b", "", "élan"]), src_aux=st.sampled_from(["", "aux"]),
+    community=st.sampled_from(["", "other"]), id=st.integers(-3, 100),
+)  # fmt: skip
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(["a", "b"]), st.lists(_notifications, min_size=1, max_size=5)), max_size=10))
+def test_fuzz_forwarded_bytes_are_the_publishers_with_the_community(packets):
+    """Whatever mix of sources, communities and types: a subscriber gets each accepted
+    notification as its publisher encoded it, the DB's community filled in when empty."""
+    core = DBCore("fz", VirtualClock(1000.0))
+    for name in ("a", "b", "w"):
+        core.connect(p.handshake_message(name, 0.0))
+    star = p.MOOSMessage(p.WILDCARD_REGISTER, p.STRING, "w", sval=p.wildcard_sval("*", "*", 0), src="w")
+    run(core, "w", star)  # (and the DB_EVENT snapshots, discarded)
+    locked: dict[str, str] = {}
+    for name, msgs in packets:
+        core.process_packet(name, p.encode_packet(msgs))
+        got = [raw for pk in take_packets(core).get("w", []) for _, raw in _messages_with_bytes(pk)]
+        expected = []
+        for m in msgs:
+            if locked.setdefault(m.key, m.data_type) == m.data_type:
+                expected.append(p.encode_message(dataclasses.replace(m, community=m.community or "fz")))
+        assert got == expected
