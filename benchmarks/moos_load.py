@@ -3,11 +3,11 @@
 Each publisher or subscriber is its own process speaking raw MOOS V10 over a blocking socket,
 so that the generator is never what limits a flood:
 
-* a flooding publisher encodes one packet of `--batch` notifications once and writes it again
-  and again (a C++ libMOOS client packs its whole outbox into one packet the same way), with a
-  `T` packet every second as the keep-alive;
-* a paced publisher sends one notification per packet at `--rate` per second, stamped with the
-  wall clock at sending, so that subscribers can measure latency;
+* a publisher encodes one packet of `--batch` notifications once and writes it again and again
+  (a C++ libMOOS client packs its whole outbox into one packet the same way), as fast as the
+  DB takes them (flood) or `--rate` notifications per second, with a `T` packet every second as
+  the keep-alive; with `--batch 1` each notification is stamped with the wall clock at sending,
+  so that subscribers can measure latency;
 * a subscriber counts notifications from packet headers (`n_msgs`, less a leading `T` echo),
   decoding messages only when it measures latency.
 
@@ -86,36 +86,28 @@ def publish(args: argparse.Namespace) -> None:
     start = time.monotonic()
     last_timing = -1.0
     sent = 0
-    if args.rate is None:  # flood: one packet encoded once, sent again and again
-        batch = [p.notify(args.var, payload, time=time.time(), src=args.name, msg_id=i)
-                 for i in range(args.batch)]  # fmt: skip
-        packet = p.encode_packet(batch)
-        sock.setblocking(True)
-        while sent < args.count:
-            now = time.monotonic()
-            if now - last_timing >= 1.0:
-                sock.sendall(_timing_packet())
-                last_timing = now
-            if args.count - sent < args.batch:
-                packet = p.encode_packet(batch[: args.count - sent])
-            sock.sendall(packet)
-            sent += min(args.batch, args.count - sent)
-            _drain(sock)
-    else:
-        period = 1.0 / args.rate
-        next_send = start
-        while sent < args.count:
-            now = time.monotonic()
-            if now < next_send:
-                time.sleep(next_send - now)
-            next_send += period
-            msgs = [p.notify(args.var, payload, time=time.time(), src=args.name, msg_id=sent)]
-            if time.monotonic() - last_timing >= 1.0:
-                msgs.insert(0, p.timing_message(time.time()))
-                last_timing = time.monotonic()
-            sock.sendall(p.encode_packet(msgs))
-            sent += 1
-            _drain(sock)
+    batch = [p.notify(args.var, payload, time=time.time(), src=args.name, msg_id=i)
+             for i in range(args.batch)]  # fmt: skip
+    packet = p.encode_packet(batch)  # encoded once, sent again and again (flood, paced batches)
+    period = 0.0 if args.rate is None else args.batch / args.rate
+    next_send = start
+    while sent < args.count:
+        now = time.monotonic()
+        if now < next_send:
+            time.sleep(next_send - now)
+        next_send += period
+        if time.monotonic() - last_timing >= 1.0:
+            sock.sendall(_timing_packet())
+            last_timing = time.monotonic()
+        n = min(args.batch, args.count - sent)
+        if args.batch == 1:  # stamped at sending, for latency
+            packet = p.encode_packet([p.notify(args.var, payload, time=time.time(), src=args.name,
+                                               msg_id=sent)])  # fmt: skip
+        elif n < args.batch:
+            packet = p.encode_packet(batch[:n])
+        sock.sendall(packet)
+        sent += n
+        _drain(sock)
     end = time.monotonic()
     # everything sent reaches the DB before our FIN; the DB then closes its side
     sock.shutdown(socket.SHUT_WR)
@@ -190,7 +182,7 @@ def main() -> None:
     sub = parser.add_subparsers(dest="role", required=True)
     pub = sub.add_parser("pub")
     pub.add_argument("--count", type=int, required=True)
-    pub.add_argument("--batch", type=int, default=50, help="notifications per packet (flood)")
+    pub.add_argument("--batch", type=int, default=50, help="notifications per packet")
     pub.add_argument("--rate", type=float, help="notifications per second (default: flood)")
     pub.add_argument("--size", type=int, default=64, help="string value length, bytes")
     sbs = sub.add_parser("sub")

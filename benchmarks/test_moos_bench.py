@@ -8,7 +8,10 @@ so that Python clients are not what limits the figures:
   delivered per second (summed over subscribers) and the DB process's CPU time (user + system)
   per delivered notification — the figure that does not depend on what else the 2 cores run;
 * paced, 1 x 1 at 1,000 notifications/s: latency p50/p99 (subscriber's wall clock at receipt
-  minus the publisher's time stamp at sending).
+  minus the publisher's time stamp at sending);
+* a GobyMOOSApp (in this process) subscribed to a variable that a load generator publishes at
+  100,000 notifications/s for a bounded time: how many its handler saw, how far behind it was
+  when the publisher stopped, and this process's resident memory before, at its peak and after.
 
 Each figure is the median of three runs; they are printed and stored in the benchmark's
 extra_info; nothing is asserted about them. `PYGOBY_BENCH_MOOSDB` runs another DB instead, for
@@ -19,6 +22,7 @@ side-by-side figures: a command line with `{port}`, e.g.
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import shlex
@@ -105,7 +109,7 @@ def run_load(port: int, db_pid: int, n_pub: int, n_sub: int, per_pub: int,
             for i in range(n_sub)]  # fmt: skip
     _wait_ready(subs)
     pubs = [_spawn("pub", "--port", str(port), "--name", f"p{i}_{tag}", "--var", var,
-                   "--count", str(per_pub), *(["--rate", str(rate)] if rate else []))
+                   "--count", str(per_pub), *(["--rate", str(rate), "--batch", "1"] if rate else []))
             for i in range(n_pub)]  # fmt: skip
     _wait_ready(pubs)
     cpu0 = _cpu_seconds(db_pid)
@@ -157,3 +161,72 @@ def test_moosdb_paced_latency(benchmark, moosdb):
     benchmark.extra_info.update(result)
     print(f"\n1 pub x 1 sub paced at {PACED_RATE:.0f}/s: latency p50 {result['p50_ms']:.3f} ms, "
           f"p99 {result['p99_ms']:.3f} ms ({result['delivered']}/{result['expected']} delivered)")  # fmt: skip
+
+
+APP_FLOOD_RATE = 100_000
+APP_FLOOD_SECONDS = 5.0
+
+
+def _rss_bytes() -> int:
+    return int(Path("/proc/self/statm").read_text().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+async def _app_flood(port: int) -> dict:
+    from pygoby.moos.app import GobyMOOSApp
+    from tests.moos.example_app import config_class as test_app_config
+
+    class FloodApp(GobyMOOSApp):
+        config_class = test_app_config()
+
+        def __init__(self, cfg, **kwargs):
+            super().__init__(cfg, **kwargs)
+            self.handled = 0
+            self.subscribe("FLOOD", self.on_flood)
+
+        def on_flood(self, msg):
+            self.handled += 1
+
+    cfg = FloodApp.config_class()
+    cfg.common.app_tick = 10
+    app = FloodApp(cfg, name=f"flood_app_{time.monotonic_ns()}", port=port)
+    await app.start(connect_timeout=5.0)
+    await asyncio.sleep(0.5)
+    count = int(APP_FLOOD_RATE * APP_FLOOD_SECONDS)
+    pub = _spawn("pub", "--port", str(port), "--name", f"flooder_{time.monotonic_ns()}",
+                 "--var", "FLOOD", "--count", str(count), "--rate", str(APP_FLOOD_RATE),
+                 "--batch", "500")  # fmt: skip
+    await asyncio.to_thread(_wait_ready, [pub])
+    rss = [_rss_bytes()]
+    pub.stdin.write("go\n")
+    pub.stdin.flush()
+    while pub.poll() is None:
+        await asyncio.sleep(0.25)
+        rss.append(_rss_bytes())
+    sent = _result(pub)
+    behind = count - app.handled
+    deadline = time.monotonic() + 30
+    while app.handled < count and time.monotonic() < deadline:
+        await asyncio.sleep(0.05)
+    caught_up = time.monotonic() - sent["end"]
+    rss.append(_rss_bytes())
+    await app.stop()
+    return {
+        "sent": sent["sent"],
+        "handled": app.handled,
+        "behind_at_end": behind,
+        "caught_up_s": caught_up,
+        "rss_start_mb": rss[0] / 2**20,
+        "rss_peak_mb": max(rss) / 2**20,
+        "rss_end_mb": rss[-1] / 2**20,
+    }
+
+
+def test_goby_moos_app_under_a_flood(benchmark, moosdb):
+    port, _ = moosdb
+    result = benchmark.pedantic(lambda: asyncio.run(_app_flood(port)), rounds=1, iterations=1)
+    benchmark.extra_info.update(result)
+    print(f"\nGobyMOOSApp, {APP_FLOOD_RATE:,} notifications/s for {APP_FLOOD_SECONDS:g} s: "
+          f"handled {result['handled']}/{result['sent']}, {result['behind_at_end']} behind when "
+          f"the publisher stopped, all handled {result['caught_up_s']:.2f} s after; RSS "
+          f"{result['rss_start_mb']:.1f} MB at start, {result['rss_peak_mb']:.1f} MB peak, "
+          f"{result['rss_end_mb']:.1f} MB at the end")  # fmt: skip
