@@ -184,13 +184,15 @@ class _Source:
     """What the DB learnt from a message's src/src_aux/community bytes, for the messages that
     follow with the same bytes (normally every message of a client's packet)."""
 
-    __slots__ = ("head", "forwarded", "growth", "src", "publisher")
+    __slots__ = ("head", "layout", "forwarded", "growth", "src", "publisher")
 
     def __init__(self, core: DBCore, data: bytes, at: int, stop: int) -> None:
         src, pos = p.read_str(data, at, stop, "src")
         _aux, pos = p.read_str(data, pos, stop, "src_aux")
         community, pos = p.read_str(data, pos, stop, "community")
         self.head = bytes(data[at:pos])
+        # msg_len, id + msg_type + data_type, these bytes, key length
+        self.layout = struct.Struct(f"<i6s{len(self.head)}si")
         self.src = p.decode_text(src)
         self.publisher = core.clients.get(self.src)
         if community:  # bridged from another community: forwarded untouched
@@ -311,33 +313,43 @@ class DBCore:
     ) -> bool:  # fmt: skip
         """Apply `count` messages from data[pos:end]; True if one was a notification."""
         by_key = self._by_key
-        read_head = _MSG_HEAD.unpack_from
         read_int = _INT.unpack_from
         pack_int = _INT.pack
         source = self._source
-        head, head_len, forwarded, growth = (source.head, len(source.head), source.forwarded,
-                                             source.growth)  # fmt: skip
+        head, read_start, forwarded, growth = (source.head, source.layout.unpack_from,
+                                               source.forwarded, source.growth)  # fmt: skip
+        key_at_offset = 10 + len(head)
         had_notify = False
         for _ in range(count):
-            if end - pos < p.MESSAGE_FIXED_SIZE:
-                raise p.ProtocolError("message truncated before the end of its fixed fields")
-            msg_len, msg_type, data_type = read_head(data, pos)
+            try:  # one unpack reads a notification from the remembered source up to its key
+                msg_len, id_types, head_seen, key_len = read_start(data, pos)
+            except struct.error:  # the layout runs past the buffer: read it the long way
+                head_seen = None
+            if head_seen != head:
+                if end - pos < p.MESSAGE_FIXED_SIZE:
+                    raise p.ProtocolError("message truncated before the end of its fixed fields")
+                msg_len, msg_type, _ = _MSG_HEAD.unpack_from(data, pos)
+                stop = pos + msg_len
+                if msg_len < p.MESSAGE_FIXED_SIZE or stop > end or msg_type != _NOTIFY:
+                    self._on_other(client, p.decode_message(data, pos, end)[0], now, answers)
+                    pos = stop
+                    continue
+                source = self._source = _Source(self, data, pos + 10, stop)
+                head, read_start, forwarded, growth = (source.head, source.layout.unpack_from,
+                                                       source.forwarded, source.growth)  # fmt: skip
+                key_at_offset = 10 + len(head)
+                msg_len, id_types, head_seen, key_len = read_start(data, pos)
             stop = pos + msg_len
             if msg_len < p.MESSAGE_FIXED_SIZE or stop > end:
                 raise p.ProtocolError(f"message length {msg_len} is below "
                                       f"{p.MESSAGE_FIXED_SIZE} or runs past the packet end")  # fmt: skip
-            if msg_type != _NOTIFY:
+            if id_types[4] != _NOTIFY:
                 self._on_other(client, p.decode_message(data, pos, stop)[0], now, answers)
                 pos = stop
                 continue
             had_notify = True
-            key_at = pos + 10 + head_len
-            if key_at > stop or data[pos + 10 : key_at] != head:
-                source = self._source = _Source(self, data, pos + 10, stop)
-                head, head_len, forwarded, growth = (source.head, len(source.head),
-                                                     source.forwarded, source.growth)  # fmt: skip
-                key_at = pos + 10 + head_len
-            (key_len,) = read_int(data, key_at)
+            data_type = id_types[5]
+            key_at = pos + key_at_offset
             key_end = key_at + 4 + key_len
             if key_len < 0 or key_end + 28 > stop:
                 raise p.ProtocolError(f"key length {key_len} is negative or runs past the message end")
@@ -347,8 +359,7 @@ class DBCore:
             if forwarded is None:
                 raw = data[pos:stop]
             else:
-                raw = b"".join((pack_int(msg_len + growth), data[pos + 4 : pos + 10], forwarded,
-                                data[key_at:stop]))  # fmt: skip
+                raw = b"".join((pack_int(msg_len + growth), id_types, forwarded, data[key_at:stop]))
             var = by_key.get(data[key_at + 4 : key_end])
             if var is None or var.accepts != data_type:
                 var = self._first_or_mistyped_write(var, data[key_at + 4 : key_end], data_type, source.src, now)
