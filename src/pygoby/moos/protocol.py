@@ -53,8 +53,9 @@ PACKET_HEADER_SIZE = 9
 MESSAGE_FIXED_SIZE = 54
 _HEADER = struct.Struct("<iiB")
 _INT = struct.Struct("<i")
-_ID_TYPES = struct.Struct("<icc")
-_DOUBLES = struct.Struct("<ddd")
+_START = struct.Struct("<iiBBi")  # msg_len, id, msg_type, data_type, length of src
+_DOUBLES_LENGTH = struct.Struct("<dddi")  # time, dval, dval2, length of sval
+_CHARS = tuple(map(chr, range(256)))
 
 Value = float | str | bytes
 
@@ -204,32 +205,52 @@ def read_str(data: bytes | memoryview, pos: int, end: int, what: str) -> tuple[b
 
 def decode_message(data: bytes | memoryview, offset: int = 0, end: int | None = None) -> tuple[MOOSMessage, int]:
     """Decode the message starting at `offset`; returns it and the offset after it."""
+    if not isinstance(data, bytes):
+        data = bytes(data)
     limit = len(data) if end is None else end
-    if offset + 4 > limit:
-        raise MoosProtocolError("message truncated before its length field")
-    (msg_len,) = _INT.unpack_from(data, offset)
-    if msg_len < MESSAGE_FIXED_SIZE or offset + msg_len > limit:
-        raise MoosProtocolError(
+    if limit - offset < MESSAGE_FIXED_SIZE:
+        raise ProtocolError(f"message truncated: {limit - offset} bytes left, a message has "
+                            f"at least {MESSAGE_FIXED_SIZE}")  # fmt: skip
+    msg_len, msg_id, msg_type, data_type, n = _START.unpack_from(data, offset)
+    stop = offset + msg_len
+    if msg_len < MESSAGE_FIXED_SIZE or stop > limit:
+        raise ProtocolError(
             f"message length {msg_len} is below {MESSAGE_FIXED_SIZE} or runs past the packet end"
         )
-    stop = offset + msg_len
-    msg_id, mtype, dtype = _ID_TYPES.unpack_from(data, offset + 4)
-    pos = offset + 10
-    src, pos = read_str(data, pos, stop, "src")
-    aux, pos = read_str(data, pos, stop, "src_aux")
-    com, pos = read_str(data, pos, stop, "community")
-    key, pos = read_str(data, pos, stop, "key")
-    if pos + 24 > stop:
-        raise MoosProtocolError("message truncated in its time/dval/dval2 fields")
-    time_, dval, dval2 = _DOUBLES.unpack_from(data, pos)
-    sval, pos = read_str(data, pos + 24, stop, "sval")
-    if pos != stop:
-        raise MoosProtocolError(f"message has {stop - pos} bytes after sval inside its msg_len")
-    msg = MOOSMessage(
-        mtype.decode("latin-1"), dtype.decode("latin-1"), decode_text(key), time_, dval, dval2,
-        sval, decode_text(src), decode_text(aux), decode_text(com), msg_id,
-    )  # fmt: skip
+    # each string must leave room for the fixed fields after it: 40, 36, 32, 28 bytes
+    pos = offset + 14
+    if n < 0 or pos + n + 40 > stop:
+        raise _bad_length("src", n)
+    src = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
+    pos += n
+    (n,) = _INT.unpack_from(data, pos)
+    pos += 4
+    if n < 0 or pos + n + 36 > stop:
+        raise _bad_length("src_aux", n)
+    aux = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
+    pos += n
+    (n,) = _INT.unpack_from(data, pos)
+    pos += 4
+    if n < 0 or pos + n + 32 > stop:
+        raise _bad_length("community", n)
+    community = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
+    pos += n
+    (n,) = _INT.unpack_from(data, pos)
+    pos += 4
+    if n < 0 or pos + n + 28 > stop:
+        raise _bad_length("key", n)
+    key = data[pos : pos + n].decode("utf-8", "surrogateescape")
+    time_, dval, dval2, sval_len = _DOUBLES_LENGTH.unpack_from(data, pos + n)
+    pos += n + 28
+    if sval_len < 0 or pos + sval_len != stop:
+        raise ProtocolError(f"sval length {sval_len} does not end the message at its msg_len")
+    msg = MOOSMessage(_CHARS[msg_type], _CHARS[data_type], key, time_, dval, dval2,
+                      data[pos:stop], src, aux, community, msg_id)  # fmt: skip
     return msg, stop
+
+
+def _bad_length(what: str, n: int) -> ProtocolError:
+    return ProtocolError(f"{what} length {n} is negative or runs past the message end")
 
 
 def parse_packet_header(header: bytes | memoryview) -> tuple[int, int]:
