@@ -17,7 +17,8 @@ Each figure is the median of three runs; they are printed and stored in the benc
 extra_info; nothing is asserted about them. `PYGOBY_BENCH_MOOSDB` runs another DB instead, for
 side-by-side figures: a command line with `{port}`, e.g.
 `PYGOBY_BENCH_MOOSDB="MOOSDB --moos_port={port} --moos_suicide_disable"` for the C++ one, or
-`"pygoby moosdb --port {port} --no-uvloop"` for the pure-asyncio event loop.
+the DB of another pygoby checkout. `PYGOBY_BENCH_LOADGEN` replaces the load generator (a
+command taking moos_load.py's arguments, e.g. one built on libMOOS).
 """
 
 from __future__ import annotations
@@ -78,8 +79,9 @@ def _cpu_seconds(pid: int) -> float:
 
 
 def _spawn(*args: str) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, LOAD, *args], stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, text=True)  # fmt: skip
+    command = shlex.split(os.environ.get("PYGOBY_BENCH_LOADGEN", "")) or [sys.executable, LOAD]
+    return subprocess.Popen([*command, *args], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            text=True)  # fmt: skip
 
 
 def _wait_ready(procs: list[subprocess.Popen]) -> None:
