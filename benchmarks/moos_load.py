@@ -44,33 +44,20 @@ def _connect(port: int, name: str) -> socket.socket:
 
 
 class _PacketReader:
-    """Cuts the socket's byte stream into packets without copying more than once."""
+    """The packets of a blocking socket, one at a time."""
 
     def __init__(self, sock: socket.socket) -> None:
         self.sock = sock
-        self.rest = b""
+        self.framer = p.PacketFramer()
         self.queued: list[bytes] = []
-
-    def feed(self, data: bytes) -> list[tuple[bytes, int, int]]:
-        """(buffer, offset, length) of every packet completed by `data`."""
-        buf = self.rest + data if self.rest else data
-        pos, end = 0, len(buf)
-        found = []
-        while end - pos >= _HEADER_SIZE:
-            total = int.from_bytes(buf[pos : pos + 4], "little")
-            if end - pos < total:
-                break
-            found.append((buf, pos, total))
-            pos += total
-        self.rest = buf[pos:]
-        return found
 
     def next_packet(self) -> bytes:
         while not self.queued:
             data = self.sock.recv(1 << 16)
             if not data:
                 raise SystemExit("the MOOSDB closed the connection")
-            self.queued = [bytes(b[pos : pos + n]) for b, pos, n in self.feed(data)]
+            buf, spans = self.framer.feed(data)
+            self.queued = [buf[start:end] for start, end in spans]
         return self.queued.pop(0)
 
 
@@ -158,9 +145,10 @@ def subscribe(args: argparse.Namespace) -> None:
         if not data:
             break
         arrived = time.monotonic()
-        for buf, pos, total in reader.feed(data):
-            n = int.from_bytes(buf[pos + 4 : pos + 8], "little")
-            if n and buf[pos + _HEADER_SIZE + 8] == timing_type:
+        buf, spans = reader.framer.feed(data)
+        for start, end in spans:
+            n = int.from_bytes(buf[start + 4 : start + 8], "little")
+            if n and buf[start + _HEADER_SIZE + 8] == timing_type:
                 n -= 1
             if not n:
                 continue
@@ -170,7 +158,7 @@ def subscribe(args: argparse.Namespace) -> None:
             last = arrived
             if args.latency:
                 wall = time.time()
-                latencies.extend(wall - m.time for m in p.decode_packet(buf[pos : pos + total])
+                latencies.extend(wall - m.time for m in p.decode_packet(buf, start, end)
                                  if m.msg_type == p.NOTIFY)  # fmt: skip
     sock.close()
     print(json.dumps({"received": received, "first": first, "last": last,

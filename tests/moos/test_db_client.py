@@ -32,10 +32,9 @@ async def _raw_connect(port: int, name: str | None = None):
         await writer.drain()
         framer = p.PacketFramer()
         while True:
-            framer.feed(await asyncio.wait_for(reader.read(4096), 2))
-            packets = list(framer.packets())
-            if packets:
-                assert p.decode_packet(packets[0])[0].msg_type == p.WELCOME
+            buf, spans = framer.feed(await asyncio.wait_for(reader.read(4096), 2))
+            if spans:
+                assert p.decode_packet(buf, *spans[0])[0].msg_type == p.WELCOME
                 break
     return reader, writer
 
@@ -256,8 +255,8 @@ async def test_cpp_client_bytes_replayed_over_a_socket(vectors_dir):
 
         async def read_some():
             with contextlib.suppress(TimeoutError):
-                framer.feed(await asyncio.wait_for(reader.read(65536), 0.1))
-            received.extend(p.decode_packet(x) for x in framer.packets())
+                buf, spans = framer.feed(await asyncio.wait_for(reader.read(65536), 0.1))
+                received.extend(p.decode_packet(buf, *span) for span in spans)
 
         for u in session:
             if u["dir"] == "client_to_db" and u["unit"] in ("protocol_string", "packet"):
@@ -339,13 +338,13 @@ async def test_legacy_synchronous_client_is_polled_not_pushed():
         hs = p.handshake_message("old", 0.0, asynchronous=False)
         writer.write(p.PROTOCOL_STRING + p.encode_packet([hs]))
         framer = p.PacketFramer()
+        queued: list[list[p.MOOSMessage]] = []
 
         async def next_packet(timeout=2.0):
-            while True:
-                packets = list(framer.packets())
-                if packets:
-                    return p.decode_packet(packets[0])
-                framer.feed(await asyncio.wait_for(reader.read(4096), timeout))
+            while not queued:
+                buf, spans = framer.feed(await asyncio.wait_for(reader.read(4096), timeout))
+                queued.extend(p.decode_packet(buf, *span) for span in spans)
+            return queued.pop(0)
 
         assert (await next_packet())[0].msg_type == p.WELCOME
         writer.write(p.encode_packet([p.MOOSMessage(p.REGISTER, p.DOUBLE, "V", dval=0, src="old")]))

@@ -22,7 +22,6 @@ import asyncio
 import contextlib
 import logging
 import socket
-import struct
 
 from pygoby.moos import protocol as p
 from pygoby.moos.dbcore import DBCore
@@ -38,8 +37,6 @@ DEFAULT_MAX_CLIENTS = 512
 DEFAULT_MEMORY_BUDGET = 256 * 1024 * 1024
 MAX_WRITE_BUFFER = 64 * 1024 * 1024
 
-_HEADER = struct.Struct("<iiB")
-
 
 class _Connection(asyncio.Protocol):
     """One client connection: preamble, handshake, then packets into the core."""
@@ -50,9 +47,8 @@ class _Connection(asyncio.Protocol):
         self.name: str | None = None
         self.peer = "?"
         self._preamble = b""
-        self._chunks: list[bytes] = []  # an incomplete packet, as received
-        self.pending = 0  # bytes in _chunks
-        self._need = 0  # bytes the head packet needs before it can be processed
+        self._framer = p.PacketFramer(server.max_packet_size)
+        self.pending = 0  # bytes of an incomplete packet (as last counted in the budget)
         self.packet_since: float | None = None  # loop time the incomplete packet began
         self.unsent = 0  # the transport's write buffer, as last seen
         self.last_rx = 0.0
@@ -97,16 +93,8 @@ class _Connection(asyncio.Protocol):
                 if not p.check_protocol_string(self._preamble):
                     self._drop("wrong protocol string", quiet=True)
                     return
-            if not data:
-                return
-            if self._chunks:
-                self._chunks.append(data)
-                self._set_pending(self.pending + len(data))
-                if self.pending < self._need:
-                    server._check_budget()
-                    return
-                data = b"".join(self._chunks)
-            self._consume(data, now)
+            if data:
+                self._consume(data, now)
         except p.ProtocolError as err:
             self._drop(f"protocol error: {err}")
         except Exception:  # a bug must cost one connection, never the DB
@@ -129,41 +117,25 @@ class _Connection(asyncio.Protocol):
 
     # ------------------------------------------------------------------------------------------
 
-    def _consume(self, buf: bytes, now: float) -> None:
-        """Process every complete packet in `buf`; keep the rest for later."""
-        server = self.server
-        core = server.core
-        pos, end = 0, len(buf)
-        need = p.PACKET_HEADER_SIZE
-        while end - pos >= p.PACKET_HEADER_SIZE:
-            total, count, _ = _HEADER.unpack_from(buf, pos)
-            if total < p.PACKET_HEADER_SIZE or count < 0:
-                raise p.ProtocolError(f"packet header claims {total} bytes and {count} messages")
-            if total > server.max_packet_size:
-                raise p.ProtocolError(
-                    f"packet of {total} bytes exceeds the limit of {server.max_packet_size} bytes"
-                )
-            if end - pos < total:
-                need = total
-                break
+    def _consume(self, data: bytes, now: float) -> None:
+        """Process every packet that `data` completes; the rest waits in the framer."""
+        framer = self._framer
+        buf, spans = framer.feed(data)
+        core = self.server.core
+        for start, end in spans:
             if self.name is None:
-                self._handshake(buf[pos : pos + total])
+                self._handshake(buf[start:end])
             else:
-                core.process_packet(self.name, buf, pos, pos + total)
-            pos += total
+                core.process_packet(self.name, buf, start, end)
             if self._closed:
                 return
-        if pos == end:
-            self._chunks = []
-            self._set_pending(0)
+        if not framer.buffered:
             self.packet_since = None
-            return
-        if pos or self.packet_since is None:  # a new packet began in this read
+        elif framer.began_packet:
             self.packet_since = now
-        self._chunks = [buf[pos:]]
-        self._need = need
-        self._set_pending(end - pos)
-        server._check_budget()
+        self._set_pending(framer.buffered)
+        if framer.buffered:
+            self.server._check_budget()
 
     def _handshake(self, packet: bytes) -> None:
         msgs = p.decode_packet(packet)
@@ -200,7 +172,7 @@ class _Connection(asyncio.Protocol):
         self.pending = size
 
     def _release_buffers(self) -> None:
-        self._chunks = []
+        self._framer = p.PacketFramer(self.server.max_packet_size)
         self._set_pending(0)
         self.server._unsent_total -= self.unsent
         self.unsent = 0

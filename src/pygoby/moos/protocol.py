@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import re
 import struct
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from pygoby.moos.errors import MoosProtocolError
@@ -253,9 +253,9 @@ def _bad_length(what: str, n: int) -> ProtocolError:
     return ProtocolError(f"{what} length {n} is negative or runs past the message end")
 
 
-def parse_packet_header(header: bytes | memoryview) -> tuple[int, int]:
-    """(total_len, n_msgs) from the first 9 bytes, validated."""
-    total, n_msgs, _compressed = _HEADER.unpack_from(header, 0)
+def parse_packet_header(data: bytes | memoryview, offset: int = 0) -> tuple[int, int]:
+    """(total_len, n_msgs) from the 9 bytes at `offset`, validated."""
+    total, n_msgs, _compressed = _HEADER.unpack_from(data, offset)
     if total < PACKET_HEADER_SIZE:
         raise MoosProtocolError(f"packet length {total} is below the {PACKET_HEADER_SIZE}-byte header")
     if n_msgs < 0:
@@ -263,66 +263,72 @@ def parse_packet_header(header: bytes | memoryview) -> tuple[int, int]:
     return total, n_msgs
 
 
-def decode_packet(data: bytes | memoryview) -> list[MOOSMessage]:
-    """Decode one complete packet (exactly `total_len` bytes)."""
-    if len(data) < PACKET_HEADER_SIZE:
-        raise MoosProtocolError(f"packet of {len(data)} bytes is shorter than its header")
-    total, n_msgs = parse_packet_header(data)
-    if total != len(data):
-        raise MoosProtocolError(f"packet length field says {total} bytes but {len(data)} were given")
+def decode_packet(data: bytes | memoryview, start: int = 0, end: int | None = None) -> list[MOOSMessage]:
+    """Decode one complete packet: data[start:end] (by default all of `data`) must be exactly
+    its `total_len` bytes."""
+    if not isinstance(data, bytes):
+        data = bytes(data)
+    end = len(data) if end is None else end
+    if end - start < PACKET_HEADER_SIZE:
+        raise ProtocolError(f"packet of {end - start} bytes is shorter than its header")
+    total, n_msgs = parse_packet_header(data, start)
+    if total != end - start:
+        raise ProtocolError(f"packet length field says {total} bytes but {end - start} were given")
     msgs = []
-    pos = PACKET_HEADER_SIZE
+    pos = start + PACKET_HEADER_SIZE
     for _ in range(n_msgs):
-        msg, pos = decode_message(data, pos, total)
+        msg, pos = decode_message(data, pos, end)
         msgs.append(msg)
-    if pos != total:
-        raise MoosProtocolError(f"{total - pos} trailing bytes after the last message of the packet")
+    if pos != end:
+        raise ProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
     return msgs
 
 
 class PacketFramer:
-    """Cuts a TCP byte stream into packets.
+    """Cuts a TCP byte stream into packets, copying each byte at most once.
 
-    `feed(data)` buffers bytes; iterating `packets()` yields each complete packet's bytes. A
-    length field above `max_packet_size` raises MoosProtocolError as soon as the header is seen, so
-    an oversized packet is refused before any of it is buffered beyond its header.
+    `feed(data)` returns `(buffer, spans)`: the packets that `data` completed are
+    buffer[start:end] for each (start, end) in spans; what follows them is kept for the next
+    feed. A length field above `max_packet_size` raises ProtocolError as soon as the header is
+    seen, so an oversized packet is refused before any of it is buffered beyond its header.
+    `buffered` is the number of bytes held; `began_packet` tells whether the last feed left an
+    incomplete packet that it started (rather than one already begun).
     """
 
     def __init__(self, max_packet_size: int = DEFAULT_MAX_PACKET_SIZE) -> None:
         self.max_packet_size = max_packet_size
-        self._buf = bytearray()
-        self._need: int | None = None
+        self._chunks: list[bytes] = []  # an incomplete packet, as received
+        self.buffered = 0
+        self._need = PACKET_HEADER_SIZE  # bytes the incomplete packet needs, once known
+        self.began_packet = False
 
-    def feed(self, data: bytes) -> None:
-        self._buf += data
-        if self._need is None:
-            self._check_header()
-
-    def _check_header(self) -> None:
-        if len(self._buf) >= PACKET_HEADER_SIZE:
-            total, _ = parse_packet_header(self._buf)
+    def feed(self, data: bytes) -> tuple[bytes, list[tuple[int, int]]]:
+        if self._chunks:
+            self._chunks.append(data)
+            self.buffered += len(data)
+            self.began_packet = False
+            if self.buffered < self._need:
+                return b"", []
+            data = b"".join(self._chunks)
+        pos, end = 0, len(data)
+        need = PACKET_HEADER_SIZE
+        spans = []
+        while end - pos >= PACKET_HEADER_SIZE:
+            total, _ = parse_packet_header(data, pos)
             if total > self.max_packet_size:
                 raise MoosProtocolError(
                     f"packet of {total} bytes exceeds the limit of {self.max_packet_size} bytes"
                 )
-            self._need = total
-
-    def packets(self) -> Iterator[bytes]:
-        while True:
-            if self._need is None:
-                self._check_header()
-                if self._need is None:
-                    return
-            if len(self._buf) < self._need:
-                return
-            packet = bytes(self._buf[: self._need])
-            del self._buf[: self._need]
-            self._need = None
-            yield packet
-
-    @property
-    def buffered(self) -> int:
-        return len(self._buf)
+            if end - pos < total:
+                need = total
+                break
+            spans.append((pos, pos + total))
+            pos += total
+        self.began_packet = pos < end and (bool(spans) or not self._chunks)
+        self._chunks = [data[pos:]] if pos < end else []
+        self.buffered = end - pos
+        self._need = need
+        return data, spans
 
 
 # ---------------------------------------------------------------------------------------------
