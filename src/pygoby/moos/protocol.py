@@ -207,46 +207,59 @@ def decode_message(data: bytes | memoryview, offset: int = 0, end: int | None = 
     """Decode the message starting at `offset`; returns it and the offset after it."""
     if not isinstance(data, bytes):
         data = bytes(data)
-    limit = len(data) if end is None else end
-    if limit - offset < MESSAGE_FIXED_SIZE:
-        raise ProtocolError(f"message truncated: {limit - offset} bytes left, a message has "
-                            f"at least {MESSAGE_FIXED_SIZE}")  # fmt: skip
-    msg_len, msg_id, msg_type, data_type, n = _START.unpack_from(data, offset)
-    stop = offset + msg_len
-    if msg_len < MESSAGE_FIXED_SIZE or stop > limit:
-        raise ProtocolError(
-            f"message length {msg_len} is below {MESSAGE_FIXED_SIZE} or runs past the packet end"
-        )
-    # each string must leave room for the fixed fields after it: 40, 36, 32, 28 bytes
-    pos = offset + 14
-    if n < 0 or pos + n + 40 > stop:
-        raise _bad_length("src", n)
-    src = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
-    pos += n
-    (n,) = _INT.unpack_from(data, pos)
-    pos += 4
-    if n < 0 or pos + n + 36 > stop:
-        raise _bad_length("src_aux", n)
-    aux = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
-    pos += n
-    (n,) = _INT.unpack_from(data, pos)
-    pos += 4
-    if n < 0 or pos + n + 32 > stop:
-        raise _bad_length("community", n)
-    community = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
-    pos += n
-    (n,) = _INT.unpack_from(data, pos)
-    pos += 4
-    if n < 0 or pos + n + 28 > stop:
-        raise _bad_length("key", n)
-    key = data[pos : pos + n].decode("utf-8", "surrogateescape")
-    time_, dval, dval2, sval_len = _DOUBLES_LENGTH.unpack_from(data, pos + n)
-    pos += n + 28
-    if sval_len < 0 or pos + sval_len != stop:
-        raise ProtocolError(f"sval length {sval_len} does not end the message at its msg_len")
-    msg = MOOSMessage(_CHARS[msg_type], _CHARS[data_type], key, time_, dval, dval2,
-                      data[pos:stop], src, aux, community, msg_id)  # fmt: skip
-    return msg, stop
+    msgs, stop = _decode_messages(data, offset, len(data) if end is None else end, 1)
+    return msgs[0], stop
+
+
+def _decode_messages(data: bytes, pos: int, limit: int, count: int) -> tuple[list[MOOSMessage], int]:
+    """`count` messages from data[pos:limit]; and the offset after the last."""
+    msgs = []
+    append = msgs.append
+    read_start = _START.unpack_from
+    read_int = _INT.unpack_from
+    read_doubles = _DOUBLES_LENGTH.unpack_from
+    chars = _CHARS
+    for _ in range(count):
+        if limit - pos < MESSAGE_FIXED_SIZE:
+            raise ProtocolError(f"message truncated: {limit - pos} bytes left, a message has "
+                                f"at least {MESSAGE_FIXED_SIZE}")  # fmt: skip
+        msg_len, msg_id, msg_type, data_type, n = read_start(data, pos)
+        stop = pos + msg_len
+        if msg_len < MESSAGE_FIXED_SIZE or stop > limit:
+            raise ProtocolError(
+                f"message length {msg_len} is below {MESSAGE_FIXED_SIZE} or runs past the packet end"
+            )
+        # each string must leave room for the fixed fields after it: 40, 36, 32, 28 bytes
+        pos += 14
+        if n < 0 or pos + n + 40 > stop:
+            raise _bad_length("src", n)
+        src = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
+        pos += n
+        (n,) = read_int(data, pos)
+        pos += 4
+        if n < 0 or pos + n + 36 > stop:
+            raise _bad_length("src_aux", n)
+        aux = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
+        pos += n
+        (n,) = read_int(data, pos)
+        pos += 4
+        if n < 0 or pos + n + 32 > stop:
+            raise _bad_length("community", n)
+        community = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
+        pos += n
+        (n,) = read_int(data, pos)
+        pos += 4
+        if n < 0 or pos + n + 28 > stop:
+            raise _bad_length("key", n)
+        key = data[pos : pos + n].decode("utf-8", "surrogateescape")
+        time_, dval, dval2, sval_len = read_doubles(data, pos + n)
+        pos += n + 28
+        if sval_len < 0 or pos + sval_len != stop:
+            raise ProtocolError(f"sval length {sval_len} does not end the message at its msg_len")
+        append(MOOSMessage(chars[msg_type], chars[data_type], key, time_, dval, dval2,
+                           data[pos:stop], src, aux, community, msg_id))  # fmt: skip
+        pos = stop
+    return msgs, pos
 
 
 def _bad_length(what: str, n: int) -> ProtocolError:
@@ -274,11 +287,7 @@ def decode_packet(data: bytes | memoryview, start: int = 0, end: int | None = No
     total, n_msgs = parse_packet_header(data, start)
     if total != end - start:
         raise ProtocolError(f"packet length field says {total} bytes but {end - start} were given")
-    msgs = []
-    pos = start + PACKET_HEADER_SIZE
-    for _ in range(n_msgs):
-        msg, pos = decode_message(data, pos, end)
-        msgs.append(msg)
+    msgs, pos = _decode_messages(data, start + PACKET_HEADER_SIZE, end, n_msgs)
     if pos != end:
         raise ProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
     return msgs
