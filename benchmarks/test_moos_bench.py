@@ -95,7 +95,7 @@ def _wait_ready(procs: list[subprocess.Popen]) -> None:
 
 def _result(proc: subprocess.Popen) -> dict:
     out, _ = proc.communicate(timeout=120)
-    return json.loads(out.strip().splitlines()[-1])
+    return json.loads([line for line in out.splitlines() if line.startswith("{")][-1])
 
 
 def _percentile(values: list[float], q: float) -> float:
