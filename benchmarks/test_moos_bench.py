@@ -192,6 +192,7 @@ async def _app_flood(port: int) -> dict:
 
     cfg = FloodApp.config_class()
     cfg.common.app_tick = 10
+    cfg.common.log = False  # no log file in the working directory
     app = FloodApp(cfg, name=f"flood_app_{time.monotonic_ns()}", port=port)
     await app.start(connect_timeout=5.0)
     await asyncio.sleep(0.5)

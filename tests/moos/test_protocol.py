@@ -211,9 +211,9 @@ def test_fuzz_framer_never_crashes(chunks):
         for chunk in chunks:
             buf, spans = framer.feed(chunk)
             for start, end in spans:
-                with contextlib.suppress(p.ProtocolError):
+                with contextlib.suppress(p.MoosProtocolError):
                     p.decode_packet(buf, start, end)
-    except p.ProtocolError:
+    except p.MoosProtocolError:
         pass
 
 

@@ -215,8 +215,8 @@ class GobyMOOSApp:
             port = self.common.server_port if self.common.HasField("server_port") else p.DEFAULT_PORT
         self._mail: list[MOOSMessage] = []  # received, for the next tick (the list is kept)
         self.client = MOOSClient(self.name, host, port, clock=self.clock, on_message=self._mail.append)
-        self.client.on_connect.append(self._connected)
-        self.client.on_disconnect.append(self._disconnected)
+        self.client.signal_connect.connect(self._connected)
+        self.client.signal_disconnect.connect(self._disconnected)
         self.log = logging.getLogger(f"pygoby.app.{self.name}")
         self.start_time = self.clock.now()
         self.dynamic_vars: dict[str, MOOSMessage] = {}

@@ -405,7 +405,7 @@ class MOOSClient:
             elif kind == p.NULL:
                 continue
             elif kind in (p.WELCOME, p.POISON):
-                raise p.ProtocolError(f"unexpected {kind!r} message after the handshake")
+                raise MoosProtocolError(f"unexpected {kind!r} message after the handshake")
             try:
                 deliver(msg)
             except Exception:

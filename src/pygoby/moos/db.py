@@ -95,7 +95,7 @@ class _Connection(asyncio.Protocol):
                     return
             if data:
                 self._consume(data, now)
-        except p.ProtocolError as err:
+        except MoosProtocolError as err:
             self._drop(f"protocol error: {err}")
         except Exception:  # a bug must cost one connection, never the DB
             log.exception("error while serving client %s", self.name)

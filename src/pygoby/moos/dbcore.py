@@ -25,6 +25,7 @@ import struct
 import time as _time
 
 from pygoby.moos import protocol as p
+from pygoby.moos.errors import MoosProtocolError
 from pygoby.util.clock import Clock, WallClock
 
 log = logging.getLogger(__name__)
@@ -265,16 +266,16 @@ class DBCore:
     # -- packets -------------------------------------------------------------------------------
 
     def process_packet(self, name: str, data: bytes, start: int = 0, end: int | None = None) -> None:
-        """Process the packet in data[start:end] from client `name` (ProtocolError if it is
+        """Process the packet in data[start:end] from client `name` (MoosProtocolError if it is
         malformed: the messages before the fault have taken effect)."""
         client = self.clients[name]
         if end is None:
             end = len(data)
         if end - start < p.PACKET_HEADER_SIZE:
-            raise p.ProtocolError(f"packet of {end - start} bytes is shorter than its header")
+            raise MoosProtocolError(f"packet of {end - start} bytes is shorter than its header")
         total, count, _ = _HEADER.unpack_from(data, start)
         if total != end - start or count < 0:
-            raise p.ProtocolError(f"packet header ({total} bytes, {count} messages) does not "
+            raise MoosProtocolError(f"packet header ({total} bytes, {count} messages) does not "
                                   f"fit the {end - start} bytes given")  # fmt: skip
         now = self.clock.now()
         pos = start + p.PACKET_HEADER_SIZE
@@ -327,7 +328,7 @@ class DBCore:
                 head_seen = None
             if head_seen != head:
                 if end - pos < p.MESSAGE_FIXED_SIZE:
-                    raise p.ProtocolError("message truncated before the end of its fixed fields")
+                    raise MoosProtocolError("message truncated before the end of its fixed fields")
                 msg_len, msg_type, _ = _MSG_HEAD.unpack_from(data, pos)
                 stop = pos + msg_len
                 if msg_len < p.MESSAGE_FIXED_SIZE or stop > end or msg_type != _NOTIFY:
@@ -341,7 +342,7 @@ class DBCore:
                 msg_len, id_types, head_seen, key_len = read_start(data, pos)
             stop = pos + msg_len
             if msg_len < p.MESSAGE_FIXED_SIZE or stop > end:
-                raise p.ProtocolError(f"message length {msg_len} is below "
+                raise MoosProtocolError(f"message length {msg_len} is below "
                                       f"{p.MESSAGE_FIXED_SIZE} or runs past the packet end")  # fmt: skip
             if id_types[4] != _NOTIFY:
                 self._on_other(client, p.decode_message(data, pos, stop)[0], now, answers)
@@ -352,10 +353,10 @@ class DBCore:
             key_at = pos + key_at_offset
             key_end = key_at + 4 + key_len
             if key_len < 0 or key_end + 28 > stop:
-                raise p.ProtocolError(f"key length {key_len} is negative or runs past the message end")
+                raise MoosProtocolError(f"key length {key_len} is negative or runs past the message end")
             (sval_len,) = read_int(data, key_end + 24)
             if sval_len < 0 or key_end + 28 + sval_len != stop:
-                raise p.ProtocolError(f"sval length {sval_len} does not end the message")
+                raise MoosProtocolError(f"sval length {sval_len} does not end the message")
             if forwarded is None:
                 raw = data[pos:stop]
             else:
@@ -383,7 +384,7 @@ class DBCore:
                     sub.client.held.append(raw)
             pos = stop
         if pos != end:
-            raise p.ProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
+            raise MoosProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
         return had_notify
 
     def _first_or_mistyped_write(

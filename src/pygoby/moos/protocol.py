@@ -221,12 +221,12 @@ def _decode_messages(data: bytes, pos: int, limit: int, count: int) -> tuple[lis
     chars = _CHARS
     for _ in range(count):
         if limit - pos < MESSAGE_FIXED_SIZE:
-            raise ProtocolError(f"message truncated: {limit - pos} bytes left, a message has "
+            raise MoosProtocolError(f"message truncated: {limit - pos} bytes left, a message has "
                                 f"at least {MESSAGE_FIXED_SIZE}")  # fmt: skip
         msg_len, msg_id, msg_type, data_type, n = read_start(data, pos)
         stop = pos + msg_len
         if msg_len < MESSAGE_FIXED_SIZE or stop > limit:
-            raise ProtocolError(
+            raise MoosProtocolError(
                 f"message length {msg_len} is below {MESSAGE_FIXED_SIZE} or runs past the packet end"
             )
         # each string must leave room for the fixed fields after it: 40, 36, 32, 28 bytes
@@ -255,15 +255,15 @@ def _decode_messages(data: bytes, pos: int, limit: int, count: int) -> tuple[lis
         time_, dval, dval2, sval_len = read_doubles(data, pos + n)
         pos += n + 28
         if sval_len < 0 or pos + sval_len != stop:
-            raise ProtocolError(f"sval length {sval_len} does not end the message at its msg_len")
+            raise MoosProtocolError(f"sval length {sval_len} does not end the message at its msg_len")
         append(MOOSMessage(chars[msg_type], chars[data_type], key, time_, dval, dval2,
                            data[pos:stop], src, aux, community, msg_id))  # fmt: skip
         pos = stop
     return msgs, pos
 
 
-def _bad_length(what: str, n: int) -> ProtocolError:
-    return ProtocolError(f"{what} length {n} is negative or runs past the message end")
+def _bad_length(what: str, n: int) -> MoosProtocolError:
+    return MoosProtocolError(f"{what} length {n} is negative or runs past the message end")
 
 
 def parse_packet_header(data: bytes | memoryview, offset: int = 0) -> tuple[int, int]:
@@ -283,13 +283,13 @@ def decode_packet(data: bytes | memoryview, start: int = 0, end: int | None = No
         data = bytes(data)
     end = len(data) if end is None else end
     if end - start < PACKET_HEADER_SIZE:
-        raise ProtocolError(f"packet of {end - start} bytes is shorter than its header")
+        raise MoosProtocolError(f"packet of {end - start} bytes is shorter than its header")
     total, n_msgs = parse_packet_header(data, start)
     if total != end - start:
-        raise ProtocolError(f"packet length field says {total} bytes but {end - start} were given")
+        raise MoosProtocolError(f"packet length field says {total} bytes but {end - start} were given")
     msgs, pos = _decode_messages(data, start + PACKET_HEADER_SIZE, end, n_msgs)
     if pos != end:
-        raise ProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
+        raise MoosProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
     return msgs
 
 
@@ -298,7 +298,7 @@ class PacketFramer:
 
     `feed(data)` returns `(buffer, spans)`: the packets that `data` completed are
     buffer[start:end] for each (start, end) in spans; what follows them is kept for the next
-    feed. A length field above `max_packet_size` raises ProtocolError as soon as the header is
+    feed. A length field above `max_packet_size` raises MoosProtocolError as soon as the header is
     seen, so an oversized packet is refused before any of it is buffered beyond its header.
     `buffered` is the number of bytes held; `began_packet` tells whether the last feed left an
     incomplete packet that it started (rather than one already begun).
