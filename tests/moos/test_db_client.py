@@ -16,6 +16,7 @@ import pytest
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient, MoosRefusedError
 from pygoby.moos.db import MOOSDB
+from tests.moos.rawclient import closed_by_peer, raw_connect
 
 
 async def _expect(client: MOOSClient, key: str, timeout: float = 2.0) -> p.MOOSMessage:
@@ -23,30 +24,6 @@ async def _expect(client: MOOSClient, key: str, timeout: float = 2.0) -> p.MOOSM
         msg = await client.receive(timeout)
         if msg.key == key:
             return msg
-
-
-async def _raw_connect(port: int, name: str | None = None):
-    reader, writer = await asyncio.open_connection("127.0.0.1", port)
-    if name is not None:
-        writer.write(p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(name, 0.0)]))
-        await writer.drain()
-        framer = p.PacketFramer()
-        while True:
-            buf, spans = framer.feed(await asyncio.wait_for(reader.read(4096), 2))
-            if spans:
-                assert p.decode_packet(buf, *spans[0])[0].msg_type == p.WELCOME
-                break
-    return reader, writer
-
-
-async def _closed_by_peer(reader: asyncio.StreamReader, timeout: float) -> bool:
-    try:
-        async with asyncio.timeout(timeout):
-            while await reader.read(4096):
-                pass
-        return True
-    except (ConnectionError, TimeoutError):
-        return False
 
 
 async def test_publish_subscribe_all_types():
@@ -179,10 +156,10 @@ async def test_reconnect_resubscribe_and_queue_while_away():
 async def test_garbage_client_is_dropped_and_others_served(caplog):
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     async with MOOSDB(port=0) as db, MOOSClient("good", port=db.port) as good:
-        reader, writer = await _raw_connect(db.port, "bad")
+        reader, writer = await raw_connect(db.port, "bad")
         writer.write(struct.pack("<iiB", 20, 1, 0) + b"\xff" * 11)
         await writer.drain()
-        assert await _closed_by_peer(reader, 2)
+        assert await closed_by_peer(reader, 2)
         assert "dropping client bad" in caplog.text and "protocol error" in caplog.text
         good.subscribe("Z")
         good.publish("Z", 1.0)
@@ -193,21 +170,21 @@ async def test_garbage_client_is_dropped_and_others_served(caplog):
 async def test_oversized_packet_refused_from_header(caplog):
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     async with MOOSDB(port=0, max_packet_size=4096) as db:
-        reader, writer = await _raw_connect(db.port, "big")
+        reader, writer = await raw_connect(db.port, "big")
         writer.write(struct.pack("<iiB", 1 << 30, 1, 0))
         await writer.drain()
-        assert await _closed_by_peer(reader, 2)
+        assert await closed_by_peer(reader, 2)
         assert "exceeds the limit" in caplog.text
         writer.close()
 
 
 async def test_silent_client_dropped_after_timeout():
     async with MOOSDB(port=0, client_timeout=1.5) as db:
-        reader, writer = await _raw_connect(db.port, "quiet")
+        reader, writer = await raw_connect(db.port, "quiet")
         # a real client keeps itself alive with T messages
         async with MOOSClient("chatty", port=db.port, reconnect_interval=5) as c:
             assert "quiet" in db.client_names
-            assert await _closed_by_peer(reader, 3)
+            assert await closed_by_peer(reader, 3)
             assert "quiet" not in db.client_names
             await asyncio.sleep(1.0)
             assert c.connected and c.connections == 1
@@ -216,16 +193,16 @@ async def test_silent_client_dropped_after_timeout():
 
 async def test_half_open_handshake_does_not_block_others():
     async with MOOSDB(port=0, handshake_timeout=1.0) as db:
-        idle_reader, idle_writer = await _raw_connect(db.port)  # connects, sends nothing
+        idle_reader, idle_writer = await raw_connect(db.port)  # connects, sends nothing
         async with MOOSClient("after", port=db.port) as c:
             assert c.connected
-        assert await _closed_by_peer(idle_reader, 3)  # and the idle one is closed in time
+        assert await closed_by_peer(idle_reader, 3)  # and the idle one is closed in time
         idle_writer.close()
 
 
 async def test_wrong_protocol_string_closed_silently():
     async with MOOSDB(port=0) as db:
-        reader, writer = await _raw_connect(db.port)
+        reader, writer = await raw_connect(db.port)
         writer.write(b"HELLO".ljust(32, b"\0"))
         await writer.drain()
         assert await asyncio.wait_for(reader.read(100), 2) == b""
@@ -369,7 +346,7 @@ async def test_packets_cut_anywhere_by_tcp_are_all_delivered():
     async with MOOSDB(port=0) as db, MOOSClient("sink", port=db.port) as sink:
         sink.subscribe("CUT")
         await sink.flush()
-        reader, writer = await _raw_connect(db.port, "cutter")
+        reader, writer = await raw_connect(db.port, "cutter")
         writer.get_extra_info("socket").setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         stream = b"".join(
             p.encode_packet([p.notify("CUT", float(i * 3 + j), time=1.0, src="cutter", msg_id=i)

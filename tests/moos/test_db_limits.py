@@ -14,31 +14,9 @@ from pathlib import Path
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
+from tests.moos.rawclient import closed_by_peer, raw_connect
 
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))
-
-
-async def _handshaken(port: int, name: str) -> tuple[asyncio.StreamReader, asyncio.StreamWriter]:
-    reader, writer = await asyncio.open_connection("127.0.0.1", port)
-    writer.write(p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(name, 0.0)]))
-    header = await asyncio.wait_for(reader.readexactly(p.PACKET_HEADER_SIZE), 2)
-    total, _ = p.parse_packet_header(header)
-    welcome = p.decode_packet(header + await reader.readexactly(total - p.PACKET_HEADER_SIZE))
-    assert welcome[0].msg_type == p.WELCOME
-    return reader, writer
-
-
-async def _closed_by_peer(reader: asyncio.StreamReader, timeout: float) -> bool:
-    """Did the DB close (or reset) the connection within `timeout`?"""
-    try:
-        async with asyncio.timeout(timeout):
-            while await reader.read(65536):
-                pass
-    except ConnectionError:
-        return True  # reset: the DB aborted with our bytes unread
-    except TimeoutError:
-        return False
-    return True
 
 
 async def _delivered(port: int, key: str) -> bool:
@@ -74,14 +52,14 @@ async def test_hostile_wildcard_does_not_freeze_the_db():
 async def test_trickled_packet_dropped_at_its_deadline(caplog):
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     async with MOOSDB(port=0, packet_timeout=1.0, client_timeout=30.0) as db:
-        reader, writer = await _handshaken(db.port, "trickler")
+        reader, writer = await raw_connect(db.port, "trickler")
         writer.write(struct.pack("<iiB", 1 << 20, 1, 0) + b"\0" * 1000)  # 1 MB announced
         for _ in range(10):  # a byte every 0.2 s: never silent, never finished
             await asyncio.sleep(0.2)
             if writer.is_closing() or reader.at_eof():
                 break
             writer.write(b"\0")
-        assert await _closed_by_peer(reader, 2)
+        assert await closed_by_peer(reader, 2)
         assert "took more than 1 s to arrive" in caplog.text
         assert db.buffered == 0
         assert await _delivered(db.port, "STILL_SERVING")
@@ -92,7 +70,7 @@ async def test_partial_packets_stay_within_the_memory_budget(caplog):
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     budget = 1 << 20
     async with MOOSDB(port=0, memory_budget=budget) as db:
-        hogs = [await _handshaken(db.port, f"hog{i}") for i in range(3)]
+        hogs = [await raw_connect(db.port, f"hog{i}") for i in range(3)]
         # each announces a 4 MB packet; two send 300 kB of it, then the third 600 kB: when the
         # budget is exceeded the third holds more than 1 MB - 600 kB, the most
         for (_, writer), size in zip(hogs, (300 << 10, 300 << 10, 600 << 10), strict=True):
@@ -100,7 +78,7 @@ async def test_partial_packets_stay_within_the_memory_budget(caplog):
             await writer.drain()
             await asyncio.sleep(0.2)
         assert db.buffered <= budget
-        dropped = [await _closed_by_peer(reader, 0.5) for reader, _ in hogs]
+        dropped = [await closed_by_peer(reader, 0.5) for reader, _ in hogs]
         assert dropped == [False, False, True]
         assert "memory budget" in caplog.text
         assert await _delivered(db.port, "STILL_SERVING")
@@ -112,7 +90,7 @@ async def test_unread_output_stays_within_the_memory_budget(caplog):
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     budget = 1 << 20
     async with MOOSDB(port=0, memory_budget=budget) as db:
-        reader, writer = await _handshaken(db.port, "sleeper")
+        reader, writer = await raw_connect(db.port, "sleeper")
         sock = writer.get_extra_info("socket")
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
         writer.write(p.encode_packet([p.MOOSMessage(p.REGISTER, p.DOUBLE, "BULK", dval=0, src="sleeper")]))
@@ -136,11 +114,11 @@ async def test_unread_output_stays_within_the_memory_budget(caplog):
 async def test_connection_limit(caplog):
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     async with MOOSDB(port=0, max_clients=3) as db:
-        first = [await _handshaken(db.port, f"c{i}") for i in range(2)]
+        first = [await raw_connect(db.port, f"c{i}") for i in range(2)]
         _, idle_writer = await asyncio.open_connection("127.0.0.1", db.port)
         await asyncio.sleep(0.1)  # handshaking connections count too
         extra_reader, extra_writer = await asyncio.open_connection("127.0.0.1", db.port)
-        assert await _closed_by_peer(extra_reader, 2)
+        assert await closed_by_peer(extra_reader, 2)
         assert "max_clients" in caplog.text
         idle_writer.close()
         await asyncio.sleep(0.2)
@@ -155,11 +133,11 @@ async def test_console_script_limits():
                            "--packet-timeout", "0.5"], stdout=subprocess.PIPE, text=True)  # fmt: skip
     try:
         port = int(db.stdout.readline().rsplit(":", 1)[1])
-        reader, writer = await _handshaken(port, "only")
+        reader, writer = await raw_connect(port, "only")
         extra_reader, extra_writer = await asyncio.open_connection("127.0.0.1", port)
-        assert await _closed_by_peer(extra_reader, 2)  # one client at most
+        assert await closed_by_peer(extra_reader, 2)  # one client at most
         writer.write(struct.pack("<iiB", 1000, 1, 0))  # a packet that never completes
-        assert await _closed_by_peer(reader, 3)
+        assert await closed_by_peer(reader, 3)
         writer.close()
         extra_writer.close()
     finally:
