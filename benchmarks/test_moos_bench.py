@@ -225,6 +225,7 @@ async def _app_flood(port: int) -> dict:
         "behind_at_end": behind,
         "caught_up_s": caught_up,
         "rss_start_mb": rss[0] / 2**20,
+        "rss_1s_mb": rss[min(4, len(rss) - 1)] / 2**20,  # a second into the flood
         "rss_peak_mb": max(rss) / 2**20,
         "rss_end_mb": rss[-1] / 2**20,
     }
@@ -239,5 +240,5 @@ def test_goby_moos_app_under_a_flood(benchmark, moosdb):
           f"{result['sent']} at {result['app_cpu_us']:.2f} us CPU each (client + app), "
           f"{result['behind_at_end']} behind when "
           f"the publisher stopped, all handled {result['caught_up_s']:.2f} s after; RSS "
-          f"{result['rss_start_mb']:.1f} MB at start, {result['rss_peak_mb']:.1f} MB peak, "
-          f"{result['rss_end_mb']:.1f} MB at the end")  # fmt: skip
+          f"{result['rss_start_mb']:.1f} MB at start, {result['rss_1s_mb']:.1f} MB after 1 s, "
+          f"{result['rss_peak_mb']:.1f} MB peak, {result['rss_end_mb']:.1f} MB at the end")  # fmt: skip
