@@ -4,10 +4,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import TypeVar
 
+from pygoby.dccl.arithmetic import ArithmeticCodec
+from pygoby.dccl.ccl.codecs import CCL_FIELD_CODECS
 from pygoby.dccl.codecs.base import ALL_CATEGORIES, NUMERIC_CATEGORIES, FieldCodec, FieldInfo
 from pygoby.dccl.codecs.boolean import BoolCodec
 from pygoby.dccl.codecs.enum import EnumCodec, EnumCodecV2
+from pygoby.dccl.codecs.native_protobuf import NativeProtobufCodec
 from pygoby.dccl.codecs.numeric import NumericCodec
 from pygoby.dccl.codecs.presence import make_presence_codec
 from pygoby.dccl.codecs.static import StaticCodec
@@ -16,6 +20,7 @@ from pygoby.dccl.codecs.time import TimeCodec
 from pygoby.dccl.errors import DcclLoadError
 
 CodecFactory = Callable[[FieldInfo], FieldCodec]
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -33,6 +38,7 @@ class CodecRegistry:
 
     def __init__(self) -> None:
         self._entries: dict[tuple[str, str], CodecFactory | DefaultMessageCodec] = {}
+        self._state: dict[type, object] = {}
 
     def register(
         self, name: str, categories: Iterable[str], factory: CodecFactory | DefaultMessageCodec
@@ -44,9 +50,18 @@ class CodecRegistry:
             self._entries[(name, category)] = factory
 
     def copy(self) -> CodecRegistry:
+        """The same codecs, with state of its own (e.g. no arithmetic models)."""
         other = CodecRegistry()
         other._entries = dict(self._entries)
         return other
+
+    def shared_state(self, kind: type[T]) -> T:
+        """The one `kind()` object that the codecs of this registry share (created on first
+        use), e.g. the arithmetic models of a Codec (C++ DCCL's codec-specific data)."""
+        state = self._state.get(kind)
+        if state is None:
+            state = self._state[kind] = kind()
+        return state  # type: ignore[return-value]
 
     def resolve(
         self, name: str, version: int, category: str
@@ -103,6 +118,13 @@ def _build_default_registry() -> CodecRegistry:
             registry.register(f"dccl.var_bytes{version}", ["string", "bytes"], VarBytesCodec)
     registry.register("_time", time_types, TimeCodec)
     registry.register("_static", static_types, StaticCodec)
+    for name, (categories, factory) in CCL_FIELD_CODECS.items():
+        registry.register(name, categories, factory)
+    arithmetic_types = (*NUMERIC_CATEGORIES, "bool", "enum")
+    registry.register("dccl.arithmetic", arithmetic_types, ArithmeticCodec)
+    registry.register("_arithmetic", arithmetic_types, ArithmeticCodec)
+    registry.register("dccl.native_protobuf", arithmetic_types, NativeProtobufCodec)
+    registry.register("dccl.native_protobuf", ["message"], DefaultMessageCodec(4))
     return registry
 
 
