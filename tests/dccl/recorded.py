@@ -74,6 +74,10 @@ class RecordCodecs:
         self.clock = VirtualClock(0)
         self._codecs: dict[tuple[str, str, str | None], Codec] = {}
 
+    def drop(self, record: dict) -> None:
+        """Forget this record's Codec (the recorder restarted C++ after a hang: fresh state)."""
+        self._codecs.pop((record["where"], record["proto"], record.get("passphrase")), None)
+
     def get(self, record: dict, strict: bool = False) -> Codec:
         key = (record["where"], record["proto"], record.get("passphrase"))
         codec = self._codecs.get(key)

@@ -18,6 +18,7 @@ from pygoby.dccl.compiler import compile_decoder, compile_encoder
 from pygoby.dccl.conditions import DynamicConditions
 from pygoby.dccl.crypto import BodyCipher
 from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError, DcclError, DcclLoadError
+from pygoby.dccl.hashing import definition_hash, hash_codecs
 from pygoby.dccl.identifier import DefaultIdCodec, is_ccl_id
 from pygoby.dccl.identifier import id_codec as lookup_id_codec
 from pygoby.dccl.plan import Part, Planner, root_options
@@ -167,6 +168,11 @@ class Codec:
         planner = Planner(root, self.registry, self._now, self._lua)
         head = planner.plan_root(descriptor, Part.HEAD)
         body = planner.plan_root(descriptor, Part.BODY)
+        hash_fields = [*hash_codecs(head), *hash_codecs(body)]
+        if hash_fields:
+            full_hash = definition_hash(descriptor, head, body)
+            for codec in hash_fields:
+                codec.set_hash(full_hash)
         id_raw, id_bits = (0, 0) if root.id is None else self._id_codec.encode(root.id, root.name)
         head_bytes = (id_bits + head.max_size() + 7) // 8
         max_encoded = head_bytes + (body.max_size() + 7) // 8
@@ -241,6 +247,12 @@ class Codec:
     def analyze(self, message_type: type[Message] | Descriptor | str) -> str:
         """A table of the type's fields: codec, part (head/body), bit sizes, and totals."""
         return describe(self.compiled(message_type))
+
+    def definition_hash(self, message_type: type[Message] | Descriptor | str) -> int:
+        """The 64-bit hash of a type's DCCL definition that C++ DCCL's `load()` returns (and
+        `dccl.hash` fields send masked); see pygoby.dccl.hashing."""
+        compiled = self.compiled(message_type)
+        return definition_hash(compiled.cls.DESCRIPTOR, compiled.head, compiled.body)
 
     def max_size(self, message_type: type[Message] | Descriptor | str) -> int:
         return self.compiled(message_type).max_size()

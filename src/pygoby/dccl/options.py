@@ -7,13 +7,23 @@ import functools
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf import builtin_class, default_loader
 
 _CARRIER_PROTO = "pygoby/dccl/option_carrier.proto"
 
 
+# add-on extensions of DCCLFieldOptions, known to the carriers' pool so that they parse (and
+# print, for dccl.hash) as the named extensions C++ DCCL sees
+_EXTENSION_PROTOS = (
+    "dccl/ccl/protobuf/ccl_extensions.proto",
+    "dccl/arithmetic/protobuf/arithmetic_extensions.proto",
+)
+
+
 @functools.cache
 def _carriers() -> tuple[type[Message], type[Message]]:
+    for proto in _EXTENSION_PROTOS:
+        default_loader().load_file(proto)
     return (
         builtin_class(_CARRIER_PROTO, "pygoby.dccl.FieldOptionsCarrier"),
         builtin_class(_CARRIER_PROTO, "pygoby.dccl.MessageOptionsCarrier"),

@@ -18,6 +18,7 @@ from pygoby.dccl.codecs.static import StaticCodec
 from pygoby.dccl.codecs.strings import FixedBytesCodec, StringCodecV2, StringCodecV3, VarBytesCodec
 from pygoby.dccl.codecs.time import TimeCodec
 from pygoby.dccl.errors import DcclLoadError
+from pygoby.dccl.hashing import HashCodec
 
 CodecFactory = Callable[[FieldInfo], FieldCodec]
 T = TypeVar("T")
@@ -81,13 +82,6 @@ class CodecRegistry:
         return factory(info)
 
 
-def _unsupported_hash(info: FieldInfo) -> FieldCodec:
-    raise DcclLoadError(
-        f"{info.name}: dccl.hash depends on C++ std::hash and protobuf's DebugString text and "
-        "cannot be reproduced portably; it is not supported"
-    )
-
-
 def _default_scalar_codecs(version: int) -> dict[str, CodecFactory]:
     codecs: dict[str, CodecFactory] = dict.fromkeys(NUMERIC_CATEGORIES, NumericCodec)
     codecs["bool"] = BoolCodec
@@ -110,7 +104,7 @@ def _build_default_registry() -> CodecRegistry:
         registry.register(f"dccl.default{version}", ["message"], DefaultMessageCodec(version))
         registry.register(f"dccl.time{version}", time_types, TimeCodec)
         registry.register(f"dccl.static{version}", static_types, StaticCodec)
-        registry.register(f"dccl.hash{version}", ["uint32"], _unsupported_hash)
+        registry.register(f"dccl.hash{version}", ["uint32"], HashCodec)
         if version >= 3:
             scalars = ALL_CATEGORIES - {"message"}
             registry.register(f"dccl.presence{version}", scalars, make_presence_codec)

@@ -10,8 +10,9 @@ fixed size. Used per field (`codec: "dccl.native_protobuf"`) or for a whole mess
 Strings and bytes have no native codec (as in C++).
 
 Decoding reads varint bytes while their top bit is set, as C++ does. Where C++ then reads
-undefined memory, pygoby raises DcclDecodeError: a varint longer than protobuf's 10 bytes, a
-bool byte with its top bit set (an unfinished varint); a negative enum index is "not set".
+undefined memory, pygoby decides: a varint longer than protobuf's 10 bytes is a
+DcclDecodeError, a bool byte with its top bit set is true (what C++ gives in practice), a
+negative enum index is "not set".
 """
 
 from __future__ import annotations
@@ -125,8 +126,8 @@ class NativeProtobufCodec(FieldCodec):
             pos += n
             if self.fixed is not None:
                 return self.fixed.unpack(raw.to_bytes(n // 8, "little"))[0], pos
-            if raw & 0x80:
-                raise DcclDecodeError(f"{name}: bool byte {raw:#04x} is an unfinished varint")
+            # a byte with its top bit set is an unfinished varint to protobuf; C++ DCCL then
+            # returns an undefined value, in practice true: any nonzero byte is true here
             return raw != 0, pos
         value = shift = count = 0
         while True:
