@@ -11,6 +11,7 @@ cannot run: the error says to give its messages' .proto files (`load_proto_file`
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import PurePath
 from typing import Any
@@ -86,3 +87,16 @@ def builtin_library(name: str) -> BuiltinLibrary:
             f" messages with load_proto_file instead (built in: {known})"
         )
     return library
+
+
+def split_libraries(names: Iterable[str]) -> tuple[list[BuiltinLibrary], list[str]]:
+    """A `load_shared_library` list as (pygoby built-ins for C++ DCCL codec libraries, the other
+    names: Python modules or .py files of generated message code). A shared library that is not
+    a DCCL codec library is a DcclLoadError saying what to use instead."""
+    libraries, others = [], []
+    for name in names:
+        if is_shared_library(name):
+            libraries.append(builtin_library(name))
+        else:
+            others.append(name)
+    return libraries, others
