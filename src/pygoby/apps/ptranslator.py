@@ -11,8 +11,8 @@ from google.protobuf.message import Message
 
 from pygoby.dccl import DcclError
 from pygoby.dccl.libraries import split_libraries
+from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError
 from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
 
 
