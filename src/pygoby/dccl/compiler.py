@@ -216,6 +216,15 @@ class _PartCompiler:
         """Bind a field's conditions (for `_dc.omit`/`_dc.required` calls)."""
         return self.src.name("dc", path, item.conditions, f"conditions of {item.field.full_name}")
 
+    def _omit_guard(self, item, path: str, var: str, ind: int) -> tuple[str, int]:
+        """Bind a message field's conditions; if it has omit_if, open `if not omitted:`.
+        Returns the conditions' name and the indent to continue at."""
+        dc = self._conditions(item, path)
+        if item.conditions.omit_if is not None:
+            self.src.add(ind, f"if not _dc.omit({dc}, {var}, m0):")
+            ind += 1
+        return dc, ind
+
     def _index(self, ind: int, index: str) -> None:
         """C++ DCCL's repeated index, which `this_index` reads, follows every element coded."""
         if self.lua is not None:
@@ -337,10 +346,7 @@ class EncoderCompiler(_PartCompiler):
         child_var = self.src.name("m", path)
         conditions = item.conditions
         if conditions is not None:
-            dc = self._conditions(item, path)
-            if conditions.omit_if is not None:
-                self.src.add(ind, f"if not _dc.omit({dc}, {var}, m0):")
-                ind += 1
+            dc, ind = self._omit_guard(item, path, var, ind)
             if conditions.required_if is not None and item.presence_bit:
                 # C++ asks with `this` = the sub-message (an empty one when unset)
                 self.src.add(ind, f"{child_var} = {value}")
@@ -549,10 +555,7 @@ class DecoderCompiler(_PartCompiler):
         child_var = self.src.name("m", path)
         conditions = item.conditions
         if conditions is not None:
-            dc = self._conditions(item, path)
-            if conditions.omit_if is not None:
-                self.src.add(ind, f"if not _dc.omit({dc}, {var}, m0):")
-                ind += 1
+            dc, ind = self._omit_guard(item, path, var, ind)
             if conditions.required_if is not None and item.presence_bit:
                 # as C++: the sub-message exists (empty) while it is asked and decoded
                 self.src.add(ind, f"{child_var} = {_get(var, name)}")

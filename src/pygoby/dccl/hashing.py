@@ -26,6 +26,7 @@ from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec
 from pygoby.dccl.codecs.numeric import NumericCodec
 from pygoby.dccl.errors import DcclDecodeError, DcclLoadError
 from pygoby.dccl.options import field_options, message_options
+from pygoby.protobuf.cpp_text import c_escape, message_text, scalar_text
 
 _U64 = (1 << 64) - 1
 _MUL = 0xC6A4A7935BD1E995
@@ -63,83 +64,13 @@ def _combine_text(seed: int, text: str) -> int:
 
 
 # ------------------------------------------------------------------ protobuf C++ text
-def c_escape(data: bytes) -> str:
-    """protobuf's CEscape (octal for bytes outside printable ASCII)."""
-    out = []
-    for byte in data:
-        char = chr(byte)
-        if char == "\n":
-            out.append("\\n")
-        elif char == "\r":
-            out.append("\\r")
-        elif char == "\t":
-            out.append("\\t")
-        elif char in "\"'\\":
-            out.append("\\" + char)
-        elif 0x20 <= byte < 0x7F:
-            out.append(char)
-        else:
-            out.append(f"\\{byte:03o}")
-    return "".join(out)
-
-
-def simple_dtoa(value: float) -> str:
-    if value != value:
-        return "nan"
-    if value in (float("inf"), float("-inf")):
-        return "inf" if value > 0 else "-inf"
-    text = f"{value:.15g}"
-    return text if float(text) == value else f"{value:.17g}"
-
-
-def simple_ftoa(value: float) -> str:
-    from pygoby.dccl.codecs.numeric import f32
-
-    if value != value:
-        return "nan"
-    if value in (float("inf"), float("-inf")):
-        return "inf" if value > 0 else "-inf"
-    text = f"{value:.6g}"
-    return text if f32(float(text)) == value else f"{value:.9g}"
-
-
-def _scalar_text(f: FieldDescriptor, value) -> str:
-    cpp = f.cpp_type
-    if cpp == FieldDescriptor.CPPTYPE_STRING:
-        data = value if isinstance(value, bytes) else value.encode()
-        return f'"{c_escape(data)}"'
-    if cpp == FieldDescriptor.CPPTYPE_BOOL:
-        return "true" if value else "false"
-    if cpp == FieldDescriptor.CPPTYPE_DOUBLE:
-        return simple_dtoa(value)
-    if cpp == FieldDescriptor.CPPTYPE_FLOAT:
-        return simple_ftoa(value)
-    if cpp == FieldDescriptor.CPPTYPE_ENUM:
-        known = f.enum_type.values_by_number.get(value)
-        return known.name if known is not None else str(value)
-    return str(value)
-
-
-def _field_name(f: FieldDescriptor) -> str:
-    return f"[{f.full_name}]" if f.is_extension else f.name
-
-
 def _sorted_fields(msg: Message):
     return sorted(msg.ListFields(), key=lambda fv: fv[0].number)
 
 
 def text_format(msg: Message, indent: int = 0) -> str:
     """C++ `TextFormat::Printer` (what `DebugString()` prints), from `indent` spaces."""
-    pad = " " * indent
-    lines = []
-    for f, value in _sorted_fields(msg):
-        values = list(value) if f.is_repeated else [value]
-        for v in values:
-            if f.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE:
-                lines.append(f"{pad}{_field_name(f)} {{\n{text_format(v, indent + 2)}{pad}}}\n")
-            else:
-                lines.append(f"{pad}{_field_name(f)}: {_scalar_text(f, v)}\n")
-    return "".join(lines)
+    return message_text(msg, single_line=False, indent=indent)
 
 
 def _option_entries(depth: int, options: Message, dccl_options: Message | None) -> list[str]:
@@ -149,7 +80,7 @@ def _option_entries(depth: int, options: Message, dccl_options: Message | None) 
     for f, value in _sorted_fields(options):
         if f.is_extension:
             continue
-        entries.append((f.number, f"{f.name} = {_scalar_text(f, value)}"))
+        entries.append((f.number, f"{f.name} = {scalar_text(f, value)}"))
     if dccl_options is not None and dccl_options.ListFields():
         body = text_format(dccl_options, 2 * (depth + 1))
         entries.append((1012, f"(.dccl.field) = {{\n{body}{' ' * (2 * depth)}}}"))
@@ -235,7 +166,7 @@ def enum_debug_string(enum: EnumDescriptor) -> str:
     lines = [f"enum {enum.name} {{\n"]
     for f, value in _sorted_fields(proto.options):
         if not f.is_extension:
-            lines.append(f"  option {f.name} = {_scalar_text(f, value)};\n")
+            lines.append(f"  option {f.name} = {scalar_text(f, value)};\n")
     for value in enum.values:
         value_proto = next(v for v in proto.value if v.number == value.number and v.name == value.name)
         options = _option_entries(1, value_proto.options, None)

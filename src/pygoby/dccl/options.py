@@ -8,6 +8,7 @@ from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.protobuf import builtin_class, default_loader
+from pygoby.protobuf.wire import length_delimited
 
 _CARRIER_PROTO = "pygoby/dccl/option_carrier.proto"
 
@@ -46,39 +47,6 @@ def message_options(descriptor: Descriptor) -> Message:
     return carrier.msg
 
 
-def _varint(data: bytes, pos: int) -> tuple[int, int]:
-    value = shift = 0
-    while True:
-        byte = data[pos]
-        pos += 1
-        value |= (byte & 0x7F) << shift
-        shift += 7
-        if byte < 0x80:
-            return value, pos
-
-
-def _length_delimited(data: bytes, number: int) -> bytes:
-    """The concatenated payloads of length-delimited field `number` in serialized `data`."""
-    found, pos = [], 0
-    while pos < len(data):
-        tag, pos = _varint(data, pos)
-        wire = tag & 7
-        if wire == 0:
-            _, pos = _varint(data, pos)
-        elif wire == 1:
-            pos += 8
-        elif wire == 5:
-            pos += 4
-        elif wire == 2:
-            size, pos = _varint(data, pos)
-            if tag >> 3 == number:
-                found.append(data[pos : pos + size])
-            pos += size
-        else:  # groups: not used in options
-            break
-    return b"".join(found)
-
-
 def field_extension(options: Message, proto_file: str, message_name: str, number: int) -> Message:
     """An add-on's extension of DCCLFieldOptions (e.g. `(dccl.field).(arithmetic)`, number
     1001, or `(dccl.field).(ccl)`, 1000) as a message of `message_name` from our `proto_file`.
@@ -86,5 +54,5 @@ def field_extension(options: Message, proto_file: str, message_name: str, number
     Read from the serialized options, so it works whichever descriptor pool compiled the user's
     .proto file (there the extension is known or an unknown field)."""
     extension = builtin_class(proto_file, message_name)()
-    extension.ParseFromString(_length_delimited(options.SerializeToString(), number))
+    extension.ParseFromString(length_delimited(options.SerializeToString(), number))
     return extension

@@ -17,24 +17,14 @@ from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import DecodeError, Message
 
 from pygoby.dccl.errors import DcclDecodeError
-
-
-def _varint(n: int) -> bytes:
-    out = bytearray()
-    while n > 0x7F:
-        out.append(n & 0x7F | 0x80)
-        n >>= 7
-    out.append(n)
-    return bytes(out)
+from pygoby.protobuf.wire import length_delimited_field
 
 
 def _wire(field: FieldDescriptor, values: Sequence[str | bytes]) -> bytes:
-    tag = _varint(field.number << 3 | 2)
-    parts = []
-    for value in values:
-        data = value.encode() if isinstance(value, str) else bytes(value)
-        parts.append(tag + _varint(len(data)) + data)
-    return b"".join(parts)
+    return b"".join(
+        length_delimited_field(field.number, v.encode() if isinstance(v, str) else bytes(v))
+        for v in values
+    )
 
 
 def _merge(msg: Message, field: FieldDescriptor, wire: bytes) -> None:

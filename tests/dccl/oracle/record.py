@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import random
 import select
 import subprocess
@@ -38,21 +37,25 @@ from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 REPO = Path(__file__).resolve().parents[3]
-sys.path.insert(0, str(REPO / "src"))
+sys.path[:0] = [str(REPO / "src"), str(REPO)]
 
-from pygoby.dccl.options import field_options, message_options  # noqa: E402
-from pygoby.protobuf import BUILTIN_PROTO_DIR, ProtoLoader  # noqa: E402
+from pygoby.dccl.options import field_extension, field_options, message_options  # noqa: E402
+from pygoby.protobuf import ProtoLoader  # noqa: E402
+from tests.dccl.recorded import (  # noqa: E402
+    LIBRARIES,
+    MODELS,
+    PROTO_DIRS,
+    TEST_PROTOS,
+    models_for,
+)
 
-SHARED = Path(os.environ.get("PYGOBY_SHARED", REPO.parent / "shared")) / "vectors" / "dccl"
-TEST_PROTOS = REPO / "tests" / "dccl" / "protos"
-MODELS = TEST_PROTOS / "arith_models"
+SHARED = PROTO_DIRS["shared"]
 OUT = REPO / "tests" / "dccl" / "data"
 NOW = 1_700_000_000
 ANSWERS = ("ok", "error", "hex", "text", "size", "pong")
 
-# where a record's "proto" lives: "shared" (../shared/vectors/dccl), "tests" (tests/dccl/protos),
-# "builtin" (pygoby's own .proto files, e.g. dccl/ccl/protobuf/ccl.proto)
-PROTO_DIRS = {"shared": SHARED, "tests": TEST_PROTOS, "builtin": BUILTIN_PROTO_DIR}
+# a record's "proto" is found in PROTO_DIRS[record["where"]]: "shared" (../shared/vectors/dccl),
+# "tests" (tests/dccl/protos), "builtin" (pygoby's own .proto files)
 CORPUS_PROTOS = [
     ("shared", "example.proto"),
     ("shared", "edge.proto"),
@@ -68,15 +71,6 @@ CORPUS_PROTOS = [
     ("tests", "cclmix.proto"),
     ("builtin", "dccl/ccl/protobuf/ccl.proto"),
 ]
-LIBRARIES = {
-    "arith.proto": ["libdccl_arithmetic.so"],
-    "hash.proto": ["libdccl_arithmetic.so"],
-    "native.proto": ["libdccl_native_protobuf.so"],
-    "cclmix.proto": ["libdccl_ccl_compat.so"],
-    "dccl/ccl/protobuf/ccl.proto": ["libdccl_ccl_compat.so"],
-}
-
-
 def hexs(text: str | bytes) -> str:
     return (text.encode() if isinstance(text, str) else text).hex()
 
@@ -374,47 +368,11 @@ class Values:
 
 def field_options_ext(f: FieldDescriptor, name: str):
     """An extension of (dccl.field) read from the field's options (arithmetic, ccl)."""
-    from pygoby.protobuf import builtin_class
-
     proto, cls, number = {
         "arithmetic": ("dccl/arithmetic/protobuf/arithmetic_extensions.proto", "ArithmeticOptions", 1001),
         "ccl": ("dccl/ccl/protobuf/ccl_extensions.proto", "LegacyCCLFieldOptions", 1000),
     }[name]
-    ext = builtin_class(proto, cls)()
-    for field_number, payload in _length_delimited(field_options(f).SerializeToString()):
-        if field_number == number:
-            ext.MergeFromString(payload)
-    return ext
-
-
-def _varint(data: bytes, pos: int) -> tuple[int, int]:
-    value = shift = 0
-    while True:
-        byte = data[pos]
-        pos += 1
-        value |= (byte & 0x7F) << shift
-        shift += 7
-        if byte < 0x80:
-            return value, pos
-
-
-def _length_delimited(data: bytes):
-    pos = 0
-    while pos < len(data):
-        tag, pos = _varint(data, pos)
-        wire = tag & 7
-        if wire == 0:
-            _, pos = _varint(data, pos)
-        elif wire == 1:
-            pos += 8
-        elif wire == 5:
-            pos += 4
-        elif wire == 2:
-            n, pos = _varint(data, pos)
-            yield tag >> 3, data[pos:pos + n]
-            pos += n
-        else:
-            raise ValueError(f"wire type {wire}")
+    return field_extension(field_options(f), proto, cls, number)
 
 
 def to_text(msg: Message) -> str:
@@ -487,10 +445,6 @@ def write(name: str, records: list[dict]) -> None:
         for record in records:
             out.write(json.dumps(record, sort_keys=False) + "\n")
     print(f"{path.relative_to(REPO)}: {len(records)} records", file=sys.stderr)
-
-
-def models_for(proto: str) -> list[Path]:
-    return sorted(MODELS.glob("*.txt")) if proto in ("arith.proto", "hash.proto") else []
 
 
 def corpus(oracle: Oracle, rng: random.Random, per_type: int) -> list[dict]:

@@ -24,6 +24,7 @@ from google.protobuf.descriptor import FieldDescriptor as FD
 
 from pygoby.dccl.codecs.base import FieldCodec, FieldInfo
 from pygoby.dccl.errors import DcclDecodeError, DcclLoadError
+from pygoby.protobuf.wire import encode_varint
 
 _U64 = (1 << 64) - 1
 _U32 = (1 << 32) - 1
@@ -39,17 +40,6 @@ _VARINT = {FD.TYPE_INT32, FD.TYPE_INT64, FD.TYPE_UINT32, FD.TYPE_UINT64, FD.TYPE
            FD.TYPE_SINT64, FD.TYPE_ENUM}
 _VARINT32 = {FD.TYPE_INT32, FD.TYPE_UINT32, FD.TYPE_SINT32, FD.TYPE_ENUM}
 _SIGNED_32 = {FD.TYPE_INT32, FD.TYPE_SINT32, FD.TYPE_ENUM}
-
-
-def varint_bytes(value: int) -> bytes:
-    """protobuf's varint of a 64-bit two's complement value."""
-    value &= _U64
-    out = bytearray()
-    while value > 0x7F:
-        out.append(value & 0x7F | 0x80)
-        value >>= 7
-    out.append(value)
-    return bytes(out)
 
 
 def _zigzag(value: int, bits: int) -> int:
@@ -84,12 +74,12 @@ class NativeProtobufCodec(FieldCodec):
         if kind == FD.TYPE_BOOL:
             return lambda v: b"\x01" if v else b"\x00"
         if kind == FD.TYPE_SINT32:
-            return lambda v: varint_bytes(_zigzag(v, 32) & _U32)
+            return lambda v: encode_varint(_zigzag(v, 32) & _U32)
         if kind == FD.TYPE_SINT64:
-            return lambda v: varint_bytes(_zigzag(v, 64))
+            return lambda v: encode_varint(_zigzag(v, 64))
         if kind == FD.TYPE_ENUM:
-            return lambda v: varint_bytes(self.index[v])
-        return varint_bytes  # int32 (sign-extended to 64 bits), int64, uint32, uint64
+            return lambda v: encode_varint(self.index[v])
+        return encode_varint  # int32 (sign-extended to 64 bits), int64, uint32, uint64
 
     # ------------------------------------------------------------------ sizes
     def min_size(self) -> int:
