@@ -13,3 +13,5 @@ CCL_MESSAGES = tuple(
     f"dccl.legacyccl.protobuf.CCLMDAT{name}"
     for name in ("Empty", "Redirect", "Bathy", "CTD", "State", "Command", "Error")
 )
+
+__all__ = ["CCL_MESSAGES", "CCL_PROTO", "codecs", "fields"]
