@@ -7,7 +7,11 @@ import socket
 
 from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
 from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind
-from pygoby.acomms.mmsim.multicast_channel import MulticastChannel, packet_to_json
+from pygoby.acomms.mmsim.multicast_channel import (
+    BroadcastChannel,
+    MulticastChannel,
+    packet_to_json,
+)
 from pygoby.acomms.mmsim.server import ANONYMOUS_PTY, MMSimServer
 from pygoby.util.clock import WallClock
 from pygoby.util.nmea import NMEASentence
@@ -105,6 +109,40 @@ async def test_multicast_channel_takes_only_group_datagrams_from_this_host():
 
         async with asyncio.timeout(10):
             await until_heard()
+        await asyncio.sleep(0.3)
+        here.do_work()
+        heard.extend(s for s in listener.take_output() if s.sentence_id == "MUA")
+        assert [s.fields[1:] for s in heard] == [("1", "2", "0ABC")]
+    finally:
+        for channel in (here, there):
+            channel.close()
+
+
+async def test_broadcast_channel_hears_only_its_broadcast_address():
+    """iModemSim's BroadcastAddr channel: bound to the broadcast address, so a unicast datagram
+    to the host is never taken for an acoustic packet (127.255.255.255 stands for a LAN's)."""
+    import random
+
+    port = random.randint(40000, 60000)
+    clock = WallClock()
+    address = "127.255.255.255"
+    here, there = BroadcastChannel(address, port, clock), BroadcastChannel(address, port, clock)
+    listener = MicroModemModel(2, clock, here)
+    talker = MicroModemModel(1, clock, there)
+    for channel in (there, here):  # (a unicast datagram goes to the last socket bound)
+        channel.open()
+    try:
+        forged = AcousticPacket(PacketKind.MINI, 7, 2, frames=[b"\x01\x02"], tx_time=clock.now())
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as unicast:
+            unicast.sendto(packet_to_json(forged, "intruder"), ("127.0.0.1", port))
+        talker.handle_line("$CCMUC,1,2,0abc")
+        heard = []
+        async with asyncio.timeout(10):
+            while not heard:
+                for worker in (talker, there, listener, here):
+                    worker.do_work()
+                heard.extend(s for s in listener.take_output() if s.sentence_id == "MUA")
+                await asyncio.sleep(0.01)
         await asyncio.sleep(0.3)
         here.do_work()
         heard.extend(s for s in listener.take_output() if s.sentence_id == "MUA")

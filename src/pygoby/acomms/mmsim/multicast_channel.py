@@ -2,9 +2,12 @@
 
 Each process attaches its local modems; a transmission is delivered to the other local modems
 and sent to the group, where the other processes deliver it to theirs: the LoopbackChannel's
-semantics (no loss, a fixed range), spanning processes. The socket is bound to the group address
-on the loopback interface and only datagrams sent from 127.0.0.1 count: a unicast datagram, or
-one from another host, is never taken for an acoustic packet.
+semantics (no loss, a fixed range), spanning processes. Multicast (and broadcast) datagrams
+reach every socket bound to the port, which is why emulators of one host can share a port.
+The socket is bound to the group address on the loopback interface and only datagrams sent
+from 127.0.0.1 count: a unicast datagram, or one from another host, is never taken for an
+acoustic packet. `BroadcastChannel` does the same with UDP broadcast to an address (Goby 1.1's
+iModemSim `BroadcastAddr`), to span the hosts of a LAN.
 """
 
 from __future__ import annotations
@@ -121,7 +124,7 @@ class MulticastChannel(LoopbackChannel):
         except OSError as exc:
             log.warning("channel socket: %s", exc)
             return
-        if address != LOOPBACK:
+        if not self._sender_ok(address):
             log.warning("ignoring a channel datagram from %s (not this host's loopback)", address)
             return
         try:
@@ -131,3 +134,35 @@ class MulticastChannel(LoopbackChannel):
             return
         if sender != self.token:
             self.deliver(packet, list(self.endpoints))
+
+    def _sender_ok(self, address: str) -> bool:
+        return address == LOOPBACK
+
+
+class BroadcastChannel(MulticastChannel):
+    """The channel over UDP broadcast: datagrams go to `address:port` (e.g. 192.168.1.255)
+    and are heard on `port` by every emulator of the hosts that address reaches. The socket is
+    bound to `address`, so a unicast datagram to this host is never heard; any host the
+    broadcast reaches may send (that is what the channel is for)."""
+
+    def __init__(
+        self,
+        address: str,
+        port: int,
+        clock: Clock | None = None,
+        range_m: float = 0.0,
+        sound_speed: float = DEFAULT_SOUND_SPEED,
+    ) -> None:
+        super().__init__(address, port, clock, range_m, sound_speed)
+
+    def open(self) -> None:
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_BROADCAST, 1)
+        sock.bind((self.group, self.port))
+        sock.setblocking(False)
+        self._sock = sock
+        asyncio.get_running_loop().add_reader(sock.fileno(), self._readable)
+
+    def _sender_ok(self, address: str) -> bool:
+        return True

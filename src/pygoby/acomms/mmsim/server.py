@@ -1,4 +1,4 @@
-"""asyncio front ends for the modem model: a TCP server and a pseudo-terminal (serial line).
+"""asyncio front ends for the modem model: a TCP server, a pseudo-terminal or a serial device.
 
 Text is made here, at the edge: the model's sentences are printed with their checksum and CRLF;
 host lines (CR and/or LF) are parsed by the model. The model's timed events and the channel's
@@ -7,7 +7,7 @@ deliveries run in one loop that wakes for the next of them (at most `work_period
 Output never waits for a reader: a TCP client that reads nothing is not read either once its
 pending output passes asyncio's high-water mark (so its own commands cannot grow it), and is
 disconnected when the modem's own output (receptions) passes `MAX_CLIENT_BACKLOG` bytes; the
-pseudo-terminal drops what its reader leaves unread.
+pseudo-terminal (or serial device) drops what its reader leaves unread.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import re
 from pygoby.acomms.mmsim.channel import Channel
 from pygoby.acomms.mmsim.model import MicroModemModel
 from pygoby.util.linebased import open_pty_pair
-from pygoby.util.pty import PtyEnd
+from pygoby.util.pty import PtyEnd, open_serial
 
 log = logging.getLogger(__name__)
 
@@ -46,20 +46,25 @@ class _HostLines:
 class MMSimServer:
     """Serves one emulated modem on TCP (every client sees the modem's output) and optionally
     on a pty: `pty_path` a path to link it at (e.g. /tmp/ttyLOOPA1), or ANONYMOUS_PTY; after
-    `start`, `pty_path` is where a host opens it."""
+    `start`, `pty_path` is where a host opens it. Or on a serial device (`serial_path`: a tty,
+    e.g. one end of a pygoby.util.pty.PtyPair). `port=None`: no TCP server."""
 
     def __init__(
         self,
         model: MicroModemModel,
         channel: Channel,
         host: str = "127.0.0.1",
-        port: int = 0,
+        port: int | None = 0,
         pty_path: str | None = None,
         work_period: float = 0.01,
+        serial_path: str | None = None,
     ) -> None:
+        if pty_path is not None and serial_path is not None:
+            raise ValueError("a pty or a serial device, not both")
         self.model, self.channel = model, channel
         self.host, self.port = host, port
         self.pty_path = pty_path
+        self.serial_path = serial_path
         self.work_period = work_period
         self.pty_dropped = 0  # bytes the pty's reader left unread
         self._pty: PtyEnd | None = None
@@ -69,20 +74,24 @@ class MMSimServer:
         self._tasks: list[asyncio.Task] = []
         model.on_output = self._broadcast
 
-    async def start(self) -> int:
-        self._server = await asyncio.start_server(self._client, self.host, self.port)
-        self.port = self._server.sockets[0].getsockname()[1]
-        if self.pty_path is not None:
+    async def start(self) -> int | None:
+        if self.port is not None:
+            self._server = await asyncio.start_server(self._client, self.host, self.port)
+            self.port = self._server.sockets[0].getsockname()[1]
+            log.info("Micro-Modem emulator id %d on %s:%d", self.model.modem_id, self.host, self.port)
+        if self.serial_path is not None:
+            self._pty_master = open_serial(self.serial_path)
+        elif self.pty_path is not None:
             if self.pty_path:
                 self._pty = PtyEnd(self.pty_path).open()
                 self._pty_master = self._pty.master
             else:
                 self._pty_master, self.pty_path = open_pty_pair()
                 os.set_blocking(self._pty_master, False)
+        if self._pty_master is not None:
             asyncio.get_running_loop().add_reader(self._pty_master, self._pty_readable)
             self._pty_lines = _HostLines()
         self._tasks.append(asyncio.create_task(self._work()))
-        log.info("Micro-Modem emulator id %d on %s:%d", self.model.modem_id, self.host, self.port)
         return self.port
 
     async def close(self) -> None:
