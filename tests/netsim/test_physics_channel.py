@@ -244,3 +244,29 @@ def test_rx_event_figures_are_rounded():
         got = tuple(event[key] for key in ("range_m", "owtt", "rl", "snr", "sinr", "collision"))
         assert got == fresh(*case)
         assert [str(x) for x in got] == [str(x) for x in fresh(*case)]
+
+
+def test_a_cycle_init_run_late_still_precedes_its_data():
+    """Real time: the emulator's cycle-init went on the water late (after the channel's last
+    poll, so the channel moved its start), its data on time. One transducer: the data starts
+    when the cycle-init has ended, and the receiver hears both (regression: the late cycle-init
+    overlapped its own data, a collision at a receiver 370 m away in the demo)."""
+    from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind
+
+    events = []
+    net = Net({62000: 0.0, 62001: 370.0}, events=events.append)
+    sender = net.modems[1]
+    net.clock.set(T0 + 0.004)
+    net.physics.do_work()  # polled past the cycle-init's start
+    cycle = AcousticPacket(PacketKind.CYCLE, 1, 0, 0, num_frames=1, tx_time=T0, duration=1.0)
+    data = AcousticPacket(PacketKind.DATA, 1, 0, 0, frames=[b"status"], tx_time=T0 + 1.0,
+                          duration=3.2)  # fmt: skip
+    net.physics.transmit(sender, cycle)
+    net.clock.set(T0 + 1.0)
+    net.physics.transmit(sender, data)
+    net.run_until(T0 + 10)
+    tx = [e for e in events if e["event"] == "tx"]
+    assert tx[1]["t"] >= tx[0]["t"] + 1.0
+    assert [(e["kind"], e["outcome"]) for e in events if e["event"] == "rx"] == [
+        ("cycle", "good"), ("data", "good"),
+    ]  # fmt: skip

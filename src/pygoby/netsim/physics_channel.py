@@ -97,6 +97,7 @@ class PhysicsChannel:
             self.signal_event.connect(on_event)
         self._endpoints: dict[int, ChannelEndpoint] = {}
         self._last_poll = -math.inf
+        self._air_free: dict[int, float] = {}  # by port: the end of its last transmission
         # detections held until their receptions end: (receiver, transmission number) -> arrival
         self._held: dict[tuple[int, int], float] | None = {} if detections_with_receptions else None
         self.transmissions = 0
@@ -135,10 +136,14 @@ class PhysicsChannel:
             rate, frames = packet.rate, max(1, len(packet.frames))
         else:
             rate, frames = self.control_rate, 1
+        # never before the last poll (a wall clock stepped back, or an emulator running late in
+        # real time, must not break the channel), nor before the sender's previous packet ended
+        # (one transducer: a late cycle-init moved to the last poll still precedes its data)
+        start = max(packet.tx_time, self._last_poll, self._air_free.get(port, -math.inf))
+        self._air_free[port] = start + packet.duration
         tx = Transmission(
             source=port,
-            # never before the last poll (a wall clock stepped back must not break the channel)
-            start=max(packet.tx_time, self._last_poll),
+            start=start,
             rate=rate,
             frames=frames,
             kind=PHYSICAL_KIND[kind],
