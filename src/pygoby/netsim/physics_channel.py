@@ -100,7 +100,7 @@ class PhysicsChannel:
         self._air_free: dict[int, float] = {}  # by port: the end of its last transmission
         # detections held until their receptions end: (receiver, transmission number) -> arrival
         self._held: dict[tuple[int, int], float] | None = {} if detections_with_receptions else None
-        self.transmissions = 0
+        self.transmissions: Counter[str] = Counter()  # by kind (cycle, data, ping, ...)
         self.outcomes: Counter[str] = Counter()  # receptions by outcome
 
     # -- the mmsim Channel interface -----------------------------------------------------------
@@ -152,7 +152,7 @@ class PhysicsChannel:
             payload=_Sent(sender, packet, port),
         )
         planned = self.channel.transmit(tx)
-        self.transmissions += 1
+        self.transmissions[kind._value_] += 1
         if self.signal_event:  # (the event is only made when someone listens)
             self.signal_event.emit(
                 {

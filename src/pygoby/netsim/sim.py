@@ -265,7 +265,9 @@ class Simulation:
             simulated_seconds=self.clock.now() - self.start,
             wall_seconds=time.perf_counter() - self._wall_start,
             events=self.events + Counter(
-                tx=self.physics.transmissions, rx=sum(self.physics.outcomes.values())
+                tx=self.physics.transmissions.total(),
+                tx_data=self.physics.transmissions["data"],
+                rx=self.physics.outcomes.total(),
             ),
             outcomes=Counter(self.physics.outcomes),
             status_sent=self.status_sent,

@@ -199,7 +199,7 @@ def add_cst(
     return stats[-1]
 
 
-@functools.lru_cache(maxsize=4096)
+@functools.lru_cache(maxsize=1 << 14)
 def _without_toa(version: int, mode: int, clock_mode: int, values: tuple, new_bitfield: bool):
     """parse_cst's ReceiveStatistics of a typed $CACST but its time (shared: copy it)."""
     typed = CycleStatistics(version, mode, 0, clock_mode, values)
