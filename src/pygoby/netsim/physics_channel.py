@@ -174,16 +174,20 @@ class PhysicsChannel:
         now = max(self.clock.now(), self._last_poll)
         self._last_poll = now
         held = self._held
-        for d in self.channel.detections(now):
-            if held is not None:
-                held[d.receiver, d.sequence] = d.arrival
-            else:
+        if held is None:
+            for d in self.channel.detections(now):
                 self._detect(d.receiver, d.transmission, d.arrival)
-        for reception in self.channel.poll(now):
-            if held is not None:
-                arrival = held.pop((reception.receiver, reception.sequence), None)
-                if arrival is not None:
-                    self._detect(reception.receiver, reception.transmission, arrival)
+            for reception in self.channel.poll(now):
+                self._deliver(reception)
+            return
+        detected: list = []
+        receptions = self.channel.poll(now, detected)
+        for d in detected:
+            held[d.receiver, d.sequence] = d.arrival
+        for reception in receptions:
+            arrival = held.pop((reception.receiver, reception.sequence), None)
+            if arrival is not None:
+                self._detect(reception.receiver, reception.transmission, arrival)
             self._deliver(reception)
 
     def _detect(self, receiver: int, transmission: Transmission, arrival: float) -> None:

@@ -59,6 +59,9 @@ class AcousticPacket:
     duration: float = 0.0  # s on the water
     hw_control: tuple[int, int, int] | None = None  # (line, mode, arg) of HW_CONTROL
     reply: bool = False  # HW_CONTROL: the answer to a command
+    # the sentences every receiver prints alike for this packet ($CACYC, each $CARXD), made by
+    # the first receiver (sentences are immutable) and dropped with the packet
+    heard: dict = field(default_factory=dict, compare=False, repr=False)
 
 
 @dataclass

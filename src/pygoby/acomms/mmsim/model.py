@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import base64
 import datetime as dt
+import functools
 import logging
 import math
 from collections.abc import Callable
@@ -118,8 +119,8 @@ class MicroModemModel:
         self.timing = timing
         self.statistics_version = CST_VERSION_MM2 if self.mm2 else 0
         self.nvram = self._factory_nvram(modem_id)
-        self.on_output = on_output
         self._outbox: list = []
+        self.on_output = on_output
         self._clock_offset = 0.0
         self._clock_source = "RTC"  # the modem's own clock until the host sets it
         self._tx: _Transmit | None = None
@@ -155,15 +156,21 @@ class MicroModemModel:
     def _say(self, token: str, *values: object) -> None:
         self._emit(NMEASentence.build(token, values))
 
-    def _emit(self, sentence) -> None:
-        if self.on_output is not None:
-            self.on_output(sentence)
-        else:
-            self._outbox.append(sentence)
+    @property
+    def on_output(self) -> Callable[[object], None] | None:
+        """Called with each sentence the modem says (None: they wait in `take_output`)."""
+        return self._on_output
+
+    @on_output.setter
+    def on_output(self, on_output: Callable[[object], None] | None) -> None:
+        self._on_output = on_output
+        # (every sentence goes through _emit: one call, straight to where it goes)
+        self._emit = on_output if on_output is not None else self._outbox.append
 
     def take_output(self) -> list:
         """The sentences said since the last call (when there is no `on_output`)."""
-        out, self._outbox = self._outbox, []
+        out = self._outbox[:]
+        self._outbox.clear()
         return out
 
     def _hhmmss(self) -> str:
@@ -512,12 +519,18 @@ class MicroModemModel:
 
     def _heard_data(self, p: AcousticPacket, r: Reception) -> None:
         if p.rate != 0:  # (a PSK packet's header is its cycle-init)
-            self._say("$CACYC", 0, p.src, p.dest, p.rate, int(p.ack_requested), len(p.frames))
+            self._emit(_heard_cycle_sentence(p, len(p.frames)))
         good: list[int] = []
+        rxd = self._on("RXD")
         for i, frame in enumerate(p.frames):
             if r.frame_good(i):
-                if self._on("RXD"):
-                    self._say("$CARXD", p.src, p.dest, int(p.ack_requested), i + 1, frame.hex())
+                if rxd:
+                    sentence = p.heard.get(i)
+                    if sentence is None:
+                        sentence = p.heard[i] = NMEASentence.build(
+                            "$CARXD", (p.src, p.dest, int(p.ack_requested), i + 1, frame.hex())
+                        )
+                    self._emit(sentence)
                 good.append(i + 1)
             else:
                 self._say("$CAMSG", "BAD_CRC", i + 1)
@@ -527,7 +540,7 @@ class MicroModemModel:
             self._send(ack, self.timing.mini_packet)
 
     def _heard_cycle(self, p: AcousticPacket, r: Reception) -> None:
-        self._say("$CACYC", 0, p.src, p.dest, p.rate, int(p.ack_requested), p.num_frames)
+        self._emit(_heard_cycle_sentence(p, p.num_frames))
         self._cst(p, r, frames=0, bad=0)
         if p.src == self.modem_id and self._tx is None:  # polled: send our data
             self._start_transmit(_Transmit(p.src, p.dest, p.rate, p.ack_requested, p.num_frames))
@@ -595,25 +608,49 @@ class MicroModemModel:
     def _cst(self, p: AcousticPacket, r: Reception, frames: int, bad: int) -> None:
         if not self._on("CST"):
             return
-        values = list(_CST_DEFAULTS)
-        values[_RATE : _BAD_FRAMES + 1] = (
-            p.rate, p.src, p.dest, 3 if bad else 0, _packet_type(p), frames, bad
-        )
-        for name, value in r.stats.items():
-            i = CST_FIELD_INDEX.get(name)
-            if i is None:
-                log.warning("%s: unknown $CACST statistic %r from the channel", self.name, name)
-            elif i == DOPPLER_INDEX:
-                values[i] = round(value, 1)
-            else:
-                values[i] = value if type(value) is int else int(round(value))
+        stats = tuple(r.stats.items())
+        doppler = r.stats.get("doppler")
+        if doppler == 0 and math.copysign(1, doppler) < 0:  # (-0.0 would share 0.0's memo)
+            base = _cst_values.__wrapped__(stats)
+        else:
+            base = _cst_values(stats)
+        values = (
+            *base[:_RATE], p.rate, p.src, p.dest, 3 if bad else 0, _packet_type(p), frames, bad,
+            *base[_BAD_FRAMES + 1 :],
+        )  # fmt: skip
         self._emit(
             CycleStatistics(
                 self.statistics_version, 1 if bad else 0,
                 acomms_pb.now_us(r.arrival_time + self._clock_offset), self._clock_mode_field(),
-                tuple(values),
+                values,
             )  # fmt: skip
         )
+
+
+@functools.lru_cache(maxsize=1 << 14)  # (a link's statistics recur: fixed nodes, steady noise)
+def _cst_values(stats: tuple[tuple[str, float], ...]) -> tuple:
+    """$CACST values with the channel's statistics in place of the defaults (the packet's own
+    fields, rate .. number_bad_frames, are set by the caller)."""
+    values = list(_CST_DEFAULTS)
+    for name, value in stats:
+        i = CST_FIELD_INDEX.get(name)
+        if i is None:
+            log.warning("unknown $CACST statistic %r from the channel", name)
+        elif i == DOPPLER_INDEX:
+            values[i] = round(value, 1)
+        else:
+            values[i] = value if type(value) is int else int(round(value))
+    return tuple(values)
+
+
+def _heard_cycle_sentence(p: AcousticPacket, frames: int) -> NMEASentence:
+    """The $CACYC a receiver prints for `p` (made once per packet)."""
+    sentence = p.heard.get("CYC")
+    if sentence is None:
+        sentence = p.heard["CYC"] = NMEASentence.build(
+            "$CACYC", (0, p.src, p.dest, p.rate, int(p.ack_requested), frames)
+        )
+    return sentence
 
 
 def _packet_type(p: AcousticPacket) -> int:

@@ -362,10 +362,13 @@ class Channel:
         detected, self._detected = self._detected, []
         return detected
 
-    def poll(self, now: float) -> list[Reception]:
-        """Receptions delivered by `now` (no transmission may be registered before `now` later)."""
+    def poll(self, now: float, detections: list[Detection] | None = None) -> list[Reception]:
+        """Receptions delivered by `now` (no transmission may be registered before `now` later).
+        `detections`: a list to append `detections(now)` to (one call for both)."""
         self._horizon = max(self._horizon, now)
         self._decide_locks(now)
+        if detections is not None:
+            detections += self._detected
         self._detected.clear()
         latency = self.config.decode_latency
         ends = self._ends

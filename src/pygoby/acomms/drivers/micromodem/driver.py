@@ -25,7 +25,12 @@ from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
 from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
-from pygoby.acomms.drivers.micromodem.statistics import add_cst, parse_toa, parse_xst
+from pygoby.acomms.drivers.micromodem.statistics import (
+    CycleStatistics,
+    add_cst,
+    parse_toa,
+    parse_xst,
+)
 from pygoby.acomms.errors import ModemDriverError
 from pygoby.util.errors import LinkClosedError, NMEAError
 from pygoby.util.nmea import NMEASentence
@@ -373,12 +378,22 @@ class MMDriver(ModemDriverBase):
     def _handle_sentences(self, sentences: list) -> None:
         """Sentences from a typed link (parsed already; `$CACST` as its values)."""
         self._last_rx_at = self.clock.now()
-        raw = self.signal_raw_incoming or self._raw_log is not None
-        for sentence in sentences:
-            if raw:
+        if self.signal_raw_incoming or self._raw_log is not None:
+            for sentence in sentences:
                 self._log_raw("[rx] ", sentence.message())
                 self.emit_raw(True, sentence.message())
-            self._dispatch(sentence)
+                self._dispatch(sentence)
+            return
+        for sentence in sentences:  # (_dispatch, inline: a batch per reception)
+            self._fails = 0
+            handler = _HANDLERS.get(sentence.sentence_id)
+            if handler is not None:
+                try:
+                    handler(self, sentence)
+                except (NMEAError, ValueError, IndexError) as exc:
+                    log.warning("ignoring malformed %s: %s", sentence.message(), exc)
+            if self._written_at is not None:
+                self._acknowledge(sentence)
 
     def _dispatch(self, sentence) -> None:
         """Handle a valid sentence from the modem (received now)."""
@@ -585,7 +600,10 @@ class MMDriver(ModemDriverBase):
                 self._finish_receive()
 
     def _on_cst(self, s: NMEASentence) -> None:
-        today = _utc_date(self.clock.now())
+        if type(s) is CycleStatistics and s.version >= 6:
+            today = _EPOCH_DATE  # (a dated time of arrival: the reader's date is not used)
+        else:
+            today = _utc_date(self.clock.now())
         new_clock = self.revision >= MM2_BITFIELD_CLOCK_REVISION
         if self._ack_msg is not None and self._receive is None and not self._expected_cst:
             add_cst(self._ack_msg.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat, s, today, new_clock)
@@ -787,6 +805,9 @@ class MMDriver(ModemDriverBase):
         for i in range(1, 5):
             reply.one_way_travel_time.append(s.as_float(i, 0.0, MAX_TRAVEL_TIME) if s[i] else 0.0)
         self.signal_receive.emit(msg)
+
+
+_EPOCH_DATE = dt.date(1970, 1, 1)
 
 
 def _utc_date(seconds: float) -> dt.date:
