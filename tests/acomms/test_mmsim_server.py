@@ -78,64 +78,21 @@ async def test_a_pty_nobody_reads_does_not_freeze_the_emulator():
         await server.close()
 
 
-async def test_multicast_channel_takes_only_group_datagrams_from_this_host():
-    """Regression: the channel socket bound 0.0.0.0 and took a unicast datagram from anyone for
-    an acoustic packet."""
+async def only_the_real_packet_is_heard(make_channel, address: str, forgeries) -> None:
+    """Two channels on one port: `forgeries(port)` sends datagrams that must not count; a real
+    mini-packet through the channel must arrive, alone."""
     import random
 
     port = random.randint(40000, 60000)
     clock = WallClock()
-    group = "239.255.42.95"
-    here, there = MulticastChannel(group, port, clock), MulticastChannel(group, port, clock)
-    listener = MicroModemModel(2, clock, here)
-    talker = MicroModemModel(1, clock, there)
-    for channel in (here, there):
-        channel.open()
-    try:
-        forged = AcousticPacket(PacketKind.MINI, 7, 2, frames=[b"\x01\x02"], tx_time=clock.now())
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as unicast:
-            unicast.sendto(packet_to_json(forged, "intruder"), ("127.0.0.1", port))
-            unicast.sendto(b"not json", ("127.0.0.1", port))
-            unicast.sendto(json.dumps({"frames": ["AAAA"] * 100}).encode(), (group, port))
-        talker.handle_line("$CCMUC,1,2,0abc")  # a real one, through the group
-        heard = []
-
-        async def until_heard():
-            while not heard:
-                for worker in (talker, there, listener, here):
-                    worker.do_work()
-                heard.extend(s for s in listener.take_output() if s.sentence_id == "MUA")
-                await asyncio.sleep(0.01)
-
-        async with asyncio.timeout(10):
-            await until_heard()
-        await asyncio.sleep(0.3)
-        here.do_work()
-        heard.extend(s for s in listener.take_output() if s.sentence_id == "MUA")
-        assert [s.fields[1:] for s in heard] == [("1", "2", "0ABC")]
-    finally:
-        for channel in (here, there):
-            channel.close()
-
-
-async def test_broadcast_channel_hears_only_its_broadcast_address():
-    """iModemSim's BroadcastAddr channel: bound to the broadcast address, so a unicast datagram
-    to the host is never taken for an acoustic packet (127.255.255.255 stands for a LAN's)."""
-    import random
-
-    port = random.randint(40000, 60000)
-    clock = WallClock()
-    address = "127.255.255.255"
-    here, there = BroadcastChannel(address, port, clock), BroadcastChannel(address, port, clock)
+    here, there = make_channel(address, port, clock), make_channel(address, port, clock)
     listener = MicroModemModel(2, clock, here)
     talker = MicroModemModel(1, clock, there)
     for channel in (there, here):  # (a unicast datagram goes to the last socket bound)
         channel.open()
     try:
-        forged = AcousticPacket(PacketKind.MINI, 7, 2, frames=[b"\x01\x02"], tx_time=clock.now())
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as unicast:
-            unicast.sendto(packet_to_json(forged, "intruder"), ("127.0.0.1", port))
-        talker.handle_line("$CCMUC,1,2,0abc")
+        forgeries(port)
+        talker.handle_line("$CCMUC,1,2,0abc")  # a real one, through the channel
         heard = []
         async with asyncio.timeout(10):
             while not heard:
@@ -150,3 +107,33 @@ async def test_broadcast_channel_hears_only_its_broadcast_address():
     finally:
         for channel in (here, there):
             channel.close()
+
+
+def forged_mini_packet() -> bytes:
+    forged = AcousticPacket(PacketKind.MINI, 7, 2, frames=[b"\x01\x02"], tx_time=WallClock().now())
+    return packet_to_json(forged, "intruder")
+
+
+async def test_multicast_channel_takes_only_group_datagrams_from_this_host():
+    """Regression: the channel socket bound 0.0.0.0 and took a unicast datagram from anyone for
+    an acoustic packet."""
+    group = "239.255.42.95"
+
+    def forgeries(port: int) -> None:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as unicast:
+            unicast.sendto(forged_mini_packet(), ("127.0.0.1", port))
+            unicast.sendto(b"not json", ("127.0.0.1", port))
+            unicast.sendto(json.dumps({"frames": ["AAAA"] * 100}).encode(), (group, port))
+
+    await only_the_real_packet_is_heard(MulticastChannel, group, forgeries)
+
+
+async def test_broadcast_channel_hears_only_its_broadcast_address():
+    """iModemSim's BroadcastAddr channel: bound to the broadcast address, so a unicast datagram
+    to the host is never taken for an acoustic packet (127.255.255.255 stands for a LAN's)."""
+
+    def forgeries(port: int) -> None:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as unicast:
+            unicast.sendto(forged_mini_packet(), ("127.0.0.1", port))
+
+    await only_the_real_packet_is_heard(BroadcastChannel, "127.255.255.255", forgeries)

@@ -63,13 +63,10 @@ class LineSplitter:
         return lines
 
 
-class MemoryLink:
-    """A link with no I/O: tests push incoming text with `feed` and inspect `written`."""
+class LocalLink:
+    """The open/closed state of a link without I/O (it counts its openings)."""
 
-    def __init__(self, delimiter: str = "\r\n") -> None:
-        self._splitter = LineSplitter(delimiter)
-        self._lines: deque[str] = deque()
-        self.written: list[str] = []
+    def __init__(self) -> None:
         self._open = False
         self.connections = 0
 
@@ -84,6 +81,16 @@ class MemoryLink:
 
     def close(self) -> None:
         self._open = False
+
+
+class MemoryLink(LocalLink):
+    """A link with no I/O: tests push incoming text with `feed` and inspect `written`."""
+
+    def __init__(self, delimiter: str = "\r\n") -> None:
+        super().__init__()
+        self._splitter = LineSplitter(delimiter)
+        self._lines: deque[str] = deque()
+        self.written: list[str] = []
 
     def feed(self, text: str) -> None:
         self._lines.extend(self._splitter.feed(text.encode("latin-1")))

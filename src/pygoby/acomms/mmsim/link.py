@@ -10,17 +10,17 @@ from __future__ import annotations
 
 from pygoby.acomms.mmsim.model import MicroModemModel
 from pygoby.util.errors import LinkClosedError
+from pygoby.util.linebased import LocalLink
 from pygoby.util.nmea import NMEASentence
 
 
-class ModemLink:
+class ModemLink(LocalLink):
     """`waiting` (optional): a set that holds `key` while sentences wait to be read (so that a
     loop over many links need not ask each one)."""
 
     def __init__(self, model: MicroModemModel, waiting: set | None = None, key=None) -> None:
+        super().__init__()
         self.model = model
-        self.connections = 0
-        self._open = False
         self._sentences: list = []
         self._waiting = waiting if waiting is not None else set()
         self._key = key
@@ -31,20 +31,8 @@ class ModemLink:
         self._waiting.add(self._key)
 
     @property
-    def is_open(self) -> bool:
-        return self._open
-
-    @property
     def pending(self) -> bool:
         return bool(self._sentences)
-
-    def open(self) -> None:
-        if not self._open:
-            self.connections += 1
-        self._open = True
-
-    def close(self) -> None:
-        self._open = False
 
     def write_sentence(self, sentence: NMEASentence) -> None:
         if not self._open:

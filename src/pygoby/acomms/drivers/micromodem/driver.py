@@ -373,7 +373,7 @@ class MMDriver(ModemDriverBase):
             log.warning("ignoring invalid line from the modem: %s", exc)
             return
         self._last_rx_at = self.clock.now()
-        self._dispatch(sentence)
+        self._dispatch((sentence,))
 
     def _handle_sentences(self, sentences: list) -> None:
         """Sentences from a typed link (parsed already; `$CACST` as its values)."""
@@ -382,9 +382,13 @@ class MMDriver(ModemDriverBase):
             for sentence in sentences:
                 self._log_raw("[rx] ", sentence.message())
                 self.emit_raw(True, sentence.message())
-                self._dispatch(sentence)
-            return
-        for sentence in sentences:  # (_dispatch, inline: a batch per reception)
+                self._dispatch((sentence,))
+        else:
+            self._dispatch(sentences)
+
+    def _dispatch(self, sentences) -> None:
+        """Handle valid sentences from the modem (received now), in order."""
+        for sentence in sentences:
             self._fails = 0
             handler = _HANDLERS.get(sentence.sentence_id)
             if handler is not None:
@@ -394,18 +398,6 @@ class MMDriver(ModemDriverBase):
                     log.warning("ignoring malformed %s: %s", sentence.message(), exc)
             if self._written_at is not None:
                 self._acknowledge(sentence)
-
-    def _dispatch(self, sentence) -> None:
-        """Handle a valid sentence from the modem (received now)."""
-        self._fails = 0
-        handler = _HANDLERS.get(sentence.sentence_id)
-        if handler is not None:
-            try:
-                handler(self, sentence)
-            except (NMEAError, ValueError, IndexError) as exc:
-                log.warning("ignoring malformed %s: %s", sentence.message(), exc)
-        if self._written_at is not None:
-            self._acknowledge(sentence)
 
     def _on_rev(self, s: NMEASentence) -> None:
         if s[2] == "INIT":
