@@ -34,7 +34,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Store server for DRIVER_STORE_SERVER clients (RUDICS packets over TCP).",
     )
     s.add_argument("--port", type=int, default=11244, help="TCP port (default %(default)s)")
-    s.add_argument("--host", default="0.0.0.0", help="address to bind (default %(default)s)")
+    s.add_argument("--host", default="127.0.0.1",
+                   help="address to bind (default %(default)s; 0.0.0.0: every interface)")  # fmt: skip
     s.add_argument("--db", default="goby_store_server.db", help="SQLite file (default %(default)s)")
     s.add_argument("--max-lookback", type=float, default=3600.0,
                    help="seconds of history a new client receives (default %(default)s)")  # fmt: skip

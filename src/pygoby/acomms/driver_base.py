@@ -135,7 +135,10 @@ class ModemDriverBase(ABC):
             return TCPClientLink(cfg.tcp_server, cfg.tcp_port, delimiter, cfg.reconnect_interval)
         if not cfg.HasField("tcp_port"):
             raise ModemDriverException("tcp_port is required", Status.INVALID_CONFIGURATION)
-        return TCPServerLink(cfg.tcp_port, delimiter=delimiter)
+        # A modem (or serial-to-TCP box) elsewhere on the network connects to this server, so,
+        # as upstream, every interface unless `tcp_server` names the address to bind.
+        host = cfg.tcp_server if cfg.HasField("tcp_server") else "0.0.0.0"
+        return TCPServerLink(cfg.tcp_port, host=host, delimiter=delimiter)
 
     def modem_read(self) -> list[str]:
         if self.link is None:

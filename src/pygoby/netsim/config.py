@@ -33,7 +33,7 @@ env_bounds { environment_id: 0 lat_min: 41.5 lon_min: -71.0 lat_max: 42.5 lon_ma
              depth_min: 0 depth_max: 200 }
 manager_tcp_port: 61999          # default 61999
 # pygoby-only settings:
-listen_address: "0.0.0.0"        # IPv4 address to listen on
+listen_address: "127.0.0.1"      # IPv4 address to listen on ("0.0.0.0": every interface)
 reject_nonfinite_position: true  # NaN/inf lat, lon or depth -> OUT_OF_DEFINED_REGION
 max_line_length: 1048576         # longer NETSIM lines are discarded
 # Channel model of environment 0 (every field optional; defaults shown or described).

@@ -94,7 +94,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("config", nargs="?", help="configuration file (protobuf TextFormat)")
     parser.add_argument("--example_config", action="store_true", help="print an example config")
     parser.add_argument("--port", type=int, help="override manager_tcp_port")
-    parser.add_argument("--listen", help="override listen_address")
+    parser.add_argument(
+        "--host",
+        "--listen",
+        dest="host",
+        help="address to listen on, overriding listen_address (default 127.0.0.1; "
+        "0.0.0.0: every interface)",
+    )
     parser.add_argument("-v", "--verbose", action="count", default=0)
     return parser
 
@@ -127,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
     except (OSError, ConfigError) as exc:
         print(f"netsim_manager: {exc}", file=sys.stderr)
         return 1
-    run_until_signal(_run(manager, args.listen, args.port))
+    run_until_signal(_run(manager, args.host, args.port))
     return 0
 
 

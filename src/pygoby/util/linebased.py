@@ -230,7 +230,7 @@ class TCPServerLink(_StreamLinkBase):
     Writes go to every connected client; lines from all clients are merged.
     """
 
-    def __init__(self, port: int, host: str = "0.0.0.0", delimiter: str = "\r\n") -> None:
+    def __init__(self, port: int, host: str = "127.0.0.1", delimiter: str = "\r\n") -> None:
         super().__init__(delimiter)
         self.host, self.port = host, port
         self._server: asyncio.Server | None = None
