@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from collections.abc import Callable, Iterable
 
@@ -14,6 +15,8 @@ from pygoby.dccl.codec import Codec
 from pygoby.dccl.errors import DcclError
 from pygoby.dccl.trace import log as trace_log
 
+PASSPHRASE_ENV = "PYGOBY_DCCL_PASSPHRASE"
+
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser("dccl", help="encode, decode and analyze DCCL messages")
@@ -23,7 +26,13 @@ def register(subparsers) -> None:
                         help="include directory for imports (repeatable)")
     parser.add_argument("--message", required=True, metavar="FULL.NAME",
                         help="fully qualified message name")
-    parser.add_argument("--passphrase", help="encrypt/decrypt the body with this passphrase")
+    secret = parser.add_mutually_exclusive_group()
+    secret.add_argument("--passphrase-file", metavar="FILE",
+                        help="encrypt/decrypt the body with the passphrase in FILE (one trailing "
+                        f"newline ignored); without a passphrase option, ${PASSPHRASE_ENV} is used")
+    secret.add_argument("--passphrase",
+                        help="the passphrase itself (visible to every user in the process list: "
+                        "prefer --passphrase-file or the environment variable)")
     parser.add_argument("--strict", action="store_true",
                         help="refuse out-of-range values instead of degrading them")
     parser.add_argument("--source", action="store_true",
@@ -39,10 +48,11 @@ def run(args: argparse.Namespace) -> int:
         handler.setFormatter(logging.Formatter("%(message)s"))
         trace_log.addHandler(handler)
         trace_log.setLevel(logging.DEBUG)
-    codec = Codec(passphrase=args.passphrase, strict=args.strict, trace=args.trace)
     try:
+        passphrase = read_passphrase(args)
+        codec = Codec(passphrase=passphrase, strict=args.strict, trace=args.trace)
         cls = codec.load_proto(args.proto, args.message, args.include)
-    except DcclError as exc:
+    except (DcclError, OSError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     if args.action == "analyze":
@@ -63,6 +73,18 @@ def run(args: argparse.Namespace) -> int:
         return text_format.MessageToString(codec.decode(data, cls), as_one_line=True)
 
     return process_lines(sys.stdin, encode if args.action == "encode" else decode)
+
+
+def read_passphrase(args: argparse.Namespace) -> str | bytes | None:
+    """--passphrase-file (its bytes), else --passphrase, else the environment variable."""
+    if args.passphrase_file is not None:
+        with open(args.passphrase_file, "rb") as file:
+            secret = file.read()
+        # `echo secret > FILE` adds a newline that is not part of the passphrase
+        return secret.removesuffix(b"\n")
+    if args.passphrase is not None:
+        return args.passphrase
+    return os.environ.get(PASSPHRASE_ENV) or None
 
 
 def process_lines(lines: Iterable[str], convert: Callable[[str], str]) -> int:
