@@ -1,6 +1,7 @@
 """RUDICS framing, the SQLite store (persistence across restarts), driver ⇄ server over TCP."""
 
 import asyncio
+import contextlib
 
 import pytest
 from hypothesis import given, settings
@@ -8,7 +9,13 @@ from hypothesis import strategies as st
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.drivers.store_server import StoreServerDriver
-from pygoby.acomms.rudics import RudicsPacketError, parse_rudics_packet, serialize_rudics_packet
+from pygoby.acomms.rudics import (
+    MAX_PACKET_BYTES,
+    RudicsPacketError,
+    max_data_bytes,
+    parse_rudics_packet,
+    serialize_rudics_packet,
+)
 from pygoby.acomms.store_server import StoreServer, TransmissionStore, serve_store
 from pygoby.util.clock import WallClock
 
@@ -16,12 +23,44 @@ from .mm_e2e import run_until
 from .queue_helpers import status_link
 
 
+def schoolbook_convert(data: bytes, source_base: int, sink_base: int) -> bytes:
+    """The conversion digit by digit, as C++ Goby's base_convert does it: the oracle."""
+    value = 0
+    for digit in reversed(data):
+        value = value * source_base + digit
+    out = bytearray()
+    while value:
+        value, remainder = divmod(value, sink_base)
+        out.append(remainder)
+    return bytes(out) + b"\0" * (len(data) - len(data.rstrip(b"\0")))
+
+
 @settings(max_examples=200, deadline=None)
-@given(st.binary(max_size=300))
-def test_rudics_round_trip_and_no_cr(data):
+@given(st.binary(max_size=300) | st.binary(min_size=1000, max_size=3000), st.integers(0, 3))
+def test_rudics_round_trip_and_no_cr(data, top_zeros):
+    data += b"\0" * top_zeros
     packet = serialize_rudics_packet(data)
     assert packet.endswith(b"\r") and b"\r" not in packet[:-1]
     assert parse_rudics_packet(packet) == data
+    plain = serialize_rudics_packet(data, include_crc=False)
+    assert plain[:-1].replace(b"\xff", b"\r") == schoolbook_convert(data, 256, 255)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.binary(max_size=400))
+def test_rudics_parse_of_arbitrary_bytes_raises_only_its_own_error(garbage):
+    with contextlib.suppress(RudicsPacketError):
+        parse_rudics_packet(garbage + b"\r")
+
+
+def test_rudics_packet_limit_is_checked_before_any_conversion():
+    """Issue 16 item 2: a 128 KB garbage line used to be converted (38 s on the event loop)."""
+    with pytest.raises(RudicsPacketError, match="exceeds the 65536-byte limit"):
+        parse_rudics_packet(b"\x01" * (128 * 1024) + b"\r")
+    # the largest payload the limit allows, in its worst case (no zero digits to spare), fits
+    worst = serialize_rudics_packet(b"\xfe" * max_data_bytes())
+    assert len(worst) <= MAX_PACKET_BYTES
+    assert parse_rudics_packet(worst) == b"\xfe" * max_data_bytes()
 
 
 def test_rudics_known_layout_and_errors():
@@ -89,4 +128,82 @@ async def test_driver_to_driver_through_store_server_with_ack(tmp_path):
         d1.shutdown()
         d2.shutdown()
         server.close()
+        store.close()
+
+
+def bulk(src: int, size: int, dest: int = 0) -> m.ModemTransmission:
+    return m.ModemTransmission(src=src, dest=dest, type=m.DATA, frame=[b"x" * size])
+
+
+def test_responses_stay_within_a_packet_and_the_rest_comes_next_time(caplog):
+    """Issue 16 item 2: a response never exceeds the packet limit (a client's line limit)."""
+    store = TransmissionStore()
+    request = m.StoreServerRequest(modem_id=1)
+    request.outbox.extend([bulk(1, 30000), bulk(1, 30000), bulk(1, 70000), bulk(1, 30000)])
+    store.exchange(request, 100.0)
+    sizes = []
+    for t in (101.0, 102.0, 103.0):
+        reply = store.exchange(m.StoreServerRequest(modem_id=2), t, max_data_bytes())
+        assert reply.ByteSize() <= max_data_bytes()
+        sizes.append([len(x.frame[0]) for x in reply.inbox])
+    # two fit in the first; the 70 000-byte one can never fit: skipped with a warning
+    assert sizes == [[30000, 30000], [30000], []]
+    assert "cannot fit in a response" in caplog.text
+
+
+def test_driver_requests_stay_within_a_packet():
+    """The driver sends its outbox over as many requests as it needs, and its own frames are
+    never larger than a packet allows, whatever max_frame_size says."""
+    from pygoby.util.clock import VirtualClock
+    from pygoby.util.linebased import MemoryLink
+
+    link = MemoryLink("\r")
+    driver = StoreServerDriver(VirtualClock(0), link)
+    cfg = m.DriverConfig(driver_type=5, modem_id=1)
+    cfg.Extensions[m.STORE_SERVER_CONFIG].max_frame_size = 1_000_000
+    driver.startup(cfg)
+    requests = []
+    driver.signal_data_request.connect(lambda msg: requests.append(msg.max_frame_bytes))
+    driver.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=0))
+    assert 0 < requests[0] < max_data_bytes()
+    driver._outbox.extend([bulk(1, 30000), bulk(1, 30000), bulk(1, 30000)])
+    driver._send_request(0.0)
+    driver._send_request(1.0)
+    packets = [text.encode("latin-1") for text in link.take_written()]
+    assert all(len(p) <= MAX_PACKET_BYTES for p in packets)
+    outboxes = [m.StoreServerRequest.FromString(parse_rudics_packet(p)).outbox for p in packets]
+    assert [len(o) for o in outboxes] == [2, 1] and driver._outbox == []
+
+
+async def test_a_garbage_line_and_a_pipelining_client_do_not_hold_up_others():
+    """Issue 16 item 2: a 128 KB garbage line is dropped as it streams in (never converted),
+    and a client pipelining thousands of requests delays another's by a few requests only."""
+    store = TransmissionStore()
+    server = StoreServer(store)
+    tcp = await serve_store(server, "127.0.0.1", 0)
+    port = tcp.sockets[0].getsockname()[1]
+    request = serialize_rudics_packet(m.StoreServerRequest(modem_id=1).SerializeToString())
+    try:
+        a_reader, a_writer = await asyncio.open_connection("127.0.0.1", port)
+        a_writer.write(b"\x01" * (128 * 1024) + b"\r" + request)
+        await a_writer.drain()
+        reply = await asyncio.wait_for(a_reader.readuntil(b"\r"), 30)
+        assert m.StoreServerResponse.FromString(parse_rudics_packet(reply)).modem_id == 1
+        assert server.requests_answered == 1 and server.requests_refused == 0  # never parsed
+
+        pipelined = 3000
+        a_writer.write(request * pipelined)
+        await a_writer.drain()
+        while server.requests_answered < 2:  # A's requests are being served
+            await asyncio.sleep(0)
+        b_reader, b_writer = await asyncio.open_connection("127.0.0.1", port)
+        b_writer.write(serialize_rudics_packet(m.StoreServerRequest(modem_id=2).SerializeToString()))
+        await b_writer.drain()
+        await asyncio.wait_for(b_reader.readuntil(b"\r"), 60)
+        served_before_b = server.requests_answered - 2
+        assert served_before_b < pipelined // 10, served_before_b
+        b_writer.close()
+        a_writer.close()
+    finally:
+        tcp.close()
         store.close()

@@ -14,12 +14,21 @@ from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as m
 from pygoby.acomms.driver_base import ModemDriverBase
-from pygoby.acomms.rudics import RudicsPacketError, parse_rudics_packet, serialize_rudics_packet
+from pygoby.acomms.rudics import (
+    RudicsPacketError,
+    embedded_size,
+    max_data_bytes,
+    parse_rudics_packet,
+    serialize_rudics_packet,
+)
 
 log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 11244
 POLL = 1  # store_server.protobuf.Transmission.STORE_SERVER_DRIVER_POLL
+# Room in a request for everything but the frames' bytes (ids, times, the transmission's other
+# fields, the request around it), so that one full transmission always fits in one packet.
+TRANSMISSION_OVERHEAD = 256
 
 
 class StoreServerDriver(ModemDriverBase):
@@ -70,11 +79,15 @@ class StoreServerDriver(ModemDriverBase):
         rate = msg.rate
         msg.frame_start = self._frame_counter
         to_bytes, to_frames = self.ss_cfg.rate_to_bytes, self.ss_cfg.rate_to_frames
-        msg.max_frame_bytes = (
-            to_bytes[rate] if 0 <= rate < len(to_bytes) else self.ss_cfg.max_frame_size
-        )
         if 0 <= rate < len(to_frames):
             msg.max_num_frames = to_frames[rate]
+        # whatever the configuration says, a transmission must fit in one RUDICS packet
+        frames = max(1, msg.max_num_frames)
+        packet_room = (max_data_bytes() - TRANSMISSION_OVERHEAD) // frames
+        msg.max_frame_bytes = min(
+            to_bytes[rate] if 0 <= rate < len(to_bytes) else self.ss_cfg.max_frame_size,
+            packet_room,
+        )
         if len(msg.frame) < msg.max_num_frames:
             self.signal_data_request.emit(msg)
         self._frame_counter += len(msg.frame)
@@ -107,11 +120,23 @@ class StoreServerDriver(ModemDriverBase):
     def _send_request(self, now: float) -> None:
         self._request_id += 1
         request = m.StoreServerRequest(modem_id=self.modem_id, request_id=self._request_id)
-        request.outbox.extend(self._outbox)
+        # as much of the outbox as fits in one packet, oldest first; the rest goes next time
+        room = max_data_bytes() - request.ByteSize()
+        sent = 0
+        for t in self._outbox:
+            size = embedded_size(t.ByteSize())
+            if size > room:
+                if sent == 0:
+                    log.error("dropping a transmission of %d bytes: larger than a packet", size)
+                    sent = 1
+                break
+            room -= size
+            request.outbox.append(t)
+            sent += 1
         packet = serialize_rudics_packet(request.SerializeToString())
         self.modem_write(packet.decode("latin-1"))
         self.emit_raw(False, packet)
-        self._outbox = []
+        self._outbox = self._outbox[sent:]
         self._waiting_since = now
         self._last_query = now
 
