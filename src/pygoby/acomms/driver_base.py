@@ -52,6 +52,7 @@ class ModemDriverBase(ABC):
 
     DEFAULT_SERIAL_BAUD: int | None = None
     DEFAULT_LINE_DELIMITER: str | None = None  # overrides DriverConfig's default when unset
+    RATES: range | None = None  # the transmission rates the modem has (None: any number)
 
     def __init__(self, clock: Clock | None = None, link: LineLink | None = None) -> None:
         self.clock: Clock = clock if clock is not None else WallClock()

@@ -37,6 +37,7 @@ from pygoby.acomms.queue import QueueError, QueueManager
 from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
 from pygoby.acomms.signals import Signal
 from pygoby.dccl import Codec, DcclError
+from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
 from pygoby.util.clock import Clock
 from pygoby.util.modules import import_module_or_file
@@ -93,6 +94,19 @@ def plugin_driver_factory(driver_name: str) -> Callable[[Clock], ModemDriverBase
     raise HandlerError(
         f"no driver plugin named {driver_name!r} in ${PLUGINS_ENV} ({', '.join(listed) or 'empty'})"
     )
+
+
+def _check_slot_rates(mac_cfg, driver: ModemDriverBase) -> None:
+    """Every slot's rate is one the driver has: a wrong one would fail every cycle, not once."""
+    if driver.RATES is None:
+        return
+    for index, slot in enumerate(mac_cfg.slot):
+        if slot.type == m.DATA and slot.rate not in driver.RATES:
+            raise ConfigError(
+                f"rate {slot.rate} is not a rate of {type(driver).__name__} "
+                f"({driver.RATES.start}-{driver.RATES.stop - 1})",
+                field=f"mac_cfg.slot[{index}].rate",
+            )
 
 
 def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
@@ -198,6 +212,7 @@ class AcommsHandler:
         self.mac_cfg.modem_id = self.modem_id
         self.mac = MACManager(clock)
         if self.primary is not None:
+            _check_slot_rates(self.mac_cfg, self.primary.driver)
             self.mac.signal_initiate_transmission.connect(self._initiate_on_primary)
             self.primary.driver.signal_receive.connect(self.mac.handle_modem_receive)
 

@@ -24,7 +24,7 @@ from pygoby.acomms.queue import QueueError
 from pygoby.dccl import DcclError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError, prefixed_var_names
+from pygoby.moos.appconfig import ConfigError, locate, prefixed_var_names
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, TranslatorError
 from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
@@ -58,6 +58,8 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.acomms = AcommsHandler(cfg, self.clock, self.loader)
         except HandlerError as err:
             raise ConfigError(str(err)) from None
+        except ConfigError as err:
+            raise locate(err, self.mission, self.name) from None
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))

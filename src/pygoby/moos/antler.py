@@ -20,6 +20,7 @@ import sys
 import time
 from pathlib import Path
 
+from pygoby.errors import ConfigError
 from pygoby.moos.moosfile import AntlerRun, MissionFile, MissionFileError
 from pygoby.moos.protocol import DEFAULT_PORT
 
@@ -55,6 +56,7 @@ class Antler:
         self.mission_path = Path(mission_path).resolve()
         self.mission = MissionFile.read(self.mission_path)
         self.config = self.mission.antler()
+        self._db_address()  # a bad ServerPort fails here, before anything is started
         self.start_db = start_db
         self.grace = grace
         self.children: list[tuple[str, subprocess.Popen[bytes]]] = []
@@ -63,7 +65,7 @@ class Antler:
 
     def _db_address(self) -> tuple[str, int]:
         host = self.mission.get_value("ServerHost") or "localhost"
-        return ("127.0.0.1" if host.upper() == "LOCALHOST" else host), self.mission.get_int("ServerPort") or DEFAULT_PORT
+        return ("127.0.0.1" if host.upper() == "LOCALHOST" else host), self.mission.get_port("ServerPort") or DEFAULT_PORT
 
     def launch(self) -> None:
         host, port = self._db_address()
@@ -133,7 +135,7 @@ def run_antler(mission: str, start_db: bool = True) -> int:
     logging.basicConfig(level=logging.INFO, format="antler: %(message)s")
     try:
         antler = Antler(mission, start_db=start_db)
-    except (OSError, MissionFileError) as err:
+    except (OSError, MissionFileError, ConfigError) as err:
         print(f"antler: {err}", file=sys.stderr)
         return 1
     return antler.run()

@@ -17,15 +17,15 @@ from __future__ import annotations
 import functools
 import logging
 import math
-import re
 from collections.abc import Callable, Sequence
 
-from google.protobuf import text_format
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.moos.moosfile import MissionFile, parse_number
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
 
 log = logging.getLogger(__name__)
 
@@ -33,10 +33,6 @@ GOBY_FIELD_EXTENSION = 1009
 EXAMPLE_WIDTH = 66
 EXAMPLE_MIN_WIDTH = 20
 EXAMPLE_FALLBACK_INDENT = 46
-
-
-class ConfigError(Exception):
-    """The configuration could not be read; the message says where and why."""
 
 
 @functools.cache
@@ -85,30 +81,19 @@ def goby_field_options(field: FieldDescriptor) -> Message:
 # Reading
 
 
-def _field_near(line_text: str, column: int) -> str | None:
-    names = re.findall(r"([A-Za-z_][\w.]*|\[[\w.]+\])\s*[:{]", line_text[: max(column, 1)])
-    return names[-1] if names else None
+def locate(err: ConfigError, mission: MissionFile | None, app_name: str) -> ConfigError:
+    """`err` (about the field at `err.field` of the app's configuration) with the mission file
+    and the line of that field in the app's ProcessConfig block filled in."""
+    block = mission.goby_block(app_name) if mission is not None else None
+    if block is None or err.field is None:
+        return err
+    path = mission.path if mission.path else "mission file"
+    return err.located(file=path, line=line_of_field(block.text, err.field, block.first_line))
 
 
 def parse_block(config: Message, text: str, first_line: int, source: str) -> None:
     """Merge TextFormat `text` into `config`; errors give the file line and the field."""
-    try:
-        text_format.Merge(text, config)
-    except text_format.ParseError as err:
-        line, column = err.GetLine(), err.GetColumn()
-        if line is None:
-            raise ConfigError(f"{source}: {err}") from None
-        lines = text.splitlines()
-        line_text = lines[line - 1] if 0 < line <= len(lines) else ""
-        detail = str(err).split(" : ", 1)[-1]
-        quoted = f"'{line_text}': "
-        if detail.startswith(quoted):
-            detail = detail[len(quoted) :]
-        field = _field_near(line_text, column or 0)
-        where = f' in field "{field}"' if field and field not in detail else ""
-        raise ConfigError(
-            f"{source}:{first_line + line - 1}: {detail}{where}\n    {line_text.strip()}"
-        ) from None
+    merge_config_text(text, config, file=source, first_line=first_line)
 
 
 def apply_moos_globals(config: Message, mission: MissionFile) -> None:
@@ -136,10 +121,16 @@ def apply_moos_globals(config: Message, mission: MissionFile) -> None:
             log.info("MOOS global %s=%s ignored: %s is set in the ProcessConfig block",
                      name, value, field.full_name)  # fmt: skip
             continue
-        _set_from_global(config, field, name, value)
+        try:
+            _set_from_global(config, field, name, value)
+        except ConfigError as err:
+            path = mission.path if mission.path else "mission file"
+            raise err.located(file=path, line=mission.global_line(name)) from None
 
 
 def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: str) -> None:
+    """A MOOS global's text as the field's value; text that is no value of its type is an
+    error (MOOS would read "abc" as 0: a mistyped ServerPort must not mean port 9000)."""
     kind = field.type
     if kind == FieldDescriptor.TYPE_STRING:
         setattr(config, field.name, value)
@@ -153,14 +144,17 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
         if enum_value is None:
             raise ConfigError(f'invalid enumeration "{value}" for {field.name} (MOOS global {name})')
         setattr(config, field.name, enum_value.number)
+    elif (number := parse_number(value)) is None:
+        raise ConfigError(f"{name} = {value} is not a number", field=field.full_name)
     elif kind in (FieldDescriptor.TYPE_DOUBLE, FieldDescriptor.TYPE_FLOAT):
-        if (number := parse_number(value)) is not None:
-            setattr(config, field.name, number)
-    elif (number := parse_number(value)) is not None:
+        setattr(config, field.name, number)
+    elif number != int(number):
+        raise ConfigError(f"{name} = {value} is not a whole number", field=field.full_name)
+    else:
         try:
             setattr(config, field.name, int(number))
         except ValueError:
-            raise ConfigError(f"MOOS global {name}={value} is out of range for {field.name}") from None
+            raise ConfigError(f"{name} = {value} is out of range", field=field.full_name) from None
 
 
 def apply_overrides(config: Message, overrides: Sequence[tuple[str, str]]) -> None:
@@ -208,6 +202,8 @@ def read_configuration(
     missing = config.FindInitializationErrors()
     if missing:
         raise ConfigError(f"missing required configuration fields: {', '.join(missing)}")
+    block_text, first_line = (block.text, block.first_line) if mission is not None else ("", 1)
+    check_config_values(config, block_text, file=source, first_line=first_line)
     return config
 
 

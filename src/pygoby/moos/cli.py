@@ -14,6 +14,7 @@ import sys
 from collections.abc import Coroutine
 from typing import Any
 
+from pygoby.errors import ConfigError
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import DEFAULT_CLIENT_TIMEOUT, MOOSDB
@@ -85,7 +86,11 @@ def _run_moosdb(args: argparse.Namespace) -> int:
             print(f"moosdb: cannot read {args.mission} ({err.strerror}); using defaults", file=sys.stderr)
     port = args.port
     if port is None:
-        port = mission.get_int("ServerPort") if mission else None
+        try:
+            port = mission.get_port("ServerPort") if mission else None
+        except ConfigError as err:
+            print(f"moosdb: {err}", file=sys.stderr)
+            return 1
         port = p.DEFAULT_PORT if port is None else port
     community = args.community or (mission and mission.get_value("Community")) or p.DEFAULT_COMMUNITY
     warp = args.time_warp or (mission and mission.get_float("MOOSTimeWarp")) or 1.0

@@ -17,6 +17,8 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from pygoby.errors import ConfigError
+
 _NUMERIC = re.compile(r"[0-9.eE+\-]+")
 _MACRO_USE = re.compile(r"\$\{([^}]*)\}")
 
@@ -180,6 +182,31 @@ class MissionFile:
             if sep and key.lower() == wanted:
                 return value
         return None
+
+    def global_line(self, name: str, outside_blocks: bool = True) -> int | None:
+        """The file line (1-based) of the `name = value` line that get_value reads."""
+        wanted = name.lower()
+        for number, (line, in_block) in enumerate(zip(self.lines, self._in_block, strict=True)):
+            if outside_blocks and in_block:
+                continue
+            key, sep, _ = _no_space(line).partition("=")
+            if sep and key.lower() == wanted:
+                return number + 1
+        return None
+
+    def get_port(self, name: str = "ServerPort") -> int | None:
+        """A port number global (None if absent); anything but 0-65535 is a ConfigError."""
+        value = self.get_value(name)
+        if value is None:
+            return None
+        if not value.isdigit() or int(value) > 65535:
+            raise ConfigError(
+                f"{name} = {value} is not a port number (0-65535)",
+                file=self.path if self.path else "mission file",
+                line=self.global_line(name, outside_blocks=False),
+                field=name,
+            )
+        return int(value)
 
     def get_float(self, name: str, outside_blocks: bool = False) -> float | None:
         value = self.get_value(name, outside_blocks)

@@ -15,8 +15,9 @@ from collections.abc import Callable, Iterable
 from google.protobuf import descriptor_pool, message_factory
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError
+from pygoby.moos.appconfig import locate
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import (
     LAT_ORIGIN_VAR,
@@ -80,16 +81,19 @@ class TranslatorBinding:
         self.on_created = on_created
         self.multiplex_vars = list(multiplex_vars)
         modem_ids = ModemIdLookup.from_file(modem_id_lookup_path) if modem_id_lookup_path else None
-        try:
-            self.translator = Translator(
-                entries,
-                resolve,
-                lat_origin=app.common.lat_origin,
-                lon_origin=app.common.lon_origin,
-                modem_ids=modem_ids,
-            )
-        except TranslatorError as err:
-            raise ConfigError(str(err)) from None
+        self.translator = Translator(
+            (),
+            resolve,
+            lat_origin=app.common.lat_origin,
+            lon_origin=app.common.lon_origin,
+            modem_ids=modem_ids,
+        )
+        for index, entry in enumerate(entries):
+            try:
+                self.translator.add_entry(entry)
+            except TranslatorError as err:
+                error = ConfigError(str(err), field=f"translator_entry[{index}]")
+                raise locate(error, app.mission, app.name) from None
         self.moos_technique = app.moos_technique
         self.runner: TranslatorRunner | None = None
 

@@ -8,13 +8,16 @@ the parts pygoby uses are still caught.
 
 from __future__ import annotations
 
+import os
 from functools import cache
 
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.netsim.channel.settings import environment_channel_configs
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
 
 CONFIG_PROTO = "netsim/messages/manager_config.proto"
 CONFIG_TYPE = "netsim.protobuf.NetSimManagerConfig"
@@ -58,10 +61,6 @@ environment_channel {
 """
 
 
-class ConfigError(Exception):
-    """The configuration cannot be used (parse error or a fatal start-up check)."""
-
-
 @cache
 def config_class() -> type[Message]:
     return builtin_class(CONFIG_PROTO, CONFIG_TYPE)
@@ -75,15 +74,21 @@ class _Parser(text_format._Parser):  # noqa: SLF001 - per-message control of unk
         super()._MergeField(tokenizer, message)
 
 
-def parse_config(text: str) -> Message:
-    """Parse and validate a TextFormat configuration; raises ConfigError."""
+def parse_config(text: str, file: str | os.PathLike[str] | None = None) -> Message:
+    """Parse and validate a TextFormat configuration; raises ConfigError (with `file`:line)."""
     config = config_class()()
+    merge_config_text(text, config, file=file, parser=_Parser())
+    check_config_values(config, text, file=file)
     try:
-        _Parser().ParseLines(text.split("\n"), config)
-    except text_format.ParseError as exc:
-        raise ConfigError(f"cannot parse configuration: {exc}") from exc
-    validate_config(config)
+        validate_config(config)
+    except ConfigError as err:
+        raise err.located(file=file) from None
     return config
+
+
+def load_config(path: str | os.PathLike[str]) -> Message:
+    """The configuration file at `path`, whatever its bytes: ConfigError for every problem."""
+    return parse_config(read_config_file(path), path)
 
 
 def validate_config(config: Message) -> None:

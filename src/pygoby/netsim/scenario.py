@@ -16,15 +16,16 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
-from google.protobuf import text_format
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as m
+from pygoby.errors import ConfigError
 from pygoby.netsim.channel import Band, ChannelConfig, Position
 from pygoby.netsim.channel.errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.config import config_class as manager_config_class
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
 
 SCENARIO_PROTO = "pygoby/netsim/scenario.proto"
 FIRST_MODEM_PORT = 62000
@@ -34,7 +35,7 @@ MAC_FIXED_DECENTRALIZED = m.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_typ
 ].number
 
 
-class ScenarioError(Exception):
+class ScenarioError(ConfigError):
     """The scenario cannot be run (parse error or inconsistent settings)."""
 
 
@@ -50,19 +51,23 @@ def node_status_class() -> type[Message]:
 
 def load_scenario(path: str | Path) -> Message:
     try:
-        text = Path(path).read_text()
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario: {exc}") from exc
-    return parse_scenario(text)
+        text = read_config_file(path)
+    except ConfigError as err:
+        raise ScenarioError(err.reason, file=path) from None
+    return parse_scenario(text, path)
 
 
-def parse_scenario(text: str) -> Message:
+def parse_scenario(text: str, file: str | Path | None = None) -> Message:
     scenario = scenario_class()()
     try:
-        text_format.Parse(text, scenario)
-    except text_format.ParseError as exc:
-        raise ScenarioError(f"cannot parse scenario: {exc}") from exc
-    check_scenario(scenario)
+        merge_config_text(text, scenario, file=file)
+        check_config_values(scenario, text, file=file)
+    except ConfigError as err:
+        raise ScenarioError(err.reason, file=err.file, line=err.line, field=err.field) from None
+    try:
+        check_scenario(scenario)
+    except ScenarioError as err:
+        raise err.located(file=file) from None
     return scenario
 
 

@@ -11,9 +11,9 @@ import argparse
 import asyncio
 import logging
 import sys
-from pathlib import Path
 
-from pygoby.netsim.config import EXAMPLE_CONFIG, ConfigError, parse_config
+from pygoby.errors import ConfigError
+from pygoby.netsim.config import EXAMPLE_CONFIG, load_config
 from pygoby.netsim.gprmc import GpsOutputs
 from pygoby.netsim.manager import NetSimManager
 from pygoby.util.aiorun import run_until_signal
@@ -126,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
     level = logging.WARNING - 10 * args.verbose
     logging.basicConfig(level=level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     try:
-        config = parse_config(Path(args.config).read_text())
+        config = load_config(args.config)
         manager = NetSimManager(config)
         if config.gps_out:
             manager.on_nav(GpsOutputs.open_serial(config, WallClock()).on_nav_update)

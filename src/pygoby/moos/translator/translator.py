@@ -170,8 +170,9 @@ class Translator:
                     raise TranslatorConfigError(
                         f"{name}: publish to {publish.moos_var} needs a format"
                     )
-                format_technique.check_serialize_format(descriptor, publish.format)
-                format_technique.check_serialize_format(descriptor, publish.moos_var)
+                virtual = {algorithm.output_virtual_field for algorithm in publish.algorithm}
+                format_technique.check_serialize_format(descriptor, publish.format, virtual)
+                format_technique.check_serialize_format(descriptor, publish.moos_var, virtual)
 
     def set_datum(self, lat_origin: float, lon_origin: float) -> None:
         """Re-initialise the UTM datum used by the UTM algorithms."""
