@@ -207,3 +207,145 @@ async def test_a_garbage_line_and_a_pipelining_client_do_not_hold_up_others():
     finally:
         tcp.close()
         store.close()
+
+
+# -- issue 16 item 13: who may read a modem's mail, a locked database, pruning -------------------
+
+def signed(modem_id: int, secret: bytes | None, now: float, **fields) -> bytes:
+    from pygoby.acomms.store_server.auth import sign_request
+
+    payload = m.StoreServerRequest(modem_id=modem_id, **fields).SerializeToString()
+    if secret is not None:
+        payload = sign_request(payload, secret, now)
+    return serialize_rudics_packet(payload)
+
+
+def answer(server: StoreServer, packet: bytes):
+    """(response, error) for a request packet."""
+    payload = parse_rudics_packet(server.handle_packet(packet))
+    return (m.StoreServerResponse.FromString(payload),
+            m.StoreServerResponseStatus.FromString(payload).error)  # fmt: skip
+
+
+def test_only_the_holder_of_a_modem_ids_secret_reads_its_mail():
+    from pygoby.util.clock import VirtualClock
+
+    clock = VirtualClock(1000.0)
+    store = TransmissionStore()
+    server = StoreServer(store, clock, secrets={1: b"one", 2: b"two"})
+    mail = m.ModemTransmission(src=1, dest=2, type=m.DATA, frame=[b"for two"])
+    response, error = answer(server, signed(1, b"one", 1000.0, outbox=[mail]))
+    assert error == "" and server.requests_answered == 1
+    # an unsigned request, a wrong secret, an unknown id, a stale time: refused, nothing taken
+    for packet in (signed(2, None, 1000.0), signed(2, b"one", 1000.0), signed(3, b"x", 1000.0),
+                   signed(2, b"two", 1000.0 - 301)):  # fmt: skip
+        response, error = answer(server, packet)
+        assert error == "not authenticated for this modem id" and not response.inbox
+    assert server.requests_refused == 4
+    clock.set(1001.0)
+    recorded = signed(2, b"two", 1001.0)
+    response, error = answer(server, recorded)
+    assert error == "" and [bytes(t.frame[0]) for t in response.inbox] == [b"for two"]
+    # the recorded request played back (to read mail that arrives later) is refused
+    answer(server, signed(1, b"one", 1001.5, outbox=[mail]))
+    response, error = answer(server, recorded)
+    assert error and not response.inbox
+    # a C++ style client without a secret is answered as before by a server without secrets
+    open_server = StoreServer(store, clock)
+    response, error = answer(open_server, signed(2, None, 0.0))
+    assert error == "" and len(response.inbox) == 1
+
+
+def test_a_locked_database_gets_an_error_reply_and_the_driver_sends_again(tmp_path):
+    """Issue 16 item 13: SQLite's lock timeout used to drop the connection (and the outbox)."""
+    import sqlite3
+
+    from pygoby.util.clock import VirtualClock
+    from pygoby.util.linebased import MemoryLink
+
+    db = tmp_path / "store.db"
+    store = TransmissionStore(db, lock_timeout_seconds=0.05)
+    server = StoreServer(store)
+    link = MemoryLink("\r")
+    driver = StoreServerDriver(VirtualClock(0), link)
+    driver.startup(m.DriverConfig(driver_type=5, modem_id=1))
+    driver._outbox.append(bulk(1, 10, dest=2))
+    other = sqlite3.connect(db)
+    other.execute("BEGIN EXCLUSIVE")  # another process holds the database
+    driver._send_request(0.0)
+    reply = server.handle_packet(link.take_written()[0].encode("latin-1"))
+    status = m.StoreServerResponseStatus.FromString(parse_rudics_packet(reply))
+    assert server.store_errors == 1 and status.error.startswith("store unavailable: database")
+    link.feed(reply.decode("latin-1"))
+    driver.do_work()
+    assert len(driver._outbox) == 1  # nothing was stored: the transmission is kept
+    other.rollback()
+    other.close()
+    driver._send_request(1.0)
+    link.feed(server.handle_packet(link.take_written()[0].encode("latin-1")).decode("latin-1"))
+    driver.do_work()
+    assert driver._outbox == [] and server.requests_answered == 1
+    got = store.exchange(m.StoreServerRequest(modem_id=2), 2.0)
+    assert [bytes(t.frame[0]) for t in got.inbox] == [b"x" * 10]  # stored once
+    store.close()
+
+
+def test_delivered_transmissions_are_pruned_after_the_retention_time():
+    store = TransmissionStore(max_lookback_seconds=1000.0, retention_seconds=100.0)
+    request = m.StoreServerRequest(modem_id=1)
+    request.outbox.extend([bulk(1, 1, dest=2), bulk(1, 2, dest=3), bulk(1, 3, dest=0)])
+    store.exchange(request, 0.0)
+    store.exchange(m.StoreServerRequest(modem_id=2), 10.0)  # 2 reads its mail and the broadcast
+    store.exchange(m.StoreServerRequest(modem_id=3), 10.0)  # 3 too
+    store.exchange(m.StoreServerRequest(modem_id=4), 10.0)  # 4 only knows the broadcast
+    assert store.prune(50.0) == 0  # delivered, but within the retention time
+    store.exchange(request, 60.0)  # new mail for 2, 3 and all, read by nobody yet
+    assert store.prune(150.0) == 3  # the first three: delivered and older than 100 s
+    store.exchange(m.StoreServerRequest(modem_id=2), 160.0)
+    assert store.prune(200.0) == 1  # 2's new mail went; 3's and the broadcast wait for 3 and 4
+    assert store.prune(1059.0) == 0
+    assert store.prune(1061.0) == 2  # past the look-back nobody can be served them
+    assert store.db.execute("SELECT COUNT(*) FROM transmission").fetchone()[0] == 0
+
+
+async def test_signed_drivers_exchange_mail_through_a_server_with_secrets(tmp_path):
+    clock = WallClock()
+    store = TransmissionStore(tmp_path / "s.db")
+    (tmp_path / "secrets").write_text("# modem secrets\n1 alpha\n2 bravo\n")
+    from pygoby.acomms.store_server.auth import read_secrets
+
+    tcp = await serve_store(StoreServer(store, secrets=read_secrets(tmp_path / "secrets")),
+                            "127.0.0.1", 0)  # fmt: skip
+    port = tcp.sockets[0].getsockname()[1]
+    drivers = []
+    for modem_id, secret in ((1, "alpha"), (2, "bravo")):
+        (tmp_path / f"{modem_id}.secret").write_text(secret + "\n")
+        cfg = store_cfg(modem_id, port)
+        cfg.Extensions[m.STORE_SERVER_AUTH].secret_file = str(tmp_path / f"{modem_id}.secret")
+        driver = StoreServerDriver(clock)
+        driver.startup(cfg)
+        drivers.append(driver)
+    d1, d2 = drivers
+    q1, q2, Status, got, acked = status_link(clock, d1, d2)
+    try:
+        await d1.link.wait_open()
+        q1.push_message(Status(src=1, dest=2, value=7))
+        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        await run_until(lambda: bool(acked), [d1, d2, q1, q2], timeout=10)
+        assert [x.value for x in got] == [7]
+    finally:
+        d1.shutdown()
+        d2.shutdown()
+        tcp.close()
+        store.close()
+
+
+def test_store_server_refuses_a_bad_secrets_file(tmp_path):
+    import subprocess
+    import sys
+
+    (tmp_path / "secrets").write_text("1 alpha\ntwo bravo\n")
+    run = subprocess.run([sys.executable, "-m", "pygoby.cli", "store_server", "--port", "0",
+                          "--db", str(tmp_path / "s.db"), "--secrets", str(tmp_path / "secrets")],
+                         capture_output=True, text=True, timeout=30)  # fmt: skip
+    assert run.returncode == 1 and "secrets:2: expected MODEM_ID SECRET" in run.stderr

@@ -13,7 +13,7 @@ import logging
 from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
 from pygoby.acomms.rudics import (
     RudicsPacketError,
     embedded_size,
@@ -21,6 +21,8 @@ from pygoby.acomms.rudics import (
     parse_rudics_packet,
     serialize_rudics_packet,
 )
+from pygoby.acomms.store_server.auth import AUTH_BYTES, read_secret_file, sign_request
+from pygoby.errors import ConfigError
 
 log = logging.getLogger(__name__)
 
@@ -43,6 +45,8 @@ class StoreServerDriver(ModemDriverBase):
         self._last_query = 0.0
         self._frame_counter = 0
         self._running = False
+        self._secret: bytes | None = None
+        self._in_flight: list = []  # the outbox of the request awaiting its reply
 
     def startup(self, cfg) -> None:
         cfg_copy = m.DriverConfig()
@@ -53,6 +57,15 @@ class StoreServerDriver(ModemDriverBase):
         if not cfg.HasField("connection_type"):
             cfg.connection_type = m.DriverConfig.CONNECTION_TCP_AS_CLIENT
         self.ss_cfg = cfg.Extensions[m.STORE_SERVER_CONFIG]
+        auth = cfg.Extensions[m.STORE_SERVER_AUTH]
+        if auth.HasField("secret_file"):
+            try:
+                self._secret = read_secret_file(auth.secret_file)
+            except ConfigError as exc:
+                raise ModemDriverException(
+                    f"store_server_auth.secret_file: {exc}",
+                    m.ModemDriverStatus.INVALID_CONFIGURATION,
+                ) from None
         self.modem_start(cfg)
         self._running = True
 
@@ -121,7 +134,7 @@ class StoreServerDriver(ModemDriverBase):
         self._request_id += 1
         request = m.StoreServerRequest(modem_id=self.modem_id, request_id=self._request_id)
         # as much of the outbox as fits in one packet, oldest first; the rest goes next time
-        room = max_data_bytes() - request.ByteSize()
+        room = max_data_bytes() - request.ByteSize() - (AUTH_BYTES if self._secret else 0)
         sent = 0
         for t in self._outbox:
             size = embedded_size(t.ByteSize())
@@ -133,9 +146,13 @@ class StoreServerDriver(ModemDriverBase):
             room -= size
             request.outbox.append(t)
             sent += 1
-        packet = serialize_rudics_packet(request.SerializeToString())
+        payload = request.SerializeToString()
+        if self._secret is not None:
+            payload = sign_request(payload, self._secret, now)
+        packet = serialize_rudics_packet(payload)
         self.modem_write(packet.decode("latin-1"))
         self.emit_raw(False, packet)
+        self._in_flight = list(request.outbox)
         self._outbox = self._outbox[sent:]
         self._waiting_since = now
         self._last_query = now
@@ -143,11 +160,19 @@ class StoreServerDriver(ModemDriverBase):
     def _handle_packet(self, packet: bytes) -> None:
         self.emit_raw(True, packet)
         try:
-            response = m.StoreServerResponse.FromString(parse_rudics_packet(packet))
+            payload = parse_rudics_packet(packet)
+            response = m.StoreServerResponse.FromString(payload)
+            status = m.StoreServerResponseStatus.FromString(payload)
         except (RudicsPacketError, DecodeError) as exc:
             log.warning("ignoring a bad store-server response: %s", exc)
             return
         self._waiting_since = None
+        if status.error:  # nothing was stored: that outbox goes with the next request
+            log.warning("store server: %s; sending again", status.error)
+            self._outbox[:0] = self._in_flight
+            self._in_flight = []
+            return
+        self._in_flight = []
         for t in response.inbox:
             ext = t.Extensions[m.STORE_SERVER_TRANSMISSION]
             if t.type == m.DRIVER_SPECIFIC and ext.type == POLL:

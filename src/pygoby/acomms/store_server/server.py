@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import sqlite3
+from collections.abc import Mapping
 
 from google.protobuf.message import DecodeError
 
@@ -21,7 +23,8 @@ from pygoby.acomms.rudics import (
     parse_rudics_packet,
     serialize_rudics_packet,
 )
-from pygoby.acomms.store_server.store import TransmissionStore
+from pygoby.acomms.store_server.auth import AuthError, verify_request
+from pygoby.acomms.store_server.store import ReplayedRequestError, TransmissionStore
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.linebased import LineSplitter
 
@@ -29,20 +32,40 @@ log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 11244
 READ_SIZE = 16384
+DEFAULT_AUTH_WINDOW = 300.0  # s between a signed request's time and the server's clock
+DEFAULT_PRUNE_INTERVAL = 60.0  # s between prunes of the store
 
 
 class StoreServer:
-    """Sans-I/O request handling: packet bytes in, packet bytes out (or None if invalid)."""
+    """Sans-I/O request handling: packet bytes in, packet bytes out (or None if invalid).
 
-    def __init__(self, store: TransmissionStore, clock: Clock | None = None) -> None:
+    `secrets`: modem id -> shared secret; when given, only requests signed with their modem
+    id's secret (store_server.auth) are carried out, and ids without a secret are refused.
+    `auth_window`: how far (s) a signed request's time may be from the server's clock.
+    """
+
+    def __init__(
+        self,
+        store: TransmissionStore,
+        clock: Clock | None = None,
+        secrets: Mapping[int, bytes] | None = None,
+        auth_window: float = DEFAULT_AUTH_WINDOW,
+        prune_interval: float = DEFAULT_PRUNE_INTERVAL,
+    ) -> None:
         self.store = store
         self.clock = clock if clock is not None else WallClock()
+        self.secrets = secrets
+        self.auth_window = auth_window
+        self.prune_interval = prune_interval
+        self._next_prune = 0.0
         self.requests_answered = 0
-        self.requests_refused = 0  # packets that are not valid requests
+        self.requests_refused = 0  # packets that are not valid requests, or not authentic
+        self.store_errors = 0  # requests answered with an error: the store could not be used
 
     def handle_packet(self, packet: bytes) -> bytes | None:
         try:
-            request = m.StoreServerRequest.FromString(parse_rudics_packet(packet))
+            payload = parse_rudics_packet(packet)
+            request = m.StoreServerRequest.FromString(payload)
         except (RudicsPacketError, DecodeError) as exc:
             log.warning("ignoring a bad store-server request: %s", exc)
             self.requests_refused += 1
@@ -51,9 +74,52 @@ class StoreServer:
             log.warning("ignoring a store-server request without modem_id")
             self.requests_refused += 1
             return None
-        response = self.store.exchange(request, self.clock.now(), max_data_bytes())
+        now = self.clock.now()
+        try:
+            auth_time = self._authenticate(request.modem_id, payload, now)
+            response = self.store.exchange(request, now, max_data_bytes(), auth_time)
+        except (AuthError, ReplayedRequestError) as exc:
+            log.warning("refusing a request for modem id %d: %s", request.modem_id, exc)
+            self.requests_refused += 1
+            return _error_reply(request, "not authenticated for this modem id")
+        except sqlite3.Error as exc:  # e.g. locked by another process: the client tries again
+            log.warning("store unavailable for modem id %d: %s", request.modem_id, exc)
+            self.store_errors += 1
+            return _error_reply(request, f"store unavailable: {exc}")
         self.requests_answered += 1
+        self._prune(now)
         return serialize_rudics_packet(response.SerializeToString())
+
+    def _authenticate(self, modem_id: int, payload: bytes, now: float) -> float | None:
+        if self.secrets is None:
+            return None
+        secret = self.secrets.get(modem_id)
+        if secret is None:
+            raise AuthError("no secret is configured for it")
+        auth_time = verify_request(payload, secret)
+        if not abs(auth_time - now) <= self.auth_window:
+            raise AuthError(f"request time is {auth_time - now:+.0f} s from the server's clock")
+        return auth_time
+
+    def _prune(self, now: float) -> None:
+        if now < self._next_prune:
+            return
+        self._next_prune = now + self.prune_interval
+        try:
+            pruned = self.store.prune(now)
+        except sqlite3.Error as exc:
+            log.warning("cannot prune the store: %s", exc)
+            return
+        if pruned:
+            log.info("pruned %d delivered or expired transmissions", pruned)
+
+
+def _error_reply(request, error: str) -> bytes:
+    response = m.StoreServerResponse(modem_id=request.modem_id)
+    if request.HasField("request_id"):
+        response.request_id = request.request_id
+    status = m.StoreServerResponseStatus(error=error)
+    return serialize_rudics_packet(response.SerializeToString() + status.SerializeToString())
 
 
 async def serve_store(server: StoreServer, host: str = "127.0.0.1", port: int = DEFAULT_PORT):
