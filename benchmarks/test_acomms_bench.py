@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.util.clock import VirtualClock
 
 # the test DCCL types and queue set-up shared with tests/acomms (loaded by path: the test
@@ -49,7 +49,7 @@ def test_pop_one_frame_with_100k_queued(benchmark, loaded):
 
     def pop():
         clock.advance(0.001)
-        request = m.ModemTransmission(src=1, dest=-1, max_num_frames=1, max_frame_bytes=32)
+        request = acomms_pb.ModemTransmission(src=1, dest=-1, max_num_frames=1, max_frame_bytes=32)
         qm.handle_modem_data_request(request)
         return request
 
@@ -72,10 +72,10 @@ def test_acked_pop_and_ack_with_100k_queued(benchmark):
     def pop_and_ack():
         clock.advance(0.001)
         n = next(frame)
-        request = m.ModemTransmission(src=1, dest=-1, max_num_frames=1, max_frame_bytes=32,
+        request = acomms_pb.ModemTransmission(src=1, dest=-1, max_num_frames=1, max_frame_bytes=32,
                                       frame_start=n)  # fmt: skip
         qm.handle_modem_data_request(request)
-        qm.handle_modem_receive(m.ModemTransmission(type=m.ACK, src=2, dest=1, acked_frame=[n]))
+        qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[n]))
 
     benchmark(pop_and_ack)
     assert qm.size(20) < QUEUED

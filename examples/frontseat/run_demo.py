@@ -17,7 +17,7 @@ import logging
 from pathlib import Path
 
 from pygoby.apps.ifrontseat import iFrontSeat
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.simulator.server import SimulatorServer
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
@@ -93,7 +93,7 @@ async def demo(warp: float, duration: float) -> bool:
         settled = False  # at the last sample where the leg had run SETTLE_S: on course?
         while (elapsed := clock.now() - start) < duration:
             leg_start, heading, speed, depth = leg_at(elapsed)
-            state = m.InterfaceState.Name(app.interface.state).removeprefix("INTERFACE_")
+            state = frontseat_pb.InterfaceState.Name(app.interface.state).removeprefix("INTERFACE_")
             nav = [latest.get(var, float("nan")) for var in NAV]
             print(f"{elapsed:5.0f}s {state:10s} {heading:5.0f} {speed:4.1f} {depth:5.1f}    "
                   f"{nav[0]:7.1f} {nav[1]:4.2f} {nav[2]:5.1f}   {nav[3]:8.1f} {nav[4]:8.1f}")  # fmt: skip

@@ -183,7 +183,7 @@ class Monitor:
         return msg
 
     def _on_mail(self, msg) -> None:
-        from pygoby.acomms import messages as m
+        from pygoby.acomms import messages as acomms_pb
 
         s, value = self.stats, msg.value
         if msg.key in NAV and msg.is_double:
@@ -191,10 +191,10 @@ class Monitor:
             if len(self.nav) == len(NAV):
                 self.on_nav(self.nav, msg.time)
         elif msg.key == "ACOMMS_MAC_SLOT_START" and (
-            slot := self._parse(m.ModemTransmission, value)
+            slot := self._parse(acomms_pb.ModemTransmission, value)
         ):
             self.slot = (slot.slot_index, slot.src)
-        elif msg.key == "ACOMMS_MODEM_TRANSMIT" and (tx := self._parse(m.ModemTransmission, value)):
+        elif msg.key == "ACOMMS_MODEM_TRANSMIT" and (tx := self._parse(acomms_pb.ModemTransmission, value)):
             for frame in tx.frame:
                 s.sent.update(self._types_in(bytes(frame)))
         elif msg.key == "ACOMMS_QUEUE_RECEIVE" and isinstance(value, str):
@@ -204,7 +204,7 @@ class Monitor:
             self.say(
                 f"{s.name}: {_short(value)} {_field(value, 'command_id')} acknowledged by the receiving modem"
             )
-        elif msg.key == "ACOMMS_QSIZE" and (size := self._parse(m.QueueSize, value)):
+        elif msg.key == "ACOMMS_QSIZE" and (size := self._parse(acomms_pb.QueueSize, value)):
             s.queued[self.id_names.get(size.dccl_id, str(size.dccl_id))] = size.size
         elif msg.key == "STATUS_REPORT_IN":
             s.last_report = str(value)

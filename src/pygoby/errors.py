@@ -1,9 +1,19 @@
 """The root of pygoby's error family.
 
-Every error pygoby raises on purpose is a `PygobyError`. Each package has one root of its own
-(`DcclError`, `MoosError`, `AcommsError`, `NetsimError`, `FrontSeatError`, ...) so a caller
-catches one class per layer; every configuration problem, whichever package finds it, is a
-`ConfigError` that says where (file:line) and which field.
+Every error pygoby raises on purpose is a `PygobyError`. Each package has one root of its own,
+defined with the rest of its family in the package's `errors` module and exported by the
+package, so a caller catches one class per layer:
+
+    pygoby.dccl.DcclError          pygoby.moos.MoosError (translator errors under it)
+    pygoby.acomms.AcommsError      pygoby.netsim.NetsimError
+    pygoby.frontseat.FrontSeatError
+    pygoby.protobuf.ProtoError     (.proto files and message types)
+    pygoby.util.NMEAError, pygoby.util.LinkClosedError   (independent helpers: one per kind)
+
+Every configuration problem, whichever package finds it, is a `ConfigError` (or a subclass that
+is also under its package's root, e.g. `ScenarioError`, `TranslatorConfigError`) that says
+where (file:line) and which field. Standard mix-ins let callers catch the usual kinds:
+`ValueError` for bad values (ConfigError, decode errors), `ConnectionError` for closed links.
 """
 
 from __future__ import annotations

@@ -5,22 +5,22 @@ from __future__ import annotations
 import asyncio
 from collections.abc import Callable
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
 from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.util.clock import WallClock
 
 DRIVER_WHOI_MICROMODEM = 2
-TCP_CLIENT = m.DriverConfig.CONNECTION_TCP_AS_CLIENT
+TCP_CLIENT = acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT
 
 
 def mm_config(modem_id: int, port: int, **mm) -> object:
-    cfg = m.DriverConfig(
+    cfg = acomms_pb.DriverConfig(
         driver_type=DRIVER_WHOI_MICROMODEM, modem_id=modem_id, connection_type=TCP_CLIENT,
         tcp_server="127.0.0.1", tcp_port=port, reconnect_interval=1,
     )  # fmt: skip
-    ext = cfg.Extensions[m.MM_CONFIG]
+    ext = cfg.Extensions[acomms_pb.MM_CONFIG]
     ext.query_cfg_on_startup = mm.pop("query", False)
     for key, value in mm.items():
         setattr(ext, key, value)

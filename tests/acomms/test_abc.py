@@ -4,7 +4,7 @@ import asyncio
 
 import pytest
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.abc_protocol import ABCParseError, format_abc, parse_abc
 from pygoby.acomms.abc_simulator import ABCSimulator, serve_abc
 from pygoby.acomms.drivers.abc import ABCDriver
@@ -34,8 +34,8 @@ def test_parse_and_simulator_rules():
 
 
 def abc_cfg(modem_id, port):
-    return m.DriverConfig(driver_type=3, modem_id=modem_id, tcp_server="127.0.0.1", tcp_port=port,
-                          connection_type=m.DriverConfig.CONNECTION_TCP_AS_CLIENT)  # fmt: skip
+    return acomms_pb.DriverConfig(driver_type=3, modem_id=modem_id, tcp_server="127.0.0.1", tcp_port=port,
+                          connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT)  # fmt: skip
 
 
 async def test_abc_driver_queue_to_queue_with_ack():
@@ -54,7 +54,7 @@ async def test_abc_driver_queue_to_queue_with_ack():
         await asyncio.sleep(0.05)  # let the CONF lines register both modems
         q1.push_message(Status(src=1, dest=2, value=5))
         await asyncio.sleep(0.01)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=0))
         await run_until(lambda: bool(acked), [d1, d2], timeout=10)
         assert [x.value for x in got] == [5] and acked == [5]
     finally:

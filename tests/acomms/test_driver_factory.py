@@ -2,8 +2,8 @@
 
 import pytest
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverException, NoDriver, driver_name
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.driver_base import ModemDriverError, NoDriver, driver_name
 from pygoby.acomms.drivers import make_driver
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.drivers.udp import UDPDriver
@@ -12,29 +12,29 @@ from pygoby.util.clock import VirtualClock
 
 def test_factory_and_driver_none():
     clock = VirtualClock(0)
-    none = make_driver(m.DriverConfig(driver_type=1, modem_id=1), clock)
+    none = make_driver(acomms_pb.DriverConfig(driver_type=1, modem_id=1), clock)
     assert isinstance(none, NoDriver)
-    none.startup(m.DriverConfig(driver_type=1, modem_id=1))
+    none.startup(acomms_pb.DriverConfig(driver_type=1, modem_id=1))
     requests = []
     none.signal_data_request.connect(requests.append)
-    none.handle_initiate_transmission(m.ModemTransmission(src=1))
+    none.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1))
     none.do_work()
     assert requests == []
-    assert isinstance(make_driver(m.DriverConfig(driver_type=2), clock), MMDriver)
-    assert isinstance(make_driver(m.DriverConfig(driver_type=6), clock), UDPDriver)
-    with pytest.raises(ModemDriverException):
-        make_driver(m.DriverConfig(driver_type=8), clock)  # Iridium: not implemented
+    assert isinstance(make_driver(acomms_pb.DriverConfig(driver_type=2), clock), MMDriver)
+    assert isinstance(make_driver(acomms_pb.DriverConfig(driver_type=6), clock), UDPDriver)
+    with pytest.raises(ModemDriverError):
+        make_driver(acomms_pb.DriverConfig(driver_type=8), clock)  # Iridium: not implemented
 
 
 def test_driver_name_and_missing_settings():
-    assert driver_name(m.DriverConfig(driver_type=2, modem_id=1)) == "WHOI_MICROMODEM::1"
-    assert driver_name(m.DriverConfig(driver_name="my_plugin", modem_id=3)) == "my_plugin::3"
+    assert driver_name(acomms_pb.DriverConfig(driver_type=2, modem_id=1)) == "WHOI_MICROMODEM::1"
+    assert driver_name(acomms_pb.DriverConfig(driver_name="my_plugin", modem_id=3)) == "my_plugin::3"
     d = MMDriver(VirtualClock(0))
-    with pytest.raises(ModemDriverException) as info:
-        d.startup(m.DriverConfig(driver_type=2))  # no modem_id
-    assert info.value.status == m.ModemDriverStatus.INVALID_CONFIGURATION
-    with pytest.raises(ModemDriverException):
-        d.startup(m.DriverConfig(driver_type=2, modem_id=1))  # SERIAL without serial_port
-    with pytest.raises(ModemDriverException):
-        d.startup(m.DriverConfig(driver_type=2, modem_id=1,
-                                 connection_type=m.DriverConfig.CONNECTION_TCP_AS_CLIENT))  # fmt: skip
+    with pytest.raises(ModemDriverError) as info:
+        d.startup(acomms_pb.DriverConfig(driver_type=2))  # no modem_id
+    assert info.value.status == acomms_pb.ModemDriverStatus.INVALID_CONFIGURATION
+    with pytest.raises(ModemDriverError):
+        d.startup(acomms_pb.DriverConfig(driver_type=2, modem_id=1))  # SERIAL without serial_port
+    with pytest.raises(ModemDriverError):
+        d.startup(acomms_pb.DriverConfig(driver_type=2, modem_id=1,
+                                 connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT))  # fmt: skip

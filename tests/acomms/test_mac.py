@@ -2,7 +2,7 @@
 
 import pytest
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mac import (
     MAC_AUTO_DECENTRALIZED,
     MAC_FIXED_DECENTRALIZED,
@@ -13,11 +13,11 @@ from pygoby.acomms.mac import (
 from pygoby.util.clock import VirtualClock
 
 DAY = 1_700_006_400.0  # 2023-11-15T00:00:00Z (UTC midnight)
-U = m.MACUpdate
+U = acomms_pb.MACUpdate
 
 
 def slot(src, dest=-1, seconds=10, **kw):
-    return m.ModemTransmission(src=src, dest=dest, slot_seconds=seconds, **kw)
+    return acomms_pb.ModemTransmission(src=src, dest=dest, slot_seconds=seconds, **kw)
 
 
 def make(kind, slots, modem_id=1, now=DAY + 43207, **cfg):
@@ -26,7 +26,7 @@ def make(kind, slots, modem_id=1, now=DAY + 43207, **cfg):
     initiated, started = [], []
     mac.signal_initiate_transmission.connect(initiated.append)
     mac.signal_slot_start.connect(started.append)
-    mac.startup(m.MACConfig(modem_id=modem_id, type=kind, slot=slots, **cfg))
+    mac.startup(acomms_pb.MACConfig(modem_id=modem_id, type=kind, slot=slots, **cfg))
     return clock, mac, initiated, started
 
 
@@ -57,7 +57,7 @@ def test_without_start_in_middle_waits_for_cycle_start():
 def test_fixed_reference():
     clock, mac, _, _ = make(
         MAC_FIXED_DECENTRALIZED, [slot(1, seconds=7)] * 3, now=1000.0,
-        ref_time_type=m.MACConfig.REFERENCE_FIXED, fixed_ref_time=990,
+        ref_time_type=acomms_pb.MACConfig.REFERENCE_FIXED, fixed_ref_time=990,
     )  # fmt: skip
     assert (mac.current, mac.next_slot_time) == (2, 1004.0)
 
@@ -134,7 +134,7 @@ class Water:
         self.sent: dict[int, list] = {}
         for i in ids:
             mac = MACManager(self.clock)
-            mac.startup(m.MACConfig(modem_id=i, type=MAC_AUTO_DECENTRALIZED,
+            mac.startup(acomms_pb.MACConfig(modem_id=i, type=MAC_AUTO_DECENTRALIZED,
                                     slot_seconds=slot_seconds, expire_cycles=expire_cycles))  # fmt: skip
             mac.signal_initiate_transmission.connect(self.sent.setdefault(i, []).append)
             self.macs[i] = mac
@@ -147,7 +147,7 @@ class Water:
         for src in self.pending:
             for i, mac in self.macs.items():
                 if i != src:
-                    mac.handle_modem_receive(m.ModemTransmission(src=src))
+                    mac.handle_modem_receive(acomms_pb.ModemTransmission(src=src))
         self.clock.set(t + 0.01)
         before = {i: len(s) for i, s in self.sent.items()}
         for mac in self.macs.values():

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem.statistics import (
     add_cst,
     cst_head,
@@ -17,7 +17,8 @@ from pygoby.acomms.drivers.micromodem.statistics import (
     parse_toa,
     parse_xst,
 )
-from pygoby.util.nmea import NMEAFormatError, NMEASentence, with_checksum
+from pygoby.util.errors import NMEAFormatError
+from pygoby.util.nmea import NMEASentence, with_checksum
 
 DAY = dt.date(2023, 11, 14)
 MIDNIGHT_US = int(dt.datetime(2023, 11, 14, tzinfo=dt.UTC).timestamp()) * 1_000_000
@@ -44,7 +45,7 @@ INTS = (
 def test_format_then_parse_gives_the_statistics_back(
     toa_us, mode, clock_mode, psk_error_code, packet_type, ints, doppler_tenths, version
 ):
-    stat = m.ReceiveStatistics(
+    stat = acomms_pb.ReceiveStatistics(
         version=version, mode=mode, time=MIDNIGHT_US + toa_us, clock_mode=clock_mode,
         psk_error_code=psk_error_code, packet_type=packet_type, doppler=doppler_tenths / 10,
         **dict(zip(INTS, ints, strict=True)),
@@ -85,8 +86,8 @@ def test_a_field_that_is_not_a_number_is_named(index, text):
 def test_add_cst_gives_parse_cst_for_recurring_statistics():
     """The second sentence of a link (same fields, another time of arrival) comes from the
     remembered parse of the first: the result must still be exactly parse_cst's."""
-    rx = m.ModemTransmission()
-    stats = rx.Extensions[m.MM_TRANSMISSION].receive_stat
+    rx = acomms_pb.ModemTransmission()
+    stats = rx.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat
     second = CST.replace("221330.6675", "221407.0125")
     for text in (CST, second, CST):
         sentence = NMEASentence.parse(text)
@@ -102,8 +103,8 @@ def test_add_cst_gives_parse_cst_for_recurring_statistics():
 
 
 def test_add_cst_appends_nothing_for_a_bad_sentence():
-    rx = m.ModemTransmission()
-    stats = rx.Extensions[m.MM_TRANSMISSION].receive_stat
+    rx = acomms_pb.ModemTransmission()
+    stats = rx.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat
     add_cst(stats, NMEASentence.parse(CST), DAY)  # remembered: only the TOA is read next
     with pytest.raises(NMEAFormatError, match="bad time of arrival"):
         add_cst(stats, NMEASentence.parse(CST.replace("221330.6675", "2213x0.6675")), DAY)
@@ -118,8 +119,8 @@ def test_add_cst_appends_nothing_for_a_bad_sentence():
 
 
 def test_add_cst_warns_about_every_short_sentence(caplog):
-    rx = m.ModemTransmission()
-    stats = rx.Extensions[m.MM_TRANSMISSION].receive_stat
+    rx = acomms_pb.ModemTransmission()
+    stats = rx.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat
     short = NMEASentence.parse(",".join(CST.split(",")[:13]))
     with caplog.at_level(logging.WARNING):
         add_cst(stats, short, DAY)

@@ -2,7 +2,7 @@
 
 import asyncio
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
 from pygoby.acomms.mmsim.server import MMSimServer
@@ -28,25 +28,25 @@ async def test_data_with_ack_and_ranging_over_tcp():
             msg.frame.append(b"world")
 
         d1.signal_data_request.connect(fill)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, rate=1))
-        data = lambda: [t for t in got2 if t.type == m.DATA and t.frame]  # noqa: E731
-        acks = lambda: [t for t in got1 if t.type == m.ACK]  # noqa: E731
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, rate=1))
+        data = lambda: [t for t in got2 if t.type == acomms_pb.DATA and t.frame]  # noqa: E731
+        acks = lambda: [t for t in got1 if t.type == acomms_pb.ACK]  # noqa: E731
         await run_until(lambda: data() and acks(), [d1, d2])
         (rx,) = data()
         assert (rx.src, rx.dest, list(rx.frame)) == (1, 2, [b"hello", b"world"])
-        assert rx.Extensions[m.MM_TRANSMISSION].receive_stat[0].snr_in == 15
+        assert rx.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat[0].snr_in == 15
         assert sorted(acks()[0].acked_frame) == [0, 1]
-        assert results and results[0].Extensions[m.MM_TRANSMISSION].transmit_stat
+        assert results and results[0].Extensions[acomms_pb.MM_TRANSMISSION].transmit_stat
 
-        ping = m.ModemTransmission(src=1, dest=2, type=m.DRIVER_SPECIFIC)
-        ping.Extensions[m.MM_TRANSMISSION].type = m.MICROMODEM_TWO_WAY_PING
+        ping = acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DRIVER_SPECIFIC)
+        ping.Extensions[acomms_pb.MM_TRANSMISSION].type = acomms_pb.MICROMODEM_TWO_WAY_PING
         got1.clear()
         d1.handle_initiate_transmission(ping)
-        await run_until(lambda: any(t.type == m.DRIVER_SPECIFIC for t in got1), [d1, d2])
-        reply = next(t for t in got1 if t.type == m.DRIVER_SPECIFIC)
-        owtt = reply.Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time
+        await run_until(lambda: any(t.type == acomms_pb.DRIVER_SPECIFIC for t in got1), [d1, d2])
+        reply = next(t for t in got1 if t.type == acomms_pb.DRIVER_SPECIFIC)
+        owtt = reply.Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply.one_way_travel_time
         assert list(owtt) == [0.6667] and (reply.src, reply.dest) == (2, 1)
-        assert any(t.type == m.DRIVER_SPECIFIC and t.src == 1 for t in got2)  # $CAMPA heard
+        assert any(t.type == acomms_pb.DRIVER_SPECIFIC and t.src == 1 for t in got2)  # $CAMPA heard
     finally:
         for d in (d1, d2):
             d.shutdown()
@@ -61,7 +61,7 @@ async def test_polled_transmission_rate0_over_tcp():
         got1 = []
         d1.signal_receive.connect(got1.append)
         d2.signal_data_request.connect(lambda msg: msg.frame.append(b"\x2a" * 32))
-        d1.handle_initiate_transmission(m.ModemTransmission(src=2, dest=1, rate=0))  # poll node 2
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=2, dest=1, rate=0))  # poll node 2
         await run_until(lambda: any(t.frame for t in got1), [d1, d2])
         (rx,) = [t for t in got1 if t.frame]
         assert (rx.src, rx.dest, list(rx.frame)) == (2, 1, [b"\x2a" * 32])
@@ -83,10 +83,10 @@ async def test_driver_reconnects_after_link_drop_and_resumes():
         requests = []
         d1.signal_data_request.connect(requests.append)
         d1.signal_data_request.connect(lambda msg: msg.frame.append(b"after"))
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=2, rate=0))
         assert requests == []  # link down: nothing is taken from the queue
         await run_until(lambda: d1.link.is_open, [d1, d2], timeout=10)  # reconnects (1 s)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=2, rate=0))
         await run_until(lambda: any(t.frame for t in got2), [d1, d2], timeout=10)
         assert [bytes(f) for t in got2 for f in t.frame] == [b"after"]
     finally:
@@ -100,8 +100,8 @@ async def test_driver_over_serial_pty():
     channel = LoopbackChannel()
     sim = MMSimServer(MicroModemModel(3, WallClock(), channel), channel, use_pty=True)
     await sim.start()
-    cfg = m.DriverConfig(driver_type=2, modem_id=3, serial_port=sim.pty_path, serial_baud=19200)
-    cfg.Extensions[m.MM_CONFIG].query_cfg_on_startup = False
+    cfg = acomms_pb.DriverConfig(driver_type=2, modem_id=3, serial_port=sim.pty_path, serial_baud=19200)
+    cfg.Extensions[acomms_pb.MM_CONFIG].query_cfg_on_startup = False
     driver = MMDriver(WallClock())
     driver.startup(cfg)
     try:
@@ -125,8 +125,8 @@ async def test_acked_message_queued_during_link_outage_is_delivered_after_reconn
     q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
     q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
     mac = MACManager(clock)  # node 1 owns every 1 s slot
-    mac.startup(m.MACConfig(modem_id=1, type=MAC_FIXED_DECENTRALIZED,
-                            slot=[m.ModemTransmission(src=1, dest=-1, rate=0, slot_seconds=1)]))  # fmt: skip
+    mac.startup(acomms_pb.MACConfig(modem_id=1, type=MAC_FIXED_DECENTRALIZED,
+                            slot=[acomms_pb.ModemTransmission(src=1, dest=-1, rate=0, slot_seconds=1)]))  # fmt: skip
     bind(d1, q1, mac)
     bind(d2, q2)
     received, acked = [], []
@@ -157,10 +157,10 @@ async def test_application_acks_over_tcp():
     try:
         q1.push_message(Status(src=1, dest=2, value=77))
         await asyncio.sleep(0.01)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=1))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=1))
         await run_until(lambda: bool(got), [d1, d2])
         assert [x.value for x in got] == [77] and acked == []  # the ack is owed, not sent yet
-        d2.handle_initiate_transmission(m.ModemTransmission(src=2, dest=-1, rate=1))  # no data
+        d2.handle_initiate_transmission(acomms_pb.ModemTransmission(src=2, dest=-1, rate=1))  # no data
         await run_until(lambda: bool(acked), [d1, d2])  # the ack-only packet acknowledges
         assert acked == [77] and q1.size(20) == 0
     finally:

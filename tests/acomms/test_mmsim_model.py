@@ -127,12 +127,12 @@ def test_channel_statistics_reach_cacst():
 
 def test_recurring_cacst_text_is_the_text_made_from_scratch():
     """The emulator keeps the $CACST text after the time of arrival by link and statistics:
-    a remembered one must be what is made from scratch, and what format_cst prints."""
+    each reception's line must be what format_cst prints for it, every time it recurs, and
+    equal statistics must print the same whatever their number type."""
     import datetime as dt
 
     from pygoby.acomms.drivers.micromodem.statistics import format_cst, parse_cst
     from pygoby.acomms.mmsim import AcousticPacket, PacketKind, Reception
-    from pygoby.acomms.mmsim import model as model_module
 
     model = MicroModemModel(2, VirtualClock(1e9))
     packet = AcousticPacket(PacketKind.DATA, 1, 2, rate=1, frames=[b"a", b"b"])
@@ -142,26 +142,31 @@ def test_recurring_cacst_text_is_the_text_made_from_scratch():
         return [x.strip() for x in model.take_output() if x.startswith("$CACST")]
 
     as_ints = {"snr_in": 8, "doppler": 0, "spl": 151}
-    as_floats = {"snr_in": 8.0, "doppler": 0.0, "spl": 151.0}  # the same key: equal numbers
+    as_floats = {"snr_in": 8.0, "doppler": 0.0, "spl": 151.0}  # equal numbers
     other = {"snr_in": 7.6, "doppler": -0.4, "spl": 151}
     cases = [(1e9 + 0.25, as_ints), (1e9 + 3.5, as_floats), (1e9 + 7.125, other, [True, False])]
-    fresh = []
-    for case in cases:
-        model_module._cst_tails.clear()
-        fresh.append(cst(*case))
-    model_module._cst_tails.clear()
-    for _ in range(2):  # the second round is remembered
-        assert [cst(*case) for case in cases] == fresh
-    assert len(model_module._cst_tails) == 2
+    first = [cst(*case) for case in cases]
+    for _ in range(2):  # the links recur
+        assert [cst(*case) for case in cases] == first
     day = dt.datetime.fromtimestamp(1e9, dt.UTC).date()
-    for [line] in fresh:
+    for [line] in first:
         assert format_cst(parse_cst(NMEASentence.parse(line), day)).message() == line
+
+    def after_time_of_arrival(line: str) -> list[str]:
+        return line.split("*")[0].split(",")[3:]
+
+    assert after_time_of_arrival(first[0][0]) == after_time_of_arrival(first[1][0])
 
 
 def test_recurring_sentence_text_depends_on_the_value_types():
-    from pygoby.acomms.mmsim.model import _sentence_line
-
+    """The emulator keeps the text of recurring sentences: 1, 1.0 and True must still print
+    as themselves (here: NVRAM values answered to $CCCFQ)."""
+    model = MicroModemModel(2, VirtualClock(1e9))
     values = [1, 1.0, True, 1, 1.0]
-    lines = [_sentence_line("$CACFG", "X", v) for v in values]
+    lines = []
+    for value in values:
+        model.nvram["X"] = value
+        model.handle_line("$CCCFQ,X\r\n")
+        lines.extend(model.take_output())
     assert lines == [NMEASentence.build("$CACFG", ["X", v]).message() + "\r\n" for v in values]
     assert [NMEASentence.parse(line)[2] for line in lines[:3]] == ["1", "1.0", "1"]

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
 from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.util.clock import WallClock
@@ -57,7 +57,7 @@ async def test_pyacomms_talks_to_emulator_and_our_driver():
         rx = next(t for t in got if t.frame)
         assert (rx.src, rx.dest, bytes(rx.frame[0])) == (1, 2, b"from pyacomms")
         # our driver -> emulators -> pyacomms parses our $CACYC/$CARXD
-        driver.handle_initiate_transmission(m.ModemTransmission(src=2, dest=1, rate=1))
+        driver.handle_initiate_transmission(acomms_pb.ModemTransmission(src=2, dest=1, rate=1))
         line = asyncio.ensure_future(proc.stdout.readline())
         await run_until(line.done, [driver], timeout=20)
         frames = json.loads(line.result())["frames"]

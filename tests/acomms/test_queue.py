@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.queue import QueueError
 from pygoby.acomms.queue.roles import RoleError
 from pygoby.util.clock import VirtualClock
@@ -17,7 +17,7 @@ T0 = 1_700_000_000.0
 
 
 def request(dest=-1, frames=1, max_bytes=None, frame_start=0, **kw):
-    r = m.ModemTransmission(src=-1, dest=dest, max_num_frames=frames, frame_start=frame_start, **kw)
+    r = acomms_pb.ModemTransmission(src=-1, dest=dest, max_num_frames=frames, frame_start=frame_start, **kw)
     if max_bytes is not None:
         r.max_frame_bytes = max_bytes
     return r
@@ -32,7 +32,7 @@ def fill(qm, **kw):
 def decoded(qm, frame):
     got = []
     qm.signal_receive.connect(got.append)
-    qm.handle_modem_receive(m.ModemTransmission(type=m.DATA, frame=[frame]))
+    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.DATA, frame=[frame]))
     qm.signal_receive.disconnect(got.append)
     return got
 
@@ -142,11 +142,11 @@ def test_ack_keeps_message_until_acknowledged_and_reoffers_it(clock):
     clock.advance(1)
     r2 = fill(qm, frame_start=2)  # no ack came: offered again
     assert r2.frame[0] == r1.frame[0]
-    qm.handle_modem_receive(m.ModemTransmission(type=m.ACK, src=2, dest=3, acked_frame=[2]))
+    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=3, acked_frame=[2]))
     assert acks == [] and qm.size(20) == 1  # not for us
-    qm.handle_modem_receive(m.ModemTransmission(type=m.ACK, src=2, dest=1, acked_frame=[0]))
+    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[0]))
     assert acks == []  # the wait for frame 0 was released by the second request
-    qm.handle_modem_receive(m.ModemTransmission(type=m.ACK, src=2, dest=1, acked_frame=[2]))
+    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[2]))
     assert acks == [([2], 7)] and qm.size(20) == 0 and sizes[-1] == 0
 
 
@@ -187,7 +187,7 @@ def test_destination_and_ack_rules(clock):
 
 
 def test_receive_filters_and_manipulators(clock):
-    Manip = m.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
     bulk = entry("Bulk")
     bulk.manipulator.append(Manip["PROMISCUOUS"].number)
     note = entry("Note", roles=False)
@@ -201,7 +201,7 @@ def test_receive_filters_and_manipulators(clock):
 
 
 def test_push_to_self_loopback_and_errors(clock):
-    Manip = m.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
     loop = entry("Bulk")
     loop.manipulator.extend([Manip["LOOPBACK"].number, Manip["NO_QUEUE"].number])
     qm, (Status, Bulk, Note) = manager(clock, entries=[entry("Status"), loop])
@@ -217,7 +217,7 @@ def test_push_to_self_loopback_and_errors(clock):
 
 
 def test_on_demand(clock):
-    Manip = m.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
     e = entry("Status", ack=False)
     e.manipulator.append(Manip["ON_DEMAND"].number)
     qm, (Status, *_) = manager(clock, entries=[e])
@@ -273,7 +273,7 @@ def test_garbage_frames_are_logged_not_fatal(clock, caplog):
 @given(st.binary(max_size=64))
 def test_fuzz_receive_never_raises(data):
     qm, _ = FUZZ
-    qm.handle_modem_receive(m.ModemTransmission(type=m.DATA, frame=[data]))
+    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.DATA, frame=[data]))
 
 
 FUZZ = manager(VirtualClock(T0), modem_id=2, entries=[entry("Status"), entry("Bulk")])
@@ -288,15 +288,15 @@ def test_network_acks_for_configured_sources(clock):
     qm.push_message(Status(src=1, dest=2, value=2))
     clock.advance(1)
     fill(qm, max_bytes=7)
-    qm.handle_modem_receive(m.ModemTransmission(type=m.ACK, src=2, dest=1, acked_frame=[0]))
+    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[0]))
     clock.advance(100)
     qm.do_work()
     kinds = [(a.ack_type, a.ack_src, a.message_src, a.message_dest, a.message_dccl_id) for a in got]
-    assert kinds == [(m.NetworkAck.ACK, 2, 1, 2, 20), (m.NetworkAck.EXPIRE, 1, 1, 2, 20)]
+    assert kinds == [(acomms_pb.NetworkAck.ACK, 2, 1, 2, 20), (acomms_pb.NetworkAck.EXPIRE, 1, 1, 2, 20)]
 
 
 def test_encrypt_rules_per_peer(clock):
-    rule = m.QueueManagerConfig.EncryptRule
+    rule = acomms_pb.QueueManagerConfig.EncryptRule
     q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")],
                                encrypt_rule=[rule(id=2, crypto_passphrase="two")])  # fmt: skip
     q2, _ = manager(clock, modem_id=2, entries=[entry("Status")],
@@ -313,7 +313,7 @@ def test_encrypt_rules_per_peer(clock):
 
 
 def test_loopback_as_sent_minimum_ack_wait_and_flush(clock):
-    Manip = m.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
     e = entry("Status")
     e.manipulator.append(Manip["LOOPBACK_AS_SENT"].number)
     qm, (Status, *_) = manager(clock, entries=[e], minimum_ack_wait_seconds=10)
@@ -330,5 +330,5 @@ def test_loopback_as_sent_minimum_ack_wait_and_flush(clock):
     assert fill(qm, frame_start=2).frame[0] == first.frame[0]  # released after 10 s
     sizes = []
     qm.signal_queue_size_change.connect(lambda qs: sizes.append((qs.dccl_id, qs.size)))
-    qm.flush_queue(m.QueueFlush(dccl_id=20))
+    qm.flush_queue(acomms_pb.QueueFlush(dccl_id=20))
     assert sizes == [(20, 0)] and qm.size(20) == 0

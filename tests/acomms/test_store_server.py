@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.store_server import StoreServerDriver
 from pygoby.acomms.rudics import (
     MAX_PACKET_BYTES,
@@ -81,23 +81,23 @@ def test_rudics_known_layout_and_errors():
 def test_store_keeps_messages_across_restart(tmp_path):
     db = tmp_path / "store.db"
     store = TransmissionStore(db)
-    request = m.StoreServerRequest(modem_id=1, request_id=1)
+    request = acomms_pb.StoreServerRequest(modem_id=1, request_id=1)
     request.outbox.add(src=1, dest=2, frame=[b"kept"])
     assert list(store.exchange(request, 100.0).inbox) == []
     store.close()
     store = TransmissionStore(db)  # restart
-    reply = store.exchange(m.StoreServerRequest(modem_id=2, request_id=5), 101.0)
+    reply = store.exchange(acomms_pb.StoreServerRequest(modem_id=2, request_id=5), 101.0)
     assert [bytes(t.frame[0]) for t in reply.inbox] == [b"kept"] and reply.request_id == 5
-    assert list(store.exchange(m.StoreServerRequest(modem_id=2), 102.0).inbox) == []  # seen
+    assert list(store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 102.0).inbox) == []  # seen
     store.close()
     store = TransmissionStore(db)
-    assert list(store.exchange(m.StoreServerRequest(modem_id=2), 103.0).inbox) == []  # cursor kept
+    assert list(store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 103.0).inbox) == []  # cursor kept
 
 
 def store_cfg(modem_id, port):
-    cfg = m.DriverConfig(driver_type=5, modem_id=modem_id, tcp_server="127.0.0.1", tcp_port=port,
-                         connection_type=m.DriverConfig.CONNECTION_TCP_AS_CLIENT)  # fmt: skip
-    cfg.Extensions[m.STORE_SERVER_CONFIG].query_interval_seconds = 0.05
+    cfg = acomms_pb.DriverConfig(driver_type=5, modem_id=modem_id, tcp_server="127.0.0.1", tcp_port=port,
+                         connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT)  # fmt: skip
+    cfg.Extensions[acomms_pb.STORE_SERVER_CONFIG].query_interval_seconds = 0.05
     return cfg
 
 
@@ -114,14 +114,14 @@ async def test_driver_to_driver_through_store_server_with_ack(tmp_path):
         await d1.link.wait_open()
         q1.push_message(Status(src=1, dest=2, value=33))
         await asyncio.sleep(0.01)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=0))
         await run_until(lambda: bool(acked), [d1, d2, q1, q2], timeout=10)
         assert [x.value for x in got] == [33] and acked == [33] and q1.size(20) == 0
         # polling: node 1 asks node 2 for data through the store
         q2.push_message(Status(src=2, dest=1, value=44))
         back = []
         q1.signal_receive.connect(back.append)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=2, dest=1, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=2, dest=1, rate=0))
         await run_until(lambda: bool(back), [d1, d2, q1, q2], timeout=10)
         assert [x.value for x in back] == [44]
     finally:
@@ -131,19 +131,19 @@ async def test_driver_to_driver_through_store_server_with_ack(tmp_path):
         store.close()
 
 
-def bulk(src: int, size: int, dest: int = 0) -> m.ModemTransmission:
-    return m.ModemTransmission(src=src, dest=dest, type=m.DATA, frame=[b"x" * size])
+def bulk(src: int, size: int, dest: int = 0) -> acomms_pb.ModemTransmission:
+    return acomms_pb.ModemTransmission(src=src, dest=dest, type=acomms_pb.DATA, frame=[b"x" * size])
 
 
 def test_responses_stay_within_a_packet_and_the_rest_comes_next_time(caplog):
     """Issue 16 item 2: a response never exceeds the packet limit (a client's line limit)."""
     store = TransmissionStore()
-    request = m.StoreServerRequest(modem_id=1)
+    request = acomms_pb.StoreServerRequest(modem_id=1)
     request.outbox.extend([bulk(1, 30000), bulk(1, 30000), bulk(1, 70000), bulk(1, 30000)])
     store.exchange(request, 100.0)
     sizes = []
     for t in (101.0, 102.0, 103.0):
-        reply = store.exchange(m.StoreServerRequest(modem_id=2), t, max_data_bytes())
+        reply = store.exchange(acomms_pb.StoreServerRequest(modem_id=2), t, max_data_bytes())
         assert reply.ByteSize() <= max_data_bytes()
         sizes.append([len(x.frame[0]) for x in reply.inbox])
     # two fit in the first; the 70 000-byte one can never fit: skipped with a warning
@@ -159,19 +159,19 @@ def test_driver_requests_stay_within_a_packet():
 
     link = MemoryLink("\r")
     driver = StoreServerDriver(VirtualClock(0), link)
-    cfg = m.DriverConfig(driver_type=5, modem_id=1)
-    cfg.Extensions[m.STORE_SERVER_CONFIG].max_frame_size = 1_000_000
+    cfg = acomms_pb.DriverConfig(driver_type=5, modem_id=1)
+    cfg.Extensions[acomms_pb.STORE_SERVER_CONFIG].max_frame_size = 1_000_000
     driver.startup(cfg)
     requests = []
     driver.signal_data_request.connect(lambda msg: requests.append(msg.max_frame_bytes))
-    driver.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=0))
+    driver.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=2, rate=0))
     assert 0 < requests[0] < max_data_bytes()
     driver._outbox.extend([bulk(1, 30000), bulk(1, 30000), bulk(1, 30000)])
     driver._send_request(0.0)
     driver._send_request(1.0)
     packets = [text.encode("latin-1") for text in link.take_written()]
     assert all(len(p) <= MAX_PACKET_BYTES for p in packets)
-    outboxes = [m.StoreServerRequest.FromString(parse_rudics_packet(p)).outbox for p in packets]
+    outboxes = [acomms_pb.StoreServerRequest.FromString(parse_rudics_packet(p)).outbox for p in packets]
     assert [len(o) for o in outboxes] == [2, 1] and driver._outbox == []
 
 
@@ -182,13 +182,13 @@ async def test_a_garbage_line_and_a_pipelining_client_do_not_hold_up_others():
     server = StoreServer(store)
     tcp = await serve_store(server, "127.0.0.1", 0)
     port = tcp.sockets[0].getsockname()[1]
-    request = serialize_rudics_packet(m.StoreServerRequest(modem_id=1).SerializeToString())
+    request = serialize_rudics_packet(acomms_pb.StoreServerRequest(modem_id=1).SerializeToString())
     try:
         a_reader, a_writer = await asyncio.open_connection("127.0.0.1", port)
         a_writer.write(b"\x01" * (128 * 1024) + b"\r" + request)
         await a_writer.drain()
         reply = await asyncio.wait_for(a_reader.readuntil(b"\r"), 30)
-        assert m.StoreServerResponse.FromString(parse_rudics_packet(reply)).modem_id == 1
+        assert acomms_pb.StoreServerResponse.FromString(parse_rudics_packet(reply)).modem_id == 1
         assert server.requests_answered == 1 and server.requests_refused == 0  # never parsed
 
         pipelined = 3000
@@ -197,7 +197,7 @@ async def test_a_garbage_line_and_a_pipelining_client_do_not_hold_up_others():
         while server.requests_answered < 2:  # A's requests are being served
             await asyncio.sleep(0)
         b_reader, b_writer = await asyncio.open_connection("127.0.0.1", port)
-        b_writer.write(serialize_rudics_packet(m.StoreServerRequest(modem_id=2).SerializeToString()))
+        b_writer.write(serialize_rudics_packet(acomms_pb.StoreServerRequest(modem_id=2).SerializeToString()))
         await b_writer.drain()
         await asyncio.wait_for(b_reader.readuntil(b"\r"), 60)
         served_before_b = server.requests_answered - 2
@@ -214,7 +214,7 @@ async def test_a_garbage_line_and_a_pipelining_client_do_not_hold_up_others():
 def signed(modem_id: int, secret: bytes | None, now: float, **fields) -> bytes:
     from pygoby.acomms.store_server.auth import sign_request
 
-    payload = m.StoreServerRequest(modem_id=modem_id, **fields).SerializeToString()
+    payload = acomms_pb.StoreServerRequest(modem_id=modem_id, **fields).SerializeToString()
     if secret is not None:
         payload = sign_request(payload, secret, now)
     return serialize_rudics_packet(payload)
@@ -223,8 +223,8 @@ def signed(modem_id: int, secret: bytes | None, now: float, **fields) -> bytes:
 def answer(server: StoreServer, packet: bytes):
     """(response, error) for a request packet."""
     payload = parse_rudics_packet(server.handle_packet(packet))
-    return (m.StoreServerResponse.FromString(payload),
-            m.StoreServerResponseStatus.FromString(payload).error)  # fmt: skip
+    return (acomms_pb.StoreServerResponse.FromString(payload),
+            acomms_pb.StoreServerResponseStatus.FromString(payload).error)  # fmt: skip
 
 
 def test_only_the_holder_of_a_modem_ids_secret_reads_its_mail():
@@ -233,7 +233,7 @@ def test_only_the_holder_of_a_modem_ids_secret_reads_its_mail():
     clock = VirtualClock(1000.0)
     store = TransmissionStore()
     server = StoreServer(store, clock, secrets={1: b"one", 2: b"two"})
-    mail = m.ModemTransmission(src=1, dest=2, type=m.DATA, frame=[b"for two"])
+    mail = acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DATA, frame=[b"for two"])
     response, error = answer(server, signed(1, b"one", 1000.0, outbox=[mail]))
     assert error == "" and server.requests_answered == 1
     # an unsigned request, a wrong secret, an unknown id, a stale time: refused, nothing taken
@@ -268,13 +268,13 @@ def test_a_locked_database_gets_an_error_reply_and_the_driver_sends_again(tmp_pa
     server = StoreServer(store)
     link = MemoryLink("\r")
     driver = StoreServerDriver(VirtualClock(0), link)
-    driver.startup(m.DriverConfig(driver_type=5, modem_id=1))
+    driver.startup(acomms_pb.DriverConfig(driver_type=5, modem_id=1))
     driver._outbox.append(bulk(1, 10, dest=2))
     other = sqlite3.connect(db)
     other.execute("BEGIN EXCLUSIVE")  # another process holds the database
     driver._send_request(0.0)
     reply = server.handle_packet(link.take_written()[0].encode("latin-1"))
-    status = m.StoreServerResponseStatus.FromString(parse_rudics_packet(reply))
+    status = acomms_pb.StoreServerResponseStatus.FromString(parse_rudics_packet(reply))
     assert server.store_errors == 1 and status.error.startswith("store unavailable: database")
     link.feed(reply.decode("latin-1"))
     driver.do_work()
@@ -285,23 +285,23 @@ def test_a_locked_database_gets_an_error_reply_and_the_driver_sends_again(tmp_pa
     link.feed(server.handle_packet(link.take_written()[0].encode("latin-1")).decode("latin-1"))
     driver.do_work()
     assert driver._outbox == [] and server.requests_answered == 1
-    got = store.exchange(m.StoreServerRequest(modem_id=2), 2.0)
+    got = store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 2.0)
     assert [bytes(t.frame[0]) for t in got.inbox] == [b"x" * 10]  # stored once
     store.close()
 
 
 def test_delivered_transmissions_are_pruned_after_the_retention_time():
     store = TransmissionStore(max_lookback_seconds=1000.0, retention_seconds=100.0)
-    request = m.StoreServerRequest(modem_id=1)
+    request = acomms_pb.StoreServerRequest(modem_id=1)
     request.outbox.extend([bulk(1, 1, dest=2), bulk(1, 2, dest=3), bulk(1, 3, dest=0)])
     store.exchange(request, 0.0)
-    store.exchange(m.StoreServerRequest(modem_id=2), 10.0)  # 2 reads its mail and the broadcast
-    store.exchange(m.StoreServerRequest(modem_id=3), 10.0)  # 3 too
-    store.exchange(m.StoreServerRequest(modem_id=4), 10.0)  # 4 only knows the broadcast
+    store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 10.0)  # 2 reads its mail and the broadcast
+    store.exchange(acomms_pb.StoreServerRequest(modem_id=3), 10.0)  # 3 too
+    store.exchange(acomms_pb.StoreServerRequest(modem_id=4), 10.0)  # 4 only knows the broadcast
     assert store.prune(50.0) == 0  # delivered, but within the retention time
     store.exchange(request, 60.0)  # new mail for 2, 3 and all, read by nobody yet
     assert store.prune(150.0) == 3  # the first three: delivered and older than 100 s
-    store.exchange(m.StoreServerRequest(modem_id=2), 160.0)
+    store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 160.0)
     assert store.prune(200.0) == 1  # 2's new mail went; 3's and the broadcast wait for 3 and 4
     assert store.prune(1059.0) == 0
     assert store.prune(1061.0) == 2  # past the look-back nobody can be served them
@@ -321,7 +321,7 @@ async def test_signed_drivers_exchange_mail_through_a_server_with_secrets(tmp_pa
     for modem_id, secret in ((1, "alpha"), (2, "bravo")):
         (tmp_path / f"{modem_id}.secret").write_text(secret + "\n")
         cfg = store_cfg(modem_id, port)
-        cfg.Extensions[m.STORE_SERVER_AUTH].secret_file = str(tmp_path / f"{modem_id}.secret")
+        cfg.Extensions[acomms_pb.STORE_SERVER_AUTH].secret_file = str(tmp_path / f"{modem_id}.secret")
         driver = StoreServerDriver(clock)
         driver.startup(cfg)
         drivers.append(driver)
@@ -330,7 +330,7 @@ async def test_signed_drivers_exchange_mail_through_a_server_with_secrets(tmp_pa
     try:
         await d1.link.wait_open()
         q1.push_message(Status(src=1, dest=2, value=7))
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=0))
         await run_until(lambda: bool(acked), [d1, d2, q1, q2], timeout=10)
         assert [x.value for x in got] == [7]
     finally:

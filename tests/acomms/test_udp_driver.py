@@ -3,7 +3,7 @@
 import logging
 import socket
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.bind import bind
 from pygoby.acomms.drivers.udp import UDPDriver
 from pygoby.util.clock import VirtualClock
@@ -14,8 +14,8 @@ DRIVER_UDP = 6
 
 
 def udp_cfg(modem_id, local_port, remotes):
-    cfg = m.DriverConfig(driver_type=DRIVER_UDP, modem_id=modem_id)
-    ext = cfg.Extensions[m.UDP_CONFIG]
+    cfg = acomms_pb.DriverConfig(driver_type=DRIVER_UDP, modem_id=modem_id)
+    ext = cfg.Extensions[acomms_pb.UDP_CONFIG]
     ext.local.port = local_port
     for rid, port in remotes:
         ext.remote.add(modem_id=rid, ip="127.0.0.1", port=port)
@@ -49,12 +49,12 @@ def test_queue_to_queue_over_udp_with_ack():
         q1.signal_ack.connect(lambda ack, orig: acked.append((list(ack.acked_frame), orig.value)))
         q1.push_message(Status(src=1, dest=2, value=11))
         clock.advance(1)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=0))
         pump([d1, d2])
         assert [x.value for x in got] == [11]
         assert acked == [([0], 11)] and q1.size(20) == 0
         q1.push_message(Status(src=1, dest=2, value=12))
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=0))
         pump([d1, d2])
         assert acked[-1] == ([1], 12)  # running frame counter
     finally:
@@ -71,11 +71,11 @@ def test_datagram_is_plain_protobuf_and_garbage_is_skipped(caplog):
     d.startup(udp_cfg(1, 0, [(2, listener.getsockname()[1])]))
     try:
         d.signal_data_request.connect(lambda msg: msg.frame.append(b"\x01\x02\x03\x04\x05"))
-        d.handle_initiate_transmission(m.ModemTransmission(src=1, dest=2, rate=0))
+        d.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=2, rate=0))
         data, _ = listener.recvfrom(65535)
-        expected = m.ModemTransmission(src=1, dest=2, rate=0, max_frame_bytes=1400, frame_start=0)
+        expected = acomms_pb.ModemTransmission(src=1, dest=2, rate=0, max_frame_bytes=1400, frame_start=0)
         expected.frame.append(b"\x01\x02\x03\x04\x05")
-        assert m.ModemTransmission.FromString(data) == expected
+        assert acomms_pb.ModemTransmission.FromString(data) == expected
         got = []
         d.signal_receive.connect(got.append)
         with caplog.at_level(logging.WARNING):
@@ -98,7 +98,7 @@ def test_multicast_queue_to_queue_with_ack():
     clock = VirtualClock(1_700_000_000.0)
     drivers = []
     for i in (1, 2):
-        cfg = m.DriverConfig(driver_type=11, modem_id=i)
+        cfg = acomms_pb.DriverConfig(driver_type=11, modem_id=i)
         cfg.Extensions[ext].listen_address = "127.0.0.1"
         cfg.Extensions[ext].multicast_address = "239.255.42.97"
         cfg.Extensions[ext].multicast_port = port
@@ -110,7 +110,7 @@ def test_multicast_queue_to_queue_with_ack():
         q1, q2, Status, got, acked = status_link(clock, d1, d2)
         q1.push_message(Status(src=1, dest=2, value=8))
         clock.advance(1)
-        d1.handle_initiate_transmission(m.ModemTransmission(src=1, dest=-1, rate=0))
+        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=0))
         pump(drivers)
         assert [x.value for x in got] == [8] and acked == [8]
     finally:

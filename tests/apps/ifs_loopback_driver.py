@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.interface import InterfaceBase
 from pygoby.protobuf import default_loader
 
@@ -25,9 +25,9 @@ class LoopbackFrontSeat(InterfaceBase):
     def __init__(self, cfg, clock=None) -> None:
         super().__init__(cfg, clock)
         self.settings = self.cfg.Extensions[LOOPBACK_CONFIG]
-        self.fs_state = m.FRONTSEAT_ACCEPTING_COMMANDS
+        self.fs_state = frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS
         self.online = True
-        self.course = m.DesiredCourse(time=0)
+        self.course = frontseat_pb.DesiredCourse(time=0)
         self.last_nav = -float("inf")
         self.started = self.stopped = 0
         self.commands: list = []
@@ -45,7 +45,7 @@ class LoopbackFrontSeat(InterfaceBase):
         self.course.CopyFrom(command.desired_course)
         if command.response_requested:
             self.signal_command_response(
-                m.CommandResponse(request_successful=True, request_id=command.request_id)
+                frontseat_pb.CommandResponse(request_successful=True, request_id=command.request_id)
             )
 
     def send_data_to_frontseat(self, data) -> None:
@@ -66,16 +66,16 @@ class LoopbackFrontSeat(InterfaceBase):
         if not self.online or now - self.last_nav < self.settings.nav_period:
             return
         self.last_nav = now
-        status = m.NodeStatus()
+        status = frontseat_pb.NodeStatus()
         status.global_fix.lat, status.global_fix.lon = self.settings.lat, self.settings.lon
         status.global_fix.depth = self.course.depth
         status.pose.heading = self.course.heading
         status.pose.pitch = 2.0
         status.speed.over_ground = self.course.speed
-        status.source.position = m.Source.GPS
+        status.source.position = frontseat_pb.Source.GPS
         self.compute_missing(status)
-        self.signal_raw_from_frontseat(m.Raw(raw=f"NAV,HEADING:{status.pose.heading:g}".encode()))
-        self.signal_data_from_frontseat(m.InterfaceData(node_status=status))
+        self.signal_raw_from_frontseat(frontseat_pb.Raw(raw=f"NAV,HEADING:{status.pose.heading:g}".encode()))
+        self.signal_data_from_frontseat(frontseat_pb.InterfaceData(node_status=status))
 
 
 def frontseat_driver_load(cfg, clock=None) -> LoopbackFrontSeat:

@@ -6,8 +6,8 @@ before one succeeds) and, per instance, `fail_next_work` (the next do_work raise
 
 from __future__ import annotations
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverError
 
 
 class ScriptedDriver(ModemDriverBase):
@@ -27,7 +27,7 @@ class ScriptedDriver(ModemDriverBase):
         self.cfg = cfg
         if ScriptedDriver.fail_startups > 0:
             ScriptedDriver.fail_startups -= 1
-            raise ModemDriverException("modem absent", m.ModemDriverStatus.STARTUP_FAILED)
+            raise ModemDriverError("modem absent", acomms_pb.ModemDriverStatus.STARTUP_FAILED)
         self.started += 1
 
     def shutdown(self) -> None:
@@ -36,7 +36,7 @@ class ScriptedDriver(ModemDriverBase):
     def do_work(self) -> None:
         if self.fail_next_work:
             self.fail_next_work = False
-            raise ModemDriverException("modem silent", m.ModemDriverStatus.MODEM_NOT_RESPONDING)
+            raise ModemDriverError("modem silent", acomms_pb.ModemDriverStatus.MODEM_NOT_RESPONDING)
 
     def handle_initiate_transmission(self, transmission) -> None:
         self.initiated.append(transmission)

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from google.protobuf import text_format
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.util.clock import VirtualClock
@@ -153,7 +153,7 @@ def test_driver_cfg_update_goes_to_running_drivers_with_that_id(plugins):
         f"modem_id: 3 driver_cfg {{ {SCRIPTED} }} listen_driver_cfg {{ {SCRIPTED} modem_id: 7 }}",
         clock,
     )
-    handler.update_driver_cfg(m.DriverConfig(modem_id=7))
+    handler.update_driver_cfg(acomms_pb.DriverConfig(modem_id=7))
     assert [len(s.driver.cfg_updates) for s in handler.slots] == [0, 1]
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from pygoby.apps.ifrontseat import iFrontSeat
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.moos.appconfig import ConfigError
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.moosfile import MissionFile
@@ -100,7 +100,7 @@ def test_goby2_abc_config_is_read_as_the_basic_simulator_block(tmp_path, caplog)
   }"""
     with caplog.at_level(logging.WARNING):
         cfg = iFrontSeat.read_config(MissionFile.read(mission(tmp_path, body)), "iFrontSeat")
-    sim = cfg.frontseat_cfg.Extensions[m.BASIC_SIMULATOR_CONFIG]
+    sim = cfg.frontseat_cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
     assert (sim.tcp_address, sim.tcp_port) == ("localhost", 54322)
     assert (sim.start.lat, sim.start.lon, sim.start.duration) == (44.0888889, 9.84861111, 600)
     assert "Goby 2 [abc_config] block is read as frontseat_cfg" in caplog.text
@@ -156,7 +156,7 @@ def test_the_example_mission_reads():
     cfg = iFrontSeat.read_config(MissionFile.read(REPO / "examples/frontseat/abc_auv.moos"),
                                  "iFrontSeat")  # fmt: skip
     assert cfg.driver_library == "abc" and cfg.legacy_cfg.publish_fs_bs_ready
-    sim = cfg.frontseat_cfg.Extensions[m.BASIC_SIMULATOR_CONFIG]
+    sim = cfg.frontseat_cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
     assert (sim.tcp_port, sim.start.lat) == (54321, 44.0888889)
 
 

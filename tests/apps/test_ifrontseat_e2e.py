@@ -17,7 +17,7 @@ import contextlib
 import math
 
 from pygoby.apps.ifrontseat import iFrontSeat
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.simulator.core import BasicFrontSeatSimulator
 from pygoby.frontseat.simulator.server import SimulatorServer
 from pygoby.moos.client import MOOSClient
@@ -128,7 +128,7 @@ class ScriptedHelm:
 
 
 def status_of(value) -> object:
-    status = m.InterfaceStatus()
+    status = frontseat_pb.InterfaceStatus()
     parse_for_moos(value, status)
     return status
 
@@ -163,13 +163,13 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
             return interface.state == state
 
         # Connected: START, then CTRL,STATE:PAYLOAD and NAV -> LISTEN (no helm yet).
-        await until(lambda: in_state(m.INTERFACE_LISTEN))
+        await until(lambda: in_state(frontseat_pb.INTERFACE_LISTEN))
         assert simulator.sim.received[0].startswith("START,LAT:42.5,LON:-70.5,DURATION:0,FREQ:2,")
         assert simulator.sim.received[0].endswith(f",WARP:{WARP}")
 
         # LISTEN: a command request (also one made from DESIRED_SPEED) never reaches the
         # simulator.
-        request = m.CommandRequest(request_id=5)
+        request = frontseat_pb.CommandRequest(request_id=5)
         course = request.desired_course
         course.time, course.heading, course.speed, course.depth = 1.0, 180.0, 1.0, 30.0
         helm.client.publish("IFS_COMMAND_REQUEST", serialize_for_moos(request))
@@ -177,73 +177,73 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
         await until(lambda: app.dynamic_vars.get("IFS_COMMAND_REQUEST", None) is not None
                     and app.dynamic_vars["IFS_COMMAND_REQUEST"].src == "iFrontSeat")  # fmt: skip
         await asyncio.sleep(0.3)  # a few more of the app's ticks
-        assert interface.state == m.INTERFACE_LISTEN
+        assert interface.state == frontseat_pb.INTERFACE_LISTEN
         assert simulator.sim.commands() == []
 
         # The helm drives: COMMAND; the vehicle turns east, speeds up and dives.
         helm.run()
-        await until(lambda: in_state(m.INTERFACE_COMMAND))
+        await until(lambda: in_state(frontseat_pb.INTERFACE_COMMAND))
         vehicle = simulator.sim.vehicle
         await until(lambda: (vehicle.heading, vehicle.speed, vehicle.z) == (90.0, 2.0, -10.0))
         assert set(simulator.sim.commands()) == {"CMD,HEADING:90,SPEED:2,DEPTH:10"}
         await recorder.wait_for("NAV_SPEED", lambda v: v == 2.0)
         await recorder.wait_for("NAV_DEPTH", lambda v: v == 10.0)
         assert recorder.values("NAV_HEADING")[-1] == 90.0
-        node = m.NodeStatus()
+        node = frontseat_pb.NodeStatus()
         parse_for_moos(await recorder.wait_for("IFS_NODE_STATUS", lambda v: "depth: 10 " in v
                                                and "over_ground: 2 " in v), node)  # fmt: skip
         assert node.name == "auv1" and node.global_fix.depth == 10.0
         assert node.local_fix.x > 0 and math.isclose(node.global_fix.lat, 42.5, abs_tol=1e-3)
-        response = m.CommandResponse()
+        response = frontseat_pb.CommandResponse()
         parse_for_moos(await recorder.wait_for("IFS_COMMAND_RESPONSE"), response)
         assert response.request_successful and response.request_id >= 65536
-        await recorder.wait_for("IFS_STATUS", lambda v: status_of(v).state == m.INTERFACE_COMMAND)
+        await recorder.wait_for("IFS_STATUS", lambda v: status_of(v).state == frontseat_pb.INTERFACE_COMMAND)
 
         # Garbage from the simulator is seen raw, skipped, and changes nothing.
         simulator.server.link.write("NAV,LAT:north,LON:-70\r\nnot a message\r\n")
         await recorder.wait_for("IFS_RAW_IN", lambda v: "not a message" in v)
-        assert interface.state == m.INTERFACE_COMMAND
+        assert interface.state == frontseat_pb.INTERFACE_COMMAND
 
         # The helm parks: HELM_ERROR, and no command goes out until it drives again.
         helm.state = "PARK"
-        await until(lambda: in_state(m.INTERFACE_HELM_ERROR))
-        assert interface.status().helm_error == m.ERROR_HELM_PARKED
+        await until(lambda: in_state(frontseat_pb.INTERFACE_HELM_ERROR))
+        assert interface.status().helm_error == frontseat_pb.ERROR_HELM_PARKED
         sent = len(simulator.sim.commands())
         await asyncio.sleep(0.5)  # five DESIRED_SPEED posts
         assert len(simulator.sim.commands()) == sent
         helm.state = "DRIVE"
-        await until(lambda: in_state(m.INTERFACE_COMMAND))
+        await until(lambda: in_state(frontseat_pb.INTERFACE_COMMAND))
         await until(lambda: len(simulator.sim.commands()) > sent)
 
         # Another process posts IVPHELM_STATE: the helm is not running -> HELM_ERROR.
         recorder.client.publish("IVPHELM_STATE", "DRIVE", time=app.moos_time())
-        await until(lambda: in_state(m.INTERFACE_HELM_ERROR))
-        assert interface.status().helm_error == m.ERROR_HELM_NOT_RUNNING
-        await until(lambda: in_state(m.INTERFACE_COMMAND))  # the helm's next post
+        await until(lambda: in_state(frontseat_pb.INTERFACE_HELM_ERROR))
+        assert interface.status().helm_error == frontseat_pb.ERROR_HELM_NOT_RUNNING
+        await until(lambda: in_state(frontseat_pb.INTERFACE_COMMAND))  # the helm's next post
 
         # The helm hangs (no more posts): HELM_ERROR after helm_state_timeout (5 s warped), no
         # command goes out meanwhile; when it posts again: back to COMMAND.
         await helm.stop_posting()
         sent = len(simulator.sim.commands())
-        await until(lambda: in_state(m.INTERFACE_HELM_ERROR))
-        assert interface.status().helm_error == m.ERROR_HELM_NOT_RUNNING
-        assert interface.helm_state == m.HELM_NOT_RUNNING
+        await until(lambda: in_state(frontseat_pb.INTERFACE_HELM_ERROR))
+        assert interface.status().helm_error == frontseat_pb.ERROR_HELM_NOT_RUNNING
+        assert interface.helm_state == frontseat_pb.HELM_NOT_RUNNING
         assert len(simulator.sim.commands()) == sent
         helm.run()
-        await until(lambda: in_state(m.INTERFACE_COMMAND))
+        await until(lambda: in_state(frontseat_pb.INTERFACE_COMMAND))
 
         # The simulator goes away: FS_ERROR (not connected); it comes back on the same port:
         # STANDBY -> LISTEN -> COMMAND, and the new vehicle is driven to the helm's course.
         await simulator.stop()
-        await until(lambda: in_state(m.INTERFACE_FS_ERROR))
-        assert interface.status().frontseat_error == m.ERROR_FRONTSEAT_NOT_CONNECTED
-        await recorder.wait_for("IFS_STATUS", lambda v: status_of(v).state == m.INTERFACE_FS_ERROR)
+        await until(lambda: in_state(frontseat_pb.INTERFACE_FS_ERROR))
+        assert interface.status().frontseat_error == frontseat_pb.ERROR_FRONTSEAT_NOT_CONNECTED
+        await recorder.wait_for("IFS_STATUS", lambda v: status_of(v).state == frontseat_pb.INTERFACE_FS_ERROR)
         mark = len(states)
         simulator = Simulator(sim_port)
         await simulator.start()
-        await until(lambda: in_state(m.INTERFACE_COMMAND))
-        assert states[mark - 1 :] == [m.INTERFACE_FS_ERROR, m.INTERFACE_STANDBY,
-                                      m.INTERFACE_LISTEN, m.INTERFACE_COMMAND]  # fmt: skip
+        await until(lambda: in_state(frontseat_pb.INTERFACE_COMMAND))
+        assert states[mark - 1 :] == [frontseat_pb.INTERFACE_FS_ERROR, frontseat_pb.INTERFACE_STANDBY,
+                                      frontseat_pb.INTERFACE_LISTEN, frontseat_pb.INTERFACE_COMMAND]  # fmt: skip
         assert simulator.sim.received[0].startswith("START,")
         vehicle = simulator.sim.vehicle
         await until(lambda: (vehicle.heading, vehicle.speed, vehicle.z) == (90.0, 2.0, -10.0))
@@ -253,17 +253,17 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
         # wall). iFrontSeat sends nothing in FS_ERROR; an operator's START on the
         # simulator brings the data back, and the interface back to COMMAND.
         start = "START,LAT:42.5,LON:-70.5,DURATION:1,FREQ:2,WARP:10"
-        recorder.client.publish("IFS_RAW_OUT", serialize_for_moos(m.Raw(raw=start.encode())),
+        recorder.client.publish("IFS_RAW_OUT", serialize_for_moos(frontseat_pb.Raw(raw=start.encode())),
                                 time=app.moos_time())  # fmt: skip
-        await until(lambda: in_state(m.INTERFACE_FS_ERROR))
-        assert interface.status().frontseat_error == m.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
+        await until(lambda: in_state(frontseat_pb.INTERFACE_FS_ERROR))
+        assert interface.status().frontseat_error == frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
         assert start in simulator.sim.received
         mark = len(states)
         _, operator = await asyncio.open_connection("127.0.0.1", sim_port)
         operator.write(b"START,LAT:42.5,LON:-70.5,FREQ:2,WARP:10\r\n")
-        await until(lambda: in_state(m.INTERFACE_COMMAND))
+        await until(lambda: in_state(frontseat_pb.INTERFACE_COMMAND))
         operator.close()
-        assert states[mark:] == [m.INTERFACE_STANDBY, m.INTERFACE_LISTEN, m.INTERFACE_COMMAND]
+        assert states[mark:] == [frontseat_pb.INTERFACE_STANDBY, frontseat_pb.INTERFACE_LISTEN, frontseat_pb.INTERFACE_COMMAND]
 
     assert all(
         line.startswith(("START", "CMD,HEADING:90,SPEED:2,DEPTH:10"))

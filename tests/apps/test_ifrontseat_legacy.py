@@ -7,7 +7,7 @@ import math
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.legacy import (
     LEGACY_REQUEST_ID_BASE,
     CtdSamples,
@@ -18,7 +18,7 @@ from pygoby.frontseat.legacy import (
 
 
 def node_status(**pose):
-    status = m.NodeStatus(time=1700000000.123456789, name="auv")
+    status = frontseat_pb.NodeStatus(time=1700000000.123456789, name="auv")
     status.global_fix.lat, status.global_fix.lon = 42.5, -70.25
     status.local_fix.x, status.local_fix.y = 10.5, -3.25
     status.speed.over_ground = 1.5
@@ -40,7 +40,7 @@ def test_nav_posts_full_solution_with_gps():
     status.local_fix.z = -12.0
     status.global_fix.depth = 12.0
     status.global_fix.altitude = 30.0
-    status.source.position = m.Source.GPS
+    status.source.position = frontseat_pb.Source.GPS
     posts = dict(nav_posts(status))
     assert [var for var, _ in nav_posts(status)] == [
         "NAV_X", "NAV_Y", "NAV_LAT", "NAV_LONG", "NAV_Z", "NAV_DEPTH", "NAV_HEADING", "NAV_YAW",
@@ -58,9 +58,9 @@ def test_nav_posts_full_solution_with_gps():
 
 def test_no_gps_update_for_other_or_unknown_position_sources():
     status = node_status()
-    status.source.depth = m.Source.PRESSURE  # position source not given (reads GPS=1)
+    status.source.depth = frontseat_pb.Source.PRESSURE  # position source not given (reads GPS=1)
     assert "GPS_UPDATE_RECEIVED" not in dict(nav_posts(status))
-    status.source.position = m.Source.INERTIAL_NAVIGATION_SYSTEM
+    status.source.position = frontseat_pb.Source.INERTIAL_NAVIGATION_SYSTEM
     assert "GPS_UPDATE_RECEIVED" not in dict(nav_posts(status))
 
 
@@ -97,13 +97,13 @@ def test_ctd_sample_on_temperature_at_the_last_fix():
 
 
 def test_ready_posts():
-    status = m.InterfaceStatus(
-        state=m.INTERFACE_COMMAND,
-        frontseat_state=m.FRONTSEAT_ACCEPTING_COMMANDS,
-        helm_state=m.HELM_DRIVE,
+    status = frontseat_pb.InterfaceStatus(
+        state=frontseat_pb.INTERFACE_COMMAND,
+        frontseat_state=frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS,
+        helm_state=frontseat_pb.HELM_DRIVE,
     )
     assert ready_posts(status) == [("FRONTSEAT_READY", 1.0), ("BACKSEAT_READY", 1.0)]
-    status.frontseat_state, status.helm_state = m.FRONTSEAT_IDLE, m.HELM_PARK
+    status.frontseat_state, status.helm_state = frontseat_pb.FRONTSEAT_IDLE, frontseat_pb.HELM_PARK
     assert ready_posts(status) == [("FRONTSEAT_READY", 0.0), ("BACKSEAT_READY", 0.0)]
 
 
@@ -116,7 +116,7 @@ def test_nav_posts_are_numbers_for_any_solution(heading, pitch, speed, time):
     status = node_status(heading=heading, pitch=pitch)
     status.speed.over_ground = speed
     status.time = time
-    status.source.position = m.Source.GPS
+    status.source.position = frontseat_pb.Source.GPS
     posts = dict(nav_posts(status))
     assert posts["NAV_YAW"] == -math.radians(heading)
     assert float(posts["GPS_UPDATE_RECEIVED"].removeprefix("Timestamp=")) == float(f"{time:.15g}")

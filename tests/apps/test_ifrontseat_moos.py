@@ -10,7 +10,7 @@ import logging
 import math
 
 from pygoby.apps.ifrontseat import iFrontSeat
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.translator import parse_for_moos, serialize_for_moos
@@ -58,7 +58,7 @@ def parsed(cls, value):
 
 def status_is(state, **fields):
     def check(value) -> bool:
-        status = parsed(m.InterfaceStatus, value)
+        status = parsed(frontseat_pb.InterfaceStatus, value)
         return status.state == state and all(getattr(status, k) == v for k, v in fields.items())
 
     return check
@@ -115,19 +115,19 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
         # The driver got the community's name and datum; its NAV flows: STANDBY -> LISTEN.
         assert driver.cfg.name == "auv1" and driver.cfg.sim_warp_factor == 1
         assert (driver.cfg.origin.lat, driver.cfg.origin.lon) == (42.5, -70.5)
-        await r.wait_for("IFS_STATUS", status_is(m.INTERFACE_LISTEN))
+        await r.wait_for("IFS_STATUS", status_is(frontseat_pb.INTERFACE_LISTEN))
         status_text = await r.wait_for("IFS_STATUS")
         assert status_text.startswith(PB.format("InterfaceStatus"))
         assert await r.wait_for("FRONTSEAT_READY") == 1.0
         assert await r.wait_for("BACKSEAT_READY") == 0.0
 
         # NAV_* and IFS_NODE_STATUS / IFS_DATA_IN / IFS_RAW_IN from the frontseat's solution.
-        node = parsed(m.NodeStatus, await r.wait_for("IFS_NODE_STATUS"))
+        node = parsed(frontseat_pb.NodeStatus, await r.wait_for("IFS_NODE_STATUS"))
         assert node.name == "auv1" and node.global_fix.lat == 42.51
-        data = parsed(m.InterfaceData, await r.wait_for("IFS_DATA_IN"))
+        data = parsed(frontseat_pb.InterfaceData, await r.wait_for("IFS_DATA_IN"))
         assert data.node_status.global_fix.lon == -70.5
         raw = await r.wait_for("IFS_RAW_IN")
-        assert raw.startswith(PB.format("Raw")) and parsed(m.Raw, raw).raw == b"NAV,HEADING:0"
+        assert raw.startswith(PB.format("Raw")) and parsed(frontseat_pb.Raw, raw).raw == b"NAV,HEADING:0"
         assert await r.wait_for("NAV_LAT") == 42.51 and await r.wait_for("NAV_LONG") == -70.5
         x, y = UTMGeodesy(42.5, -70.5).to_local(42.51, -70.5)  # 0.01 deg north of the datum
         assert await r.wait_for("NAV_X") == x and await r.wait_for("NAV_Y") == y
@@ -136,7 +136,7 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
         assert (await r.wait_for("GPS_UPDATE_RECEIVED")).startswith("Timestamp=17")
 
         # LISTEN: a command request is dropped, even the one made from DESIRED_*; data passes.
-        request = m.CommandRequest(request_id=7)
+        request = frontseat_pb.CommandRequest(request_id=7)
         request.desired_course.time, request.desired_course.heading = 1.0, 45.0
         c.post("IFS_COMMAND_REQUEST", serialize_for_moos(request))
         await c.handled("IFS_COMMAND_REQUEST", "tester")
@@ -146,12 +146,12 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
             ("DESIRED_SPEED", 1.5),
         ):
             c.post(var, value, c.helm)
-        legacy = parsed(m.CommandRequest, await r.wait_for("IFS_COMMAND_REQUEST",
+        legacy = parsed(frontseat_pb.CommandRequest, await r.wait_for("IFS_COMMAND_REQUEST",
                                                               lambda v: "65536" in v))  # fmt: skip
         assert legacy.response_requested and legacy.request_id == 65536
         assert (legacy.desired_course.heading, legacy.desired_course.speed) == (90.0, 1.5)
         await c.handled("IFS_COMMAND_REQUEST", "iFrontSeat")
-        c.post("IFS_DATA_OUT", serialize_for_moos(m.InterfaceData(dccl_message=b"\x01\x02")))
+        c.post("IFS_DATA_OUT", serialize_for_moos(frontseat_pb.InterfaceData(dccl_message=b"\x01\x02")))
         async with asyncio.timeout(5):
             while not driver.data:
                 await asyncio.sleep(0.01)
@@ -161,15 +161,15 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
         # The helm drives: LISTEN -> COMMAND; the next DESIRED_SPEED (after the 1 s blackout)
         # reaches the frontseat and its response comes back.
         c.post("IVPHELM_STATE", "DRIVE", c.helm)
-        await c.state(m.INTERFACE_COMMAND)
+        await c.state(frontseat_pb.INTERFACE_COMMAND)
         assert await r.wait_for("BACKSEAT_READY", lambda v: v == 1.0) == 1.0
-        await r.wait_for("IFS_STATUS", status_is(m.INTERFACE_COMMAND, helm_state=m.HELM_DRIVE,
-                                                 frontseat_state=m.FRONTSEAT_ACCEPTING_COMMANDS))  # fmt: skip
+        await r.wait_for("IFS_STATUS", status_is(frontseat_pb.INTERFACE_COMMAND, helm_state=frontseat_pb.HELM_DRIVE,
+                                                 frontseat_state=frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS))  # fmt: skip
         await asyncio.sleep(1.05)
         c.post("DESIRED_SPEED", 1.2, c.helm)
         response = await r.wait_for("IFS_COMMAND_RESPONSE")
         assert response.startswith(PB.format("CommandResponse"))
-        assert parsed(m.CommandResponse, response).request_id == 65537
+        assert parsed(frontseat_pb.CommandResponse, response).request_id == 65537
         assert [cmd.request_id for cmd in driver.commands] == [65537]
         course = driver.commands[0].desired_course
         assert (course.heading, course.speed, course.depth) == (90.0, 1.2, 5.0)
@@ -180,7 +180,7 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
 
         # Raw text from another process goes to the frontseat once; the app's own IFS_RAW_OUT
         # post of what the driver wrote is not sent again.
-        c.post("IFS_RAW_OUT", serialize_for_moos(m.Raw(raw=b"HELLO")))
+        c.post("IFS_RAW_OUT", serialize_for_moos(frontseat_pb.Raw(raw=b"HELLO")))
         await c.handled("IFS_RAW_OUT", "iFrontSeat")
         assert [raw.raw for raw in driver.raws] == [b"HELLO"]
 
@@ -199,13 +199,13 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
 
         # PARK -> HELM_ERROR; commands are dropped; DRIVE -> STANDBY -> LISTEN -> COMMAND.
         c.post("IVPHELM_STATE", "PARK", c.helm)
-        await r.wait_for("IFS_STATUS", status_is(m.INTERFACE_HELM_ERROR,
-                                                 helm_error=m.ERROR_HELM_PARKED))  # fmt: skip
+        await r.wait_for("IFS_STATUS", status_is(frontseat_pb.INTERFACE_HELM_ERROR,
+                                                 helm_error=frontseat_pb.ERROR_HELM_PARKED))  # fmt: skip
         c.post("IFS_COMMAND_REQUEST", serialize_for_moos(request))
         await c.handled("IFS_COMMAND_REQUEST", "tester")
         assert len(driver.commands) == 1
         c.post("IVPHELM_STATE", "DRIVE", c.helm)
-        await c.state(m.INTERFACE_COMMAND)
+        await c.state(frontseat_pb.INTERFACE_COMMAND)
         c.post("IFS_COMMAND_REQUEST", serialize_for_moos(request))
         async with asyncio.timeout(5):
             while len(driver.commands) < 2:
@@ -214,18 +214,18 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
 
         # IVPHELM_STATE from any other process: the helm is not running -> HELM_ERROR.
         c.post("IVPHELM_STATE", "DRIVE")
-        await r.wait_for("IFS_STATUS", status_is(m.INTERFACE_HELM_ERROR,
-                                                 helm_error=m.ERROR_HELM_NOT_RUNNING,
-                                                 helm_state=m.HELM_NOT_RUNNING))  # fmt: skip
+        await r.wait_for("IFS_STATUS", status_is(frontseat_pb.INTERFACE_HELM_ERROR,
+                                                 helm_error=frontseat_pb.ERROR_HELM_NOT_RUNNING,
+                                                 helm_state=frontseat_pb.HELM_NOT_RUNNING))  # fmt: skip
         c.post("IVPHELM_STATE", "DRIVE", c.helm)
-        await c.state(m.INTERFACE_COMMAND)
+        await c.state(frontseat_pb.INTERFACE_COMMAND)
 
         # The frontseat falls silent -> FS_ERROR (not providing data); back -> COMMAND.
         driver.online = False
         await r.wait_for("IFS_STATUS", status_is(
-            m.INTERFACE_FS_ERROR, frontseat_error=m.ERROR_FRONTSEAT_NOT_PROVIDING_DATA))  # fmt: skip
+            frontseat_pb.INTERFACE_FS_ERROR, frontseat_error=frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA))  # fmt: skip
         driver.online = True
-        await c.state(m.INTERFACE_COMMAND)
+        await c.state(frontseat_pb.INTERFACE_COMMAND)
 
         # A new datum from LAT_ORIGIN: the local grid moves (0.01 deg south of the vehicle now).
         c.post("LAT_ORIGIN", 42.52)
@@ -248,8 +248,8 @@ async def test_renamed_variables_ctd_samples_and_no_helm_required(tmp_path):
         for var in ("FS_STAT", "FS_TO_VEHICLE", "FS_NODE_STATUS"):
             r.client.subscribe(var)
         # require_helm: false -> COMMAND without a helm.
-        status = await r.wait_for("FS_STAT", status_is(m.INTERFACE_COMMAND), timeout=10)
-        assert parsed(m.InterfaceStatus, status).helm_state == m.HELM_NOT_RUNNING
+        status = await r.wait_for("FS_STAT", status_is(frontseat_pb.INTERFACE_COMMAND), timeout=10)
+        assert parsed(frontseat_pb.InterfaceStatus, status).helm_state == frontseat_pb.HELM_NOT_RUNNING
         await r.wait_for("FS_NODE_STATUS")
         assert r.values("IFS_STATUS") == [] and r.values("NAV_LAT") == []  # publish_nav: false
 
@@ -258,7 +258,7 @@ async def test_renamed_variables_ctd_samples_and_no_helm_required(tmp_path):
         for var, value in (("CTD_CONDUCTIVITY", 4.2914), ("CTD_PRESSURE", 100.0),
                            ("CTD_TEMPERATURE", 15.0)):  # fmt: skip
             c.post(var, value)
-        posted = m.InterfaceData()
+        posted = frontseat_pb.InterfaceData()
         parse_for_moos(await r.wait_for("FS_TO_VEHICLE"), posted)
         sample = posted.ctd_sample
         assert (sample.global_fix.lat, sample.global_fix.lon) == (42.51, -70.5)

@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.dccl import Codec
 from pygoby.moos.appconfig import ConfigError
@@ -70,7 +70,7 @@ def test_spec_example_configures_every_layer(tmp_path):
     acomms = app.acomms
     assert type(acomms.primary.driver).__name__ == "MMDriver"
     assert acomms.primary.cfg.modem_id == 1 and acomms.primary.cfg.serial_port == "/dev/ttyUSB0"
-    assert acomms.primary.cfg.Extensions[m.MM_CONFIG].nvram_cfg == ["DQF,1"]
+    assert acomms.primary.cfg.Extensions[acomms_pb.MM_CONFIG].nvram_cfg == ["DQF,1"]
     assert len(acomms.mac_cfg.slot) == 2 and acomms.mac_cfg.modem_id == 1
     app.on_start()
     assert acomms.mac.running and len(acomms.mac.slots) == 2 and acomms.mac.cfg.modem_id == 1
@@ -79,7 +79,7 @@ def test_spec_example_configures_every_layer(tmp_path):
     assert list(acomms.route_cfg.route.hop) == [1, 2]
     assert acomms.failure.driver_backoff_sec == 30
     assert app.var["queue_size"] == "AC_QSIZE" and app.ifs_data_out == "IFS_DATA_OUT"
-    status = app._message_class(STATUS)(
+    status = app.message_types(STATUS)(
         time=float(int(time.time())), src=1, nav_x=1, nav_y=2, speed=0, heading=0, depth=0
     )
     encrypted = acomms.codec.encode(status)
@@ -90,8 +90,8 @@ def test_spec_example_configures_every_layer(tmp_path):
 
 def test_goby_messages_resolve_for_translator_entries(tmp_path):
     app = pAcommsHandler.from_mission(write(tmp_path, EXAMPLE))
-    assert app._message_class("goby.acomms.protobuf.MACUpdate") is m.MACUpdate
-    assert app._message_class("goby.acomms.protobuf.RouteCommand").DESCRIPTOR.name == "RouteCommand"
+    assert app.message_types("goby.acomms.protobuf.MACUpdate") is acomms_pb.MACUpdate
+    assert app.message_types("goby.acomms.protobuf.RouteCommand").DESCRIPTOR.name == "RouteCommand"
 
 
 @pytest.mark.parametrize(
@@ -154,11 +154,11 @@ ProcessConfig = pAcommsHandler
 }}
 """
     app = pAcommsHandler.from_mission(write(tmp_path, mission))
-    command = app._message_class(COMMAND)(
+    command = app.message_types(COMMAND)(
         time=float(int(time.time())), src=1, dest=3, command_id=7, heading=90, speed=1, depth=5
     )
     app.acomms.queue.push_message(command)
-    request = m.ModemTransmission(src=1, dest=m.QUERY_DESTINATION_ID, type=m.DATA, max_frame_bytes=32)
+    request = acomms_pb.ModemTransmission(src=1, dest=acomms_pb.QUERY_DESTINATION_ID, type=acomms_pb.DATA, max_frame_bytes=32)
     app.acomms.queue.handle_modem_data_request(request)
     assert request.dest == 2
     assert list(request.frame)  # the command is in the frame

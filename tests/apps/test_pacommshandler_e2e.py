@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import asyncio
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.translator import parse_for_moos, serialize_for_moos
 
 from .acomms_mission import COMMAND, STATUS, TwoCommunities
@@ -36,40 +36,40 @@ async def test_status_and_acked_command_between_two_vehicles(tmp_path):
         r1.client.publish("COMMAND_OUT", "dest=2,command_id=7,heading=90,speed=1.5,depth=20")
         assert await r2.wait_for("DESIRED_HEADING") == 90.0
         assert "command_id=7" in await r2.wait_for("COMMAND_IN")
-        ack = parsed(m.ModemTransmission, await r1.wait_for("ACOMMS_ACK"))
-        assert (ack.type, ack.src, ack.dest) == (m.ACK, 2, 1)
+        ack = parsed(acomms_pb.ModemTransmission, await r1.wait_for("ACOMMS_ACK"))
+        assert (ack.type, ack.src, ack.dest) == (acomms_pb.ACK, 2, 1)
         original = await r1.wait_for("ACOMMS_ACK_ORIGINAL")
         assert original.startswith(f"@PB[{COMMAND}] ") and "command_id: 7" in original
 
         # The informational variables of the primary driver, the MAC and the queue.
         assert any(v.startswith("$CCCYC") for v in r1.values("ACOMMS_NMEA_OUT"))
         assert any(v.startswith("$CARXD") for v in r2.values("ACOMMS_NMEA_IN"))
-        raw = parsed(m.ModemRaw, r2.values("ACOMMS_RAW_INCOMING")[0])
+        raw = parsed(acomms_pb.ModemRaw, r2.values("ACOMMS_RAW_INCOMING")[0])
         assert raw.raw.startswith(b"$CA") or raw.raw.startswith(b"$SN")
         assert r1.values("ACOMMS_RAW_OUTGOING")
-        sent = [parsed(m.ModemTransmission, v) for v in r1.values("ACOMMS_MODEM_TRANSMIT")]
+        sent = [parsed(acomms_pb.ModemTransmission, v) for v in r1.values("ACOMMS_MODEM_TRANSMIT")]
         assert any(t.src == 1 and t.frame for t in sent)
-        heard = [parsed(m.ModemTransmission, v) for v in r2.values("ACOMMS_MODEM_RECEIVE")]
-        assert any(t.src == 1 and t.type == m.DATA and t.frame for t in heard)
-        starts = [parsed(m.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_SLOT_START")]
+        heard = [parsed(acomms_pb.ModemTransmission, v) for v in r2.values("ACOMMS_MODEM_RECEIVE")]
+        assert any(t.src == 1 and t.type == acomms_pb.DATA and t.frame for t in heard)
+        starts = [parsed(acomms_pb.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_SLOT_START")]
         assert {s.src for s in starts} == {1, 2}  # every slot, own or not
         initiated = [
-            parsed(m.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_INITIATE_TRANSMISSION")
+            parsed(acomms_pb.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_INITIATE_TRANSMISSION")
         ]
         assert initiated and {s.src for s in initiated} == {1}  # own slots only
-        sizes = [parsed(m.QueueSize, v) for v in r1.values("ACOMMS_QSIZE")]
+        sizes = [parsed(acomms_pb.QueueSize, v) for v in r1.values("ACOMMS_QSIZE")]
         assert {(s.dccl_id, s.size) for s in sizes} >= {(20, 0), (20, 1), (21, 0), (21, 1)}
         assert app1.queue.size(21) == 0
 
         # Another process asks for a ping through ACOMMS_MAC_INITIATE_TRANSMISSION.
-        ping = m.ModemTransmission(src=1, dest=2, type=m.DRIVER_SPECIFIC)
-        ping.Extensions[m.MM_TRANSMISSION].type = m.MICROMODEM_TWO_WAY_PING
+        ping = acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DRIVER_SPECIFIC)
+        ping.Extensions[acomms_pb.MM_TRANSMISSION].type = acomms_pb.MICROMODEM_TWO_WAY_PING
         r1.client.publish("ACOMMS_MAC_INITIATE_TRANSMISSION", serialize_for_moos(ping))
         reply = await r1.wait_for("ACOMMS_MODEM_RECEIVE", lambda v: "ranging_reply" in v)
         assert "one_way_travel_time" in reply
 
         # MACUpdate with cycle_state STOPPED: the MAC stops and the Micro-Modem goes silent.
-        stop = m.MACUpdate(src=2, dest=2, cycle_state=m.MACUpdate.STOPPED)
+        stop = acomms_pb.MACUpdate(src=2, dest=2, cycle_state=acomms_pb.MACUpdate.STOPPED)
         r2.client.publish("ACOMMS_MAC_CYCLE_UPDATE", serialize_for_moos(stop))
         await r2.wait_for("ACOMMS_NMEA_OUT", lambda v: v.startswith("$CCCFG,SRC,0*"))
         assert not net.apps[1].acomms.mac.running

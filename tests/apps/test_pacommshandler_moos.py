@@ -8,7 +8,7 @@ import asyncio
 import base64
 import logging
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.dccl import Codec
 from pygoby.moos.db import MOOSDB
@@ -73,7 +73,7 @@ async def test_moos_interface_without_a_modem(tmp_path, caplog):
             await r.wait_for("ACOMMS_QSIZE", qsize(20, 0))  # queues announced; the unknown
             await r.wait_for("ACOMMS_QSIZE", qsize(21, 0))  # type got no queue
             assert sorted(app.queue.queues) == [20, 21]
-            start_ = m.ModemTransmission()
+            start_ = acomms_pb.ModemTransmission()
             parse_for_moos(await r.wait_for("ACOMMS_MAC_SLOT_START"), start_)
             assert start_.src in (1, 2) and start_.time > 0  # the MAC runs without a driver
 
@@ -82,7 +82,7 @@ async def test_moos_interface_without_a_modem(tmp_path, caplog):
             status_cls = codec.load_proto(PROTO, STATUS)
             status = status_cls(time=1.8e9, src=2, nav_x=5, nav_y=6, speed=1, heading=2, depth=3)
             data = codec.encode(status)
-            rx = m.ModemTransmission(src=2, dest=0, type=m.DATA, frame=[data])
+            rx = acomms_pb.ModemTransmission(src=2, dest=0, type=acomms_pb.DATA, frame=[data])
             r.client.publish("ACOMMS_MODEM_RECEIVE", serialize_for_moos(rx))
             report = await r.wait_for("STATUS_REPORT_IN")
             assert report == "src=2,x=5,y=6,speed=1,heading=2,depth=3"
@@ -96,7 +96,7 @@ async def test_moos_interface_without_a_modem(tmp_path, caplog):
             # Queue: a command is queued, flushed; another expires (ttl 2 s).
             r.client.publish("COMMAND_OUT", "dest=2,command_id=4,heading=1,speed=1,depth=1")
             await r.wait_for("ACOMMS_QSIZE", qsize(21, 1))
-            r.client.publish("ACOMMS_FLUSH_QUEUE", serialize_for_moos(m.QueueFlush(dccl_id=21)))
+            r.client.publish("ACOMMS_FLUSH_QUEUE", serialize_for_moos(acomms_pb.QueueFlush(dccl_id=21)))
             async with asyncio.timeout(5):
                 while app.queue.size(21):
                     await asyncio.sleep(0.02)
@@ -124,15 +124,15 @@ async def test_moos_interface_without_a_modem(tmp_path, caplog):
                 r.client.publish(
                     "ACOMMS_MAC_CYCLE_UPDATE", "@PB[goby.acomms.protobuf.MACUpdate] garbage {"
                 )
-                update = m.MACUpdate(src=2, dest=5, update_type=m.MACUpdate.CLEAR)
+                update = acomms_pb.MACUpdate(src=2, dest=5, update_type=acomms_pb.MACUpdate.CLEAR)
                 r.client.publish("ACOMMS_MAC_CYCLE_UPDATE", serialize_for_moos(update))
-                update = m.MACUpdate(src=2, dest=1, update_type=m.MACUpdate.PUSH_BACK,
-                                     slot=[m.ModemTransmission(src=1, slot_seconds=1)])  # fmt: skip
+                update = acomms_pb.MACUpdate(src=2, dest=1, update_type=acomms_pb.MACUpdate.PUSH_BACK,
+                                     slot=[acomms_pb.ModemTransmission(src=1, slot_seconds=1)])  # fmt: skip
                 r.client.publish("ACOMMS_MAC_CYCLE_UPDATE", serialize_for_moos(update))
                 async with asyncio.timeout(5):
                     while len(app.acomms.mac.slots) != 3:
                         await asyncio.sleep(0.02)
-                update = m.MACUpdate(src=2, dest=1, cycle_state=m.MACUpdate.STOPPED)
+                update = acomms_pb.MACUpdate(src=2, dest=1, cycle_state=acomms_pb.MACUpdate.STOPPED)
                 r.client.publish("ACOMMS_MAC_CYCLE_UPDATE", serialize_for_moos(update))
                 r.client.publish("ACOMMS_DRIVER_RESET", "now")  # no driver: a warning
                 r.client.publish("ACOMMS_MODEM_RECEIVE", "not a transmission")
@@ -208,7 +208,7 @@ async def test_on_demand_messages_are_created_at_each_data_request(tmp_path, mon
             status_cls = codec.load_proto(PROTO, STATUS)
 
             def carries_nav(text):
-                tx = m.ModemTransmission()
+                tx = acomms_pb.ModemTransmission()
                 parse_for_moos(text, tx)
                 return tx.frame and tx.frame[0] and codec.decode(tx.frame[0]).nav_x == 1.0
 
@@ -226,11 +226,11 @@ async def test_received_route_command_replaces_the_route(tmp_path):
         app, r = await start(tmp_path, db, extra=route_cfg)
         try:
             assert 514 in app.queue.queues
-            command_cls = app._message_class("goby.acomms.protobuf.RouteCommand")
+            command_cls = app.message_types("goby.acomms.protobuf.RouteCommand")
             command = command_cls(src=3, dest=1, time=int(1.8e15))
             command.new_route.hop.extend([1, 2, 3])
             frame = app.acomms.codec.encode(command)
-            rx = m.ModemTransmission(src=3, dest=1, type=m.DATA, frame=[frame])
+            rx = acomms_pb.ModemTransmission(src=3, dest=1, type=acomms_pb.DATA, frame=[frame])
             r.client.publish("ACOMMS_MODEM_RECEIVE", serialize_for_moos(rx))
             async with asyncio.timeout(5):
                 while list(app.acomms.route_cfg.route.hop) != [1, 2, 3]:

@@ -20,7 +20,7 @@ def _codec(record: dict, strict: bool = False):
     codec = CODECS.get(record["proto"], record["passphrase"])
     codec.strict = strict
     if record.get("decode_now") is not None:
-        CODECS.clock._now = float(record["decode_now"])
+        CODECS.clock.time = float(record["decode_now"])
     return codec
 
 

@@ -5,14 +5,14 @@ calls and raises `raise_in_loop` (once) from loop(). Also loadable as a driver p
 
 from __future__ import annotations
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.interface import InterfaceBase
 
 
 class ScriptedFrontSeat(InterfaceBase):
     def __init__(self, cfg, clock=None) -> None:
         super().__init__(cfg, clock)
-        self.fs_state = m.FRONTSEAT_NOT_CONNECTED
+        self.fs_state = frontseat_pb.FRONTSEAT_NOT_CONNECTED
         self.providing = False
         self.loop_calls = 0
         self.raise_in_loop: Exception | None = None

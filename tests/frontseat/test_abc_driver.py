@@ -7,7 +7,7 @@ import logging
 import pytest
 from google.protobuf import text_format
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.drivers.abc import (
     AbcConfigError,
     AbcFrontSeat,
@@ -35,7 +35,7 @@ sim_warp_factor: 3
 
 
 def config(text: str = CONFIG):
-    return text_format.Parse(text, m.Config())
+    return text_format.Parse(text, frontseat_pb.Config())
 
 
 class Recorder:
@@ -63,8 +63,8 @@ def connect(driver: AbcFrontSeat, link: MemoryLink) -> list[str]:
 
 
 def request(request_id: int, heading=260.0, speed=1.5, depth=100.0, response=True):
-    return m.CommandRequest(
-        desired_course=m.DesiredCourse(time=T0, heading=heading, speed=speed, depth=depth),
+    return frontseat_pb.CommandRequest(
+        desired_course=frontseat_pb.DesiredCourse(time=T0, heading=heading, speed=speed, depth=depth),
         response_requested=response,
         request_id=request_id,
     )
@@ -73,7 +73,7 @@ def request(request_id: int, heading=260.0, speed=1.5, depth=100.0, response=Tru
 def test_start_is_sent_once_connected_with_all_eight_fields(rig):
     driver, link, rec = rig
     driver.loop()
-    assert driver.frontseat_state() == m.FRONTSEAT_NOT_CONNECTED
+    assert driver.frontseat_state() == frontseat_pb.FRONTSEAT_NOT_CONNECTED
     written = connect(driver, link)
     line = (
         "START,LAT:44.0888889,LON:9.84861111,DURATION:600,FREQ:10,ACCEL:0.5,HDG_RATE:45,"
@@ -81,7 +81,7 @@ def test_start_is_sent_once_connected_with_all_eight_fields(rig):
     )
     assert written == [line + "\r\n"]
     assert rec.raw_out == [line]
-    assert driver.frontseat_state() == m.FRONTSEAT_IDLE
+    assert driver.frontseat_state() == frontseat_pb.FRONTSEAT_IDLE
     driver.loop()
     assert link.take_written() == []  # once per connection
 
@@ -89,11 +89,11 @@ def test_start_is_sent_once_connected_with_all_eight_fields(rig):
 @pytest.mark.parametrize(
     ("line", "state"),
     [
-        ("CTRL,STATE:PAYLOAD", m.FRONTSEAT_ACCEPTING_COMMANDS),
-        ("CTRL,STATE:AUV", m.FRONTSEAT_IN_CONTROL),
-        ("CTRL,STATE:IDLE", m.FRONTSEAT_IDLE),
-        ("CTRL,STATE:WHATEVER", m.FRONTSEAT_IDLE),
-        ("CTRL", m.FRONTSEAT_IDLE),
+        ("CTRL,STATE:PAYLOAD", frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS),
+        ("CTRL,STATE:AUV", frontseat_pb.FRONTSEAT_IN_CONTROL),
+        ("CTRL,STATE:IDLE", frontseat_pb.FRONTSEAT_IDLE),
+        ("CTRL,STATE:WHATEVER", frontseat_pb.FRONTSEAT_IDLE),
+        ("CTRL", frontseat_pb.FRONTSEAT_IDLE),
     ],
 )
 def test_ctrl_sets_the_frontseat_state(rig, line, state):
@@ -115,7 +115,7 @@ def test_nav_becomes_a_full_node_status(rig):
     assert rec.raw_in == ["NAV,LAT:44.0889,LON:9.8486,DEPTH:12.5,HEADING:223,SPEED:1.4"]
     (data,) = rec.data
     status = data.node_status
-    assert status.name == "auv1" and status.type == m.VehicleType.Value("AUV")
+    assert status.name == "auv1" and status.type == frontseat_pb.VehicleType.Value("AUV")
     assert status.time == T0
     assert (status.global_fix.lat, status.global_fix.lon) == (44.0889, 9.8486)
     assert status.global_fix.depth == 12.5
@@ -150,11 +150,11 @@ def test_command_is_formatted_with_six_digits_and_answered_with_its_id(rig):
     assert rec.raw_out[-1] == "CMD,HEADING:123.457,SPEED:1.5,DEPTH:100"
     link.feed("CMD,RESULT:OK\r\n")
     driver.loop()
-    assert rec.responses == [m.CommandResponse(request_successful=True, request_id=7)]
+    assert rec.responses == [frontseat_pb.CommandResponse(request_successful=True, request_id=7)]
     driver.send_command_to_frontseat(request(8))
     link.feed("CMD,RESULT:ERROR\r\n")
     driver.loop()
-    assert rec.responses[-1] == m.CommandResponse(request_successful=False, request_id=8)
+    assert rec.responses[-1] == frontseat_pb.CommandResponse(request_successful=False, request_id=8)
 
 
 def test_no_response_unless_requested(rig):
@@ -172,11 +172,11 @@ def test_other_commands_data_are_ignored_and_raw_is_written(rig, caplog):
     driver, link, rec = rig
     connect(driver, link)
     with caplog.at_level(logging.INFO):
-        driver.send_command_to_frontseat(m.CommandRequest(cancel_request_id=3))
+        driver.send_command_to_frontseat(frontseat_pb.CommandRequest(cancel_request_id=3))
     assert "unhandled command" in caplog.text
-    driver.send_data_to_frontseat(m.InterfaceData(dccl_message=b"\x01"))
+    driver.send_data_to_frontseat(frontseat_pb.InterfaceData(dccl_message=b"\x01"))
     assert link.take_written() == []
-    driver.send_raw_to_frontseat(m.Raw(raw=b"CMD,HEADING:1,SPEED:2,DEPTH:3"))
+    driver.send_raw_to_frontseat(frontseat_pb.Raw(raw=b"CMD,HEADING:1,SPEED:2,DEPTH:3"))
     assert link.take_written() == ["CMD,HEADING:1,SPEED:2,DEPTH:3\r\n"]
     assert rec.raw_out[-1] == "CMD,HEADING:1,SPEED:2,DEPTH:3"
 
@@ -198,7 +198,7 @@ def test_malformed_lines_are_logged_and_skipped_but_still_emitted_raw(rig, caplo
     assert log_text in caplog.text
     assert rec.raw_in[0] == line
     assert len(rec.data) == 1  # the following good line still counts
-    assert driver.frontseat_state() == m.FRONTSEAT_IDLE
+    assert driver.frontseat_state() == frontseat_pb.FRONTSEAT_IDLE
 
 
 def test_lost_connection_goes_back_to_not_connected_and_a_new_one_restarts(rig, caplog):
@@ -211,39 +211,39 @@ def test_lost_connection_goes_back_to_not_connected_and_a_new_one_restarts(rig, 
     with caplog.at_level(logging.WARNING):
         driver.loop()
         driver.send_command_to_frontseat(request(1))  # not sent, no exception
-    assert driver.frontseat_state() == m.FRONTSEAT_NOT_CONNECTED
+    assert driver.frontseat_state() == frontseat_pb.FRONTSEAT_NOT_CONNECTED
     assert "reconnecting" in caplog.text and "not sent" in caplog.text
     written = connect(driver, link)
     assert len(written) == 1 and written[0].startswith("START,")
-    assert driver.frontseat_state() == m.FRONTSEAT_IDLE
+    assert driver.frontseat_state() == frontseat_pb.FRONTSEAT_IDLE
 
 
 def test_interface_state_machine_runs_on_the_driver(rig):
     driver, link, _ = rig
     driver.do_work()
-    assert driver.state == m.INTERFACE_STANDBY
+    assert driver.state == frontseat_pb.INTERFACE_STANDBY
     link.open()
     link.feed("CTRL,STATE:PAYLOAD\r\nNAV,LAT:44.0889,LON:9.8486,DEPTH:0,HEADING:0,SPEED:0\r\n")
     driver.do_work()  # transition check first (nothing yet), then loop() reads the lines
     driver.do_work()
-    assert driver.state == m.INTERFACE_LISTEN
-    driver.set_helm_state(m.HELM_DRIVE)
+    assert driver.state == frontseat_pb.INTERFACE_LISTEN
+    driver.set_helm_state(frontseat_pb.HELM_DRIVE)
     driver.do_work()
-    assert driver.state == m.INTERFACE_COMMAND
+    assert driver.state == frontseat_pb.INTERFACE_COMMAND
     link.feed("CTRL,STATE:IDLE\r\n")
     driver.do_work()
     driver.do_work()
-    assert driver.state == m.INTERFACE_LISTEN
+    assert driver.state == frontseat_pb.INTERFACE_LISTEN
     driver.clock.advance(10.5)  # no NAV any more
     driver.do_work()
     driver.do_work()
-    assert driver.state == m.INTERFACE_FS_ERROR
-    assert driver.status().frontseat_error == m.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
+    assert driver.state == frontseat_pb.INTERFACE_FS_ERROR
+    assert driver.status().frontseat_error == frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
 
 
 def test_config_errors_are_specific():
     with pytest.raises(AbcConfigError, match="no \\[goby.middleware"):
-        start_params(m.Config())
+        start_params(frontseat_pb.Config())
     with pytest.raises(AbcConfigError, match="lacks required start.lon"):
         start_params(
             config(
@@ -265,4 +265,4 @@ def test_factory_builds_a_tcp_driver():
     driver = frontseat_driver_load(config(), VirtualClock(T0))
     assert isinstance(driver, AbcFrontSeat)
     assert (driver.link.host, driver.link.port) == ("localhost", 54321)
-    assert driver.frontseat_state() == m.FRONTSEAT_NOT_CONNECTED
+    assert driver.frontseat_state() == frontseat_pb.FRONTSEAT_NOT_CONNECTED

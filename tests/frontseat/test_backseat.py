@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.backseat import Backseat
 from pygoby.protobuf import builtin_class
 from pygoby.util.clock import VirtualClock
@@ -21,35 +21,35 @@ LegacyOperations = builtin_class(
 
 
 def backseat(**legacy) -> Backseat:
-    driver = ScriptedFrontSeat(m.Config(), VirtualClock(1000.0))
+    driver = ScriptedFrontSeat(frontseat_pb.Config(), VirtualClock(1000.0))
     return Backseat(driver, LegacyOperations(**legacy))
 
 
 def bring_to(seat: Backseat, state: int) -> None:
     driver = seat.interface
-    driver.set_helm_state(m.HELM_DRIVE)
-    driver.fs_state, driver.providing = m.FRONTSEAT_IDLE, True
+    driver.set_helm_state(frontseat_pb.HELM_DRIVE)
+    driver.fs_state, driver.providing = frontseat_pb.FRONTSEAT_IDLE, True
     driver.do_work()  # LISTEN
-    if state == m.INTERFACE_COMMAND:
-        driver.fs_state = m.FRONTSEAT_ACCEPTING_COMMANDS
+    if state == frontseat_pb.INTERFACE_COMMAND:
+        driver.fs_state = frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS
         driver.do_work()
     assert driver.state == state
 
 
 @pytest.mark.parametrize(
     ("state", "command", "send"),
-    [(m.INTERFACE_STANDBY, False, False), (m.INTERFACE_LISTEN, False, True),
-     (m.INTERFACE_COMMAND, True, True)],
+    [(frontseat_pb.INTERFACE_STANDBY, False, False), (frontseat_pb.INTERFACE_LISTEN, False, True),
+     (frontseat_pb.INTERFACE_COMMAND, True, True)],
 )  # fmt: skip
 def test_what_may_go_to_the_frontseat_in_each_state(state, command, send, caplog):
     seat = backseat()
-    if state != m.INTERFACE_STANDBY:
+    if state != frontseat_pb.INTERFACE_STANDBY:
         bring_to(seat, state)
     with caplog.at_level(logging.DEBUG, logger="pygoby.frontseat.backseat"):
         assert seat.may_command("IFS_COMMAND_REQUEST") is command
         assert seat.may_send("IFS_DATA_OUT") is send
     if not command:
-        name = m.InterfaceState.Name(state)
+        name = frontseat_pb.InterfaceState.Name(state)
         assert f"IFS_COMMAND_REQUEST not sent: the interface is in {name}" in caplog.text
     if not send:
         assert "IFS_DATA_OUT not sent: the interface is in INTERFACE_STANDBY" in caplog.text
@@ -59,13 +59,13 @@ def test_helm_state_by_posting_process(caplog):
     seat = backseat()
     with caplog.at_level(logging.INFO, logger="pygoby.frontseat.backseat"):
         seat.helm_state("DRIVE", "pHelmIvP")
-    assert seat.interface.helm_state == m.HELM_DRIVE
+    assert seat.interface.helm_state == frontseat_pb.HELM_DRIVE
     change = "helm state HELM_NOT_RUNNING -> HELM_DRIVE (IVPHELM_STATE='DRIVE' from pHelmIvP)"
     assert change in caplog.text
     seat.helm_state("PARK+", "pHelmIvP_standby")
-    assert seat.interface.helm_state == m.HELM_PARK
+    assert seat.interface.helm_state == frontseat_pb.HELM_PARK
     seat.helm_state("DRIVE", "uPokeDB")  # not a helm: the helm is not running
-    assert seat.interface.helm_state == m.HELM_NOT_RUNNING
+    assert seat.interface.helm_state == frontseat_pb.HELM_NOT_RUNNING
 
 
 def test_origin_applies_once_both_are_known():
@@ -89,7 +89,7 @@ def test_desired_course_becomes_a_command_request_on_desired_speed():
 
 def test_ctd_sample_at_the_last_position_with_missing_fields_computed():
     seat = backseat(subscribe_ctd=True, publish_nav=False)
-    data = m.InterfaceData()
+    data = frontseat_pb.InterfaceData()
     data.node_status.global_fix.lat, data.node_status.global_fix.lon = 42.5, -70.25
     assert seat.legacy_posts(data) == []  # publish_nav is off; the position is kept
     assert seat.ctd("CTD_CONDUCTIVITY", 4.2914, 1.0) is None
@@ -104,8 +104,8 @@ def test_ctd_sample_at_the_last_position_with_missing_fields_computed():
 
 def test_legacy_posts_with_publish_nav():
     seat = backseat(publish_nav=True)
-    assert seat.legacy_posts(m.InterfaceData(dccl_message=b"x")) == []
-    data = m.InterfaceData()
+    assert seat.legacy_posts(frontseat_pb.InterfaceData(dccl_message=b"x")) == []
+    data = frontseat_pb.InterfaceData()
     data.node_status.local_fix.x = 1.5
     data.node_status.speed.over_ground = 2.0
     posts = dict(seat.legacy_posts(data))

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 
 from pygoby.frontseat import config as fs_config
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.plugins import DRIVER_ENV_VAR, DriverLoadError
 from pygoby.moos.appconfig import ConfigError
 from pygoby.protobuf import builtin_class
@@ -58,7 +58,7 @@ def test_goby2_abc_config_migrates_once(config_class, caplog):
     old.tcp_address, old.tcp_port = "localhost", 54322
     old.start.lat, old.start.lon = 44.5, 9.5
     fs_config.migrate_goby2_abc_config(cfg)
-    sim = cfg.frontseat_cfg.Extensions[m.BASIC_SIMULATOR_CONFIG]
+    sim = cfg.frontseat_cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
     assert (sim.tcp_address, sim.tcp_port) == ("localhost", 54322)
     assert (sim.start.lat, sim.start.lon) == (44.5, 9.5)
     assert not sim.start.HasField("duration") and not cfg.HasExtension(abc)

@@ -24,7 +24,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.ctd import (
     compute_missing_ctd,
     conductivity_ratio,
@@ -37,7 +37,7 @@ from pygoby.util.clock import VirtualClock
 
 from .scripted_driver import ScriptedFrontSeat
 
-CTD = m.CTDSample
+CTD = frontseat_pb.CTDSample
 PA_PER_DBAR = 1e4
 
 
@@ -204,7 +204,7 @@ def test_no_conductivity_and_no_salinity(caplog) -> None:
 
 
 def test_interface_base_delegates() -> None:
-    driver = ScriptedFrontSeat(m.Config(), VirtualClock(0))
+    driver = ScriptedFrontSeat(frontseat_pb.Config(), VirtualClock(0))
     ctd = sample(conductivity=4.2914, temperature=15.0, pressure=0.0)
     ctd.global_fix.lat, ctd.global_fix.lon = 42.0, -70.0
     driver.compute_missing_ctd(ctd)

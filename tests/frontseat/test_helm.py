@@ -6,10 +6,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.helm import helm_state_from_ivphelm
 
-NOT_RUNNING, DRIVE, PARK = m.HELM_NOT_RUNNING, m.HELM_DRIVE, m.HELM_PARK
+NOT_RUNNING, DRIVE, PARK = frontseat_pb.HELM_NOT_RUNNING, frontseat_pb.HELM_DRIVE, frontseat_pb.HELM_PARK
 ALL = (NOT_RUNNING, DRIVE, PARK)
 
 

@@ -10,33 +10,33 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.interface import (
-    FrontSeatException,
+    FrontSeatDriverError,
     FrontSeatFatalError,
     InterfaceBase,
-    Signal,
 )
 from pygoby.util.clock import VirtualClock
+from pygoby.util.signal import Signal
 
 from .scripted_driver import ScriptedFrontSeat
 
 START = 1000.0
-ERRORS = (m.INTERFACE_HELM_ERROR, m.INTERFACE_FS_ERROR)
+ERRORS = (frontseat_pb.INTERFACE_HELM_ERROR, frontseat_pb.INTERFACE_FS_ERROR)
 
-STANDBY, LISTEN, COMMAND = m.INTERFACE_STANDBY, m.INTERFACE_LISTEN, m.INTERFACE_COMMAND
-HELM_ERROR, FS_ERROR = m.INTERFACE_HELM_ERROR, m.INTERFACE_FS_ERROR
-NOT_CONNECTED, IDLE = m.FRONTSEAT_NOT_CONNECTED, m.FRONTSEAT_IDLE
-ACCEPTING, IN_CONTROL = m.FRONTSEAT_ACCEPTING_COMMANDS, m.FRONTSEAT_IN_CONTROL
-NOT_RUNNING, DRIVE, PARK = m.HELM_NOT_RUNNING, m.HELM_DRIVE, m.HELM_PARK
-PARKED, HELM_NOT_RUNNING_ERR = m.ERROR_HELM_PARKED, m.ERROR_HELM_NOT_RUNNING
-FS_NOT_CONNECTED_ERR = m.ERROR_FRONTSEAT_NOT_CONNECTED
-NOT_PROVIDING_ERR = m.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
-IGNORING_ERR = m.ERROR_FRONTSEAT_IGNORING_COMMANDS
+STANDBY, LISTEN, COMMAND = frontseat_pb.INTERFACE_STANDBY, frontseat_pb.INTERFACE_LISTEN, frontseat_pb.INTERFACE_COMMAND
+HELM_ERROR, FS_ERROR = frontseat_pb.INTERFACE_HELM_ERROR, frontseat_pb.INTERFACE_FS_ERROR
+NOT_CONNECTED, IDLE = frontseat_pb.FRONTSEAT_NOT_CONNECTED, frontseat_pb.FRONTSEAT_IDLE
+ACCEPTING, IN_CONTROL = frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS, frontseat_pb.FRONTSEAT_IN_CONTROL
+NOT_RUNNING, DRIVE, PARK = frontseat_pb.HELM_NOT_RUNNING, frontseat_pb.HELM_DRIVE, frontseat_pb.HELM_PARK
+PARKED, HELM_NOT_RUNNING_ERR = frontseat_pb.ERROR_HELM_PARKED, frontseat_pb.ERROR_HELM_NOT_RUNNING
+FS_NOT_CONNECTED_ERR = frontseat_pb.ERROR_FRONTSEAT_NOT_CONNECTED
+NOT_PROVIDING_ERR = frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
+IGNORING_ERR = frontseat_pb.ERROR_FRONTSEAT_IGNORING_COMMANDS
 
 
 def make(start: float = START, **cfg_fields) -> ScriptedFrontSeat:
-    driver = ScriptedFrontSeat(m.Config(**cfg_fields), VirtualClock(start))
+    driver = ScriptedFrontSeat(frontseat_pb.Config(**cfg_fields), VirtualClock(start))
     driver.changes = []
     driver.signal_state_change.connect(driver.changes.append)
     return driver
@@ -78,7 +78,7 @@ def bring_to(driver: ScriptedFrontSeat, where: str) -> None:
             elif where == "FS_NOT_PROVIDING":
                 tick(driver, providing=False)
             elif where == "FS_IGNORING":
-                driver.raise_in_loop = FrontSeatException(frontseat_error=IGNORING_ERR)
+                driver.raise_in_loop = FrontSeatDriverError(frontseat_error=IGNORING_ERR)
                 tick(driver)
     expected = {
         "STANDBY": (STANDBY, None, None),
@@ -222,7 +222,7 @@ def test_transition_table(row: Row) -> None:
 
     tick(driver, helm=row.helm, fs=row.fs, providing=row.providing, at=row.at)
 
-    assert driver.state == row.expect, m.InterfaceState.Name(driver.state)
+    assert driver.state == row.expect, frontseat_pb.InterfaceState.Name(driver.state)
     assert errors(driver) == (row.helm_error, row.fs_error)
     entered_error_by_check = row.expect in ERRORS and before not in ERRORS
     # loop() is skipped exactly on the tick the transition check enters an error state
@@ -254,7 +254,7 @@ def test_initial_state() -> None:
 def test_grace_periods_are_measured_from_construction() -> None:
     clock = VirtualClock(0.0)
     clock.advance(500)
-    driver = ScriptedFrontSeat(m.Config(), clock)
+    driver = ScriptedFrontSeat(frontseat_pb.Config(), clock)
     driver.fs_state = IDLE
     clock.set(510)
     driver.do_work()
@@ -319,7 +319,7 @@ def test_a_full_session_signals_each_change_once() -> None:
     tick(driver, providing=False, at=1)  # E4
     tick(driver, at=20)  # stays
     tick(driver, providing=True, at=21)  # T8
-    assert [m.InterfaceState.Name(s.state) for s in driver.changes] == [
+    assert [frontseat_pb.InterfaceState.Name(s.state) for s in driver.changes] == [
         "INTERFACE_LISTEN",
         "INTERFACE_COMMAND",
         "INTERFACE_LISTEN",
@@ -345,7 +345,7 @@ def test_a_full_session_signals_each_change_once() -> None:
 def test_t9_driver_exception_forces_error_state(where, exc_args, expect) -> None:
     driver = make()
     bring_to(driver, where)
-    driver.raise_in_loop = FrontSeatException(**exc_args, message="frontseat says no")
+    driver.raise_in_loop = FrontSeatDriverError(**exc_args, message="frontseat says no")
     driver.do_work()
     state, helm_error, fs_error = expect
     assert driver.state == state
@@ -363,7 +363,7 @@ def test_t9_keeps_the_other_error_code_until_its_own_exit() -> None:
     """goby3 clears each error only on its own exit (T7 / T8)."""
     driver = make()
     bring_to(driver, "FS_NOT_PROVIDING")
-    driver.raise_in_loop = FrontSeatException(helm_error=PARKED)
+    driver.raise_in_loop = FrontSeatDriverError(helm_error=PARKED)
     tick(driver)
     assert driver.state == HELM_ERROR
     assert errors(driver) == (PARKED, NOT_PROVIDING_ERR)
@@ -375,7 +375,7 @@ def test_t9_keeps_the_other_error_code_until_its_own_exit() -> None:
 def test_t9_after_a_transition_on_the_same_tick() -> None:
     driver = make()
     driver.fs_state, driver.providing = IDLE, True
-    driver.raise_in_loop = FrontSeatException(frontseat_error=IGNORING_ERR)
+    driver.raise_in_loop = FrontSeatDriverError(frontseat_error=IGNORING_ERR)
     driver.do_work()
     assert [s.state for s in driver.changes] == [LISTEN, FS_ERROR]
 
@@ -383,8 +383,8 @@ def test_t9_after_a_transition_on_the_same_tick() -> None:
 def test_exception_without_error_propagates() -> None:
     driver = make()
     bring_to(driver, "LISTEN")
-    driver.raise_in_loop = FrontSeatException(message="bad")
-    with pytest.raises(FrontSeatException, match="bad"):
+    driver.raise_in_loop = FrontSeatDriverError(message="bad")
+    with pytest.raises(FrontSeatDriverError, match="bad"):
         driver.do_work()
     assert driver.state == LISTEN
     driver.raise_in_loop = KeyError("bug")
@@ -395,11 +395,11 @@ def test_exception_without_error_propagates() -> None:
 
 def test_exception_carries_one_error() -> None:
     with pytest.raises(ValueError):
-        FrontSeatException(helm_error=PARKED, frontseat_error=IGNORING_ERR)
-    exc = FrontSeatException(frontseat_error=IGNORING_ERR, message="no ack")
+        FrontSeatDriverError(helm_error=PARKED, frontseat_error=IGNORING_ERR)
+    exc = FrontSeatDriverError(frontseat_error=IGNORING_ERR, message="no ack")
     assert exc.is_fs_error and not exc.is_helm_error
     assert str(exc) == "ERROR_FRONTSEAT_IGNORING_COMMANDS: no ack"
-    assert FrontSeatException(helm_error=PARKED).is_helm_error
+    assert FrontSeatDriverError(helm_error=PARKED).is_helm_error
 
 
 # --- exit_on_error ----------------------------------------------------------------------
@@ -419,7 +419,7 @@ def test_exit_on_error_raises_after_the_state_change() -> None:
 
 def test_exit_on_error_on_driver_exception() -> None:
     driver = make(exit_on_error=True)
-    driver.raise_in_loop = FrontSeatException(helm_error=PARKED)
+    driver.raise_in_loop = FrontSeatDriverError(helm_error=PARKED)
     with pytest.raises(FrontSeatFatalError):
         driver.do_work()
     assert driver.state == HELM_ERROR
@@ -436,7 +436,7 @@ def test_without_exit_on_error_error_states_do_not_raise() -> None:
 
 
 def test_signal_calls_every_callback_in_order_even_if_one_raises(caplog) -> None:
-    sig = Signal()
+    sig = Signal(contain_errors=True)  # (as the interface's signals are)
     seen: list = []
 
     def broken(value):
@@ -467,11 +467,11 @@ def test_driver_hooks_are_abstract() -> None:
             pass
 
     with pytest.raises(TypeError):
-        Incomplete(m.Config())
+        Incomplete(frontseat_pb.Config())
 
 
 def test_cfg_is_a_copy() -> None:
-    cfg = m.Config(name="auv1")
+    cfg = frontseat_pb.Config(name="auv1")
     driver = ScriptedFrontSeat(cfg, VirtualClock(0))
     cfg.name = "changed"
     assert driver.cfg.name == "auv1"
@@ -505,7 +505,7 @@ def test_random_sequences_respect_command_and_error_exits(require_helm, steps) -
         if raised is not None:
             kind, code = raised
             key = "helm_error" if kind == "helm" else "frontseat_error"
-            driver.raise_in_loop = FrontSeatException(**{key: code})
+            driver.raise_in_loop = FrontSeatDriverError(**{key: code})
         before = driver.state
         last_fs_error = errors(driver)[1]
         loops = driver.loop_calls

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from pyproj import Geod, Transformer
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.util.clock import VirtualClock
 
 from .scripted_driver import ScriptedFrontSeat
@@ -20,7 +20,7 @@ ORIGIN = (42.5, -70.5)  # UTM zone 19 north
 
 
 def make(origin=ORIGIN, **cfg_fields) -> ScriptedFrontSeat:
-    cfg = m.Config(**cfg_fields)
+    cfg = frontseat_pb.Config(**cfg_fields)
     if origin is not None:
         cfg.origin.lat, cfg.origin.lon = origin
     return ScriptedFrontSeat(cfg, VirtualClock(1_700_000_000.0))
@@ -35,7 +35,7 @@ def epsg_local(lat: float, lon: float, origin=ORIGIN, epsg: int = 32619) -> tupl
 
 
 def global_status(lat: float, lon: float, depth: float | None = None):
-    status = m.NodeStatus()
+    status = frontseat_pb.NodeStatus()
     status.global_fix.lat, status.global_fix.lon = lat, lon
     if depth is not None:
         status.global_fix.depth = depth
@@ -43,7 +43,7 @@ def global_status(lat: float, lon: float, depth: float | None = None):
 
 
 def local_status(x: float, y: float, z: float | None = None):
-    status = m.NodeStatus()
+    status = frontseat_pb.NodeStatus()
     status.local_fix.x, status.local_fix.y = x, y
     if z is not None:
         status.local_fix.z = z
@@ -120,23 +120,23 @@ def test_depth_and_z_only_when_set() -> None:
 
 
 def test_name_type_and_time_filled_from_config_and_clock() -> None:
-    driver = make(name="auv1", type=m.VehicleType.Value("GLIDER"))
+    driver = make(name="auv1", type=frontseat_pb.VehicleType.Value("GLIDER"))
     status = global_status(42.5, -70.5)
     driver.compute_missing(status)
     assert status.name == "auv1"
-    assert status.type == m.VehicleType.Value("GLIDER")
+    assert status.type == frontseat_pb.VehicleType.Value("GLIDER")
     assert status.time == 1_700_000_000.0
 
 
 def test_type_default_is_auv_and_given_values_are_kept() -> None:
     driver = make(name="auv1")
     status = global_status(42.5, -70.5)
-    status.name, status.type, status.time = "other", m.VehicleType.Value("USV"), 5.0
+    status.name, status.type, status.time = "other", frontseat_pb.VehicleType.Value("USV"), 5.0
     driver.compute_missing(status)
-    assert (status.name, status.type, status.time) == ("other", m.VehicleType.Value("USV"), 5.0)
+    assert (status.name, status.type, status.time) == ("other", frontseat_pb.VehicleType.Value("USV"), 5.0)
     fresh = global_status(42.5, -70.5)
     driver.compute_missing(fresh)
-    assert fresh.type == m.VehicleType.Value("AUV")
+    assert fresh.type == frontseat_pb.VehicleType.Value("AUV")
 
 
 def test_both_fixes_present_are_left_alone() -> None:
@@ -154,7 +154,7 @@ def test_both_fixes_present_are_left_alone() -> None:
 
 def test_neither_fix_warns_and_changes_no_position(caplog) -> None:
     driver = make(name="auv1")
-    status = m.NodeStatus()
+    status = frontseat_pb.NodeStatus()
     with caplog.at_level(logging.WARNING):
         driver.compute_missing(status)
     assert "neither global_fix nor local_fix" in caplog.text

@@ -3,14 +3,13 @@ paths, and the errors for everything else."""
 
 from __future__ import annotations
 
-from importlib.metadata import EntryPoint
+from importlib.metadata import entry_points
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pygoby.frontseat import messages as m
-from pygoby.frontseat import plugins
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.plugins import (
     DRIVER_ENV_VAR,
     ENTRY_POINT_GROUP,
@@ -29,28 +28,28 @@ TEST_MODULE = "tests.frontseat.scripted_driver"
 
 
 def cfg():
-    return m.Config(name="auv1", require_helm=False)
+    return frontseat_pb.Config(name="auv1", require_helm=False)
 
 
 @pytest.fixture
-def scripted_entry_point(monkeypatch):
-    """The installed entry points plus one for the test driver module."""
-    real = plugins._entry_points()
-    extra = EntryPoint(
-        name="scripted", value=f"{TEST_MODULE}:frontseat_driver_load", group=ENTRY_POINT_GROUP
+def scripted_entry_point(monkeypatch, tmp_path):
+    """The installed entry points plus two of a distribution installed for the test (found on
+    sys.path, as pip-installed driver packages are): the test driver module and a broken one."""
+    dist_info = tmp_path / "pygoby_test_drivers-1.0.dist-info"
+    dist_info.mkdir()
+    (dist_info / "METADATA").write_text("Metadata-Version: 2.1\nName: pygoby-test-drivers\nVersion: 1.0\n")
+    (dist_info / "entry_points.txt").write_text(
+        f"[{ENTRY_POINT_GROUP}]\n"
+        f"scripted = {TEST_MODULE}:frontseat_driver_load\n"
+        "broken = tests.frontseat.no_such_module:x\n"
     )
-    broken = EntryPoint(
-        name="broken", value="tests.frontseat.no_such_module:x", group=ENTRY_POINT_GROUP
-    )
-    monkeypatch.setattr(
-        plugins, "_entry_points", lambda: {**real, "scripted": extra, "broken": broken}
-    )
+    monkeypatch.syspath_prepend(str(tmp_path))
 
 
 def test_pygoby_registers_its_drivers() -> None:
     """pyproject's entry points are installed (pip install -e .)."""
     assert {"abc", "basic_simulator"} <= set(available_drivers())
-    found = plugins._entry_points()
+    found = {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
     for name in ("abc", "basic_simulator"):
         assert found[name].value == "pygoby.frontseat.drivers.abc:frontseat_driver_load"
 
@@ -122,7 +121,7 @@ def test_module_without_factory() -> None:
     with pytest.raises(DriverLoadError, match="no 'missing' factory"):
         load_driver(f"{TEST_MODULE}:missing", cfg())
     with pytest.raises(DriverLoadError, match="not callable"):
-        load_driver(f"{TEST_MODULE}:m", cfg())  # the module's messages import
+        load_driver(f"{TEST_MODULE}:frontseat_pb", cfg())  # the module's messages import
 
 
 def test_factory_that_raises() -> None:
@@ -167,7 +166,7 @@ def test_basic_simulator_driver_loads_when_installed() -> None:
     """The real ABC / basic simulator driver through its entry point (once it exists)."""
     pytest.importorskip("pygoby.frontseat.drivers.abc")
     config = cfg()
-    sim = config.Extensions[m.BASIC_SIMULATOR_CONFIG]
+    sim = config.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
     sim.tcp_address, sim.start.lat, sim.start.lon = "127.0.0.1", 42.5, -70.5
     for name in ("basic_simulator", "abc", "libgoby_frontseat_basic_simulator.so.30"):
         driver = load_driver(name, config, VirtualClock(0.0))

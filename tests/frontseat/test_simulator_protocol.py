@@ -15,7 +15,7 @@ from pygoby.frontseat.simulator.protocol import (
     Command,
     Message,
     Nav,
-    ProtocolError,
+    SimulatorProtocolError,
     Start,
     format_g,
     format_line,
@@ -86,7 +86,7 @@ def test_parse_line_keeps_the_first_of_repeated_names():
     "line", ["CMD,HEADING", "CMD,HEADING:1,", "START,LAT:1:2,LON:3", "NAV,,LAT:1"]
 )
 def test_parse_line_rejects_fields_that_are_not_name_colon_value(line):
-    with pytest.raises(ProtocolError, match="not NAME:VALUE"):
+    with pytest.raises(SimulatorProtocolError, match="not NAME:VALUE"):
         parse_line(line)
 
 
@@ -99,10 +99,10 @@ def test_parse_line_keeps_latin1_spaces_that_cpp_isspace_does_not_strip():
 def test_parse_line_raises_only_protocol_errors(line):
     try:
         msg = parse_line(line)
-    except ProtocolError:
+    except SimulatorProtocolError:
         return
     for parse in (Start.from_message, Nav.from_message, Command.from_message):
-        with contextlib.suppress(ProtocolError):
+        with contextlib.suppress(SimulatorProtocolError):
             parse(msg)
 
 
@@ -164,7 +164,7 @@ def test_start_round_trips_exactly(lat, lon, duration, freq, rate, warp):
     ],
 )
 def test_start_rejects_bad_values(line, error):
-    with pytest.raises(ProtocolError, match=error):
+    with pytest.raises(SimulatorProtocolError, match=error):
         Start.from_message(parse_line(line))
 
 
@@ -182,5 +182,5 @@ def test_command_prints_six_significant_digits():
     assert Command.from_message(parse_line("CMD,HEADING:260,SPEED:1.5,DEPTH:100")) == Command(
         260.0, 1.5, 100.0
     )
-    with pytest.raises(ProtocolError, match="CMD without DEPTH"):
+    with pytest.raises(SimulatorProtocolError, match="CMD without DEPTH"):
         Command.from_message(parse_line("CMD,HEADING:260,SPEED:1.5"))

@@ -14,7 +14,7 @@ import struct
 import pytest
 
 from pygoby.moos import protocol as p
-from pygoby.moos.client import MOOSClient, MOOSRefused
+from pygoby.moos.client import MOOSClient, MoosRefusedError
 from pygoby.moos.db import MOOSDB
 
 
@@ -138,7 +138,7 @@ async def test_server_requests():
 async def test_name_collision_is_refused():
     async with MOOSDB(port=0) as db, MOOSClient("dup", port=db.port):
         second = MOOSClient("dup", port=db.port)
-        with pytest.raises(MOOSRefused, match="already exists"):
+        with pytest.raises(MoosRefusedError, match="already exists"):
             await second.connect(timeout=3)
         await second.close()
 
@@ -326,7 +326,7 @@ async def test_client_raises_on_recorded_poison(vectors_dir):
     server = await _scripted_db([u for u in units if u["seq"] == 110])
     client = MOOSClient("dup", port=server.sockets[0].getsockname()[1])
     try:
-        with pytest.raises(MOOSRefused, match='A client of this name \\("dup"\\) already exists'):
+        with pytest.raises(MoosRefusedError, match='A client of this name \\("dup"\\) already exists'):
             await client.connect()
     finally:
         await client.close()

@@ -134,15 +134,15 @@ def test_wildcard_match(pattern, name, expected):
 
 def test_rejects_malformed_packets():
     good = p.encode_packet([p.notify("X", 1.0, time=1.0, src="a")])
-    with pytest.raises(p.ProtocolError):
+    with pytest.raises(p.MoosProtocolError):
         p.decode_packet(good[:-1])
-    with pytest.raises(p.ProtocolError):
+    with pytest.raises(p.MoosProtocolError):
         p.decode_packet(struct.pack("<iiB", 5, 1, 0))
-    with pytest.raises(p.ProtocolError):
+    with pytest.raises(p.MoosProtocolError):
         p.decode_packet(struct.pack("<iiB", 9, -1, 0))
-    with pytest.raises(p.ProtocolError):  # trailing garbage
+    with pytest.raises(p.MoosProtocolError):  # trailing garbage
         p.decode_packet(struct.pack("<iiB", len(good) + 3, 1, 0) + good[9:] + b"abc")
-    with pytest.raises(p.ProtocolError):  # string length past the message end
+    with pytest.raises(p.MoosProtocolError):  # string length past the message end
         bad = bytearray(good)
         bad[9 + 10 : 9 + 14] = struct.pack("<i", 10_000)
         p.decode_packet(bytes(bad))
@@ -152,7 +152,7 @@ def test_rejects_malformed_packets():
 
 def test_framer_refuses_oversized_packet_from_its_header():
     framer = p.PacketFramer(max_packet_size=1000)
-    with pytest.raises(p.ProtocolError, match="exceeds the limit"):
+    with pytest.raises(p.MoosProtocolError, match="exceeds the limit"):
         framer.feed(struct.pack("<iiB", 2**31 - 1, 1, 0))
 
 
@@ -174,7 +174,7 @@ def test_notify_types():
 @settings(max_examples=200, deadline=None)
 @given(st.binary(max_size=300))
 def test_fuzz_decode_packet_never_crashes(data):
-    with contextlib.suppress(p.ProtocolError):
+    with contextlib.suppress(p.MoosProtocolError):
         p.decode_packet(data)
 
 
@@ -186,9 +186,9 @@ def test_fuzz_framer_never_crashes(chunks):
         for chunk in chunks:
             framer.feed(chunk)
             for packet in framer.packets():
-                with contextlib.suppress(p.ProtocolError):
+                with contextlib.suppress(p.MoosProtocolError):
                     p.decode_packet(packet)
-    except p.ProtocolError:
+    except p.MoosProtocolError:
         pass
 
 

@@ -8,7 +8,7 @@ import logging
 
 import pytest
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.apps.inetsimmanager import iNetSimManager
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
@@ -46,8 +46,8 @@ ProcessConfig = iNetSimManager
 
 
 def reception_with_stats(mode: int) -> object:
-    rx = m.ModemTransmission(src=2, dest=1, type=m.ModemTransmission.DATA)
-    stat = rx.Extensions[m.MM_TRANSMISSION].receive_stat.add(
+    rx = acomms_pb.ModemTransmission(src=2, dest=1, type=acomms_pb.ModemTransmission.DATA)
+    stat = rx.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat.add(
         mode=mode, time=1_700_000_000_000_000, clock_mode=1, mfd_power=10, mfd_ratio=100,
         rate=1, source=2, dest=1, psk_error_code=0, packet_type=3, number_frames=3,
         number_bad_frames=0, snr_rss=40, snr_in=12, snr_out=20, snr_symbols=20,
@@ -147,4 +147,4 @@ def test_reporter_needs_position_and_depth():
     assert (reporter.nav_update().lat, reporter.nav_update().lon) == (42.5, -70.5)  # lat/lon win
     assert NavReporter(62000, modem_ports={3: 62100}).port_of(3) == 62100
     assert reporter.port_of(4) == 62003
-    assert reporter.receive_stats(m.ModemTransmission(src=1)) == []
+    assert reporter.receive_stats(acomms_pb.ModemTransmission(src=1)) == []

@@ -39,11 +39,16 @@ def test_id_sequence_vector():
 
 
 def test_ids_wrap_to_zero_and_legacy_name():
-    tracker = RequestTracker(legacy_names=True)
-    tracker._next_id = MAX_REQUEST_ID
+    tracker = RequestTracker(legacy_names=True, first_id=MAX_REQUEST_ID)
     assert [tracker.take_id() for _ in range(3)] == [MAX_REQUEST_ID, 0, 1]
     line = tracker.encode(tracker.build())
     assert line.startswith(b"NETSIM|" + LEGACY_REQUEST_NAME.encode() + b"|")
+
+
+@pytest.mark.parametrize("first_id", [-1, MAX_REQUEST_ID + 1])
+def test_first_id_must_be_a_request_id(first_id):
+    with pytest.raises(ValueError, match="within 0.."):
+        RequestTracker(first_id=first_id)
 
 
 @pytest.fixture

@@ -323,15 +323,21 @@ def test_position_dead_reckons_on_the_ellipsoid():
 
 
 def test_remembered_geodesics_are_the_geodesics():
-    a, b = geometry.Position(42.0, -70.0, 5.0), geometry.Position(42.01, -69.99, 30.0)
-    geometry._geodesics.clear()
-    azimuth, _, distance = geometry.WGS84.inv(a.lon, a.lat, b.lon, b.lat)
-    assert geometry.horizontal_range(a, b) == geometry.horizontal_range(a, b) == (distance, azimuth)
-    assert len(geometry._geodesics) == 1
-    # a zero coordinate is not remembered: -0.0 would share its key
-    on_equator = geometry.Position(0.0, -70.0, 5.0)
-    assert geometry.horizontal_range(a, on_equator)[0] > 0
-    assert len(geometry._geodesics) == 1
+    """Fixed nodes ask for the same geodesics again and again (they are remembered): every
+    answer, the first or a recurring one, is the geodesic's, zero coordinates of either sign
+    included."""
+    a = geometry.Position(42.0, -70.0, 5.0)
+    ends = [
+        geometry.Position(42.01, -69.99, 30.0),
+        geometry.Position(0.0, -70.0, 5.0),
+        geometry.Position(-0.0, -70.0, 5.0),
+        geometry.Position(42.01, 0.0, 5.0),
+        geometry.Position(42.01, -0.0, 5.0),
+    ]
+    for b in ends * 2:
+        azimuth, _, distance = geometry.WGS84.inv(a.lon, a.lat, b.lon, b.lat)
+        assert geometry.horizontal_range(a, b) == (distance, azimuth)
+        assert geometry.horizontal_range(a, b) == (distance, azimuth)
 
 
 @_cases(P["doppler"])

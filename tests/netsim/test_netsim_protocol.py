@@ -11,10 +11,10 @@ from pygoby.netsim.protocol import (
     LEGACY_REQUEST_NAME,
     REQUEST_NAME,
     LineDecoder,
-    LineTooLong,
-    MissingSeparator,
+    LineTooLongError,
+    MissingSeparatorError,
     ReceivedMessage,
-    UnknownName,
+    UnknownNameError,
     b64decode_libb64,
     b64encode,
     encode_line,
@@ -97,9 +97,9 @@ def test_parse_vectors_at_manager_and_client(vector):
         return
     (event,) = events
     if vector["dispatch"] is False:
-        assert isinstance(event, (UnknownName, MissingSeparator))
+        assert isinstance(event, (UnknownNameError, MissingSeparatorError))
         if vector["name"] is not None:
-            assert isinstance(event, UnknownName)
+            assert isinstance(event, UnknownNameError)
             assert event.name == vector["name"].encode()
         return
     # dispatched: True, or "legacy" (pygoby accepts the legacy name too)
@@ -119,14 +119,14 @@ def test_partial_payload_is_reported_and_kept():
 def test_line_without_separators_resyncs_on_next_line():
     good = encode_line(request_class()(id=5))
     events = LineDecoder(request_names()).feed(b"hello\n" + good)
-    assert isinstance(events[0], MissingSeparator)
+    assert isinstance(events[0], MissingSeparatorError)
     assert events[1].message.id == 5
 
 
 def test_response_name_is_unknown_to_a_manager():
     line = encode_line(response_class()(request_id=1, status=1))
     (event,) = LineDecoder(request_names()).feed(line)
-    assert isinstance(event, UnknownName)
+    assert isinstance(event, UnknownNameError)
 
 
 def test_ten_megabyte_line_is_discarded_without_buffering():
@@ -137,14 +137,14 @@ def test_ten_megabyte_line_is_discarded_without_buffering():
         events += decoder.feed(chunk)
         assert decoder.buffered <= decoder.max_line_length
     events += decoder.feed(b"tail|of|it\n" + encode_line(request_class()(id=9)))
-    assert [type(e) for e in events] == [LineTooLong, ReceivedMessage]
+    assert [type(e) for e in events] == [LineTooLongError, ReceivedMessage]
     assert events[1].message.id == 9
 
 
 def test_long_line_ending_inside_the_same_chunk():
     decoder = LineDecoder(request_names(), max_line_length=100)
     events = decoder.feed(b"x" * 500 + b"\n" + encode_line(request_class()(id=1)))
-    assert [type(e) for e in events] == [LineTooLong, ReceivedMessage]
+    assert [type(e) for e in events] == [LineTooLongError, ReceivedMessage]
 
 
 def test_byte_at_a_time_equals_whole_stream():
@@ -194,7 +194,7 @@ def test_fuzz_garbage_then_a_good_line_always_decodes(garbage, cuts):
     last = events[-1]
     assert isinstance(last, ReceivedMessage) and last.message.id == 4242
     for event in events[:-1]:
-        assert isinstance(event, (ReceivedMessage, LineTooLong, MissingSeparator, UnknownName))
+        assert isinstance(event, (ReceivedMessage, LineTooLongError, MissingSeparatorError, UnknownNameError))
 
 
 @settings(max_examples=200, deadline=None)

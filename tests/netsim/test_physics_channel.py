@@ -4,6 +4,7 @@ half-duplex, losses growing with range, seeded repeatability."""
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as dt
 
 import pytest
@@ -189,7 +190,9 @@ def test_modem_without_port_is_refused():
 
 
 def test_rx_event_figures_are_rounded_the_same_when_remembered():
-    from pygoby.netsim import physics_channel
+    """A link's rx figures recur and are remembered: every rx event (the first of a link or a
+    recurring one) carries the reception's figures rounded as from scratch, a zero and the
+    sign of a negative zero included."""
 
     def fresh(range_m, owtt, rl, noise, sinr):
         snr = rl - noise
@@ -198,16 +201,32 @@ def test_rx_event_figures_are_rounded_the_same_when_remembered():
             sinr < snr - 0.01,
         )  # fmt: skip
 
-    physics_channel._figures.clear()
     cases = [
         (1234.56789, 0.8230452, 120.4449, 62.3, 58.1449),
         (1234.56789, 0.8230452, 120.4449, 62.3, 50.0),  # a collision
         (0.0, 0.0, 185.0, 62.3, -0.004),  # a zero: not remembered
         (10.0, 0.0066, 62.3, 62.3, -0.0),  # -0.0 keeps its sign
-    ]
-    for _ in range(2):
-        for case in cases:
-            got = physics_channel._link_figures(*case)
-            assert got == fresh(*case)
-            assert [str(x) for x in got] == [str(x) for x in fresh(*case)]
-    assert len(physics_channel._figures) == 2
+    ] * 2
+    events: list[dict] = []
+    net = Net({62000: 0.0, 62001: 1500.0}, events=events.append)
+    # the physics' receptions, with the levels of the cases in turn
+    physics_poll, scripted = net.physics.channel.poll, iter(cases)
+
+    def poll(now):
+        return [
+            dataclasses.replace(r, range_m=rng, owtt=owtt, received_level=rl, noise_level=noise,
+                                sinr=sinr)  # fmt: skip
+            for r in physics_poll(now)
+            for rng, owtt, rl, noise, sinr in [next(scripted)]
+        ]
+
+    net.physics.channel.poll = poll
+    for i in range(len(cases)):
+        net.send(1, 2, [b"x"])
+        net.run_until(T0 + 10 * (i + 1))
+    rx = [e for e in events if e["event"] == "rx"]
+    assert len(rx) == len(cases)
+    for event, case in zip(rx, cases, strict=True):
+        got = tuple(event[key] for key in ("range_m", "owtt", "rl", "snr", "sinr", "collision"))
+        assert got == fresh(*case)
+        assert [str(x) for x in got] == [str(x) for x in fresh(*case)]

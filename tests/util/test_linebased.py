@@ -7,9 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from pygoby.util.errors import LinkClosedError
 from pygoby.util.linebased import (
     LineSplitter,
-    LinkClosedError,
     MemoryLink,
     SerialLink,
     TCPClientLink,

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-
-class ABCParseError(ValueError):
-    """A line is not `KEY,NAME:VALUE,...`."""
+from pygoby.acomms.errors import ABCParseError
 
 
 def parse_abc(line: str) -> tuple[str, dict[str, str]]:

@@ -13,28 +13,16 @@ import logging
 from abc import ABC, abstractmethod
 from typing import IO
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.signals import Signal
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.errors import ModemDriverError
 from pygoby.util.clock import Clock, WallClock
-from pygoby.util.linebased import (
-    LineLink,
-    LinkClosedError,
-    SerialLink,
-    TCPClientLink,
-    TCPServerLink,
-)
+from pygoby.util.errors import LinkClosedError
+from pygoby.util.linebased import LineLink, SerialLink, TCPClientLink, TCPServerLink
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
-Status = m.ModemDriverStatus
-
-
-class ModemDriverException(Exception):
-    """A driver failure; `status` is a ModemDriverStatus.Status value."""
-
-    def __init__(self, message: str, status: int) -> None:
-        super().__init__(message)
-        self.status = status
+Status = acomms_pb.ModemDriverStatus
 
 
 def driver_name(cfg) -> str:
@@ -42,7 +30,7 @@ def driver_name(cfg) -> str:
     if cfg.WhichOneof("driver") == "driver_name":
         kind = cfg.driver_name
     else:
-        driver_type = m.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
+        driver_type = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
         kind = driver_type.values_by_number[cfg.driver_type].name.removeprefix("DRIVER_")
     return f"{kind}::{cfg.modem_id}"
 
@@ -62,7 +50,7 @@ class ModemDriverBase(ABC):
         self.signal_modify_transmission = Signal()
         self.signal_raw_incoming = Signal()
         self.signal_raw_outgoing = Signal()
-        self.cfg = m.DriverConfig()
+        self.cfg = acomms_pb.DriverConfig()
         self.link: LineLink | None = link
         self._injected_link = link is not None
         self._raw_log: IO[str] | None = None
@@ -84,11 +72,11 @@ class ModemDriverBase(ABC):
         log.warning("%s: update_cfg is not implemented by this driver", type(self).__name__)
 
     def report(self):
-        report = m.ModemReport(modem_id=self.cfg.modem_id, time=m.now_us(self.clock.now()))
+        report = acomms_pb.ModemReport(modem_id=self.cfg.modem_id, time=acomms_pb.now_us(self.clock.now()))
         report.link_state = (
-            m.ModemReport.LINK_AVAILABLE
+            acomms_pb.ModemReport.LINK_AVAILABLE
             if self.link is not None and self.link.is_open
-            else m.ModemReport.LINK_NOT_AVAILABLE
+            else acomms_pb.ModemReport.LINK_NOT_AVAILABLE
         )
         return report
 
@@ -100,13 +88,13 @@ class ModemDriverBase(ABC):
     def modem_start(self, cfg) -> None:
         """Validate the link settings, build (or reuse the injected) link and open it."""
         if not cfg.HasField("modem_id"):
-            raise ModemDriverException("modem_id is required", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
         self.cfg = cfg
         delimiter = self.line_delimiter(cfg)
         if not self._injected_link:
             self.link = self._make_link(cfg, delimiter)
         if self.link is None:
-            raise ModemDriverException("no link configured", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("no link configured", Status.INVALID_CONFIGURATION)
         if cfg.HasField("raw_log"):
             stamp = dt.datetime.fromtimestamp(self.clock.now(), dt.UTC).strftime("%Y%m%dT%H%M%S")
             self._raw_log = open(cfg.raw_log.replace("%1%", stamp), "a", encoding="latin-1")  # noqa: SIM115
@@ -118,24 +106,24 @@ class ModemDriverBase(ABC):
         return cfg.line_delimiter
 
     def _make_link(self, cfg, delimiter: str) -> LineLink:
-        C = m.DriverConfig
+        C = acomms_pb.DriverConfig
         # Quirk A1 (sane): an implicit connection_type is the documented default, SERIAL.
         kind = cfg.connection_type
         if kind == C.CONNECTION_SERIAL:
             if not cfg.HasField("serial_port"):
-                raise ModemDriverException("serial_port is required", Status.INVALID_CONFIGURATION)
+                raise ModemDriverError("serial_port is required", Status.INVALID_CONFIGURATION)
             baud = cfg.serial_baud if cfg.HasField("serial_baud") else self.DEFAULT_SERIAL_BAUD
             if baud is None:
-                raise ModemDriverException("serial_baud is required", Status.INVALID_CONFIGURATION)
+                raise ModemDriverError("serial_baud is required", Status.INVALID_CONFIGURATION)
             return SerialLink(cfg.serial_port, baud, delimiter)
         if kind == C.CONNECTION_TCP_AS_CLIENT:
             if not (cfg.HasField("tcp_server") and cfg.HasField("tcp_port")):
-                raise ModemDriverException(
+                raise ModemDriverError(
                     "tcp_server and tcp_port are required", Status.INVALID_CONFIGURATION
                 )
             return TCPClientLink(cfg.tcp_server, cfg.tcp_port, delimiter, cfg.reconnect_interval)
         if not cfg.HasField("tcp_port"):
-            raise ModemDriverException("tcp_port is required", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("tcp_port is required", Status.INVALID_CONFIGURATION)
         # A modem (or serial-to-TCP box) elsewhere on the network connects to this server, so,
         # as upstream, every interface unless `tcp_server` names the address to bind.
         host = cfg.tcp_server if cfg.HasField("tcp_server") else "0.0.0.0"
@@ -152,11 +140,11 @@ class ModemDriverBase(ABC):
 
     def modem_write(self, text: str) -> None:
         if self.link is None:
-            raise ModemDriverException("no link", Status.CONNECTION_TO_MODEM_FAILED)
+            raise ModemDriverError("no link", Status.CONNECTION_TO_MODEM_FAILED)
         try:
             self.link.write(text)
         except LinkClosedError as exc:
-            raise ModemDriverException(str(exc), Status.CONNECTION_TO_MODEM_FAILED) from exc
+            raise ModemDriverError(str(exc), Status.CONNECTION_TO_MODEM_FAILED) from exc
         self._log_raw("[tx] ", text.rstrip("\r\n"))
 
     def modem_close(self) -> None:
@@ -176,7 +164,7 @@ class ModemDriverBase(ABC):
         if not signal:
             return  # nobody listens: skip building a ModemRaw for every line
         data = raw.encode("latin-1") if isinstance(raw, str) else raw
-        msg = m.ModemRaw(raw=data)
+        msg = acomms_pb.ModemRaw(raw=data)
         if description:
             msg.description = description
         signal.emit(msg)

@@ -29,23 +29,24 @@ from dataclasses import dataclass
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.bind import bind, unbind
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException, driver_name
+from pygoby.acomms.driver_base import ModemDriverBase, driver_name
+from pygoby.acomms.errors import HandlerError, ModemDriverError, QueueError
 from pygoby.acomms.mac import MACManager
-from pygoby.acomms.queue import QueueError, QueueManager
+from pygoby.acomms.queue import QueueManager
 from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
-from pygoby.acomms.signals import Signal
 from pygoby.dccl import Codec, DcclError
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
 from pygoby.util.clock import Clock
 from pygoby.util.modules import import_module_or_file
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
-Status = m.ModemDriverStatus
-DriverType = m.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type.values_by_name
+Status = acomms_pb.ModemDriverStatus
+DriverType = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type.values_by_name
 DRIVER_NONE = DriverType["DRIVER_NONE"].number
 
 # Built-in drivers: DriverType name -> "module:class" (imported when first used).
@@ -60,10 +61,6 @@ ROUTE_COMMAND = RouteCommand.DESCRIPTOR.full_name
 CONTINUALLY_RESTART_DRIVER = 1
 MOVE_LISTEN_DRIVER_TO_PRIMARY = 2
 DISABLE_AND_MOVE_LISTEN_DRIVER_TO_PRIMARY = 3
-
-
-class HandlerError(Exception):
-    """The configuration cannot be used, or a failure the handler cannot recover from."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -101,7 +98,7 @@ def _check_slot_rates(mac_cfg, driver: ModemDriverBase) -> None:
     if driver.RATES is None:
         return
     for index, slot in enumerate(mac_cfg.slot):
-        if slot.type == m.DATA and slot.rate not in driver.RATES:
+        if slot.type == acomms_pb.DATA and slot.rate not in driver.RATES:
             raise ConfigError(
                 f"rate {slot.rate} is not a rate of {type(driver).__name__} "
                 f"({driver.RATES.start}-{driver.RATES.stop - 1})",
@@ -120,7 +117,7 @@ def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
     if cfg.driver_type == DRIVER_NONE:
         return None
     type_name = (
-        m.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"]
+        acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"]
         .enum_type.values_by_number[cfg.driver_type]
         .name
     )
@@ -155,7 +152,7 @@ class AcommsHandler:
         loader: ProtoLoader | None = None,
         driver_factory: Callable[[object, Clock], ModemDriverBase | None] = make_driver,
     ) -> None:
-        if cfg.modem_id == m.BROADCAST_ID:
+        if cfg.modem_id == acomms_pb.BROADCAST_ID:
             raise HandlerError("modem_id 0 is the broadcast address; set a modem_id of 1 or more")
         self.clock = clock
         self.modem_id = cfg.modem_id
@@ -169,18 +166,18 @@ class AcommsHandler:
         self.signal_raw_outgoing = Signal()
         self.signal_modem_receive = Signal()  # (ModemTransmission) received by the primary
         self.signal_modem_transmit = Signal()  # (ModemTransmission) transmit result
-        primary_cfg = m.DriverConfig()
+        primary_cfg = acomms_pb.DriverConfig()
         primary_cfg.CopyFrom(cfg.driver_cfg)
         if primary_cfg.WhichOneof("driver") is None and cfg.HasField("driver_type"):
             primary_cfg.driver_type = cfg.driver_type  # Goby 2 style top-level driver_type
         for index, driver_cfg in enumerate([primary_cfg, *cfg.listen_driver_cfg]):
-            own = m.DriverConfig()
+            own = acomms_pb.DriverConfig()
             own.CopyFrom(driver_cfg)
             if not own.HasField("modem_id"):
                 own.modem_id = self.modem_id
             try:
                 driver = driver_factory(own, clock)
-            except ModemDriverException as exc:
+            except ModemDriverError as exc:
                 raise HandlerError(f"driver configuration: {exc}") from None
             if driver is None:
                 continue
@@ -200,14 +197,14 @@ class AcommsHandler:
             log.warning("dccl_cfg.id_codec %r: custom id codecs are not supported; using the "
                         "default id codec", cfg.dccl_cfg.id_codec)  # fmt: skip
 
-        self.queue_cfg = m.QueueManagerConfig()
+        self.queue_cfg = acomms_pb.QueueManagerConfig()
         self.queue_cfg.CopyFrom(cfg.queue_cfg)
         self.queue_cfg.modem_id = self.modem_id
         self.queue = QueueManager(self.codec, clock)
         for slot in self.slots:
             bind(slot.driver, self.queue)
 
-        self.mac_cfg = m.MACConfig()
+        self.mac_cfg = acomms_pb.MACConfig()
         self.mac_cfg.CopyFrom(cfg.mac_cfg)
         self.mac_cfg.modem_id = self.modem_id
         self.mac = MACManager(clock)
@@ -225,7 +222,7 @@ class AcommsHandler:
         """Create one queue per `queue_cfg.message_entry` whose type `resolve` knows; the
         others are skipped (as upstream) and their names returned."""
         entries = list(self.queue_cfg.message_entry)
-        base = m.QueueManagerConfig()
+        base = acomms_pb.QueueManagerConfig()
         base.CopyFrom(self.queue_cfg)
         del base.message_entry[:]
         self.queue.set_cfg(base)
@@ -403,7 +400,7 @@ class AcommsHandler:
 
 
 def _status_of(exc: BaseException, default: int) -> int:
-    return exc.status if isinstance(exc, ModemDriverException) else default
+    return exc.status if isinstance(exc, ModemDriverError) else default
 
 
 def _name(slot: DriverSlot) -> str:

@@ -12,9 +12,9 @@ from __future__ import annotations
 import logging
 import math
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.signals import Signal
+from pygoby.acomms import messages as acomms_pb
 from pygoby.util.clock import Clock
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
@@ -22,18 +22,18 @@ SKEW_TOLERANCE = 2.0  # s late before a slot is skipped and the schedule re-anch
 AUTO_ENTROPY = 5
 SECONDS_PER_DAY = 86400
 
-MACType = m.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name
+MACType = acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name
 MAC_NONE = MACType["MAC_NONE"].number
 MAC_FIXED_DECENTRALIZED = MACType["MAC_FIXED_DECENTRALIZED"].number
 MAC_AUTO_DECENTRALIZED = MACType["MAC_AUTO_DECENTRALIZED"].number
 MAC_POLLED = MACType["MAC_POLLED"].number
-U = m.MACUpdate
+U = acomms_pb.MACUpdate
 
 
 class MACManager:
     def __init__(self, clock: Clock) -> None:
         self.clock = clock
-        self.cfg = m.MACConfig()
+        self.cfg = acomms_pb.MACConfig()
         self.signal_initiate_transmission = Signal()
         self.signal_slot_start = Signal()
         self.slots: list = []  # the cycle: ModemTransmissions, in order
@@ -46,7 +46,7 @@ class MACManager:
 
     # ------------------------------------------------------------------ control
     def startup(self, cfg) -> None:
-        self.cfg = m.MACConfig()
+        self.cfg = acomms_pb.MACConfig()
         self.cfg.CopyFrom(cfg)
         self.slots = []
         if cfg.type in (MAC_FIXED_DECENTRALIZED, MAC_POLLED):
@@ -74,7 +74,7 @@ class MACManager:
         return sum(s.slot_seconds for s in self.slots)
 
     def reference_time(self, now: float) -> float:
-        if self.cfg.ref_time_type == m.MACConfig.REFERENCE_FIXED:
+        if self.cfg.ref_time_type == acomms_pb.MACConfig.REFERENCE_FIXED:
             return float(self.cfg.fixed_ref_time)
         return math.floor(now / SECONDS_PER_DAY) * SECONDS_PER_DAY
 
@@ -125,7 +125,7 @@ class MACManager:
         if self.cfg.type == MAC_AUTO_DECENTRALIZED and self.current == 0:
             self._auto_place_blank(self.next_slot_time)
         slot = _copy(self.slots[self.current])
-        slot.time = m.now_us(self.next_slot_time)
+        slot.time = acomms_pb.now_us(self.next_slot_time)
         if self._initiates(slot):
             self.signal_initiate_transmission.emit(slot)
         self.signal_slot_start.emit(slot)
@@ -197,8 +197,8 @@ class MACManager:
             self._auto_schedule()
 
     def _auto_slot(self, src: int):
-        return m.ModemTransmission(
-            src=src, dest=-1, rate=self.cfg.rate, type=m.DATA, slot_seconds=self.cfg.slot_seconds
+        return acomms_pb.ModemTransmission(
+            src=src, dest=-1, rate=self.cfg.rate, type=acomms_pb.DATA, slot_seconds=self.cfg.slot_seconds
         )
 
     def _auto_schedule(self) -> None:
@@ -236,6 +236,6 @@ class MACManager:
 
 
 def _copy(slot):
-    out = m.ModemTransmission()
+    out = acomms_pb.ModemTransmission()
     out.CopyFrom(slot)
     return out

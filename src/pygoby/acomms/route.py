@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.protobuf import default_loader
 
 log = logging.getLogger(__name__)
@@ -48,14 +48,14 @@ class RouteManager:
 
     def handle_out(self, item, modem_id: int) -> None:
         """Rewrite a queued item's link destination to the next hop (broadcasts untouched)."""
-        if item.dest == m.BROADCAST_ID:
+        if item.dest == acomms_pb.BROADCAST_ID:
             return
         hop = self.find_next_hop(modem_id, item.dest)
         if hop != NO_ROUTE:
             item.dest = hop
 
     def handle_in(self, msg, encoded: bytes, dest: int, modem_id: int) -> None:
-        if dest in (modem_id, m.BROADCAST_ID):
+        if dest in (modem_id, acomms_pb.BROADCAST_ID):
             return
         hop = self.find_next_hop(modem_id, dest)
         if hop == NO_ROUTE:

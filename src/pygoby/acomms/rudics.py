@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import zlib
 
-from pygoby.errors import PygobyError
+from pygoby.acomms.errors import RudicsPacketError
 
 DEFAULT_RESERVED = b"\r"
 CRC_BYTES = 4
@@ -26,10 +26,6 @@ CRC_BYTES = 4
 # requests and responses within it.
 MAX_PACKET_BYTES = 65536
 _LEAF_DIGITS = 32  # runs of digits converted with small-integer arithmetic
-
-
-class RudicsPacketError(PygobyError, ValueError):
-    """A packet is too short, too long or fails its CRC."""
 
 
 def max_data_bytes(packet_bytes: int = MAX_PACKET_BYTES, reserved: bytes = DEFAULT_RESERVED) -> int:

@@ -33,11 +33,10 @@ from typing import Any
 from google.protobuf.message import Message
 
 from pygoby.frontseat import config as fs_config
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.backseat import HELM_STATE_VAR, Backseat
-from pygoby.frontseat.interface import FrontSeatFatalError
+from pygoby.frontseat.errors import DriverLoadError, FrontSeatFatalError
 from pygoby.frontseat.legacy import CTD_FIELDS, DESIRED_FIELDS, Post, ready_posts
-from pygoby.frontseat.plugins import DriverLoadError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import prefixed_var_names, read_configuration
 from pygoby.moos.moosfile import MissionFile
@@ -156,20 +155,20 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def _on_command_request(self, msg: MOOSMessage) -> None:
         if self.backseat.may_command(msg.key) and (
-            command := self.parse_pb(msg, m.CommandRequest)
+            command := self.parse_pb(msg, frontseat_pb.CommandRequest)
         ) is not None:
             self.interface.send_command_to_frontseat(command)
 
     def _on_data_to_frontseat(self, msg: MOOSMessage) -> None:
         if self.backseat.may_send(msg.key) and (
-            data := self.parse_pb(msg, m.InterfaceData)
+            data := self.parse_pb(msg, frontseat_pb.InterfaceData)
         ) is not None:
             self.interface.send_data_to_frontseat(data)
 
     def _on_raw_out(self, msg: MOOSMessage) -> None:
         if msg.src == self.name:
             return  # our own post of what the driver sent
-        if self.backseat.may_send(msg.key) and (raw := self.parse_pb(msg, m.Raw)) is not None:
+        if self.backseat.may_send(msg.key) and (raw := self.parse_pb(msg, frontseat_pb.Raw)) is not None:
             self.interface.send_raw_to_frontseat(raw)
 
     def _on_helm_state(self, msg: MOOSMessage) -> None:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.netsim.client import NetSimClient, status_name
@@ -46,7 +46,7 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
         }  # fmt: skip
         for var, name in names.items():
             self.subscribe(var, lambda msg, name=name: self._nav(name, msg))
-        self.subscribe_pb(cfg.modem_receive_var, m.ModemTransmission, self._modem_receive)
+        self.subscribe_pb(cfg.modem_receive_var, acomms_pb.ModemTransmission, self._modem_receive)
         self.register_timer(cfg.nav_period, self.send_nav)
 
     async def start(self, connect_timeout: float | None = None) -> None:

@@ -18,13 +18,14 @@ import functools
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.acomms.queue import QueueError
 from pygoby.dccl import DcclError
+from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import ConfigError, locate, prefixed_var_names
+from pygoby.moos.appconfig import locate, prefixed_var_names
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, TranslatorError
 from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
@@ -63,15 +64,15 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
-        self._message_class = MessageTypes(
+        self.message_types = MessageTypes(
             [self.find_file(path) for path in cfg.load_proto_file],
             [self.find_file(module) for module in cfg.load_shared_library],
-            fallback=m.goby_message_class,
+            fallback=acomms_pb.goby_message_class,
             loader=self.loader,
         )
         lookup = cfg.modem_id_lookup_path
         self.binding = TranslatorBinding(
-            self, cfg.translator_entry, self._message_class, on_created=self._push,
+            self, cfg.translator_entry, self.message_types, on_created=self._push,
             multiplex_vars=cfg.multiplex_create_moos_var,
             modem_id_lookup_path=self.find_file(lookup) if lookup else "",
         )  # fmt: skip
@@ -88,7 +89,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def _configure_queue(self) -> None:
         try:
-            skipped = self.acomms.configure_queue(self._message_class)
+            skipped = self.acomms.configure_queue(self.message_types)
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         for name in skipped:
@@ -96,7 +97,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def _loaded(self, name: str) -> str:
         try:
-            self._message_class(name)
+            self.message_types(name)
         except Exception:
             raise ConfigError(
                 f"dccl_frontseat_forward_name {name!r} is not a loaded type"
@@ -123,28 +124,19 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             (queue.signal_data_on_demand, self._on_data_on_demand),
         ]
         for signal, slot in connections:
-            signal.connect(self._contained(slot))
-
-    def _contained(self, slot):
-        def run(*args) -> None:
-            try:
-                slot(*args)
-            except Exception:
-                self.log.exception("pAcommsHandler failed to handle an acomms event")
-
-        return run
+            signal.connect(slot, contain_errors=True, logger=self.log)
 
     def _subscribe_all(self) -> None:
         acomms = self.acomms
         from_others = {"driver_receive": acomms.inject_receive,
                        "mac_initiate_transmission": acomms.initiate_transmission}  # fmt: skip
         for key, handler in from_others.items():
-            self.subscribe_pb(self.var[key], m.ModemTransmission, handler, ignore_own=True)
-        self.subscribe_pb(self.var["mac_cycle_update"], m.MACUpdate, acomms.apply_mac_update)
-        self.subscribe_pb(self.var["queue_flush"], m.QueueFlush, self.queue.flush_queue)
+            self.subscribe_pb(self.var[key], acomms_pb.ModemTransmission, handler, ignore_own=True)
+        self.subscribe_pb(self.var["mac_cycle_update"], acomms_pb.MACUpdate, acomms.apply_mac_update)
+        self.subscribe_pb(self.var["queue_flush"], acomms_pb.QueueFlush, self.queue.flush_queue)
         self.subscribe(self.var["config_file_request"], self._on_config_request)
         self.subscribe(self.var["driver_reset"], self._on_driver_reset)
-        self.subscribe_pb(self.var["driver_cfg_update"], m.DriverConfig, acomms.update_driver_cfg)
+        self.subscribe_pb(self.var["driver_cfg_update"], acomms_pb.DriverConfig, acomms.update_driver_cfg)
         self.binding.subscribe_all()
 
     # ------------------------------------------------------------------ running

@@ -1,7 +1,9 @@
 """The DcclError family: one base class for every DCCL failure."""
 
+from pygoby.errors import PygobyError
 
-class DcclError(Exception):
+
+class DcclError(PygobyError):
     """Base class of every DCCL error."""
 
 
@@ -9,9 +11,9 @@ class DcclLoadError(DcclError):
     """A message definition is not valid DCCL (raised when the type is loaded)."""
 
 
-class DcclEncodeError(DcclError):
+class DcclEncodeError(DcclError, ValueError):
     """A message cannot be encoded (missing required field, strict-mode violation, ...)."""
 
 
-class DcclDecodeError(DcclError):
+class DcclDecodeError(DcclError, ValueError):
     """Bytes cannot be decoded (truncated, unknown ID, wrong type, ...)."""

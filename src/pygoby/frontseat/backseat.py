@@ -23,12 +23,12 @@ import logging
 import math
 from typing import Any
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.helm import helm_state_from_ivphelm
 from pygoby.frontseat.interface import InterfaceBase
 from pygoby.frontseat.legacy import CtdSamples, DesiredCourseCommands, Post, nav_posts
 
-CONTROL_STATES = frozenset({m.INTERFACE_LISTEN, m.INTERFACE_COMMAND})
+CONTROL_STATES = frozenset({frontseat_pb.INTERFACE_LISTEN, frontseat_pb.INTERFACE_COMMAND})
 HELM_STATE_VAR = "IVPHELM_STATE"
 
 _log = logging.getLogger(__name__)
@@ -55,25 +55,25 @@ class Backseat:
 
     def may_command(self, var: str) -> bool:
         state = self.interface.state
-        if state == m.INTERFACE_COMMAND:
+        if state == frontseat_pb.INTERFACE_COMMAND:
             return True
         self.log.debug("%s not sent: the interface is in %s, not INTERFACE_COMMAND",
-                       var, m.InterfaceState.Name(state))  # fmt: skip
+                       var, frontseat_pb.InterfaceState.Name(state))  # fmt: skip
         return False
 
     def may_send(self, var: str) -> bool:
         if self.interface.state in CONTROL_STATES:
             return True
         self.log.debug("%s not sent: the interface is in %s", var,
-                       m.InterfaceState.Name(self.interface.state))  # fmt: skip
+                       frontseat_pb.InterfaceState.Name(self.interface.state))  # fmt: skip
         return False
 
     def helm_state(self, value: str, source: str) -> None:
         current = self.interface.helm_state
         state = helm_state_from_ivphelm(value, source, current)
         if state != current:
-            self.log.info("helm state %s -> %s (%s=%r from %s)", m.HelmState.Name(current),
-                          m.HelmState.Name(state), HELM_STATE_VAR, value, source)  # fmt: skip
+            self.log.info("helm state %s -> %s (%s=%r from %s)", frontseat_pb.HelmState.Name(current),
+                          frontseat_pb.HelmState.Name(state), HELM_STATE_VAR, value, source)  # fmt: skip
         self.interface.set_helm_state(state)  # every post counts for helm_state_timeout
 
     def set_origin(self, *, lat: float | None = None, lon: float | None = None) -> None:
@@ -93,7 +93,7 @@ class Backseat:
         if sample is None:
             return None
         self.interface.compute_missing_ctd(sample)
-        return m.InterfaceData(ctd_sample=sample)
+        return frontseat_pb.InterfaceData(ctd_sample=sample)
 
     # -- frontseat -> backseat -------------------------------------------------------------
 

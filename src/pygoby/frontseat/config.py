@@ -26,16 +26,16 @@ from typing import Any
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
-from pygoby.frontseat import messages as m
+from pygoby.errors import ConfigError
+from pygoby.frontseat import messages as frontseat_pb
+from pygoby.frontseat.errors import DriverLoadError
 from pygoby.frontseat.interface import InterfaceBase
 from pygoby.frontseat.plugins import (
     DRIVER_ENV_VAR,
-    DriverLoadError,
     driver_name_from,
     find_driver,
     load_driver,
 )
-from pygoby.moos.appconfig import ConfigError
 from pygoby.protobuf import default_loader
 from pygoby.util.clock import Clock
 
@@ -109,10 +109,10 @@ def migrate_goby2_abc_config(cfg: Message) -> None:
     if not cfg.HasExtension(abc):
         return
     old = cfg.Extensions[abc]
-    sim_cfg = cfg.frontseat_cfg.Extensions[m.BASIC_SIMULATOR_CONFIG]
-    if cfg.frontseat_cfg.HasExtension(m.BASIC_SIMULATOR_CONFIG):
+    sim_cfg = cfg.frontseat_cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
+    if cfg.frontseat_cfg.HasExtension(frontseat_pb.BASIC_SIMULATOR_CONFIG):
         raise ConfigError(
-            f"both [{ABC_CONFIG}] and frontseat_cfg {{ [{m.BASIC_SIMULATOR_CONFIG.full_name}] }} "
+            f"both [{ABC_CONFIG}] and frontseat_cfg {{ [{frontseat_pb.BASIC_SIMULATOR_CONFIG.full_name}] }} "
             "are given; keep one"
         )
     sim_cfg.tcp_address = old.tcp_address
@@ -122,7 +122,7 @@ def migrate_goby2_abc_config(cfg: Message) -> None:
         sim_cfg.start.duration = old.start.duration
     cfg.ClearExtension(abc)
     _log.warning("the Goby 2 [%s] block is read as frontseat_cfg { [%s] { %s } }", ABC_CONFIG,
-                 m.BASIC_SIMULATOR_CONFIG.full_name,
+                 frontseat_pb.BASIC_SIMULATOR_CONFIG.full_name,
                  text_format.MessageToString(sim_cfg, as_one_line=True))  # fmt: skip
 
 

@@ -14,7 +14,7 @@ State machine (spec 5.3), run by `do_work()` before the driver's `loop()`:
   check E1-E4 with the helm rule applied without its start-up grace period (T6);
 * HELM_ERROR -> STANDBY when the helm drives (T7); FS_ERROR -> STANDBY when the condition behind
   the last frontseat error is gone (T8); an IGNORING_COMMANDS error has no automatic exit;
-* a driver raising `FrontSeatException` from `loop()` forces the matching error state (T9).
+* a driver raising `FrontSeatDriverError` from `loop()` forces the matching error state (T9).
 
 goby3 keeps the helm's last reported state with no timeout (Quirk Q24, the default here too).
 The pygoby option `helm_state_timeout` (> 0) turns a helm that has not reported for that long
@@ -30,13 +30,12 @@ from __future__ import annotations
 import abc
 import logging
 import math
-from collections.abc import Callable
 from typing import Any
 
 from google.protobuf import text_format
 
-from pygoby.acomms.signals import Signal as _SlotList
 from pygoby.frontseat.ctd import compute_missing_ctd as _compute_missing_ctd
+from pygoby.frontseat.errors import FrontSeatDriverError, FrontSeatFatalError
 from pygoby.frontseat.messages import (
     ERROR_FRONTSEAT_NONE,
     ERROR_FRONTSEAT_NOT_CONNECTED,
@@ -57,90 +56,14 @@ from pygoby.frontseat.messages import (
     INTERFACE_HELM_ERROR,
     INTERFACE_LISTEN,
     INTERFACE_STANDBY,
-    FrontSeatError,
-    HelmError,
     InterfaceState,
     InterfaceStatus,
 )
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.geodesy import UTMGeodesy
+from pygoby.util.signal import Signal
 
 _log = logging.getLogger(__name__)
-
-
-class FrontSeatException(Exception):
-    """A driver raises it from loop() to force an error state (T9).
-
-    Carries at most one of a HelmError (-> INTERFACE_HELM_ERROR) or a FrontSeatError
-    (-> INTERFACE_FS_ERROR); one with neither is not a state change and propagates out of
-    `do_work()`.
-    """
-
-    def __init__(
-        self,
-        *,
-        helm_error: int | None = None,
-        frontseat_error: int | None = None,
-        message: str = "",
-    ) -> None:
-        if helm_error is not None and frontseat_error is not None:
-            raise ValueError(
-                "a FrontSeatException carries a helm error or a frontseat error, not both"
-            )
-        self.helm_error = helm_error
-        self.frontseat_error = frontseat_error
-        self.message = message
-        if helm_error is not None:
-            what = (
-                HelmError.Name(helm_error) if helm_error in HelmError.values() else str(helm_error)
-            )
-        elif frontseat_error is not None:
-            what = (
-                FrontSeatError.Name(frontseat_error)
-                if frontseat_error in FrontSeatError.values()
-                else str(frontseat_error)
-            )
-        else:
-            what = ""
-        super().__init__(": ".join(part for part in (what, message) if part))
-
-    @property
-    def is_helm_error(self) -> bool:
-        return self.helm_error is not None
-
-    @property
-    def is_fs_error(self) -> bool:
-        return self.frontseat_error is not None
-
-
-class FrontSeatFatalError(RuntimeError):
-    """Raised by do_work() in an error state when `exit_on_error` is set (the app exits 1)."""
-
-    def __init__(self, status: Any) -> None:
-        self.status = status
-        super().__init__(
-            f"error state {InterfaceState.Name(status.state)} with exit_on_error: true "
-            f"({_short(status)})"
-        )
-
-
-class Signal(_SlotList):
-    """Callback list: `sig.connect(cb)`; `sig(arg)` (or `sig.emit(arg)`) calls every cb(arg) in
-    order. A raising callback is logged and does not stop the others (a subscriber's bug must not
-    stop the interface's tick)."""
-
-    def emit(self, *args: Any) -> None:
-        for slot in list(self._slots):
-            try:
-                slot(*args)
-            except Exception:
-                _log.exception("frontseat signal callback %s raised", _slot_name(slot))
-
-    __call__ = emit
-
-
-def _slot_name(slot: Callable[..., Any]) -> str:
-    return getattr(slot, "__qualname__", repr(slot))
 
 
 def _short(status: Any) -> str:
@@ -168,11 +91,12 @@ class InterfaceBase(abc.ABC):
         self._last_helm_error: int = ERROR_HELM_NONE
         self._last_frontseat_error: int = ERROR_FRONTSEAT_NONE
 
-        self.signal_data_from_frontseat = Signal()
-        self.signal_command_response = Signal()
-        self.signal_raw_from_frontseat = Signal()
-        self.signal_raw_to_frontseat = Signal()
-        self.signal_state_change = Signal()
+        # A raising subscriber is logged and does not stop the others (nor the interface's tick)
+        self.signal_data_from_frontseat = Signal(contain_errors=True, logger=_log)
+        self.signal_command_response = Signal(contain_errors=True, logger=_log)
+        self.signal_raw_from_frontseat = Signal(contain_errors=True, logger=_log)
+        self.signal_raw_to_frontseat = Signal(contain_errors=True, logger=_log)
+        self.signal_state_change = Signal(contain_errors=True, logger=_log)
 
         self._geodesy: UTMGeodesy | None = None
         origin = self.cfg.origin
@@ -307,7 +231,7 @@ class InterfaceBase(abc.ABC):
         if not self._check_change_state():
             try:
                 self.loop()
-            except FrontSeatException as exc:
+            except FrontSeatDriverError as exc:
                 if not (exc.is_helm_error or exc.is_fs_error):
                     raise
                 self.log.warning("driver reported an error: %s", exc)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
 
 Post = tuple[str, float | str]
 
@@ -74,7 +74,7 @@ def nav_posts(status: Any) -> list[Post]:
     if fix.HasField("altitude"):
         posts.append(("NAV_ALTITUDE", fix.altitude))
     # Only a position source that is set: goby3 compares the proto2 default too (unset reads GPS).
-    if status.source.HasField("position") and status.source.position == m.Source.GPS:
+    if status.source.HasField("position") and status.source.position == frontseat_pb.Source.GPS:
         posts.append(("GPS_UPDATE_RECEIVED", f"Timestamp={status.time:.15g}"))
     return posts
 
@@ -83,7 +83,7 @@ class DesiredCourseCommands:
     """The helm's desired course, one variable at a time."""
 
     def __init__(self) -> None:
-        self.course = m.DesiredCourse()
+        self.course = frontseat_pb.DesiredCourse()
         self.requests = 0
 
     def update(self, var: str, value: float, time: float) -> Any | None:
@@ -93,7 +93,7 @@ class DesiredCourseCommands:
         if var != DESIRED_TRIGGER:
             return None
         self.course.time = time
-        request = m.CommandRequest(
+        request = frontseat_pb.CommandRequest(
             response_requested=True, request_id=LEGACY_REQUEST_ID_BASE + self.requests
         )
         request.desired_course.CopyFrom(self.course)
@@ -106,7 +106,7 @@ class CtdSamples:
     one arrives)."""
 
     def __init__(self) -> None:
-        self.sample = m.CTDSample()
+        self.sample = frontseat_pb.CTDSample()
         self.lat = math.nan
         self.lon = math.nan
 
@@ -122,7 +122,7 @@ class CtdSamples:
         if var != CTD_TRIGGER:
             return None
         self.sample.time = time
-        sample = m.CTDSample()
+        sample = frontseat_pb.CTDSample()
         sample.CopyFrom(self.sample)
         sample.global_fix.lat = self.lat
         sample.global_fix.lon = self.lon
@@ -132,6 +132,6 @@ class CtdSamples:
 def ready_posts(status: Any) -> list[Post]:
     """FRONTSEAT_READY (frontseat accepting commands) and BACKSEAT_READY (helm driving), 1 or 0."""
     return [
-        ("FRONTSEAT_READY", float(status.frontseat_state == m.FRONTSEAT_ACCEPTING_COMMANDS)),
-        ("BACKSEAT_READY", float(status.helm_state == m.HELM_DRIVE)),
+        ("FRONTSEAT_READY", float(status.frontseat_state == frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS)),
+        ("BACKSEAT_READY", float(status.helm_state == frontseat_pb.HELM_DRIVE)),
     ]

@@ -21,6 +21,7 @@ from collections.abc import Callable, Mapping
 from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
+from pygoby.frontseat.errors import DriverLoadError
 from pygoby.frontseat.interface import InterfaceBase
 from pygoby.util.clock import Clock
 
@@ -30,10 +31,6 @@ DEFAULT_FACTORY = "frontseat_driver_load"
 
 _UPSTREAM_LIBRARY = re.compile(r"(?:.*/)?libgoby_frontseat_(?P<name>\w+?)\.so(?:\.\d+)*")
 _MODULE_PATH = re.compile(r"[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*(?::[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*)?")
-
-
-class DriverLoadError(Exception):
-    """No driver could be found or made from the given name."""
 
 
 def _entry_points() -> dict[str, EntryPoint]:

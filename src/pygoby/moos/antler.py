@@ -21,7 +21,8 @@ import time
 from pathlib import Path
 
 from pygoby.errors import ConfigError
-from pygoby.moos.moosfile import AntlerRun, MissionFile, MissionFileError
+from pygoby.moos.errors import MissionFileError
+from pygoby.moos.moosfile import AntlerRun, MissionFile
 from pygoby.moos.protocol import DEFAULT_PORT
 
 log = logging.getLogger(__name__)

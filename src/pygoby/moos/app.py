@@ -81,14 +81,10 @@ from typing import ClassVar
 
 from google.protobuf.message import Message
 
+from pygoby.errors import ConfigError
 from pygoby.moos import appcli
 from pygoby.moos import protocol as p
-from pygoby.moos.appconfig import (
-    ConfigError,
-    example_config,
-    initializer_posts,
-    read_configuration,
-)
+from pygoby.moos.appconfig import example_config, initializer_posts, read_configuration
 from pygoby.moos.applog import AppLogHandlers
 from pygoby.moos.appstatus import StatusReport
 from pygoby.moos.client import MOOSClient
@@ -203,8 +199,8 @@ class GobyMOOSApp:
         if port is None:
             port = self.common.server_port if self.common.HasField("server_port") else p.DEFAULT_PORT
         self.client = MOOSClient(self.name, host, port, clock=self.clock, on_message=self._on_mail)
-        self.client.on_connect.append(self._connected)
-        self.client.on_disconnect.append(self._disconnected)
+        self.client.signal_connect.connect(self._connected)
+        self.client.signal_disconnect.connect(self._disconnected)
         self.log = logging.getLogger(f"pygoby.app.{self.name}")
         self.start_time = self.clock.now()
         self.dynamic_vars: dict[str, MOOSMessage] = {}

@@ -21,7 +21,7 @@ from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from pygoby.moos.appconfig import ConfigError
+from pygoby.errors import ConfigError
 from pygoby.moos.moosfile import MissionFile
 
 if TYPE_CHECKING:

@@ -1,9 +1,10 @@
 """Goby MOOS application configuration (spec goby-moos-apps.md 2.2-2.5), sans I/O.
 
 * `read_configuration(config_class, mission, app_name, overrides)`: the app's ProcessConfig block
-  parsed as protobuf TextFormat (errors name the file line and the field), then the MOOS globals
+  parsed as protobuf TextFormat, then the MOOS globals
   named by `(goby.field).moos_global` options, then command-line overrides, then the check for
-  required fields.
+  required fields. Every problem is a `pygoby.errors.ConfigError` naming the file, the line
+  and the field where they are known.
 * `example_config(config_class, app_name)`: the `--example_config` text.
 * `initializer_posts(common, mission)`: what `common.initializer` posts on every connect.
 * `prefixed_var_names(moos_var)`: an app's `moos_var { prefix: ... }` block as full names.
@@ -142,7 +143,9 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
     elif kind == FieldDescriptor.TYPE_ENUM:
         enum_value = field.enum_type.values_by_name.get(value)
         if enum_value is None:
-            raise ConfigError(f'invalid enumeration "{value}" for {field.name} (MOOS global {name})')
+            raise ConfigError(
+                f'invalid enumeration "{value}" (MOOS global {name})', field=field.name
+            )
         setattr(config, field.name, enum_value.number)
     elif (number := parse_number(value)) is None:
         raise ConfigError(f"{name} = {value} is not a number", field=field.full_name)
@@ -163,7 +166,7 @@ def apply_overrides(config: Message, overrides: Sequence[tuple[str, str]]) -> No
     for name, value in overrides:
         field = config.DESCRIPTOR.fields_by_name.get(name)
         if field is None:
-            raise ConfigError(f"unknown option --{name}")
+            raise ConfigError(f"unknown option --{name}", file="command line")
         if field.type == FieldDescriptor.TYPE_MESSAGE:
             text = f"{name} {{ {value} }}"
         elif field.type == FieldDescriptor.TYPE_STRING:
@@ -193,9 +196,12 @@ def read_configuration(
     if mission is not None:
         block = mission.goby_block(app_name)
         if block is None:
-            raise ConfigError(f"no ProcessConfig block for {app_name} in {source}")
+            raise ConfigError(f"no ProcessConfig block for {app_name}", file=source)
         parse_block(config, block.text, block.first_line, source)
-        apply_moos_globals(config, mission)
+        try:
+            apply_moos_globals(config, mission)
+        except ConfigError as err:
+            raise err.located(file=source) from None
     apply_overrides(config, overrides)
     if complete is not None:
         complete(config)

@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from pygoby.moos.appconfig import ConfigError
+from pygoby.errors import ConfigError
 
 # goby.util.protobuf.GLogConfig.Verbosity -> logging level
 VERBOSITY_LEVELS = {1: logging.CRITICAL + 10, 2: logging.WARNING, 4: logging.INFO,

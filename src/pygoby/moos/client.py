@@ -10,9 +10,9 @@
 Behaviour: a `T` timing message leads a packet at least once a second (keep-alive and clock
 sync); everything queued is sent in one packet as soon as the event loop runs the writer. The
 client reconnects by itself (every `reconnect_interval` s) after a lost connection, sends its
-subscriptions again, calls the `on_connect` callbacks, then sends publications queued while it
+subscriptions again, emits `signal_connect`, then sends publications queued while it
 was away (bounded by `outbox_limit`; the oldest are dropped beyond it, with a warning). A `K`
-(name already in use) ends the client with `MOOSRefused`: no retry, as in C++.
+(name already in use) ends the client with `MoosRefusedError`: no retry, as in C++.
 """
 
 from __future__ import annotations
@@ -25,17 +25,15 @@ from collections import deque
 from collections.abc import AsyncIterator, Callable
 
 from pygoby.moos import protocol as p
+from pygoby.moos.errors import MoosProtocolError, MoosRefusedError
 from pygoby.moos.protocol import MOOSMessage, Value
 from pygoby.util.clock import Clock, WallClock
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
 TIMING_PERIOD = 1.0
 MAX_PACKET_MESSAGES = 4096
-
-
-class MOOSRefused(Exception):
-    """The DB refused the handshake (poison message); carries the DB's reason."""
 
 
 class MOOSClient:
@@ -45,6 +43,10 @@ class MOOSClient:
     `pygoby.moos.timewarp.moos_clock`), on_message (callback for every received message; when
     None, messages go to the inbox read by `receive()`), reconnect_interval (s), outbox_limit,
     inbox_limit (messages), max_packet_size (bytes accepted from the DB).
+
+    Signals (`pygoby.util.signal.Signal`, no arguments): `signal_connect` after each
+    (re)connection, once the subscriptions are sent again (a raising slot is logged);
+    `signal_disconnect` when a connection is lost.
     """
 
     def __init__(
@@ -67,8 +69,9 @@ class MOOSClient:
         self.port = port
         self.clock = clock or WallClock()
         self.on_message = on_message
-        self.on_connect: list[Callable[[], None]] = []
-        self.on_disconnect: list[Callable[[], None]] = []
+        # a failing connect slot is logged (the session goes on); disconnect slots' errors propagate
+        self.signal_connect = Signal(contain_errors=True, logger=log)
+        self.signal_disconnect = Signal()
         self.reconnect_interval = reconnect_interval
         self.outbox_limit = outbox_limit
         self.inbox_limit = inbox_limit
@@ -101,7 +104,7 @@ class MOOSClient:
             self._task = asyncio.create_task(self._run(), name=f"moos-client-{self.name}")
 
     async def connect(self, timeout: float | None = 5.0) -> None:
-        """Start and wait until connected (TimeoutError after `timeout`; MOOSRefused on K)."""
+        """Start and wait until connected (TimeoutError after `timeout`; MoosRefusedError on K)."""
         self.start()
         await self.wait_connected(timeout)
 
@@ -287,12 +290,12 @@ class MOOSClient:
                     continue
                 try:
                     await self._session(reader, writer)
-                except MOOSRefused as err:
+                except MoosRefusedError as err:
                     log.error("%s: %s", self.name, err)
                     self.failure = err
                     self._stopped.set()
                     return
-                except (OSError, EOFError, TimeoutError, p.ProtocolError) as err:
+                except (OSError, EOFError, TimeoutError, MoosProtocolError) as err:
                     log.warning("%s: connection to %s:%d lost: %s", self.name, self.host,
                                 self.port, err or type(err).__name__)  # fmt: skip
                 finally:
@@ -314,8 +317,7 @@ class MOOSClient:
         for future in self._requests:
             if not future.done():
                 future.set_result([])
-        for callback in self.on_disconnect:
-            callback()
+        self.signal_disconnect.emit()
 
     async def _session(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         sock = writer.get_extra_info("socket")
@@ -327,9 +329,9 @@ class MOOSClient:
         framer = p.PacketFramer(self.max_packet_size)
         welcome = await asyncio.wait_for(self._read_first_packet(reader, framer), 5.0)
         if welcome.msg_type == p.POISON:
-            raise MOOSRefused(f"MOOSDB refused {self.name!r}: {welcome.string}")
+            raise MoosRefusedError(f"MOOSDB refused {self.name!r}: {welcome.string}")
         if welcome.msg_type != p.WELCOME:
-            raise p.ProtocolError(f"expected a welcome, got message type {welcome.msg_type!r}")
+            raise MoosProtocolError(f"expected a welcome, got message type {welcome.msg_type!r}")
         self.community = welcome.community
         self.db_hostname = p.welcome_hostname(welcome)
         self.clock_correction = bool(self.db_hostname) and self.db_hostname != socket.gethostname()
@@ -340,11 +342,7 @@ class MOOSClient:
         self.connections += 1
         self._connected.set()
         log.info("%s: connected to MOOSDB %s at %s:%d", self.name, self.community, self.host, self.port)
-        for callback in self.on_connect:
-            try:
-                callback()
-            except Exception:
-                log.exception("%s: on_connect callback failed", self.name)
+        self.signal_connect.emit()
         write_task = asyncio.create_task(self._write_loop(writer))
         try:
             await self._read_loop(reader, framer)
@@ -401,7 +399,7 @@ class MOOSClient:
             if kind == p.NULL or (kind == p.NOTIFY and msg.id == p.SERVER_REQUEST_ID):
                 continue
             if kind in (p.WELCOME, p.POISON):
-                raise p.ProtocolError(f"unexpected {kind!r} message after the handshake")
+                raise MoosProtocolError(f"unexpected {kind!r} message after the handshake")
             self._deliver(msg)
 
     async def _write_loop(self, writer: asyncio.StreamWriter) -> None:

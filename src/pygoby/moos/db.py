@@ -18,6 +18,7 @@ import socket
 
 from pygoby.moos import protocol as p
 from pygoby.moos.dbcore import DBCore
+from pygoby.moos.errors import MoosProtocolError
 from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
@@ -80,7 +81,7 @@ class _Connection(asyncio.Protocol):
                     self._handshake(msgs)
                 else:
                     self.server._dispatch(self.server.core.process_packet(self.name, msgs))
-        except p.ProtocolError as err:
+        except MoosProtocolError as err:
             self._drop(f"protocol error: {err}")
         except Exception:  # a bug must cost one connection, never the DB
             log.exception("error while serving client %s", self.name)
@@ -100,7 +101,7 @@ class _Connection(asyncio.Protocol):
 
     def _handshake(self, msgs: list[p.MOOSMessage]) -> None:
         if not msgs:
-            raise p.ProtocolError("empty handshake packet")
+            raise MoosProtocolError("empty handshake packet")
         reply = self.server.core.connect(msgs[0])
         self.send([reply])
         if reply.msg_type == p.POISON:

@@ -18,13 +18,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from pygoby.errors import ConfigError
+from pygoby.moos.errors import MissionFileError
 
 _NUMERIC = re.compile(r"[0-9.eE+\-]+")
 _MACRO_USE = re.compile(r"\$\{([^}]*)\}")
-
-
-class MissionFileError(Exception):
-    pass
 
 
 def strip_comment(line: str) -> str:
@@ -300,7 +297,9 @@ class MissionFile:
     def antler(self) -> AntlerConfig:
         settings = self.process_config("ANTLER")
         if settings is None:
-            raise MissionFileError("no ProcessConfig = ANTLER block in the mission file")
+            raise MissionFileError(
+                "no ProcessConfig = ANTLER block in the mission file", file=self.path
+            )
         compact = [(_no_space(k), _no_space(v)) for k, v in settings]
         lookup = {k.lower(): v for k, v in reversed(compact)}  # first occurrence wins
         runs = []

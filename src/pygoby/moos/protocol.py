@@ -17,6 +17,8 @@ import struct
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
+from pygoby.moos.errors import MoosProtocolError
+
 PROTOCOL_STRING_TEXT = "ELKS CAN'T DANCE 2/8/10"
 PROTOCOL_STRING_SIZE = 32
 PROTOCOL_STRING = PROTOCOL_STRING_TEXT.encode("ascii").ljust(PROTOCOL_STRING_SIZE, b"\0")
@@ -55,10 +57,6 @@ _ID_TYPES = struct.Struct("<icc")
 _DOUBLES = struct.Struct("<ddd")
 
 Value = float | str | bytes
-
-
-class ProtocolError(Exception):
-    """Bytes that do not form a valid MOOS unit (bad length, truncated message, ...)."""
 
 
 def decode_text(raw: bytes) -> str:
@@ -201,11 +199,11 @@ def encode_packet(msgs: Iterable[MOOSMessage], cache: dict[int, bytes] | None = 
 
 def _get_str(data: bytes | memoryview, pos: int, end: int, what: str) -> tuple[bytes, int]:
     if pos + 4 > end:
-        raise ProtocolError(f"message truncated in the length of {what}")
+        raise MoosProtocolError(f"message truncated in the length of {what}")
     (n,) = _INT.unpack_from(data, pos)
     pos += 4
     if n < 0 or pos + n > end:
-        raise ProtocolError(f"{what} length {n} is negative or runs past the message end")
+        raise MoosProtocolError(f"{what} length {n} is negative or runs past the message end")
     return bytes(data[pos : pos + n]), pos + n
 
 
@@ -213,10 +211,10 @@ def decode_message(data: bytes | memoryview, offset: int = 0, end: int | None = 
     """Decode the message starting at `offset`; returns it and the offset after it."""
     limit = len(data) if end is None else end
     if offset + 4 > limit:
-        raise ProtocolError("message truncated before its length field")
+        raise MoosProtocolError("message truncated before its length field")
     (msg_len,) = _INT.unpack_from(data, offset)
     if msg_len < MESSAGE_FIXED_SIZE or offset + msg_len > limit:
-        raise ProtocolError(
+        raise MoosProtocolError(
             f"message length {msg_len} is below {MESSAGE_FIXED_SIZE} or runs past the packet end"
         )
     stop = offset + msg_len
@@ -227,11 +225,11 @@ def decode_message(data: bytes | memoryview, offset: int = 0, end: int | None = 
     com, pos = _get_str(data, pos, stop, "community")
     key, pos = _get_str(data, pos, stop, "key")
     if pos + 24 > stop:
-        raise ProtocolError("message truncated in its time/dval/dval2 fields")
+        raise MoosProtocolError("message truncated in its time/dval/dval2 fields")
     time_, dval, dval2 = _DOUBLES.unpack_from(data, pos)
     sval, pos = _get_str(data, pos + 24, stop, "sval")
     if pos != stop:
-        raise ProtocolError(f"message has {stop - pos} bytes after sval inside its msg_len")
+        raise MoosProtocolError(f"message has {stop - pos} bytes after sval inside its msg_len")
     msg = MOOSMessage(
         mtype.decode("latin-1"), dtype.decode("latin-1"), decode_text(key), time_, dval, dval2,
         sval, decode_text(src), decode_text(aux), decode_text(com), msg_id,
@@ -243,26 +241,26 @@ def parse_packet_header(header: bytes | memoryview) -> tuple[int, int]:
     """(total_len, n_msgs) from the first 9 bytes, validated."""
     total, n_msgs, _compressed = _HEADER.unpack_from(header, 0)
     if total < PACKET_HEADER_SIZE:
-        raise ProtocolError(f"packet length {total} is below the {PACKET_HEADER_SIZE}-byte header")
+        raise MoosProtocolError(f"packet length {total} is below the {PACKET_HEADER_SIZE}-byte header")
     if n_msgs < 0:
-        raise ProtocolError(f"packet claims {n_msgs} messages")
+        raise MoosProtocolError(f"packet claims {n_msgs} messages")
     return total, n_msgs
 
 
 def decode_packet(data: bytes | memoryview) -> list[MOOSMessage]:
     """Decode one complete packet (exactly `total_len` bytes)."""
     if len(data) < PACKET_HEADER_SIZE:
-        raise ProtocolError(f"packet of {len(data)} bytes is shorter than its header")
+        raise MoosProtocolError(f"packet of {len(data)} bytes is shorter than its header")
     total, n_msgs = parse_packet_header(data)
     if total != len(data):
-        raise ProtocolError(f"packet length field says {total} bytes but {len(data)} were given")
+        raise MoosProtocolError(f"packet length field says {total} bytes but {len(data)} were given")
     msgs = []
     pos = PACKET_HEADER_SIZE
     for _ in range(n_msgs):
         msg, pos = decode_message(data, pos, total)
         msgs.append(msg)
     if pos != total:
-        raise ProtocolError(f"{total - pos} trailing bytes after the last message of the packet")
+        raise MoosProtocolError(f"{total - pos} trailing bytes after the last message of the packet")
     return msgs
 
 
@@ -270,7 +268,7 @@ class PacketFramer:
     """Cuts a TCP byte stream into packets.
 
     `feed(data)` buffers bytes; iterating `packets()` yields each complete packet's bytes. A
-    length field above `max_packet_size` raises ProtocolError as soon as the header is seen, so
+    length field above `max_packet_size` raises MoosProtocolError as soon as the header is seen, so
     an oversized packet is refused before any of it is buffered beyond its header.
     """
 
@@ -288,7 +286,7 @@ class PacketFramer:
         if len(self._buf) >= PACKET_HEADER_SIZE:
             total, _ = parse_packet_header(self._buf)
             if total > self.max_packet_size:
-                raise ProtocolError(
+                raise MoosProtocolError(
                     f"packet of {total} bytes exceeds the limit of {self.max_packet_size} bytes"
                 )
             self._need = total

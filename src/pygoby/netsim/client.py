@@ -24,16 +24,17 @@ from collections.abc import Callable, Iterable
 
 from google.protobuf.message import Message
 
+from pygoby.netsim.errors import LineError
 from pygoby.netsim.protocol import (
     LEGACY_REQUEST_NAME,
     REQUEST_NAME,
     LineDecoder,
-    LineError,
     encode_line,
     message_class,
     request_class,
     response_names,
 )
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
@@ -47,11 +48,14 @@ def status_name(response: Message) -> str:
 
 
 class RequestTracker:
-    """Request numbering, encoding and response matching for one client."""
+    """Request numbering, encoding and response matching for one client. `first_id`: the id
+    of the first request (0, as upstream; another value continues a sequence)."""
 
-    def __init__(self, legacy_names: bool = False) -> None:
+    def __init__(self, legacy_names: bool = False, first_id: int = 0) -> None:
+        if not 0 <= first_id <= MAX_REQUEST_ID:
+            raise ValueError(f"a request id is within 0..{MAX_REQUEST_ID}, not {first_id}")
         self.request_name = LEGACY_REQUEST_NAME if legacy_names else REQUEST_NAME
-        self._next_id = 0
+        self._next_id = first_id
         self._decoder = LineDecoder(response_names())
         self._waiting: dict[int, asyncio.Future[Message]] = {}
 
@@ -111,7 +115,9 @@ class NetSimClient:
     ) -> None:
         self.host, self.port = host, port
         self.tracker = RequestTracker(legacy_names)
-        self._callbacks: list[ResponseCallback] = [on_response] if on_response else []
+        self.signal_response = Signal()  # every response received, in arrival order
+        if on_response is not None:
+            self.signal_response.connect(on_response)
         self.backoff_initial, self.backoff_max = backoff_initial, backoff_max
         self._writer: asyncio.StreamWriter | None = None
         self._connected = asyncio.Event()
@@ -122,9 +128,6 @@ class NetSimClient:
     @property
     def connected(self) -> bool:
         return self._writer is not None
-
-    def add_response_callback(self, callback: ResponseCallback) -> None:
-        self._callbacks.append(callback)
 
     async def start(self) -> None:
         if self._task is None:
@@ -198,8 +201,7 @@ class NetSimClient:
                         log.warning(
                             "netsim request %d: %s", response.request_id, status_name(response)
                         )
-                    for callback in self._callbacks:
-                        callback(response)
+                    self.signal_response.emit(response)
         except OSError as exc:
             log.info("netsim client: connection lost: %s", exc)
         finally:

@@ -4,8 +4,9 @@
 order (for each nav: configured port -> source address -> region; stop at the first failure;
 stats are passed on regardless) and returns a `RequestOutcome` with the one response to send,
 the navs accepted for the simulation and the stats received. Accepted, complete navs become the
-latest position of their modem port (`position(port)`, `positions()`); listeners registered with
-`on_nav` / `on_stats` see them as they arrive (the channel and the modem emulators use this).
+latest position of their modem port (`position(port)`, `positions()`); the signals `signal_nav`
+and `signal_stats` (`on_nav(listener)` / `on_stats(listener)` connect to them) emit them as they
+arrive (the channel and the modem emulators use this).
 
 `ManagerConnection` adds the line protocol for one client connection: feed it the bytes received
 and it returns the response lines to write, logging and skipping bad lines. It has no I/O of its
@@ -26,15 +27,16 @@ from dataclasses import dataclass, field
 
 from google.protobuf.message import Message
 
+from pygoby.netsim.errors import LineError
 from pygoby.netsim.protocol import (
     LEGACY_RESPONSE_NAME,
     RESPONSE_NAME,
     LineDecoder,
-    LineError,
     encode_line,
     message_class,
     request_names,
 )
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
@@ -75,8 +77,8 @@ class NetSimManager:
         self._pairs = {pair.modem_tcp_port: pair for pair in config.sim_env_pair}
         self._bounds = {bounds.environment_id: bounds for bounds in config.env_bounds}
         self._latest: dict[int, Message] = {}
-        self._nav_listeners: list[NavListener] = []
-        self._stats_listeners: list[StatsListener] = []
+        self.signal_nav = Signal()  # each forwarded EnvironmentNavUpdate
+        self.signal_stats = Signal()  # each ReceiveStats
         self._response_cls = message_class("NetSimManagerResponse")
         # the status values, looked up once (each enum attribute access is a Python __getattr__)
         status = status_enum()
@@ -100,10 +102,12 @@ class NetSimManager:
         return None if pair is None else pair.environment_id
 
     def on_nav(self, listener: NavListener) -> None:
-        self._nav_listeners.append(listener)
+        """Connect `listener` to `signal_nav`."""
+        self.signal_nav.connect(listener)
 
     def on_stats(self, listener: StatsListener) -> None:
-        self._stats_listeners.append(listener)
+        """Connect `listener` to `signal_stats`."""
+        self.signal_stats.connect(listener)
 
     # -- processing ----------------------------------------------------------------------
 
@@ -127,11 +131,9 @@ class NetSimManager:
         outcome.stats.extend(request.stats)
         for update in outcome.forwarded:
             self._latest[update.nav.modem_tcp_port] = update.nav
-            for listener in self._nav_listeners:
-                listener(update)
+            self.signal_nav.emit(update)
         for stats in outcome.stats:
-            for listener in self._stats_listeners:
-                listener(stats)
+            self.signal_stats.emit(stats)
         return outcome
 
     def _check_nav(self, nav: Message, peer_ip: str) -> int:

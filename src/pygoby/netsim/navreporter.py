@@ -16,7 +16,7 @@ from collections.abc import Mapping
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.netsim.protocol import message_class
 from pygoby.util.geodesy import UTMGeodesy
 
@@ -79,10 +79,10 @@ class NavReporter:
 
     def receive_stats(self, transmission: Message) -> list[Message]:
         """One ReceiveStats per $CACST in a driver reception (none for other transmissions)."""
-        if not transmission.HasExtension(m.MM_TRANSMISSION):
+        if not transmission.HasExtension(acomms_pb.MM_TRANSMISSION):
             return []
         stats = []
-        for stat in transmission.Extensions[m.MM_TRANSMISSION].receive_stat:
+        for stat in transmission.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat:
             if not stat.IsInitialized():
                 log.warning("skipping incomplete receive statistics: %s", stat)
                 continue

@@ -16,8 +16,9 @@
 * `$CACST` numbers (SNR, SPL, Doppler, ...) come from `pygoby.netsim.channel.stats`;
 * a ping reply carries the true travel time: the mean of the two legs' one-way travel times, each
   computed for the nodes' positions at the time (what the modem's `(round trip - TAT) / 2` gives);
-* every transmission and reception is reported to `on_event` as a dict (JSON-ready), which
-  `pygoby.netsim.eventlog` writes as the run's event log.
+* every transmission and reception is emitted by `signal_event` (the `on_event` argument is
+  connected to it) as a dict (JSON-ready), which `pygoby.netsim.eventlog` writes as the run's
+  event log.
 
 Randomness is the Channel's own (seeded per transmission and receiver), so a run driven by a
 virtual clock repeats exactly for the same seed.
@@ -36,6 +37,7 @@ from pygoby.acomms.mmsim.channel import Reception as ModemReception
 from pygoby.netsim.channel import Channel, Outcome, PacketKind, Reception, Transmission
 from pygoby.netsim.channel.stats import link_statistics
 from pygoby.util.clock import Clock
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
@@ -80,7 +82,9 @@ class PhysicsChannel:
         self.clock = clock
         self.ports = dict(ports or {})
         self.control_rate = control_rate
-        self.on_event = on_event
+        self.signal_event = Signal()
+        if on_event is not None:
+            self.signal_event.connect(on_event)
         self._endpoints: dict[int, ChannelEndpoint] = {}
         self._answering: tuple[int, float] | None = None  # (port, owtt) of a ping being heard
         self._last_poll = -math.inf
@@ -130,8 +134,8 @@ class PhysicsChannel:
             payload=_Sent(sender, packet, port, first_leg),
         )
         planned = self.channel.transmit(tx)
-        if self.on_event is not None:
-            self.on_event(
+        if self.signal_event:  # (the event is only made when someone listens)
+            self.signal_event.emit(
                 {
                     "event": "tx",
                     "t": tx.start,
@@ -167,7 +171,7 @@ class PhysicsChannel:
         travel_time = r.owtt
         if packet.kind is ModemPacketKind.PING_REPLY and sent.first_leg_owtt is not None:
             travel_time = (sent.first_leg_owtt + r.owtt) / 2
-        if self.on_event is not None:
+        if self.signal_event:
             self._log_reception(r, sent, delivered, travel_time)
         if not delivered:
             return
@@ -199,12 +203,11 @@ class PhysicsChannel:
 
     def _log_reception(self, r: Reception, sent: _Sent, delivered: bool, owtt: float) -> None:
         # (enum values read as `_value_`: the `value` property is a Python call per event)
-        assert self.on_event is not None
         packet = sent.packet
         range_m, owtt, rl, snr, sinr, collision = _link_figures(
             r.range_m, owtt, r.received_level, r.noise_level, r.sinr
         )
-        self.on_event(
+        self.signal_event.emit(
             {
                 "event": "rx",
                 "t": r.deliver_at,

@@ -8,10 +8,10 @@ so one bad line is reported and skipped while the stream carries on at the next 
 Tolerance follows the spec (netsim.md §2.5/§2.6):
 
 * every ``\\n``-terminated line is handled on its own; blank lines are skipped; a line longer than
-  `max_line_length` is discarded (without buffering it) and reported once as `LineTooLong`;
-* a line is split at its first two ``|``; fewer than two is `MissingSeparator`; the preamble is
-  not checked (it is reported in the message so callers can log a non-``NETSIM`` one);
-* the name must match an accepted name exactly (no trimming), else `UnknownName`;
+  `max_line_length` is discarded (without buffering it) and reported once as `LineTooLongError`;
+* a line is split at its first two ``|``; fewer than two is `MissingSeparatorError`; the
+  preamble is not checked (it is reported in the message so callers can log a non-``NETSIM`` one);
+* the name must match an accepted name exactly (no trimming), else `UnknownNameError`;
 * the payload is base64-decoded with libb64 semantics (`b64decode_libb64`), which never fails;
 * the protobuf payload is parsed permissively: missing required fields read as defaults, and a
   corrupt payload yields the part parsed before the error, with `ReceivedMessage.parse_error`
@@ -28,6 +28,12 @@ from functools import cache
 
 from google.protobuf.message import DecodeError, Message
 
+from pygoby.netsim.errors import (
+    LineError,
+    LineTooLongError,
+    MissingSeparatorError,
+    UnknownNameError,
+)
 from pygoby.protobuf import builtin_class
 
 NETSIM_PROTO = "netsim/messages/netsim.proto"
@@ -106,34 +112,6 @@ def encode_line(message: Message, name: str | None = None) -> bytes:
 # reading
 
 
-class LineError(Exception):
-    """A line that was dropped. Carries (a prefix of) the offending line for logging."""
-
-    def __init__(self, reason: str, line: bytes = b"") -> None:
-        super().__init__(reason)
-        self.line = line[:80]
-
-    def __str__(self) -> str:
-        text = super().__str__()
-        return f"{text}: {self.line!r}" if self.line else text
-
-
-class LineTooLong(LineError):
-    """A line exceeded the length limit; it was discarded up to its newline."""
-
-
-class MissingSeparator(LineError):
-    """A line with fewer than two ``|``."""
-
-
-class UnknownName(LineError):
-    """A well-formed line whose type name is not one this reader handles."""
-
-    def __init__(self, name: bytes, line: bytes = b"") -> None:
-        super().__init__(f"unknown message name {name!r}", line)
-        self.name = name
-
-
 @dataclass(frozen=True)
 class NetsimLine:
     preamble: bytes
@@ -158,7 +136,7 @@ def split_line(line: bytes) -> NetsimLine:
     """Split one line (without its ``\\n``) into preamble, name and decoded payload."""
     parts = line.split(b"|", 2)
     if len(parts) < 3:
-        raise MissingSeparator("line has fewer than two '|' separators", line)
+        raise MissingSeparatorError("line has fewer than two '|' separators", line)
     preamble, name, text = parts
     return NetsimLine(preamble, name, b64decode_libb64(text))
 
@@ -204,7 +182,7 @@ class LineDecoder:
                     self._discarding = False
             elif len(self._buffer) + (end - start) > self.max_line_length:
                 events.append(
-                    LineTooLong(
+                    LineTooLongError(
                         f"line longer than {self.max_line_length} bytes discarded",
                         bytes(self._buffer[:80]) or data[start : start + 80],
                     )
@@ -238,7 +216,7 @@ class LineDecoder:
             return exc
         known = self._accepted.get(parts.name)
         if known is None:
-            return UnknownName(parts.name, line)
+            return UnknownNameError(parts.name, line)
         name, cls = known
         message, error = parse_payload(cls, parts.payload)
         return ReceivedMessage(name, message, parts.preamble, error)

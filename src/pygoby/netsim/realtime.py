@@ -19,7 +19,7 @@ import time
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.netsim.scenario import speed_factor
@@ -76,7 +76,7 @@ class RealTimeRun:
                 self.sim.attach_stack(node, driver)
                 driver.startup(
                     driver_config(
-                        node.modem_id, connection_type=m.DriverConfig.CONNECTION_TCP_AS_CLIENT,
+                        node.modem_id, connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT,
                         tcp_server=self.host, tcp_port=server.port, reconnect_interval=1,
                     )  # fmt: skip
                 )

@@ -18,25 +18,22 @@ from pathlib import Path
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.errors import ConfigError
 from pygoby.netsim.channel import Band, ChannelConfig, Position
 from pygoby.netsim.channel.errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.config import config_class as manager_config_class
+from pygoby.netsim.errors import ScenarioError
 from pygoby.protobuf import builtin_class
 from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
 
 SCENARIO_PROTO = "pygoby/netsim/scenario.proto"
 FIRST_MODEM_PORT = 62000
 VIRTUAL_START = 1_700_000_000.0  # default start of a "max"-speed run (repeatable)
-MAC_FIXED_DECENTRALIZED = m.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name[
+MAC_FIXED_DECENTRALIZED = acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name[
     "MAC_FIXED_DECENTRALIZED"
 ].number
-
-
-class ScenarioError(ConfigError):
-    """The scenario cannot be run (parse error or inconsistent settings)."""
 
 
 @cache
@@ -168,7 +165,7 @@ def manager_config(scenario: Message, endpoint_ip: str = "127.0.0.1") -> Message
 
 def mac_config(scenario: Message, modem_id: int) -> Message:
     """The scenario's TDMA cycle for one node (the same slots at every node)."""
-    cfg = m.MACConfig()
+    cfg = acomms_pb.MACConfig()
     cfg.CopyFrom(scenario.mac)
     cfg.modem_id = modem_id
     if not scenario.mac.HasField("type"):
@@ -177,7 +174,7 @@ def mac_config(scenario: Message, modem_id: int) -> Message:
         for node in scenario.node:
             cfg.slot.add(
                 src=node.modem_id, dest=scenario.traffic.status_dest, rate=cfg.rate,
-                type=m.ModemTransmission.DATA, slot_seconds=cfg.slot_seconds,
+                type=acomms_pb.ModemTransmission.DATA, slot_seconds=cfg.slot_seconds,
                 ack_requested=scenario.traffic.ack,
             )  # fmt: skip
     return cfg

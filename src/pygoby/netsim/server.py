@@ -130,7 +130,10 @@ def main(argv: list[str] | None = None) -> int:
         manager = NetSimManager(config)
         if config.gps_out:
             manager.on_nav(GpsOutputs.open_serial(config, WallClock()).on_nav_update)
-    except (OSError, ConfigError) as exc:
+    except ConfigError as exc:
+        print(f"netsim_manager: {exc.located(file=args.config)}", file=sys.stderr)
+        return 1
+    except OSError as exc:
         print(f"netsim_manager: {exc}", file=sys.stderr)
         return 1
     run_until_signal(_run(manager, args.host, args.port))

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.bind import bind
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mac import MACManager
@@ -52,7 +52,8 @@ from pygoby.netsim.scenario import (
     start_time,
 )
 from pygoby.util.clock import Clock, VirtualClock
-from pygoby.util.linebased import LinkClosedError
+from pygoby.util.errors import LinkClosedError
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
@@ -108,16 +109,16 @@ class ModemLink:
 
 
 def driver_config(modem_id: int, **link) -> Message:
-    cfg = m.DriverConfig(driver_type=DRIVER_WHOI_MICROMODEM, modem_id=modem_id, **link)
-    cfg.Extensions[m.MM_CONFIG].query_cfg_on_startup = False
+    cfg = acomms_pb.DriverConfig(driver_type=DRIVER_WHOI_MICROMODEM, modem_id=modem_id, **link)
+    cfg.Extensions[acomms_pb.MM_CONFIG].query_cfg_on_startup = False
     return cfg
 
 
 def status_queue_entry(ack: bool) -> Message:
-    entry = m.QueuedMessageEntry(
+    entry = acomms_pb.QueuedMessageEntry(
         protobuf_name="pygoby.netsim.protobuf.NodeStatus", ack=ack, max_queue=1, ttl=3600
     )
-    Role = m.QueuedMessageEntry.Role
+    Role = acomms_pb.QueuedMessageEntry.Role
     entry.role.add(type=Role.SOURCE_ID, field="src")
     entry.role.add(type=Role.DESTINATION_ID, field="dest")
     entry.role.add(type=Role.TIMESTAMP, field="time")
@@ -169,7 +170,9 @@ class Simulation:
         self.scenario = scenario
         self.start = start_time(scenario)
         self.clock: Clock = clock if clock is not None else VirtualClock(self.start)
-        self.on_event = on_event
+        self.signal_event = Signal()  # every event (see the module's documentation)
+        if on_event is not None:
+            self.signal_event.connect(on_event)
         self.events: Counter = Counter()
         self.outcomes: Counter = Counter()
         self.status_sent = 0
@@ -197,7 +200,7 @@ class Simulation:
         traffic = self.scenario.traffic
         if traffic.status:
             node.queue = QueueManager(self.codec, self.clock)
-            node.queue.set_cfg(m.QueueManagerConfig(modem_id=node.modem_id))
+            node.queue.set_cfg(acomms_pb.QueueManagerConfig(modem_id=node.modem_id))
             node.queue.add_queue(status_queue_entry(traffic.ack), self.status_class)
             node.queue.signal_receive.connect(lambda msg, n=node: self._status_heard(n, msg))
             node.mac.signal_slot_start.connect(lambda slot, n=node: self._slot_started(n, slot))
@@ -240,9 +243,9 @@ class Simulation:
 
     def _modem_heard(self, node: SimNode, msg: Message) -> None:
         """Ranging results the driver reports (two-way pings) become `range` events."""
-        if msg.type != m.ModemTransmission.DRIVER_SPECIFIC:
+        if msg.type != acomms_pb.ModemTransmission.DRIVER_SPECIFIC:
             return
-        owtt = msg.Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time
+        owtt = msg.Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply.one_way_travel_time
         if owtt:
             self._event(
                 {"event": "range", "t": self.clock.now(), "port": node.port, "src": msg.src,
@@ -253,8 +256,7 @@ class Simulation:
         self.events[event["event"]] += 1
         if event["event"] == "rx":
             self.outcomes[event["outcome"]] += 1
-        if self.on_event is not None:
-            self.on_event(event)
+        self.signal_event.emit(event)
 
     # -- positions -------------------------------------------------------------------------------
 

@@ -19,11 +19,14 @@ from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 from google.protobuf.descriptor import Descriptor, FileDescriptor
 from google.protobuf.message import Message
 
+from pygoby.errors import PygobyError
+
 BUILTIN_PROTO_DIR = Path(__file__).resolve().parent
 
 
-class ProtoError(Exception):
-    """A .proto file could not be compiled or a message type could not be found."""
+class ProtoError(PygobyError):
+    """A .proto file could not be compiled or a message type could not be found (the root of
+    the protobuf package's errors)."""
 
 
 @functools.cache

@@ -1,2 +1,37 @@
 """Topside operator tools: the command composer (`commander`), iCommander in the terminal
-(`icommander`) and liaison in the browser (`liaison`). Layer: above acomms and moos, below apps."""
+(`icommander`) and liaison in the browser (`liaison`). Layer: above acomms and moos, below apps.
+`errors`: the TopsideError family."""
+
+from pygoby.topside.errors import (
+    CommanderError,
+    FieldValueError,
+    SaveFileError,
+    SpecialError,
+    TopsideError,
+)
+from pygoby.util.modules import lazy_exports
+
+# imported on first use: the terminal and web front ends need textual / starlette
+__getattr__, __dir__ = lazy_exports(
+    globals(),
+    {
+        "CommandSet": "pygoby.topside.commander",
+        "Commander": "pygoby.topside.commander",
+        "ICommanderTUI": "pygoby.topside.icommander",
+        "LiaisonState": "pygoby.topside.liaison",
+        "WebServer": "pygoby.topside.liaison",
+    },
+)
+
+__all__ = [
+    "CommandSet",
+    "Commander",
+    "CommanderError",
+    "FieldValueError",
+    "ICommanderTUI",
+    "LiaisonState",
+    "SaveFileError",
+    "SpecialError",
+    "TopsideError",
+    "WebServer",
+]

@@ -1,1 +1,20 @@
-"""Small shared utilities: clocks, geodesy, NMEA, line-based I/O."""
+"""Small shared utilities: clocks, signals, geodesy, kinematics, NMEA, line-based I/O, the
+modem-id lookup. The light, widely used ones and the errors are exported here; import the
+others (geodesy, nmea, linebased, aiorun, ...) from their modules."""
+
+from pygoby.util.clock import Clock, VirtualClock, WallClock
+from pygoby.util.errors import LinkClosedError, NMEAChecksumError, NMEAError, NMEAFormatError
+from pygoby.util.modem_id import ModemIdLookup
+from pygoby.util.signal import Signal
+
+__all__ = [
+    "Clock",
+    "LinkClosedError",
+    "ModemIdLookup",
+    "NMEAChecksumError",
+    "NMEAError",
+    "NMEAFormatError",
+    "Signal",
+    "VirtualClock",
+    "WallClock",
+]

@@ -16,13 +16,11 @@ import os
 from collections import deque
 from typing import Protocol
 
+from pygoby.util.errors import LinkClosedError
+
 log = logging.getLogger(__name__)
 
 MAX_LINE_BYTES = 65536  # a peer that never sends the delimiter must not grow memory forever
-
-
-class LinkClosedError(ConnectionError):
-    """Writing to a link that is not open."""
 
 
 class LineLink(Protocol):

@@ -1,4 +1,5 @@
-"""Loading Python modules named in configuration (plugins, generated message code)."""
+"""Loading Python modules: those named in configuration (plugins, generated message code), and
+the names a package exports from its submodules on first use (`lazy_exports`)."""
 
 from __future__ import annotations
 
@@ -6,8 +7,10 @@ import importlib
 import importlib.util
 import sys
 import zlib
+from collections.abc import Callable, Mapping, MutableMapping
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 
 def import_module_or_file(name: str) -> ModuleType:
@@ -31,3 +34,26 @@ def import_module_or_file(name: str) -> ModuleType:
         del sys.modules[module_name]
         raise
     return module
+
+
+def lazy_exports(
+    package_globals: MutableMapping[str, Any], exports: Mapping[str, str]
+) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
+    """`__getattr__` and `__dir__` (PEP 562) for a package that exports `name` from the module
+    `exports[name]` without importing that module until the name is first used: importing one
+    light submodule (a CLI registering its commands, a console script) must not import the
+    whole package. `from package import name` works as for an eager import."""
+    package = package_globals["__name__"]
+
+    def __getattr__(name: str) -> Any:  # noqa: N807 - the module hook's name
+        source = exports.get(name)
+        if source is None:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}")
+        value = getattr(importlib.import_module(source), name)
+        package_globals[name] = value  # (found directly from now on)
+        return value
+
+    def __dir__() -> list[str]:  # noqa: N807 - the module hook's name
+        return sorted({*package_globals, *exports})
+
+    return __getattr__, __dir__

@@ -12,17 +12,7 @@ import functools
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-
-class NMEAError(ValueError):
-    """A line is not a valid NMEA sentence."""
-
-
-class NMEAFormatError(NMEAError):
-    """Missing start character, bad token, non-ASCII text or a malformed checksum field."""
-
-
-class NMEAChecksumError(NMEAError):
-    """The `*HH` checksum does not match the sentence."""
+from pygoby.util.errors import NMEAChecksumError, NMEAFormatError
 
 
 def checksum(body: str) -> int:

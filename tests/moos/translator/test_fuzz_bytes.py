@@ -68,7 +68,7 @@ def test_one_entry_bad_bytes_never_cost_the_other_its_message(Entry, loader, tec
         runner.on_mail("GOOD", "alpha")
         runner.on_mail("BAD", value)
         created = runner.tick(1.0)  # raises nothing
-        names = [m.DESCRIPTOR.full_name for m in created]
+        names = [msg.DESCRIPTOR.full_name for msg in created]
         assert BNR in names and created[names.index(BNR)].Name == "alpha"
         for msg in created:  # whatever was built is valid and can be published
             msg.SerializePartialToString()  # required fields may stay unset, as upstream

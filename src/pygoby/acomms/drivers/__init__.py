@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import importlib
 
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.errors import ModemDriverError
+
+__all__ = ["DRIVER_CLASSES", "make_driver"]
 
 # DriverType value -> "module:Class"
 DRIVER_CLASSES = {
@@ -23,11 +26,11 @@ def make_driver(cfg, clock=None, **kwargs) -> ModemDriverBase:
     (e.g. `publish=` for the uField driver)."""
     target = DRIVER_CLASSES.get(cfg.driver_type)
     if target is None:
-        from pygoby.acomms import messages as m
+        from pygoby.acomms import messages as acomms_pb
 
-        raise ModemDriverException(
+        raise ModemDriverError(
             f"driver type {cfg.driver_type} is not implemented",
-            m.ModemDriverStatus.INVALID_CONFIGURATION,
+            acomms_pb.ModemDriverStatus.INVALID_CONFIGURATION,
         )
     module, name = target.split(":")
     return getattr(importlib.import_module(module), name)(clock=clock, **kwargs)

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import logging
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.abc_protocol import ABCParseError, format_abc, parse_abc
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.abc_protocol import format_abc, parse_abc
 from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.errors import ABCParseError
 
 log = logging.getLogger(__name__)
 
@@ -30,7 +31,7 @@ class ABCDriver(ModemDriverBase):
 
     def _configure(self) -> None:
         # on every (re)connection: the simulator registers modems per connection
-        abc = self.cfg.Extensions[m.ABC_CONFIG]
+        abc = self.cfg.Extensions[acomms_pb.ABC_CONFIG]
         self._write(format_abc("CONF", MAC=self.cfg.modem_id))
         self._write(format_abc("CONF", FOO=int(abc.enable_foo)))
         self._write(format_abc("CONF", BAR=int(abc.enable_bar)))
@@ -45,7 +46,7 @@ class ABCDriver(ModemDriverBase):
         self.emit_raw(False, text.rstrip("\r\n"))
 
     def handle_initiate_transmission(self, transmission) -> None:
-        msg = m.ModemTransmission()
+        msg = acomms_pb.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)
         msg.max_frame_bytes = MAX_FRAME_BYTES
@@ -79,15 +80,15 @@ class ABCDriver(ModemDriverBase):
 
     def _handle_line(self, line: str) -> None:
         key, fields = parse_abc(line)
-        now = m.now_us(self.clock.now())
+        now = acomms_pb.now_us(self.clock.now())
         if key == "RECV":
-            msg = m.ModemTransmission(type=m.DATA, src=int(fields["FROM"]), dest=int(fields["TO"]),
+            msg = acomms_pb.ModemTransmission(type=acomms_pb.DATA, src=int(fields["FROM"]), dest=int(fields["TO"]),
                                       time=now)  # fmt: skip
             msg.frame.append(bytes.fromhex(fields["HEX"]))
         elif key == "ACKN":
-            msg = m.ModemTransmission(type=m.ACK, src=int(fields["FROM"]), dest=int(fields["TO"]),
+            msg = acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=int(fields["FROM"]), dest=int(fields["TO"]),
                                       time=now)  # fmt: skip
             msg.acked_frame.extend(self._last_sent_frames)  # Quirk A9 (sane)
         else:
-            msg = m.ModemTransmission(type=m.DATA, time=now)
+            msg = acomms_pb.ModemTransmission(type=acomms_pb.DATA, time=now)
         self.signal_receive.emit(msg)

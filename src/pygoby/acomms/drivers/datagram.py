@@ -8,7 +8,7 @@ import socket
 
 from google.protobuf.message import DecodeError
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
 
 log = logging.getLogger(__name__)
@@ -31,7 +31,7 @@ class DatagramDriverBase(ModemDriverBase):
             self._sock = None
 
     def handle_initiate_transmission(self, transmission) -> None:
-        msg = m.ModemTransmission()
+        msg = acomms_pb.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)
         if not msg.HasField("frame_start"):
@@ -55,7 +55,7 @@ class DatagramDriverBase(ModemDriverBase):
             except OSError as exc:  # e.g. ICMP port unreachable reported on a later call
                 log.debug("%s receive error: %s", type(self).__name__, exc)
                 continue
-            msg = m.ModemTransmission()
+            msg = acomms_pb.ModemTransmission()
             try:
                 msg.ParseFromString(data)
             except DecodeError as exc:

@@ -12,10 +12,10 @@ import logging
 
 from google.protobuf.message import DecodeError
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.errors import ModemDriverError, RudicsPacketError
 from pygoby.acomms.rudics import (
-    RudicsPacketError,
     embedded_size,
     max_data_bytes,
     parse_rudics_packet,
@@ -38,7 +38,7 @@ class StoreServerDriver(ModemDriverBase):
 
     def __init__(self, clock=None, link=None) -> None:
         super().__init__(clock, link)
-        self.ss_cfg = m.StoreServerConfig()
+        self.ss_cfg = acomms_pb.StoreServerConfig()
         self._outbox: list = []
         self._request_id = 0
         self._waiting_since: float | None = None
@@ -49,22 +49,22 @@ class StoreServerDriver(ModemDriverBase):
         self._in_flight: list = []  # the outbox of the request awaiting its reply
 
     def startup(self, cfg) -> None:
-        cfg_copy = m.DriverConfig()
+        cfg_copy = acomms_pb.DriverConfig()
         cfg_copy.CopyFrom(cfg)
         cfg = cfg_copy
         if not cfg.HasField("tcp_port"):
             cfg.tcp_port = DEFAULT_PORT
         if not cfg.HasField("connection_type"):
-            cfg.connection_type = m.DriverConfig.CONNECTION_TCP_AS_CLIENT
-        self.ss_cfg = cfg.Extensions[m.STORE_SERVER_CONFIG]
-        auth = cfg.Extensions[m.STORE_SERVER_AUTH]
+            cfg.connection_type = acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT
+        self.ss_cfg = cfg.Extensions[acomms_pb.STORE_SERVER_CONFIG]
+        auth = cfg.Extensions[acomms_pb.STORE_SERVER_AUTH]
         if auth.HasField("secret_file"):
             try:
                 self._secret = read_secret_file(auth.secret_file)
             except ConfigError as exc:
-                raise ModemDriverException(
+                raise ModemDriverError(
                     f"store_server_auth.secret_file: {exc}",
-                    m.ModemDriverStatus.INVALID_CONFIGURATION,
+                    acomms_pb.ModemDriverStatus.INVALID_CONFIGURATION,
                 ) from None
         self.modem_start(cfg)
         self._running = True
@@ -75,17 +75,17 @@ class StoreServerDriver(ModemDriverBase):
 
     # ------------------------------------------------------------------ sending
     def handle_initiate_transmission(self, transmission) -> None:
-        msg = m.ModemTransmission()
+        msg = acomms_pb.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)
-        if msg.type != m.DATA:
+        if msg.type != acomms_pb.DATA:
             log.warning("store-server driver only sends DATA transmissions")
             return
         if msg.src < 0:
             msg.src = self.modem_id
         if msg.src != self.modem_id:
-            poll = m.ModemTransmission(src=self.modem_id, dest=msg.src, type=m.DRIVER_SPECIFIC)
-            ext = poll.Extensions[m.STORE_SERVER_TRANSMISSION]
+            poll = acomms_pb.ModemTransmission(src=self.modem_id, dest=msg.src, type=acomms_pb.DRIVER_SPECIFIC)
+            ext = poll.Extensions[acomms_pb.STORE_SERVER_TRANSMISSION]
             ext.type, ext.poll_src, ext.poll_dest = POLL, msg.src, msg.dest
             self._outbox.append(poll)
             return
@@ -132,7 +132,7 @@ class StoreServerDriver(ModemDriverBase):
 
     def _send_request(self, now: float) -> None:
         self._request_id += 1
-        request = m.StoreServerRequest(modem_id=self.modem_id, request_id=self._request_id)
+        request = acomms_pb.StoreServerRequest(modem_id=self.modem_id, request_id=self._request_id)
         # as much of the outbox as fits in one packet, oldest first; the rest goes next time
         room = max_data_bytes() - request.ByteSize() - (AUTH_BYTES if self._secret else 0)
         sent = 0
@@ -161,8 +161,8 @@ class StoreServerDriver(ModemDriverBase):
         self.emit_raw(True, packet)
         try:
             payload = parse_rudics_packet(packet)
-            response = m.StoreServerResponse.FromString(payload)
-            status = m.StoreServerResponseStatus.FromString(payload)
+            response = acomms_pb.StoreServerResponse.FromString(payload)
+            status = acomms_pb.StoreServerResponseStatus.FromString(payload)
         except (RudicsPacketError, DecodeError) as exc:
             log.warning("ignoring a bad store-server response: %s", exc)
             return
@@ -174,14 +174,14 @@ class StoreServerDriver(ModemDriverBase):
             return
         self._in_flight = []
         for t in response.inbox:
-            ext = t.Extensions[m.STORE_SERVER_TRANSMISSION]
-            if t.type == m.DRIVER_SPECIFIC and ext.type == POLL:
+            ext = t.Extensions[acomms_pb.STORE_SERVER_TRANSMISSION]
+            if t.type == acomms_pb.DRIVER_SPECIFIC and ext.type == POLL:
                 if ext.poll_src == self.modem_id:
-                    request = m.ModemTransmission(src=ext.poll_src, dest=ext.poll_dest, type=m.DATA)
+                    request = acomms_pb.ModemTransmission(src=ext.poll_src, dest=ext.poll_dest, type=acomms_pb.DATA)
                     self.handle_initiate_transmission(request)
                 continue
-            if t.type == m.DATA and t.dest == self.modem_id and t.ack_requested:
-                ack = m.ModemTransmission(type=m.ACK, src=t.dest, dest=t.src)
+            if t.type == acomms_pb.DATA and t.dest == self.modem_id and t.ack_requested:
+                ack = acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=t.dest, dest=t.src)
                 ack.acked_frame.extend(range(t.frame_start, t.frame_start + len(t.frame)))
                 self._outbox.append(ack)
             self.signal_receive.emit(t)

@@ -10,19 +10,19 @@ from __future__ import annotations
 import logging
 import socket
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverException
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.datagram import DatagramDriverBase
+from pygoby.acomms.errors import ModemDriverError
 
 log = logging.getLogger(__name__)
 
-Status = m.ModemDriverStatus
+Status = acomms_pb.ModemDriverStatus
 
 
 class UDPDriver(DatagramDriverBase):
     def __init__(self, clock=None) -> None:
         super().__init__(clock)
-        self.udp_cfg = m.UDPConfig()
+        self.udp_cfg = acomms_pb.UDPConfig()
         self._remotes: dict[int, list[tuple[str, int]]] = {}
         self._ack_ids: set[int] = set()
 
@@ -33,18 +33,18 @@ class UDPDriver(DatagramDriverBase):
 
     def startup(self, cfg) -> None:
         if not cfg.HasField("modem_id"):
-            raise ModemDriverException("modem_id is required", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
         self.cfg = cfg
-        self.udp_cfg = cfg.Extensions[m.UDP_CONFIG]
+        self.udp_cfg = cfg.Extensions[acomms_pb.UDP_CONFIG]
         if not self.udp_cfg.HasField("local"):
-            raise ModemDriverException("UDP config needs local", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("UDP config needs local", Status.INVALID_CONFIGURATION)
         family = socket.AF_INET6 if self.udp_cfg.ipv6 else socket.AF_INET
         sock = socket.socket(family, socket.SOCK_DGRAM)
         try:
             sock.bind(("::" if self.udp_cfg.ipv6 else "0.0.0.0", self.udp_cfg.local.port))
         except OSError as exc:
             sock.close()
-            raise ModemDriverException(str(exc), Status.STARTUP_FAILED) from exc
+            raise ModemDriverError(str(exc), Status.STARTUP_FAILED) from exc
         sock.setblocking(False)
         self._sock = sock
         self._remotes = {}
@@ -52,7 +52,7 @@ class UDPDriver(DatagramDriverBase):
             try:
                 info = socket.getaddrinfo(remote.ip, remote.port, family, socket.SOCK_DGRAM)
             except OSError as exc:
-                raise ModemDriverException(
+                raise ModemDriverError(
                     f"cannot resolve {remote.ip}: {exc}", Status.INVALID_CONFIGURATION
                 ) from exc
             self._remotes.setdefault(remote.modem_id, []).append(info[0][4][:2])
@@ -63,12 +63,12 @@ class UDPDriver(DatagramDriverBase):
 
     def _send(self, msg) -> None:
         if self._sock is None:
-            raise ModemDriverException(
+            raise ModemDriverError(
                 "UDP driver is not started", Status.CONNECTION_TO_MODEM_FAILED
             )
         data = msg.SerializeToString()
-        targets = list(self._remotes.get(m.BROADCAST_ID, []))
-        if msg.HasField("dest") and msg.dest != m.BROADCAST_ID:
+        targets = list(self._remotes.get(acomms_pb.BROADCAST_ID, []))
+        if msg.HasField("dest") and msg.dest != acomms_pb.BROADCAST_ID:
             targets += self._remotes.get(msg.dest, [])
         for address in targets:
             try:
@@ -79,9 +79,9 @@ class UDPDriver(DatagramDriverBase):
 
     def _handle_transmission(self, msg, data: bytes) -> None:
         self.emit_raw(True, data)
-        if msg.type != m.ACK and msg.ack_requested and msg.dest in self._ack_ids:
-            ack = m.ModemTransmission(
-                type=m.ACK, time=m.now_us(self.clock.now()), src=msg.dest, dest=msg.src
+        if msg.type != acomms_pb.ACK and msg.ack_requested and msg.dest in self._ack_ids:
+            ack = acomms_pb.ModemTransmission(
+                type=acomms_pb.ACK, time=acomms_pb.now_us(self.clock.now()), src=msg.dest, dest=msg.src
             )
             ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
             self._send(ack)

@@ -11,14 +11,14 @@ import logging
 import socket
 import struct
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverException
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.datagram import DatagramDriverBase
+from pygoby.acomms.errors import ModemDriverError
 from pygoby.protobuf import default_loader
 
 log = logging.getLogger(__name__)
 
-Status = m.ModemDriverStatus
+Status = acomms_pb.ModemDriverStatus
 _CONFIG = default_loader().pool.FindExtensionByName("goby.acomms.udp_multicast.protobuf.config")
 
 
@@ -29,7 +29,7 @@ class UDPMulticastDriver(DatagramDriverBase):
 
     def startup(self, cfg) -> None:
         if not cfg.HasField("modem_id"):
-            raise ModemDriverException("modem_id is required", Status.INVALID_CONFIGURATION)
+            raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
         self.cfg = cfg
         self.mc_cfg = c = cfg.Extensions[_CONFIG]
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
@@ -48,7 +48,7 @@ class UDPMulticastDriver(DatagramDriverBase):
             sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
         except OSError as exc:
             sock.close()
-            raise ModemDriverException(str(exc), Status.STARTUP_FAILED) from exc
+            raise ModemDriverError(str(exc), Status.STARTUP_FAILED) from exc
         sock.setblocking(False)
         self._sock = sock
 
@@ -58,7 +58,7 @@ class UDPMulticastDriver(DatagramDriverBase):
 
     def _send(self, msg) -> None:
         if self._sock is None:
-            raise ModemDriverException("driver is not started", Status.CONNECTION_TO_MODEM_FAILED)
+            raise ModemDriverError("driver is not started", Status.CONNECTION_TO_MODEM_FAILED)
         data = msg.SerializeToString()
         try:
             self._sock.sendto(data, (self.mc_cfg.multicast_address, self.mc_cfg.multicast_port))
@@ -70,8 +70,8 @@ class UDPMulticastDriver(DatagramDriverBase):
         if msg.src == self.modem_id:
             return  # our own transmission looped back
         self.emit_raw(True, data)
-        if msg.type == m.DATA and msg.ack_requested and msg.dest == self.modem_id:
-            ack = m.ModemTransmission(type=m.ACK, src=self.modem_id, dest=msg.src)
+        if msg.type == acomms_pb.DATA and msg.ack_requested and msg.dest == self.modem_id:
+            ack = acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=self.modem_id, dest=msg.src)
             ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
             self._send(ack)
         self.signal_receive.emit(msg)

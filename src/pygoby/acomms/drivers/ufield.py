@@ -14,9 +14,9 @@ from collections.abc import Callable
 
 from google.protobuf.message import DecodeError
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
-from pygoby.moos.translator.modem_id import ModemIdLookup
+from pygoby.util.modem_id import ModemIdLookup
 
 log = logging.getLogger(__name__)
 
@@ -38,13 +38,13 @@ class UFldDriver(ModemDriverBase):
     def __init__(self, clock=None, publish: Callable[[str, str], None] | None = None) -> None:
         super().__init__(clock)
         self.publish = publish if publish is not None else (lambda var, text: None)
-        self.ufld = m.UFldConfig()
+        self.ufld = acomms_pb.UFldConfig()
         self.lookup = ModemIdLookup()
         self._ping_target: str | None = None
 
     def startup(self, cfg) -> None:
         self.cfg = cfg
-        self.ufld = cfg.Extensions[m.UFLD_CONFIG]
+        self.ufld = cfg.Extensions[acomms_pb.UFLD_CONFIG]
         if self.ufld.modem_id_lookup_path:
             self.lookup = ModemIdLookup.from_file(self.ufld.modem_id_lookup_path)
 
@@ -60,15 +60,15 @@ class UFldDriver(ModemDriverBase):
         return [self.ufld.incoming_moos_var, self.ufld.micromodem_mimic.range_report_var]
 
     def _name(self, modem_id: int) -> str:
-        return "all" if modem_id == m.BROADCAST_ID else self.lookup.name(modem_id)
+        return "all" if modem_id == acomms_pb.BROADCAST_ID else self.lookup.name(modem_id)
 
     # ------------------------------------------------------------------ sending
     def handle_initiate_transmission(self, transmission) -> None:
-        msg = m.ModemTransmission()
+        msg = acomms_pb.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)
-        mm_type = msg.Extensions[m.MM_TRANSMISSION].type
-        if msg.type == m.DATA and msg.src in (self.modem_id, m.QUERY_SOURCE_ID):
+        mm_type = msg.Extensions[acomms_pb.MM_TRANSMISSION].type
+        if msg.type == acomms_pb.DATA and msg.src in (self.modem_id, acomms_pb.QUERY_SOURCE_ID):
             msg.src = self.modem_id
             sizes = self.ufld.rate_to_bytes
             msg.max_frame_bytes = (
@@ -78,12 +78,12 @@ class UFldDriver(ModemDriverBase):
                 self.signal_data_request.emit(msg)
             if msg.frame and msg.frame[0]:
                 self._send(msg)
-        elif msg.type == m.DATA:  # third party: ask that node to send
-            poll = m.ModemTransmission(type=m.DRIVER_SPECIFIC, src=self.modem_id, dest=msg.src)
-            ext = poll.Extensions[m.UFLD_TRANSMISSION]
+        elif msg.type == acomms_pb.DATA:  # third party: ask that node to send
+            poll = acomms_pb.ModemTransmission(type=acomms_pb.DRIVER_SPECIFIC, src=self.modem_id, dest=msg.src)
+            ext = poll.Extensions[acomms_pb.UFLD_TRANSMISSION]
             ext.type, ext.poll_src, ext.poll_dest = POLL, msg.src, msg.dest
             self._send(poll)
-        elif msg.type == m.DRIVER_SPECIFIC and mm_type == m.MICROMODEM_TWO_WAY_PING:
+        elif msg.type == acomms_pb.DRIVER_SPECIFIC and mm_type == acomms_pb.MICROMODEM_TWO_WAY_PING:
             self.publish(
                 self.ufld.micromodem_mimic.range_request_var, f"name={self._name(self.modem_id)}"
             )
@@ -111,17 +111,17 @@ class UFldDriver(ModemDriverBase):
     def _handle_incoming(self, text: str) -> None:
         self.emit_raw(True, text)
         try:
-            msg = m.ModemTransmission.FromString(bytes.fromhex(text.strip()))
+            msg = acomms_pb.ModemTransmission.FromString(bytes.fromhex(text.strip()))
         except (ValueError, DecodeError) as exc:
             log.warning("ignoring bad %s: %s", self.ufld.incoming_moos_var, exc)
             return
-        ext = msg.Extensions[m.UFLD_TRANSMISSION]
-        if msg.type == m.DRIVER_SPECIFIC and ext.type == POLL:
-            request = m.ModemTransmission(type=m.DATA, src=ext.poll_src, dest=ext.poll_dest)
+        ext = msg.Extensions[acomms_pb.UFLD_TRANSMISSION]
+        if msg.type == acomms_pb.DRIVER_SPECIFIC and ext.type == POLL:
+            request = acomms_pb.ModemTransmission(type=acomms_pb.DATA, src=ext.poll_src, dest=ext.poll_dest)
             self.handle_initiate_transmission(request)
             return
-        if msg.type == m.DATA and msg.ack_requested and msg.dest != m.BROADCAST_ID:
-            ack = m.ModemTransmission(type=m.ACK, src=msg.dest, dest=msg.src)
+        if msg.type == acomms_pb.DATA and msg.ack_requested and msg.dest != acomms_pb.BROADCAST_ID:
+            ack = acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=msg.dest, dest=msg.src)
             ack.acked_frame.extend(range(len(msg.frame)))
             self._send(ack)
         self.signal_receive.emit(msg)
@@ -136,10 +136,10 @@ class UFldDriver(ModemDriverBase):
         except (KeyError, ValueError) as exc:
             log.warning("ignoring bad range report %r: %s", text, exc)
             return
-        msg = m.ModemTransmission(type=m.DRIVER_SPECIFIC, src=self.modem_id,
+        msg = acomms_pb.ModemTransmission(type=acomms_pb.DRIVER_SPECIFIC, src=self.modem_id,
                                   dest=self.lookup.modem_id(self._ping_target), time=when * 1_000_000)  # fmt: skip
-        ext = msg.Extensions[m.MM_TRANSMISSION]
-        ext.type = m.MICROMODEM_TWO_WAY_PING
+        ext = msg.Extensions[acomms_pb.MM_TRANSMISSION]
+        ext.type = acomms_pb.MICROMODEM_TWO_WAY_PING
         ext.ranging_reply.one_way_travel_time.append(owtt)
         self._ping_target = None
         self.signal_receive.emit(msg)

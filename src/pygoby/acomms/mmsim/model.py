@@ -16,12 +16,13 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES
 from pygoby.acomms.drivers.micromodem.statistics import cst_head_fields, cst_tail, format_xst
 from pygoby.acomms.mmsim.channel import AcousticPacket, Channel, PacketKind, Reception
 from pygoby.util.clock import Clock
-from pygoby.util.nmea import NMEAError, NMEASentence, checksum, printed
+from pygoby.util.errors import NMEAError
+from pygoby.util.nmea import NMEASentence, checksum, printed
 
 log = logging.getLogger(__name__)
 
@@ -285,7 +286,7 @@ class MicroModemModel:
         # same statistics): that text and its checksum are made once.
         key = (p.rate, p.src, p.dest, frames, bad, *r.stats.items())
         tail = _cst_tails.get(key) or self._cst_tail(key, p, r, frames, bad)
-        head = cst_head_fields(1 if bad else 0, m.now_us(r.arrival_time + self._clock_offset))
+        head = cst_head_fields(1 if bad else 0, acomms_pb.now_us(r.arrival_time + self._clock_offset))
         self._output(printed(NMEASentence.of_parts(head, *tail)) + "\r\n")
 
     def _cst_tail(
@@ -332,7 +333,7 @@ def _sentence_line(token: str, *values: object) -> str:
     return printed(NMEASentence.build(token, values)) + "\r\n"
 
 
-_STATISTICS = m.ReceiveStatistics.DESCRIPTOR.fields_by_name
+_STATISTICS = acomms_pb.ReceiveStatistics.DESCRIPTOR.fields_by_name
 _DECIMAL_STATISTICS = {
     name for name, f in _STATISTICS.items() if f.cpp_type == f.CPPTYPE_DOUBLE
 }  # fmt: skip

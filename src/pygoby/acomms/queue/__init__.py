@@ -1,6 +1,7 @@
 """Priority queuing of DCCL messages for the acoustic link (spec acomms.md §5)."""
 
-from pygoby.acomms.queue.manager import QueueError, QueueManager
+from pygoby.acomms.errors import QueueError
+from pygoby.acomms.queue.manager import QueueManager
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 
 __all__ = ["MessageQueue", "QueueError", "QueueManager", "QueuedItem"]

@@ -10,18 +10,15 @@ from __future__ import annotations
 
 import logging
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.errors import QueueError
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
-from pygoby.acomms.signals import Signal
 from pygoby.dccl import DcclError
 from pygoby.util.clock import Clock, WallClock
+from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
-
-
-class QueueError(Exception):
-    """A message cannot be queued (no queue for its type, empty encoding, bad config)."""
 
 
 class QueueManager:
@@ -30,7 +27,7 @@ class QueueManager:
         self.codec = codec
         self._peer_codecs: dict[int, object] = {}  # encrypt_rule: peer id -> Codec
         self.clock: Clock = clock if clock is not None else WallClock()
-        self.cfg = m.QueueManagerConfig()
+        self.cfg = acomms_pb.QueueManagerConfig()
         self.queues: dict[int, MessageQueue] = {}  # by DCCL id, kept in ascending order
         self._by_name: dict[str, MessageQueue] = {}
         self.signal_receive = Signal()  # (message)
@@ -49,7 +46,7 @@ class QueueManager:
 
     # ------------------------------------------------------------------ configuration
     def set_cfg(self, cfg) -> None:
-        self.cfg = m.QueueManagerConfig()
+        self.cfg = acomms_pb.QueueManagerConfig()
         self.cfg.CopyFrom(cfg)
         self._peer_codecs = {
             rule.id: type(self.codec)(
@@ -75,7 +72,7 @@ class QueueManager:
         compiled = self.codec.compiled(message_class)
         if compiled.id is None:
             raise QueueError(f"{entry.protobuf_name} has no DCCL id")
-        copy = m.QueuedMessageEntry()
+        copy = acomms_pb.QueuedMessageEntry()
         copy.CopyFrom(entry)
         roles = compile_roles(copy, message_class.DESCRIPTOR)
         existing = self.queues.get(compiled.id)
@@ -90,7 +87,7 @@ class QueueManager:
         return queue
 
     def _size_changed(self, queue: MessageQueue) -> None:
-        self.signal_queue_size_change.emit(m.QueueSize(dccl_id=queue.dccl_id, size=len(queue)))
+        self.signal_queue_size_change.emit(acomms_pb.QueueSize(dccl_id=queue.dccl_id, size=len(queue)))
 
     # ------------------------------------------------------------------ push
     def push_message(self, msg, encoded: bytes | None = None) -> None:
@@ -112,14 +109,14 @@ class QueueManager:
         if item.dest == self.modem_id:
             self.signal_receive.emit(msg)
             if queue.entry.ack:
-                now = m.now_us(self.clock.now())
-                ack_msg = m.ModemTransmission(src=item.dest, dest=item.dest, type=m.ACK, time=now)
+                now = acomms_pb.now_us(self.clock.now())
+                ack_msg = acomms_pb.ModemTransmission(src=item.dest, dest=item.dest, type=acomms_pb.ACK, time=now)
                 self.signal_ack.emit(ack_msg, msg)
             return
-        item.ack_requested = queue.entry.ack and item.dest != m.BROADCAST_ID
+        item.ack_requested = queue.entry.ack and item.dest != acomms_pb.BROADCAST_ID
         getter = queue.roles.get(Role.TIMESTAMP)
         when = timestamp_us(getter, msg) if getter is not None else None
-        item.time = when if when is not None else m.now_us(self.clock.now())
+        item.time = when if when is not None else acomms_pb.now_us(self.clock.now())
         if encoded is None:  # encrypt_rule: the passphrase of the message's destination
             encoded = self._peer_codecs.get(dest, self.codec).encode(msg)
         item.encoded = encoded
@@ -177,9 +174,9 @@ class QueueManager:
                 item = self._give_data(winner, frame_no, now)
                 packet_ack |= item.ack_requested
                 if frame_no == start:
-                    if request.dest == m.QUERY_DESTINATION_ID:
+                    if request.dest == acomms_pb.QUERY_DESTINATION_ID:
                         request.dest = item.dest
-                    if request.src == m.QUERY_SOURCE_ID:
+                    if request.src == acomms_pb.QUERY_SOURCE_ID:
                         request.src = self.modem_id
                     if packet_dest in (0, -1):
                         packet_dest = request.dest
@@ -208,8 +205,8 @@ class QueueManager:
                 continue
             if (
                 request.HasField("dest")
-                and request.dest != m.QUERY_DESTINATION_ID
-                and item.dest != m.BROADCAST_ID
+                and request.dest != acomms_pb.QUERY_DESTINATION_ID
+                and item.dest != acomms_pb.BROADCAST_ID
                 and item.dest != request.dest
             ):
                 continue
@@ -217,7 +214,7 @@ class QueueManager:
                 request.HasField("ack_requested")
                 and not request.ack_requested
                 and item.ack_requested
-                and request.dest != m.BROADCAST_ID
+                and request.dest != acomms_pb.BROADCAST_ID
             ):
                 continue
             priority = queue.priority(now)
@@ -241,7 +238,7 @@ class QueueManager:
     def _give_data(self, queue: MessageQueue, frame_no: int, now: float) -> QueuedItem:
         item = queue.next_item()
         assert item is not None
-        if item.dest == m.BROADCAST_ID:
+        if item.dest == acomms_pb.BROADCAST_ID:
             item.ack_requested = False
         item.last_sent = now
         if item.ack_requested:
@@ -256,9 +253,9 @@ class QueueManager:
 
     # ------------------------------------------------------------------ receive
     def handle_modem_receive(self, transmission) -> None:
-        if transmission.type == m.ACK:
+        if transmission.type == acomms_pb.ACK:
             self._handle_ack(transmission)
-        elif transmission.type == m.DATA and not self.cfg.skip_decoding:
+        elif transmission.type == acomms_pb.DATA and not self.cfg.skip_decoding:
             route = len(self.signal_in_route) > 0 and (
                 transmission.dest == self.modem_id
                 or transmission.dest in self.cfg.route_for_additional_modem_id
@@ -279,7 +276,7 @@ class QueueManager:
                     queue.remove(item)
                     self._size_changed(queue)
                     self.signal_ack.emit(ack, item.msg)
-                    self._network_ack(queue, item, m.NetworkAck.ACK, ack.src)
+                    self._network_ack(queue, item, acomms_pb.NetworkAck.ACK, ack.src)
 
     def _decode_frame(self, data: bytes, route: bool = False) -> None:
         offset = 0
@@ -320,9 +317,9 @@ class QueueManager:
             return
         src = self._role(queue, Role.SOURCE_ID, msg, 0)
         dest = self._role(queue, Role.DESTINATION_ID, msg, 0)
-        if dest not in (m.BROADCAST_ID, self.modem_id) and not queue.has("PROMISCUOUS"):
+        if dest not in (acomms_pb.BROADCAST_ID, self.modem_id) and not queue.has("PROMISCUOUS"):
             return
-        if dest == m.BROADCAST_ID and src == self.modem_id and queue.roles.get(Role.SOURCE_ID):
+        if dest == acomms_pb.BROADCAST_ID and src == self.modem_id and queue.roles.get(Role.SOURCE_ID):
             return  # our own broadcast heard back
         if queue.has("NO_DEQUEUE"):
             return
@@ -330,22 +327,22 @@ class QueueManager:
 
     # ------------------------------------------------------------------ expiry
     def do_work(self) -> None:
-        now_us = m.now_us(self.clock.now())
+        now_us = acomms_pb.now_us(self.clock.now())
         for queue in self.queues.values():
             while (item := queue.expired_front(now_us)) is not None:
                 queue.remove(item)
                 self._size_changed(queue)
                 self.signal_expire.emit(item.msg)
-                self._network_ack(queue, item, m.NetworkAck.EXPIRE, self.modem_id)
+                self._network_ack(queue, item, acomms_pb.NetworkAck.EXPIRE, self.modem_id)
 
     def _network_ack(self, queue: MessageQueue, item: QueuedItem, kind: int, ack_src: int) -> None:
         """NetworkAck for messages from `make_network_ack_for_src_id` sources (never for a
         NetworkAck): delivered here if we sent the original, else offered to the router."""
         if item.src not in self.cfg.make_network_ack_for_src_id:
             return
-        if item.msg.DESCRIPTOR.full_name == m.NetworkAck.DESCRIPTOR.full_name:
+        if item.msg.DESCRIPTOR.full_name == acomms_pb.NetworkAck.DESCRIPTOR.full_name:
             return
-        ack = m.NetworkAck(
+        ack = acomms_pb.NetworkAck(
             message_src=item.src, message_dest=self.message_dest(item.msg), message_time=item.time,
             message_dccl_id=queue.dccl_id, ack_src=ack_src, ack_type=kind,
         )  # fmt: skip

@@ -11,9 +11,9 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 
-Manip = m.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
 
 
 @dataclass(eq=False, slots=True)

@@ -8,19 +8,16 @@ from dataclasses import dataclass
 
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.errors import RoleError
 
-Role = m.QueuedMessageEntry.Role
+Role = acomms_pb.QueuedMessageEntry.Role
 _INTEGER_TYPES = {
     FieldDescriptor.TYPE_INT32, FieldDescriptor.TYPE_INT64, FieldDescriptor.TYPE_UINT32,
     FieldDescriptor.TYPE_UINT64, FieldDescriptor.TYPE_SINT32, FieldDescriptor.TYPE_SINT64,
     FieldDescriptor.TYPE_FIXED32, FieldDescriptor.TYPE_FIXED64, FieldDescriptor.TYPE_SFIXED32,
     FieldDescriptor.TYPE_SFIXED64, FieldDescriptor.TYPE_ENUM,
 }  # fmt: skip
-
-
-class RoleError(ValueError):
-    """A role in the queue configuration is invalid for its message type."""
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ import hashlib
 import hmac
 import os
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.errors import ConfigError, PygobyError
 
 # room the two fields take in a request: auth_time (key + 8 bytes) and auth_hmac (key, length,
@@ -27,17 +27,17 @@ class AuthError(PygobyError):
 
 
 def sign_request(payload: bytes, secret: bytes, now: float) -> bytes:
-    signed = payload + m.StoreServerRequestAuth(auth_time=now).SerializeToString()
+    signed = payload + acomms_pb.StoreServerRequestAuth(auth_time=now).SerializeToString()
     tag = hmac.new(secret, signed, hashlib.sha256).digest()
-    return signed + m.StoreServerRequestAuth(auth_hmac=tag).SerializeToString()
+    return signed + acomms_pb.StoreServerRequestAuth(auth_hmac=tag).SerializeToString()
 
 
 def verify_request(payload: bytes, secret: bytes) -> float:
     """The request's auth_time if it is signed with `secret`; AuthError otherwise."""
-    auth = m.StoreServerRequestAuth.FromString(payload)  # the other fields are unknown to it
+    auth = acomms_pb.StoreServerRequestAuth.FromString(payload)  # the other fields are unknown to it
     if not (auth.HasField("auth_hmac") and auth.HasField("auth_time")):
         raise AuthError("the request is not signed")
-    tail = m.StoreServerRequestAuth(auth_hmac=auth.auth_hmac).SerializeToString()
+    tail = acomms_pb.StoreServerRequestAuth(auth_hmac=auth.auth_hmac).SerializeToString()
     if not payload.endswith(tail):
         raise AuthError("the signature is not the request's last field")
     expected = hmac.new(secret, payload[: -len(tail)], hashlib.sha256).digest()

@@ -15,10 +15,10 @@ from collections.abc import Mapping
 
 from google.protobuf.message import DecodeError
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.errors import RudicsPacketError
 from pygoby.acomms.rudics import (
     MAX_PACKET_BYTES,
-    RudicsPacketError,
     max_data_bytes,
     parse_rudics_packet,
     serialize_rudics_packet,
@@ -65,7 +65,7 @@ class StoreServer:
     def handle_packet(self, packet: bytes) -> bytes | None:
         try:
             payload = parse_rudics_packet(packet)
-            request = m.StoreServerRequest.FromString(payload)
+            request = acomms_pb.StoreServerRequest.FromString(payload)
         except (RudicsPacketError, DecodeError) as exc:
             log.warning("ignoring a bad store-server request: %s", exc)
             self.requests_refused += 1
@@ -115,10 +115,10 @@ class StoreServer:
 
 
 def _error_reply(request, error: str) -> bytes:
-    response = m.StoreServerResponse(modem_id=request.modem_id)
+    response = acomms_pb.StoreServerResponse(modem_id=request.modem_id)
     if request.HasField("request_id"):
         response.request_id = request.request_id
-    status = m.StoreServerResponseStatus(error=error)
+    status = acomms_pb.StoreServerResponseStatus(error=error)
     return serialize_rudics_packet(response.SerializeToString() + status.SerializeToString())
 
 

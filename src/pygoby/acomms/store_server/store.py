@@ -14,7 +14,7 @@ import logging
 import sqlite3
 from pathlib import Path
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.rudics import embedded_size
 from pygoby.errors import PygobyError
 
@@ -90,7 +90,7 @@ class TransmissionStore:
         is skipped with a warning (it would otherwise block the requester's mail forever).
         `auth_time`: a signed request's time, which must be later than the last accepted one
         for the modem id (ReplayedRequestError otherwise)."""
-        response = m.StoreServerResponse(modem_id=request.modem_id)
+        response = acomms_pb.StoreServerResponse(modem_id=request.modem_id)
         if request.HasField("request_id"):
             response.request_id = request.request_id
         budget = None if max_response_bytes is None else max_response_bytes - response.ByteSize()

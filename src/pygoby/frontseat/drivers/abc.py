@@ -36,7 +36,8 @@ from __future__ import annotations
 import asyncio
 from typing import Any
 
-from pygoby.frontseat import messages as m
+from pygoby.frontseat import messages as frontseat_pb
+from pygoby.frontseat.errors import AbcConfigError, SimulatorProtocolError
 from pygoby.frontseat.interface import InterfaceBase
 from pygoby.frontseat.simulator.protocol import (
     KEY_CMD,
@@ -45,37 +46,36 @@ from pygoby.frontseat.simulator.protocol import (
     WHITESPACE,
     Command,
     Nav,
-    ProtocolError,
     Start,
     parse_line,
 )
 from pygoby.util.clock import Clock
-from pygoby.util.linebased import LineLink, LinkClosedError, TCPClientLink
+from pygoby.util.errors import LinkClosedError
+from pygoby.util.linebased import LineLink, TCPClientLink
 
 NAV_TIMEOUT = 10.0  # s without NAV before the frontseat counts as not providing data
 CONNECT_TIMEOUT = 10.0  # s start() waits for the first connection
 RECONNECT_INTERVAL = 1.0  # s between connection attempts
 
 _CTRL_STATES = {
-    "PAYLOAD": m.FRONTSEAT_ACCEPTING_COMMANDS,
-    "AUV": m.FRONTSEAT_IN_CONTROL,
+    "PAYLOAD": frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS,
+    "AUV": frontseat_pb.FRONTSEAT_IN_CONTROL,
 }
-
-
-class AbcConfigError(ValueError):
-    """The frontseat Config lacks a usable `basic_simulator_config`."""
 
 
 def start_params(cfg: Any) -> Start:
     """The START message a frontseat Config asks for."""
-    if not cfg.HasExtension(m.BASIC_SIMULATOR_CONFIG):
+    if not cfg.HasExtension(frontseat_pb.BASIC_SIMULATOR_CONFIG):
         raise AbcConfigError(
-            "frontseat_cfg has no [goby.middleware.frontseat.protobuf.basic_simulator_config]"
+            "has no [goby.middleware.frontseat.protobuf.basic_simulator_config]",
+            field="frontseat_cfg",
         )
-    sim = cfg.Extensions[m.BASIC_SIMULATOR_CONFIG]
+    sim = cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
     missing = sim.FindInitializationErrors()
     if missing:
-        raise AbcConfigError(f"basic_simulator_config lacks required {', '.join(missing)}")
+        raise AbcConfigError(
+            f"lacks required {', '.join(missing)}", field="basic_simulator_config"
+        )
     start = sim.start
     try:
         return Start(
@@ -88,8 +88,8 @@ def start_params(cfg: Any) -> Start:
             z_rate=start.vehicle.z_rate,
             warp=cfg.sim_warp_factor,
         )
-    except ProtocolError as exc:
-        raise AbcConfigError(f"basic_simulator_config: {exc}") from None
+    except SimulatorProtocolError as exc:
+        raise AbcConfigError(str(exc), field="basic_simulator_config") from None
 
 
 class AbcFrontSeat(InterfaceBase):
@@ -106,7 +106,7 @@ class AbcFrontSeat(InterfaceBase):
     ) -> None:
         super().__init__(cfg, clock)
         self.start_message = start_params(self.cfg)
-        sim = self.cfg.Extensions[m.BASIC_SIMULATOR_CONFIG]
+        sim = self.cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
         self.address = f"{sim.tcp_address}:{sim.tcp_port}"
         self.link: LineLink = (
             link
@@ -114,7 +114,7 @@ class AbcFrontSeat(InterfaceBase):
             else TCPClientLink(sim.tcp_address, sim.tcp_port, reconnect_interval=reconnect_interval)
         )
         self.connect_timeout = connect_timeout
-        self._frontseat_state: int = m.FRONTSEAT_NOT_CONNECTED
+        self._frontseat_state: int = frontseat_pb.FRONTSEAT_NOT_CONNECTED
         self._providing_data = False
         self._last_nav_time: float | None = None
         self._started_connection: int | None = None  # link.connections when START was sent
@@ -152,7 +152,7 @@ class AbcFrontSeat(InterfaceBase):
         for line in self.link.read_lines():
             self._receive(line)
         if not self.link.is_open:  # a CTRL just read came from the lost connection: stale
-            self._frontseat_state = m.FRONTSEAT_NOT_CONNECTED
+            self._frontseat_state = frontseat_pb.FRONTSEAT_NOT_CONNECTED
         if self._last_nav_time is None or self.clock.now() > self._last_nav_time + NAV_TIMEOUT:
             self._providing_data = False
 
@@ -178,14 +178,14 @@ class AbcFrontSeat(InterfaceBase):
             if self._started_connection != self.link.connections:
                 self._started_connection = self.link.connections
                 self.log.info("connected to the frontseat simulator at %s", self.address)
-                self._frontseat_state = m.FRONTSEAT_IDLE
+                self._frontseat_state = frontseat_pb.FRONTSEAT_IDLE
                 self._write(self.start_message.to_line())
-        elif self._frontseat_state != m.FRONTSEAT_NOT_CONNECTED:
+        elif self._frontseat_state != frontseat_pb.FRONTSEAT_NOT_CONNECTED:
             self.log.warning("lost the frontseat simulator at %s; reconnecting", self.address)
-            self._frontseat_state = m.FRONTSEAT_NOT_CONNECTED
+            self._frontseat_state = frontseat_pb.FRONTSEAT_NOT_CONNECTED
 
     def _write(self, line: str) -> None:
-        self.signal_raw_to_frontseat(m.Raw(raw=line.encode("latin-1")))
+        self.signal_raw_to_frontseat(frontseat_pb.Raw(raw=line.encode("latin-1")))
         try:
             self.link.write(line + "\r\n")
         except LinkClosedError as exc:
@@ -193,23 +193,23 @@ class AbcFrontSeat(InterfaceBase):
 
     def _receive(self, line: str) -> None:
         line = line.strip(WHITESPACE)
-        self.signal_raw_from_frontseat(m.Raw(raw=line.encode("latin-1")))
+        self.signal_raw_from_frontseat(frontseat_pb.Raw(raw=line.encode("latin-1")))
         try:
             msg = parse_line(line)
             if msg.key == KEY_CTRL:
                 state = msg.fields.get("STATE", "")
-                self._frontseat_state = _CTRL_STATES.get(state, m.FRONTSEAT_IDLE)
+                self._frontseat_state = _CTRL_STATES.get(state, frontseat_pb.FRONTSEAT_IDLE)
             elif msg.key == KEY_NAV:
                 self._navigation(Nav.from_message(msg))
             elif msg.key == KEY_CMD:
                 self._command_result(msg.fields.get("RESULT", ""))
             else:
                 self.log.info("unknown message from the frontseat: %r", line)
-        except ProtocolError as exc:
+        except SimulatorProtocolError as exc:
             self.log.warning("skipping bad line from the frontseat %r: %s", line, exc)
 
     def _navigation(self, nav: Nav) -> None:
-        data = m.InterfaceData()
+        data = frontseat_pb.InterfaceData()
         status = data.node_status
         status.pose.heading = nav.heading
         status.speed.over_ground = nav.speed
@@ -226,7 +226,7 @@ class AbcFrontSeat(InterfaceBase):
         if request is None or not request.response_requested:
             return
         self.signal_command_response(
-            m.CommandResponse(request_successful=result == "OK", request_id=request.request_id)
+            frontseat_pb.CommandResponse(request_successful=result == "OK", request_id=request.request_id)
         )
 
 

@@ -44,6 +44,7 @@ import logging
 import math
 from dataclasses import dataclass
 
+from pygoby.frontseat.errors import SimulatorProtocolError
 from pygoby.frontseat.simulator.protocol import (
     CMD_ERROR,
     CMD_OK,
@@ -54,7 +55,6 @@ from pygoby.frontseat.simulator.protocol import (
     Command,
     Message,
     Nav,
-    ProtocolError,
     Start,
     parse_line,
 )
@@ -111,7 +111,7 @@ class BasicFrontSeatSimulator:
                 return self._start(Start.from_message(msg), line)
             if msg.key == KEY_CMD and self.running:
                 return [self._command(msg)]
-        except ProtocolError as exc:
+        except SimulatorProtocolError as exc:
             log.warning("invalid line from payload %r: %s", line, exc)
             return []
         if msg.key == KEY_CMD:
@@ -130,7 +130,7 @@ class BasicFrontSeatSimulator:
     def _command(self, msg: Message) -> str:
         try:
             command = Command.from_message(msg)
-        except ProtocolError as exc:
+        except SimulatorProtocolError as exc:
             log.warning("rejected command: %s", exc)
             return CMD_ERROR
         self.desired = DesiredCourse(

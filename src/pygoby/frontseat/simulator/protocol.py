@@ -9,7 +9,8 @@ Parsing follows the upstream splitter (whitespace trimmed at both ends of the li
 ",", the first element is the key, each other element split on ":"; the first occurrence of a
 name wins) but is stricter where upstream silently produced garbage: a field with no ":" or
 more than one, a missing required field, a value that is not a finite decimal number, and
-out-of-range START parameters all raise `ProtocolError` instead of yielding NaN or INT_MAX.
+out-of-range START parameters all raise `SimulatorProtocolError` instead of yielding NaN or
+INT_MAX.
 
 Number formats reproduce C++ iostreams (default float format = printf "%.<precision>g", so no
 trailing zeros, "1e-05" exponent forms, "-0" for negative zero): NAV with precision 10, CMD
@@ -25,6 +26,8 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
+
+from pygoby.frontseat.errors import SimulatorProtocolError
 
 # What C++ isspace() (boost::trim in the default locale) strips; str.strip() would also take
 # latin-1 characters such as NBSP.
@@ -46,10 +49,6 @@ _INTEGER = re.compile(r"[+-]?\d{1,10}")
 INT32_MIN, INT32_MAX = -(2**31), 2**31 - 1
 
 
-class ProtocolError(ValueError):
-    """A line that is not `KEY,NAME:VALUE,...`, or a message field missing or out of range."""
-
-
 def format_g(value: float, precision: int = 6) -> str:
     """`value` as a C++ ostream prints it in the default float format with `precision`."""
     return f"{value:.{precision}g}"
@@ -67,19 +66,19 @@ def format_round_trip(value: float) -> str:
 def parse_decimal(text: str, what: str) -> float:
     """A finite decimal number (digits, optional point and exponent); no NaN, inf or spaces."""
     if _DECIMAL.fullmatch(text) is None:
-        raise ProtocolError(f"{what}: {text!r} is not a decimal number")
+        raise SimulatorProtocolError(f"{what}: {text!r} is not a decimal number")
     value = float(text)
     if not math.isfinite(value):
-        raise ProtocolError(f"{what}: {text!r} is out of range")
+        raise SimulatorProtocolError(f"{what}: {text!r} is out of range")
     return value
 
 
 def parse_int32(text: str, what: str) -> int:
     if _INTEGER.fullmatch(text) is None:
-        raise ProtocolError(f"{what}: {text!r} is not an integer")
+        raise SimulatorProtocolError(f"{what}: {text!r} is not an integer")
     value = int(text)
     if not INT32_MIN <= value <= INT32_MAX:
-        raise ProtocolError(f"{what}: {text!r} is out of the 32-bit integer range")
+        raise SimulatorProtocolError(f"{what}: {text!r} is out of the 32-bit integer range")
     return value
 
 
@@ -94,7 +93,7 @@ class Message:
         try:
             return self.fields[name]
         except KeyError:
-            raise ProtocolError(f"{self.key} without {name}") from None
+            raise SimulatorProtocolError(f"{self.key} without {name}") from None
 
     def number(self, name: str) -> float:
         return parse_decimal(self.require(name), f"{self.key} {name}")
@@ -104,13 +103,13 @@ class Message:
 
 
 def parse_line(line: str) -> Message:
-    """Split `KEY,NAME:VALUE,...` (surrounding whitespace ignored). Raises ProtocolError."""
+    """Split `KEY,NAME:VALUE,...` (surrounding whitespace ignored). Raises SimulatorProtocolError."""
     key, *elements = line.strip(WHITESPACE).split(",")
     fields: dict[str, str] = {}
     for element in elements:
         parts = element.split(":")
         if len(parts) != 2:
-            raise ProtocolError(f"field {element!r} of {key!r} is not NAME:VALUE")
+            raise SimulatorProtocolError(f"field {element!r} of {key!r} is not NAME:VALUE")
         fields.setdefault(parts[0], parts[1])
     return Message(key, fields)
 
@@ -145,17 +144,17 @@ class Start:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.lat) and -90.0 <= self.lat <= 90.0):
-            raise ProtocolError(f"START LAT {self.lat} is not a latitude")
+            raise SimulatorProtocolError(f"START LAT {self.lat} is not a latitude")
         if not math.isfinite(self.lon):
-            raise ProtocolError(f"START LON {self.lon} is not a longitude")
+            raise SimulatorProtocolError(f"START LON {self.lon} is not a longitude")
         if self.freq <= 0:
-            raise ProtocolError(f"START FREQ must be positive, not {self.freq}")
+            raise SimulatorProtocolError(f"START FREQ must be positive, not {self.freq}")
         if self.warp <= 0:
-            raise ProtocolError(f"START WARP must be positive, not {self.warp}")
+            raise SimulatorProtocolError(f"START WARP must be positive, not {self.warp}")
         for name, rate in (("ACCEL", self.accel), ("HDG_RATE", self.hdg_rate),
                            ("Z_RATE", self.z_rate)):  # fmt: skip
             if not (math.isfinite(rate) and rate >= 0):
-                raise ProtocolError(f"START {name} must be zero or positive, not {rate}")
+                raise SimulatorProtocolError(f"START {name} must be zero or positive, not {rate}")
 
     @classmethod
     def from_message(cls, msg: Message) -> Start:

@@ -16,7 +16,8 @@ import sys
 
 from pygoby.frontseat.simulator.core import BasicFrontSeatSimulator
 from pygoby.util.aiorun import run_until_signal
-from pygoby.util.linebased import LinkClosedError, TCPServerLink
+from pygoby.util.errors import LinkClosedError
+from pygoby.util.linebased import TCPServerLink
 
 log = logging.getLogger(__name__)
 

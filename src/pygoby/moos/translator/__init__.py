@@ -22,8 +22,11 @@
 """
 
 from pygoby.moos.translator.algorithms import AlgorithmRegistry, render_double
-from pygoby.moos.translator.errors import TranslatorConfigError, TranslatorError
-from pygoby.moos.translator.modem_id import ModemIdLookup
+from pygoby.moos.translator.errors import (
+    TranslatorConfigError,
+    TranslatorError,
+    UnconvertibleError,
+)
 from pygoby.moos.translator.techniques import (
     MAGIC_PROTOBUF_HEADER,
     MoosValue,
@@ -46,6 +49,7 @@ from pygoby.moos.translator.translator import (
     post_for_moos,
 )
 from pygoby.util.geodesy import UTMGeodesy
+from pygoby.util.modem_id import ModemIdLookup
 
 TRANSLATOR_PROTO = "goby/moos/protobuf/translator.proto"
 
@@ -73,6 +77,7 @@ __all__ = [
     "TranslatorError",
     "TranslatorRunner",
     "UTMGeodesy",
+    "UnconvertibleError",
     "dynamic_parse",
     "entry_class",
     "make_post",

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 from pygoby.moos.translator.conversions import lexical_double
 from pygoby.moos.translator.errors import TranslatorConfigError
-from pygoby.moos.translator.modem_id import ModemIdLookup
 from pygoby.util.geodesy import UTMGeodesy
+from pygoby.util.modem_id import ModemIdLookup
 from pygoby.util.ocean import mackenzie_1981
 
 

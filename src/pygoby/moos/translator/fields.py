@@ -18,7 +18,7 @@ from pygoby.moos.translator.conversions import (
     hex_decode,
     hex_encode,
 )
-from pygoby.moos.translator.errors import TranslatorError
+from pygoby.moos.translator.errors import TranslatorError, UnconvertibleError
 
 log = logging.getLogger("pygoby.moos.translator")
 
@@ -96,10 +96,6 @@ _TYPE_DEFAULTS = {
 }
 
 
-class Unconvertible(Exception):
-    """A string names no value of an enum (the element is skipped, as upstream does)."""
-
-
 def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
     """Convert `text` to a scalar value for `field` (not for message fields)."""
     cpp = field.cpp_type
@@ -126,7 +122,7 @@ def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
         value = field.enum_type.values_by_name.get(candidate)
         if value is not None:
             return value.number
-    raise Unconvertible(f"{text!r} is not a value of enum {field.enum_type.full_name}")
+    raise UnconvertibleError(f"{text!r} is not a value of enum {field.enum_type.full_name}")
 
 
 def parse_message_bytes(target: Message, data: bytes, where: str) -> None:
@@ -146,7 +142,7 @@ def set_from_string(msg: Message, field: FieldDescriptor, text: str, use_short_e
         return
     try:
         setattr(msg, field.name, value_from_string(field, text, use_short_enum))
-    except Unconvertible as exc:
+    except UnconvertibleError as exc:
         log.warning("field %s: %s; field left unchanged", field.name, exc)
 
 
@@ -160,7 +156,7 @@ def append_from_string(
         return
     try:
         container.append(value_from_string(field, text, use_short_enum))
-    except Unconvertible as exc:
+    except UnconvertibleError as exc:
         log.warning("field %s: %s; element skipped", field.name, exc)
 
 
@@ -178,5 +174,5 @@ def set_element_from_string(
         container.append(default_value(field))
     try:
         container[index] = value_from_string(field, text, use_short_enum)
-    except Unconvertible as exc:
+    except UnconvertibleError as exc:
         log.warning("field %s[%d]: %s; element left unchanged", field.name, index, exc)

@@ -19,7 +19,6 @@ from pygoby.moos.translator import keyvalue
 from pygoby.moos.translator.algorithms import AlgorithmRegistry
 from pygoby.moos.translator.conversions import double_to_string17, looks_like_double
 from pygoby.moos.translator.errors import TranslatorConfigError, TranslatorError
-from pygoby.moos.translator.modem_id import ModemIdLookup
 from pygoby.moos.translator.techniques import (
     BINARY_TECHNIQUES,
     PROTOBUF_TECHNIQUES,
@@ -31,6 +30,7 @@ from pygoby.moos.translator.techniques import (
     serialize_for_moos,
     serialize_protobuf,
 )
+from pygoby.util.modem_id import ModemIdLookup
 
 log = logging.getLogger("pygoby.moos.translator")
 

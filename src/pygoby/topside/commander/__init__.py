@@ -12,16 +12,14 @@ from pygoby.topside.commander.commander import (
     KEY_VALUE,
     MULTIPLEX,
     Commander,
-    CommanderError,
     Draft,
     Notice,
     Outgoing,
     SentRecord,
 )
-from pygoby.topside.commander.fields import FieldSpec, FieldValueError
+from pygoby.topside.commander.fields import FieldSpec
 from pygoby.topside.commander.messageset import AcommsVariables, CommandSet, CommandType
-from pygoby.topside.commander.savefile import SaveFileError
-from pygoby.topside.commander.specials import SpecialError
+from pygoby.topside.errors import CommanderError, FieldValueError, SaveFileError, SpecialError
 
 __all__ = [
     "KEY_VALUE",

@@ -32,7 +32,6 @@ from google.protobuf import text_format
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
-from pygoby.errors import PygobyError
 from pygoby.moos.translator import (
     Post,
     Technique,
@@ -44,15 +43,12 @@ from pygoby.moos.translator import (
 from pygoby.topside.commander import savefile, specials
 from pygoby.topside.commander.fields import FieldSpec, FieldValueError
 from pygoby.topside.commander.messageset import CommandSet, CommandType
+from pygoby.topside.errors import CommanderError
 
 KEY_VALUE = "key_value"
 MULTIPLEX = "multiplex"
 _PREFIXED_TEXT = Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT
 _FD = FieldDescriptor
-
-
-class CommanderError(PygobyError):
-    """The commander cannot do what was asked (unknown message, no multiplex variable, ...)."""
 
 
 @dataclass

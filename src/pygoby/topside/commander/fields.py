@@ -13,8 +13,8 @@ from dataclasses import dataclass
 from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.dccl.options import field_options
-from pygoby.errors import PygobyError
 from pygoby.topside.commander import specials
+from pygoby.topside.errors import FieldValueError
 
 _FD = FieldDescriptor
 _INT_TYPES = {
@@ -23,10 +23,6 @@ _INT_TYPES = {
 }  # fmt: skip
 _UNSIGNED = {_FD.TYPE_UINT32, _FD.TYPE_UINT64, _FD.TYPE_FIXED32, _FD.TYPE_FIXED64}
 _FLOAT_TYPES = {_FD.TYPE_DOUBLE, _FD.TYPE_FLOAT}
-
-
-class FieldValueError(PygobyError, ValueError):
-    """A value the field cannot take; the message names the field and the limit."""
 
 
 def _kind(field: FieldDescriptor, codec: str) -> str:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as acomms_messages
+from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.translator import ModemIdLookup, Technique, Translator, UTMGeodesy
 from pygoby.moos.translator.format import parsed_fields
 from pygoby.moos.translator.techniques import PROTOBUF_TECHNIQUES
@@ -160,7 +160,7 @@ class CommandSet:
         types = MessageTypes(
             [find(path) for path in cfg.load_proto_file],
             [find(module) for module in cfg.load_shared_library],
-            fallback=acomms_messages.goby_message_class,
+            fallback=acomms_pb.goby_message_class,
         )
         lookup_path = modem_id_lookup_path or cfg.modem_id_lookup_path
         modem_ids = ModemIdLookup.from_file(find(lookup_path)) if lookup_path else None

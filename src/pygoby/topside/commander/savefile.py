@@ -15,14 +15,10 @@ import re
 import time
 from collections.abc import Iterable, Sequence
 
-from pygoby.errors import PygobyError
+from pygoby.topside.errors import SaveFileError
 
 HEADER_PREFIX = "%%% iCommander message save file: "
 _ITEM = re.compile(r"(?:^|\s)(\S+?):=")
-
-
-class SaveFileError(PygobyError, ValueError):
-    """Not an iCommander save file."""
 
 
 def dump(messages: Iterable[tuple[str, Sequence[tuple[str, str, str]]]], when: float | None = None) -> str:

@@ -16,16 +16,12 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Sequence
 
-from pygoby.errors import PygobyError
+from pygoby.topside.errors import SpecialError
 
 TIME = "_time"
 _XY = re.compile(r"^(?:_(?P<axis>[xy])|(?P<axis1>[xy])\((?:lat|lon)\)(?P<pair>\d+)):(?P<value>.*)$")
 _PREFIXES = (TIME, "_x:", "_y:", "x(lon)", "y(lat)")
 _NUMBERING = re.compile(r"[xy]\((?:lat|lon)\)\d*")
-
-
-class SpecialError(PygobyError, ValueError):
-    """A placeholder that cannot be replaced (an x without its y, metres that are no number)."""
 
 
 def is_placeholder(text: str, *, partial: bool = False) -> bool:

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as am
+from pygoby.acomms import messages as acomms_pb
 from pygoby.dccl import Codec, DcclError
 from pygoby.moos import protocol as p
 from pygoby.moos.protocol import MOOSMessage
@@ -124,8 +124,8 @@ def _enum_name(msg: Message, field: str) -> str:
 
 
 def _mm_extension(transmission: Message) -> Message | None:
-    if transmission.HasExtension(am.MM_TRANSMISSION):
-        return transmission.Extensions[am.MM_TRANSMISSION]
+    if transmission.HasExtension(acomms_pb.MM_TRANSMISSION):
+        return transmission.Extensions[acomms_pb.MM_TRANSMISSION]
     return None
 
 
@@ -152,7 +152,7 @@ class AcommsModel:
                 pass
             self.queues[entry.protobuf_name] = QueueState(entry.protobuf_name, dccl_id, entry, last_sent=now)
         self.slots = [
-            {"src": s.src, "dest": s.dest, "rate": s.rate, "type": am.ModemTransmission.TransmissionType.Name(s.type),
+            {"src": s.src, "dest": s.dest, "rate": s.rate, "type": acomms_pb.ModemTransmission.TransmissionType.Name(s.type),
              "seconds": s.slot_seconds} for s in cfg.mac_cfg.slot
         ]  # fmt: skip
         self.slot_index: int | None = None
@@ -187,7 +187,7 @@ class AcommsModel:
         return out
 
     def _on_qsize(self, value: MoosValue, when: float) -> None:
-        size = self._parse(am.QueueSize, value)
+        size = self._parse(acomms_pb.QueueSize, value)
         if size is None:
             return
         for queue in self.queues.values():
@@ -195,7 +195,7 @@ class AcommsModel:
                 queue.size = size.size
 
     def _on_slot(self, value: MoosValue, when: float) -> None:
-        slot = self._parse(am.ModemTransmission, value)
+        slot = self._parse(acomms_pb.ModemTransmission, value)
         if slot is not None:
             self.slot_index = slot.slot_index if slot.HasField("slot_index") else None
             self.slot_start = slot.time / 1e6 if slot.HasField("time") else when
@@ -217,14 +217,14 @@ class AcommsModel:
     def _on_modem(self, sent: bool, value: MoosValue, when: float) -> None:
         """ACOMMS_MODEM_TRANSMIT (sent) / ACOMMS_MODEM_RECEIVE: one row, with the modem's
         statistics ($CAXST result, $CACST SNR, Doppler, bad frames) when it gives them."""
-        transmission = self._parse(am.ModemTransmission, value)
+        transmission = self._parse(acomms_pb.ModemTransmission, value)
         if transmission is None:
             return
         names = self._messages_in(transmission)
         row = {
             "time": transmission.time / 1e6 if transmission.HasField("time") else when,
             "src": transmission.src, "dest": transmission.dest,
-            "type": am.ModemTransmission.TransmissionType.Name(transmission.type),
+            "type": acomms_pb.ModemTransmission.TransmissionType.Name(transmission.type),
             "rate": transmission.rate, "frames": len(transmission.frame),
             "messages": [n.rsplit(".", 1)[-1] for n in names],
         }  # fmt: skip
@@ -388,12 +388,12 @@ class MapModel:
         self._place(name, x, y, heading, when)
 
     def _link(self, received: bool, value: MoosValue, when: float) -> None:
-        transmission = am.ModemTransmission()
+        transmission = acomms_pb.ModemTransmission()
         try:
             parse_for_moos(value, transmission)
         except Exception:  # noqa: BLE001 - bad mail is skipped
             return
-        if transmission.type == am.ModemTransmission.ACK and not received:
+        if transmission.type == acomms_pb.ModemTransmission.ACK and not received:
             return
         if self.own_id is None or transmission.src < 0:
             return

@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import logging
 
-from pygoby.acomms import messages as m
+from pygoby.acomms import messages as acomms_pb
 from pygoby.dccl import Codec, DcclError
 
 log = logging.getLogger(__name__)
 
 MAX_FRAME_NUMBER = 32
-MMApplicationAck = m.MMApplicationAck
+MMApplicationAck = acomms_pb.MMApplicationAck
 
 
 class ApplicationAcks:
@@ -54,7 +54,7 @@ class ApplicationAcks:
         if not has_data and not self.owed:
             return False
         if msg.dest < 0:
-            msg.dest = m.BROADCAST_ID
+            msg.dest = acomms_pb.BROADCAST_ID
         ack = self.codec.encode(self._ack_message(msg.frame_start, msg.ack_requested))
         msg.frame[0] = ack + bytes(msg.frame[0])[placeholder:]
         self.owed.clear()
@@ -77,7 +77,7 @@ class ApplicationAcks:
             return []
         msg.frame[0] = data[used:]
         if msg.dest in self.ack_ids and ack.ack_requested:
-            bad = set(msg.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc)
+            bad = set(msg.Extensions[acomms_pb.MM_TRANSMISSION].frame_with_bad_crc)
             for i in range(len(msg.frame)):
                 if i not in bad:
                     self.owed[msg.src] = self.owed.get(msg.src, 0) | 1 << (ack.frame_start + i)
@@ -87,6 +87,6 @@ class ApplicationAcks:
                 continue
             for j in range(MAX_FRAME_NUMBER):
                 if part.acked_frames >> j & 1:
-                    acks.append(m.ModemTransmission(type=m.ACK, src=msg.src, dest=part.ack_dest,
+                    acks.append(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=msg.src, dest=part.ack_dest,
                                                     acked_frame=[j]))  # fmt: skip
         return acks

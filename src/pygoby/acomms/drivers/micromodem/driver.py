@@ -17,12 +17,14 @@ from collections import deque
 from collections.abc import Callable
 from enum import Enum, auto
 
-from pygoby.acomms import messages as m
-from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverException
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.driver_base import ModemDriverBase
 from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
 from pygoby.acomms.drivers.micromodem.statistics import add_cst, parse_toa, parse_xst
-from pygoby.util.nmea import NMEAError, NMEASentence, printed
+from pygoby.acomms.errors import ModemDriverError
+from pygoby.util.errors import NMEAError
+from pygoby.util.nmea import NMEASentence, printed
 
 log = logging.getLogger(__name__)
 
@@ -36,7 +38,7 @@ MM2_BITFIELD_CLOCK_REVISION = (2, 0, 26038)
 HYDROID_GPS_REQUEST_INTERVAL = 30.0
 FDP_MAX_FRAME_BYTES = 100
 
-Status = m.ModemDriverStatus
+Status = acomms_pb.ModemDriverStatus
 _UNKNOWN = object()  # a sentence id not looked up yet
 _MAX_REMEMBERED_IDS = 64  # sentence ids remembered with their handler (or lack of one)
 
@@ -56,7 +58,7 @@ class MMDriver(ModemDriverBase):
 
     def __init__(self, clock=None, link=None) -> None:
         super().__init__(clock, link)
-        self.mm_cfg = m.MMConfig()
+        self.mm_cfg = acomms_pb.MMConfig()
         self.phase = Phase.STOPPED
         self.app_acks: ApplicationAcks | None = None
         self.nvram: dict[str, int] = {}
@@ -77,18 +79,18 @@ class MMDriver(ModemDriverBase):
         self._link_was_open = False
         self._last_gps_request = float("-inf")
         # transmission state
-        self._cached = m.ModemTransmission()
+        self._cached = acomms_pb.ModemTransmission()
         self._frame_counter = 0
         self._expected_acks: set[int] = set()
         self._expected_ack_src = -1
         self._expected_xst = 0
-        self._transmit = m.ModemTransmission()
+        self._transmit = acomms_pb.ModemTransmission()
         # reception state
-        self._receive: m.ModemTransmission | None = None
+        self._receive: acomms_pb.ModemTransmission | None = None
         self._expected_frames: set[int] = set()
         self._expected_cst = 0
-        self._ack_msg: m.ModemTransmission | None = None
-        self._last_lbl_type = m.MICROMODEM_REMUS_LBL_RANGING
+        self._ack_msg: acomms_pb.ModemTransmission | None = None
+        self._last_lbl_type = acomms_pb.MICROMODEM_REMUS_LBL_RANGING
 
     # ------------------------------------------------------------------ interface
     @property
@@ -101,7 +103,7 @@ class MMDriver(ModemDriverBase):
 
     def startup(self, cfg) -> None:
         self._reset_state()
-        self.mm_cfg = cfg.Extensions[m.MM_CONFIG]
+        self.mm_cfg = cfg.Extensions[acomms_pb.MM_CONFIG]
         self.modem_start(cfg)
         self.app_acks = None
         if self.mm_cfg.use_application_acks:
@@ -163,18 +165,18 @@ class MMDriver(ModemDriverBase):
             # nothing is taken from the queue, so queued messages wait for the link
             log.warning("link to the modem is down: transmission not started")
             return
-        msg = m.ModemTransmission()
+        msg = acomms_pb.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)
-        if msg.type == m.DATA:
+        if msg.type == acomms_pb.DATA:
             self._initiate_data(msg)
-        elif msg.type == m.DRIVER_SPECIFIC:
-            kind = msg.Extensions[m.MM_TRANSMISSION].type
-            if kind == m.MICROMODEM_TWO_WAY_PING:
+        elif msg.type == acomms_pb.DRIVER_SPECIFIC:
+            kind = msg.Extensions[acomms_pb.MM_TRANSMISSION].type
+            if kind == acomms_pb.MICROMODEM_TWO_WAY_PING:
                 self._push("$CCMPC", msg.src if msg.src >= 0 else self.modem_id, msg.dest)
-            elif kind == m.MICROMODEM_MINI_DATA:
+            elif kind == acomms_pb.MICROMODEM_MINI_DATA:
                 self._initiate_mini(msg)
-            elif kind == m.MICROMODEM_FLEXIBLE_DATA:
+            elif kind == acomms_pb.MICROMODEM_FLEXIBLE_DATA:
                 self._initiate_fdp(msg)
             elif kind in self._SIMPLE_COMMANDS:
                 getattr(self, self._SIMPLE_COMMANDS[kind])(msg)
@@ -214,7 +216,7 @@ class MMDriver(ModemDriverBase):
         log.warning("no valid answer to %s (%s)", front, reason)
         if self._fails >= MAX_FAILS_BEFORE_DEAD:
             self.shutdown()
-            raise ModemDriverException(
+            raise ModemDriverError(
                 f"modem did not respond to {front}", Status.MODEM_NOT_RESPONDING
             )
         if self._tries >= RETRIES:
@@ -406,7 +408,7 @@ class MMDriver(ModemDriverBase):
             return
         c = self._cached
         self._expected_xst = 2 if c.rate == 0 else 1
-        self._transmit = m.ModemTransmission()
+        self._transmit = acomms_pb.ModemTransmission()
         self._transmit.CopyFrom(c)
         firmware_ack = c.ack_requested and self.app_acks is None
         self._push("$CCCYC", 0, c.src, c.dest, c.rate, firmware_ack, len(c.frame))
@@ -421,7 +423,7 @@ class MMDriver(ModemDriverBase):
         if self.app_acks is not None and not self.app_acks.finish(msg, placeholder):
             msg.ClearField("frame")
         if msg.dest < 0:
-            msg.dest = m.BROADCAST_ID
+            msg.dest = acomms_pb.BROADCAST_ID
         self._cached = msg
         return bool(msg.frame) and bool(msg.frame[0])
 
@@ -431,14 +433,14 @@ class MMDriver(ModemDriverBase):
             return  # the modem's echo of our own $CCCYC
         if src == self.modem_id:
             check_rate(rate)
-            request = m.ModemTransmission(
-                src=src, dest=dest, rate=rate, type=m.DATA, time=m.now_us(self.clock.now()),
+            request = acomms_pb.ModemTransmission(
+                src=src, dest=dest, rate=rate, type=acomms_pb.DATA, time=acomms_pb.now_us(self.clock.now()),
                 max_num_frames=nframes, max_frame_bytes=RATE_FRAME_BYTES[rate],
                 ack_requested=bool(ack),
             )  # fmt: skip
             self._request_data(request)
             self._expected_xst = 2 if rate == 0 else 1
-            self._transmit = m.ModemTransmission()
+            self._transmit = acomms_pb.ModemTransmission()
             self._transmit.CopyFrom(self._cached)
             return
         if self._expected_frames:
@@ -463,11 +465,11 @@ class MMDriver(ModemDriverBase):
             self._push("$CCTXD", src, dest, ack, "")
 
     def _on_xst(self, s: NMEASentence) -> None:
-        self._transmit.Extensions[m.MM_TRANSMISSION].transmit_stat.append(parse_xst(s))
+        self._transmit.Extensions[acomms_pb.MM_TRANSMISSION].transmit_stat.append(parse_xst(s))
         self._expected_xst -= 1
         if self._expected_xst <= 0:
             self.signal_transmit_result.emit(self._transmit)
-            self._transmit = m.ModemTransmission()
+            self._transmit = acomms_pb.ModemTransmission()
 
     def _on_ack(self, s: NMEASentence) -> None:
         src, dest, frame_no = s.as_ints(1, 4)
@@ -479,8 +481,8 @@ class MMDriver(ModemDriverBase):
             return
         self._expected_acks.discard(goby_frame)
         if self._ack_msg is None:
-            self._ack_msg = m.ModemTransmission(
-                type=m.ACK, src=src, dest=dest, time=m.now_us(self.clock.now())
+            self._ack_msg = acomms_pb.ModemTransmission(
+                type=acomms_pb.ACK, src=src, dest=dest, time=acomms_pb.now_us(self.clock.now())
             )
         self._ack_msg.acked_frame.append(goby_frame)
         if not self._cst_enabled:
@@ -496,9 +498,9 @@ class MMDriver(ModemDriverBase):
         return self.nvram.get("CST", 1) != 0
 
     # ------------------------------------------------------------------ reception
-    def _receiving(self) -> m.ModemTransmission:
+    def _receiving(self) -> acomms_pb.ModemTransmission:
         if self._receive is None:
-            self._receive = m.ModemTransmission(type=m.DATA)
+            self._receive = acomms_pb.ModemTransmission(type=acomms_pb.DATA)
         return self._receive
 
     def _on_rxd(self, s: NMEASentence) -> None:
@@ -506,8 +508,8 @@ class MMDriver(ModemDriverBase):
         data = bytes.fromhex(s[5]) if len(s) > 5 else b""
         rx = self._receiving()
         if frame_no == 1:
-            rx.time = m.now_us(self.clock.now())
-            rx.src, rx.dest, rx.type, rx.ack_requested = src, dest, m.DATA, bool(ack)
+            rx.time = acomms_pb.now_us(self.clock.now())
+            rx.src, rx.dest, rx.type, rx.ack_requested = src, dest, acomms_pb.DATA, bool(ack)
         if data:
             if frame_no - 1 != len(rx.frame):
                 log.warning("frame %d arrived as frame %d", frame_no, len(rx.frame) + 1)
@@ -519,7 +521,7 @@ class MMDriver(ModemDriverBase):
     def _on_msg(self, s: NMEASentence) -> None:
         if s[1] in ("BAD_CRC", "Bad CRC") and self._expected_frames:
             rx = self._receiving()
-            rx.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc.append(len(rx.frame))
+            rx.Extensions[acomms_pb.MM_TRANSMISSION].frame_with_bad_crc.append(len(rx.frame))
             rx.frame.append(b"")
             self._expected_frames.discard(min(self._expected_frames))
             if not self._cst_enabled and not self._expected_frames:
@@ -529,22 +531,22 @@ class MMDriver(ModemDriverBase):
         today = _utc_date(self.clock.now())
         new_clock = self.revision >= MM2_BITFIELD_CLOCK_REVISION
         if self._ack_msg is not None and self._receive is None and not self._expected_cst:
-            add_cst(self._ack_msg.Extensions[m.MM_TRANSMISSION].receive_stat, s, today, new_clock)
+            add_cst(self._ack_msg.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat, s, today, new_clock)
             self._flush_ack()
             return
         # (what _receiving() gives, kept only once the statistics are in: add_cst appends
         # nothing when the sentence is bad)
-        rx = self._receive if self._receive is not None else m.ModemTransmission(type=m.DATA)
-        ext = rx.Extensions[m.MM_TRANSMISSION]
+        rx = self._receive if self._receive is not None else acomms_pb.ModemTransmission(type=acomms_pb.DATA)
+        ext = rx.Extensions[acomms_pb.MM_TRANSMISSION]
         stat = add_cst(ext.receive_stat, s, today, new_clock)
         self._receive = rx
-        rx.time, rx.time_source = stat.time, m.ModemTransmission.MODEM_TIME
+        rx.time, rx.time_source = stat.time, acomms_pb.ModemTransmission.MODEM_TIME
         if not rx.HasField("src"):
             rx.src, rx.dest = stat.source, stat.dest
         if stat.clock_mode in (2, 3):
             ranging = ext.ranging_reply
             ranging.one_way_travel_time.append((stat.time % 1_000_000) / 1e6)
-            ranging.ambiguity = m.RangingReply.OWTT_SECOND_AMBIGUOUS
+            ranging.ambiguity = acomms_pb.RangingReply.OWTT_SECOND_AMBIGUOUS
             ranging.receiver_clk_mode = stat.clock_mode
             ranging.is_one_way_synchronous = True
         self._expected_cst -= 1
@@ -563,7 +565,7 @@ class MMDriver(ModemDriverBase):
         """Deliver a data reception (after taking out an application ack, if enabled)."""
         if self.app_acks is not None:
             for ack in self.app_acks.strip(rx):
-                ack.time = m.now_us(self.clock.now())
+                ack.time = acomms_pb.now_us(self.clock.now())
                 self.signal_receive.emit(ack)
         self.signal_receive.emit(rx)
 
@@ -571,17 +573,17 @@ class MMDriver(ModemDriverBase):
     def _on_mpr(self, s: NMEASentence) -> None:
         # Quirk A5 (faithful): src/dest copied as they appear in the sentence
         msg = self._ping_result(s.as_int(1), s.as_int(2))
-        msg.Extensions[m.MM_TRANSMISSION].ranging_reply.one_way_travel_time.append(s.as_float(3))
+        msg.Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply.one_way_travel_time.append(s.as_float(3))
         self.signal_receive.emit(msg)
 
     def _on_mpa(self, s: NMEASentence) -> None:
         self.signal_receive.emit(self._ping_result(s.as_int(1), s.as_int(2)))
 
-    def _ping_result(self, src: int, dest: int, kind: int = m.MICROMODEM_TWO_WAY_PING):
-        msg = m.ModemTransmission(
-            type=m.DRIVER_SPECIFIC, src=src, dest=dest, time=m.now_us(self.clock.now())
+    def _ping_result(self, src: int, dest: int, kind: int = acomms_pb.MICROMODEM_TWO_WAY_PING):
+        msg = acomms_pb.ModemTransmission(
+            type=acomms_pb.DRIVER_SPECIFIC, src=src, dest=dest, time=acomms_pb.now_us(self.clock.now())
         )
-        msg.Extensions[m.MM_TRANSMISSION].type = kind
+        msg.Extensions[acomms_pb.MM_TRANSMISSION].type = kind
         return msg
 
     def _initiate_mini(self, msg) -> None:
@@ -620,7 +622,7 @@ class MMDriver(ModemDriverBase):
         self._push("$CCTDP", msg.dest, msg.rate, 0, 0, data.hex())
 
     def _on_rdp(self, s: NMEASentence) -> None:
-        msg = self._ping_result(s.as_int(1), s.as_int(2), m.MICROMODEM_FLEXIBLE_DATA)
+        msg = self._ping_result(s.as_int(1), s.as_int(2), acomms_pb.MICROMODEM_FLEXIBLE_DATA)
         msg.rate = s.as_int(3)
         frame, good = b"", True
         for part in s.fields[6:8]:
@@ -637,28 +639,28 @@ class MMDriver(ModemDriverBase):
             msg.frame.append(frame)
         else:
             msg.frame.append(b"")
-            msg.Extensions[m.MM_TRANSMISSION].frame_with_bad_crc.append(0)
+            msg.Extensions[acomms_pb.MM_TRANSMISSION].frame_with_bad_crc.append(0)
         self._emit_data(msg)
 
     def _on_mua(self, s: NMEASentence) -> None:
-        msg = self._ping_result(s.as_int(1), s.as_int(2), m.MICROMODEM_MINI_DATA)
+        msg = self._ping_result(s.as_int(1), s.as_int(2), acomms_pb.MICROMODEM_MINI_DATA)
         msg.frame.append(bytes.fromhex(s[3]))
         self.signal_receive.emit(msg)
 
     _SIMPLE_COMMANDS = {
-        m.MICROMODEM_REMUS_LBL_RANGING: "_initiate_remus_lbl",
-        m.MICROMODEM_NARROWBAND_LBL_RANGING: "_initiate_narrowband_lbl",
-        m.MICROMODEM_GENERIC_LBL_RANGING: "_initiate_generic_lbl",
-        m.MICROMODEM_HARDWARE_CONTROL: "_initiate_hardware_control",
-        m.MICROMODEM_FM_SWEEP: "_initiate_fm_sweep",
-        m.MICROMODEM_M_SEQUENCE: "_initiate_m_sequence",
+        acomms_pb.MICROMODEM_REMUS_LBL_RANGING: "_initiate_remus_lbl",
+        acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING: "_initiate_narrowband_lbl",
+        acomms_pb.MICROMODEM_GENERIC_LBL_RANGING: "_initiate_generic_lbl",
+        acomms_pb.MICROMODEM_HARDWARE_CONTROL: "_initiate_hardware_control",
+        acomms_pb.MICROMODEM_FM_SWEEP: "_initiate_fm_sweep",
+        acomms_pb.MICROMODEM_M_SEQUENCE: "_initiate_m_sequence",
     }
 
     def _lbl_params(self, msg, name: str):
         """Configured LBL parameters merged with the request's own (§7.4)."""
         params = type(getattr(self.mm_cfg, name))()
         params.CopyFrom(getattr(self.mm_cfg, name))
-        params.MergeFrom(getattr(msg.Extensions[m.MM_TRANSMISSION], name))
+        params.MergeFrom(getattr(msg.Extensions[acomms_pb.MM_TRANSMISSION], name))
         if self.nvram.get("TAT") != params.turnaround_ms:
             self._push("$CCCFG", "TAT", params.turnaround_ms)
         return params, int(params.lbl_max_range * 2 / 1500 * 1000 + params.turnaround_ms)
@@ -666,7 +668,7 @@ class MMDriver(ModemDriverBase):
     def _initiate_remus_lbl(self, msg) -> None:
         params, timeout = self._lbl_params(msg, "remus_lbl")
         bits = params.enable_beacons
-        self._last_lbl_type = m.MICROMODEM_REMUS_LBL_RANGING
+        self._last_lbl_type = acomms_pb.MICROMODEM_REMUS_LBL_RANGING
         self._push(
             "$CCPDT", 1, self.modem_id % 4 + 1, 0, 0, timeout, *((bits >> i) & 1 for i in range(4))
         )
@@ -674,34 +676,34 @@ class MMDriver(ModemDriverBase):
     def _initiate_narrowband_lbl(self, msg) -> None:
         p, timeout = self._lbl_params(msg, "narrowband_lbl")
         freqs = [*list(p.receive_freq)[:4], 0, 0, 0, 0][:4]
-        self._last_lbl_type = m.MICROMODEM_NARROWBAND_LBL_RANGING
+        self._last_lbl_type = acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING
         self._push("$CCPNT", p.transmit_freq, p.transmit_ping_ms, p.receive_ping_ms, timeout,
                    *freqs, int(p.transmit_flag))  # fmt: skip
 
     def _initiate_generic_lbl(self, msg) -> None:
         p, timeout = self._lbl_params(msg, "generic_lbl")
         codes = [*list(p.receive_seq_code)[:4], 0, 0, 0, 0][:4]
-        self._last_lbl_type = m.MICROMODEM_GENERIC_LBL_RANGING
+        self._last_lbl_type = acomms_pb.MICROMODEM_GENERIC_LBL_RANGING
         self._push("$CCPGT", p.transmit_freq, p.n_bits, p.transmit_seq_code, timeout,
                    p.receive_freq, *codes, p.bandwidth, 0)  # fmt: skip
 
     def _initiate_hardware_control(self, msg) -> None:
-        hw = msg.Extensions[m.MM_TRANSMISSION].hw_ctl
+        hw = msg.Extensions[acomms_pb.MM_TRANSMISSION].hw_ctl
         src = msg.src if msg.src >= 0 else self.modem_id
         self._push("$CCMEC", src, msg.dest, hw.line, hw.mode, hw.arg)
 
     def _initiate_fm_sweep(self, msg) -> None:
-        p = m.MMConfig().fm_sweep
+        p = acomms_pb.MMConfig().fm_sweep
         p.CopyFrom(self.mm_cfg.fm_sweep)
-        p.MergeFrom(msg.Extensions[m.MM_TRANSMISSION].fm_sweep)
+        p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].fm_sweep)
         self._push("$CCSWP", int(p.start_freq * 10), int(p.stop_freq * 10),
                    int(abs(p.start_freq - p.stop_freq)), int(p.duration_ms * 10),
                    p.number_repetitions, int(p.repetition_period_ms * 10))  # fmt: skip
 
     def _initiate_m_sequence(self, msg) -> None:
-        p = m.MMConfig().m_sequence
+        p = acomms_pb.MMConfig().m_sequence
         p.CopyFrom(self.mm_cfg.m_sequence)
-        p.MergeFrom(msg.Extensions[m.MM_TRANSMISSION].m_sequence)
+        p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].m_sequence)
         self._push("$CCMSQ", p.seqlen_bits, p.number_repetitions, p.carrier_cycles_per_chip,
                    p.carrier_freq)  # fmt: skip
 
@@ -710,18 +712,18 @@ class MMDriver(ModemDriverBase):
         major, minor, patch = self.revision
         if major == 2 and minor == 0 and patch < 18307:  # these firmwares swap src and dest
             src, dest = dest, src
-        msg = self._ping_result(src, dest, m.MICROMODEM_HARDWARE_CONTROL_REPLY)
-        hw = msg.Extensions[m.MM_TRANSMISSION].hw_ctl
+        msg = self._ping_result(src, dest, acomms_pb.MICROMODEM_HARDWARE_CONTROL_REPLY)
+        hw = msg.Extensions[acomms_pb.MM_TRANSMISSION].hw_ctl
         hw.line, hw.mode, hw.arg = s.as_int(3), s.as_int(4), s.as_int(5)
         self.signal_receive.emit(msg)
 
     def _on_tta(self, s: NMEASentence) -> None:
         msg = self._ping_result(self.modem_id, -1, self._last_lbl_type)
         msg.ClearField("dest")
-        msg.time_source = m.ModemTransmission.MODEM_TIME
+        msg.time_source = acomms_pb.ModemTransmission.MODEM_TIME
         today = _utc_date(self.clock.now())
         msg.time = parse_toa(s[5], today)
-        reply = msg.Extensions[m.MM_TRANSMISSION].ranging_reply
+        reply = msg.Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply
         for i in range(1, 5):
             reply.one_way_travel_time.append(s.as_float(i) if s[i] else 0.0)
         self.signal_receive.emit(msg)

@@ -10,8 +10,9 @@ from collections.abc import Mapping
 
 from google.protobuf.message import Message
 
-from pygoby.acomms import messages as m
-from pygoby.util.nmea import NMEAFormatError, NMEASentence, parse_ints
+from pygoby.acomms import messages as acomms_pb
+from pygoby.util.errors import NMEAFormatError
+from pygoby.util.nmea import NMEASentence, parse_ints
 
 log = logging.getLogger(__name__)
 
@@ -69,7 +70,7 @@ def clock_mode_from_field(value: int, new_bitfield: bool) -> int:
 
 def parse_cst(sentence: NMEASentence, today: dt.date, new_clock_bitfield: bool = False):
     """A $CACST sentence -> ReceiveStatistics (fields up to a short sentence's end)."""
-    return m.ReceiveStatistics(**cst_fields(sentence, today, new_clock_bitfield))
+    return acomms_pb.ReceiveStatistics(**cst_fields(sentence, today, new_clock_bitfield))
 
 
 def cst_fields(sentence: NMEASentence, today: dt.date, new_clock_bitfield: bool = False) -> dict:
@@ -109,7 +110,7 @@ def add_cst(stats, sentence: NMEASentence, today: dt.date, new_clock_bitfield: b
     key = (new_clock_bitfield, fields[: 2 + off], fields[3 + off :])
     template = _cst_templates.get(key)
     if template is None:
-        template = m.ReceiveStatistics(**cst_fields(sentence, today, new_clock_bitfield))
+        template = acomms_pb.ReceiveStatistics(**cst_fields(sentence, today, new_clock_bitfield))
         # (short sentences are not remembered: their warning is logged every time)
         if len(fields) == 4 + off + len(_CST_INT_FIELDS):
             if len(_cst_templates) >= _CST_TEMPLATES_LIMIT:
@@ -223,7 +224,7 @@ def parse_xst(sentence: NMEASentence):
     if "ack_requested" in fields:
         fields["ack_requested"] = bool(fields["ack_requested"])
     # (one constructor call: setting the fields one by one is several times slower)
-    stat = m.TransmitStatistics(version=version, date=date, time=time, **fields)
+    stat = acomms_pb.TransmitStatistics(version=version, date=date, time=time, **fields)
     if present < len(_XST_FIELDS):
         log.warning("short $CAXST (%d fields): stopped at %s", len(sentence), _XST_FIELDS[present])
     return stat

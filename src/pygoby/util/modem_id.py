@@ -1,4 +1,5 @@
-"""The modem-id lookup file: `modem_id, name, type[, location]` per line, `//` and `#` comments."""
+"""The modem-id lookup file: `modem_id, name, type[, location]` per line, `//` and `#` comments
+(goby's ModemIdConvert; shared by the MOOS translator's algorithms and the uField driver)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import os
 import re
 from dataclasses import dataclass
 
-log = logging.getLogger("pygoby.moos.translator")
+log = logging.getLogger(__name__)
 
 _LEADING_INT = re.compile(r"\s*([+-]?[0-9]+)")
 

@@ -1,6 +1,6 @@
 import logging
 
-from pygoby.moos.translator import ModemIdLookup
+from pygoby.util.modem_id import ModemIdLookup
 
 
 def test_parse_lookup_file(tmp_path, caplog):

@@ -1,0 +1,37 @@
+"""The AcommsError family: what goby-acomms (drivers, queue, MAC, handler, wire formats)
+raises on purpose."""
+
+from pygoby.errors import PygobyError
+
+
+class AcommsError(PygobyError):
+    """Base class of every acomms error."""
+
+
+class ModemDriverError(AcommsError):
+    """A driver failure; `status` is a ModemDriverStatus.Status value."""
+
+    def __init__(self, message: str, status: int) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+class QueueError(AcommsError):
+    """A message cannot be queued (no queue for its type, empty encoding, bad config)."""
+
+
+class RoleError(AcommsError, ValueError):
+    """A role in the queue configuration is invalid for its message type (or a message's role
+    field holds a value the role cannot use)."""
+
+
+class HandlerError(AcommsError):
+    """The handler's configuration cannot be used, or a failure it cannot recover from."""
+
+
+class RudicsPacketError(AcommsError, ValueError):
+    """A RUDICS packet is too short, too long or fails its CRC."""
+
+
+class ABCParseError(AcommsError, ValueError):
+    """A line is not `KEY,NAME:VALUE,...` (the ABC example modem's protocol)."""

@@ -1,0 +1,21 @@
+"""The MoosError family: what the MOOS layer (wire protocol, client, DB, mission files, apps'
+configuration, translator) raises on purpose. `pygoby.moos.translator` adds TranslatorError
+under MoosError; configuration problems are `pygoby.errors.ConfigError`s."""
+
+from pygoby.errors import ConfigError, PygobyError
+
+
+class MoosError(PygobyError):
+    """Base class of every MOOS error."""
+
+
+class MoosProtocolError(MoosError, ValueError):
+    """Bytes that do not form a valid MOOS unit (bad length, truncated message, ...)."""
+
+
+class MoosRefusedError(MoosError):
+    """The DB refused the handshake (poison message); carries the DB's reason."""
+
+
+class MissionFileError(MoosError, ConfigError):
+    """A .moos mission file lacks what is asked of it (e.g. the ANTLER block)."""
