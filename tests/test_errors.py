@@ -143,7 +143,7 @@ def test_configuration_errors_from_files_carry_file_and_line(tmp_path):
     with pytest.raises(ScenarioError) as info:
         load_scenario(scenario)
     assert (info.value.file, info.value.line) == (str(scenario), 3)
-    assert str(info.value).startswith(f"{scenario}:3: cannot parse scenario: ")
+    assert str(info.value).startswith(f"{scenario}:3: speed: Expected string")
 
     mission = tmp_path / "m.moos"
     mission.write_text("ProcessConfig = pApp\n{\n  app_tick: soon\n}\n")

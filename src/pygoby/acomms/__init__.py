@@ -36,6 +36,7 @@ from pygoby.acomms.errors import (
     QueueError,
     RoleError,
     RudicsPacketError,
+    StoreServerAuthError,
 )
 from pygoby.util.modules import lazy_exports
 
@@ -68,6 +69,7 @@ __all__ = [
     "RoleError",
     "RouteManager",
     "RudicsPacketError",
+    "StoreServerAuthError",
     "bind",
     "make_driver",
     "unbind",

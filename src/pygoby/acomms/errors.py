@@ -29,6 +29,10 @@ class HandlerError(AcommsError):
     """The handler's configuration cannot be used, or a failure it cannot recover from."""
 
 
+class StoreServerAuthError(AcommsError):
+    """A store-server request is not signed with its modem id's secret, or replays an older one."""
+
+
 class RudicsPacketError(AcommsError, ValueError):
     """A RUDICS packet is too short, too long or fails its CRC."""
 

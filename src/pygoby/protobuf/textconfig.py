@@ -89,8 +89,11 @@ def _printable(text: str) -> str:
 
 
 def _field_near(line_text: str, column: int) -> str | None:
-    names = re.findall(r"([A-Za-z_][\w.]*|\[[\w.]+\])\s*[:{]", line_text[: max(column, 1)])
-    return names[-1] if names else None
+    """The field name at or before the (1-based) column of an error on `line_text`."""
+    names = list(re.finditer(r"([A-Za-z_][\w.]*|\[[\w.]+\])\s*[:{]", line_text))
+    before = [match for match in names if match.start() < max(column, 1)]
+    chosen = before[-1] if before else (names[0] if names else None)
+    return chosen.group(1) if chosen else None
 
 
 def check_config_values(

@@ -15,15 +15,12 @@ import hmac
 import os
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.errors import ConfigError, PygobyError
+from pygoby.acomms.errors import StoreServerAuthError
+from pygoby.errors import ConfigError
 
 # room the two fields take in a request: auth_time (key + 8 bytes) and auth_hmac (key, length,
 # 32 bytes), rounded up
 AUTH_BYTES = 64
-
-
-class AuthError(PygobyError):
-    """A request is not signed, or not signed with its modem id's secret."""
 
 
 def sign_request(payload: bytes, secret: bytes, now: float) -> bytes:
@@ -33,16 +30,16 @@ def sign_request(payload: bytes, secret: bytes, now: float) -> bytes:
 
 
 def verify_request(payload: bytes, secret: bytes) -> float:
-    """The request's auth_time if it is signed with `secret`; AuthError otherwise."""
+    """The request's auth_time if it is signed with `secret`; StoreServerAuthError otherwise."""
     auth = acomms_pb.StoreServerRequestAuth.FromString(payload)  # the other fields are unknown to it
     if not (auth.HasField("auth_hmac") and auth.HasField("auth_time")):
-        raise AuthError("the request is not signed")
+        raise StoreServerAuthError("the request is not signed")
     tail = acomms_pb.StoreServerRequestAuth(auth_hmac=auth.auth_hmac).SerializeToString()
     if not payload.endswith(tail):
-        raise AuthError("the signature is not the request's last field")
+        raise StoreServerAuthError("the signature is not the request's last field")
     expected = hmac.new(secret, payload[: -len(tail)], hashlib.sha256).digest()
     if not hmac.compare_digest(expected, auth.auth_hmac):
-        raise AuthError("wrong signature")
+        raise StoreServerAuthError("wrong signature")
     return auth.auth_time
 
 

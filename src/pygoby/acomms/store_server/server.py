@@ -16,15 +16,15 @@ from collections.abc import Mapping
 from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.errors import RudicsPacketError
+from pygoby.acomms.errors import RudicsPacketError, StoreServerAuthError
 from pygoby.acomms.rudics import (
     MAX_PACKET_BYTES,
     max_data_bytes,
     parse_rudics_packet,
     serialize_rudics_packet,
 )
-from pygoby.acomms.store_server.auth import AuthError, verify_request
-from pygoby.acomms.store_server.store import ReplayedRequestError, TransmissionStore
+from pygoby.acomms.store_server.auth import verify_request
+from pygoby.acomms.store_server.store import TransmissionStore
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.linebased import LineSplitter
 
@@ -78,7 +78,7 @@ class StoreServer:
         try:
             auth_time = self._authenticate(request.modem_id, payload, now)
             response = self.store.exchange(request, now, max_data_bytes(), auth_time)
-        except (AuthError, ReplayedRequestError) as exc:
+        except StoreServerAuthError as exc:
             log.warning("refusing a request for modem id %d: %s", request.modem_id, exc)
             self.requests_refused += 1
             return _error_reply(request, "not authenticated for this modem id")
@@ -95,10 +95,10 @@ class StoreServer:
             return None
         secret = self.secrets.get(modem_id)
         if secret is None:
-            raise AuthError("no secret is configured for it")
+            raise StoreServerAuthError("no secret is configured for it")
         auth_time = verify_request(payload, secret)
         if not abs(auth_time - now) <= self.auth_window:
-            raise AuthError(f"request time is {auth_time - now:+.0f} s from the server's clock")
+            raise StoreServerAuthError(f"request time is {auth_time - now:+.0f} s from the server's clock")
         return auth_time
 
     def _prune(self, now: float) -> None:

@@ -15,8 +15,8 @@ import sqlite3
 from pathlib import Path
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.errors import StoreServerAuthError
 from pygoby.acomms.rudics import embedded_size
-from pygoby.errors import PygobyError
 
 log = logging.getLogger(__name__)
 
@@ -44,9 +44,6 @@ _DELIVERED = """(
         (SELECT 1 FROM client c WHERE c.modem_id != t.src AND c.last_id < t.id))
 )"""
 
-
-class ReplayedRequestError(PygobyError):
-    """A signed request is not newer than the last one accepted for its modem id."""
 
 
 class TransmissionStore:
@@ -89,7 +86,7 @@ class TransmissionStore:
         comes with the next request. A single stored transmission too large for any response
         is skipped with a warning (it would otherwise block the requester's mail forever).
         `auth_time`: a signed request's time, which must be later than the last accepted one
-        for the modem id (ReplayedRequestError otherwise)."""
+        for the modem id (StoreServerAuthError otherwise)."""
         response = acomms_pb.StoreServerResponse(modem_id=request.modem_id)
         if request.HasField("request_id"):
             response.request_id = request.request_id
@@ -139,7 +136,7 @@ class TransmissionStore:
         row = self.db.execute("SELECT last_time FROM auth WHERE modem_id = ?", (modem_id,))
         last = row.fetchone()
         if last is not None and auth_time <= last[0]:
-            raise ReplayedRequestError(
+            raise StoreServerAuthError(
                 f"request time {auth_time} is not after the last accepted, {last[0]}"
             )
         self.db.execute(
