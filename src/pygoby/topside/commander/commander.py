@@ -333,7 +333,9 @@ class Commander:
         for kind in self.commands.types.values():
             names[kind.short_name] = names[kind.name] = [f.name for f in kind.fields]
         warnings = []
-        for message_name, values in savefile.parse(Path(path).read_text(), names):
+        # a hand-edited file in another encoding still loads (its odd bytes become U+FFFD)
+        text = Path(path).read_text(encoding="utf-8", errors="replace")
+        for message_name, values in savefile.parse(text, names):
             try:
                 draft = self.open(message_name)
             except KeyError:
