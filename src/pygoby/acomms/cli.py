@@ -51,6 +51,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "with its secret, ids not listed are refused (default: no check)")  # fmt: skip
     s.set_defaults(func=run_store_server)
 
+    lb = subparsers.add_parser(
+        "loopbacks",
+        help="virtual serial line pairs (/tmp/ttyLOOPA1 <-> /tmp/ttyLOOPA2, ...) for emulated modems",
+        description="Pseudo-terminal pairs joined back to back, linked at PREFIX<X>1 and "
+        "PREFIX<X>2 for each pair name X (what Goby 1.1 missions made with socat). Runs until "
+        "Ctrl-C, then removes the links. Links left by a process that died are replaced.",
+    )
+    lb.add_argument("--prefix", default="/tmp/ttyLOOP", help="link name prefix (default %(default)s)")
+    lb.add_argument("--pairs", default="A,B,C,D", help="pair names (default %(default)s)")
+    lb.set_defaults(func=run_loopbacks)
+
     a = subparsers.add_parser(
         "abc_modem_simulator",
         help="simulator for the ABC example modem (DRIVER_ABC_EXAMPLE_MODEM)",
@@ -87,6 +98,35 @@ async def _serve(args: argparse.Namespace) -> None:
     finally:
         await server.close()
         channel.close()
+
+
+def run_loopbacks(args: argparse.Namespace) -> int:
+    from pygoby.util.pty import PtyError, PtyPair
+
+    names = [n.strip() for n in args.pairs.split(",") if n.strip()]
+    pairs: list[PtyPair] = []
+    try:
+        for name in names:
+            pairs.append(PtyPair(f"{args.prefix}{name}1", f"{args.prefix}{name}2").open())
+    except (PtyError, OSError) as err:
+        for pair in pairs:
+            pair.close()
+        print(f"loopbacks: {err}", file=sys.stderr)
+        return 1
+    for pair in pairs:
+        print(f"loopback {pair.paths[0]} <-> {pair.paths[1]}", flush=True)
+
+    async def relay() -> None:
+        for pair in pairs:
+            pair.attach()
+        try:
+            await asyncio.Future()
+        finally:
+            for pair in pairs:
+                pair.close()
+
+    run_until_signal(relay())
+    return 0
 
 
 def run_store_server(args: argparse.Namespace) -> int:

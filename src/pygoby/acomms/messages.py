@@ -84,6 +84,16 @@ StoreServerResponseStatus = _cls("pygoby.acomms.protobuf.StoreServerResponseStat
 UFldConfig = _cls("goby.moos.ufld.protobuf.Config")
 UFldTransmission = _cls("goby.moos.ufld.protobuf.Transmission")
 
+# Goby 1.1 forms (goby.transitional.protobuf): CCL queues and the 1.1 MOOS variables
+V1QueueConfig = _cls("goby.transitional.protobuf.QueueConfig")
+V1ModemDataTransmission = _cls("goby.transitional.protobuf.ModemDataTransmission")
+V1ModemRangingRequest = _cls("goby.transitional.protobuf.ModemRangingRequest")
+V1ModemRangingReply = _cls("goby.transitional.protobuf.ModemRangingReply")
+V1MACUpdate = _cls("goby.transitional.protobuf.MACUpdate")
+QUEUE_CCL = _loader.pool.FindEnumTypeByName("goby.transitional.protobuf.QueueType").values_by_name[
+    "QUEUE_CCL"
+].number
+
 MM_CONFIG = extension("goby.acomms.micromodem.protobuf.config")
 MM_TRANSMISSION = extension("goby.acomms.micromodem.protobuf.transmission")
 UDP_CONFIG = extension("goby.acomms.udp.protobuf.config")

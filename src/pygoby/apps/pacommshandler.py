@@ -21,6 +21,8 @@ from google.protobuf.message import Message
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.acomms.queue import QueueError
+from pygoby.acomms.transitional import TransitionalMessages
+from pygoby.apps.pacommshandler_goby11 import Goby11Variables
 from pygoby.dccl import DcclError
 from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
@@ -55,6 +57,8 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.var = prefixed_var_names(cfg.moos_var, skip=(IFS_DATA_OUT,))
         self.ifs_data_out = getattr(cfg.moos_var, IFS_DATA_OUT)
         self.loader = ProtoLoader()
+        # Goby 1.1 XML message files -> DCCL types, queue and translator entries
+        self.transitional = TransitionalMessages.expand(cfg, self.loader, self.find_file)
         try:
             self.acomms = AcommsHandler(cfg, self.clock, self.loader)
         except HandlerError as err:
@@ -72,12 +76,14 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         )
         lookup = cfg.modem_id_lookup_path
         self.binding = TranslatorBinding(
-            self, cfg.translator_entry, self.message_types, on_created=self._push,
+            self, cfg.translator_entry, self.message_types, on_created=self._created,
             multiplex_vars=cfg.multiplex_create_moos_var,
             modem_id_lookup_path=self.find_file(lookup) if lookup else "",
         )  # fmt: skip
         self.translator = self.binding.translator
         self._connect_signals()
+        self.goby11 = Goby11Variables(self, self.acomms, cfg.queue_cfg, enabled=bool(
+            cfg.queue_cfg.queue or cfg.transitional_cfg.message_file))  # fmt: skip
         self._configure_queue()
         self._subscribe_all()
         self.frontseat_forward = {self._loaded(name) for name in cfg.dccl_frontseat_forward_name}
@@ -132,12 +138,13 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
                        "mac_initiate_transmission": acomms.initiate_transmission}  # fmt: skip
         for key, handler in from_others.items():
             self.subscribe_pb(self.var[key], acomms_pb.ModemTransmission, handler, ignore_own=True)
-        self.subscribe_pb(self.var["mac_cycle_update"], acomms_pb.MACUpdate, acomms.apply_mac_update)
+        self.subscribe(self.var["mac_cycle_update"], self._on_mac_update)
         self.subscribe_pb(self.var["queue_flush"], acomms_pb.QueueFlush, self.queue.flush_queue)
         self.subscribe(self.var["config_file_request"], self._on_config_request)
         self.subscribe(self.var["driver_reset"], self._on_driver_reset)
         self.subscribe_pb(self.var["driver_cfg_update"], acomms_pb.DriverConfig, acomms.update_driver_cfg)
         self.binding.subscribe_all()
+        self.goby11.subscribe_all()
 
     # ------------------------------------------------------------------ running
     def on_start(self) -> None:
@@ -169,6 +176,14 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.request_stop()
 
     # ------------------------------------------------------------------ MOOS -> acomms
+    def _created(self, message: Message) -> None:
+        self._push(self.transitional.complete(message, self.clock.now(), self.cfg.modem_id))
+
+    def _on_mac_update(self, msg: MOOSMessage) -> None:
+        """Today's MACUpdate, or Goby 1.1's (ADD/REMOVE/REPLACE with SLOT_* slots)."""
+        if not self.goby11.apply_mac_update(msg) and (update := self.parse_pb(msg, acomms_pb.MACUpdate)):
+            self.acomms.apply_mac_update(update)
+
     def _push(self, message: Message) -> None:
         try:
             self.queue.push_message(message)

@@ -14,6 +14,7 @@ from pygoby.dccl.analyze import describe, generated_source
 from pygoby.dccl.codec import Codec
 from pygoby.dccl.errors import DcclError
 from pygoby.dccl.trace import log as trace_log
+from pygoby.errors import ConfigError
 
 PASSPHRASE_ENV = "PYGOBY_DCCL_PASSPHRASE"
 
@@ -21,11 +22,17 @@ PASSPHRASE_ENV = "PYGOBY_DCCL_PASSPHRASE"
 def register(subparsers) -> None:
     parser = subparsers.add_parser("dccl", help="encode, decode and analyze DCCL messages")
     parser.add_argument("action", choices=["encode", "decode", "analyze"])
-    parser.add_argument("--proto", required=True, help=".proto file defining the message")
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--proto", help=".proto file defining the message")
+    source.add_argument("--xml", metavar="FILE",
+                        help="Goby 1.1 XML message set (converted to DCCL in memory)")
     parser.add_argument("-I", "--include", action="append", default=[], metavar="DIR",
                         help="include directory for imports (repeatable)")
-    parser.add_argument("--message", required=True, metavar="FULL.NAME",
-                        help="fully qualified message name")
+    parser.add_argument("--message", metavar="FULL.NAME",
+                        help="fully qualified message name (with --xml: the XML <name>; "
+                             "analyze without it shows every message of the file)")
+    parser.add_argument("--write-proto", metavar="DIR",
+                        help="with --xml: also write the converted .proto file into DIR")
     secret = parser.add_mutually_exclusive_group()
     secret.add_argument("--passphrase-file", metavar="FILE",
                         help="encrypt/decrypt the body with the passphrase in FILE (one trailing "
@@ -42,7 +49,28 @@ def register(subparsers) -> None:
     parser.set_defaults(func=run)
 
 
+def _load_xml(codec: Codec, args: argparse.Namespace) -> list:
+    from pygoby.dccl.xml import load_message_set
+
+    message_set = load_message_set(args.xml)
+    classes = message_set.load_into(codec)
+    if args.write_proto:
+        print(f"wrote {message_set.write_proto(args.write_proto)}", file=sys.stderr)
+    if args.message is None:
+        return classes
+    if args.message not in message_set.names:
+        raise ConfigError(f"no message named {args.message!r} (the file has "
+                          f"{', '.join(message_set.names)})", file=args.xml)  # fmt: skip
+    return [classes[message_set.names.index(args.message)]]
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.write_proto and not args.xml:
+        print("error: --write-proto needs --xml", file=sys.stderr)
+        return 2
+    if args.message is None and not (args.xml and args.action == "analyze"):
+        print("error: --message is required", file=sys.stderr)
+        return 2
     if args.trace:
         handler = logging.StreamHandler(sys.stderr)
         handler.setFormatter(logging.Formatter("%(message)s"))
@@ -51,14 +79,18 @@ def run(args: argparse.Namespace) -> int:
     try:
         passphrase = read_passphrase(args)
         codec = Codec(passphrase=passphrase, strict=args.strict, trace=args.trace)
-        cls = codec.load_proto(args.proto, args.message, args.include)
-    except (DcclError, OSError) as exc:
+        if args.xml:
+            classes = _load_xml(codec, args)
+        else:
+            classes = [codec.load_proto(args.proto, args.message, args.include)]
+    except (DcclError, ConfigError, OSError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     if args.action == "analyze":
         show = generated_source if args.source else describe
-        print(show(codec.compiled(cls)))
+        print("\n\n".join(show(codec.compiled(c)) for c in classes))
         return 0
+    cls = classes[0]
 
     def encode(line: str) -> str:
         msg = cls()

@@ -43,7 +43,9 @@ def child_argv(run: AntlerRun, mission: Path, executable_path: str | None) -> li
     if directory and directory.upper() != "SYSTEM":
         program = str(Path(directory) / run.program)
     else:
-        program = shutil.which(run.program) or ""
+        # PATH, then beside this Python (pygoby's console scripts when its venv is not activated)
+        beside = Path(sys.executable).with_name(run.program)
+        program = shutil.which(run.program) or (str(beside) if beside.is_file() else "")
     if not program or not os.access(program, os.X_OK):
         return None
     argv = [program]
@@ -89,7 +91,8 @@ class Antler:
             argv = child_argv(run, self.mission_path, self.config.executable_path)
             if argv is None:
                 log.error("cannot find executable %r; not launched", run.program)
-                print(f"antler: cannot find {run.program}", file=sys.stderr)
+                print(f"antler: {run.moos_name}: {run.program} is not available (no such program "
+                      "on PATH); the other processes run without it", file=sys.stderr, flush=True)  # fmt: skip
                 continue
             if run.options.get("NewConsole", "false").lower() == "true":
                 log.info("%s: NewConsole is not supported; running in this terminal", run.moos_name)

@@ -84,7 +84,12 @@ from google.protobuf.message import Message
 from pygoby.errors import ConfigError
 from pygoby.moos import appcli
 from pygoby.moos import protocol as p
-from pygoby.moos.appconfig import example_config, initializer_posts, read_configuration
+from pygoby.moos.appconfig import (
+    collecting_notes,
+    example_config,
+    initializer_posts,
+    read_configuration,
+)
 from pygoby.moos.applog import AppLogHandlers
 from pygoby.moos.appstatus import StatusReport
 from pygoby.moos.client import MOOSClient
@@ -163,8 +168,11 @@ class GobyMOOSApp:
     ) -> GobyMOOSApp:  # fmt: skip
         app_name = name or cls.default_name or cls.__name__
         mission = MissionFile.read(path)
-        cfg = cls.read_config(mission, app_name, overrides)
-        return cls(cfg, name=app_name, mission=mission, **kwargs)  # type: ignore[arg-type]
+        with collecting_notes() as notes:
+            cfg = cls.read_config(mission, app_name, overrides)
+        app = cls(cfg, name=app_name, mission=mission, **kwargs)  # type: ignore[arg-type]
+        app.config_notes = notes
+        return app
 
     @classmethod
     def example_config(cls, name: str | None = None) -> str:
@@ -216,6 +224,8 @@ class GobyMOOSApp:
         self._status = StatusReport()
         self.iterations = 0
         self.exit_status = 0
+        # Goby 1.1/2 configuration forms mapped at load (appconfig.collecting_notes), logged once
+        self.config_notes: list[str] = []
 
     # -- API for subclasses --------------------------------------------------------------------
 
@@ -309,6 +319,9 @@ class GobyMOOSApp:
         """Start logging, the comms and the tick loop. With `connect_timeout`, wait for the
         first connection (TimeoutError otherwise); without, carry on and keep trying."""
         self._log_handlers = AppLogHandlers.open(self.log, self.name, self.common)
+        if self.config_notes:
+            self.log.info("Goby 1.1/2 configuration forms mapped onto today's:\n  %s",
+                          "\n  ".join(self.config_notes))  # fmt: skip
         self._stop_requested = asyncio.Event()
         self._stopping = False
         self.start_time = self.clock.now()

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pygoby.errors import ConfigError
+from pygoby.moos.appconfig import collecting_notes
 from pygoby.moos.moosfile import MissionFile
 
 if TYPE_CHECKING:
@@ -103,8 +104,10 @@ def run_app(
         parser.error(str(err))
     mission = read_mission(known.moos_file or known.mission, name)
     try:
-        cfg = app_class.read_config(mission, name, overrides)
+        with collecting_notes() as notes:
+            cfg = app_class.read_config(mission, name, overrides)
         app = app_class(cfg, name=name, mission=mission)
+        app.config_notes = notes
     except ConfigError as err:
         print(f"{name}: fatal configuration error: {err}", file=sys.stderr)
         return 1

@@ -15,15 +15,18 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import logging
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextvars import ContextVar
 
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
+from pygoby.moos import goby11_config
 from pygoby.moos.moosfile import MissionFile, parse_number
 from pygoby.protobuf import builtin_class
 from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
@@ -182,26 +185,54 @@ def _quote(value: str) -> str:
     return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
+# Where read_configuration reports the Goby 1.1/2 forms it mapped, while `collecting_notes` runs
+# (the app logs them once its logging is set up).
+_NOTES: ContextVar[list[str] | None] = ContextVar("pygoby_config_notes", default=None)
+
+
+@contextlib.contextmanager
+def collecting_notes() -> Iterator[list[str]]:
+    """`with collecting_notes() as notes:` every read_configuration inside adds its notes."""
+    notes: list[str] = []
+    token = _NOTES.set(notes)
+    try:
+        yield notes
+    finally:
+        _NOTES.reset(token)
+
+
 def read_configuration(
     config_class: type[Message],
     mission: MissionFile | None,
     app_name: str,
     overrides: Sequence[tuple[str, str]] = (),
     complete: Callable[[Message], None] | None = None,
+    notes: list[str] | None = None,
 ) -> Message:
     """`complete(config)`, if given, runs after the overrides and before the check for required
-    fields (an app's own rewriting of older configuration forms)."""
+    fields (an app's own rewriting of older configuration forms). Goby 1.1 and Goby 2 forms are
+    mapped onto today's configuration first (pygoby.moos.goby11_config); what was mapped is
+    appended to `notes` (for the app to log once)."""
     config = config_class()
     source = str(mission.path) if mission is not None and mission.path else "mission file"
+    translated: list[str] = []
     if mission is not None:
         block = mission.goby_block(app_name)
         if block is None:
             raise ConfigError(f"no ProcessConfig block for {app_name}", file=source)
-        parse_block(config, block.text, block.first_line, source)
+        translation = goby11_config.translate(block.text, config_class.DESCRIPTOR)
+        parse_block(config, translation.text, block.first_line, source)
+        translated = [f"{source}:{_shift(note, block.first_line)}" for note in translation.notes]
         try:
             apply_moos_globals(config, mission)
         except ConfigError as err:
             raise err.located(file=source) from None
+    moved: list[str] = []
+    goby11_config.finish(config, moved)
+    translated += [f"{source}: {note}" for note in moved]
+    sink = notes if notes is not None else _NOTES.get()
+    if sink is not None:
+        sink.extend(translated)
     apply_overrides(config, overrides)
     if complete is not None:
         complete(config)
@@ -211,6 +242,14 @@ def read_configuration(
     block_text, first_line = (block.text, block.first_line) if mission is not None else ("", 1)
     check_config_values(config, block_text, file=source, first_line=first_line)
     return config
+
+
+def _shift(note: str, first_line: int) -> str:
+    """A translation note's block line ("line N: ...") as a file line ("M: ...")."""
+    head, sep, rest = note.partition(": ")
+    if sep and head.startswith("line ") and head[5:].isdigit():
+        return f"{first_line + int(head[5:]) - 1}: {rest}"
+    return f" {note}"
 
 
 # ---------------------------------------------------------------------------------------------

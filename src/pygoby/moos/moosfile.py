@@ -113,6 +113,8 @@ class MissionFile:
         self.path = path
         self.raw_lines = raw_lines
         self.lines = self._preprocess(raw_lines)  # comments removed, macros expanded
+        # the same with double quotes kept (MOOS's reader with verbatim quoting disabled)
+        self.quoted_lines = self._preprocess(raw_lines, keep_quotes=True)
         self._in_block = self._block_mask(self.lines)
 
     @classmethod
@@ -134,7 +136,7 @@ class MissionFile:
         return str(beside) if beside.exists() else path
 
     @staticmethod
-    def _preprocess(raw_lines: list[str]) -> list[str]:
+    def _preprocess(raw_lines: list[str], keep_quotes: bool = False) -> list[str]:
         macros: dict[str, str] = {}
 
         def expand(match: re.Match[str]) -> str:
@@ -150,7 +152,11 @@ class MissionFile:
                 macros[_no_space(name)] = _no_space(strip_comment(value))
                 out.append("")
                 continue
-            out.append(strip_comment(line))
+            if keep_quotes:
+                cut = line.find("//")
+                out.append(("" if line.strip().startswith("//") else line[:cut] if cut >= 0 else line).strip())
+            else:
+                out.append(strip_comment(line))
         return out
 
     @staticmethod
@@ -224,9 +230,9 @@ class MissionFile:
 
     # -- ProcessConfig blocks (moos.md 17.3) ---------------------------------------------------
 
-    def _block_lines(self, app: str) -> list[str] | None:
+    def _block_lines(self, app: str, keep_quotes: bool = False) -> list[str] | None:
         header = f"PROCESSCONFIG={app}".upper()
-        lines = self.lines
+        lines = self.quoted_lines if keep_quotes else self.lines
         for i, line in enumerate(lines):
             if _no_space(line).upper() != header:
                 continue
@@ -246,10 +252,12 @@ class MissionFile:
             return body
         return None
 
-    def process_config(self, app: str) -> list[tuple[str, str]] | None:
+    def process_config(self, app: str, keep_quotes: bool = False) -> list[tuple[str, str]] | None:
         """The block's `name = value` settings in file order, names and values trimmed
-        (GetConfigurationAndPreserveSpace); None if there is no such block."""
-        body = self._block_lines(app)
+        (GetConfigurationAndPreserveSpace); None if there is no such block. MOOS's reader
+        removes the first pair of double quotes of a line ("verbatim quoting"); apps that
+        disable it (uTimerScript) pass `keep_quotes=True`."""
+        body = self._block_lines(app, keep_quotes)
         if body is None:
             return None
         out = []

@@ -127,6 +127,16 @@ class ProtoLoader:
         if known is not None and known != compiled:
             raise ProtoError(f"{file_proto.name} is already loaded with a different definition")
 
+    def add_file_proto(self, file_proto: descriptor_pb2.FileDescriptorProto) -> FileDescriptor:
+        """Add a file built in memory (its imports are loaded first, by import name)."""
+        for dependency in file_proto.dependency:
+            self.load_file(dependency)
+        try:
+            self._add(file_proto)
+            return self.pool.FindFileByName(file_proto.name)
+        except (TypeError, KeyError) as err:  # the pool refuses a malformed descriptor
+            raise ProtoError(f"cannot add {file_proto.name}: {err}") from None
+
     def find_descriptor(self, full_name: str) -> Descriptor:
         try:
             return self.pool.FindMessageTypeByName(full_name)

@@ -3,7 +3,13 @@ modem-id lookup. The light, widely used ones and the errors are exported here; i
 others (geodesy, nmea, linebased, aiorun, ...) from their modules."""
 
 from pygoby.util.clock import Clock, VirtualClock, WallClock
-from pygoby.util.errors import LinkClosedError, NMEAChecksumError, NMEAError, NMEAFormatError
+from pygoby.util.errors import (
+    LinkClosedError,
+    NMEAChecksumError,
+    NMEAError,
+    NMEAFormatError,
+    PtyError,
+)
 from pygoby.util.modem_id import ModemIdLookup
 from pygoby.util.signal import Signal
 
@@ -14,6 +20,7 @@ __all__ = [
     "NMEAChecksumError",
     "NMEAError",
     "NMEAFormatError",
+    "PtyError",
     "Signal",
     "VirtualClock",
     "WallClock",

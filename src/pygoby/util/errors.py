@@ -20,3 +20,8 @@ class NMEAChecksumError(NMEAError):
 
 class LinkClosedError(PygobyError, ConnectionError):
     """Writing to a link that is not open."""
+
+
+class PtyError(PygobyError, OSError):
+    """A pseudo-terminal link cannot be made (a running process owns it, or the path is not
+    one we may replace)."""

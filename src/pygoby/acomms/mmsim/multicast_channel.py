@@ -2,7 +2,10 @@
 
 Each process attaches its local modems; a transmission is delivered at once to the other local
 modems and sent to the group, where the other processes deliver it to theirs. Same semantics as
-LoopbackChannel (no loss, no delay); it only spans processes.
+LoopbackChannel (no loss, no delay); it only spans processes. Multicast (and broadcast)
+datagrams reach every socket bound to the port, which is why emulators of one host can share a
+port (a unicast datagram would reach only one of them). `BroadcastChannel` does the same with
+UDP broadcast to an address (Goby 1.1's iModemSim `BroadcastAddr`), to span hosts of a LAN.
 """
 
 from __future__ import annotations
@@ -102,3 +105,20 @@ class MulticastChannel(LoopbackChannel):
         for endpoint in list(self.endpoints):
             endpoint.receive(packet, Reception(packet.tx_time + self.travel_time,
                                                travel_time=self.travel_time))  # fmt: skip
+
+
+class BroadcastChannel(MulticastChannel):
+    """The channel over UDP broadcast: datagrams go to `address:port` (e.g. 192.168.1.255)
+    and are heard on `port` by every emulator of the hosts that address reaches."""
+
+    def __init__(self, address: str, port: int, travel_time: float = 0.0) -> None:
+        super().__init__(address, port, travel_time)
+
+    def open(self) -> None:
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_BROADCAST, 1)
+        sock.bind(("", self.port))
+        sock.setblocking(False)
+        self._sock = sock
+        asyncio.get_running_loop().add_reader(sock.fileno(), self._readable)

@@ -1,4 +1,4 @@
-"""asyncio front ends for the modem model: a TCP server and a pseudo-terminal (serial)."""
+"""asyncio front ends for the modem model: a TCP server, a pseudo-terminal or a serial device."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import re
 from pygoby.acomms.mmsim.channel import Channel
 from pygoby.acomms.mmsim.model import MicroModemModel
 from pygoby.util.linebased import open_pty_pair
+from pygoby.util.pty import open_serial
 
 log = logging.getLogger(__name__)
 
@@ -33,20 +34,24 @@ class _HostLines:
 
 class MMSimServer:
     """Serves one emulated modem on TCP (every client sees the modem's output) and optionally
-    on a pty (`pty_path` after `start`). Runs `channel.do_work()` every `work_period` s."""
+    on a pty (`pty_path` after `start`) or on a serial device (`serial_path`: a tty, e.g. one end
+    of a pygoby.util.pty.PtyPair). `port=None`: no TCP server. Runs `channel.do_work()` every
+    `work_period` s."""
 
     def __init__(
         self,
         model: MicroModemModel,
         channel: Channel,
         host: str = "127.0.0.1",
-        port: int = 0,
+        port: int | None = 0,
         use_pty: bool = False,
         work_period: float = 0.05,
+        serial_path: str | None = None,
     ) -> None:
         self.model, self.channel = model, channel
         self.host, self.port = host, port
         self.use_pty = use_pty
+        self.serial_path = serial_path
         self.work_period = work_period
         self.pty_path: str | None = None
         self._pty_master: int | None = None
@@ -55,15 +60,19 @@ class MMSimServer:
         self._tasks: list[asyncio.Task] = []
         model.on_output = self._broadcast
 
-    async def start(self) -> int:
-        self._server = await asyncio.start_server(self._client, self.host, self.port)
-        self.port = self._server.sockets[0].getsockname()[1]
-        if self.use_pty:
-            self._pty_master, self.pty_path = open_pty_pair()
+    async def start(self) -> int | None:
+        if self.port is not None:
+            self._server = await asyncio.start_server(self._client, self.host, self.port)
+            self.port = self._server.sockets[0].getsockname()[1]
+            log.info("Micro-Modem emulator id %d on %s:%d", self.model.modem_id, self.host, self.port)
+        if self.use_pty or self.serial_path:
+            if self.serial_path:
+                self._pty_master = open_serial(self.serial_path)
+            else:
+                self._pty_master, self.pty_path = open_pty_pair()
             asyncio.get_running_loop().add_reader(self._pty_master, self._pty_readable)
             self._pty_lines = _HostLines()
         self._tasks.append(asyncio.create_task(self._work()))
-        log.info("Micro-Modem emulator id %d on %s:%d", self.model.modem_id, self.host, self.port)
         return self.port
 
     async def close(self) -> None:

@@ -12,6 +12,8 @@ import logging
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import QueueError
+from pygoby.acomms.queue import ccl
+from pygoby.acomms.queue.ccl import CCLQueue
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
 from pygoby.dccl import DcclError
@@ -30,7 +32,9 @@ class QueueManager:
         self.cfg = acomms_pb.QueueManagerConfig()
         self.queues: dict[int, MessageQueue] = {}  # by DCCL id, kept in ascending order
         self._by_name: dict[str, MessageQueue] = {}
+        self.ccl_queues: dict[int, CCLQueue] = {}  # Goby 1.1 raw CCL queues, by CCL id
         self.signal_receive = Signal()  # (message)
+        self.signal_receive_ccl = Signal()  # (Goby 1.1 ModemDataTransmission of a CCL frame)
         self.signal_ack = Signal()  # (ack ModemTransmission, original message)
         self.signal_expire = Signal()  # (original message)
         self.signal_queue_size_change = Signal()  # (QueueSize)
@@ -59,6 +63,8 @@ class QueueManager:
                 peer.load(loaded)
         for entry in cfg.message_entry:
             self.add_queue(entry)
+        for queue_cfg in cfg.queue:
+            self.add_ccl_queue(queue_cfg)
 
     def add_queue(self, entry, message_class=None) -> MessageQueue:
         """Create (or update the options of) the queue for `entry.protobuf_name`.
@@ -72,6 +78,13 @@ class QueueManager:
         compiled = self.codec.compiled(message_class)
         if compiled.id is None:
             raise QueueError(f"{entry.protobuf_name} has no DCCL id")
+        first = ccl.dccl_first_byte(compiled.id)
+        if first in self.ccl_queues:
+            raise QueueError(
+                f"{entry.protobuf_name}: DCCL id {compiled.id} starts its frames with byte "
+                f"{first}, the id of CCL queue {self.ccl_queues[first].name}; received frames "
+                "could not be told apart"
+            )
         copy = acomms_pb.QueuedMessageEntry()
         copy.CopyFrom(entry)
         roles = compile_roles(copy, message_class.DESCRIPTOR)
@@ -86,7 +99,63 @@ class QueueManager:
         self._size_changed(queue)
         return queue
 
+    def add_ccl_queue(self, cfg) -> CCLQueue:
+        """Create (or update) a Goby 1.1 CCL queue from a goby.transitional.protobuf.QueueConfig."""
+        if not cfg.HasField("key") or cfg.key.type != acomms_pb.QUEUE_CCL:
+            raise QueueError(
+                f"queue {cfg.name!r}: queue blocks configure CCL queues (key {{ type: QUEUE_CCL "
+                "id: N }}); DCCL queues come from XML message files or message_entry"
+            )
+        ccl_id = cfg.key.id
+        if ccl_id > ccl.MAX_CCL_ID:
+            raise QueueError(f"queue {cfg.name!r}: CCL id {ccl_id} is not a byte (0-255)")
+        for loaded in self.codec.loaded():
+            dccl_id = self.codec.compiled(loaded).id
+            if dccl_id is not None and ccl.dccl_first_byte(dccl_id) == ccl_id:
+                raise QueueError(
+                    f"queue {cfg.name!r}: CCL id {ccl_id} is also the first byte of DCCL "
+                    f"id {dccl_id} ({loaded.DESCRIPTOR.full_name}); received frames could not "
+                    "be told apart"
+                )
+        entry = ccl.queue_entry(cfg)
+        existing = self.ccl_queues.get(ccl_id)
+        if existing is not None:
+            existing.entry = entry
+            return existing
+        queue = CCLQueue(entry, ccl_id, self.clock.now())
+        self.ccl_queues[ccl_id] = queue
+        return queue
+
+    def push_ccl(self, ccl_id: int, transmission) -> None:
+        """Queue a raw frame (a Goby 1.1 ModemDataTransmission: `data`, `base.dest`) on the CCL
+        queue `ccl_id`; its first byte must be that id."""
+        queue = self.ccl_queues.get(ccl_id)
+        if queue is None:
+            raise QueueError(f"no CCL queue with id {ccl_id}")
+        data = bytes(transmission.data)
+        if not data:
+            raise QueueError(f"{queue.name}: the frame is empty; not queued")
+        if data[0] != ccl_id:
+            raise QueueError(
+                f"{queue.name}: the frame starts with byte {data[0]}, not the queue's CCL id "
+                f"{ccl_id}; not queued"
+            )
+        dest = transmission.base.dest
+        if dest == self.modem_id:  # to ourselves: looped back, as Goby 1.1 did
+            now = acomms_pb.now_us(self.clock.now())
+            loop = acomms_pb.ModemTransmission(src=self.modem_id, dest=dest, time=now, type=acomms_pb.DATA)
+            self.signal_receive_ccl.emit(ccl.received(loop, data, ccl_id, 0))
+            return
+        ack = queue.entry.ack and dest != acomms_pb.BROADCAST_ID
+        queue.push(QueuedItem(transmission, data, self.modem_id, dest,
+                              acomms_pb.now_us(self.clock.now()), ack))  # fmt: skip
+
+    def _all_queues(self) -> list[MessageQueue]:
+        return [*self.queues.values(), *self.ccl_queues.values()]
+
     def _size_changed(self, queue: MessageQueue) -> None:
+        if isinstance(queue, CCLQueue):
+            return  # QueueSize names DCCL ids only
         self.signal_queue_size_change.emit(acomms_pb.QueueSize(dccl_id=queue.dccl_id, size=len(queue)))
 
     # ------------------------------------------------------------------ push
@@ -151,7 +220,7 @@ class QueueManager:
     # ------------------------------------------------------------------ data request
     def handle_modem_data_request(self, request) -> None:
         now = self.clock.now()
-        for queue in self.queues.values():
+        for queue in self._all_queues():
             queue.clear_stale_waits(request.frame_start, now, self.cfg.minimum_ack_wait_seconds)
         packet_ack = request.ack_requested if request.HasField("ack_requested") else False
         packet_dest = request.dest
@@ -166,7 +235,7 @@ class QueueManager:
                 prefix = b""
             parts = [prefix]
             used = len(prefix)
-            winner = self._contest(request, used, limit, now)
+            winner = self._contest(request, used, limit, now, first=not prefix)
             if winner is None:
                 request.dest = packet_dest
                 continue
@@ -182,16 +251,19 @@ class QueueManager:
                         packet_dest = request.dest
                 parts.append(item.encoded)
                 used += len(item.encoded)
-                if limit is not None and limit - used <= 0:
-                    break
-                winner = self._contest(request, used, limit, now)
+                if (limit is not None and limit - used <= 0) or isinstance(winner, CCLQueue):
+                    break  # full, or a CCL frame, which travels alone
+                winner = self._contest(request, used, limit, now, first=False)
             request.frame[index] = b"".join(parts)
         request.ack_requested = packet_ack
 
-    def _contest(self, request, used: int, limit: int | None, now: float) -> MessageQueue | None:
+    def _contest(
+        self, request, used: int, limit: int | None, now: float, first: bool
+    ) -> MessageQueue | None:
+        """The queue that sends next; CCL queues only compete for the start of a frame."""
         best: MessageQueue | None = None
         best_priority = 0.0
-        for queue in self.queues.values():
+        for queue in self._all_queues() if first and self.ccl_queues else self.queues.values():
             if queue.has("ON_DEMAND"):
                 self._refresh_on_demand(queue, request, now)
             if len(queue) <= queue.waiting_count:
@@ -260,15 +332,25 @@ class QueueManager:
                 transmission.dest == self.modem_id
                 or transmission.dest in self.cfg.route_for_additional_modem_id
             )
-            for frame in transmission.frame:
-                self._decode_frame(bytes(frame), route)
+            for index, frame in enumerate(transmission.frame):
+                data = bytes(frame)
+                if data and data[0] in self.ccl_queues:
+                    self._receive_ccl(transmission, data, index)
+                else:
+                    self._decode_frame(data, route)
+
+    def _receive_ccl(self, transmission, data: bytes, index: int) -> None:
+        if transmission.dest not in (acomms_pb.BROADCAST_ID, self.modem_id):
+            return  # not for us (Goby 1.1 ignores messages to other modems)
+        frame = transmission.frame_start + index
+        self.signal_receive_ccl.emit(ccl.received(transmission, data, data[0], frame))
 
     def _handle_ack(self, ack) -> None:
         if ack.dest != self.modem_id:
             log.warning("ignoring an ACK for modem %d (we are %d)", ack.dest, self.modem_id)
             return
         for frame_no in ack.acked_frame:
-            for queue in self.queues.values():
+            for queue in self._all_queues():
                 items = queue.waiting.get(frame_no)
                 if not items:
                     continue
@@ -328,7 +410,7 @@ class QueueManager:
     # ------------------------------------------------------------------ expiry
     def do_work(self) -> None:
         now_us = acomms_pb.now_us(self.clock.now())
-        for queue in self.queues.values():
+        for queue in self._all_queues():
             while (item := queue.expired_front(now_us)) is not None:
                 queue.remove(item)
                 self._size_changed(queue)

@@ -1,0 +1,144 @@
+"""iModemSim: Goby 1.1's WHOI Micro-Modem simulator process (moos-ivp-local), as pygoby's
+Micro-Modem emulator on the serial line the mission names.
+
+    iModemSim mission.moos [AppName]
+
+ProcessConfig (seed 003 §2.3.15):
+  Port = /tmp/ttyLOOPA1     serial device of the emulated modem; the host (pAcommsHandler)
+                            opens its partner, /tmp/ttyLOOPA2. When the pair does not exist (or
+                            its links are stale) iModemSim makes it, so pAntler alone is enough.
+  Speed = 19200             baud (accepted; a pseudo-terminal has none)
+  IPPort = 49234            UDP port shared by the emulators of a mission
+  BroadcastAddr = 127.0.0.1 loopback: every emulator on this host hears every other one (UDP
+                            multicast on the loopback); another address: UDP broadcast to it
+  InputLocType = constant_local | constant_global | moos_local | moos_global
+  ConstantPosX/ConstantPosY/ConstantDepth (local) or ConstantLat/ConstantLon/ConstantDepth
+                            the modem's position (logged; the emulated channel is perfect: no
+                            loss, no travel time, so the position does not change what is heard)
+  ModemID = 1               NVRAM SRC before the host configures it (pygoby extension)
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import logging
+
+from pygoby.acomms.mmsim.model import MicroModemModel
+from pygoby.acomms.mmsim.multicast_channel import BroadcastChannel, MulticastChannel
+from pygoby.acomms.mmsim.server import MMSimServer
+from pygoby.errors import ConfigError
+from pygoby.moos.classic_app import ClassicMOOSApp
+from pygoby.moos.protocol import MOOSMessage
+from pygoby.util.pty import PtyError, PtyPair, is_live, partner_of
+
+log = logging.getLogger(__name__)
+
+MULTICAST_GROUP = "239.255.42.99"
+LOCATION_TYPES = {
+    "constant_local": ("ConstantPosX", "ConstantPosY", "ConstantDepth"),
+    "constant_global": ("ConstantLat", "ConstantLon", "ConstantDepth"),
+    "moos_local": ("NAV_X", "NAV_Y", "NAV_DEPTH"),
+    "moos_global": ("NAV_LAT", "NAV_LONG", "NAV_DEPTH"),
+}
+KNOWN = {"port", "speed", "ipport", "broadcastaddr", "inputloctype", "constantposx", "constantposy",
+         "constantdepth", "constantlat", "constantlon", "modemid"}  # fmt: skip
+
+
+class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
+    default_name = "iModemSim"
+
+    def __init__(self, cfg, **kwargs) -> None:
+        super().__init__(cfg, **kwargs)
+        settings = {k.lower(): v for k, v in self.params}
+        for key, _ in self.params:
+            if key.lower() not in KNOWN:
+                self.log.warning("unknown iModemSim parameter %r ignored", key)
+        self.port_path = settings.get("port") or self._error("Port (the serial device) is required")
+        self._number(settings, "speed", 19200)
+        udp_port = int(self._number(settings, "ipport", 49234))
+        if not 0 < udp_port < 65536:
+            self._error(f"IPPort {udp_port} is not a UDP port")
+        address = settings.get("broadcastaddr", "127.0.0.1")
+        try:
+            loopback = ipaddress.ip_address(address).is_loopback
+        except ValueError:
+            self._error(f"BroadcastAddr {address!r} is not an IPv4 address")
+        self.channel = (MulticastChannel(MULTICAST_GROUP, udp_port) if loopback
+                        else BroadcastChannel(address, udp_port))  # fmt: skip
+        location = settings.get("inputloctype", "constant_local").lower()
+        if location not in LOCATION_TYPES:
+            self._error(f"InputLocType {location!r} is not one of {', '.join(LOCATION_TYPES)}")
+        self.position = [0.0, 0.0, 0.0]
+        if location.startswith("constant"):
+            names = LOCATION_TYPES[location]
+            self.position = [self._number(settings, n.lower(), 0.0) for n in names]
+        else:
+            for index, var in enumerate(LOCATION_TYPES[location]):
+                self.subscribe(var, lambda msg, i=index: self._on_position(i, msg))
+        modem_id = int(self._number(settings, "modemid", 1))
+        self.pair = self._make_pair()
+        self.model = MicroModemModel(modem_id, self.clock, self.channel, name=f"{self.name}:{self.port_path}")
+        self.server = MMSimServer(self.model, self.channel, port=None, serial_path=self.port_path)
+
+    def _error(self, reason: str):
+        raise ConfigError(f"{self.name}: {reason}", file=self.mission.path if self.mission else None)
+
+    def _number(self, settings: dict[str, str], key: str, default: float) -> float:
+        text = settings.get(key)
+        if text is None:
+            return default
+        try:
+            return float(text)
+        except ValueError:
+            self._error(f"{key} must be a number, not {text!r}")
+            raise  # unreachable: _error raises
+
+    def _make_pair(self) -> PtyPair | None:
+        """The Goby 1.1 loopback pair, made here unless a running process (pygoby loopbacks,
+        socat) provides it."""
+        if is_live(self.port_path):
+            self.log.info("using %s (made by another process)", self.port_path)
+            return None
+        partner = partner_of(self.port_path)
+        if partner is None:
+            self._error(f"Port {self.port_path} does not exist, and only loopback names ending "
+                        "in 1 or 2 (/tmp/ttyLOOPA1 <-> /tmp/ttyLOOPA2) can be made here; run "
+                        "`pygoby loopbacks` or give a real serial device")  # fmt: skip
+        try:
+            pair = PtyPair(self.port_path, partner).open()
+        except (PtyError, OSError) as err:
+            self._error(f"cannot make the loopback {self.port_path} <-> {partner}: {err}")
+        self.log.info("made the loopback %s <-> %s (the host opens %s)", self.port_path, partner, partner)
+        return pair
+
+    def _on_position(self, index: int, msg: MOOSMessage) -> None:
+        if isinstance(msg.value, float):
+            self.position[index] = msg.value
+
+    async def start(self, connect_timeout: float | None = None) -> None:
+        if self.pair is not None:
+            self.pair.attach()
+        self.channel.open()
+        await self.server.start()
+        await super().start(connect_timeout)
+        self.log.info("Micro-Modem emulator on %s, channel %s:%d, position %s", self.port_path,
+                      self.channel.group, self.channel.port, self.position)  # fmt: skip
+
+    async def stop(self) -> None:
+        """The serial line and its links go first: they must not outlive a quick kill."""
+        try:
+            await self.server.close()
+            self.channel.close()
+            if self.pair is not None:
+                self.pair.close()
+        finally:
+            await super().stop()
+
+
+
+def main(argv=None) -> int:
+    return iModemSim.main(argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

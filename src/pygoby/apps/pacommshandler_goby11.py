@@ -1,0 +1,175 @@
+"""pAcommsHandler's wiring of the Goby 1.1 MOOS variables (seed 003 §2.3.6-2.3.7, spec
+acomms.md §5.8) that goby3 lacks or spells differently (the XML message sets themselves are
+pygoby.acomms.transitional):
+
+* `Goby11Variables`: CCL queues (`out_pubsub_var` -> queue, received frames ->
+  `in_pubsub_var`), ACOMMS_INCOMING_DATA / ACOMMS_OUTGOING_DATA (ModemDataTransmission text),
+  ACOMMS_RANGE_COMMAND -> ping, ACOMMS_RANGE_RESPONSE, ACOMMS_POLLER_UPDATE.
+* `mac_update_from_goby11`: a Goby 1.1 MACUpdate (ADD/REMOVE/REPLACE, SLOT_* slots) as today's.
+"""
+
+from __future__ import annotations
+
+from google.protobuf import text_format
+from google.protobuf.message import Message
+
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.queue import QueueError
+from pygoby.acomms.queue.ccl import goby11_time
+from pygoby.moos import goby11_config
+from pygoby.moos.protocol import MOOSMessage
+from pygoby.moos.translator import Technique, serialize_for_moos
+
+INCOMING_DATA = "ACOMMS_INCOMING_DATA"
+OUTGOING_DATA = "ACOMMS_OUTGOING_DATA"
+RANGE_COMMAND = "ACOMMS_RANGE_COMMAND"
+RANGE_RESPONSE = "ACOMMS_RANGE_RESPONSE"
+POLLER_UPDATE = "ACOMMS_POLLER_UPDATE"
+# Goby 1.1 posted its acomms messages as plain single-line TextFormat
+GOBY11_TECHNIQUE = Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT
+V1_RANGING = acomms_pb.V1ModemRangingRequest.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name
+RANGING_TYPES = {  # Goby 1.1 RangingType -> Micro-Modem transmission type
+    V1_RANGING["MODEM_TWO_WAY_PING"].number: acomms_pb.MICROMODEM_TWO_WAY_PING,
+    V1_RANGING["REMUS_LBL_RANGING"].number: acomms_pb.MICROMODEM_REMUS_LBL_RANGING,
+}
+V1_RANGING_OF = {v: k for k, v in RANGING_TYPES.items()}
+
+
+def parse_goby11(value: str | bytes, out: Message) -> None:
+    """A Goby 1.1 (or goby3) TextFormat string, 1.1 spellings (slot types, ...) translated."""
+    text = value.decode("latin-1") if isinstance(value, bytes) else value
+    text_format.Merge(goby11_config.translate(text, out.DESCRIPTOR).text, out)
+
+
+V1_UPDATE = acomms_pb.V1MACUpdate.UpdateType
+
+
+def _slot(v1_slot) -> Message:
+    slot = acomms_pb.ModemTransmission()
+    parse_goby11(text_format.MessageToString(v1_slot), slot)
+    return slot
+
+
+def _same_slot(a: Message, b: Message) -> bool:
+    return all(getattr(a, f) == getattr(b, f) for f in ("src", "dest", "rate", "type", "slot_seconds"))
+
+
+def mac_update_from_goby11(value: str | bytes, current: list[Message], src: int) -> Message | None:
+    """A Goby 1.1 MACUpdate (`dest update_type: ADD|REMOVE|REPLACE slot {...}`) as today's
+    MACUpdate against the `current` cycle; None if `value` is not the Goby 1.1 form."""
+    text = value.decode("latin-1") if isinstance(value, bytes) else value
+    old = acomms_pb.V1MACUpdate()
+    try:
+        text_format.Merge(text, old)
+    except text_format.ParseError:
+        return None
+    slots = [_slot(s) for s in old.slot]
+    update = acomms_pb.MACUpdate(src=src, dest=old.dest)
+    U = acomms_pb.MACUpdate.UpdateType
+    if old.update_type == V1_UPDATE.Value("ADD"):
+        update.update_type = U.Value("PUSH_BACK")
+        update.slot.extend(slots)
+    else:
+        if old.update_type == V1_UPDATE.Value("REMOVE"):
+            slots = [s for s in current if not any(_same_slot(s, r) for r in slots)]
+        update.update_type = U.Value("ASSIGN")
+        update.slot.extend(slots)
+    return update
+
+
+class Goby11Variables:
+    """The Goby 1.1 MOOS variables of a pAcommsHandler (see the module docstring).
+
+    `app` publishes/subscribes (a GobyMOOSApp); `acomms` is its AcommsHandler."""
+
+    def __init__(self, app, acomms, queue_cfg: Message, enabled: bool) -> None:
+        self.app, self.acomms = app, acomms
+        self.enabled = enabled  # the 1.1 data variables (only for Goby 1.1 style configurations)
+        self.in_vars = {q.key.id: q.in_pubsub_var for q in queue_cfg.queue if q.in_pubsub_var}
+        self.out_vars = {q.out_pubsub_var: q.key.id for q in queue_cfg.queue if q.out_pubsub_var}
+        # these run inside the queue's and the driver's work: a failure is logged, not raised
+        acomms.queue.signal_receive_ccl.connect(self._on_ccl_received, contain_errors=True, logger=app.log)
+        acomms.signal_modem_receive.connect(self._on_modem_receive, contain_errors=True, logger=app.log)
+
+    def subscribe_all(self) -> None:
+        for var in self.out_vars:
+            self.app.subscribe(var, self._on_ccl_out)
+        self.app.subscribe(RANGE_COMMAND, self._on_range_command)
+        self.app.subscribe(POLLER_UPDATE, self._on_poller_update)
+
+    def _publish(self, var: str, message: Message) -> None:
+        self.app.publish(var, serialize_for_moos(message, GOBY11_TECHNIQUE))
+
+    # ---------------------------------------------------------------- MOOS -> acomms
+    def _parse(self, msg: MOOSMessage, out: Message) -> Message | None:
+        try:
+            parse_goby11(msg.value, out)
+        except text_format.ParseError as err:
+            self.app.log.warning("%s: not a %s (%s)", msg.key, out.DESCRIPTOR.name, err)
+            return None
+        return out
+
+    def _on_ccl_out(self, msg: MOOSMessage) -> None:
+        ccl_id = self.out_vars[msg.key]
+        transmission = self._parse(msg, acomms_pb.V1ModemDataTransmission())
+        if transmission is None:
+            return
+        if not transmission.base.HasField("time"):
+            transmission.base.time = goby11_time(self.app.clock.now())
+        transmission.queue_key.type, transmission.queue_key.id = acomms_pb.QUEUE_CCL, ccl_id
+        try:
+            self.acomms.queue.push_ccl(ccl_id, transmission)
+        except QueueError as err:
+            self.app.log.warning("%s: %s", msg.key, err)
+            return
+        if self.enabled:
+            self._publish(OUTGOING_DATA, transmission)
+
+    def _on_range_command(self, msg: MOOSMessage) -> None:
+        request = self._parse(msg, acomms_pb.V1ModemRangingRequest())
+        if request is None:
+            return
+        kind = RANGING_TYPES.get(request.type, acomms_pb.MICROMODEM_TWO_WAY_PING)
+        ping = acomms_pb.ModemTransmission(src=self.acomms.modem_id, dest=request.base.dest,
+                                   type=acomms_pb.DRIVER_SPECIFIC)  # fmt: skip
+        extension = ping.Extensions[acomms_pb.MM_TRANSMISSION]
+        extension.type = kind
+        if kind == acomms_pb.MICROMODEM_REMUS_LBL_RANGING:
+            extension.remus_lbl.enable_beacons = request.enable_beacons
+            extension.remus_lbl.lbl_max_range = request.max_range
+        self.acomms.initiate_transmission(ping)
+
+    def _on_poller_update(self, msg: MOOSMessage) -> None:
+        self.apply_mac_update(msg)
+
+    def apply_mac_update(self, msg: MOOSMessage) -> bool:
+        """A MACUpdate in Goby 1.1's form applied to the cycle; False if it is not one."""
+        update = mac_update_from_goby11(msg.value, self.acomms.mac.slots, self.acomms.modem_id)
+        if update is None:
+            return False
+        self.acomms.apply_mac_update(update)
+        return True
+
+    # ---------------------------------------------------------------- acomms -> MOOS
+    def _on_ccl_received(self, transmission: Message) -> None:
+        var = self.in_vars.get(transmission.queue_key.id)
+        if var:
+            self._publish(var, transmission)
+
+    def _on_modem_receive(self, transmission: Message) -> None:
+        if transmission.type == acomms_pb.DATA and self.enabled:
+            for index, frame in enumerate(transmission.frame):
+                data = acomms_pb.V1ModemDataTransmission(data=bytes(frame), frame=transmission.frame_start + index,
+                                                 ack_requested=transmission.ack_requested)  # fmt: skip
+                base = data.base
+                base.src, base.dest, base.rate = transmission.src, transmission.dest, max(transmission.rate, 0)
+                base.time = goby11_time(transmission.time / 1e6)
+                self._publish(INCOMING_DATA, data)
+        elif transmission.type == acomms_pb.DRIVER_SPECIFIC and transmission.HasExtension(acomms_pb.MM_TRANSMISSION):
+            extension = transmission.Extensions[acomms_pb.MM_TRANSMISSION]
+            if extension.type in V1_RANGING_OF and extension.HasField("ranging_reply"):
+                reply = acomms_pb.V1ModemRangingReply(type=V1_RANGING_OF[extension.type])
+                reply.one_way_travel_time.extend(extension.ranging_reply.one_way_travel_time)
+                reply.base.src, reply.base.dest = transmission.src, transmission.dest
+                reply.base.time = goby11_time(transmission.time / 1e6)
+                self._publish(RANGE_RESPONSE, reply)

@@ -1,0 +1,63 @@
+"""Classic MOOS applications (MOOS-IvP style `name = value` configuration) on pygoby's app base.
+
+    class uExample(ClassicMOOSApp):
+        default_name = "uExample"
+        keep_quotes = False            # True: read values with their double quotes
+        def __init__(self, cfg, **kwargs):
+            super().__init__(cfg, **kwargs)
+            self.params                # [(name, value), ...] of the ProcessConfig block
+
+The block's AppTick and CommsTick and the mission's globals (ServerHost, ServerPort, Community,
+MOOSTimeWarp, LatOrigin, ...) fill the `common` settings Goby apps share, so the app runs with
+the same MOOS client, tick loop, logging and command line (`uExample mission.moos [name]`).
+No log file is written (classic MOOS apps write none).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import ClassVar
+
+from google.protobuf.message import Message
+
+from pygoby.errors import ConfigError
+from pygoby.moos.app import GobyMOOSApp
+from pygoby.moos.appconfig import apply_moos_globals
+from pygoby.moos.moosfile import MissionFile, parse_number
+
+
+class ClassicMOOSApp(GobyMOOSApp):
+    config_proto = ("pygoby/moos/classic_app.proto", "pygoby.moos.protobuf.ClassicMOOSAppConfig")
+    keep_quotes: ClassVar[bool] = False
+
+    @classmethod
+    def read_config(
+        cls, mission: MissionFile | None, name: str, overrides: Sequence[tuple[str, str]] = ()
+    ) -> Message:
+        if overrides:
+            raise ConfigError("takes no --option overrides: set them in its ProcessConfig block", field=name)
+        cfg = cls.load_config_class()()
+        cfg.common.log = False
+        if mission is None:
+            return cfg
+        apply_moos_globals(cfg, mission)
+        for key, value in mission.process_config(name) or []:
+            field = {"apptick": "app_tick", "commstick": "comm_tick"}.get(key.lower())
+            if field is None:
+                continue
+            number = parse_number(value)
+            if number is None or number <= 0:
+                raise ConfigError(f"{key} must be a positive number, not {value!r}",
+                                  file=mission.path, field=name)  # fmt: skip
+            setattr(cfg.common, field, max(1, math.ceil(number)))
+        return cfg
+
+    def __init__(self, cfg: Message, **kwargs) -> None:
+        super().__init__(cfg, **kwargs)
+        block = self.mission.process_config(self.name, self.keep_quotes) if self.mission else None
+        if block is None:
+            self.log.warning("no ProcessConfig = %s block; running with the defaults", self.name)
+        self.params: list[tuple[str, str]] = [
+            (k, v) for k, v in (block or []) if k.lower() not in ("apptick", "commstick")
+        ]
