@@ -16,6 +16,7 @@ import pytest
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient, MoosRefusedError
 from pygoby.moos.db import MOOSDB
+from tests.moos.rawclient import closed_by_peer, raw_connect
 
 
 async def _expect(client: MOOSClient, key: str, timeout: float = 2.0) -> p.MOOSMessage:
@@ -23,31 +24,6 @@ async def _expect(client: MOOSClient, key: str, timeout: float = 2.0) -> p.MOOSM
         msg = await client.receive(timeout)
         if msg.key == key:
             return msg
-
-
-async def _raw_connect(port: int, name: str | None = None):
-    reader, writer = await asyncio.open_connection("127.0.0.1", port)
-    if name is not None:
-        writer.write(p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(name, 0.0)]))
-        await writer.drain()
-        framer = p.PacketFramer()
-        while True:
-            framer.feed(await asyncio.wait_for(reader.read(4096), 2))
-            packets = list(framer.packets())
-            if packets:
-                assert p.decode_packet(packets[0])[0].msg_type == p.WELCOME
-                break
-    return reader, writer
-
-
-async def _closed_by_peer(reader: asyncio.StreamReader, timeout: float) -> bool:
-    try:
-        async with asyncio.timeout(timeout):
-            while await reader.read(4096):
-                pass
-        return True
-    except (ConnectionError, TimeoutError):
-        return False
 
 
 async def test_publish_subscribe_all_types():
@@ -132,7 +108,7 @@ async def test_server_requests():
         assert names == sorted(names, reverse=True) and "FOO" in names
         assert all(m.id == p.SERVER_REQUEST_ID for m in everything)
         assert await c.server_request("DB_CLEAR", timeout=0.3) == []
-        assert db.core.variables["FOO"].writes == 0
+        assert not db.core.variables["FOO"].written
 
 
 async def test_name_collision_is_refused():
@@ -180,10 +156,10 @@ async def test_reconnect_resubscribe_and_queue_while_away():
 async def test_garbage_client_is_dropped_and_others_served(caplog):
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     async with MOOSDB(port=0) as db, MOOSClient("good", port=db.port) as good:
-        reader, writer = await _raw_connect(db.port, "bad")
+        reader, writer = await raw_connect(db.port, "bad")
         writer.write(struct.pack("<iiB", 20, 1, 0) + b"\xff" * 11)
         await writer.drain()
-        assert await _closed_by_peer(reader, 2)
+        assert await closed_by_peer(reader, 2)
         assert "dropping client bad" in caplog.text and "protocol error" in caplog.text
         good.subscribe("Z")
         good.publish("Z", 1.0)
@@ -194,21 +170,21 @@ async def test_garbage_client_is_dropped_and_others_served(caplog):
 async def test_oversized_packet_refused_from_header(caplog):
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     async with MOOSDB(port=0, max_packet_size=4096) as db:
-        reader, writer = await _raw_connect(db.port, "big")
+        reader, writer = await raw_connect(db.port, "big")
         writer.write(struct.pack("<iiB", 1 << 30, 1, 0))
         await writer.drain()
-        assert await _closed_by_peer(reader, 2)
+        assert await closed_by_peer(reader, 2)
         assert "exceeds the limit" in caplog.text
         writer.close()
 
 
 async def test_silent_client_dropped_after_timeout():
     async with MOOSDB(port=0, client_timeout=1.5) as db:
-        reader, writer = await _raw_connect(db.port, "quiet")
+        reader, writer = await raw_connect(db.port, "quiet")
         # a real client keeps itself alive with T messages
         async with MOOSClient("chatty", port=db.port, reconnect_interval=5) as c:
             assert "quiet" in db.client_names
-            assert await _closed_by_peer(reader, 3)
+            assert await closed_by_peer(reader, 3)
             assert "quiet" not in db.client_names
             await asyncio.sleep(1.0)
             assert c.connected and c.connections == 1
@@ -217,16 +193,16 @@ async def test_silent_client_dropped_after_timeout():
 
 async def test_half_open_handshake_does_not_block_others():
     async with MOOSDB(port=0, handshake_timeout=1.0) as db:
-        idle_reader, idle_writer = await _raw_connect(db.port)  # connects, sends nothing
+        idle_reader, idle_writer = await raw_connect(db.port)  # connects, sends nothing
         async with MOOSClient("after", port=db.port) as c:
             assert c.connected
-        assert await _closed_by_peer(idle_reader, 3)  # and the idle one is closed in time
+        assert await closed_by_peer(idle_reader, 3)  # and the idle one is closed in time
         idle_writer.close()
 
 
 async def test_wrong_protocol_string_closed_silently():
     async with MOOSDB(port=0) as db:
-        reader, writer = await _raw_connect(db.port)
+        reader, writer = await raw_connect(db.port)
         writer.write(b"HELLO".ljust(32, b"\0"))
         await writer.drain()
         assert await asyncio.wait_for(reader.read(100), 2) == b""
@@ -256,8 +232,8 @@ async def test_cpp_client_bytes_replayed_over_a_socket(vectors_dir):
 
         async def read_some():
             with contextlib.suppress(TimeoutError):
-                framer.feed(await asyncio.wait_for(reader.read(65536), 0.1))
-            received.extend(p.decode_packet(x) for x in framer.packets())
+                buf, spans = framer.feed(await asyncio.wait_for(reader.read(65536), 0.1))
+                received.extend(p.decode_packet(buf, *span) for span in spans)
 
         for u in session:
             if u["dir"] == "client_to_db" and u["unit"] in ("protocol_string", "packet"):
@@ -339,13 +315,13 @@ async def test_legacy_synchronous_client_is_polled_not_pushed():
         hs = p.handshake_message("old", 0.0, asynchronous=False)
         writer.write(p.PROTOCOL_STRING + p.encode_packet([hs]))
         framer = p.PacketFramer()
+        queued: list[list[p.MOOSMessage]] = []
 
         async def next_packet(timeout=2.0):
-            while True:
-                packets = list(framer.packets())
-                if packets:
-                    return p.decode_packet(packets[0])
-                framer.feed(await asyncio.wait_for(reader.read(4096), timeout))
+            while not queued:
+                buf, spans = framer.feed(await asyncio.wait_for(reader.read(4096), timeout))
+                queued.extend(p.decode_packet(buf, *span) for span in spans)
+            return queued.pop(0)
 
         assert (await next_packet())[0].msg_type == p.WELCOME
         writer.write(p.encode_packet([p.MOOSMessage(p.REGISTER, p.DOUBLE, "V", dval=0, src="old")]))
@@ -358,4 +334,39 @@ async def test_legacy_synchronous_client_is_polled_not_pushed():
         reply = await next_packet()
         assert [(m.msg_type, m.key) for m in reply] == [(p.NULL, ""), (p.NOTIFY, "V")]
         assert reply[0].time == -1.0 and reply[0].dval > 1e9  # the DB clock for the skew
+        writer.close()
+
+
+async def test_packets_cut_anywhere_by_tcp_are_all_delivered():
+    """A client's stream split at random points (one byte, inside headers, many packets per
+    read): the DB reassembles every packet and forwards every notification in order."""
+    import random
+
+    rng = random.Random(20)
+    async with MOOSDB(port=0) as db, MOOSClient("sink", port=db.port) as sink:
+        sink.subscribe("CUT")
+        await sink.flush()
+        reader, writer = await raw_connect(db.port, "cutter")
+        writer.get_extra_info("socket").setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        stream = b"".join(
+            p.encode_packet([p.notify("CUT", float(i * 3 + j), time=1.0, src="cutter", msg_id=i)
+                             for j in range(rng.randint(1, 3))])
+            for i in range(150)
+        )  # fmt: skip
+        pos = 0
+        while pos < len(stream):
+            step = rng.choice((1, 2, 5, 9, 13, 100, 700, 3000))
+            writer.write(stream[pos : pos + step])
+            pos += step
+            await writer.drain()
+            if rng.random() < 0.3:
+                await asyncio.sleep(0.002)
+        expected = []
+        offset = 0
+        while offset < len(stream):
+            total, _ = p.parse_packet_header(stream[offset : offset + 9])
+            expected += [m.dval for m in p.decode_packet(stream[offset : offset + total])]
+            offset += total
+        got = [(await _expect(sink, "CUT")).dval for _ in expected]
+        assert got == expected
         writer.close()

@@ -3,6 +3,7 @@ answers with the C++ MOOSDB's, structurally (types, keys, ids, sources, values, 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import socket
 
@@ -17,6 +18,36 @@ from pygoby.util.clock import VirtualClock
 CLOCK_DEPENDENT_STRINGS = {"DB_VARSUMMARY", "DB_QOS", "DB_RWSUMMARY", "UPOKEDB_STATUS"}
 
 
+def _messages_with_bytes(packet: bytes) -> list[tuple[p.MOOSMessage, bytes]]:
+    """A packet's messages, each with its own bytes."""
+    p.decode_packet(packet)  # validates the whole packet
+    out, pos = [], p.PACKET_HEADER_SIZE
+    while pos < len(packet):
+        msg, end = p.decode_message(packet, pos)
+        out.append((msg, packet[pos:end]))
+        pos = end
+    return out
+
+
+def take_packets(core: DBCore) -> dict[str, list[bytes]]:
+    """What the core made due, per client, cut into packets."""
+    out = {}
+    for record in core.take_ready():
+        data, packets, pos = record.take_output(), [], 0
+        while pos < len(data):
+            total, _ = p.parse_packet_header(data[pos : pos + p.PACKET_HEADER_SIZE])
+            packets.append(data[pos : pos + total])
+            pos += total
+        out[record.name] = packets
+    return out
+
+
+def run(core: DBCore, name: str, *msgs: p.MOOSMessage) -> dict[str, list[p.MOOSMessage]]:
+    """Process one packet of `msgs` from `name`; the messages made due, per client."""
+    core.process_packet(name, p.encode_packet(msgs))
+    return {n: [m for pk in pks for m in p.decode_packet(pk)] for n, pks in take_packets(core).items()}
+
+
 def _units(vectors_dir):
     with open(vectors_dir / "moos" / "sessions.jsonl") as f:
         return [json.loads(line) for line in f]
@@ -24,7 +55,7 @@ def _units(vectors_dir):
 
 def _replay(units, community, warp=1.0, skip_sessions=()):
     """Feed every client packet to a DBCore; returns (ours, theirs): per conn, lists of packets
-    as decoded messages."""
+    as bytes."""
     units = [u for u in units if u["session"] not in skip_sessions]
     # absolute DB time of each session's start, from the DB clock in its first T echo or null
     base = {}
@@ -38,12 +69,12 @@ def _replay(units, community, warp=1.0, skip_sessions=()):
     core = DBCore(community, clock, hostname="localhost")
     name_of: dict[int, str] = {}
     conn_of: dict[str, int] = {}
-    ours: dict[int, list[list[p.MOOSMessage]]] = {}
-    theirs: dict[int, list[list[p.MOOSMessage]]] = {}
+    ours: dict[int, list[bytes]] = {}
+    theirs: dict[int, list[bytes]] = {}
 
-    def emit(outgoing):
-        for name, msgs in outgoing.items():
-            ours.setdefault(conn_of[name], []).append(msgs)
+    def emit():
+        for name, packets in take_packets(core).items():
+            ours.setdefault(conn_of[name], []).extend(packets)
 
     for u in units:
         conn = u["conn"]
@@ -51,24 +82,27 @@ def _replay(units, community, warp=1.0, skip_sessions=()):
         clock.set(max(t, clock.now()))
         if u["dir"] == "db_to_client":
             if u["unit"] == "packet":
-                theirs.setdefault(conn, []).append(p.decode_packet(bytes.fromhex(u["hex"])))
+                theirs.setdefault(conn, []).append(bytes.fromhex(u["hex"]))
             continue
         if u["unit"] == "close":
             if conn in name_of:
-                emit(core.disconnect(name_of.pop(conn)))
+                core.disconnect(name_of.pop(conn))
+                emit()
             continue
         if u["unit"] != "packet":
             continue
-        msgs = p.decode_packet(bytes.fromhex(u["hex"]))
+        packet = bytes.fromhex(u["hex"])
         if conn not in name_of:
-            reply = core.connect(msgs[0])
-            ours.setdefault(conn, []).append([reply])
+            hello = p.decode_packet(packet)[0]
+            reply = core.connect(hello)
+            ours.setdefault(conn, []).append(p.encode_packet([reply]))
             if reply.msg_type == p.WELCOME:
-                name_of[conn] = msgs[0].string
-                conn_of[msgs[0].string] = conn
-                emit(core.collect_pushes(exclude=msgs[0].string))
+                name_of[conn] = hello.string
+                conn_of[hello.string] = conn
+                emit()
             continue
-        emit(core.process_packet(name_of[conn], msgs))
+        core.process_packet(name_of[conn], packet)
+        emit()
     return ours, theirs, core
 
 
@@ -94,21 +128,29 @@ def _same(mine: p.MOOSMessage, ref: p.MOOSMessage, where: str) -> None:
 
 
 def _compare(ours, theirs):
+    """Structurally everywhere; byte for byte for notifications forwarded from a client."""
     assert set(ours) == set(theirs)
+    forwarded = 0
     for conn, packets in theirs.items():
-        mine = ours[conn]
-        assert len(mine) == len(packets), (conn, [[m.key for m in x] for x in mine])
-        for i, (a, b) in enumerate(zip(mine, packets, strict=True)):
-            assert [m.key for m in a] == [m.key for m in b], (conn, i)
-            for j, (ma, mb) in enumerate(zip(a, b, strict=True)):
-                _same(ma, mb, f"conn {conn} packet {i} message {j} ({mb.key})")
+        mine = [_messages_with_bytes(x) for x in ours[conn]]
+        ref = [_messages_with_bytes(x) for x in packets]
+        assert len(mine) == len(ref), (conn, [[m.key for m, _ in x] for x in mine])
+        for i, (a, b) in enumerate(zip(mine, ref, strict=True)):
+            assert [m.key for m, _ in a] == [m.key for m, _ in b], (conn, i)
+            for j, ((ma, raw_a), (mb, raw_b)) in enumerate(zip(a, b, strict=True)):
+                where = f"conn {conn} packet {i} message {j} ({mb.key})"
+                _same(ma, mb, where)
+                if mb.msg_type == p.NOTIFY and mb.id >= 0 and not mb.src.startswith("MOOSDB_"):
+                    assert raw_a == raw_b, where
+                    forwarded += 1
+    return forwarded
 
 
 def test_alpha_sessions_match_the_cpp_moosdb(vectors_dir):
     units = [u for u in _units(vectors_dir) if u["session"] != "time_warp_10"]
     # the silent client's timeout and the bad protocol string are socket-level (test_db.py)
     ours, theirs, core = _replay(units, "alpha", skip_sessions=("probe_bad_protocol",))
-    _compare(ours, theirs)
+    assert _compare(ours, theirs) >= 14  # forwarded notifications compared byte for byte
     # the type lock kept FOO a double (the probe's string write was dropped, seq 128)
     assert core.variables["FOO"].data_type == p.DOUBLE
 
@@ -131,14 +173,14 @@ def _join(core, name, asynchronous=True):
 
 
 def _pkt(core, name, *msgs):
-    return core.process_packet(name, list(msgs))
+    return run(core, name, *msgs)
 
 
 def test_type_lock_binary_vs_string(core):
     _join(core, "a")
     _pkt(core, "a", p.notify("X", "text", time=1, src="a"))
     _pkt(core, "a", p.notify("X", b"bin", time=2, src="a"))
-    assert core.variables["X"].sval == b"text"
+    assert core.variables["X"].message().sval == b"text"
     _pkt(core, "a", p.MOOSMessage(p.SERVER_REQUEST, p.STRING, "DB_CLEAR", id=-2, src="a"))
     _pkt(core, "a", p.notify("X", b"bin", time=3, src="a"))
     assert core.variables["X"].data_type == p.BINARY
@@ -186,7 +228,8 @@ def test_name_collision_and_disconnect_event(core):
     _pkt(core, "watcher", p.MOOSMessage(p.REGISTER, p.DOUBLE, "DB_EVENT", dval=0, src="watcher"))
     k = core.connect(p.handshake_message("dup", 0.0))
     assert k.msg_type == p.POISON and "dup" in k.string
-    out = core.disconnect("dup")
+    core.disconnect("dup")
+    out = {n: [m for pk in pks for m in p.decode_packet(pk)] for n, pks in take_packets(core).items()}
     assert out["watcher"][0].string == "disconnected=dup"
     assert _join(core, "dup").msg_type == p.WELCOME
 
@@ -223,8 +266,40 @@ def test_fuzz_core_never_crashes(packets):
     core.connect(p.handshake_message("b", 0.0, asynchronous=False))
     for name, msgs in packets:
         clock.advance(0.7)
-        out = core.process_packet(name, msgs)
-        assert all(out.values())  # never an empty packet
+        empty = b"\x09\0\0\0\0\0\0\0\0"  # a header of no message: accepted, as by the C++ DB
+        core.process_packet(name, p.encode_packet(msgs) if msgs else empty)
+        for packets_out in take_packets(core).values():
+            assert all(p.decode_packet(x) for x in packets_out)  # never an empty packet
     core.disconnect("a")
     core.disconnect("b")
     assert not core.clients
+
+
+_notifications = st.builds(
+    p.MOOSMessage,
+    msg_type=st.just(p.NOTIFY), data_type=st.sampled_from("DSB"), key=st.sampled_from("XYZ"),
+    time=st.floats(), dval=st.floats(), dval2=st.floats(), sval=st.binary(max_size=6),
+    src=st.sampled_from(["a", "b", "", "élan"]), src_aux=st.sampled_from(["", "aux"]),
+    community=st.sampled_from(["", "other"]), id=st.integers(-3, 100),
+)  # fmt: skip
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(["a", "b"]), st.lists(_notifications, min_size=1, max_size=5)), max_size=10))
+def test_fuzz_forwarded_bytes_are_the_publishers_with_the_community(packets):
+    """Whatever mix of sources, communities and types: a subscriber gets each accepted
+    notification as its publisher encoded it, the DB's community filled in when empty."""
+    core = DBCore("fz", VirtualClock(1000.0))
+    for name in ("a", "b", "w"):
+        core.connect(p.handshake_message(name, 0.0))
+    star = p.MOOSMessage(p.WILDCARD_REGISTER, p.STRING, "w", sval=p.wildcard_sval("*", "*", 0), src="w")
+    run(core, "w", star)  # (and the DB_EVENT snapshots, discarded)
+    locked: dict[str, str] = {}
+    for name, msgs in packets:
+        core.process_packet(name, p.encode_packet(msgs))
+        got = [raw for pk in take_packets(core).get("w", []) for _, raw in _messages_with_bytes(pk)]
+        expected = []
+        for m in msgs:
+            if locked.setdefault(m.key, m.data_type) == m.data_type:
+                expected.append(p.encode_message(dataclasses.replace(m, community=m.community or "fz")))
+        assert got == expected

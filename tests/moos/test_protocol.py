@@ -64,9 +64,9 @@ def test_every_session_packet_round_trips(vectors_dir):
         framer = p.PacketFramer()
         out = []
         for i in range(len(raw)):
-            framer.feed(raw[i : i + 1])
-            out.extend(framer.packets())
-        assert out == [raw]
+            buf, spans = framer.feed(raw[i : i + 1])
+            out.extend(buf[start:end] for start, end in spans)
+        assert out == [raw] and framer.buffered == 0
 
 
 def test_protocol_string_matches_recording(vectors_dir):
@@ -132,6 +132,31 @@ def test_wildcard_match(pattern, name, expected):
     assert p.wildcard_match(pattern, name) is expected
 
 
+def _reference_glob(pattern: str, name: str) -> bool:
+    """MOOSWildCmp's meaning by dynamic programming: can pattern[:i] match name[:j]?"""
+    row = [True] + [False] * len(name)
+    for c in pattern:
+        if c == "*":
+            row = [any(row[: j + 1]) for j in range(len(name) + 1)]
+        else:
+            row = [False] + [row[j] and c in ("?", name[j]) for j in range(len(name))]
+    return row[-1]
+
+
+@settings(max_examples=2000, deadline=None)
+@given(st.text("ab*?", max_size=8), st.text("abc", max_size=10))
+def test_glob_agrees_with_the_definition(pattern, name):
+    assert p.Glob(pattern).match(name) is _reference_glob(pattern, name)
+
+
+@pytest.mark.timeout(10)  # a backtracking matcher takes hours here (issue 16, item 1)
+def test_glob_has_no_catastrophic_backtracking():
+    name = "a" * 200
+    for pattern in ("*a*a*a*a*a*a*a*a*a*a*b", "*?a*?a*?a*?a*?a*?a*?a*?a*b", "a*" * 50 + "b"):
+        assert not p.Glob(pattern).match(name)
+    assert p.Glob("*a*a*a*a*a*a*a*a*a*a").match(name)
+
+
 def test_rejects_malformed_packets():
     good = p.encode_packet([p.notify("X", 1.0, time=1.0, src="a")])
     with pytest.raises(p.MoosProtocolError):
@@ -184,12 +209,30 @@ def test_fuzz_framer_never_crashes(chunks):
     framer = p.PacketFramer(max_packet_size=500)
     try:
         for chunk in chunks:
-            framer.feed(chunk)
-            for packet in framer.packets():
+            buf, spans = framer.feed(chunk)
+            for start, end in spans:
                 with contextlib.suppress(p.MoosProtocolError):
-                    p.decode_packet(packet)
+                    p.decode_packet(buf, start, end)
     except p.MoosProtocolError:
         pass
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.integers(1, 40), max_size=30), st.integers(1, 6))
+def test_framer_cuts_a_stream_cut_anywhere(cuts, n_packets):
+    """However TCP cuts the stream, the framer gives back the packets, each exactly once."""
+    packets = [p.encode_packet([p.notify(f"K{i}", float(j), time=1.0) for j in range(i % 3 + 1)])
+               for i in range(n_packets)]  # fmt: skip
+    stream = b"".join(packets)
+    framer = p.PacketFramer()
+    out, pos = [], 0
+    for cut in [*cuts, len(stream)]:
+        buf, spans = framer.feed(stream[pos : pos + cut])
+        out.extend(buf[start:end] for start, end in spans)
+        pos += cut
+        if pos >= len(stream):
+            break
+    assert out == packets and framer.buffered == 0
 
 
 _text = st.text(max_size=20)

@@ -77,6 +77,7 @@ import logging
 import math
 import os
 from collections.abc import Callable, Sequence
+from operator import attrgetter
 from typing import ClassVar
 
 from google.protobuf.message import Message
@@ -109,6 +110,12 @@ from pygoby.util.clock import Clock
 Handler = Callable[[MOOSMessage], None]
 
 COMMON_PROTO = ("goby/moos/protobuf/goby_moos_app.proto", "goby.moos.protobuf.GobyMOOSAppConfig")
+# Mail waiting for the next tick beyond this many messages: the oldest are dropped (an app far
+# slower than its mail; CMOOSApp's comms drop their whole inbox beyond 2,048).
+MAIL_LIMIT = 100_000
+# Routes of pattern subscriptions remembered per (variable, publisher) before starting afresh.
+PATTERN_ROUTES_LIMIT = 10_000
+_by_time = attrgetter("time")
 
 
 class _Timer:
@@ -206,16 +213,17 @@ class GobyMOOSApp:
             host = self.common.server_host if self.common.HasField("server_host") else "127.0.0.1"
         if port is None:
             port = self.common.server_port if self.common.HasField("server_port") else p.DEFAULT_PORT
-        self.client = MOOSClient(self.name, host, port, clock=self.clock, on_message=self._on_mail)
+        self._mail: list[MOOSMessage] = []  # received, for the next tick (the list is kept)
+        self.client = MOOSClient(self.name, host, port, clock=self.clock, on_message=self._mail.append)
         self.client.signal_connect.connect(self._connected)
         self.client.signal_disconnect.connect(self._disconnected)
         self.log = logging.getLogger(f"pygoby.app.{self.name}")
         self.start_time = self.clock.now()
         self.dynamic_vars: dict[str, MOOSMessage] = {}
         self._handlers: dict[str, list[Handler]] = {}
-        self._pattern_handlers: list[tuple[str, str, Handler]] = []
+        self._pattern_handlers: list[tuple[p.Glob, p.Glob, Handler]] = []
+        self._pattern_routes: dict[tuple[str, str], list[Handler]] = {}  # (key, src) -> handlers
         self._timers: list[_Timer] = []
-        self._mail: list[MOOSMessage] = []
         self._published: set[str] = set()
         self._task: asyncio.Task[None] | None = None
         self._stop_requested: asyncio.Event | None = None
@@ -237,7 +245,8 @@ class GobyMOOSApp:
         self.client.subscribe(var, blackout)
 
     def subscribe_pattern(self, var_pattern: str, app_pattern: str, handler: Handler) -> None:
-        self._pattern_handlers.append((var_pattern, app_pattern, handler))
+        self._pattern_handlers.append((p.Glob(var_pattern), p.Glob(app_pattern), handler))
+        self._pattern_routes.clear()
         self.client.subscribe_wildcard(var_pattern, app_pattern)
 
     def publish(
@@ -390,34 +399,52 @@ class GobyMOOSApp:
 
     # -- mail ----------------------------------------------------------------------------------
 
-    def _on_mail(self, msg: MOOSMessage) -> None:
-        self._mail.append(msg)
-
     def _handle_mail(self) -> None:
-        mail, self._mail = self._mail, []
-        mail.sort(key=lambda m: m.time)  # CMOOSApp's SortMailByTime
+        mail = self._mail[:]
+        self._mail.clear()
+        if len(mail) > MAIL_LIMIT:
+            self.log.warning("%d messages arrived since the last tick; handling the newest %d",
+                             len(mail), MAIL_LIMIT)  # fmt: skip
+            del mail[:-MAIL_LIMIT]
+        mail.sort(key=_by_time)  # CMOOSApp's SortMailByTime
+        dynamic_vars = self.dynamic_vars
+        handlers_of = self._handlers.get
+        stale_before = self.start_time if self.ignore_stale else -math.inf
+        patterns = self._pattern_handlers
         for msg in mail:
-            if msg.msg_type == p.NOTIFY:
-                self._dispatch(msg)
+            if msg.msg_type != p.NOTIFY:
+                continue
+            key = msg.key
+            dynamic_vars[key] = msg
+            handlers = handlers_of(key)
+            if handlers:
+                if msg.time < stale_before:
+                    self.log.warning("ignoring stale message %s (time %.3f before the app started)",
+                                     key, msg.time)  # fmt: skip
+                else:
+                    for handler in handlers:
+                        try:
+                            handler(msg)
+                        except Exception:
+                            self.log.exception("handler for %s failed", key)
+            if patterns:
+                for handler in self._pattern_route(key, msg.src):
+                    try:
+                        handler(msg)
+                    except Exception:
+                        self.log.exception("handler for %s failed", key)
 
-    def _dispatch(self, msg: MOOSMessage) -> None:
-        self.dynamic_vars[msg.key] = msg
-        handlers = self._handlers.get(msg.key, ())
-        if handlers and self.ignore_stale and msg.time < self.start_time:
-            self.log.warning("ignoring stale message %s (time %.3f before the app started)",
-                             msg.key, msg.time)  # fmt: skip
-        else:
-            for handler in handlers:
-                self._call(handler, msg)
-        for var_pattern, app_pattern, handler in self._pattern_handlers:
-            if p.wildcard_match(var_pattern, msg.key) and p.wildcard_match(app_pattern, msg.src):
-                self._call(handler, msg)
-
-    def _call(self, handler: Handler, msg: MOOSMessage) -> None:
-        try:
-            handler(msg)
-        except Exception:
-            self.log.exception("handler for %s failed", msg.key)
+    def _pattern_route(self, key: str, src: str) -> list[Handler]:
+        """The pattern handlers for `key` from `src`, matched once per (key, src)."""
+        route = self._pattern_routes.get((key, src))
+        if route is None:
+            if len(self._pattern_routes) >= PATTERN_ROUTES_LIMIT:
+                self._pattern_routes.clear()
+            route = self._pattern_routes[(key, src)] = [
+                handler for var_glob, app_glob, handler in self._pattern_handlers
+                if var_glob.match(key) and app_glob.match(src)
+            ]  # fmt: skip
+        return route
 
     # -- ticks ---------------------------------------------------------------------------------
 

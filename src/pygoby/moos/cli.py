@@ -17,7 +17,13 @@ from typing import Any
 from pygoby.errors import ConfigError
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient
-from pygoby.moos.db import DEFAULT_CLIENT_TIMEOUT, MOOSDB
+from pygoby.moos.db import (
+    DEFAULT_CLIENT_TIMEOUT,
+    DEFAULT_MAX_CLIENTS,
+    DEFAULT_MEMORY_BUDGET,
+    DEFAULT_PACKET_TIMEOUT,
+    MOOSDB,
+)
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.timewarp import moos_clock
 
@@ -33,6 +39,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     db.add_argument("--timeout", "--moos_timeout", type=float, help="client silence timeout, s")
     db.add_argument("--host", default="127.0.0.1", help="address to bind (0.0.0.0: all interfaces)")
     db.add_argument("--max-packet", type=int, default=p.DEFAULT_MAX_PACKET_SIZE, help="largest packet accepted, bytes")
+    db.add_argument("--packet-timeout", type=float, default=DEFAULT_PACKET_TIMEOUT,
+                    help="seconds a packet may take from its first byte to its last")  # fmt: skip
+    db.add_argument("--max-clients", type=int, default=DEFAULT_MAX_CLIENTS,
+                    help="most connections at once (handshaking ones included)")  # fmt: skip
+    db.add_argument("--memory-budget", type=float, default=DEFAULT_MEMORY_BUDGET / 2**20,
+                    help="MB of partial packets and unsent output for all clients together")  # fmt: skip
     db.add_argument("-v", "--verbose", action="store_true")
     db.set_defaults(func=_run_moosdb)
 
@@ -96,7 +108,8 @@ def _run_moosdb(args: argparse.Namespace) -> int:
     warp = args.time_warp or (mission and mission.get_float("MOOSTimeWarp")) or 1.0
     timeout = args.timeout or (mission and mission.get_float("ClientTimeout")) or DEFAULT_CLIENT_TIMEOUT
     db = MOOSDB(args.host, port, community, clock=moos_clock(warp), client_timeout=timeout,
-                max_packet_size=args.max_packet)  # fmt: skip
+                max_packet_size=args.max_packet, packet_timeout=args.packet_timeout,
+                max_clients=args.max_clients, memory_budget=int(args.memory_budget * 2**20))  # fmt: skip
     return _run(_serve(db))
 
 

@@ -267,13 +267,7 @@ class MOOSClient:
                         self.name, self.outbox_limit, dropped)  # fmt: skip
         self._wake.set()
 
-    def _deliver(self, msg: MOOSMessage) -> None:
-        if self.on_message is not None:
-            try:
-                self.on_message(msg)
-            except Exception:
-                log.exception("%s: message handler failed on %s", self.name, msg.key)
-            return
+    def _to_inbox(self, msg: MOOSMessage) -> None:
         self._inbox.append(msg)
         if len(self._inbox) > self.inbox_limit:
             self._inbox.popleft()
@@ -327,7 +321,7 @@ class MOOSClient:
         writer.write(p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(self.name, self.time())]))
         await writer.drain()
         framer = p.PacketFramer(self.max_packet_size)
-        welcome = await asyncio.wait_for(self._read_first_packet(reader, framer), 5.0)
+        welcome, early = await asyncio.wait_for(self._read_first_packet(reader, framer), 5.0)
         if welcome.msg_type == p.POISON:
             raise MoosRefusedError(f"MOOSDB refused {self.name!r}: {welcome.string}")
         if welcome.msg_type != p.WELCOME:
@@ -345,7 +339,7 @@ class MOOSClient:
         self.signal_connect.emit()
         write_task = asyncio.create_task(self._write_loop(writer))
         try:
-            await self._read_loop(reader, framer)
+            await self._read_loop(reader, framer, early)
         finally:
             write_task.cancel()
             with contextlib.suppress(asyncio.CancelledError, OSError):
@@ -361,26 +355,33 @@ class MOOSClient:
         self._outbox.extend(pending)
         self._wake.set()
 
-    async def _read_first_packet(self, reader: asyncio.StreamReader, framer: p.PacketFramer) -> MOOSMessage:
+    async def _read_first_packet(
+        self, reader: asyncio.StreamReader, framer: p.PacketFramer
+    ) -> tuple[MOOSMessage, list[list[MOOSMessage]]]:
+        """The handshake's answer, and the packets that came with it (for the read loop)."""
         while True:
             data = await reader.read(65536)
             if not data:
                 raise EOFError("MOOSDB closed the connection during the handshake")
-            framer.feed(data)
-            for packet in framer.packets():
-                msgs = p.decode_packet(packet)
+            buf, spans = framer.feed(data)
+            packets = [p.decode_packet(buf, start, end) for start, end in spans]
+            for i, msgs in enumerate(packets):
                 if msgs:
-                    return msgs[0]
+                    return msgs[0], packets[i + 1 :]
 
-    async def _read_loop(self, reader: asyncio.StreamReader, framer: p.PacketFramer) -> None:
-        # bytes already buffered after the welcome are in `framer`
+    async def _read_loop(
+        self, reader: asyncio.StreamReader, framer: p.PacketFramer, early: list[list[MOOSMessage]]
+    ) -> None:
+        for msgs in early:
+            self._on_packet(msgs)
+        decode = p.decode_packet
         while True:
-            for packet in framer.packets():
-                self._on_packet(p.decode_packet(packet))
             data = await reader.read(262144)
             if not data:
                 raise EOFError("MOOSDB closed the connection")
-            framer.feed(data)
+            buf, spans = framer.feed(data)
+            for start, end in spans:
+                self._on_packet(decode(buf, start, end))
 
     def _on_packet(self, msgs: list[MOOSMessage]) -> None:
         if msgs and msgs[0].msg_type == p.TIMING:
@@ -388,19 +389,27 @@ class MOOSClient:
             if echo.dval > 0:
                 self.skew.update(echo.time, echo.dval, self.local_time())
             self.throttle = max(echo.dval2, 0.0)
-            msgs = msgs[1:]
-        replies = [m for m in msgs if m.id == p.SERVER_REQUEST_ID and m.msg_type == p.NOTIFY]
-        if replies and self._requests:
-            future = self._requests.pop(0)
-            if not future.done():
-                future.set_result(replies)
+            del msgs[0]
+        if self._requests:
+            replies = [m for m in msgs if m.id == p.SERVER_REQUEST_ID and m.msg_type == p.NOTIFY]
+            if replies:
+                future = self._requests.pop(0)
+                if not future.done():
+                    future.set_result(replies)
+        deliver = self.on_message or self._to_inbox
         for msg in msgs:
             kind = msg.msg_type
-            if kind == p.NULL or (kind == p.NOTIFY and msg.id == p.SERVER_REQUEST_ID):
+            if kind == p.NOTIFY:
+                if msg.id == p.SERVER_REQUEST_ID:
+                    continue
+            elif kind == p.NULL:
                 continue
-            if kind in (p.WELCOME, p.POISON):
+            elif kind in (p.WELCOME, p.POISON):
                 raise MoosProtocolError(f"unexpected {kind!r} message after the handshake")
-            self._deliver(msg)
+            try:
+                deliver(msg)
+            except Exception:
+                log.exception("%s: message handler failed on %s", self.name, msg.key)
 
     async def _write_loop(self, writer: asyncio.StreamWriter) -> None:
         loop = asyncio.get_running_loop()

@@ -7,6 +7,13 @@ Unlike the C++ DB, each connection does its own handshake with timeouts, so a co
 never completes its handshake blocks nobody. The server binds 127.0.0.1 unless `host` says
 otherwise ("0.0.0.0" opens it to the network). A client that sends bytes that are not MOOS
 packets, or a packet above `max_packet_size`, is dropped with a log line; the others carry on.
+
+Mail for a client is collected in one outgoing buffer and written once per event-loop
+iteration, so a burst of notifications leaves in a few large packets (as libMOOS packs its
+outbox). Resources are bounded: at most `max_clients` connections; a packet must arrive whole
+within `packet_timeout` of its first byte; partial packets and unsent output together stay
+within `memory_budget` bytes (beyond it the connection holding the most is dropped), and one
+client's unsent output within MAX_WRITE_BUFFER.
 """
 
 from __future__ import annotations
@@ -25,6 +32,9 @@ log = logging.getLogger(__name__)
 
 DEFAULT_CLIENT_TIMEOUT = 5.0
 DEFAULT_HANDSHAKE_TIMEOUT = 5.0
+DEFAULT_PACKET_TIMEOUT = 30.0
+DEFAULT_MAX_CLIENTS = 512
+DEFAULT_MEMORY_BUDGET = 256 * 1024 * 1024
 MAX_WRITE_BUFFER = 64 * 1024 * 1024
 
 
@@ -36,8 +46,11 @@ class _Connection(asyncio.Protocol):
         self.transport: asyncio.Transport | None = None
         self.name: str | None = None
         self.peer = "?"
-        self._preamble = bytearray()
+        self._preamble = b""
         self._framer = p.PacketFramer(server.max_packet_size)
+        self.pending = 0  # bytes of an incomplete packet (as last counted in the budget)
+        self.packet_since: float | None = None  # loop time the incomplete packet began
+        self.unsent = 0  # the transport's write buffer, as last seen
         self.last_rx = 0.0
         self._handshake_timer: asyncio.TimerHandle | None = None
         self._closed = False
@@ -45,22 +58,31 @@ class _Connection(asyncio.Protocol):
     # asyncio.Protocol ---------------------------------------------------------------------------
 
     def connection_made(self, transport: asyncio.BaseTransport) -> None:
-        assert isinstance(transport, asyncio.Transport)
-        self.transport = transport
+        self.transport = transport  # type: ignore[assignment]  # uvloop's is no asyncio.Transport
+        self.peer = str(transport.get_extra_info("peername"))
+        server = self.server
+        if len(server._connections) >= server.max_clients:
+            self._closed = True
+            log.warning("refusing a connection from %s: %d connections already (max_clients)",
+                        self.peer, len(server._connections))  # fmt: skip
+            transport.abort()
+            return
         sock = transport.get_extra_info("socket")
         if sock is not None:
             with contextlib.suppress(OSError):
                 sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.peer = str(transport.get_extra_info("peername"))
-        loop = asyncio.get_running_loop()
+        loop = server._loop
         self.last_rx = loop.time()
         self._handshake_timer = loop.call_later(
-            self.server.handshake_timeout, self._drop, "handshake not completed in time"
+            server.handshake_timeout, self._drop, "handshake not completed in time"
         )
-        self.server._connections.add(self)
+        server._connections.add(self)
 
     def data_received(self, data: bytes) -> None:
-        self.last_rx = asyncio.get_running_loop().time()
+        if self._closed:
+            return
+        server = self.server
+        now = self.last_rx = server._loop.time()
         try:
             if len(self._preamble) < p.PROTOCOL_STRING_SIZE:
                 need = p.PROTOCOL_STRING_SIZE - len(self._preamble)
@@ -68,42 +90,59 @@ class _Connection(asyncio.Protocol):
                 data = data[need:]
                 if len(self._preamble) < p.PROTOCOL_STRING_SIZE:
                     return
-                if not p.check_protocol_string(bytes(self._preamble)):
+                if not p.check_protocol_string(self._preamble):
                     self._drop("wrong protocol string", quiet=True)
                     return
             if data:
-                self._framer.feed(data)
-            for packet in self._framer.packets():
-                if self._closed:
-                    return
-                msgs = p.decode_packet(packet)
-                if self.name is None:
-                    self._handshake(msgs)
-                else:
-                    self.server._dispatch(self.server.core.process_packet(self.name, msgs))
+                self._consume(data, now)
         except MoosProtocolError as err:
             self._drop(f"protocol error: {err}")
         except Exception:  # a bug must cost one connection, never the DB
             log.exception("error while serving client %s", self.name)
             self._drop("internal error")
+        server._schedule_flush()
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._closed = True
+        self._release_buffers()
         if self._handshake_timer is not None:
             self._handshake_timer.cancel()
-        self.server._connections.discard(self)
-        if self.name is not None and self.server._clients.get(self.name) is self:
-            del self.server._clients[self.name]
+        server = self.server
+        server._connections.discard(self)
+        if self.name is not None and server._clients.get(self.name) is self:
+            del server._clients[self.name]
             log.info("client %s disconnected", self.name)
-            self.server._dispatch(self.server.core.disconnect(self.name))
+            server.core.disconnect(self.name)
+            server._schedule_flush()
 
     # ------------------------------------------------------------------------------------------
 
-    def _handshake(self, msgs: list[p.MOOSMessage]) -> None:
+    def _consume(self, data: bytes, now: float) -> None:
+        """Process every packet that `data` completes; the rest waits in the framer."""
+        framer = self._framer
+        buf, spans = framer.feed(data)
+        core = self.server.core
+        for start, end in spans:
+            if self.name is None:
+                self._handshake(buf[start:end])
+            else:
+                core.process_packet(self.name, buf, start, end)
+            if self._closed:
+                return
+        if not framer.buffered:
+            self.packet_since = None
+        elif framer.began_packet:
+            self.packet_since = now
+        self._set_pending(framer.buffered)
+        if framer.buffered:
+            self.server._check_budget()
+
+    def _handshake(self, packet: bytes) -> None:
+        msgs = p.decode_packet(packet)
         if not msgs:
             raise MoosProtocolError("empty handshake packet")
         reply = self.server.core.connect(msgs[0])
-        self.send([reply])
+        self.write(p.encode_packet([reply]))
         if reply.msg_type == p.POISON:
             self._drop(f"refused: {reply.string}")
             return
@@ -112,19 +151,37 @@ class _Connection(asyncio.Protocol):
         self.name = msgs[0].string
         self.server._clients[self.name] = self
         log.info("client %s connected from %s", self.name, self.peer)
-        self.server._dispatch(self.server.core.collect_pushes(exclude=self.name))
 
-    def send(self, msgs: list[p.MOOSMessage], cache: dict[int, bytes] | None = None) -> None:
+    def write(self, data: bytes) -> None:
         if self._closed or self.transport is None:
             return
-        self.transport.write(p.encode_packet(msgs, cache))
-        if self.transport.get_write_buffer_size() > MAX_WRITE_BUFFER:
+        transport = self.transport
+        transport.write(data)
+        self.update_unsent()
+        if self.unsent > MAX_WRITE_BUFFER:
             self._drop("not reading its mail (write buffer full)")
+
+    def update_unsent(self) -> None:
+        assert self.transport is not None
+        size = self.transport.get_write_buffer_size()
+        self.server._unsent_total += size - self.unsent
+        self.unsent = size
+
+    def _set_pending(self, size: int) -> None:
+        self.server._pending_total += size - self.pending
+        self.pending = size
+
+    def _release_buffers(self) -> None:
+        self._framer = p.PacketFramer(self.server.max_packet_size)
+        self._set_pending(0)
+        self.server._unsent_total -= self.unsent
+        self.unsent = 0
 
     def _drop(self, reason: str, quiet: bool = False) -> None:
         if self._closed:
             return
         self._closed = True
+        self._release_buffers()
         (log.debug if quiet else log.warning)(
             "dropping client %s (%s): %s", self.name or "<handshaking>", self.peer, reason
         )
@@ -141,7 +198,9 @@ class MOOSDB:
     Args: host (default 127.0.0.1), port (default 9000; 0 = ephemeral, read `port` after
     start), community (default "#1"), clock (MOOS time; see `pygoby.moos.timewarp`),
     client_timeout (s of silence before a client is dropped), handshake_timeout,
-    max_packet_size (bytes; larger packets are refused from their header).
+    packet_timeout (s from a packet's first byte to its last), max_packet_size (bytes; larger
+    packets are refused from their header), max_clients (connections, handshaking ones
+    included), memory_budget (bytes of partial packets and unsent output, all clients).
     """
 
     def __init__(
@@ -153,19 +212,29 @@ class MOOSDB:
         clock: Clock | None = None,
         client_timeout: float = DEFAULT_CLIENT_TIMEOUT,
         handshake_timeout: float = DEFAULT_HANDSHAKE_TIMEOUT,
+        packet_timeout: float = DEFAULT_PACKET_TIMEOUT,
         max_packet_size: int = p.DEFAULT_MAX_PACKET_SIZE,
+        max_clients: int = DEFAULT_MAX_CLIENTS,
+        memory_budget: int = DEFAULT_MEMORY_BUDGET,
         hostname: str | None = None,
     ) -> None:
         self.host = host
         self._requested_port = port
         self.client_timeout = client_timeout
         self.handshake_timeout = handshake_timeout
+        self.packet_timeout = packet_timeout
         self.max_packet_size = max_packet_size
+        self.max_clients = max_clients
+        self.memory_budget = memory_budget
         self.core = DBCore(community, clock, hostname or socket.gethostname())
         self._server: asyncio.Server | None = None
         self._sweeper: asyncio.Task[None] | None = None
         self._connections: set[_Connection] = set()
         self._clients: dict[str, _Connection] = {}
+        self._pending_total = 0
+        self._unsent_total = 0
+        self._flush_scheduled = False
+        self._loop: asyncio.AbstractEventLoop = None  # type: ignore[assignment]  # start() sets it
 
     @property
     def community(self) -> str:
@@ -181,9 +250,14 @@ class MOOSDB:
     def client_names(self) -> list[str]:
         return list(self._clients)
 
+    @property
+    def buffered(self) -> int:
+        """Bytes of partial packets and unsent output held for all clients (as last seen)."""
+        return self._pending_total + self._unsent_total
+
     async def start(self) -> None:
-        loop = asyncio.get_running_loop()
-        self._server = await loop.create_server(
+        self._loop = asyncio.get_running_loop()
+        self._server = await self._loop.create_server(
             lambda: _Connection(self), self.host, self._requested_port, reuse_address=True
         )
         self._sweeper = asyncio.create_task(self._sweep(), name="moosdb-timeouts")
@@ -219,18 +293,49 @@ class MOOSDB:
     async def __aexit__(self, *exc: object) -> None:
         await self.stop()
 
-    def _dispatch(self, outgoing: dict[str, list[p.MOOSMessage]]) -> None:
-        cache: dict[int, bytes] = {}  # a notification routed to many clients is encoded once
-        for name, msgs in outgoing.items():
-            conn = self._clients.get(name)
-            if conn is not None and msgs:
-                conn.send(msgs, cache)
+    # ------------------------------------------------------------------------------------------
+
+    def _schedule_flush(self) -> None:
+        if not self._flush_scheduled:
+            self._flush_scheduled = True
+            self._loop.call_soon(self._flush)
+
+    def _flush(self) -> None:
+        """Write every client's due mail: once per loop iteration, however many packets came."""
+        self._flush_scheduled = False
+        clients = self._clients
+        for record in self.core.take_ready():
+            data = record.take_output()
+            conn = clients.get(record.name)
+            if conn is not None and data:
+                conn.write(data)
+        self._check_budget()
+
+    def _check_budget(self) -> None:
+        while self._pending_total + self._unsent_total > self.memory_budget:
+            biggest = max(self._connections, key=lambda c: c.pending + c.unsent, default=None)
+            if biggest is None or biggest.pending + biggest.unsent == 0:
+                return
+            biggest._drop(
+                f"holding {biggest.pending + biggest.unsent} bytes while all clients' buffers "
+                f"exceed the memory budget of {self.memory_budget} bytes"
+            )  # fmt: skip
 
     async def _sweep(self) -> None:
-        loop = asyncio.get_running_loop()
+        loop = self._loop
         while True:
-            await asyncio.sleep(min(0.5, self.client_timeout / 4))
-            limit = loop.time() - self.client_timeout
-            for conn in list(self._clients.values()):
-                if conn.last_rx < limit:
-                    conn._drop(f"silent for more than {self.client_timeout:g} s")
+            await asyncio.sleep(min(0.5, self.client_timeout / 4, self.packet_timeout / 4))
+            try:
+                self._enforce_deadlines(loop.time())
+            except Exception:  # the timeouts must outlive any bug
+                log.exception("error while checking client deadlines")
+
+    def _enforce_deadlines(self, now: float) -> None:
+        for conn in list(self._connections):
+            if conn.name is not None and conn.last_rx < now - self.client_timeout:
+                conn._drop(f"silent for more than {self.client_timeout:g} s")
+            elif conn.packet_since is not None and conn.packet_since < now - self.packet_timeout:
+                conn._drop(f"a packet took more than {self.packet_timeout:g} s to arrive")
+            elif conn.transport is not None and not conn.transport.is_closing():
+                conn.update_unsent()
+        self._check_budget()

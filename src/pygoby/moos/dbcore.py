@@ -1,76 +1,207 @@
 """The MOOSDB's semantics, sans I/O: variables, subscriptions, routing, server requests.
 
-`DBCore` is fed events (a handshake, a packet of messages from a named client, a disconnect)
-and returns what to send to whom; the asyncio server in `db.py` owns the sockets and timeouts.
-Behaviour follows the C++ MOOSDB (spec moos.md sections 8-13): the first write fixes a
-variable's type (S and B differ) and other writes are dropped silently; subscribing queues the
-current value at once; an interval drops updates that come too soon; wildcard filters are
-tested when a variable is first written or when the filter is registered; the DB publishes
-DB_TIME, DB_UPTIME, DB_CLIENTS, DB_VARSUMMARY, DB_QOS, DB_RWSUMMARY (refreshed at most every
-2 s of DB time, when a packet with more than a T message arrives) and DB_EVENT on connect and
-disconnect.
+`DBCore` is fed events (a handshake, a packet's bytes from a named client, a disconnect); what
+they cause to be sent collects in each client's outgoing buffer, which the asyncio server in
+`db.py` takes (`take_ready`) and writes once per event-loop iteration. Behaviour follows the
+C++ MOOSDB (spec moos.md sections 8-13): the first write fixes a variable's type (S and B
+differ) and other writes are dropped silently; subscribing queues the current value at once;
+an interval drops updates that come too soon; wildcard filters are tested when a variable is
+first written or when the filter is registered; the DB publishes DB_TIME, DB_UPTIME,
+DB_CLIENTS, DB_VARSUMMARY, DB_QOS, DB_RWSUMMARY (refreshed at most every 2 s of DB time, when
+a packet with more than a T message arrives) and DB_EVENT on connect and disconnect.
+
+The hot path is a notification: it is forwarded to its subscribers as the bytes it arrived in
+(the DB's community spliced in when the publisher left it empty, as the C++ DB does), parsing
+only what routing needs (key, data type, source). A variable keeps its last message as those
+bytes and decodes it only when asked (a snapshot for a new subscriber, `Q ALL`, summaries).
+A packet's messages are processed at one DB time (the clock is read once per packet).
 """
 
 from __future__ import annotations
 
 import logging
 import math
+import struct
 import time as _time
-from dataclasses import dataclass, field
 
 from pygoby.moos import protocol as p
+from pygoby.moos.errors import MoosProtocolError
 from pygoby.util.clock import Clock, WallClock
 
 log = logging.getLogger(__name__)
 
 REFRESH_PERIOD = 2.0
 DB_VARIABLES = ("DB_TIME", "DB_UPTIME", "DB_CLIENTS", "DB_VARSUMMARY", "DB_QOS", "DB_RWSUMMARY")
+# Outgoing packets are cut at this size: mail merged over one loop iteration can be large.
+MAX_OUTGOING_PACKET = 1 << 20
+
+_HEADER = struct.Struct("<iiB")
+_MSG_HEAD = struct.Struct("<i4xBB")  # msg_len, (id), msg_type, data_type
+_INT = struct.Struct("<i")
+_NOTIFY = ord(p.NOTIFY)
+_TIMING = ord(p.TIMING)
+_DOUBLE = ord(p.DOUBLE)
+_NOT_SET = ord(p.NOT_SET)
 
 
-@dataclass(slots=True)
 class Subscription:
-    interval: float
-    last_sent: float = 0.0
+    """One client's subscription to one variable (interval in DB seconds; 0 = every update)."""
+
+    __slots__ = ("client", "interval", "last_sent")
+
+    def __init__(self, client: ClientRecord, interval: float) -> None:
+        self.client = client
+        self.interval = interval
+        self.last_sent = 0.0
 
 
-@dataclass(slots=True)
 class Variable:
-    name: str
-    data_type: str = p.NOT_SET
-    dval: float = -1.0
-    sval: bytes = b""
-    time: float = -1.0
-    src: str = ""
-    src_aux: str = ""
-    community: str = ""
-    write_time: float = -1.0
-    writes: int = 0
-    write_rate: float = 0.0
-    writers: set[str] = field(default_factory=set)
-    subscribers: dict[str, Subscription] = field(default_factory=dict)
+    """One MOOS variable; its value is the last notification as forwarded (`raw`)."""
 
-    def snapshot(self) -> p.MOOSMessage:
-        """The current value as the N message a new subscriber gets."""
-        is_double = self.data_type == p.DOUBLE
-        return p.MOOSMessage(
-            p.NOTIFY, self.data_type, self.name, self.time, self.dval if is_double else -1.0,
-            -1.0, b"" if is_double else self.sval, self.src, self.src_aux, self.community, -1,
-        )  # fmt: skip
+    __slots__ = ("name", "key", "type_code", "accepts", "raw", "community", "write_time",
+                 "write_rate", "last_source", "subscribers", "every_update", "timed")  # fmt: skip
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.key = p.encode_text(name)
+        self.type_code = _NOT_SET
+        self.accepts = -1  # the type code of the writes routed without further checks
+        self.raw: bytes | None = None  # None: never written (since the last DB_CLEAR)
+        self.community = ""  # of a variable cleared by DB_CLEAR (the C++ DB keeps it)
+        self.write_time = -1.0
+        self.write_rate = 0.0
+        self.last_source: _Source | None = None  # whose publisher already lists this variable
+        self.subscribers: dict[str, Subscription] = {}
+        # routing tables derived from `subscribers` (rebuilt when they change): the held-mail
+        # appenders of interval-0 subscribers, and the subscriptions with an interval
+        self.every_update: list = []
+        self.timed: list[Subscription] = []
+
+    @property
+    def data_type(self) -> str:
+        return chr(self.type_code)
+
+    @property
+    def written(self) -> bool:
+        return self.raw is not None
+
+    def message(self) -> p.MOOSMessage:
+        """The stored value as a message (an empty one with defaults when never written)."""
+        if self.raw is None:
+            return p.MOOSMessage(p.NOTIFY, self.data_type, self.name, community=self.community)
+        return p.decode_message(self.raw)[0]
+
+    @property
+    def src(self) -> str:
+        return self.message().src if self.raw is not None else ""
+
+    def snapshot(self) -> bytes:
+        """The current value as the N message a new subscriber gets (id -1, dval2 -1)."""
+        m = self.message()
+        is_double = self.type_code == _DOUBLE
+        return p.encode_message(p.MOOSMessage(
+            p.NOTIFY, m.data_type, self.name, m.time, m.dval if is_double else -1.0, -1.0,
+            b"" if is_double else m.sval, m.src, m.src_aux, m.community, -1,
+        ))  # fmt: skip
+
+    def subscribe(self, client: ClientRecord, interval: float) -> Subscription:
+        sub = self.subscribers[client.name] = Subscription(client, interval)
+        self._reroute()
+        return sub
+
+    def unsubscribe(self, name: str) -> None:
+        if self.subscribers.pop(name, None) is not None:
+            self._reroute()
+
+    def _reroute(self) -> None:
+        subs = self.subscribers.values()
+        self.every_update = [s.client.held.append for s in subs if s.interval == 0.0]
+        self.timed = [s for s in subs if s.interval != 0.0]
 
     def clear(self) -> None:
-        self.dval, self.sval, self.time, self.src, self.src_aux = -1.0, b"", -1.0, "", ""
-        self.write_time, self.writes, self.write_rate = -1.0, 0, 0.0
-        self.writers.clear()
+        if self.raw is not None:
+            self.community = self.message().community
+        self.raw = None
+        self.accepts = -1
+        self.write_time, self.write_rate = -1.0, 0.0
 
 
-@dataclass(slots=True)
 class ClientRecord:
-    name: str
-    asynchronous: bool
-    held: list[p.MOOSMessage] = field(default_factory=list)
-    filters: dict[tuple[str, str], float] = field(default_factory=dict)
-    latencies_ms: list[float] = field(default_factory=list)
-    published: set[str] = field(default_factory=set)
+    """A connected client: its held mail (queued, not yet due), its outgoing buffer (due, not
+    yet written), wildcard filters, timing statistics and the variables it published."""
+
+    __slots__ = ("name", "asynchronous", "held", "out", "breaks", "filters", "latencies_ms",
+                 "published")  # fmt: skip
+
+    def __init__(self, name: str, asynchronous: bool) -> None:
+        self.name = name
+        self.asynchronous = asynchronous
+        self.held: list[bytes] = []  # encoded messages; the list object is never replaced
+        self.out: list[bytes] = []
+        self.breaks: list[int] = []  # indices in `out` that must start a packet (T echo, null)
+        self.filters: dict[tuple[str, str], tuple[p.Glob, p.Glob, float]] = {}
+        self.latencies_ms: list[float] = []
+        self.published: set[str] = set()
+
+    def release(self, head: bytes | None = None, tail: list[bytes] | None = None) -> None:
+        """Make [head] + held mail + [tail] due, as one packet (merged with mail made due
+        earlier unless `head` is given: a T echo or a null must lead its packet)."""
+        out = self.out
+        if head is not None:
+            self.breaks.append(len(out))
+            out.append(head)
+        if self.held:
+            out += self.held
+            self.held.clear()
+        if tail:
+            out += tail
+
+    def take_output(self) -> bytes:
+        """Everything due, as packets, in one byte string; empties the buffer."""
+        out, cuts = self.out, self.breaks
+        chunks: list[bytes] = []
+        start = 0
+        for cut in [*cuts, len(out)]:
+            if cut > start:
+                _append_packets(chunks, out[start:cut])
+            start = cut
+        self.out = []
+        self.breaks = []
+        return b"".join(chunks)
+
+
+def _append_packets(chunks: list[bytes], msgs: list[bytes]) -> None:
+    total = p.PACKET_HEADER_SIZE + sum(map(len, msgs))
+    if total > MAX_OUTGOING_PACKET and len(msgs) > 1:
+        half = len(msgs) // 2
+        _append_packets(chunks, msgs[:half])
+        _append_packets(chunks, msgs[half:])
+        return
+    chunks.append(_HEADER.pack(total, len(msgs), 0))
+    chunks += msgs
+
+
+class _Source:
+    """What the DB learnt from a message's src/src_aux/community bytes, for the messages that
+    follow with the same bytes (normally every message of a client's packet)."""
+
+    __slots__ = ("head", "layout", "forwarded", "growth", "src", "publisher")
+
+    def __init__(self, core: DBCore, data: bytes, at: int, stop: int) -> None:
+        src, pos = p.read_str(data, at, stop, "src")
+        _aux, pos = p.read_str(data, pos, stop, "src_aux")
+        community, pos = p.read_str(data, pos, stop, "community")
+        self.head = bytes(data[at:pos])
+        # msg_len, id + msg_type + data_type, these bytes, key length
+        self.layout = struct.Struct(f"<i6s{len(self.head)}si")
+        self.src = p.decode_text(src)
+        self.publisher = core.clients.get(self.src)
+        if community:  # bridged from another community: forwarded untouched
+            self.forwarded: bytes | None = None
+            self.growth = 0
+        else:  # the DB fills in its own community (moos.md 10.3)
+            self.forwarded = self.head[:-4] + core.community_field
+            self.growth = len(core.community_field) - 4
 
 
 class DBCore:
@@ -81,19 +212,27 @@ class DBCore:
         hostname: str = "localhost",
     ) -> None:  # fmt: skip
         self.community = community or p.DEFAULT_COMMUNITY
+        community_bytes = p.encode_text(self.community)
+        self.community_field = _INT.pack(len(community_bytes)) + community_bytes
         self.clock = clock or WallClock()
         self.hostname = hostname
         self.name = f"MOOSDB_{self.community}"
         self.start_time = self.clock.now()
         self._last_refresh = self.start_time
-        self.variables: dict[str, Variable] = {n: Variable(n) for n in DB_VARIABLES}
-        self.variables["DB_EVENT"] = Variable("DB_EVENT")
+        self.variables: dict[str, Variable] = {}
+        self._by_key: dict[bytes, Variable] = {}
+        for name in (*DB_VARIABLES, "DB_EVENT"):
+            self._variable(name)
         self.clients: dict[str, ClientRecord] = {}
+        self._ready: dict[str, ClientRecord] = {}
+        own = p.encode_message(p.notify("_", 0.0, time=0.0, src=self.name))
+        self._source = _Source(self, own, 10, len(own))
 
     # -- connections ---------------------------------------------------------------------------
 
     def connect(self, handshake: p.MOOSMessage) -> p.MOOSMessage:
-        """Handle a handshake message; returns the W (accepted) or K (refused) reply."""
+        """Handle a handshake message; returns the W (accepted) or K (refused) reply, which
+        the caller sends before anything else to that client."""
         now = self.clock.now()
         name = handshake.string
         if name in self.clients or not name:
@@ -102,166 +241,250 @@ class DBCore:
             return p.poison_message(reason, now)
         asynchronous = handshake.key.lower() == p.ASYNC_HANDSHAKE_KEY
         self.clients[name] = ClientRecord(name, asynchronous)
+        self._relearn_source()
         self._write_own("DB_EVENT", f"connected={name}")
+        self._push(exclude=name)
         return p.welcome_message(self.community, self.hostname, now, now - handshake.time)
 
-    def disconnect(self, name: str) -> dict[str, list[p.MOOSMessage]]:
-        """Forget a client: its subscriptions, filters and held mail. Returns pushes."""
+    def disconnect(self, name: str) -> None:
+        """Forget a client: its subscriptions, filters, held and unwritten mail."""
         if self.clients.pop(name, None) is None:
-            return {}
+            return
+        self._ready.pop(name, None)
+        self._relearn_source()
         for var in self.variables.values():
-            var.subscribers.pop(name, None)
+            var.unsubscribe(name)
         self._write_own("DB_EVENT", f"disconnected={name}")
-        return self.collect_pushes(exclude=None)
+        self._push(exclude=None)
+
+    def take_ready(self) -> list[ClientRecord]:
+        """The clients with output due (each then gives it with `take_output()`)."""
+        ready = list(self._ready.values())
+        self._ready.clear()
+        return ready
 
     # -- packets -------------------------------------------------------------------------------
 
-    def process_packet(
-        self, name: str, msgs: list[p.MOOSMessage]
-    ) -> dict[str, list[p.MOOSMessage]]:
-        """Process one packet from client `name`; returns {client: messages to send}."""
+    def process_packet(self, name: str, data: bytes, start: int = 0, end: int | None = None) -> None:
+        """Process the packet in data[start:end] from client `name` (MoosProtocolError if it is
+        malformed: the messages before the fault have taken effect)."""
         client = self.clients[name]
-        reply: list[p.MOOSMessage] = []
-        if client.asynchronous:
-            if msgs and msgs[0].msg_type == p.TIMING:
-                echo = msgs[0].copy()
-                echo.dval = self.clock.now()
-                echo.dval2 = 0.0
-                client.latencies_ms.append((echo.dval - echo.time) * 1000.0)
-                del client.latencies_ms[:-50]
-                reply.append(echo)
-                msgs = msgs[1:]
-        else:
-            reply.append(p.MOOSMessage(p.NULL, p.DOUBLE, "", -1.0, self.clock.now()))
-        answers: list[p.MOOSMessage] = []
-        had_notify = False
-        for msg in msgs:
-            kind = msg.msg_type
-            if kind == p.NOTIFY:
-                had_notify = True
-                self._on_notify(msg)
-            elif kind == p.REGISTER:
-                interval = msg.dval if math.isfinite(msg.dval) and msg.dval > 0 else 0.0
-                self._on_register(msg.src, msg.key, interval)
-            elif kind == p.UNREGISTER:
-                var = self.variables.get(msg.key)
-                if var is not None:
-                    var.subscribers.pop(msg.src, None)
-            elif kind == p.WILDCARD_REGISTER:
-                self._on_wildcard(msg.src, msg.sval, register=True)
-            elif kind == p.WILDCARD_UNREGISTER:
-                self._on_wildcard(msg.src, msg.sval, register=False)
-            elif kind == p.SERVER_REQUEST:
-                answers.extend(self._server_request(msg))
-        if msgs:  # a packet holding only a T does not refresh (vector seqs 87, 155-159)
-            self._maybe_refresh()
-        reply.extend(client.held)
-        client.held = []
-        reply.extend(answers)
-        out: dict[str, list[p.MOOSMessage]] = {}
+        if end is None:
+            end = len(data)
+        if end - start < p.PACKET_HEADER_SIZE:
+            raise MoosProtocolError(f"packet of {end - start} bytes is shorter than its header")
+        total, count, _ = _HEADER.unpack_from(data, start)
+        if total != end - start or count < 0:
+            raise MoosProtocolError(f"packet header ({total} bytes, {count} messages) does not "
+                                  f"fit the {end - start} bytes given")  # fmt: skip
+        now = self.clock.now()
+        pos = start + p.PACKET_HEADER_SIZE
+        head = None
+        if not client.asynchronous:
+            head = p.encode_message(p.MOOSMessage(p.NULL, p.DOUBLE, "", -1.0, now))
+        elif count and end - pos >= p.MESSAGE_FIXED_SIZE and data[pos + 8] == _TIMING:
+            timing, pos = p.decode_message(data, pos, end)
+            count -= 1
+            timing.dval = now
+            timing.dval2 = 0.0
+            client.latencies_ms.append((now - timing.time) * 1000.0)
+            del client.latencies_ms[:-50]
+            head = p.encode_message(timing)
+        answers: list[bytes] = []
+        had_notify = self._process_messages(client, data, pos, end, count, now, answers)
+        if count:  # a packet holding only a T does not refresh (vector seqs 87, 155-159)
+            self._maybe_refresh(now)
+        if head is not None or client.held or answers:
+            client.release(head, answers)
+            self._ready[name] = client
         if had_notify:
-            out = self.collect_pushes(exclude=name)
-        if reply:
-            out[name] = reply
-        return out
+            self._push(exclude=name)
 
-    def collect_pushes(self, exclude: str | None) -> dict[str, list[p.MOOSMessage]]:
-        """Take the held mail of every asynchronous client (except `exclude`) for pushing."""
-        out = {}
+    def _push(self, exclude: str | None) -> None:
+        """Make the held mail of every asynchronous client (but `exclude`) due."""
+        ready = self._ready
         for other in self.clients.values():
             if other.held and other.asynchronous and other.name != exclude:
-                out[other.name] = other.held
-                other.held = []
-        return out
+                other.release()
+                ready[other.name] = other
 
-    # -- notify / register ---------------------------------------------------------------------
+    def _process_messages(
+        self, client: ClientRecord | None, data: bytes, pos: int, end: int, count: int,
+        now: float, answers: list[bytes],
+    ) -> bool:  # fmt: skip
+        """Apply `count` messages from data[pos:end]; True if one was a notification."""
+        by_key = self._by_key
+        read_int = _INT.unpack_from
+        pack_int = _INT.pack
+        source = self._source
+        head, read_start, forwarded, growth = (source.head, source.layout.unpack_from,
+                                               source.forwarded, source.growth)  # fmt: skip
+        key_at_offset = 10 + len(head)
+        had_notify = False
+        for _ in range(count):
+            try:  # one unpack reads a notification from the remembered source up to its key
+                msg_len, id_types, head_seen, key_len = read_start(data, pos)
+            except struct.error:  # the layout runs past the buffer: read it the long way
+                head_seen = None
+            if head_seen != head:
+                if end - pos < p.MESSAGE_FIXED_SIZE:
+                    raise MoosProtocolError("message truncated before the end of its fixed fields")
+                msg_len, msg_type, _ = _MSG_HEAD.unpack_from(data, pos)
+                stop = pos + msg_len
+                if msg_len < p.MESSAGE_FIXED_SIZE or stop > end or msg_type != _NOTIFY:
+                    self._on_other(client, p.decode_message(data, pos, end)[0], now, answers)
+                    pos = stop
+                    continue
+                source = self._source = _Source(self, data, pos + 10, stop)
+                head, read_start, forwarded, growth = (source.head, source.layout.unpack_from,
+                                                       source.forwarded, source.growth)  # fmt: skip
+                key_at_offset = 10 + len(head)
+                msg_len, id_types, head_seen, key_len = read_start(data, pos)
+            stop = pos + msg_len
+            if msg_len < p.MESSAGE_FIXED_SIZE or stop > end:
+                raise MoosProtocolError(f"message length {msg_len} is below "
+                                      f"{p.MESSAGE_FIXED_SIZE} or runs past the packet end")  # fmt: skip
+            if id_types[4] != _NOTIFY:
+                self._on_other(client, p.decode_message(data, pos, stop)[0], now, answers)
+                pos = stop
+                continue
+            had_notify = True
+            data_type = id_types[5]
+            key_at = pos + key_at_offset
+            key_end = key_at + 4 + key_len
+            if key_len < 0 or key_end + 28 > stop:
+                raise MoosProtocolError(f"key length {key_len} is negative or runs past the message end")
+            (sval_len,) = read_int(data, key_end + 24)
+            if sval_len < 0 or key_end + 28 + sval_len != stop:
+                raise MoosProtocolError(f"sval length {sval_len} does not end the message")
+            if forwarded is None:
+                raw = data[pos:stop]
+            else:
+                raw = b"".join((pack_int(msg_len + growth), id_types, forwarded, data[key_at:stop]))
+            var = by_key.get(data[key_at + 4 : key_end])
+            if var is None or var.accepts != data_type:
+                var = self._first_or_mistyped_write(var, data[key_at + 4 : key_end], data_type, source.src, now)
+                if var is None:
+                    pos = stop
+                    continue
+            elif now != var.write_time:
+                if now > var.write_time:
+                    var.write_rate = 0.9 * var.write_rate + 0.1 / (now - var.write_time)
+                var.write_time = now
+            var.raw = raw
+            if var.last_source is not source:
+                var.last_source = source
+                if source.publisher is not None:
+                    source.publisher.published.add(var.name)
+            for append in var.every_update:
+                append(raw)
+            for sub in var.timed:
+                if now - sub.last_sent >= sub.interval:
+                    sub.last_sent = now
+                    sub.client.held.append(raw)
+            pos = stop
+        if pos != end:
+            raise MoosProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
+        return had_notify
+
+    def _first_or_mistyped_write(
+        self, var: Variable | None, key: bytes, data_type: int, src: str, now: float
+    ) -> Variable | None:
+        """The variable a write of `data_type` goes to, or None when the type lock drops it."""
+        if var is None:
+            var = self._variable(p.decode_text(key))
+        if var.raw is None:
+            var.type_code = var.accepts = data_type
+            var.write_time = now  # no write rate from a first write
+            self._apply_filters_on_creation(var, src)
+            return var
+        log.info('Attempting to update var "%s" which is type %s with data type %s by client %s',
+                 var.name, var.data_type, chr(data_type), src)  # fmt: skip
+        return None
+
+    def _relearn_source(self) -> None:
+        """Clients came or went: the remembered source's publisher may have changed."""
+        head = self._source.head
+        self._source = _Source(self, head, 0, len(head))
+
+    def _on_other(
+        self, client: ClientRecord | None, msg: p.MOOSMessage, now: float, answers: list[bytes]
+    ) -> None:
+        kind = msg.msg_type
+        if kind == p.REGISTER:
+            interval = msg.dval if math.isfinite(msg.dval) and msg.dval > 0 else 0.0
+            self._on_register(msg.src, msg.key, interval, now)
+        elif kind == p.UNREGISTER:
+            var = self.variables.get(msg.key)
+            if var is not None:
+                var.unsubscribe(msg.src)
+        elif kind == p.WILDCARD_REGISTER:
+            self._on_wildcard(msg.src, msg.sval, now, register=True)
+        elif kind == p.WILDCARD_UNREGISTER:
+            self._on_wildcard(msg.src, msg.sval, now, register=False)
+        elif kind == p.SERVER_REQUEST and client is not None:
+            answers += map(p.encode_message, self._server_request(msg, now))
+
+    # -- variables and subscriptions -----------------------------------------------------------
 
     def _variable(self, name: str) -> Variable:
         var = self.variables.get(name)
         if var is None:
             var = self.variables[name] = Variable(name)
+            self._by_key[var.key] = var
         return var
 
-    def _on_notify(self, msg: p.MOOSMessage) -> None:
-        var = self._variable(msg.key)
-        now = self.clock.now()
-        if var.writes == 0:
-            var.data_type = msg.data_type
-            self._apply_filters_on_creation(var, msg.src)
-        elif msg.data_type != var.data_type:
-            log.info(
-                'Attempting to update var "%s" which is type %s with data type %s by client %s',
-                var.name, var.data_type, msg.data_type, msg.src,
-            )  # fmt: skip
-            return
-        if msg.data_type == p.DOUBLE:
-            var.dval = msg.dval
-        else:
-            var.sval = msg.sval
-        if not msg.community:
-            msg.community = self.community
-        if var.writes and now > var.write_time:
-            var.write_rate = 0.9 * var.write_rate + 0.1 / (now - var.write_time)
-        var.time, var.src, var.src_aux, var.community = msg.time, msg.src, msg.src_aux, msg.community
-        var.write_time = now
-        var.writes += 1
-        var.writers.add(msg.src)
-        publisher = self.clients.get(msg.src)
-        if publisher is not None:
-            publisher.published.add(var.name)
-        for sub_name, sub in var.subscribers.items():
-            if sub.interval == 0.0 or now - sub.last_sent >= sub.interval:
-                sub.last_sent = now
-                client = self.clients.get(sub_name)
-                if client is not None:
-                    client.held.append(msg)
-
     def _write_own(self, name: str, value: float | str) -> None:
-        self._on_notify(p.notify(name, value, time=self.clock.now(), src=self.name))
+        now = self.clock.now()
+        raw = p.encode_message(p.notify(name, value, time=now, src=self.name))
+        self._process_messages(None, raw, 0, len(raw), 1, now, [])
 
-    def _on_register(self, subscriber: str, key: str, interval: float) -> None:
+    def _on_register(self, subscriber: str, key: str, interval: float, now: float) -> None:
         client = self.clients.get(subscriber)
         if client is None or not key:
             return  # the subscriber is `src`; an empty or unknown one is ignored
         var = self._variable(key)
-        sub = var.subscribers[subscriber] = Subscription(interval)
-        if var.writes > 0:
+        sub = var.subscribe(client, interval)
+        if var.written:
             client.held.append(var.snapshot())
-            sub.last_sent = self.clock.now()
+            sub.last_sent = now
 
-    def _on_wildcard(self, subscriber: str, sval: bytes, register: bool) -> None:
+    def _on_wildcard(self, subscriber: str, sval: bytes, now: float, register: bool) -> None:
         client = self.clients.get(subscriber)
         if client is None:
             return
         app, var_pattern, interval = p.parse_wildcard_sval(sval)
+        app_glob, var_glob = p.Glob(app), p.Glob(var_pattern)
         if register:
-            client.filters.setdefault((app, var_pattern), interval)
+            client.filters.setdefault((app, var_pattern), (app_glob, var_glob, interval))
         for var in sorted(self.variables.values(), key=lambda v: v.name):  # the C++ map's order
-            if p.wildcard_match(var_pattern, var.name) and p.wildcard_match(app, var.src):
+            if var_glob.match(var.name) and app_glob.match(var.src):
                 if register:
-                    self._on_register(subscriber, var.name, interval)
+                    self._on_register(subscriber, var.name, interval, now)
                 else:
-                    var.subscribers.pop(subscriber, None)
+                    var.unsubscribe(subscriber)
 
     def _apply_filters_on_creation(self, var: Variable, publisher: str) -> None:
         for client in self.clients.values():
-            for (app, var_pattern), interval in client.filters.items():
-                if p.wildcard_match(var_pattern, var.name) and p.wildcard_match(app, publisher):
-                    var.subscribers[client.name] = Subscription(interval)
+            for app_glob, var_glob, interval in client.filters.values():
+                if var_glob.match(var.name) and app_glob.match(publisher):
+                    var.subscribe(client, interval)
                     break
 
     # -- server requests -----------------------------------------------------------------------
 
-    def _server_request(self, msg: p.MOOSMessage) -> list[p.MOOSMessage]:
+    def _server_request(self, msg: p.MOOSMessage, now: float) -> list[p.MOOSMessage]:
         key = msg.key
-        now = self.clock.now()
         if key == "ALL":
             out = []
             for var in sorted(self.variables.values(), key=lambda v: v.name, reverse=True):
-                rel = var.write_time - self.start_time if var.writes else -1.0
+                m = var.message()
+                is_double = var.type_code == _DOUBLE
+                rel = var.write_time - self.start_time if var.written else -1.0
                 out.append(p.MOOSMessage(
-                    p.NOTIFY, var.data_type, var.name, rel, var.dval, var.write_rate, var.sval,
-                    var.src, var.src_aux, var.community, msg.id,
+                    p.NOTIFY, var.data_type, var.name, rel, m.dval if is_double else -1.0,
+                    var.write_rate, b"" if is_double else m.sval, m.src, m.src_aux, m.community,
+                    msg.id,
                 ))  # fmt: skip
             return out
         if "VAR_SUMMARY" in key:
@@ -279,7 +502,7 @@ class DBCore:
             for var in self.variables.values():
                 var.clear()
             for client in self.clients.values():
-                client.held = []
+                client.held.clear()
             self.start_time = now
             return []
         return []
@@ -296,8 +519,7 @@ class DBCore:
 
     # -- DB_* variables ------------------------------------------------------------------------
 
-    def _maybe_refresh(self) -> None:
-        now = self.clock.now()
+    def _maybe_refresh(self, now: float) -> None:
         if now - self._last_refresh <= REFRESH_PERIOD:
             return
         self._last_refresh = now
@@ -326,14 +548,15 @@ class DBCore:
     def _var_summary(self) -> str:
         lines = []
         for var in sorted(self.variables.values(), key=lambda v: v.name):
-            when = _time.strftime("%H:%M:%S", _time.gmtime(var.write_time)) if var.writes else "-"
-            writer = var.src if var.writes else "(write pending)"
-            if var.data_type == p.DOUBLE:
-                value = f"{var.dval:.1f}"
+            m = var.message()
+            when = _time.strftime("%H:%M:%S", _time.gmtime(var.write_time)) if var.written else "-"
+            writer = m.src if var.written else "(write pending)"
+            if var.type_code == _DOUBLE:
+                value = f"{m.dval:.1f}"
             elif var.data_type == p.BINARY:
-                value = _binary_size(len(var.sval))
+                value = _binary_size(len(m.sval))
             else:
-                text = p.decode_text(var.sval)
+                text = m.string
                 value = text[:22] + "..." if len(text) > 25 else text
             lines.append(f"{var.name} {when} {writer} {var.write_rate:.1f} Hz {var.data_type} {value}")
         return "\n".join(lines)

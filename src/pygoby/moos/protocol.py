@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import re
 import struct
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from pygoby.moos.errors import MoosProtocolError
@@ -53,8 +53,9 @@ PACKET_HEADER_SIZE = 9
 MESSAGE_FIXED_SIZE = 54
 _HEADER = struct.Struct("<iiB")
 _INT = struct.Struct("<i")
-_ID_TYPES = struct.Struct("<icc")
-_DOUBLES = struct.Struct("<ddd")
+_START = struct.Struct("<iiBBi")  # msg_len, id, msg_type, data_type, length of src
+_DOUBLES_LENGTH = struct.Struct("<dddi")  # time, dval, dval2, length of sval
+_CHARS = tuple(map(chr, range(256)))
 
 Value = float | str | bytes
 
@@ -173,31 +174,26 @@ def encode_message(msg: MOOSMessage) -> bytes:
     )  # fmt: skip
 
 
-def encode_packet(msgs: Iterable[MOOSMessage], cache: dict[int, bytes] | None = None) -> bytes:
-    """One packet holding `msgs` (never empty: an empty packet upsets C++ peers).
+def encode_packet(msgs: Iterable[MOOSMessage]) -> bytes:
+    """One packet holding `msgs` (never empty: an empty packet upsets C++ peers)."""
+    return packet_of([encode_message(m) for m in msgs])
 
-    `cache` (keyed by id(message)) lets a caller that sends the same message objects to many
-    peers in one go encode each message once; the messages must stay alive meanwhile."""
-    if cache is None:
-        body = [encode_message(m) for m in msgs]
-    else:
-        body = []
-        for m in msgs:
-            raw = cache.get(id(m))
-            if raw is None:
-                raw = cache[id(m)] = encode_message(m)
-            body.append(raw)
-    if not body:
+
+def packet_of(encoded: list[bytes]) -> bytes:
+    """One packet of already encoded messages."""
+    if not encoded:
         raise ValueError("a MOOS packet must hold at least one message")
-    total = PACKET_HEADER_SIZE + sum(len(b) for b in body)
-    return _HEADER.pack(total, len(body), 0) + b"".join(body)
+    total = PACKET_HEADER_SIZE + sum(map(len, encoded))
+    return _HEADER.pack(total, len(encoded), 0) + b"".join(encoded)
 
 
 # ---------------------------------------------------------------------------------------------
 # Decoding
 
 
-def _get_str(data: bytes | memoryview, pos: int, end: int, what: str) -> tuple[bytes, int]:
+def read_str(data: bytes | memoryview, pos: int, end: int, what: str) -> tuple[bytes, int]:
+    """The MOOS string (int32 length + bytes) at `pos`, which must end by `end`; and the offset
+    after it."""
     if pos + 4 > end:
         raise MoosProtocolError(f"message truncated in the length of {what}")
     (n,) = _INT.unpack_from(data, pos)
@@ -209,37 +205,70 @@ def _get_str(data: bytes | memoryview, pos: int, end: int, what: str) -> tuple[b
 
 def decode_message(data: bytes | memoryview, offset: int = 0, end: int | None = None) -> tuple[MOOSMessage, int]:
     """Decode the message starting at `offset`; returns it and the offset after it."""
-    limit = len(data) if end is None else end
-    if offset + 4 > limit:
-        raise MoosProtocolError("message truncated before its length field")
-    (msg_len,) = _INT.unpack_from(data, offset)
-    if msg_len < MESSAGE_FIXED_SIZE or offset + msg_len > limit:
-        raise MoosProtocolError(
-            f"message length {msg_len} is below {MESSAGE_FIXED_SIZE} or runs past the packet end"
-        )
-    stop = offset + msg_len
-    msg_id, mtype, dtype = _ID_TYPES.unpack_from(data, offset + 4)
-    pos = offset + 10
-    src, pos = _get_str(data, pos, stop, "src")
-    aux, pos = _get_str(data, pos, stop, "src_aux")
-    com, pos = _get_str(data, pos, stop, "community")
-    key, pos = _get_str(data, pos, stop, "key")
-    if pos + 24 > stop:
-        raise MoosProtocolError("message truncated in its time/dval/dval2 fields")
-    time_, dval, dval2 = _DOUBLES.unpack_from(data, pos)
-    sval, pos = _get_str(data, pos + 24, stop, "sval")
-    if pos != stop:
-        raise MoosProtocolError(f"message has {stop - pos} bytes after sval inside its msg_len")
-    msg = MOOSMessage(
-        mtype.decode("latin-1"), dtype.decode("latin-1"), decode_text(key), time_, dval, dval2,
-        sval, decode_text(src), decode_text(aux), decode_text(com), msg_id,
-    )  # fmt: skip
-    return msg, stop
+    if not isinstance(data, bytes):
+        data = bytes(data)
+    msgs, stop = _decode_messages(data, offset, len(data) if end is None else end, 1)
+    return msgs[0], stop
 
 
-def parse_packet_header(header: bytes | memoryview) -> tuple[int, int]:
-    """(total_len, n_msgs) from the first 9 bytes, validated."""
-    total, n_msgs, _compressed = _HEADER.unpack_from(header, 0)
+def _decode_messages(data: bytes, pos: int, limit: int, count: int) -> tuple[list[MOOSMessage], int]:
+    """`count` messages from data[pos:limit]; and the offset after the last."""
+    msgs = []
+    append = msgs.append
+    read_start = _START.unpack_from
+    read_int = _INT.unpack_from
+    read_doubles = _DOUBLES_LENGTH.unpack_from
+    chars = _CHARS
+    for _ in range(count):
+        if limit - pos < MESSAGE_FIXED_SIZE:
+            raise MoosProtocolError(f"message truncated: {limit - pos} bytes left, a message has "
+                                f"at least {MESSAGE_FIXED_SIZE}")  # fmt: skip
+        msg_len, msg_id, msg_type, data_type, n = read_start(data, pos)
+        stop = pos + msg_len
+        if msg_len < MESSAGE_FIXED_SIZE or stop > limit:
+            raise MoosProtocolError(
+                f"message length {msg_len} is below {MESSAGE_FIXED_SIZE} or runs past the packet end"
+            )
+        # each string must leave room for the fixed fields after it: 40, 36, 32, 28 bytes
+        pos += 14
+        if n < 0 or pos + n + 40 > stop:
+            raise _bad_length("src", n)
+        src = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
+        pos += n
+        (n,) = read_int(data, pos)
+        pos += 4
+        if n < 0 or pos + n + 36 > stop:
+            raise _bad_length("src_aux", n)
+        aux = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
+        pos += n
+        (n,) = read_int(data, pos)
+        pos += 4
+        if n < 0 or pos + n + 32 > stop:
+            raise _bad_length("community", n)
+        community = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
+        pos += n
+        (n,) = read_int(data, pos)
+        pos += 4
+        if n < 0 or pos + n + 28 > stop:
+            raise _bad_length("key", n)
+        key = data[pos : pos + n].decode("utf-8", "surrogateescape")
+        time_, dval, dval2, sval_len = read_doubles(data, pos + n)
+        pos += n + 28
+        if sval_len < 0 or pos + sval_len != stop:
+            raise MoosProtocolError(f"sval length {sval_len} does not end the message at its msg_len")
+        append(MOOSMessage(chars[msg_type], chars[data_type], key, time_, dval, dval2,
+                           data[pos:stop], src, aux, community, msg_id))  # fmt: skip
+        pos = stop
+    return msgs, pos
+
+
+def _bad_length(what: str, n: int) -> MoosProtocolError:
+    return MoosProtocolError(f"{what} length {n} is negative or runs past the message end")
+
+
+def parse_packet_header(data: bytes | memoryview, offset: int = 0) -> tuple[int, int]:
+    """(total_len, n_msgs) from the 9 bytes at `offset`, validated."""
+    total, n_msgs, _compressed = _HEADER.unpack_from(data, offset)
     if total < PACKET_HEADER_SIZE:
         raise MoosProtocolError(f"packet length {total} is below the {PACKET_HEADER_SIZE}-byte header")
     if n_msgs < 0:
@@ -247,66 +276,68 @@ def parse_packet_header(header: bytes | memoryview) -> tuple[int, int]:
     return total, n_msgs
 
 
-def decode_packet(data: bytes | memoryview) -> list[MOOSMessage]:
-    """Decode one complete packet (exactly `total_len` bytes)."""
-    if len(data) < PACKET_HEADER_SIZE:
-        raise MoosProtocolError(f"packet of {len(data)} bytes is shorter than its header")
-    total, n_msgs = parse_packet_header(data)
-    if total != len(data):
-        raise MoosProtocolError(f"packet length field says {total} bytes but {len(data)} were given")
-    msgs = []
-    pos = PACKET_HEADER_SIZE
-    for _ in range(n_msgs):
-        msg, pos = decode_message(data, pos, total)
-        msgs.append(msg)
-    if pos != total:
-        raise MoosProtocolError(f"{total - pos} trailing bytes after the last message of the packet")
+def decode_packet(data: bytes | memoryview, start: int = 0, end: int | None = None) -> list[MOOSMessage]:
+    """Decode one complete packet: data[start:end] (by default all of `data`) must be exactly
+    its `total_len` bytes."""
+    if not isinstance(data, bytes):
+        data = bytes(data)
+    end = len(data) if end is None else end
+    if end - start < PACKET_HEADER_SIZE:
+        raise MoosProtocolError(f"packet of {end - start} bytes is shorter than its header")
+    total, n_msgs = parse_packet_header(data, start)
+    if total != end - start:
+        raise MoosProtocolError(f"packet length field says {total} bytes but {end - start} were given")
+    msgs, pos = _decode_messages(data, start + PACKET_HEADER_SIZE, end, n_msgs)
+    if pos != end:
+        raise MoosProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
     return msgs
 
 
 class PacketFramer:
-    """Cuts a TCP byte stream into packets.
+    """Cuts a TCP byte stream into packets, copying each byte at most once.
 
-    `feed(data)` buffers bytes; iterating `packets()` yields each complete packet's bytes. A
-    length field above `max_packet_size` raises MoosProtocolError as soon as the header is seen, so
-    an oversized packet is refused before any of it is buffered beyond its header.
+    `feed(data)` returns `(buffer, spans)`: the packets that `data` completed are
+    buffer[start:end] for each (start, end) in spans; what follows them is kept for the next
+    feed. A length field above `max_packet_size` raises MoosProtocolError as soon as the header is
+    seen, so an oversized packet is refused before any of it is buffered beyond its header.
+    `buffered` is the number of bytes held; `began_packet` tells whether the last feed left an
+    incomplete packet that it started (rather than one already begun).
     """
 
     def __init__(self, max_packet_size: int = DEFAULT_MAX_PACKET_SIZE) -> None:
         self.max_packet_size = max_packet_size
-        self._buf = bytearray()
-        self._need: int | None = None
+        self._chunks: list[bytes] = []  # an incomplete packet, as received
+        self.buffered = 0
+        self._need = PACKET_HEADER_SIZE  # bytes the incomplete packet needs, once known
+        self.began_packet = False
 
-    def feed(self, data: bytes) -> None:
-        self._buf += data
-        if self._need is None:
-            self._check_header()
-
-    def _check_header(self) -> None:
-        if len(self._buf) >= PACKET_HEADER_SIZE:
-            total, _ = parse_packet_header(self._buf)
+    def feed(self, data: bytes) -> tuple[bytes, list[tuple[int, int]]]:
+        if self._chunks:
+            self._chunks.append(data)
+            self.buffered += len(data)
+            self.began_packet = False
+            if self.buffered < self._need:
+                return b"", []
+            data = b"".join(self._chunks)
+        pos, end = 0, len(data)
+        need = PACKET_HEADER_SIZE
+        spans = []
+        while end - pos >= PACKET_HEADER_SIZE:
+            total, _ = parse_packet_header(data, pos)
             if total > self.max_packet_size:
                 raise MoosProtocolError(
                     f"packet of {total} bytes exceeds the limit of {self.max_packet_size} bytes"
                 )
-            self._need = total
-
-    def packets(self) -> Iterator[bytes]:
-        while True:
-            if self._need is None:
-                self._check_header()
-                if self._need is None:
-                    return
-            if len(self._buf) < self._need:
-                return
-            packet = bytes(self._buf[: self._need])
-            del self._buf[: self._need]
-            self._need = None
-            yield packet
-
-    @property
-    def buffered(self) -> int:
-        return len(self._buf)
+            if end - pos < total:
+                need = total
+                break
+            spans.append((pos, pos + total))
+            pos += total
+        self.began_packet = pos < end and (bool(spans) or not self._chunks)
+        self._chunks = [data[pos:]] if pos < end else []
+        self.buffered = end - pos
+        self._need = need
+        return data, spans
 
 
 # ---------------------------------------------------------------------------------------------
@@ -386,19 +417,62 @@ def parse_wildcard_sval(sval: bytes) -> tuple[str, str, float]:
     return app, var, interval
 
 
-_WILDCARD_CACHE: dict[str, re.Pattern[str]] = {}
+class Glob:
+    """A MOOS glob, compiled once: `*` any sequence, `?` one character, everything else
+    literal, case-sensitive, whole name (unlike fnmatch, `[` and `]` are ordinary characters).
+
+    Matching never backtracks: the text between stars is placed at its leftmost possible
+    position, one piece after the other (which finds a match whenever there is one), so a test
+    costs at most len(name) x len(pattern) character comparisons whatever the pattern."""
+
+    __slots__ = ("pattern", "_pieces", "_min_len")
+
+    def __init__(self, pattern: str) -> None:
+        self.pattern = pattern
+        self._pieces = pattern.split("*")  # one piece: no star; else head, middles..., tail
+        self._min_len = len(pattern) - len(self._pieces) + 1
+
+    def match(self, name: str) -> bool:
+        pieces = self._pieces
+        if len(pieces) == 1:
+            return len(name) == self._min_len and _piece_at(pieces[0], name, 0)
+        if len(name) < self._min_len or not _piece_at(pieces[0], name, 0):
+            return False
+        tail_start = len(name) - len(pieces[-1])
+        pos = len(pieces[0])
+        for piece in pieces[1:-1]:
+            pos = _find_piece(piece, name, pos, tail_start)
+            if pos < 0:
+                return False
+            pos += len(piece)
+        return _piece_at(pieces[-1], name, tail_start)
+
+    def __repr__(self) -> str:
+        return f"Glob({self.pattern!r})"
+
+
+def _piece_at(piece: str, name: str, at: int) -> bool:
+    """Does the star-free `piece` (`?` = any character) match `name` at offset `at`?"""
+    if "?" not in piece:
+        return name.startswith(piece, at)
+    if at + len(piece) > len(name):
+        return False
+    return all(c == "?" or c == name[at + i] for i, c in enumerate(piece))
+
+
+def _find_piece(piece: str, name: str, start: int, stop: int) -> int:
+    """Leftmost offset >= start where `piece` matches and ends at or before `stop`; -1 if none."""
+    if "?" not in piece:
+        return name.find(piece, start, stop)
+    for at in range(start, stop - len(piece) + 1):
+        if _piece_at(piece, name, at):
+            return at
+    return -1
 
 
 def wildcard_match(pattern: str, name: str) -> bool:
-    """MOOS glob: `*` any sequence, `?` one character, everything else literal, case-sensitive,
-    whole name (unlike fnmatch, `[` and `]` are ordinary characters)."""
-    compiled = _WILDCARD_CACHE.get(pattern)
-    if compiled is None:
-        parts = [".*" if c == "*" else "." if c == "?" else re.escape(c) for c in pattern]
-        compiled = re.compile("".join(parts), re.DOTALL)
-        if len(_WILDCARD_CACHE) < 4096:
-            _WILDCARD_CACHE[pattern] = compiled
-    return compiled.fullmatch(name) is not None
+    """`Glob(pattern).match(name)`, for one-off tests."""
+    return Glob(pattern).match(name)
 
 
 @dataclass(slots=True)
