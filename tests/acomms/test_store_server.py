@@ -349,3 +349,28 @@ def test_store_server_refuses_a_bad_secrets_file(tmp_path):
                           "--db", str(tmp_path / "s.db"), "--secrets", str(tmp_path / "secrets")],
                          capture_output=True, text=True, timeout=30)  # fmt: skip
     assert run.returncode == 1 and "secrets:2: expected MODEM_ID SECRET" in run.stderr
+
+
+def test_store_server_stops_cleanly_on_sigint_with_a_client_connected(tmp_path):
+    import signal
+    import socket
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "pygoby.cli", "store_server", "--port", "0",
+                             "--db", str(tmp_path / "s.db")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        line = proc.stdout.readline()
+        assert "listening on 127.0.0.1:" in line
+        port = int(line.split("127.0.0.1:")[1].split()[0])
+        with socket.create_connection(("127.0.0.1", port)) as client:
+            client.sendall(serialize_rudics_packet(
+                acomms_pb.StoreServerRequest(modem_id=1).SerializeToString()))  # fmt: skip
+            assert client.recv(100)  # answered: its task is running
+            proc.send_signal(signal.SIGINT)
+            assert proc.wait(timeout=10) == 0
+        assert "Traceback" not in proc.stderr.read()
+    finally:
+        proc.kill()
+        proc.wait()

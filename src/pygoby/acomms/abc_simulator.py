@@ -74,6 +74,8 @@ async def serve_abc(sim: ABCSimulator, host: str = "127.0.0.1", port: int = 0) -
                     await asyncio.sleep(0)  # every other client's line comes next
         except ConnectionError:
             pass
+        except asyncio.CancelledError:  # shutting down: end quietly (asyncio 3.11 would log
+            pass  # the cancellation of a client task as an unhandled exception)
         finally:
             sim.forget(writer)
             writer.close()

@@ -138,6 +138,8 @@ async def serve_store(server: StoreServer, host: str = "127.0.0.1", port: int = 
                 await asyncio.sleep(0)
         except ConnectionError:
             pass
+        except asyncio.CancelledError:  # shutting down: end quietly (asyncio 3.11 would log
+            pass  # the cancellation of a client task as an unhandled exception)
         finally:
             writer.close()
 
