@@ -95,8 +95,8 @@ def load(tmp_path: Path, body: str, name: str, codec: Codec | None = None):
         ),
         (
             "message M { option (dccl.msg) = { id: 1 max_bytes: 8 codec_version: 4 };"
-            " optional uint32 h = 1 [(dccl.field) = { codec: 'dccl.hash' min: 0 max: 255 }]; }",
-            "hash",
+            " optional uint32 h = 1 [(dccl.field) = { codec: 'dccl.hash' min: 0 max: 256 }]; }",
+            "dccl.hash needs",
         ),
         (
             "message M { option (dccl.msg) = { id: 1 max_bytes: 64 codec_version: 4 };"

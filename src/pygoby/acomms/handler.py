@@ -193,7 +193,9 @@ class AcommsHandler:
             do_not_encrypt_ids=cfg.dccl_cfg.skip_crypto_for_id,
             loader=loader,
         )
-        if cfg.dccl_cfg.id_codec:
+        if cfg.dccl_cfg.id_codec in ("dccl.default.id", "dccl.ccl.id"):
+            self.codec.set_id_codec(cfg.dccl_cfg.id_codec)
+        elif cfg.dccl_cfg.id_codec:
             log.warning("dccl_cfg.id_codec %r: custom id codecs are not supported; using the "
                         "default id codec", cfg.dccl_cfg.id_codec)  # fmt: skip
 

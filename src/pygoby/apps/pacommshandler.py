@@ -24,6 +24,7 @@ from pygoby.acomms.queue import QueueError
 from pygoby.acomms.transitional import TransitionalMessages
 from pygoby.apps.pacommshandler_goby11 import Goby11Variables
 from pygoby.dccl import DcclError
+from pygoby.dccl.libraries import split_libraries
 from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
@@ -68,9 +69,15 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
+        try:  # C++ DCCL codec libraries (libdccl_ccl_compat.so, ...) are pygoby built-ins
+            dccl_libraries, modules = split_libraries(cfg.load_shared_library)
+            for library in dccl_libraries:
+                library.apply(self.acomms.codec)
+        except DcclError as err:
+            raise ConfigError(f"load_shared_library: {err}") from None
         self.message_types = MessageTypes(
             [self.find_file(path) for path in cfg.load_proto_file],
-            [self.find_file(module) for module in cfg.load_shared_library],
+            [self.find_file(module) for module in modules],
             fallback=acomms_pb.goby_message_class,
             loader=self.loader,
         )

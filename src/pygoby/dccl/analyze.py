@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pygoby.dccl.compiled import CompiledType
-from pygoby.dccl.plan import MessageItem, MessageNode, RepeatedItem, ScalarItem
+from pygoby.dccl.plan import ListItem, MessageItem, MessageNode, RepeatedItem, ScalarItem
 
 
 @dataclass
@@ -50,6 +50,12 @@ def _rows(node: MessageNode, part: str, prefix: str, depth: int) -> list[FieldRo
             )
             if item.child is not None:
                 rows += _rows(item.child, part, path + "[].", depth + 1)
+        elif isinstance(item, ListItem):
+            codec = item.codec
+            rows.append(
+                FieldRow(f"{path}[]", part, codec.info.codec_name, item.min_size(),
+                         item.max_size(), f"whole list, {codec.describe()}")
+            )
     return rows
 
 

@@ -11,8 +11,10 @@ from collections.abc import Callable, Iterable
 from google.protobuf import text_format
 
 from pygoby.dccl.analyze import describe, generated_source
+from pygoby.dccl.arithmetic import load_model_file
 from pygoby.dccl.codec import Codec
 from pygoby.dccl.errors import DcclError
+from pygoby.dccl.libraries import builtin_library
 from pygoby.dccl.trace import log as trace_log
 from pygoby.errors import ConfigError
 
@@ -46,6 +48,12 @@ def register(subparsers) -> None:
                         help="analyze: print the Python generated for the message, not the table")
     parser.add_argument("--trace", action="store_true",
                         help="encode/decode: print each field's value and bits to stderr")
+    parser.add_argument("--arithmetic-model", action="append", default=[], metavar="FILE",
+                        help="a dccl.arith.protobuf.ArithmeticModel in TextFormat for"
+                             " dccl.arithmetic fields (repeatable)")
+    parser.add_argument("--library", action="append", default=[], metavar="LIB",
+                        help="a C++ DCCL codec library name (e.g. libdccl_ccl_compat.so): use"
+                             " pygoby's built-in equivalent (repeatable)")
     parser.set_defaults(func=run)
 
 
@@ -79,6 +87,10 @@ def run(args: argparse.Namespace) -> int:
     try:
         passphrase = read_passphrase(args)
         codec = Codec(passphrase=passphrase, strict=args.strict, trace=args.trace)
+        for name in args.library:
+            builtin_library(name).apply(codec)
+        for path in args.arithmetic_model:
+            codec.set_arithmetic_model(load_model_file(path))
         if args.xml:
             classes = _load_xml(codec, args)
         else:

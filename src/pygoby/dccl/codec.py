@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import time
 from collections.abc import Callable, Iterable
@@ -10,11 +11,16 @@ from google.protobuf import message_factory
 from google.protobuf.descriptor import Descriptor
 from google.protobuf.message import Message
 
+from pygoby.dccl import arithmetic
 from pygoby.dccl.analyze import describe
 from pygoby.dccl.compiled import CompiledType
 from pygoby.dccl.compiler import compile_decoder, compile_encoder
+from pygoby.dccl.conditions import DynamicConditions
 from pygoby.dccl.crypto import BodyCipher
 from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError, DcclError, DcclLoadError
+from pygoby.dccl.hashing import definition_hash, hash_codecs
+from pygoby.dccl.identifier import DefaultIdCodec, is_ccl_id
+from pygoby.dccl.identifier import id_codec as lookup_id_codec
 from pygoby.dccl.plan import Part, Planner, root_options
 from pygoby.dccl.registry import DEFAULT_REGISTRY, CodecRegistry
 from pygoby.protobuf import ProtoError, ProtoLoader
@@ -24,10 +30,7 @@ from pygoby.util.clock import Clock
 _VALUE_ERRORS = (ValueError, TypeError, OverflowError, KeyError, IndexError, UnicodeError)
 
 
-def id_width(dccl_id: int | None) -> int:
-    if dccl_id is None:
-        return 0
-    return 8 if dccl_id < 128 else 16
+log = logging.getLogger("pygoby.dccl")
 
 
 class Codec:
@@ -40,6 +43,8 @@ class Codec:
     Codecs made later copy; `codec.registry.register` adds to this Codec only). `trace`: log each
     field's value and bits to the `pygoby.dccl.trace` logger at DEBUG while encoding and decoding
     (types are compiled with trace hooks; without `trace` the generated code has none).
+    `id_codec`: "dccl.default.id", or "dccl.ccl.id" to mix legacy CCL frames with DCCL messages
+    (chosen automatically when a CCL type is loaded, see `set_id_codec`).
     """
 
     def __init__(
@@ -51,6 +56,7 @@ class Codec:
         do_not_encrypt_ids: Iterable[int] = (),
         loader: ProtoLoader | None = None,
         trace: bool = False,
+        id_codec: str = DefaultIdCodec.name,
     ) -> None:
         self.strict = strict
         self.trace = trace
@@ -59,11 +65,51 @@ class Codec:
         self._now: Callable[[], float] = clock.now if clock is not None else time.time
         self._by_name: dict[str, CompiledType] = {}
         self._by_id: dict[int, CompiledType] = {}
+        self._id_codec = lookup_id_codec(id_codec)
+        self._conditions: DynamicConditions | None = None
         self.set_passphrase(passphrase, do_not_encrypt_ids)
 
     def set_passphrase(self, passphrase: str | bytes | None, do_not_encrypt_ids: Iterable[int] = ()) -> None:
         self._cipher = BodyCipher(passphrase) if passphrase else None
         self._clear_ids = frozenset(do_not_encrypt_ids)
+
+    def _lua(self) -> DynamicConditions:
+        """This Codec's Lua state for dynamic conditions (made when a type first needs it)."""
+        if self._conditions is None:
+            self._conditions = DynamicConditions()
+        return self._conditions
+
+    def set_arithmetic_model(self, model: Message | str | os.PathLike[str]) -> None:
+        """Give this Codec a `dccl.arith.protobuf.ArithmeticModel` (a message, or a TextFormat
+        file) for `dccl.arithmetic` fields; set models before loading the types that use them.
+        A model of the same name is replaced (adaptive ones start afresh)."""
+        arithmetic.set_model(self, model)
+
+    @property
+    def id_codec(self) -> str:
+        """The identifier codec's name: "dccl.default.id" or "dccl.ccl.id"."""
+        return self._id_codec.name
+
+    def set_id_codec(self, name: str) -> None:
+        """Use another identifier codec; the types already loaded are compiled again for it
+        (C++ DCCL unloads them instead)."""
+        new = lookup_id_codec(name)
+        if new is self._id_codec:
+            return
+        old, self._id_codec = self._id_codec, new
+        loaded = [c.cls for c in self._by_name.values()]
+        self._by_name.clear()
+        self._by_id.clear()
+        try:
+            for cls in loaded:
+                self.load(cls)
+        except DcclError:
+            self._id_codec = old
+            self._by_name.clear()
+            self._by_id.clear()
+            for cls in loaded:
+                self.load(cls)
+            raise
 
     # ---------------------------------------------------------------- loading
     def load(self, message_type: type[Message] | Descriptor) -> type[Message]:
@@ -76,6 +122,13 @@ class Codec:
         known = self._by_name.get(descriptor.full_name)
         if known is not None:
             return known.cls
+        root = root_options(descriptor)
+        if is_ccl_id(root.id) and self._id_codec.name != "dccl.ccl.id":
+            log.info(
+                "%s is a legacy CCL type: this Codec now uses the CCL identifier codec"
+                " (other DCCL messages start with the byte 0x20)", root.name
+            )
+            self.set_id_codec("dccl.ccl.id")
         compiled = self._compile(cls, descriptor)
         if compiled.id is not None:
             other = self._by_id.get(compiled.id)
@@ -112,10 +165,15 @@ class Codec:
 
     def _compile(self, cls: type[Message], descriptor: Descriptor) -> CompiledType:
         root = root_options(descriptor)
-        planner = Planner(root, self.registry, self._now)
+        planner = Planner(root, self.registry, self._now, self._lua)
         head = planner.plan_root(descriptor, Part.HEAD)
         body = planner.plan_root(descriptor, Part.BODY)
-        id_bits = id_width(root.id)
+        hash_fields = [*hash_codecs(head), *hash_codecs(body)]
+        if hash_fields:
+            full_hash = definition_hash(descriptor, head, body)
+            for codec in hash_fields:
+                codec.set_hash(full_hash)
+        id_raw, id_bits = (0, 0) if root.id is None else self._id_codec.encode(root.id, root.name)
         head_bytes = (id_bits + head.max_size() + 7) // 8
         max_encoded = head_bytes + (body.max_size() + 7) // 8
         if max_encoded > root.max_bytes:
@@ -123,12 +181,12 @@ class Codec:
                 f"{root.name}: the largest encoding is {max_encoded} bytes, more than"
                 f" max_bytes {root.max_bytes}"
             )
-        id_raw = 0 if root.id is None else root.id << 1 | (1 if id_bits == 16 else 0)
+        lua = self._lua() if planner.conditioned else None
         generated = {
-            "encode_head": compile_encoder(head, root.name, Part.HEAD, id_raw, id_bits, self.trace),
-            "encode_body": compile_encoder(body, root.name, Part.BODY, 0, 0, self.trace),
-            "decode_head": compile_decoder(head, root.name, Part.HEAD, self.trace),
-            "decode_body": compile_decoder(body, root.name, Part.BODY, self.trace),
+            "encode_head": compile_encoder(head, root.name, Part.HEAD, id_raw, id_bits, self.trace, lua),
+            "encode_body": compile_encoder(body, root.name, Part.BODY, 0, 0, self.trace, lua),
+            "decode_head": compile_decoder(head, root.name, Part.HEAD, self.trace, lua),
+            "decode_body": compile_decoder(body, root.name, Part.BODY, self.trace, lua),
         }
         return CompiledType(
             cls=cls,
@@ -190,6 +248,12 @@ class Codec:
         """A table of the type's fields: codec, part (head/body), bit sizes, and totals."""
         return describe(self.compiled(message_type))
 
+    def definition_hash(self, message_type: type[Message] | Descriptor | str) -> int:
+        """The 64-bit hash of a type's DCCL definition that C++ DCCL's `load()` returns (and
+        `dccl.hash` fields send masked); see pygoby.dccl.hashing."""
+        compiled = self.compiled(message_type)
+        return definition_hash(compiled.cls.DESCRIPTOR, compiled.head, compiled.body)
+
     def max_size(self, message_type: type[Message] | Descriptor | str) -> int:
         return self.compiled(message_type).max_size()
 
@@ -197,21 +261,14 @@ class Codec:
         return self.compiled(message_type).min_size()
 
     # ---------------------------------------------------------------- decoding
-    @staticmethod
-    def read_id(data: bytes) -> tuple[int, int]:
-        """(DCCL ID, ID width in bits) from the first one or two bytes (spec §4)."""
-        if not data:
-            raise DcclDecodeError("no bytes to read a DCCL ID from")
-        first = data[0]
-        if not first & 1:
-            return first >> 1, 8
-        if len(data) < 2:
-            raise DcclDecodeError("the long-form DCCL ID needs two bytes, got one")
-        return (first | data[1] << 8) >> 1, 16
+    def read_id(self, data: bytes) -> tuple[int, int]:
+        """(DCCL ID, ID width in bits) from the first bytes (spec §4), by this Codec's
+        identifier codec."""
+        return self._id_codec.decode(data)
 
     def id(self, data: bytes) -> int:
         """The DCCL ID of encoded bytes (without decoding them)."""
-        return self.read_id(data)[0]
+        return self._id_codec.decode(data)[0]
 
     def type_of(self, data: bytes) -> type[Message]:
         return self._compiled_for(data, None).cls

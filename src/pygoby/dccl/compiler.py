@@ -14,6 +14,7 @@ With `trace`, a variant is generated that also calls `_trace` (a `FieldTracer`) 
 
 from __future__ import annotations
 
+import dataclasses
 import keyword
 import linecache
 import re
@@ -24,8 +25,18 @@ from typing import Any
 from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.dccl.codecs.base import FixedWidthCodec
+from pygoby.dccl.conditions import ConditionedField, DynamicConditions
 from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError
-from pygoby.dccl.plan import MessageItem, MessageNode, Mode, Part, RepeatedItem, ScalarItem
+from pygoby.dccl.plan import (
+    ListItem,
+    MessageItem,
+    MessageNode,
+    Mode,
+    Part,
+    RepeatedItem,
+    ScalarItem,
+)
+from pygoby.dccl.rawtext import extend_raw_strings, set_raw_string
 from pygoby.dccl.trace import FieldTracer
 
 
@@ -39,6 +50,12 @@ def _too_many(where: str, n: int, limit: int) -> DcclEncodeError:
 
 def _too_few(where: str, n: int, limit: int) -> DcclEncodeError:
     return DcclEncodeError(f"{where}: {n} values are fewer than min_repeat {limit}")
+
+
+def _too_many_messages(where: str, n: int, limit: int) -> DcclDecodeError:
+    # C++ DCCL reserves max_repeat sub-messages and rejects a count beyond them (a count of
+    # scalar values beyond max_repeat is read by both)
+    return DcclDecodeError(f"{where}: a count of {n} messages exceeds max_repeat {limit}")
 
 
 @dataclass(frozen=True)
@@ -81,6 +98,9 @@ class _Source:
             "_truncated": _truncated,
             "_too_many": _too_many,
             "_too_few": _too_few,
+            "_too_many_messages": _too_many_messages,
+            "_set_raw_string": set_raw_string,
+            "_extend_raw_strings": extend_raw_strings,
         }
         self.bound: list[str] = []  # "name = what" for each codec/table bound in the namespace
         self._used: set[str] = set()
@@ -126,6 +146,10 @@ def _set(var: str, field_name: str, value: str) -> str:
     return f"setattr({var}, {field_name!r}, {value})"
 
 
+def _is_string(field: FieldDescriptor) -> bool:
+    return field.type == FieldDescriptor.TYPE_STRING
+
+
 def _has(var: str, item) -> str:
     f = item.field
     if f.has_presence:
@@ -138,8 +162,15 @@ class _PartCompiler:
 
     bits_var = ""  # the integer holding the part's bits: `acc` (encoding) or `b` (decoding)
 
-    def __init__(self, type_name: str, action: str, part: Part, trace: bool) -> None:
+    def __init__(
+        self, type_name: str, action: str, part: Part, trace: bool, lua: DynamicConditions | None
+    ) -> None:
         self.src = _Source()
+        # the Codec's Lua state, for types with dynamic conditions: the generated code then also
+        # keeps C++'s repeated index (`_dc.index`) up to date
+        self.lua = lua
+        if lua is not None:
+            self.src.namespace["_dc"] = lua
         self.type_name = type_name
         self.part = part
         self.func_name = f"{action}_{part.value}"
@@ -172,12 +203,50 @@ class _PartCompiler:
     def _build(self) -> GeneratedFunction:
         return self.src.build(self.type_name, self.func_name, self.summary, self.tracer is not None)
 
+    def _conditioned(self, item, path: str, element: bool = False) -> str:
+        """Bind the run-time codec choice of a field with dynamic conditions (`element`: of a
+        repeated field's element, whose omission the loop decides)."""
+        assert self.lua is not None
+        conditions = dataclasses.replace(item.conditions, omit_if=None) if element else item.conditions
+        field = ConditionedField(self.lua, conditions, item.codec,
+                                 getattr(item, "required_codec", None))
+        return self.src.name("cond", path, field, f"conditions of {item.field.full_name}")
+
+    def _conditions(self, item, path: str) -> str:
+        """Bind a field's conditions (for `_dc.omit`/`_dc.required` calls)."""
+        return self.src.name("dc", path, item.conditions, f"conditions of {item.field.full_name}")
+
+    def _omit_guard(self, item, path: str, var: str, ind: int) -> tuple[str, int]:
+        """Bind a message field's conditions; if it has omit_if, open `if not omitted:`.
+        Returns the conditions' name and the indent to continue at."""
+        dc = self._conditions(item, path)
+        if item.conditions.omit_if is not None:
+            self.src.add(ind, f"if not _dc.omit({dc}, {var}, m0):")
+            ind += 1
+        return dc, ind
+
+    def _index(self, ind: int, index: str) -> None:
+        """C++ DCCL's repeated index, which `this_index` reads, follows every element coded."""
+        if self.lua is not None:
+            self.src.add(ind, f"_dc.index = {index}")
+
+
+def _null_encoding(item: RepeatedItem) -> tuple[int, int]:
+    """(raw, bits) of one element with no value: a codec's encoding of nothing, or the
+    minimum-size (all zero) encoding of a message."""
+    codec = item.codec
+    if codec is None:
+        return 0, item.child.cpp_min_size()
+    if isinstance(codec, FixedWidthCodec):
+        return codec.null_raw, codec.bits
+    return codec.encode(None, False)
+
 
 class EncoderCompiler(_PartCompiler):
     bits_var = "acc"
 
-    def __init__(self, type_name: str, part: Part, trace: bool) -> None:
-        super().__init__(type_name, "encode", part, trace)
+    def __init__(self, type_name: str, part: Part, trace: bool, lua: DynamicConditions | None) -> None:
+        super().__init__(type_name, "encode", part, trace, lua)
 
     def compile(self, node: MessageNode, start_acc: int, start_pos: int) -> GeneratedFunction:
         self.src.add(0, f"def {self.func_name}(m0, strict):")
@@ -204,6 +273,16 @@ class EncoderCompiler(_PartCompiler):
                 cases[member] = (case, i)
         for item in node.items:
             path = prefix + item.field.name
+            if isinstance(item, ListItem):
+                start = self._trace_start(path, ind)
+                values = _get(var, item.field.name)
+                enc = self.src.name("enc", path, item.codec.encode_list,
+                                    _codec_about(item.codec, "encode_list"))
+                self.src.add(ind, f"r, n = {enc}(list({values}), strict)")
+                self.src.add(ind, "acc |= r << pos")
+                self.src.add(ind, "pos += n")
+                self._trace_end(start, path, values, ind, item.field)
+                continue
             if isinstance(item, RepeatedItem):
                 start = self._trace_start(path, ind)
                 encoded = self._repeated(item, var, ind, path)
@@ -216,21 +295,31 @@ class EncoderCompiler(_PartCompiler):
                 field_ind += 1
             present = item.mode is not Mode.OPTIONAL  # required, or the oneof's set member
             start = self._trace_start(path, field_ind)
-            self._singular(item, var, field_ind, present, path)
+            if isinstance(item, ScalarItem) and item.conditions is not None:
+                cond = self._conditioned(item, path)
+                value = _get(var, item.field.name)
+                if not present:
+                    value = f"({value} if {_has(var, item)} else None)"
+                self.src.add(field_ind, f"r, n = {cond}.encode({var}, m0, {value}, strict)")
+                self.src.add(field_ind, "acc |= r << pos")
+                self.src.add(field_ind, "pos += n")
+            else:
+                self._singular(item, var, field_ind, present, path)
             value = _get(var, item.field.name)
             if not present:
                 value = f"({value} if {_has(var, item)} else None)"
             self._trace_end(start, path, value, field_ind, item.field)
 
     def _write_value(self, codec, value: str, ind: int, path: str) -> None:
+        root = "m0, " if codec.reads_root else ""
         if isinstance(codec, FixedWidthCodec):
             if codec.bits:
                 enc = self.src.name("enc", path, codec.to_raw, _codec_about(codec, "to_raw"))
-                self.src.add(ind, f"acc |= {enc}({value}, strict) << pos")
+                self.src.add(ind, f"acc |= {enc}({root}{value}, strict) << pos")
                 self.src.add(ind, f"pos += {codec.bits}")
         else:
             enc = self.src.name("enc", path, codec.encode, _codec_about(codec, "encode"))
-            self.src.add(ind, f"r, n = {enc}({value}, strict)")
+            self.src.add(ind, f"r, n = {enc}({root}{value}, strict)")
             self.src.add(ind, "acc |= r << pos")
             self.src.add(ind, "pos += n")
 
@@ -242,15 +331,32 @@ class EncoderCompiler(_PartCompiler):
                 self._write_value(codec, value, ind, path)
             elif isinstance(codec, FixedWidthCodec):
                 if codec.bits:
+                    root = "m0, " if codec.reads_root else ""
                     enc = self.src.name("enc", path, codec.to_raw, _codec_about(codec, "to_raw"))
                     self.src.add(ind, f"if {_has(var, item)}:")
-                    self.src.add(ind + 1, f"acc |= {enc}({value}, strict) << pos")
+                    self.src.add(ind + 1, f"acc |= {enc}({root}{value}, strict) << pos")
+                    if codec.null_raw:
+                        self.src.add(ind, "else:")
+                        self.src.add(ind + 1, f"acc |= {codec.null_raw} << pos")
                     self.src.add(ind, f"pos += {codec.bits}")
             else:
                 self._write_value(codec, f"({value} if {_has(var, item)} else None)", ind, path)
             return
         # built-in message codec
         child_var = self.src.name("m", path)
+        conditions = item.conditions
+        if conditions is not None:
+            dc, ind = self._omit_guard(item, path, var, ind)
+            if conditions.required_if is not None and item.presence_bit:
+                # C++ asks with `this` = the sub-message (an empty one when unset)
+                self.src.add(ind, f"{child_var} = {value}")
+                self.src.add(ind, f"if _dc.required({dc}, {child_var}, m0):")
+                self.src.add(ind + 1, f"if {var}.HasField({item.field.name!r}):")
+                self._node(item.child, child_var, ind + 2, path + ".")
+                self.src.add(ind + 1, "else:")
+                self.src.add(ind + 2, f"pos += {item.child.cpp_min_size()}")
+                self.src.add(ind, "else:")
+                ind += 1
         if present:
             self.src.add(ind, f"{child_var} = {value}")
             self._node(item.child, child_var, ind, path + ".")
@@ -269,6 +375,32 @@ class EncoderCompiler(_PartCompiler):
             self._node(item.child, child_var, ind + 1, path + ".")
             self.src.add(ind, "else:")
             self.src.add(ind + 1, f"pos += {item.child.min_size()}")
+
+    def _element(self, item: RepeatedItem, var: str, element: str | None, index: str, ind: int,
+                 path: str, strict: str) -> None:
+        """One element (None: a padding element) of a repeated field in a type with dynamic
+        conditions: omitted elements take no bits."""
+        conditions = item.conditions
+        this = var if item.codec is not None or element is None else element
+        if conditions is not None and conditions.omit_if is not None:
+            dc = self._conditions(item, path)
+            self.src.add(ind, f"if _dc.omit({dc}, {this}, m0, {index}): continue")
+        if element is None:
+            null_raw, null_bits = _null_encoding(item)
+            if null_raw:
+                self.src.add(ind, f"acc |= {null_raw} << pos")
+            if null_bits:
+                self.src.add(ind, f"pos += {null_bits}")
+            return
+        if item.codec is None:
+            self._node(item.child, element, ind, path + "[].")
+        elif conditions is not None and conditions.bounds:
+            cond = self._conditioned(item, path, element=True)
+            self.src.add(ind, f"r, n = {cond}.encode({var}, m0, {element}, {strict})")
+            self.src.add(ind, "acc |= r << pos")
+            self.src.add(ind, "pos += n")
+        else:
+            self._write_value(item.codec, element, ind, path)
 
     def _repeated(self, item: RepeatedItem, var: str, ind: int, path: str) -> str:
         """Writes the field; returns the expression of the values written (for the trace)."""
@@ -290,24 +422,42 @@ class EncoderCompiler(_PartCompiler):
             self.src.add(ind, f"acc |= ({count} - {item.min_repeat}) << pos")
             self.src.add(ind, f"pos += {item.prefix_bits}")
         element = self.src.name("m" if item.codec is None else "v", path)
+        target = item.max_repeat if item.slots else item.min_repeat
+        if self.lua is not None:
+            index = self.src.name("i", path)
+            self.src.add(ind, f"for {index}, {element} in enumerate({vals}):")
+            self._index(ind + 1, index)
+            self._element(item, var, element, index, ind + 1, path, strict="strict")
+            if target:
+                # padding elements are coded one by one too (their index, their conditions)
+                self.src.add(ind, f"for {index} in range({n}, {target}):")
+                self._index(ind + 1, index)
+                self._element(item, var, None, index, ind + 1, path, strict="strict")
+            return vals
         self.src.add(ind, f"for {element} in {vals}:")
         if item.codec is not None:
             self._write_value(item.codec, element, ind + 1, path)
         else:
             self._node(item.child, element, ind + 1, path + "[].")
-        # missing elements: v2 slots up to max_repeat, v3/v4 padding up to min_repeat, all zeros
-        target = item.max_repeat if item.slots else item.min_repeat
-        if target and item.element_min():
+        # missing elements: v2 slots up to max_repeat, v3/v4 padding up to min_repeat, each the
+        # element codec's "no value" (all zeros but for a few legacy CCL codecs)
+        null_raw, null_bits = _null_encoding(item)
+        if target and null_bits:
             self.src.add(ind, f"if {n} < {target}:")
-            self.src.add(ind + 1, f"pos += ({target} - {n}) * {item.element_min()}")
+            if null_raw:
+                self.src.add(ind + 1, f"for _ in range({target} - {n}):")
+                self.src.add(ind + 2, f"acc |= {null_raw} << pos")
+                self.src.add(ind + 2, f"pos += {null_bits}")
+            else:
+                self.src.add(ind + 1, f"pos += ({target} - {n}) * {null_bits}")
         return vals
 
 
 class DecoderCompiler(_PartCompiler):
     bits_var = "b"
 
-    def __init__(self, type_name: str, part: Part, trace: bool) -> None:
-        super().__init__(type_name, "decode", part, trace)
+    def __init__(self, type_name: str, part: Part, trace: bool, lua: DynamicConditions | None) -> None:
+        super().__init__(type_name, "decode", part, trace, lua)
 
     def compile(self, node: MessageNode) -> GeneratedFunction:
         self.src.add(0, f"def {self.func_name}(m0, b, pos, end):")
@@ -320,7 +470,9 @@ class DecoderCompiler(_PartCompiler):
         self.src.add(ind, f"if pos + {nbits} > end: raise _truncated({where!r})")
 
     def _node(self, node: MessageNode, var: str, ind: int, prefix: str, checked: bool) -> None:
-        if not checked and node.min_size() == node.max_size() and node.max_size():
+        if self.lua is not None:
+            checked = False  # conditions change widths and omit fields: check each read
+        elif not checked and node.min_size() == node.max_size() and node.max_size():
             # fixed-size message: one bounds check covers every field in it
             self._check(node.max_size(), node.descriptor.full_name, ind)
             checked = True
@@ -341,12 +493,18 @@ class DecoderCompiler(_PartCompiler):
         for item in node.items:
             path = prefix + item.field.name
             field_ind = ind
-            if not isinstance(item, RepeatedItem) and item.mode is Mode.ONEOF:
+            if isinstance(item, (ScalarItem, MessageItem)) and item.mode is Mode.ONEOF:
                 case, i = cases[item.field.name]
                 self.src.add(ind, f"if {case} == {i}:")
                 field_ind += 1
             start = self._trace_start(path, field_ind)
-            if isinstance(item, RepeatedItem):
+            if isinstance(item, ListItem):
+                dec = self.src.name("dec", path, item.codec.decode_list,
+                                    _codec_about(item.codec, "decode_list"))
+                self.src.add(field_ind, f"values, pos = {dec}(b, pos, end)")
+                self.src.add(field_ind, f"{_get(var, item.field.name)}.extend(values)")
+                value = _get(var, item.field.name)
+            elif isinstance(item, RepeatedItem):
                 self._repeated(item, var, field_ind, path, checked)
                 value = _get(var, item.field.name)
             elif isinstance(item, ScalarItem):
@@ -360,30 +518,57 @@ class DecoderCompiler(_PartCompiler):
 
     def _read_value(self, codec, target: str, ind: int, checked: bool, where: str, path: str) -> None:
         """Read one value into local `target` (None when not set)."""
+        root = "m0, " if codec.reads_root else ""
         if isinstance(codec, FixedWidthCodec):
             dec = self.src.name("dec", path, codec.from_raw, _codec_about(codec, "from_raw"))
             if codec.bits:
                 if not checked:
                     self._check(codec.bits, where, ind)
-                self.src.add(ind, f"{target} = {dec}(b >> pos & {(1 << codec.bits) - 1})")
+                self.src.add(ind, f"{target} = {dec}({root}b >> pos & {(1 << codec.bits) - 1})")
                 self.src.add(ind, f"pos += {codec.bits}")
             else:
-                self.src.add(ind, f"{target} = {dec}(0)")
+                self.src.add(ind, f"{target} = {dec}({root}0)")
         else:
             dec = self.src.name("dec", path, codec.decode, _codec_about(codec, "decode"))
-            self.src.add(ind, f"{target}, pos = {dec}(b, pos, end)")
+            self.src.add(ind, f"{target}, pos = {dec}({root}b, pos, end)")
 
     def _scalar(self, item: ScalarItem, var: str, ind: int, path: str, checked: bool) -> None:
-        self._read_value(item.codec, "v", ind, checked, item.field.full_name, path)
+        if item.conditions is not None:
+            cond = self._conditioned(item, path)
+            self.src.add(ind, f"v, pos = {cond}.decode({var}, m0, b, pos, end)")
+        else:
+            self._read_value(item.codec, "v", ind, checked, item.field.full_name, path)
         self.src.add(ind, "if v is not None:")
         if item.field.cpp_type == item.field.CPPTYPE_MESSAGE:
             self.src.add(ind + 1, f"{_get(var, item.field.name)}.CopyFrom(v)")
+        elif _is_string(item.field):
+            field = self.src.name("field", path, item.field, f"descriptor of {item.field.full_name}")
+            self.src.add(ind + 1, "try:")
+            self.src.add(ind + 2, _set(var, item.field.name, "v"))
+            self.src.add(ind + 1, "except UnicodeDecodeError:")
+            self.src.add(ind + 2, f"_set_raw_string({var}, {field}, v)")
         else:
             self.src.add(ind + 1, _set(var, item.field.name, "v"))
 
     def _message(self, item: MessageItem, var: str, ind: int, path: str, checked: bool) -> None:
         name = item.field.name
         child_var = self.src.name("m", path)
+        conditions = item.conditions
+        if conditions is not None:
+            dc, ind = self._omit_guard(item, path, var, ind)
+            if conditions.required_if is not None and item.presence_bit:
+                # as C++: the sub-message exists (empty) while it is asked and decoded
+                self.src.add(ind, f"{child_var} = {_get(var, name)}")
+                self.src.add(ind, f"{child_var}.SetInParent()")
+                self.src.add(ind, f"if _dc.required({dc}, {child_var}, m0):")
+                self._node(item.child, child_var, ind + 1, path + ".", False)
+                self.src.add(ind, f"elif pos + 1 > end: raise _truncated({item.field.full_name!r})")
+                self.src.add(ind, "else:")
+                self.src.add(ind + 1, "pos += 1")
+                self.src.add(ind + 1, "if b >> (pos - 1) & 1:")
+                self._node(item.child, child_var, ind + 2, path + ".", False)
+                self.src.add(ind + 1, f"else: {var}.ClearField({name!r})")
+                return
         if item.presence_bit:
             if not checked:
                 self._check(1, item.field.full_name, ind)
@@ -395,9 +580,13 @@ class DecoderCompiler(_PartCompiler):
             self.src.add(ind, f"{child_var}.SetInParent()")
             self._node(item.child, child_var, ind, path + ".", checked and not item.presence_bit)
         elif item.child.max_size():
-            # v2: no presence bit; a sub-message in which nothing is set is absent
             self.src.add(ind, f"{child_var} = {_get(var, name)}")
             self._node(item.child, child_var, ind, path + ".", checked)
+        else:
+            return
+        if item.child.codec_version == 2:
+            # the v2 message codec: a sub-message in which nothing is set is absent, whether
+            # the field is optional (no presence bit in v2) or required
             self.src.add(ind, f"if not {child_var}.ListFields(): {var}.ClearField({name!r})")
 
     def _repeated(self, item: RepeatedItem, var: str, ind: int, path: str, checked: bool) -> None:
@@ -415,13 +604,36 @@ class DecoderCompiler(_PartCompiler):
             self.src.add(ind, f"{count} = (b >> pos & {mask}) + {item.min_repeat}")
             self.src.add(ind, f"pos += {item.prefix_bits}")
             checked = False  # the count is data-dependent
+            if item.codec is None and item.max_repeat - item.min_repeat + 1 < 1 << item.prefix_bits:
+                self.src.add(ind, f"if {count} > {item.max_repeat}:")
+                self.src.add(ind + 1, f"raise _too_many_messages({where!r}, {count}, {item.max_repeat})")
+        conditions = item.conditions if self.lua is not None else None
+        omits = conditions is not None and conditions.omit_if is not None
+        dc = self._conditions(item, path) if omits else ""
         if item.codec is not None:
             values = self.src.name("values", path)
+            index = self.src.name("i", path)
             self.src.add(ind, f"{values} = []")
-            self.src.add(ind, f"for _ in range({count}):")
-            self._read_value(item.codec, "v", ind + 1, checked, where, path)
+            self.src.add(ind, f"for {index} in range({count}):")
+            self._index(ind + 1, index)
+            if omits:
+                self.src.add(ind + 1, f"if _dc.omit({dc}, {var}, m0, {index}): continue")
+            if conditions is not None and conditions.bounds:
+                cond = self._conditioned(item, path, element=True)
+                self.src.add(ind + 1, f"v, pos = {cond}.decode({var}, m0, b, pos, end)")
+            else:
+                self._read_value(item.codec, "v", ind + 1, checked, where, path)
             self.src.add(ind + 1, f"if v is not None: {values}.append(v)")
-            self.src.add(ind, f"{container}.extend({values})")
+            if _is_string(item.field):
+                field = self.src.name("field", path, item.field, f"descriptor of {item.field.full_name}")
+                before = self.src.name("before", path)
+                self.src.add(ind, f"{before} = len({container})")
+                self.src.add(ind, "try:")
+                self.src.add(ind + 1, f"{container}.extend({values})")
+                self.src.add(ind, "except UnicodeDecodeError:")
+                self.src.add(ind + 1, f"_extend_raw_strings({var}, {field}, {values}, {before})")
+            else:
+                self.src.add(ind, f"{container}.extend({values})")
             return
         child_var = self.src.name("m", path)
         if item.slots:
@@ -435,9 +647,25 @@ class DecoderCompiler(_PartCompiler):
                 ind + 1,
                 f"{child_var} = {container}[{slot}] if {slot} < {existing} else {container}.add()",
             )
+            self._index(ind + 1, slot)
+            if omits:
+                self.src.add(ind + 1, f"if _dc.omit({dc}, {child_var}, m0, {slot}): continue")
             self._node(item.child, child_var, ind + 1, path + "[].", checked)
             self.src.add(ind + 1, f"if not {child_var}.ListFields(): {empties} += 1")
             self.src.add(ind, f"for _ in range({empties}): del {container}[-1]")
+        elif self.lua is not None:
+            # as C++: max_repeat sub-messages exist while the elements are decoded (`this`,
+            # `root` in conditions see them); the unused ones are removed afterwards
+            before, slot = self.src.name("before", path), self.src.name("i", path)
+            self.src.add(ind, f"{before} = len({container})")
+            self.src.add(ind, f"for _ in range({item.max_repeat}): {container}.add()")
+            self.src.add(ind, f"for {slot} in range({count}):")
+            self._index(ind + 1, slot)
+            self.src.add(ind + 1, f"{child_var} = {container}[{before} + {slot}]")
+            if omits:
+                self.src.add(ind + 1, f"if _dc.omit({dc}, {child_var}, m0, {slot}): continue")
+            self._node(item.child, child_var, ind + 1, path + "[].", checked)
+            self.src.add(ind, f"del {container}[{before} + {count}:]")
         else:
             self.src.add(ind, f"for _ in range({count}):")
             self.src.add(ind + 1, f"{child_var} = {container}.add()")
@@ -445,12 +673,21 @@ class DecoderCompiler(_PartCompiler):
 
 
 def compile_encoder(
-    node: MessageNode, type_name: str, part: Part, start_acc: int, start_pos: int, trace: bool
+    node: MessageNode,
+    type_name: str,
+    part: Part,
+    start_acc: int,
+    start_pos: int,
+    trace: bool,
+    lua: DynamicConditions | None = None,
 ) -> GeneratedFunction:
-    """`encode_PART(m0, strict) -> (acc, pos)`, starting from `start_acc` (the id) at `start_pos`."""
-    return EncoderCompiler(type_name, part, trace).compile(node, start_acc, start_pos)
+    """`encode_PART(m0, strict) -> (acc, pos)`, starting from `start_acc` (the id) at `start_pos`.
+    `lua`: the Codec's Lua state when the type has dynamic conditions."""
+    return EncoderCompiler(type_name, part, trace, lua).compile(node, start_acc, start_pos)
 
 
-def compile_decoder(node: MessageNode, type_name: str, part: Part, trace: bool) -> GeneratedFunction:
+def compile_decoder(
+    node: MessageNode, type_name: str, part: Part, trace: bool, lua: DynamicConditions | None = None
+) -> GeneratedFunction:
     """`decode_PART(m0, b, pos, end) -> pos`."""
-    return DecoderCompiler(type_name, part, trace).compile(node)
+    return DecoderCompiler(type_name, part, trace, lua).compile(node)

@@ -14,7 +14,8 @@ from enum import Enum
 
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 
-from pygoby.dccl.codecs.base import FieldCodec, FieldInfo, field_category
+from pygoby.dccl.codecs.base import FieldCodec, FieldInfo, RepeatedFieldCodec, field_category
+from pygoby.dccl.conditions import DynamicConditions, FieldConditions
 from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_options, message_options
 from pygoby.dccl.registry import CodecRegistry, DefaultMessageCodec
@@ -51,6 +52,9 @@ class ScalarItem:
     codec: FieldCodec
     mode: Mode
     oneof: Oneof | None = None
+    conditions: FieldConditions | None = None
+    # the required-encoding twin of `codec`, when `required_if` decides at run time
+    required_codec: FieldCodec | None = None
 
     def min_size(self) -> int:
         return self.codec.min_size()
@@ -68,6 +72,7 @@ class MessageItem:
     mode: Mode
     presence_bit: bool
     oneof: Oneof | None = None
+    conditions: FieldConditions | None = None
 
     def min_size(self) -> int:
         return 1 if self.presence_bit else self.child.min_size()
@@ -86,6 +91,7 @@ class RepeatedItem:
     slots: bool  # v2: always max_repeat optional-encoded slots, no prefix
     codec: FieldCodec | None = None  # element codec (None for built-in message elements)
     child: MessageNode | None = None
+    conditions: FieldConditions | None = None  # omit_if per element; min/max per element
 
     @property
     def prefix_bits(self) -> int:
@@ -105,7 +111,21 @@ class RepeatedItem:
         return self.prefix_bits + self.max_repeat * self.element_max()
 
 
-Item = ScalarItem | MessageItem | RepeatedItem
+@dataclass
+class ListItem:
+    """A repeated field coded as a whole by a `RepeatedFieldCodec` (e.g. dccl.arithmetic)."""
+
+    field: FieldDescriptor
+    codec: RepeatedFieldCodec
+
+    def min_size(self) -> int:
+        return self.codec.min_size()
+
+    def max_size(self) -> int:
+        return self.codec.max_size()
+
+
+Item = ScalarItem | MessageItem | RepeatedItem | ListItem
 
 
 @dataclass
@@ -114,6 +134,7 @@ class MessageNode:
     codec_version: int  # version of the message codec handling this message
     items: list[Item] = field(default_factory=list)
     oneofs: list[Oneof] = field(default_factory=list)  # case fields written first (v4 BODY)
+    resets: frozenset[str] = frozenset()  # see cpp_min_size
 
     def min_size(self) -> int:
         fixed = sum(i.min_size() for i in self.items if getattr(i, "oneof", None) is None)
@@ -125,6 +146,21 @@ class MessageNode:
             members = [i.max_size() for i in self.items if getattr(i, "oneof", None) is oneof]
             fixed += oneof.bits + max(members, default=0)
         return fixed
+
+    def cpp_min_size(self) -> int:
+        """The minimum size as C++ DCCL's v3/v4 message codecs compute it, which is what they
+        write for a message without value (a padding element, an absent message made
+        required by `required_if`): its running total restarts at 0 at each field with an
+        omit_if, only_if or required_if condition. Equal to `min_size()` without conditions."""
+        if not self.resets:
+            return self.min_size()
+        total = sum(o.bits for o in self.oneofs)
+        for item in self.items:
+            if item.field.name in self.resets:
+                total = 0
+            elif getattr(item, "oneof", None) is None:
+                total += item.min_size()
+        return total
 
 
 @dataclass
@@ -149,8 +185,7 @@ def root_options(descriptor: Descriptor) -> RootOptions:
     if not opts.omit_id:
         if not opts.HasField("id"):
             raise DcclLoadError(f"{name}: missing (dccl.msg).id (or set omit_id: true)")
-        if not 0 <= opts.id <= 32767:
-            raise DcclLoadError(f"{name}: id {opts.id} is outside 0..32767")
+        # the range an id may take depends on the identifier codec (pygoby.dccl.identifier)
         dccl_id = opts.id
     group = opts.codec_group if opts.HasField("codec_group") else None
     return RootOptions(name, opts.codec_version, group, dccl_id, opts.max_bytes)
@@ -160,12 +195,18 @@ class Planner:
     """Builds the plan of one root message type for one part."""
 
     def __init__(
-        self, root: RootOptions, registry: CodecRegistry, now: Callable[[], float]
+        self,
+        root: RootOptions,
+        registry: CodecRegistry,
+        now: Callable[[], float],
+        lua: Callable[[], DynamicConditions] | None = None,
     ) -> None:
         self.root = root
         self.registry = registry
         self.now = now
         self.default_name = root.codec_group or f"dccl.default{root.version}"
+        self.lua = lua  # the Codec's Lua state (made on first use) for dynamic conditions
+        self.conditioned = False  # some field has dynamic conditions
 
     def plan_root(self, descriptor: Descriptor, part: Part) -> MessageNode:
         opts = message_options(descriptor)
@@ -221,6 +262,12 @@ class Planner:
             oneofs[decl.name] = Oneof(decl.name, [f.name for f in decl.fields])
         if part is Part.BODY:
             node.oneofs = list(oneofs.values())
+        if version >= 3:
+            node.resets = frozenset(
+                f.name for f in descriptor.fields
+                if (c := FieldConditions.of(f, field_options(f))) is not None
+                and (c.omit_if is not None or c.required_if is not None)
+            )
         for f in descriptor.fields:
             item = self._plan_field(f, part, forced, version, stack, oneofs)
             if item is not None:
@@ -237,8 +284,12 @@ class Planner:
                 raise DcclLoadError(f"{where}: a oneof member cannot be in_head")
         if fopts.omit:
             return None
-        if fopts.HasField("dynamic_conditions"):
-            raise DcclLoadError(f"{where}: dynamic_conditions (Lua) are not supported")
+        conditions = FieldConditions.of(f, fopts)
+        if conditions is not None:
+            if self.lua is None:
+                raise DcclLoadError(f"{where}: dynamic_conditions need a Codec's Lua state")
+            self.lua().compile(conditions)
+            self.conditioned = True
         category = field_category(f)
         name = self._codec_name(f, fopts)
         resolved, entry = self.registry.resolve(name, self.root.version, category)
@@ -252,22 +303,38 @@ class Planner:
                 )
             return None
         repeated = f.is_repeated
+        # conditions that apply: omit_if on a singular field only in the v3/v4 message codecs
+        # (C++'s v2 codec does not look), required_if only for codec versions 3 and 4
+        singular = None if conditions is None else conditions.for_singular(version, self.root.version)
         if isinstance(entry, DefaultMessageCodec):
             child_forced = forced
             if fopts.HasField("in_head"):
                 child_forced = Part.HEAD if fopts.in_head else Part.BODY
             child = self._plan_message(f.message_type, part, child_forced, entry.version, stack)
             if repeated:
-                return self._repeated(f, fopts, child=child)
+                return self._repeated(f, fopts, child=child, conditions=conditions)
             mode = self._mode(f, oneof)
             presence = entry.version >= 3 and mode is Mode.OPTIONAL
-            return MessageItem(f, child, mode, presence, oneof)
+            return MessageItem(f, child, mode, presence, oneof,
+                               singular if mode is Mode.OPTIONAL or singular is None
+                               else singular.without_required())
         if repeated:
             info = self._info(f, fopts, category, resolved, required=self.root.version >= 3)
-            return self._repeated(f, fopts, codec=entry(info))
+            codec = entry(info)
+            if isinstance(codec, RepeatedFieldCodec):
+                return ListItem(f, codec)
+            return self._repeated(f, fopts, codec=codec, conditions=conditions)
         mode = self._mode(f, oneof)
         info = self._info(f, fopts, category, resolved, required=mode is not Mode.OPTIONAL)
-        return ScalarItem(f, entry(info), mode, oneof)
+        item = ScalarItem(f, entry(info), mode, oneof)
+        if singular is not None:
+            if mode is not Mode.OPTIONAL:
+                singular = singular.without_required()
+            item.conditions = singular
+            if singular.required_if is not None:
+                required = self._info(f, fopts, category, resolved, required=True)
+                item.required_codec = entry(required)
+        return item
 
     def _mode(self, f: FieldDescriptor, oneof: Oneof | None) -> Mode:
         if oneof is not None:
@@ -288,7 +355,7 @@ class Planner:
             registry=self.registry,
         )
 
-    def _repeated(self, f, fopts, codec=None, child=None) -> RepeatedItem:
+    def _repeated(self, f, fopts, codec=None, child=None, conditions=None) -> RepeatedItem:
         if not fopts.HasField("max_repeat"):
             raise DcclLoadError(f"{f.full_name}: repeated field needs (dccl.field).max_repeat")
         if fopts.max_repeat < 1:
@@ -302,6 +369,7 @@ class Planner:
             slots=self.root.version == 2,
             codec=codec,
             child=child,
+            conditions=conditions,
         )
 
     def _check_fixed(self, node: MessageNode) -> None:

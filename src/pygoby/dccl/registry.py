@@ -4,18 +4,24 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import TypeVar
 
+from pygoby.dccl.arithmetic import ArithmeticCodec
+from pygoby.dccl.ccl.codecs import CCL_FIELD_CODECS
 from pygoby.dccl.codecs.base import ALL_CATEGORIES, NUMERIC_CATEGORIES, FieldCodec, FieldInfo
 from pygoby.dccl.codecs.boolean import BoolCodec
 from pygoby.dccl.codecs.enum import EnumCodec, EnumCodecV2
+from pygoby.dccl.codecs.native_protobuf import NativeProtobufCodec
 from pygoby.dccl.codecs.numeric import NumericCodec
 from pygoby.dccl.codecs.presence import make_presence_codec
 from pygoby.dccl.codecs.static import StaticCodec
 from pygoby.dccl.codecs.strings import FixedBytesCodec, StringCodecV2, StringCodecV3, VarBytesCodec
 from pygoby.dccl.codecs.time import TimeCodec
 from pygoby.dccl.errors import DcclLoadError
+from pygoby.dccl.hashing import HashCodec
 
 CodecFactory = Callable[[FieldInfo], FieldCodec]
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -33,6 +39,7 @@ class CodecRegistry:
 
     def __init__(self) -> None:
         self._entries: dict[tuple[str, str], CodecFactory | DefaultMessageCodec] = {}
+        self._state: dict[type, object] = {}
 
     def register(
         self, name: str, categories: Iterable[str], factory: CodecFactory | DefaultMessageCodec
@@ -44,9 +51,18 @@ class CodecRegistry:
             self._entries[(name, category)] = factory
 
     def copy(self) -> CodecRegistry:
+        """The same codecs, with state of its own (e.g. no arithmetic models)."""
         other = CodecRegistry()
         other._entries = dict(self._entries)
         return other
+
+    def shared_state(self, kind: type[T]) -> T:
+        """The one `kind()` object that the codecs of this registry share (created on first
+        use), e.g. the arithmetic models of a Codec (C++ DCCL's codec-specific data)."""
+        state = self._state.get(kind)
+        if state is None:
+            state = self._state[kind] = kind()
+        return state  # type: ignore[return-value]
 
     def resolve(
         self, name: str, version: int, category: str
@@ -64,13 +80,6 @@ class CodecRegistry:
         if isinstance(factory, DefaultMessageCodec):
             raise DcclLoadError(f"{info.name}: {name} is a message codec")
         return factory(info)
-
-
-def _unsupported_hash(info: FieldInfo) -> FieldCodec:
-    raise DcclLoadError(
-        f"{info.name}: dccl.hash depends on C++ std::hash and protobuf's DebugString text and "
-        "cannot be reproduced portably; it is not supported"
-    )
 
 
 def _default_scalar_codecs(version: int) -> dict[str, CodecFactory]:
@@ -95,7 +104,7 @@ def _build_default_registry() -> CodecRegistry:
         registry.register(f"dccl.default{version}", ["message"], DefaultMessageCodec(version))
         registry.register(f"dccl.time{version}", time_types, TimeCodec)
         registry.register(f"dccl.static{version}", static_types, StaticCodec)
-        registry.register(f"dccl.hash{version}", ["uint32"], _unsupported_hash)
+        registry.register(f"dccl.hash{version}", ["uint32"], HashCodec)
         if version >= 3:
             scalars = ALL_CATEGORIES - {"message"}
             registry.register(f"dccl.presence{version}", scalars, make_presence_codec)
@@ -103,6 +112,13 @@ def _build_default_registry() -> CodecRegistry:
             registry.register(f"dccl.var_bytes{version}", ["string", "bytes"], VarBytesCodec)
     registry.register("_time", time_types, TimeCodec)
     registry.register("_static", static_types, StaticCodec)
+    for name, (categories, factory) in CCL_FIELD_CODECS.items():
+        registry.register(name, categories, factory)
+    arithmetic_types = (*NUMERIC_CATEGORIES, "bool", "enum")
+    registry.register("dccl.arithmetic", arithmetic_types, ArithmeticCodec)
+    registry.register("_arithmetic", arithmetic_types, ArithmeticCodec)
+    registry.register("dccl.native_protobuf", arithmetic_types, NativeProtobufCodec)
+    registry.register("dccl.native_protobuf", ["message"], DefaultMessageCodec(4))
     return registry
 
 

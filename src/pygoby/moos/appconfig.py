@@ -30,6 +30,7 @@ from pygoby.moos import goby11_config
 from pygoby.moos.moosfile import MissionFile, parse_number
 from pygoby.protobuf import builtin_class
 from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
+from pygoby.protobuf.wire import length_delimited
 
 log = logging.getLogger(__name__)
 
@@ -44,40 +45,12 @@ def _options_class() -> type[Message]:
     return builtin_class("goby/protobuf/option_extensions.proto", "goby.GobyFieldOptions")
 
 
-def _varint(data: bytes, pos: int) -> tuple[int, int]:
-    result = shift = 0
-    while True:
-        byte = data[pos]
-        pos += 1
-        result |= (byte & 0x7F) << shift
-        shift += 7
-        if not byte & 0x80:
-            return result, pos
-
-
 def goby_field_options(field: FieldDescriptor) -> Message:
     """The field's `(goby.field)` options (an empty GobyFieldOptions if it has none)."""
     out = _options_class()()
     if not field.has_options:
         return out
-    data = field.GetOptions().SerializeToString()
-    pos = 0
-    while pos < len(data):
-        tag, pos = _varint(data, pos)
-        number, wire = tag >> 3, tag & 7
-        if wire == 0:
-            _, pos = _varint(data, pos)
-        elif wire == 1:
-            pos += 8
-        elif wire == 5:
-            pos += 4
-        elif wire == 2:
-            size, pos = _varint(data, pos)
-            if number == GOBY_FIELD_EXTENSION:
-                out.MergeFromString(data[pos : pos + size])
-            pos += size
-        else:
-            break
+    out.MergeFromString(length_delimited(field.GetOptions().SerializeToString(), GOBY_FIELD_EXTENSION))
     return out
 
 

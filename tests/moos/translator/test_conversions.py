@@ -12,9 +12,9 @@ from pygoby.moos.translator.conversions import (
     format_float,
     hex_decode,
     looks_like_double,
-    text_format_double,
-    text_format_float,
 )
+from pygoby.protobuf.cpp_text import double_text as text_format_double
+from pygoby.protobuf.cpp_text import float_text as text_format_float
 
 
 @pytest.mark.parametrize(

@@ -1,6 +1,7 @@
 from google.protobuf import descriptor_pb2
 
-from pygoby.moos.translator.textformat import c_escape, message_text
+from pygoby.moos.translator.textformat import message_text
+from pygoby.protobuf.cpp_text import c_escape
 
 
 def test_cpp_single_line_example_from_spec():

@@ -10,6 +10,10 @@ A field codec turns one field value into bits and back. Two shapes exist:
 `value` is None when the field is unset; `from_raw`/`decode` return None for "not set". A raw value
 of `nbits` bits is written least-significant bit first at the current bit position (spec §3.2).
 User codecs subclass one of these and are registered with `CodecRegistry.register`.
+
+A codec whose encoding depends on other fields of the message (e.g. the legacy CCL speed, scaled
+by a thrust mode) sets `reads_root = True`: its `to_raw`/`from_raw` (or `encode`/`decode`) then
+take the root message first (the message being encoded, or as far as it is decoded).
 """
 
 from __future__ import annotations
@@ -82,6 +86,8 @@ class FieldInfo:
 class FieldCodec:
     """General field codec (variable size). Subclasses override the methods below."""
 
+    reads_root = False  # True: the methods take the root message as their first argument
+
     def __init__(self, info: FieldInfo) -> None:
         self.info = info
 
@@ -117,6 +123,9 @@ class FixedWidthCodec(FieldCodec):
     """A codec whose encoding is always `self.bits` bits."""
 
     bits: int = 0
+    # The raw value written for "no value" (an absent optional field, a padding slot of a
+    # repeated field): every default codec writes zeros; some legacy CCL codecs do not.
+    null_raw: int = 0
 
     def to_raw(self, value: Any, strict: bool) -> int:
         raise NotImplementedError
@@ -136,3 +145,17 @@ class FixedWidthCodec(FieldCodec):
 
     def max_size(self) -> int:
         return self.bits
+
+
+class RepeatedFieldCodec(FieldCodec):
+    """A codec that codes a whole repeated field itself (no count prefix, no slots), like C++
+    DCCL's RepeatedTypedFieldCodec; on a singular field it codes a list of at most one value.
+
+    Implement `encode_list(values, strict) -> (raw, nbits)` and `decode_list(bits, pos, end) ->
+    (values, pos)`; `encode`/`decode` serve singular fields."""
+
+    def encode_list(self, values: list, strict: bool) -> tuple[int, int]:
+        raise NotImplementedError
+
+    def decode_list(self, bits: int, pos: int, end: int) -> tuple[list, int]:
+        raise NotImplementedError

@@ -7,6 +7,7 @@ truncate toward zero at each conversion.
 
 from __future__ import annotations
 
+import copy
 import math
 import struct
 from collections.abc import Callable
@@ -96,9 +97,20 @@ class NumericCodec(FixedWidthCodec):
         self.res = self._resolution(info) if resolution is None else resolution
         self.null = 0 if info.required else 1
         self._validate(category)
+        self.category = category
+        self.static_bounds = (self.min, self.max)
         self.bits = ceil_log2((self.max - self.min) / self.res + 1 + self.null)
         self.inv = 1.0 / self.res
         self.to_raw, self.from_raw = self._build(category)
+
+    def rebound(self, lo: float, hi: float) -> NumericCodec:
+        """This codec with other bounds (dynamic conditions): the width follows them, as in
+        C++ DCCL; the bounds are not validated again."""
+        other = copy.copy(self)
+        other.min, other.max = lo, hi
+        other.bits = ceil_log2(max(0.0, (hi - lo) / self.res + 1 + self.null))
+        other.to_raw, other.from_raw = other._build(self.category)
+        return other
 
     def _resolution(self, info: FieldInfo) -> float:
         opts = info.options

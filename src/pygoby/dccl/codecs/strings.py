@@ -34,8 +34,9 @@ class _ByteStringCodec(FieldCodec):
         return data
 
     def from_bytes(self, data: bytes) -> Any:
-        # Strings travel as raw bytes; a cut multi-byte character must not make decoding fail.
-        return data.decode("utf-8", "replace") if self.is_text else data
+        # Strings travel as raw bytes and are decoded as such: protobuf checks UTF-8 when the
+        # bytes are put into the message (see pygoby.dccl.rawtext for bytes that are not UTF-8).
+        return data
 
     def read_bytes(self, bits: int, pos: int, end: int, n: int) -> bytes:
         raw = self.take(bits, pos, end, 8 * n, self.info.name)

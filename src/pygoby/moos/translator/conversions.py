@@ -101,27 +101,6 @@ def double_to_string17(value: float) -> str:
     return format_general(value, 17)
 
 
-def text_format_double(value: float) -> str:
-    """C++ TextFormat's double: %.15g unless it does not round-trip, then %.17g."""
-    if math.isnan(value):
-        return "nan"
-    if math.isinf(value):
-        return "inf" if value > 0 else "-inf"
-    short = f"{value:.15g}"
-    return short if float(short) == value else f"{value:.17g}"
-
-
-def text_format_float(value: float) -> str:
-    """C++ TextFormat's float: %.6g unless it does not round-trip as a float, then %.9g."""
-    value = to_float32(value)
-    if math.isnan(value):
-        return "nan"
-    if math.isinf(value):
-        return "inf" if value > 0 else "-inf"
-    short = f"{value:.6g}"
-    return short if to_float32(float(short)) == to_float32(value) else f"{value:.9g}"
-
-
 def looks_like_double(text: str) -> bool:
     """Would `boost::lexical_cast<double>` accept this? (decides MOOS double vs string posts)"""
     return lexical_double(text) is not None

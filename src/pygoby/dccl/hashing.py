@@ -1,0 +1,285 @@
+"""`dccl.hash`: a uint32 field that carries a hash of the message definition (C++ DCCL 4.2).
+
+C++ DCCL computes the hash when a type is loaded, from text: for the root message its DCCL
+message options (without max_bytes), then, in the header and the body pass, every field it
+traverses: the field's descriptor (number, label, type; not its name, type name, default or
+options) and its DCCL field options, each printed as protobuf's C++ `DebugString()` and
+hashed with the C++ standard library's `std::hash<std::string>`, folded with boost's
+`hash_combine`; embedded messages, enums (their `DebugString()`) and v4 oneofs (theirs) add
+their own hashes. The field sends `hash & max`; a decoder with another definition fails.
+
+pygoby reproduces this exactly for the common platform: `std::hash` of GNU libstdc++ on 64-bit
+(MurmurHash64A-style `_Hash_bytes`, seed 0xc70f6907) and protobuf 3.x/4.x's `DebugString`
+format. A C++ peer built with another standard library (libc++ on macOS: a different
+`std::hash`) or on a 32-bit platform computes other values; so does C++ against itself.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from google.protobuf import descriptor_pb2
+from google.protobuf.descriptor import Descriptor, EnumDescriptor, FieldDescriptor, OneofDescriptor
+from google.protobuf.message import Message
+
+from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec
+from pygoby.dccl.codecs.numeric import NumericCodec
+from pygoby.dccl.errors import DcclDecodeError, DcclLoadError
+from pygoby.dccl.options import field_options, message_options
+from pygoby.protobuf.cpp_text import c_escape, message_text, scalar_text
+
+_U64 = (1 << 64) - 1
+_MUL = 0xC6A4A7935BD1E995
+_SEED = 0xC70F6907
+
+
+# ------------------------------------------------------------------ libstdc++ std::hash
+def _shift_mix(v: int) -> int:
+    return v ^ (v >> 47)
+
+
+def cpp_string_hash(data: bytes) -> int:
+    """`std::hash<std::string>` of GNU libstdc++ on a 64-bit platform."""
+    n = len(data)
+    h = (_SEED ^ (n * _MUL)) & _U64
+    aligned = n & ~7
+    for i in range(0, aligned, 8):
+        word = int.from_bytes(data[i : i + 8], "little")
+        h ^= (_shift_mix((word * _MUL) & _U64) * _MUL) & _U64
+        h = (h * _MUL) & _U64
+    if n & 7:
+        h ^= int.from_bytes(data[aligned:], "little")
+        h = (h * _MUL) & _U64
+    h = (_shift_mix(h) * _MUL) & _U64
+    return _shift_mix(h)
+
+
+def hash_combine(seed: int, value: int) -> int:
+    """boost::hash_combine on 64-bit size_t (std::hash of an integer is the integer)."""
+    return (seed ^ ((value + 0x9E3779B9 + (seed << 6) + (seed >> 2)) & _U64)) & _U64
+
+
+def _combine_text(seed: int, text: str) -> int:
+    return hash_combine(seed, cpp_string_hash(text.encode()))
+
+
+# ------------------------------------------------------------------ protobuf C++ text
+def _sorted_fields(msg: Message):
+    return sorted(msg.ListFields(), key=lambda fv: fv[0].number)
+
+
+def text_format(msg: Message, indent: int = 0) -> str:
+    """C++ `TextFormat::Printer` (what `DebugString()` prints), from `indent` spaces."""
+    return message_text(msg, single_line=False, indent=indent)
+
+
+def _option_entries(depth: int, options: Message, dccl_options: Message | None) -> list[str]:
+    """protobuf's RetrieveOptions: `name = value` of each set option, by field number; the
+    (dccl.field) extension comes from `dccl_options`."""
+    entries: list[tuple[int, str]] = []
+    for f, value in _sorted_fields(options):
+        if f.is_extension:
+            continue
+        entries.append((f.number, f"{f.name} = {scalar_text(f, value)}"))
+    if dccl_options is not None and dccl_options.ListFields():
+        body = text_format(dccl_options, 2 * (depth + 1))
+        entries.append((1012, f"(.dccl.field) = {{\n{body}{' ' * (2 * depth)}}}"))
+    return [text for _, text in sorted(entries, key=lambda e: e[0])]
+
+
+_TYPE_NAMES = {
+    FieldDescriptor.TYPE_DOUBLE: "double", FieldDescriptor.TYPE_FLOAT: "float",
+    FieldDescriptor.TYPE_INT64: "int64", FieldDescriptor.TYPE_UINT64: "uint64",
+    FieldDescriptor.TYPE_INT32: "int32", FieldDescriptor.TYPE_FIXED64: "fixed64",
+    FieldDescriptor.TYPE_FIXED32: "fixed32", FieldDescriptor.TYPE_BOOL: "bool",
+    FieldDescriptor.TYPE_STRING: "string", FieldDescriptor.TYPE_GROUP: "group",
+    FieldDescriptor.TYPE_BYTES: "bytes", FieldDescriptor.TYPE_UINT32: "uint32",
+    FieldDescriptor.TYPE_SFIXED32: "sfixed32", FieldDescriptor.TYPE_SFIXED64: "sfixed64",
+    FieldDescriptor.TYPE_SINT32: "sint32", FieldDescriptor.TYPE_SINT64: "sint64",
+}
+_PROTO_TYPES = {
+    number: "TYPE_" + name.upper() for number, name in _TYPE_NAMES.items()
+} | {FieldDescriptor.TYPE_MESSAGE: "TYPE_MESSAGE", FieldDescriptor.TYPE_ENUM: "TYPE_ENUM"}
+
+
+def _field_proto(f: FieldDescriptor) -> descriptor_pb2.FieldDescriptorProto:
+    proto = descriptor_pb2.DescriptorProto()
+    f.containing_type.CopyToProto(proto)
+    return next(p for p in proto.field if p.number == f.number)
+
+
+def _label(f: FieldDescriptor) -> str:
+    if f.is_repeated:
+        return "LABEL_REPEATED"
+    return "LABEL_REQUIRED" if f.is_required else "LABEL_OPTIONAL"
+
+
+def _explicit_json_name(f: FieldDescriptor) -> bool:
+    camel, upper = "", False
+    for char in f.name:
+        if char == "_":
+            upper = True
+        else:
+            camel += char.upper() if upper else char
+            upper = False
+    return f.json_name != camel
+
+
+def field_descriptor_text(f: FieldDescriptor) -> str:
+    """DebugString() of the FieldDescriptorProto without name, options, type name and
+    default (what C++ DCCL hashes for a field)."""
+    lines = [f"number: {f.number}\n", f"label: {_label(f)}\n", f"type: {_PROTO_TYPES[f.type]}\n"]
+    if f.containing_oneof is not None:
+        lines.append(f"oneof_index: {f.containing_oneof.index}\n")
+    if _explicit_json_name(f):
+        lines.append(f'json_name: "{c_escape(f.json_name.encode())}"\n')
+    if getattr(f, "has_presence", False) and _field_proto(f).proto3_optional:
+        lines.append("proto3_optional: true\n")
+    return "".join(lines)
+
+
+def _field_debug_string(f: FieldDescriptor, depth: int) -> str:
+    """FieldDescriptor::DebugString at `depth` (as inside a oneof)."""
+    prefix = " " * (2 * depth)
+    if f.type in (FieldDescriptor.TYPE_MESSAGE, FieldDescriptor.TYPE_GROUP):
+        type_name = "." + f.message_type.full_name
+    elif f.type == FieldDescriptor.TYPE_ENUM:
+        type_name = "." + f.enum_type.full_name
+    else:
+        type_name = _TYPE_NAMES[f.type]
+    label = "" if f.containing_oneof is not None else _label(f)[6:].lower() + " "
+    text = f"{prefix}{label}{type_name} {f.name} = {f.number}"
+    options = _option_entries(depth, f.GetOptions(), field_options(f))
+    if options:
+        text += " [" + ", ".join(options) + "]"
+    return text + ";\n"
+
+
+def oneof_debug_string(oneof: OneofDescriptor) -> str:
+    fields = "".join(_field_debug_string(f, 1) for f in oneof.fields)
+    return f"oneof {oneof.name} {{\n{fields}}}\n"
+
+
+def enum_debug_string(enum: EnumDescriptor) -> str:
+    proto = descriptor_pb2.EnumDescriptorProto()
+    enum.CopyToProto(proto)
+    lines = [f"enum {enum.name} {{\n"]
+    for f, value in _sorted_fields(proto.options):
+        if not f.is_extension:
+            lines.append(f"  option {f.name} = {scalar_text(f, value)};\n")
+    for value in enum.values:
+        value_proto = next(v for v in proto.value if v.number == value.number and v.name == value.name)
+        options = _option_entries(1, value_proto.options, None)
+        suffix = f" [{', '.join(options)}]" if options else ""
+        lines.append(f"  {value.name} = {value.number}{suffix};\n")
+    if proto.reserved_range:
+        parts = []
+        for r in proto.reserved_range:
+            if r.start == r.end:
+                parts.append(str(r.start))
+            elif r.end == 2**31 - 1:
+                parts.append(f"{r.start} to max")
+            else:
+                parts.append(f"{r.start} to {r.end}")
+        lines.append("  reserved " + ", ".join(parts) + ";\n")
+    if proto.reserved_name:
+        names = ", ".join(f'"{c_escape(n.encode())}"' for n in proto.reserved_name)
+        lines.append(f"  reserved {names};\n")
+    lines.append("}\n")
+    return "".join(lines)
+
+
+# ------------------------------------------------------------------ the definition's hash
+def _codec_hash(item) -> int:
+    """FieldCodecBase::hash() of a field's codec: a sub-message's own hash, an enum's
+    DebugString for the default enum codecs, 0 otherwise."""
+    from pygoby.dccl.codecs.enum import EnumCodec
+    from pygoby.dccl.plan import MessageItem, RepeatedItem
+
+    if isinstance(item, MessageItem) or (isinstance(item, RepeatedItem) and item.child is not None):
+        return node_hash(item.child)
+    codec = getattr(item, "codec", None)
+    if isinstance(codec, EnumCodec):
+        return cpp_string_hash(enum_debug_string(item.field.enum_type).encode())
+    return 0
+
+
+def node_hash(node) -> int:
+    value = 0
+    for oneof in node.oneofs:
+        desc = node.descriptor.oneofs_by_name[oneof.name]
+        value = _combine_text(value, oneof_debug_string(desc))
+    for item in node.items:
+        f = item.field
+        value = _combine_text(value, field_descriptor_text(f))
+        value = _combine_text(value, text_format(field_options(f)))
+        value = hash_combine(value, _codec_hash(item))
+    return value
+
+
+def definition_hash(descriptor: Descriptor, head, body) -> int:
+    """The 64-bit hash C++ DCCL's `Codec::load` returns for a root type (from its plans)."""
+    opts = message_options(descriptor)
+    opts.ClearField("max_bytes")
+    text = text_format(opts)
+    value = 0
+    for node in (head, body):
+        value = _combine_text(value, text)
+        value = hash_combine(value, node_hash(node))
+    return value
+
+
+# ------------------------------------------------------------------ the codec
+class HashCodec(FixedWidthCodec):
+    """A uint32 field sending `definition hash & max` (always, in the required encoding); on
+    decode a different value is an error. The hash is set when the whole type is planned."""
+
+    def __init__(self, info: FieldInfo) -> None:
+        super().__init__(info)
+        opts = info.options
+        lo, hi = opts.min, opts.max
+        if lo != 0:
+            raise DcclLoadError(f"{info.name}: dccl.hash needs (dccl.field).min = 0")
+        if hi > 2**32 - 1 or hi != 2 ** (int(hi).bit_length()) - 1 or hi != int(hi):
+            raise DcclLoadError(
+                f"{info.name}: dccl.hash needs (dccl.field).max = 2^k - 1 (e.g. 255, 4294967295)"
+            )
+        required = dataclasses.replace(info, required=True)
+        self.inner = NumericCodec(required, bounds=(0.0, hi), resolution=1.0, category="uint32")
+        self.bits = self.inner.bits
+        self.mask = int(hi)
+        self.expected = 0
+        inner_to_raw, inner_from_raw = self.inner.to_raw, self.inner.from_raw
+
+        def to_raw(value, strict: bool) -> int:
+            return inner_to_raw(self.expected, strict)
+
+        def from_raw(raw: int) -> int:
+            received = inner_from_raw(raw)
+            if received != self.expected:
+                raise DcclDecodeError(
+                    f"{info.name}: hash mismatch (expected {self.expected}, received {received}):"
+                    " sender and receiver do not use the same DCCL definition"
+                )
+            return received
+
+        self.to_raw, self.from_raw = to_raw, from_raw
+
+    def set_hash(self, full_hash: int) -> None:
+        self.expected = full_hash & self.mask
+        self.null_raw = self.inner.to_raw(self.expected, False)
+
+    def describe(self) -> str:
+        return f"definition hash & {self.mask:#x}"
+
+
+def hash_codecs(node):
+    """Every HashCodec in a plan."""
+    from pygoby.dccl.plan import MessageItem, RepeatedItem
+
+    for item in node.items:
+        codec = getattr(item, "codec", None)
+        if isinstance(codec, HashCodec):
+            yield codec
+        if isinstance(item, MessageItem) or (isinstance(item, RepeatedItem) and item.child):
+            yield from hash_codecs(item.child)
