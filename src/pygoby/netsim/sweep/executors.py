@@ -88,7 +88,14 @@ class LocalExecutor:
             while (queue or in_flight) and not broken:
                 while queue and len(in_flight) < self.jobs:
                     run = queue.pop()
-                    in_flight[pool.submit(execute_run, run)] = run
+                    try:
+                        in_flight[pool.submit(execute_run, run)] = run
+                    except BrokenProcessPool:  # a worker died since the last wait
+                        queue.append(run)  # (never started)
+                        broken = True
+                        break
+                if broken:
+                    break
                 finished, _ = wait(in_flight, return_when=FIRST_COMPLETED)
                 for future in finished:
                     if isinstance(future.exception(), BrokenProcessPool):

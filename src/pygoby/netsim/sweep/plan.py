@@ -152,30 +152,23 @@ def field_descriptor(message_class_descriptor, path: str) -> FieldDescriptor:
     return field
 
 
+def _repeated(target: Message, name: str, index: int):
+    items = getattr(target, name)
+    if index >= len(items):
+        raise ValueError(f"{name}[{index}] does not exist (there are {len(items)})")
+    return items
+
+
 def set_field(message: Message, path: str, value: Value) -> None:
-    """Set the scalar at `path` (repeated elements must exist, except one past the end of a
-    repeated scalar, which is appended)."""
-    segments = _segments(path)
+    """Set the scalar at `path` (the elements of repeated fields must exist)."""
+    *parents, (name, index) = _segments(path)
     target = message
-    for name, index in segments[:-1]:
-        if index is None:
-            target = getattr(target, name)
-        else:
-            items = getattr(target, name)
-            if index >= len(items):
-                raise ValueError(f"{name}[{index}] does not exist (there are {len(items)})")
-            target = items[index]
-    name, index = segments[-1]
+    for parent, i in parents:
+        target = getattr(target, parent) if i is None else _repeated(target, parent, i)[i]
     if index is None:
         setattr(target, name, value)
-        return
-    items = getattr(target, name)
-    if index < len(items):
-        items[index] = value
-    elif index == len(items):
-        items.append(value)
     else:
-        raise ValueError(f"{name}[{index}] does not exist (there are {len(items)})")
+        _repeated(target, name, index)[index] = value
 
 
 _KINDS = {
@@ -264,7 +257,8 @@ def _axes(sweep: Message, base: Message, path: Path | None, text: str) -> list[_
         except ValueError as exc:
             raise ConfigError(str(exc), **where) from None
         name = axis.name or axis.field
-        if name in names or name in RESERVED_COLUMNS:
+        seed_column = name == "seed" and axis.field == "seed"  # (the seed column itself)
+        if name in names or (name in RESERVED_COLUMNS and not seed_column):
             raise ConfigError(f"column {name!r} is used twice: give the axis another name", **where)
         names.add(name)
         column = AxisColumn(name, axis.field, _KINDS[descriptor.cpp_type])
@@ -321,7 +315,10 @@ def expand(sweep: Message, base: Message, path: Path | None = None, text: str = 
             scenario = point_scenario(sweep, base, axes, values)
         except (ValueError, ScenarioError) as exc:
             params = ", ".join(f"{a.column.name}={v}" for a, v in zip(axes, values, strict=True))
-            raise ConfigError(f"point {index} ({params}): {exc}", file=path) from None
+            field = exc.field if isinstance(exc, _AxisValueError) else None
+            line = _axis_line(text, field) if field else None
+            raise ConfigError(f"{exc} (point {index}: {params})", file=path, line=line,
+                              field=field) from None  # fmt: skip
         params = tuple((a.column.name, v) for a, v in zip(axes, values, strict=True))
         for replicate in range(sweep.replicates):
             if not any(a.column.field == "seed" for a in axes):
@@ -334,6 +331,19 @@ def expand(sweep: Message, base: Message, path: Path | None = None, text: str = 
     return SweepPlan(runs, [a.column for a in axes], sweep.output)
 
 
+class _AxisValueError(ValueError):
+    def __init__(self, field: str, reason: str) -> None:
+        super().__init__(reason)
+        self.field = field
+
+
+def _set_axis(message: Message, axis: _Axis, path: str, value: Value) -> None:
+    try:
+        set_field(message, path, _field_value(axis.descriptor, value))
+    except ValueError as exc:
+        raise _AxisValueError(axis.column.field, str(exc)) from None
+
+
 def point_scenario(sweep: Message, base: Message, axes: list[_Axis], values) -> Message:
     """The scenario of one point: the layout with its axis values, then the scenario's axes."""
     scenario = type(base)()
@@ -344,11 +354,11 @@ def point_scenario(sweep: Message, base: Message, axes: list[_Axis], values) -> 
         layout.CopyFrom(sweep.layout)
         for axis, value in zip(axes, values, strict=True):
             if axis.column.field.startswith(LAYOUT_PREFIX):
-                set_field(layout, axis.column.field[len(LAYOUT_PREFIX):], _field_value(axis.descriptor, value))
+                _set_axis(layout, axis, axis.column.field[len(LAYOUT_PREFIX):], value)
         apply_layout(scenario, layout)
     for axis, value in zip(axes, values, strict=True):
         if not axis.column.field.startswith(LAYOUT_PREFIX):
-            set_field(scenario, axis.column.field, _field_value(axis.descriptor, value))
+            _set_axis(scenario, axis, axis.column.field, value)
     check_scenario(scenario)
     return scenario
 

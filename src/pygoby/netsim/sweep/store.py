@@ -44,7 +44,8 @@ TAIL_COLUMNS = [
 
 
 def results_schema(columns: Iterable[AxisColumn]) -> pa.Schema:
-    axes = [(c.name, _ARROW[c.kind]) for c in columns]
+    head = {name for name, _ in HEAD_COLUMNS}  # (a "seed" axis fills the seed column)
+    axes = [(c.name, _ARROW[c.kind]) for c in columns if c.name not in head]
     return pa.schema(HEAD_COLUMNS + axes + TAIL_COLUMNS)
 
 
