@@ -150,7 +150,7 @@ class DaskExecutor:
                 for run in runs
             }
             try:
-                for future in as_completed(futures):
+                for future in as_completed(futures, loop=client.loop):
                     run = futures[future]
                     try:
                         result = future.result()
