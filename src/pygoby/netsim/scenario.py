@@ -23,6 +23,7 @@ from pygoby.acomms import messages as acomms_pb
 from pygoby.netsim.channel import Band, ChannelConfig, Position
 from pygoby.netsim.channel.errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
+from pygoby.netsim.channel.settings import absorption_of, propagation_of, sound_speed_of
 from pygoby.netsim.config import config_class as manager_config_class
 from pygoby.netsim.errors import ScenarioError
 from pygoby.protobuf import builtin_class
@@ -130,8 +131,15 @@ def channel_config(scenario: Message) -> ChannelConfig:
             p.communication_range, p.detection_range, p.interference_range,
             p.p_detection, p.p_decoding,
         )  # fmt: skip
+    sound_speed = sound_speed_of(c)
+    try:
+        propagation = propagation_of(c, sound_speed)
+    except ValueError as exc:
+        raise ScenarioError(f"channel.propagation: {exc}") from None
     return ChannelConfig(
-        sound_speed=c.sound_speed,
+        sound_speed=sound_speed,
+        absorption=absorption_of(c),
+        propagation=propagation,
         source_level=c.source_level,
         spreading=c.spreading,
         noise_level=c.noise_level if c.HasField("noise_level") else None,
