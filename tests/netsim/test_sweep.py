@@ -18,6 +18,7 @@ from pygoby.netsim.sweep.plan import expand, parse_sweep
 from pygoby.netsim.sweep.report import read_results, success_by_range, wilson_interval
 from pygoby.netsim.sweep.run import execute_run
 from tests.netsim.sweep_helpers import (
+    REPO,
     descendants,
     deterministic,
     kill_group,
@@ -291,3 +292,17 @@ def test_sweep_report_draws_the_figures_and_the_page(tmp_path, capsys):
     assert close.sent == sum(r["sent"] for r in rows if r["rate"] == 1 and round(r["range_m"]) == 1000)
     assert close.success > 0.9  # 1 km at spreading 2: SNR far above rate 1's table
     assert main(["netsim", "sweep-report", str(tmp_path / "nothing")]) == 1
+
+
+def test_example_sweep_plans_and_its_readme_shows_the_figures(capsys):
+    """examples/netsim/sweep_range_rate.pb.cfg (figures: `make figures`)."""
+    example = REPO / "examples" / "netsim" / "sweep_range_rate.pb.cfg"
+    assert main(["netsim", "sweep", str(example), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "48 runs; results would go to sweep_range_rate_results" in out
+    assert "spacing_m=1500.0, vehicles=8, mac_rate=5" in out
+    readme = (example.parent / "README.md").read_text()
+    for name in ("success_vs_range", "throughput_vs_nodes", "latency_vs_nodes", "snr_vs_range"):
+        assert f"(figures/{name}.png)" in readme
+        width, height = png_size(example.parent / "figures" / f"{name}.png")
+        assert width >= 600 and height >= 400

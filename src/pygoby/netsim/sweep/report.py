@@ -8,7 +8,7 @@ HTML page that shows them with the numbers behind them.
   lower bound on the real uncertainty);
 * `throughput_vs_nodes.png` and `latency_vs_nodes.png`: per run, NodeStatus messages delivered
   per hour over all links, and their mean delivery latency (delivery time minus the message's
-  time stamp), against the node count, one line per rate: mean over the runs, bars +-1.96
+  time stamp), against the node count, one line per rate: mean over the runs, bars ±1.96
   standard errors of that mean;
 * `snr_vs_range.png`: every link's mean SNR (and SINR, interference included) against range.
 
@@ -203,10 +203,10 @@ def write_sweep_report(table: pa.Table, out_dir: str | Path) -> list[Path]:
     figures = [
         plot_success_vs_range(points, out / "success_vs_range.png"),
         _plot_vs_nodes(runs, "throughput_per_hour", "NodeStatus messages delivered per hour",
-                       "Throughput vs node count (mean over runs, +-1.96 SE)",
+                       "Throughput vs node count (mean over runs, ±1.96 SE)",
                        out / "throughput_vs_nodes.png"),  # fmt: skip
         _plot_vs_nodes(runs, "latency_s", "mean message latency (s)",
-                       "Latency vs node count (mean over runs, +-1.96 SE)",
+                       "Latency vs node count (mean over runs, ±1.96 SE)",
                        out / "latency_vs_nodes.png"),  # fmt: skip
         plot_snr_vs_range(rows, out / "snr_vs_range.png"),
     ]
