@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import os
 import time
 
 import pytest
@@ -50,6 +51,7 @@ def test_200_run_sweep_local_processes_against_one_process(benchmark, tmp_path):
     sweep, base = parse_sweep(SWEEP)
     plan = expand(sweep, base, None, SWEEP)
     assert len(plan.runs) == 200
+    load_before = os.getloadavg()[0]  # (a shared machine: other work slows both measurements)
     one = sweep_once(plan, tmp_path / "one", 1)
     jobs = default_jobs()
     many = benchmark.pedantic(lambda: sweep_once(plan, tmp_path / "many", jobs), rounds=1,
@@ -60,10 +62,12 @@ def test_200_run_sweep_local_processes_against_one_process(benchmark, tmp_path):
         "runs": 200, "jobs": jobs, "one_process_s": round(one.wall_s, 2),
         "local_processes_s": round(many.wall_s, 2), "one_process_runs_per_s": round(rate_one, 2),
         "local_runs_per_s": round(rate_many, 2), "speedup": round(rate_many / rate_one, 2),
+        "load_average_1min": [round(load_before, 2), round(os.getloadavg()[0], 2)],
     })  # fmt: skip
     print(f"\n    200 runs (8 nodes, 1 simulated hour each): one process {one.wall_s:.1f} s "
           f"({rate_one:.2f} runs/s); {jobs} local processes {many.wall_s:.1f} s "
-          f"({rate_many:.2f} runs/s): speed-up {rate_many / rate_one:.2f}x")  # fmt: skip
+          f"({rate_many:.2f} runs/s): speed-up {rate_many / rate_one:.2f}x (load average "
+          f"{load_before:.1f} before, {os.getloadavg()[0]:.1f} after)")  # fmt: skip
 
 
 BELLHOP_SCENARIO = """duration: 3600

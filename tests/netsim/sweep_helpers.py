@@ -94,3 +94,29 @@ def kill_group(process: subprocess.Popen) -> None:
     if process.poll() is None:
         os.killpg(process.pid, signal.SIGKILL)
     process.communicate(timeout=30)
+
+
+def run_files(output: Path) -> dict[str, int]:
+    """{stored run file: its modification time in ns}."""
+    return {p.name: p.stat().st_mtime_ns for p in (output / "runs").glob("*.parquet")}
+
+
+def kill_when_stored(process: subprocess.Popen, output: Path, count: int) -> dict[str, int]:
+    """SIGKILL a running sweep (no chance to clean up) once `count` runs are stored; returns
+    the run files then."""
+    try:
+        wait_for(lambda: len(stored_runs(output)) >= count, 120, f"{count} stored runs")
+    finally:
+        kill_group(process)
+    return run_files(output)
+
+
+def resume(sweep_file: Path, *args: str, cwd: Path, output: Path, before: dict[str, int],
+           total: int) -> None:  # fmt: skip
+    """Start the sweep again: it runs exactly the runs missing and leaves the stored ones be."""
+    process = start_sweep(sweep_file, *args, cwd=cwd)
+    out, err = process.communicate(timeout=180)
+    assert process.returncode == 0, err
+    assert f"{total - len(before)} run now, {len(before)} already stored, 0 failed" in out
+    after = run_files(output)
+    assert len(after) == total and all(after[name] == t for name, t in before.items())

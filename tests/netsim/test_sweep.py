@@ -22,7 +22,10 @@ from tests.netsim.sweep_helpers import (
     descendants,
     deterministic,
     kill_group,
+    kill_when_stored,
     read_table,
+    resume,
+    run_files,
     start_sweep,
     stored_runs,
     sweep_text,
@@ -201,16 +204,11 @@ def test_interrupted_sweep_resumes_without_running_anything_twice(tmp_path):
     finally:
         kill_group(process)
     assert process.returncode == 130
-    before = {p.name: p.stat().st_mtime_ns for p in (output / "runs").glob("*.parquet")}
+    before = run_files(output)
     assert 3 <= len(before) < 16, "the sweep must have been interrupted half-way"
     assert f"interrupted: {len(before)} of 16 runs are stored" in err
     assert not list((output / "runs").glob(".*")), "no partial file is left behind"
-    process = start_sweep(sweep, "--jobs", "1", cwd=tmp_path)
-    out, err = process.communicate(timeout=120)
-    assert process.returncode == 0, err
-    assert f"{16 - len(before)} run now, {len(before)} already stored, 0 failed" in out
-    after = {p.name: p.stat().st_mtime_ns for p in (output / "runs").glob("*.parquet")}
-    assert len(after) == 16 and all(after[name] == t for name, t in before.items())
+    resume(sweep, "--jobs", "1", cwd=tmp_path, output=output, before=before, total=16)
     reference = tmp_path / "reference"
     assert main(["netsim", "sweep", str(sweep), "-o", str(reference), "--jobs", "1"]) == 0
     assert deterministic(read_table(output)).equals(deterministic(read_table(reference)))
@@ -219,17 +217,11 @@ def test_interrupted_sweep_resumes_without_running_anything_twice(tmp_path):
 def test_killed_sweep_keeps_every_stored_run(tmp_path):
     sweep = write_sweep(tmp_path, duration=1800)
     output = tmp_path / "out"
-    process = start_sweep(sweep, "--jobs", "2", cwd=tmp_path)
-    try:
-        wait_for(lambda: len(stored_runs(output)) >= 2, 60, "two stored runs")
-    finally:
-        kill_group(process)  # SIGKILL: no chance to clean up
-    stored = stored_runs(output)
-    assert len(stored) < 16
-    for run_id in stored:  # every file there is a whole run
-        assert pq.read_table(output / "runs" / f"{run_id}.parquet").num_rows == 6
-    assert main(["netsim", "sweep", str(sweep), "-o", str(output), "--jobs", "1"]) == 0
-    assert read_table(output).num_rows == 16 * 6
+    before = kill_when_stored(start_sweep(sweep, "--jobs", "2", cwd=tmp_path), output, 2)
+    assert len(before) < 16
+    for name in before:  # every file there is a whole run
+        assert pq.read_table(output / "runs" / name).num_rows == 6
+    resume(sweep, "--jobs", "2", cwd=tmp_path, output=output, before=before, total=16)
 
 
 def test_a_killed_worker_process_has_its_runs_retried(tmp_path):

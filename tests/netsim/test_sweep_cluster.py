@@ -17,7 +17,9 @@ from pygoby.cli import main
 from tests.netsim.sweep_helpers import (
     deterministic,
     kill_group,
+    kill_when_stored,
     read_table,
+    resume,
     start_sweep,
     stored_runs,
     wait_for,
@@ -96,19 +98,9 @@ def test_cluster_sweep_resumes_after_its_client_is_killed(cluster, reference, tm
     address, _, _ = cluster
     sweep = write_sweep(tmp_path, duration=1800, replicates=1)
     output = tmp_path / "out"
-    process = start_sweep(sweep, "--cluster", address, cwd=tmp_path)
-    try:
-        wait_for(lambda: len(stored_runs(output)) >= 2, 120, "two stored runs")
-    finally:
-        kill_group(process)
-    before = {p.name: p.stat().st_mtime_ns for p in (output / "runs").glob("*.parquet")}
+    before = kill_when_stored(start_sweep(sweep, "--cluster", address, cwd=tmp_path), output, 2)
     assert 2 <= len(before) < 8
-    process = start_sweep(sweep, "--cluster", address, cwd=tmp_path)
-    out, err = process.communicate(timeout=180)
-    assert process.returncode == 0, err
-    assert f"{8 - len(before)} run now, {len(before)} already stored, 0 failed" in out
-    after = {p.name: p.stat().st_mtime_ns for p in (output / "runs").glob("*.parquet")}
-    assert all(after[name] == t for name, t in before.items())
+    resume(sweep, "--cluster", address, cwd=tmp_path, output=output, before=before, total=8)
     assert deterministic(read_table(output)).equals(reference)
 
 

@@ -29,7 +29,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from pygoby.netsim.report import plt
+from pygoby.netsim.report import plt, save_figure
 
 Z95 = 1.959963984540054  # standard normal 97.5 % quantile
 MAX_DISTINCT_RANGES = 30
@@ -149,7 +149,7 @@ def plot_success_vs_range(points: list[SuccessPoint], path: Path) -> Path:
     ax.set_title("Packet success vs range (95 % Wilson intervals)")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="lower left")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def _plot_vs_nodes(runs: list[RunFigures], attribute: str, ylabel: str, title: str, path: Path):
@@ -168,7 +168,7 @@ def _plot_vs_nodes(runs: list[RunFigures], attribute: str, ylabel: str, title: s
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_snr_vs_range(rows: list[dict], path: Path) -> Path:
@@ -183,14 +183,7 @@ def plot_snr_vs_range(rows: list[dict], path: Path) -> Path:
     ax.set_title(f"SNR vs range ({len(links)} links)")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return _save(fig, path)
-
-
-def _save(fig, path: Path) -> Path:
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def write_sweep_report(table: pa.Table, out_dir: str | Path) -> list[Path]:
