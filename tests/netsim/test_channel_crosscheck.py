@@ -155,6 +155,12 @@ def test_bellhop_loss_outside_the_grid():
 
 
 def test_bad_bellhop_settings_are_configuration_errors():
+    from pygoby.netsim.errors import ScenarioError
+
+    bad = SCENARIO.format(model="BELLHOP", bellhop="water_depth: 100 ssp { a: 0 b: 1500 } "
+                          "ssp { a: 50 b: 1500 }")  # fmt: skip
+    with pytest.raises(ScenarioError, match="channel.propagation: bellhop: the ssp must run"):
+        channel_config(parse_scenario(bad))
     with pytest.raises(ValueError, match="ssp must run from 0 m to the deepest bottom"):
         BellhopLoss(BellhopSettings(ssp=((0, 1500), (50, 1500)), water_depth=100))
     with pytest.raises(ValueError, match="must be positive"):

@@ -135,7 +135,7 @@ def channel_config(scenario: Message) -> ChannelConfig:
     try:
         propagation = propagation_of(c, sound_speed)
     except ValueError as exc:
-        raise ScenarioError(f"channel.propagation: {exc}") from None
+        raise ScenarioError(str(exc), field="channel.propagation") from None
     return ChannelConfig(
         sound_speed=sound_speed,
         absorption=absorption_of(c),

@@ -47,7 +47,7 @@ def _fail(command: str, message: str, code: int = 1) -> int:
 
 
 def sweep_command(args: argparse.Namespace) -> int:
-    from pygoby.errors import ConfigError
+    from pygoby.netsim.errors import ScenarioError
     from pygoby.netsim.sweep.engine import run_sweep
     from pygoby.netsim.sweep.executors import DaskExecutor, LocalExecutor, SweepExecutorError
     from pygoby.netsim.sweep.plan import plan_sweep
@@ -57,7 +57,7 @@ def sweep_command(args: argparse.Namespace) -> int:
                         format="%(asctime)s %(levelname)s %(name)s: %(message)s")  # fmt: skip
     try:
         plan = plan_sweep(args.sweep_file)
-    except ConfigError as exc:
+    except ScenarioError as exc:
         return _fail("sweep", str(exc))
     output = Path(args.output or plan.output)
     if args.dry_run:

@@ -27,7 +27,7 @@ from collections.abc import Callable, Iterable
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
-from pygoby.errors import PygobyError
+from pygoby.netsim.errors import NetsimError
 from pygoby.netsim.sweep.plan import RunSpec
 from pygoby.netsim.sweep.run import RunResult, execute_run
 
@@ -38,7 +38,7 @@ Failed = Callable[[RunSpec, str], None]
 MAX_ATTEMPTS = 3
 
 
-class SweepExecutorError(PygobyError):
+class SweepExecutorError(NetsimError):
     """The executor cannot run at all (no cluster at that address, engine not installed)."""
 
 

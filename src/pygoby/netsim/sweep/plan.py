@@ -4,9 +4,9 @@
 (parameter point, replicate), each carrying the complete scenario it runs as TextFormat, the
 parameter values (the results' columns) and a `run_id` that is a hash of both, so a stored run
 is recognised whatever order or machine it ran in. Field paths ("mac.rate",
-"node[1].track.waypoint[0].x", "layout.nodes") are resolved against the protobuf descriptors, and
-values are converted to the field's type; mistakes raise `ConfigError` naming the sweep file, the
-line of the axis and the field.
+"node[1].track.waypoint[0].x", "layout.nodes") are resolved against the protobuf descriptors,
+and values are converted to the field's type; mistakes raise `ScenarioError` (a ConfigError)
+naming the sweep file, the line of the axis and the field.
 """
 
 from __future__ import annotations
@@ -25,9 +25,9 @@ from google.protobuf import text_format
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
-from pygoby.errors import ConfigError
 from pygoby.netsim.channel.geometry import WGS84
-from pygoby.netsim.scenario import ScenarioError, check_scenario, parse_scenario
+from pygoby.netsim.errors import ScenarioError
+from pygoby.netsim.scenario import check_scenario, parse_scenario
 from pygoby.protobuf import builtin_class
 
 SWEEP_PROTO = "pygoby/netsim/sweep.proto"
@@ -72,12 +72,12 @@ class SweepPlan:
 
 
 def load_sweep(path: str | Path) -> tuple[Message, Message]:
-    """(sweep, base scenario) from a sweep file. Raises ConfigError."""
+    """(sweep, base scenario) from a sweep file. Raises ScenarioError."""
     path = Path(path)
     try:
         text = path.read_text()
     except OSError as exc:
-        raise ConfigError(f"cannot read the sweep file: {exc.strerror}", file=path) from None
+        raise ScenarioError(f"cannot read the sweep file: {exc.strerror}", file=path) from None
     return parse_sweep(text, path)
 
 
@@ -86,31 +86,31 @@ def parse_sweep(text: str, path: Path | None = None) -> tuple[Message, Message]:
     try:
         text_format.Parse(text, sweep)
     except text_format.ParseError as exc:
-        raise ConfigError(str(exc).split(":", 2)[-1].strip(), file=path, line=exc.GetLine()) from None
+        raise ScenarioError.from_parse_error(exc, "the sweep file", file=path) from None
     if sweep.HasField("scenario") == sweep.HasField("scenario_file"):
-        raise ConfigError("give exactly one of scenario {...} and scenario_file", file=path)
+        raise ScenarioError("give exactly one of scenario {...} and scenario_file", file=path)
     if sweep.HasField("scenario_file"):
         base_dir = path.parent if path is not None else Path.cwd()
         scenario_path = base_dir / sweep.scenario_file
         try:
             scenario_text = scenario_path.read_text()
         except OSError as exc:
-            raise ConfigError(
+            raise ScenarioError(
                 f"cannot read the scenario: {exc.strerror}", file=path, field="scenario_file"
             ) from None
         try:
             base = parse_scenario(scenario_text)
         except ScenarioError as exc:
-            raise ConfigError(str(exc), file=scenario_path) from None
+            raise exc.located(file=scenario_path) from None
     else:
         base = sweep.scenario
     if base.speed.strip().lower() != "max":
-        raise ConfigError('a sweep runs scenarios on the virtual clock: speed must be "max"',
+        raise ScenarioError('a sweep runs scenarios on the virtual clock: speed must be "max"',
                           file=path, field="scenario.speed")  # fmt: skip
     if not sweep.axis:
-        raise ConfigError("a sweep needs at least one axis", file=path)
+        raise ScenarioError("a sweep needs at least one axis", file=path)
     if sweep.replicates < 1 or (sweep.sampling == sweep.RANDOM and sweep.random_samples < 1):
-        raise ConfigError("replicates and random_samples must be at least 1", file=path)
+        raise ScenarioError("replicates and random_samples must be at least 1", file=path)
     return sweep, base
 
 
@@ -255,11 +255,11 @@ def _axes(sweep: Message, base: Message, path: Path | None, text: str) -> list[_
                     raise ValueError("a span needs steps >= 1 (and positive ends when log)")
                 values = _span_values(axis.span, _KINDS[descriptor.cpp_type])
         except ValueError as exc:
-            raise ConfigError(str(exc), **where) from None
+            raise ScenarioError(str(exc), **where) from None
         name = axis.name or axis.field
         seed_column = name == "seed" and axis.field == "seed"  # (the seed column itself)
         if name in names or (name in RESERVED_COLUMNS and not seed_column):
-            raise ConfigError(f"column {name!r} is used twice: give the axis another name", **where)
+            raise ScenarioError(f"column {name!r} is used twice: give the axis another name", **where)
         names.add(name)
         column = AxisColumn(name, axis.field, _KINDS[descriptor.cpp_type])
         axes.append(_Axis(column, descriptor, values, axis.span if axis.HasField("span") else None))
@@ -303,7 +303,7 @@ def expand(sweep: Message, base: Message, path: Path | None = None, text: str = 
     """Every run of the sweep, in a fixed order (points in grid/sample order, then replicates)."""
     axes = _axes(sweep, base, path, text)
     if sweep.replicates > 1 and any(a.column.field == "seed" for a in axes):
-        raise ConfigError("an axis sets seed: replicates must be 1", file=path, field="replicates")
+        raise ScenarioError("an axis sets seed: replicates must be 1", file=path, field="replicates")
     if sweep.sampling == sweep.RANDOM:
         rng = random.Random(sweep.sampling_seed)
         points = [tuple(_random_value(a, rng) for a in axes) for _ in range(sweep.random_samples)]
@@ -317,8 +317,9 @@ def expand(sweep: Message, base: Message, path: Path | None = None, text: str = 
             params = ", ".join(f"{a.column.name}={v}" for a, v in zip(axes, values, strict=True))
             field = exc.field if isinstance(exc, _AxisValueError) else None
             line = _axis_line(text, field) if field else None
-            raise ConfigError(f"{exc} (point {index}: {params})", file=path, line=line,
-                              field=field) from None  # fmt: skip
+            reason = exc.reason if isinstance(exc, ScenarioError) else str(exc)
+            raise ScenarioError(f"{reason} (point {index}: {params})", file=path, line=line,
+                                field=field) from None  # fmt: skip
         params = tuple((a.column.name, v) for a, v in zip(axes, values, strict=True))
         for replicate in range(sweep.replicates):
             if not any(a.column.field == "seed" for a in axes):
