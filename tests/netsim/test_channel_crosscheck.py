@@ -160,7 +160,7 @@ def test_bad_bellhop_settings_are_configuration_errors():
     bad = SCENARIO.format(model="BELLHOP", bellhop="water_depth: 100 ssp { a: 0 b: 1500 } "
                           "ssp { a: 50 b: 1500 }")  # fmt: skip
     with pytest.raises(ScenarioError, match="channel.propagation: bellhop: the ssp must run"):
-        channel_config(parse_scenario(bad))
+        parse_scenario(bad)
     with pytest.raises(ValueError, match="ssp must run from 0 m to the deepest bottom"):
         BellhopLoss(BellhopSettings(ssp=((0, 1500), (50, 1500)), water_depth=100))
     with pytest.raises(ValueError, match="must be positive"):

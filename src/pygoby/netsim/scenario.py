@@ -93,6 +93,8 @@ def check_scenario(scenario: Message) -> None:
         raise ScenarioError("position_period and housekeeping_period must be positive")
     if scenario.channel.position_staleness <= scenario.position_period:
         raise ScenarioError("channel.position_staleness must exceed position_period")
+    if scenario.channel.HasField("propagation"):
+        channel_config(scenario)  # raises on bad propagation settings (nothing is traced yet)
 
 
 def speed_factor(scenario: Message) -> float | None:
