@@ -313,12 +313,12 @@ def expand(sweep: Message, base: Message, path: Path | None = None, text: str = 
     for index, values in enumerate(points):
         try:
             scenario = point_scenario(sweep, base, axes, values)
-        except (ValueError, ScenarioError) as exc:
+        except (ValueError, ScenarioError) as exc:  # (a ScenarioError is a ValueError too)
             params = ", ".join(f"{a.column.name}={v}" for a, v in zip(axes, values, strict=True))
-            field = exc.field if isinstance(exc, _AxisValueError) else None
-            line = _axis_line(text, field) if field else None
-            reason = exc.reason if isinstance(exc, ScenarioError) else str(exc)
-            raise ScenarioError(f"{reason} (point {index}: {params})", file=path, line=line,
+            field = getattr(exc, "field", None)
+            reason = getattr(exc, "reason", str(exc))
+            raise ScenarioError(f"{reason} (point {index}: {params})", file=path,
+                                line=_axis_line(text, field) if field else None,
                                 field=field) from None  # fmt: skip
         params = tuple((a.column.name, v) for a, v in zip(axes, values, strict=True))
         for replicate in range(sweep.replicates):
@@ -332,17 +332,11 @@ def expand(sweep: Message, base: Message, path: Path | None = None, text: str = 
     return SweepPlan(runs, [a.column for a in axes], sweep.output)
 
 
-class _AxisValueError(ValueError):
-    def __init__(self, field: str, reason: str) -> None:
-        super().__init__(reason)
-        self.field = field
-
-
 def _set_axis(message: Message, axis: _Axis, path: str, value: Value) -> None:
     try:
         set_field(message, path, _field_value(axis.descriptor, value))
     except ValueError as exc:
-        raise _AxisValueError(axis.column.field, str(exc)) from None
+        raise ScenarioError(str(exc), field=axis.column.field) from None
 
 
 def point_scenario(sweep: Message, base: Message, axes: list[_Axis], values) -> Message:
