@@ -131,3 +131,11 @@ def test_a_killed_cluster_worker_has_its_run_retried_elsewhere(cluster, referenc
     assert running <= stored_runs(output), "the killed worker's run was run again elsewhere"
     assert len(client.scheduler_info()["workers"]) == 1
     assert deterministic(read_table(output)).equals(reference)
+
+
+def test_no_scheduler_at_the_address_is_a_clear_error(tmp_path):
+    from pygoby.netsim.sweep import DaskExecutor, SweepExecutorError, plan_sweep
+
+    plan = plan_sweep(write_sweep(tmp_path, replicates=1))
+    with pytest.raises(SweepExecutorError, match="cannot connect to the scheduler tcp://127.0.0.1:9"):
+        DaskExecutor("tcp://127.0.0.1:9", connect_timeout=1).run(plan.runs, None, None)

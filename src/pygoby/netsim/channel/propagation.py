@@ -80,7 +80,8 @@ class LossGrid:
     ranges: list[float]
     depths: list[float]
     loss: list[list[float]]
-    seconds: float = 0.0  # what BELLHOP took
+    seconds: float = 0.0  # what BELLHOP took (wall)
+    cpu_seconds: float = 0.0  # (this process' CPU time meanwhile)
 
     def at(self, depth: float, range_m: float) -> float:
         """Interpolated inside the grid (the caller handles ranges outside it)."""
@@ -114,7 +115,8 @@ class BellhopLoss:
     spreading: float = 1.5
     _fields: OrderedDict = field(default_factory=OrderedDict, repr=False)
     traced: int = 0  # fields computed
-    tracing_seconds: float = 0.0
+    tracing_seconds: float = 0.0  # wall time of those
+    tracing_cpu_seconds: float = 0.0
 
     def __post_init__(self) -> None:
         s = self.settings
@@ -171,6 +173,7 @@ class BellhopLoss:
         grid = self.trace(carrier_hz, source_depth)
         self.traced += 1
         self.tracing_seconds += grid.seconds
+        self.tracing_cpu_seconds += grid.cpu_seconds
         self._fields[key] = grid
         while len(self._fields) > self.settings.cached_fields:
             self._fields.popitem(last=False)
@@ -209,7 +212,7 @@ class BellhopLoss:
         ranges = [s.range_step * (i + 1) for i in range(count)]
         rows = max(1, math.ceil((s.deepest - 2 * EDGE_M) / s.depth_step))
         depths = [EDGE_M + (s.deepest - 2 * EDGE_M) * i / rows for i in range(rows + 1)]
-        started = time.perf_counter()
+        started, cpu_started = time.perf_counter(), time.process_time()
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
@@ -222,10 +225,10 @@ class BellhopLoss:
             log.info("BELLHOP: %s", warning.message)
         with np.errstate(divide="ignore"):
             loss = np.minimum(result.field.transmission_loss()[0], MAX_LOSS_DB)
-        seconds = time.perf_counter() - started
+        seconds, cpu = time.perf_counter() - started, time.process_time() - cpu_started
         log.debug("BELLHOP field for %g Hz, source at %g m: %d x %d in %.2f s",
                   carrier_hz, source_depth, len(depths), len(ranges), seconds)  # fmt: skip
-        return LossGrid(ranges, depths, loss.astype(float).tolist(), seconds)
+        return LossGrid(ranges, depths, loss.astype(float).tolist(), seconds, cpu)
 
 
 def propagation_model(msg: Message | None, sound_speed, spreading: float) -> BellhopLoss | None:
