@@ -12,7 +12,7 @@ import pytest
 from pygoby.cli import main
 from pygoby.errors import ConfigError
 from pygoby.netsim.channel.geometry import WGS84
-from pygoby.netsim.scenario import parse_scenario
+from pygoby.netsim.scenario import channel_config, parse_scenario
 from pygoby.netsim.sim import Simulation
 from pygoby.netsim.sweep.plan import expand, parse_sweep
 from pygoby.netsim.sweep.report import read_results, success_by_range, wilson_interval
@@ -298,3 +298,22 @@ def test_example_sweep_plans_and_its_readme_shows_the_figures(capsys):
         assert f"(figures/{name}.png)" in readme
         width, height = png_size(example.parent / "figures" / f"{name}.png")
         assert width >= 600 and height >= 400
+
+
+def test_propagation_model_and_sound_speed_formula_as_axes():
+    text = """scenario { duration: 60 origin { lat: 42 lon: -70 }
+  channel { water { temperature: 10 } propagation { bellhop { water_depth: 50 } } } }
+layout { nodes: 2 }
+axis { field: "channel.propagation.model" value: "EMPIRICAL" value: "BELLHOP" }
+axis { field: "channel.water.sound_speed_formula" value: "MACKENZIE_1981" value: "UNESCO_1983" }
+"""
+    plan = plan_of(text)
+    assert [dict(r.params) for r in plan.runs][1] == {
+        "channel.propagation.model": "EMPIRICAL",
+        "channel.water.sound_speed_formula": "UNESCO_1983",
+    }
+    bellhop = parse_scenario(plan.runs[3].scenario_text)
+    config = channel_config(bellhop)
+    assert config.propagation is not None and config.propagation.settings.water_depth == 50
+    assert config.sound_speed(10.0) != channel_config(parse_scenario(plan.runs[2].scenario_text)).sound_speed(10.0)
+    assert channel_config(parse_scenario(plan.runs[0].scenario_text)).propagation is None
