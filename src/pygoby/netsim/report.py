@@ -87,7 +87,7 @@ def plot_success_vs_range(events: list[dict], path: Path) -> Path:
     ax.grid(True, alpha=0.3)
     count_ax.set_xlabel("range (km)")
     count_ax.set_ylabel("receptions")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_success_vs_snr(events: list[dict], path: Path) -> Path:
@@ -107,7 +107,7 @@ def plot_success_vs_snr(events: list[dict], path: Path) -> Path:
     ax.grid(True, alpha=0.3)
     count_ax.set_xlabel("dB")
     count_ax.set_ylabel("receptions")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_timeline(events: list[dict], path: Path, window: tuple[float, float] | None) -> Path:
@@ -143,10 +143,10 @@ def plot_timeline(events: list[dict], path: Path, window: tuple[float, float] | 
     ax.set_title("Transmissions (bars) and receptions (ticks) per node")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     ax.grid(True, axis="x", alpha=0.3)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
-def _save(fig, path: Path) -> Path:
+def save_figure(fig, path: Path) -> Path:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

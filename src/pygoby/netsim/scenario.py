@@ -23,6 +23,7 @@ from pygoby.errors import ConfigError
 from pygoby.netsim.channel import Band, ChannelConfig, Position
 from pygoby.netsim.channel.errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
+from pygoby.netsim.channel.settings import absorption_of, propagation_of, sound_speed_of
 from pygoby.netsim.config import config_class as manager_config_class
 from pygoby.netsim.errors import ScenarioError
 from pygoby.protobuf import builtin_class
@@ -94,6 +95,8 @@ def check_scenario(scenario: Message) -> None:
         raise ScenarioError("position_period and housekeeping_period must be positive")
     if scenario.channel.position_staleness <= scenario.position_period:
         raise ScenarioError("channel.position_staleness must exceed position_period")
+    if scenario.channel.HasField("propagation"):
+        channel_config(scenario)  # raises on bad propagation settings (nothing is traced yet)
 
 
 def speed_factor(scenario: Message) -> float | None:
@@ -132,8 +135,15 @@ def channel_config(scenario: Message) -> ChannelConfig:
             p.communication_range, p.detection_range, p.interference_range,
             p.p_detection, p.p_decoding,
         )  # fmt: skip
+    sound_speed = sound_speed_of(c)
+    try:
+        propagation = propagation_of(c, sound_speed)
+    except ValueError as exc:
+        raise ScenarioError(str(exc), field="channel.propagation") from None
     return ChannelConfig(
-        sound_speed=c.sound_speed,
+        sound_speed=sound_speed,
+        absorption=absorption_of(c),
+        propagation=propagation,
         source_level=c.source_level,
         spreading=c.spreading,
         noise_level=c.noise_level if c.HasField("noise_level") else None,

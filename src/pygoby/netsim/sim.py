@@ -17,7 +17,7 @@ the same objects on the wall clock over TCP.
 
 Events go to `on_event` (`summary()` counts them): `tx` and `rx` from the channel (see
 `pygoby.netsim.physics_channel`), `app_rx` when a queue delivers a status message (port of the
-receiver, src), `range` when a driver reports a ranging reply (port, src, dest, owtt list).
+receiver, src, msg_t: the message's time stamp), `range` when a driver reports a ranging reply (port, src, dest, owtt list).
 """
 
 from __future__ import annotations
@@ -239,7 +239,10 @@ class Simulation:
 
     def _status_heard(self, node: SimNode, msg: Message) -> None:
         node.received[msg.src] += 1
-        self._event({"event": "app_rx", "t": self.clock.now(), "port": node.port, "src": msg.src})
+        self._event(
+            {"event": "app_rx", "t": self.clock.now(), "port": node.port, "src": msg.src,
+             "msg_t": msg.time}
+        )  # fmt: skip
 
     def _modem_heard(self, node: SimNode, msg: Message) -> None:
         """Ranging results the driver reports (two-way pings) become `range` events."""

@@ -3,7 +3,8 @@
 `run` reads a Scenario (TextFormat, src/pygoby/protobuf/pygoby/netsim/scenario.proto), runs it
 — speed "max": everything in process on a virtual clock; a number: in real time (times that
 factor) with the netsim_manager and the Micro-Modem emulators on TCP — writes the event log
-(JSON lines) and prints a summary. `report` draws PNG plots from an event log.
+(JSON lines) and prints a summary. `report` draws PNG plots from an event log. `sweep` and
+`sweep-report` run and plot parameter sweeps (pygoby.netsim.sweep.cli).
 """
 
 from __future__ import annotations
@@ -42,6 +43,9 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
         "(default 0:3600)",
     )  # fmt: skip
     report.set_defaults(func=report_command)
+    from pygoby.netsim.sweep.cli import add_subcommands as add_sweep_subcommands
+
+    add_sweep_subcommands(subparsers)
 
 
 def run_command(args: argparse.Namespace) -> int:
