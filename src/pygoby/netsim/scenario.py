@@ -19,7 +19,6 @@ from pathlib import Path
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.errors import ConfigError
 from pygoby.netsim.channel import Band, ChannelConfig, Position
 from pygoby.netsim.channel.errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
@@ -48,20 +47,13 @@ def node_status_class() -> type[Message]:
 
 
 def load_scenario(path: str | Path) -> Message:
-    try:
-        text = read_config_file(path)
-    except ConfigError as err:
-        raise ScenarioError(err.reason, file=path) from None
-    return parse_scenario(text, path)
+    return parse_scenario(read_config_file(path, error=ScenarioError), path)
 
 
 def parse_scenario(text: str, file: str | Path | None = None) -> Message:
     scenario = scenario_class()()
-    try:
-        merge_config_text(text, scenario, file=file)
-        check_config_values(scenario, text, file=file)
-    except ConfigError as err:
-        raise ScenarioError(err.reason, file=err.file, line=err.line, field=err.field) from None
+    merge_config_text(text, scenario, file=file, error=ScenarioError)
+    check_config_values(scenario, text, file=file, error=ScenarioError)
     try:
         check_scenario(scenario)
     except ScenarioError as err:

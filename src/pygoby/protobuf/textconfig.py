@@ -31,11 +31,13 @@ _INTEGER_TYPES = frozenset({
 })  # fmt: skip
 
 
-def read_config_file(path: str | os.PathLike[str]) -> str:
+def read_config_file(
+    path: str | os.PathLike[str], *, error: type[ConfigError] = ConfigError
+) -> str:
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
-        raise ConfigError(exc.strerror or str(exc), file=path) from None
+        raise error(f"cannot read: {exc.strerror or exc}", file=path) from None
     return data.decode("utf-8", "surrogateescape")
 
 
@@ -46,8 +48,10 @@ def merge_config_text(
     file: str | os.PathLike[str] | None = None,
     first_line: int = 1,
     parser: text_format._Parser | None = None,  # noqa: SLF001 - a parser with its own rules
+    error: type[ConfigError] = ConfigError,
 ) -> None:
-    """Merge TextFormat `text` (starting at `first_line` of `file`) into `message`."""
+    """Merge TextFormat `text` (starting at `first_line` of `file`) into `message`; problems
+    raise `error` (ConfigError or a subclass, e.g. ScenarioError)."""
     lines = text.split("\n")
     try:
         if parser is None:
@@ -55,18 +59,25 @@ def merge_config_text(
         else:
             parser.MergeLines(lines, message)
     except text_format.ParseError as err:
-        raise _located(str(err), err.GetLine(), err.GetColumn(), lines, file, first_line) from None
+        line, column = err.GetLine(), err.GetColumn()
+        raise _located(error, str(err), line, column, lines, file, first_line) from None
     except (UnicodeError, ValueError) as err:  # protobuf's own checks on a value it took
-        raise ConfigError(f"cannot parse configuration: {err}", file=file) from None
+        raise error(f"cannot parse configuration: {err}", file=file) from None
 
 
 def _located(
-    error: str, line: int | None, column: int | None, lines: list[str], file, first_line: int
+    error: type[ConfigError],
+    message: str,
+    line: int | None,
+    column: int | None,
+    lines: list[str],
+    file,
+    first_line: int,
 ) -> ConfigError:
     if line is None:
-        return ConfigError(error, file=file)
+        return error(message, file=file)
     line_text = lines[line - 1] if 0 < line <= len(lines) else ""
-    detail = error.split(" : ", 1)[-1]
+    detail = message.split(" : ", 1)[-1]
     quoted = f"'{line_text}': "
     if detail.startswith(quoted):
         detail = detail[len(quoted) :]
@@ -74,7 +85,7 @@ def _located(
         detail = "string is not valid UTF-8 (protobuf strings must be)"
     shown = _printable(line_text.strip())
     detail = _printable(detail)
-    return ConfigError(
+    return error(
         f"{detail}\n    {shown}",
         file=file,
         line=first_line + line - 1,
@@ -102,11 +113,12 @@ def check_config_values(
     *,
     file: str | os.PathLike[str] | None = None,
     first_line: int = 1,
+    error: type[ConfigError] = ConfigError,
 ) -> None:
     """Port numbers in range; the error names the field's path and, found in `text`, its line."""
     for path, field, value in _integer_values(message, ""):
         if field.name.lower().endswith("port") and not 0 <= value <= PORT_MAX:
-            raise ConfigError(
+            raise error(
                 f"{value} is not a port number (0-{PORT_MAX})",
                 file=file,
                 line=line_of_field(text, path, first_line),

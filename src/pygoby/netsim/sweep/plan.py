@@ -29,6 +29,7 @@ from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.errors import ScenarioError
 from pygoby.netsim.scenario import check_scenario, parse_scenario
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.textconfig import merge_config_text, read_config_file
 
 SWEEP_PROTO = "pygoby/netsim/sweep.proto"
 LAYOUT_PREFIX = "layout."
@@ -74,19 +75,12 @@ class SweepPlan:
 def load_sweep(path: str | Path) -> tuple[Message, Message]:
     """(sweep, base scenario) from a sweep file. Raises ScenarioError."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ScenarioError(f"cannot read the sweep file: {exc.strerror}", file=path) from None
-    return parse_sweep(text, path)
+    return parse_sweep(read_config_file(path, error=ScenarioError), path)
 
 
 def parse_sweep(text: str, path: Path | None = None) -> tuple[Message, Message]:
     sweep = sweep_class()()
-    try:
-        text_format.Parse(text, sweep)
-    except text_format.ParseError as exc:
-        raise ScenarioError.from_parse_error(exc, "the sweep file", file=path) from None
+    merge_config_text(text, sweep, file=path, error=ScenarioError)
     if sweep.HasField("scenario") == sweep.HasField("scenario_file"):
         raise ScenarioError("give exactly one of scenario {...} and scenario_file", file=path)
     if sweep.HasField("scenario_file"):
