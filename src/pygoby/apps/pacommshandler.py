@@ -21,18 +21,16 @@ from google.protobuf.message import Message
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.acomms.queue import QueueError
-from pygoby.acomms.transitional import TransitionalMessages
 from pygoby.apps.pacommshandler_goby11 import Goby11Variables
 from pygoby.dccl import DcclError
-from pygoby.dccl.libraries import split_libraries
 from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import prefixed_var_names
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, TranslatorError
-from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
-from pygoby.protobuf import ProtoLoader
+from pygoby.moos.translator_binding import TranslatorBinding
+from pygoby.topside.acomms_config import PACOMMSHANDLER_CONFIG, AcommsMessageSet
 
 IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
 
@@ -47,38 +45,29 @@ def _raw_value(raw: bytes) -> str | bytes:
 
 
 class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
-        "goby.apps.moos.protobuf.pAcommsHandlerConfig",
-    )
+    config_proto = PACOMMSHANDLER_CONFIG
     default_name = "pAcommsHandler"
 
     def __init__(self, cfg: Message, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.var = prefixed_var_names(cfg.moos_var, skip=(IFS_DATA_OUT,))
         self.ifs_data_out = getattr(cfg.moos_var, IFS_DATA_OUT)
-        self.loader = ProtoLoader()
-        # Goby 1.1 XML message files -> DCCL types, queue and translator entries
-        self.transitional = TransitionalMessages.expand(cfg, self.loader, self.find_file)
+        # load_proto_file, load_shared_library, and the Goby 1.1 XML message files (-> DCCL
+        # types, queue and translator entries)
+        self.messages = AcommsMessageSet.load(cfg, self.find_file)
+        self.message_types = self.messages.types
         try:
-            self.acomms = AcommsHandler(cfg, self.clock, self.loader)
+            self.acomms = AcommsHandler(cfg, self.clock, self.messages.loader)
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
         try:  # C++ DCCL codec libraries (libdccl_ccl_compat.so, ...) are pygoby built-ins
-            dccl_libraries, modules = split_libraries(cfg.load_shared_library)
-            for library in dccl_libraries:
+            for library in self.messages.dccl_libraries:
                 library.apply(self.acomms.codec)
         except DcclError as err:
             raise ConfigError(f"load_shared_library: {err}") from None
-        self.message_types = MessageTypes(
-            [self.find_file(path) for path in cfg.load_proto_file],
-            [self.find_file(module) for module in modules],
-            fallback=acomms_pb.goby_message_class,
-            loader=self.loader,
-        )
         lookup = cfg.modem_id_lookup_path
         self.binding = TranslatorBinding(
             self, cfg.translator_entry, self.message_types, on_created=self._created,
@@ -86,6 +75,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             modem_id_lookup_path=self.find_file(lookup) if lookup else "",
         )  # fmt: skip
         self.translator = self.binding.translator
+        self.messages.read_named_values(self.translator)
         self._connect_signals()
         self.goby11 = Goby11Variables(self, self.acomms, cfg.queue_cfg, enabled=bool(
             cfg.queue_cfg.queue or cfg.transitional_cfg.message_file))  # fmt: skip
@@ -94,9 +84,9 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.frontseat_forward = {self._loaded(name) for name in cfg.dccl_frontseat_forward_name}
         self.liaison = None
         if cfg.HasField("liaison"):
-            from pygoby.apps.liaison import Liaison  # imported only when asked for (web stack)
+            from pygoby.topside.liaison import Liaison  # imported only when asked for (web stack)
 
-            self.liaison = Liaison.embedded(self)
+            self.liaison = Liaison.embedded(self, self.messages)
 
     def _configure_queue(self) -> None:
         try:
@@ -182,7 +172,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     # ------------------------------------------------------------------ MOOS -> acomms
     def _created(self, message: Message) -> None:
-        self._push(self.transitional.complete(message, self.clock.now(), self.cfg.modem_id))
+        self._push(self.messages.transitional.complete(message, self.clock.now(), self.cfg.modem_id))
 
     def _on_mac_update(self, msg: MOOSMessage) -> None:
         """Today's MACUpdate, or Goby 1.1's (ADD/REMOVE/REPLACE with SLOT_* slots)."""
