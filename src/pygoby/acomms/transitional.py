@@ -77,14 +77,7 @@ class TransitionalMessages:
         (the translator reads them with a FORMAT create; the shared ones are key=value pairs
         already). Goby 1.1 read such a variable's string as `name=value` when it holds the
         field's name, else whole (seed 003 §2.3.8): Translator.read_named_values."""
-        out: dict[str, dict[str, str]] = {}
-        for msg in self.messages.values():
-            fields: dict[str, list[str]] = {}
-            for var in msg.all_vars():
-                if var.source_var:
-                    fields.setdefault(var.source_var, []).append(var.name)
-            out[msg.name] = {source: names[0] for source, names in fields.items() if len(names) == 1}
-        return out
+        return {name: msg.single_field_sources() for name, msg in self.messages.items()}
 
     @property
     def warnings(self) -> list[str]:

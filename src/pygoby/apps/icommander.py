@@ -20,7 +20,7 @@ from google.protobuf.message import Message
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.moos.translator import Post
+from pygoby.moos.translator import MoosValues, Post
 from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.topside.commander import KEY_VALUE, MULTIPLEX, Commander, CommanderError, CommandSet
 from pygoby.topside.icommander import ICommanderTUI
@@ -49,7 +49,7 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
                 community=self.common.community, now=self.clock.now, publish=self._post,
                 style=MULTIPLEX if options.send_style == SEND_MULTIPLEX else KEY_VALUE,
                 force_xy_only=cfg.force_xy_only or options.force_xy_only,
-                autosave_path=options.autosave_path or None,
+                autosave_path=options.autosave_path or None, values=MoosValues(self.dynamic_vars),
             )  # fmt: skip
         except CommanderError as err:
             raise ConfigError(str(err), field="commander") from None
@@ -58,9 +58,18 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
             self.subscribe(var, self._on_ack_or_expire)
         for var in cfg.show_variable:
             self.subscribe(var, self._on_show)
+        self._sources: set[str] = set()
+        self._subscribe_sources()
+        self.commander.signal_import.connect(lambda names: self._subscribe_sources())
         self.load_warnings = []
         for path in [*cfg.load, *options.load]:
             self.load_warnings += self.commander.load(path)
+
+    def _subscribe_sources(self) -> None:
+        """Keep the values of the variables a send posts to (a number goes where one is)."""
+        for var in sorted(self.commander.source_variables - self._sources):
+            self.subscribe(var)
+            self._sources.add(var)
 
     def _post(self, post: Post) -> None:
         self.publish(post.var, post.value, src_aux=post.source_aux)

@@ -12,7 +12,9 @@ What "send" publishes (spec goby-moos-apps.md §6):
 
 * key=value style (Goby 1.1 iCommander): for a Goby 1.1 XML message, one
   `name1=value1,name2=value2,...` string per source variable (the fields it feeds, in message
-  order, static ones included, unset ones left out); for a translator entry, the message
+  order, static ones included, unset ones left out), except that a variable holding a double
+  (NAV_X, ...) that feeds one numeric field gets the number: the MOOSDB refuses a string there,
+  and Goby 1.1's pAcommsHandler reads a double as the value itself; for a translator entry, the message
   serialized with each operator variable's create technique (a CSV create gives the same
   `name=value,...` string). Variables in sorted order but the trigger variable last (so
   pAcommsHandler has every other value when the trigger fires); an empty post to the trigger
@@ -26,7 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,6 +37,7 @@ from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.moos.translator import (
+    MoosValue,
     Post,
     Technique,
     TranslatorError,
@@ -46,6 +49,7 @@ from pygoby.topside.commander import savefile, specials
 from pygoby.topside.commander.fields import FieldSpec, FieldValueError
 from pygoby.topside.commander.messageset import CommandSet, CommandType
 from pygoby.topside.errors import CommanderError
+from pygoby.util.signal import Signal
 
 KEY_VALUE = "key_value"
 MULTIPLEX = "multiplex"
@@ -132,7 +136,10 @@ class Commander:
         style: str = KEY_VALUE,
         force_xy_only: bool = False,
         autosave_path: str | Path | None = "iCommander_autosave.txt",
+        values: Mapping[str, MoosValue] | None = None,
     ) -> None:
+        """`values`: the newest value of the MOOS variables (e.g. MoosValues(app.dynamic_vars),
+        with `source_variables` subscribed), to post a number where a variable holds doubles."""
         if style not in (KEY_VALUE, MULTIPLEX):
             raise CommanderError(f"unknown send style {style!r} (key_value or multiplex)")
         if style == MULTIPLEX and not commands.multiplex_var:
@@ -151,6 +158,19 @@ class Commander:
         self.records: list[SentRecord] = []
         self.notices: list[Notice] = []
         self._ids = itertools.count(1)
+        self.values: Mapping[str, MoosValue] = values if values is not None else {}
+        self.signal_import = Signal()  # (names) after import_xml: new source variables
+
+    @property
+    def source_variables(self) -> set[str]:
+        """The variables a send of a Goby 1.1 message may post to (whose types matter)."""
+        return {var for kind in self.commands.types.values() if kind.goby11 for var in kind.operator_vars}
+
+    def import_xml(self, path: str) -> list[str]:
+        """Add the messages of a Goby 1.1 XML file; ConfigError for a file that cannot be used."""
+        names = self.commands.import_xml(path)
+        self.signal_import.emit(names)
+        return names
 
     # ------------------------------------------------------------------ drafts
     def open(self, name: str) -> Draft:
@@ -272,7 +292,7 @@ class Commander:
             else:
                 values[spec.name] = text
         try:
-            posts = self._posts(kind, msg, values)
+            posts = self._posts(kind, msg, values, warnings)
         except TranslatorError as err:
             raise CommanderError(f"{kind.name} cannot be serialized: {err}") from None
         trigger = posts[-1] if posts and posts[-1].var == kind.trigger_var else None
@@ -282,11 +302,11 @@ class Commander:
                             f"{kind.mandatory_content!r}: pAcommsHandler will not make the message")  # fmt: skip
         return Outgoing(posts, warnings, msg)
 
-    def _posts(self, kind: CommandType, msg: Message, values: dict[str, str]) -> list[Post]:
+    def _posts(self, kind: CommandType, msg: Message, values: dict[str, str], warnings: list[str]) -> list[Post]:
         if self.style == MULTIPLEX:
             return [make_post(self.commands.multiplex_var, serialize_for_moos(msg), _PREFIXED_TEXT, kind.name)]
         if kind.goby11:
-            posts = _goby11_posts(kind, values)
+            posts = self._goby11_posts(kind, values, warnings)
         else:
             posts = [p for p in self.commands.translator.inverse_publish(msg)
                      if p.var in kind.operator_vars or p.var == kind.trigger_var]  # fmt: skip
@@ -294,6 +314,29 @@ class Commander:
         if kind.trigger_var and (not trigger or trigger[0].value == ""):
             trigger = [Post(kind.trigger_var, kind.mandatory_content, "")]
         return [p for p in posts if p.var != kind.trigger_var] + trigger
+
+    def _goby11_posts(self, kind: CommandType, values: dict[str, str], warnings: list[str]) -> list[Post]:
+        """Goby 1.1 iCommander: `name=value,...` (message order) on each source variable,
+        sorted; repeated values in braces (`name={1,2}`), as Goby 1.1's key=value reading takes
+        them; a number where the variable holds doubles (see the module's docstring)."""
+        by_var: dict[str, list[tuple[FieldSpec, str]]] = {}
+        for spec in kind.fields:
+            text = values.get(spec.name)
+            if spec.source and text is not None:
+                by_var.setdefault(spec.source, []).append((spec, text))
+        posts = []
+        for var, items in sorted(by_var.items()):
+            if isinstance(self.values.get(var), float):
+                spec, text = items[0]
+                if var in kind.single_field_vars and spec.kind in _NUMERIC and not spec.repeated:
+                    posts.append(Post(var, _number(text), ""))
+                else:
+                    warnings.append(f"{var} holds numbers: the MOOSDB would refuse text, not sent")
+                continue
+            pairs = [f"{spec.name}={'{' + text.strip('{}') + '}' if spec.repeated else text}"
+                     for spec, text in items]  # fmt: skip
+            posts.append(Post(var, ",".join(pairs), ""))
+        return posts
 
     # ------------------------------------------------------------------ acks and expiries
     @property
@@ -361,17 +404,15 @@ class Commander:
         return warnings
 
 
-def _goby11_posts(kind: CommandType, values: dict[str, str]) -> list[Post]:
-    """Goby 1.1 iCommander: `name=value,...` (message order) on each source variable, sorted;
-    repeated values in braces (`name={1,2}`), as Goby 1.1's key=value reading takes them."""
-    by_var: dict[str, list[str]] = {}
-    for spec in kind.fields:
-        text = values.get(spec.name)
-        if spec.source and text is not None:
-            if spec.repeated:
-                text = "{" + text.strip("{}") + "}"
-            by_var.setdefault(spec.source, []).append(f"{spec.name}={text}")
-    return [Post(var, ",".join(items), "") for var, items in sorted(by_var.items())]
+
+
+_NUMERIC = ("int", "float", "bool")
+
+
+def _number(text: str) -> float:
+    """A checked int/float/bool text as the double Goby 1.1's pAcommsHandler reads."""
+    lowered = text.lower()
+    return 1.0 if lowered == "true" else 0.0 if lowered == "false" else float(text)
 
 
 def _convert(spec: FieldSpec, field: FieldDescriptor, text: str) -> object:

@@ -44,7 +44,8 @@ MAX_NESTING = 4
 @dataclass(frozen=True)
 class CommandType:
     """One sendable message type. `goby11`: a Goby 1.1 XML message (posted as its iCommander
-    did: `name=value,...` per source variable)."""
+    did: `name=value,...` per source variable); `single_field_vars`: its source variables that
+    feed one field only (pAcommsHandler reads a double there as the value)."""
 
     name: str
     cls: type[Message]
@@ -55,6 +56,7 @@ class CommandType:
     ack: bool
     dest_field: str
     goby11: bool = False
+    single_field_vars: frozenset[str] = frozenset()
 
     @property
     def short_name(self) -> str:
@@ -153,6 +155,7 @@ def goby11_command_type(
         ack=bool(queue_entry is not None and queue_entry.ack),
         dest_field=_dest_field(queue_entry),
         goby11=True,
+        single_field_vars=frozenset(msg.single_field_sources()),
     )
 
 
@@ -210,9 +213,7 @@ class CommandSet:
         goby11 = messages.transitional.messages if messages is not None else {}
         for name, entry in translator.entries.items():
             if name in goby11:
-                self.types[name] = goby11_command_type(
-                    goby11[name], translator.message_class(name), queue_entries.get(name)
-                )
+                self._add_goby11(goby11[name])
             elif entry.HasField("trigger") and entry.trigger.type == TRIGGER_PUBLISH:
                 self.types[name] = command_type(
                     entry, translator.message_class(name), queue_entries.get(name)
@@ -233,7 +234,8 @@ class CommandSet:
         `modem_id_lookup_path` replaces the configuration's."""
         cfg, find = messages.cfg, messages.find
         lookup_path = modem_id_lookup_path or cfg.modem_id_lookup_path
-        modem_ids = ModemIdLookup.from_file(find(lookup_path)) if lookup_path else None
+        # without a lookup file the modem-id algorithms still load (the commander runs none)
+        modem_ids = ModemIdLookup.from_file(find(lookup_path)) if lookup_path else ModemIdLookup()
         translator = Translator(
             cfg.translator_entry,
             messages.types,
@@ -268,10 +270,14 @@ class CommandSet:
                 self.queue_entries[entry.protobuf_name] = entry
         goby11 = self.messages.transitional.messages
         for name in names:
-            self.types[name] = goby11_command_type(
-                goby11[name], self.translator.message_class(name), self.queue_entries.get(name)
-            )
+            self._add_goby11(goby11[name])
         return names
+
+    def _add_goby11(self, msg: XmlMessage) -> None:
+        name = msg.name
+        self.types[name] = goby11_command_type(
+            msg, self.translator.message_class(name), self.queue_entries.get(name)
+        )
 
     def __len__(self) -> int:
         return len(self.types)

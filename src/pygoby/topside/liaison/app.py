@@ -10,7 +10,7 @@ from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.translator import Post
+from pygoby.moos.translator import MoosValues, Post
 from pygoby.protobuf import builtin_class
 from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.topside.commander import CommanderError, CommandSet
@@ -36,7 +36,7 @@ class Liaison(GobyMOOSApp):
             self.state = LiaisonState(
                 web, acomms.cfg, CommandSet.from_messages(acomms, cfg.modem_id_lookup_path),
                 community=self.common.community, now=self.clock.now, publish=self._post,
-                start_time=self.start_time,
+                start_time=self.start_time, values=MoosValues(self.dynamic_vars),
             )  # fmt: skip
         except CommanderError as err:
             raise ConfigError(str(err), field="liaison.commander") from None
