@@ -23,7 +23,7 @@ from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.transitional import TransitionalMessages
-from pygoby.dccl import DcclError
+from pygoby.dccl import Codec, DcclError
 from pygoby.dccl.libraries import BuiltinLibrary, split_libraries
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
@@ -51,7 +51,7 @@ class AcommsMessageSet:
     """The message definitions of one pAcommsHandler configuration: `cfg` (with the queue and
     translator entries of its XML files added), the `loader` every type is in, `types` (name ->
     class), the XML message sets (`transitional`) and the built-ins standing for C++ DCCL codec
-    libraries (their messages are in `types`; a codec also needs `library.apply(codec)`)."""
+    libraries (their messages are in `types`; a codec also needs `apply_libraries`)."""
 
     cfg: Message
     loader: ProtoLoader
@@ -102,6 +102,24 @@ class AcommsMessageSet:
     def files(self) -> set[Path]:
         """The XML files loaded (resolved paths)."""
         return {message_set.path.resolve() for message_set in self.transitional.sets}
+
+    def apply_libraries(self, codec: Codec) -> None:
+        """Give `codec` what load_shared_library's C++ DCCL codec libraries give a C++ codec
+        (pygoby's built-ins: CCL messages and id codec, ...); ConfigError if one cannot."""
+        try:
+            for library in self.dccl_libraries:
+                library.apply(codec)
+        except DcclError as err:
+            raise ConfigError(f"load_shared_library: {err}") from None
+
+    def require(self, names: Sequence[str], field: str) -> set[str]:
+        """`names` (of configuration `field`), each a loaded type, else ConfigError."""
+        for name in names:
+            try:
+                self.types(name)
+            except Exception:
+                raise ConfigError(f"{name!r} is not a loaded type", field=field) from None
+        return set(names)
 
     def read_named_values(self, translator: Translator) -> None:
         """Goby 1.1's `name=value` rule for the XML messages' single-field source variables."""

@@ -389,7 +389,7 @@ class TranslatorRunner:
             self._origin_changed = True
         if stale:
             return []
-        created = (self._create(name) for name in self.translator.triggered_by(var, value))
+        created = (self.create(name) for name in self.translator.triggered_by(var, value))
         return [msg for msg in created if msg is not None]
 
     def on_multiplex(self, value: MoosValue, technique: Technique) -> list[Post]:
@@ -416,12 +416,13 @@ class TranslatorRunner:
                 continue
             # Late by more than 1 s (clock jump): restart the schedule from now.
             self._deadlines[name] = now + period if now - deadline > 1 else deadline + period
-            msg = self._create(name)
+            msg = self.create(name)
             if msg is not None:
                 created.append(msg)
         return created
 
-    def _create(self, name: str) -> Message | None:
+    def create(self, name: str) -> Message | None:
+        """`name` made now from the newest values; None, with a warning, when a rule fails."""
         try:
             return self.translator.create(name, self.variables)
         except TranslatorError as exc:
