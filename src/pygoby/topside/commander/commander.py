@@ -291,6 +291,9 @@ class Commander:
                 warnings.append(f"{err} (not sent)")
             else:
                 values[spec.name] = text
+        # what the rules above cannot see: an element of a repeated sub-message left without a
+        # required field
+        warnings += [f"{path}: not set" for path in msg.FindInitializationErrors() if "[" in path]
         try:
             posts = self._posts(kind, msg, values, warnings)
         except TranslatorError as err:
@@ -453,12 +456,21 @@ def _has(msg: Message, path: str) -> bool:
 
 
 def _set_field(msg: Message, spec: FieldSpec, text: str) -> None:
-    parent, name = _parent(msg, spec.name)
-    field = parent.DESCRIPTOR.fields_by_name[name]
+    *steps, name = spec.name.split(".")
+    items = [t.strip() for t in text.strip("{}").split(",")] if spec.repeated else [text]
+    for step in steps:
+        if msg.DESCRIPTOR.fields_by_name[step].is_repeated:  # one value per element
+            elements = getattr(msg, step)
+            for index, item in enumerate(items):
+                element = elements[index] if index < len(elements) else elements.add()
+                setattr(element, name, _convert(spec, element.DESCRIPTOR.fields_by_name[name], item))
+            return
+        msg = getattr(msg, step)
+    field = msg.DESCRIPTOR.fields_by_name[name]
     if spec.repeated:
-        getattr(parent, name).extend(_convert(spec, field, t.strip()) for t in text.strip("{}").split(","))
+        getattr(msg, name).extend(_convert(spec, field, item) for item in items)
     else:
-        setattr(parent, name, _convert(spec, field, text))
+        setattr(msg, name, _convert(spec, field, text))
 
 
 def _close(a: object, b: object, precision: int | None) -> bool:

@@ -75,11 +75,15 @@ class FieldSpec:
     def from_descriptor(
         cls, field: FieldDescriptor, source: str = "", automatic_from: str = "", *,
         path: str = "", required: bool | None = None, short_enum: bool = False,
+        elements_of: FieldDescriptor | None = None,
     ) -> FieldSpec:  # fmt: skip
         """`path`: the name inside the command (`pose.x` for a sub-message's field);
         `required`: whether the message needs it (a required field of an optional sub-message
-        does not); `short_enum`: enum values without their `FIELD_` prefix (use_short_enum)."""
+        does not); `short_enum`: enum values without their `FIELD_` prefix (use_short_enum);
+        `elements_of`: the repeated sub-message whose elements hold the field (`track.x`
+        takes one value per element, as a repeated field does)."""
         options = field_options(field)
+        repeat = field_options(elements_of) if elements_of is not None else options
         kind = _kind(field, options.codec)
         numeric = kind in ("int", "float")
         type_name = (
@@ -102,12 +106,12 @@ class FieldSpec:
             kind=kind,
             proto_type=type_name,
             required=field.is_required if required is None else required,
-            repeated=field.is_repeated,
+            repeated=field.is_repeated or elements_of is not None,
             minimum=options.min if numeric and options.HasField("min") else None,
             maximum=options.max if numeric and options.HasField("max") else None,
             precision=(options.precision if kind == "float" else None),
             max_length=options.max_length if options.HasField("max_length") else None,
-            max_repeat=options.max_repeat if options.HasField("max_repeat") else None,
+            max_repeat=repeat.max_repeat if repeat.HasField("max_repeat") else None,
             enum_values=tuple(enum_name(field, v.number, short_enum) for v in field.enum_type.values)
             if kind == "enum" else (),
             static_value=options.static_value if kind == "static" else None,
@@ -127,7 +131,7 @@ class FieldSpec:
         if self.kind == "static":
             return f"(static) you cannot change the value of this field: {self.static_value}"
         if self.kind == "message":
-            what = "repeated sub-messages" if self.repeated else "sub-messages this deep"
+            what = "repeated sub-messages" if self.repeated else "recursive or deeper sub-messages"
             return f"({self.proto_type}) {what} cannot be composed here"
         if self.automatic_from:
             return f"({self.kind}) filled by pAcommsHandler from {self.automatic_from}"

@@ -91,19 +91,25 @@ def _effective_sources(entry: Message, cls: type[Message]) -> dict[int, str]:
 
 
 def _leaves(
-    descriptor: Descriptor, prefix: str, required: bool, chain: tuple[str, ...]
-) -> Iterator[tuple[str, FieldDescriptor, bool]]:
-    """(path, field, required all the way down) of every field, singular sub-messages
-    unfolded (`pose.x`); repeated sub-messages, deep and recursive ones stay one field."""
+    descriptor: Descriptor, prefix: str, required: bool, chain: tuple[str, ...],
+    elements_of: FieldDescriptor | None = None,
+) -> Iterator[tuple[str, FieldDescriptor, bool, FieldDescriptor | None]]:  # fmt: skip
+    """(path, field, required all the way down, the repeated sub-message whose elements hold
+    it) of every field: singular sub-messages unfolded (`pose.x`), and repeated ones of plain
+    fields (`track.x`: one value per element); deeper, recursive and other repeated
+    sub-messages stay one field."""
     for field in descriptor.fields:
         path = prefix + field.name
-        needed = required and field.is_required
+        needed = required and field.is_required and elements_of is None
         sub = field.message_type
-        if (sub is not None and not field.is_repeated and len(chain) < MAX_NESTING
-                and sub.full_name not in chain):  # fmt: skip
-            yield from _leaves(sub, path + ".", needed, (*chain, sub.full_name))
+        if sub is None or len(chain) >= MAX_NESTING or sub.full_name in chain:
+            yield path, field, needed, elements_of
+        elif not field.is_repeated:
+            yield from _leaves(sub, path + ".", needed, (*chain, sub.full_name), elements_of)
+        elif elements_of is None and all(f.message_type is None and not f.is_repeated for f in sub.fields):
+            yield from _leaves(sub, path + ".", False, (*chain, sub.full_name), field)
         else:
-            yield path, field, needed
+            yield path, field, needed, elements_of
 
 
 def command_type(
@@ -117,12 +123,12 @@ def command_type(
     short = entry.use_short_enum
     fields = []
     top = cls.DESCRIPTOR.fields_by_name
-    for path, field, required in _leaves(cls.DESCRIPTOR, "", True, (cls.DESCRIPTOR.full_name,)):
+    for path, field, required, elements_of in _leaves(cls.DESCRIPTOR, "", True, (cls.DESCRIPTOR.full_name,)):
         var = sources.get(top[path.split(".", 1)[0]].number, "")
         mine = var in operator_vars
         fields.append(FieldSpec.from_descriptor(
             field, var if mine else "", "" if mine else var, path=path, required=required,
-            short_enum=short,
+            short_enum=short, elements_of=elements_of,
         ))  # fmt: skip
     return CommandType(
         name=entry.protobuf_name,
