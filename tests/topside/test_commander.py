@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import serialize_for_moos
+from pygoby.topside.acomms_config import read_acomms_config
 from pygoby.topside.commander import (
     MULTIPLEX,
     Commander,
@@ -56,7 +56,7 @@ def commands(tmp_path) -> CommandSet:
     path = tmp_path / "m.moos"
     path.write_text(MISSION)
     mission = MissionFile.read(path)
-    return CommandSet.from_pacommshandler(pAcommsHandler.read_config(mission, "pAcommsHandler"))
+    return CommandSet.from_pacommshandler(read_acomms_config(mission))
 
 
 def make(commands, posts, **kwargs) -> Commander:

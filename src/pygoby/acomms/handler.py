@@ -276,6 +276,24 @@ class AcommsHandler:
         self.queue.do_work()
 
     # ------------------------------------------------------------------ external requests
+    def push(self, message: Message) -> bool:
+        """Queue an outgoing message; one the queue or DCCL refuses is logged and dropped
+        (False): a bad message must not stop the caller."""
+        try:
+            self.queue.push_message(message)
+        except (QueueError, DcclError, ValueError) as err:
+            log.warning("%s not queued: %s", message.DESCRIPTOR.full_name, err)
+            return False
+        return True
+
+    def encode(self, message: Message) -> bytes | None:
+        """`message`'s DCCL bytes (to forward them); None, with a warning, if it cannot go."""
+        try:
+            return self.codec.encode(message)
+        except DcclError as err:
+            log.warning("cannot encode %s: %s", message.DESCRIPTOR.full_name, err)
+            return None
+
     def initiate_transmission(self, transmission) -> None:
         """A transmission requested from outside the MAC (e.g. an ad-hoc ping)."""
         if self.primary is None:

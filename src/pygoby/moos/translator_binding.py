@@ -125,6 +125,11 @@ class TranslatorBinding:
         if self.runner is not None:
             self._created(self.runner.tick(now))
 
+    def create(self, name: str) -> Message | None:
+        """`name` made now from the app's newest values (e.g. for an ON_DEMAND queue); None,
+        with a warning, when a rule fails or before `start`."""
+        return self.runner.create(name) if self.runner is not None else None
+
     def publish(self, message: Message) -> None:
         """Post a message through its entry's publish rules (warns instead of posting part)."""
         try:
