@@ -44,6 +44,8 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         # types, queue and translator entries)
         self.messages = AcommsMessageSet.load(cfg, self.find_file)
         self.message_types = self.messages.types
+        if cfg.modem_id_lookup_path:  # for the translator and the uField driver
+            cfg.modem_id_lookup_path = self.find_file(cfg.modem_id_lookup_path)
         try:
             self.acomms = AcommsHandler(cfg, self.clock, self.messages.loader)
         except HandlerError as err:
@@ -52,11 +54,10 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
         self.messages.apply_libraries(self.acomms.codec)
-        lookup = cfg.modem_id_lookup_path
         self.binding = TranslatorBinding(
             self, cfg.translator_entry, self.message_types, on_created=self._created,
             multiplex_vars=cfg.multiplex_create_moos_var,
-            modem_id_lookup_path=self.find_file(lookup) if lookup else "",
+            modem_id_lookup_path=cfg.modem_id_lookup_path,
         )  # fmt: skip
         self.translator = self.binding.translator
         self.messages.read_named_values(self.translator)

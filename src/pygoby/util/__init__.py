@@ -9,6 +9,7 @@ from pygoby.util.errors import (
     NMEAError,
     NMEAFormatError,
     PtyError,
+    PluginError,
 )
 from pygoby.util.modem_id import ModemIdLookup
 from pygoby.util.signal import Signal
@@ -21,6 +22,7 @@ __all__ = [
     "NMEAError",
     "NMEAFormatError",
     "PtyError",
+    "PluginError",
     "Signal",
     "VirtualClock",
     "WallClock",
