@@ -42,7 +42,9 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.ifs_data_out = getattr(cfg.moos_var, IFS_DATA_OUT)
         # load_proto_file, load_shared_library, and the Goby 1.1 XML message files (-> DCCL
         # types, queue and translator entries)
-        self.messages = AcommsMessageSet.load(cfg, self.find_file)
+        self.messages = AcommsMessageSet.load(
+            cfg, self.find_file, search_dirs=self.search_dirs(), config_error=self.config_error
+        )
         self.message_types = self.messages.types
         if cfg.modem_id_lookup_path:  # for the translator and the uField driver
             cfg.modem_id_lookup_path = self.find_file(cfg.modem_id_lookup_path)
@@ -64,10 +66,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self._connect_signals()
         self.goby11 = Goby11Variables(self, self.acomms, cfg.queue_cfg, enabled=bool(
             cfg.queue_cfg.queue or cfg.transitional_cfg.message_file))  # fmt: skip
-        try:
-            self.acomms.configure_queue(self.message_types)  # types not loaded: no queue
-        except HandlerError as err:
-            raise ConfigError(str(err)) from None
+        self._configure_queue()
         self._subscribe_all()
         self.frontseat_forward = self.messages.require(cfg.dccl_frontseat_forward_name,
                                                        "dccl_frontseat_forward_name")  # fmt: skip
@@ -76,6 +75,19 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             from pygoby.topside.liaison import Liaison  # imported only when asked for (web stack)
 
             self.liaison = Liaison.embedded(self, self.messages)
+
+    def _configure_queue(self) -> None:
+        try:
+            skipped = self.acomms.configure_queue(self.message_types)
+        except HandlerError as err:
+            raise ConfigError(str(err)) from None
+        if skipped:  # goby3 skips them silently: an operator never learns why nothing is sent
+            loaded = ", ".join(self.messages.loaded()) or "none"
+            raise self.config_error(
+                f'"{skipped[0]}" is not a loaded message type; the types load_proto_file and '
+                f"load_shared_library loaded are: {loaded}",
+                "queue_cfg.message_entry.protobuf_name", skipped[0],
+            )  # fmt: skip
 
     # ------------------------------------------------------------------ wiring
     def _connect_signals(self) -> None:

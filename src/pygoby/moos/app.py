@@ -58,7 +58,9 @@ The base provides
   not parse) and `subscribe_pb(var, cls, handler, ignore_own=False)` (`handler(message)` for
   each value that parses).
 * `find_file(path)`: a relative path from the configuration, looked up next to the mission
-  file when it does not exist from the working directory.
+  file when it does not exist from the working directory (`search_dirs()` lists both).
+* `config_error(reason, field, value="")`: a ConfigError for a problem found after parsing
+  (an unknown type, a missing file), located at the mission line that sets `field`.
 * Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`.
 * `exit_status`: what `main` returns once the app has stopped (0; an app that stops itself on a
   fatal error sets it, then calls `request_stop()`).
@@ -87,6 +89,7 @@ from pygoby.moos import appcli
 from pygoby.moos import protocol as p
 from pygoby.moos.appconfig import (
     collecting_notes,
+    config_line,
     example_config,
     initializer_posts,
     read_configuration,
@@ -286,6 +289,20 @@ class GobyMOOSApp:
         """`path` from the configuration, looked up next to the mission file when it is relative
         and does not exist from the working directory (MissionFile.find_file)."""
         return self.mission.find_file(path) if self.mission is not None else path
+
+    def search_dirs(self) -> list[str]:
+        """The folders `find_file` looks in, in order (for "not found" errors)."""
+        return self.mission.search_dirs() if self.mission is not None else [os.getcwd()]
+
+    def config_error(self, reason: str, field: str, value: str = "") -> ConfigError:
+        """A ConfigError for a problem found after parsing, located at the mission file line
+        that sets `field` (to `value`) in this app's block when there is one."""
+        file = line = None
+        if self.mission is not None and self.mission.path is not None:
+            file = str(self.mission.path)
+            block = self.mission.goby_block(self.name)
+            line = config_line(block, field, value) if block is not None else None
+        return ConfigError(reason, file=file, line=line, field=field)
 
     # -- protobuf messages on MOOS variables (the app-internal technique) ----------------------
 

@@ -8,6 +8,8 @@
 * `example_config(config_class, app_name)`: the `--example_config` text.
 * `initializer_posts(common, mission)`: what `common.initializer` posts on every connect.
 * `prefixed_var_names(moos_var)`: an app's `moos_var { prefix: ... }` block as full names.
+* `config_line(block, field, value)`: the file line where a field (with that value) is set, for
+  errors found after parsing.
 * `goby_field_options(field)`: a field's `(goby.field)` options (description, example,
   moos_global, cfg.action), read from its serialized options so that it works for classes from
   any descriptor pool.
@@ -29,7 +31,7 @@ from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
-from pygoby.moos.moosfile import MissionFile, parse_number
+from pygoby.moos.moosfile import GobyBlock, MissionFile, parse_number
 from pygoby.protobuf import builtin_class
 from pygoby.protobuf.wire import length_delimited
 
@@ -83,6 +85,17 @@ def parse_block(config: Message, text: str, first_line: int, source: str) -> Non
         raise ConfigError(
             f"{detail}{where}\n    {line_text.strip()}", file=source, line=first_line + line - 1
         ) from None
+
+
+def config_line(block: GobyBlock, field: str, value: str = "") -> int | None:
+    """The file line of the first `field:` (the last part of a dotted name) in `block` whose line
+    also contains `value`; None when there is none (e.g. set from the command line)."""
+    name = re.escape(field.rsplit(".", 1)[-1])
+    pattern = re.compile(rf"(?<![\w.]){name}\s*:")
+    for index, text in enumerate(block.text.splitlines(), start=1):
+        if pattern.search(text) and value in text:
+            return block.file_line(index)
+    return None
 
 
 def apply_moos_globals(config: Message, mission: MissionFile) -> None:

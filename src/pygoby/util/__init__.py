@@ -8,8 +8,8 @@ from pygoby.util.errors import (
     NMEAChecksumError,
     NMEAError,
     NMEAFormatError,
-    PtyError,
     PluginError,
+    PtyError,
 )
 from pygoby.util.modem_id import ModemIdLookup
 from pygoby.util.signal import Signal
