@@ -152,6 +152,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             work()
         except HandlerError as err:
             self.log.critical("%s; stopping", err)
+            self.exit_status = 1
             self.request_stop()
 
     # ------------------------------------------------------------------ MOOS -> acomms
