@@ -137,8 +137,8 @@ async def test_antler_exits_non_zero_when_an_app_dies(tmp_path):
     assert lines[-1] == "antler: failed: pEchoTwo"
 
 
-async def _clients_include(port: int, name: str) -> bool:
-    return name in await _clients(port)
+async def _clients_include(port: int, *names: str) -> bool:
+    return set(names) <= await _clients(port)
 
 
 async def test_antler_refuses_a_port_in_use_and_no_db_uses_it(tmp_path):
@@ -169,7 +169,7 @@ async def test_antler_logs_per_program_and_coloured_prefixes(tmp_path):
     logs = tmp_path / "logs"
     antler = await _antler("--logs", str(logs), str(mission))
     try:
-        await _until(lambda: _clients_include(port, "pEchoTwo"), 15)
+        await _until(lambda: _clients_include(port, "pEchoOne", "pEchoTwo"), 15)
     finally:
         antler.send_signal(signal.SIGINT)
         out, _ = await asyncio.wait_for(antler.communicate(), 15)
@@ -180,7 +180,7 @@ async def test_antler_logs_per_program_and_coloured_prefixes(tmp_path):
 
     antler = await _antler("--color", "always", str(mission))
     try:
-        await _until(lambda: _clients_include(port, "pEchoTwo"), 15)
+        await _until(lambda: _clients_include(port, "pEchoOne", "pEchoTwo"), 15)
     finally:
         antler.send_signal(signal.SIGINT)
         out, _ = await asyncio.wait_for(antler.communicate(), 15)
