@@ -122,7 +122,7 @@ def test_a_broadcast_without_a_broadcast_remote_is_reported_once(caplog):
     d = UDPDriver(VirtualClock(0.0))
     d.startup(udp_cfg(1, 0, [(2, 9)]))  # a remote for modem 2 only
     try:
-        frame = m.ModemTransmission(src=1, dest=0, frame=[b"x"])
+        frame = acomms_pb.ModemTransmission(src=1, dest=0, frame=[b"x"])
         with caplog.at_level(logging.WARNING):
             d.handle_initiate_transmission(frame)
             d.handle_initiate_transmission(frame)

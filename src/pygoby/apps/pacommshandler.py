@@ -19,8 +19,11 @@ import functools
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.handler import AcommsHandler, HandlerError
+from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.drivers.ufield import UFldDriver
+from pygoby.acomms.handler import AcommsHandler, HandlerError, make_driver
 from pygoby.apps.pacommshandler_goby11 import Goby11Variables
+from pygoby.apps.ufield_link import MOOSMailLink
 from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
@@ -30,6 +33,14 @@ from pygoby.moos.translator_binding import TranslatorBinding
 from pygoby.topside.acomms_config import PACOMMSHANDLER_CONFIG, AcommsMessageSet
 
 IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
+
+
+def _make_driver(cfg, clock) -> ModemDriverBase | None:
+    """The handler's drivers; a uField driver gets its own MOOS connection."""
+    driver = make_driver(cfg, clock)
+    if isinstance(driver, UFldDriver):
+        driver.mail = MOOSMailLink()
+    return driver
 
 
 class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
@@ -49,7 +60,9 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         if cfg.modem_id_lookup_path:  # for the translator and the uField driver
             cfg.modem_id_lookup_path = self.find_file(cfg.modem_id_lookup_path)
         try:
-            self.acomms = AcommsHandler(cfg, self.clock, self.messages.loader)
+            self.acomms = AcommsHandler(
+                cfg, self.clock, self.messages.loader, driver_factory=_make_driver
+            )
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         self.queue = self.acomms.queue

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from pygoby.errors import ConfigError
-from pygoby.util.glog import LIBRARY_ROOT, GobyFormatter, level_for
+from pygoby.util.glog import DEBUG1, LIBRARY_ROOT, GobyFormatter, level_for
 
 # The library's log lines (client connection, queue, MAC, driver traffic) go to the app's
 # handlers too.
@@ -98,8 +98,10 @@ class AppLogHandlers:
         handlers = [terminal if terminal is not None else terminal_handler(name, common.verbosity)]
         if common.log:
             handlers.append(file_handler(open_log_file(name, common, log), common.log_verbosity))
-        lowest = min(handler.level for handler in handlers)
-        log.setLevel(lowest)
+        # warnings always pass (as without any configuration: other handlers may want them);
+        # below that, only the levels some handler shows are made at all
+        lowest = min(*(handler.level for handler in handlers), logging.WARNING)
+        log.setLevel(min(lowest, DEBUG1))  # the app's own lines are few: all reach handlers
         log.propagate = False
         library = logging.getLogger(LIBRARY_LOGGER)
         saved = library.level
