@@ -19,7 +19,7 @@ import functools
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.driver_base import ModemDriverBase, driver_name
 from pygoby.acomms.drivers.ufield import UFldDriver
 from pygoby.acomms.handler import AcommsHandler, HandlerError, make_driver
 from pygoby.apps.pacommshandler_goby11 import Goby11Variables
@@ -155,6 +155,23 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         if self.liaison is not None:
             await self.liaison.stop()
         await super().stop()
+
+    def status_lines(self) -> list[str]:
+        """show_gui's panel: the drivers, the MAC's current slot, every queue's size."""
+        lines = super().status_lines()
+        for slot in self.acomms.slots:
+            state = "running" if slot.running else f"restarts at {slot.restart_at:.0f}"
+            role = "primary" if slot is self.acomms.primary else "listen"
+            lines.append(f"{role} driver {driver_name(slot.cfg)}: {state}")
+        mac = self.acomms.mac
+        if mac.running and mac.slots:
+            now = mac.slots[(mac.current - 1) % len(mac.slots)]
+            lines.append(f"MAC slot {now.slot_index} ({now.src}->{now.dest}, rate {now.rate}, "
+                         f"{now.slot_seconds:g} s); next in {mac.next_slot_time - self.clock.now():.1f} s")  # fmt: skip
+        else:
+            lines.append("MAC: not running")
+        lines += [f"queue {q.name} ({q.dccl_id}): {len(q)}" for q in self.queue.queues.values()]
+        return lines
 
     def loop(self) -> None:
         self.binding.tick(self.clock.now())

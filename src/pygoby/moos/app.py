@@ -61,7 +61,8 @@ The base provides
   file when it does not exist from the working directory (`search_dirs()` lists both).
 * `config_error(reason, field, value="")`: a ConfigError for a problem found after parsing
   (an unknown type, a missing file), located at the mission line that sets `field`.
-* Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`.
+* Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`,
+  `status_lines()` (the state shown by `common.show_gui`'s live view, pygoby.moos.appgui).
 * `exit_status`: what `main` returns once the app has stopped (0; an app that stops itself on a
   fatal error sets it, then calls `request_stop()`).
 * Mail older than the app's start time is stored in `dynamic_vars` but not handed to the
@@ -232,6 +233,7 @@ class GobyMOOSApp:
         self._stop_requested: asyncio.Event | None = None
         self._stopping = False  # a disconnect during stop() is expected, not a lost connection
         self._log_handlers: AppLogHandlers | None = None
+        self.terminal_handler: logging.Handler | None = None  # instead of stdout (show_gui)
         self._status = StatusReport()
         self.iterations = 0
         self.exit_status = 0
@@ -344,7 +346,9 @@ class GobyMOOSApp:
     async def start(self, connect_timeout: float | None = None) -> None:
         """Start logging, the comms and the tick loop. With `connect_timeout`, wait for the
         first connection (TimeoutError otherwise); without, carry on and keep trying."""
-        self._log_handlers = AppLogHandlers.open(self.log, self.name, self.common)
+        self._log_handlers = AppLogHandlers.open(
+            self.log, self.name, self.common, terminal=self.terminal_handler
+        )
         if self.config_notes:
             self.log.info("Goby 1.1/2 configuration forms mapped onto today's:\n  %s",
                           "\n  ".join(self.config_notes))  # fmt: skip
@@ -377,12 +381,30 @@ class GobyMOOSApp:
             self._stop_requested.set()
 
     async def run(self) -> None:
+        gui = None
+        if self.common.show_gui:
+            from pygoby.moos.appgui import gui_for  # textual, only when asked for
+
+            gui = gui_for(self)
+            if gui is not None:
+                self.terminal_handler = gui.handler
         await self.start()
         assert self._stop_requested is not None
+        if self.common.show_gui and gui is None:
+            self.log.info("show_gui: standard output is not a terminal; the log stays plain text")
         try:
-            await self._stop_requested.wait()
+            if gui is not None:
+                await gui.run_until(self._stop_requested)
+            else:
+                await self._stop_requested.wait()
         finally:
             await self.stop()
+
+    def status_lines(self) -> list[str]:
+        """The app's state in a few lines (show_gui's status panel). Override to add yours."""
+        state = "connected" if self.connected else "not connected"
+        return [f"MOOSDB {self.client.host}:{self.client.port}: {state}",
+                f"up {self.clock.now() - self.start_time:.0f} s, {self.iterations} iterations"]  # fmt: skip
 
     async def __aenter__(self) -> GobyMOOSApp:
         await self.start(connect_timeout=5.0)

@@ -17,7 +17,7 @@ import os
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
-from google.protobuf import descriptor_pool, message_factory
+from google.protobuf import descriptor_pool, message_factory, text_format
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
@@ -34,10 +34,12 @@ from pygoby.moos.translator import (
     TranslatorRunner,
 )
 from pygoby.protobuf import ProtoError, ProtoLoader
+from pygoby.util.glog import DEBUG1, VERBOSE, group_logger
 from pygoby.util.libraries import DCCL_CODECS, MESSAGES, builtin_for, is_shared_library, unavailable
 from pygoby.util.modules import import_module_or_file
 
 log = logging.getLogger(__name__)
+glog = group_logger("goby::moos::translator")  # created messages and their publications
 
 
 class MessageTypes:
@@ -83,6 +85,7 @@ class MessageTypes:
             descriptor = self.loader.load_file(found or path)
         except (ProtoError, OSError) as err:
             raise self._error(f'cannot load "{path}": {err}', "load_proto_file", path) from None
+        log.info("loaded %s", found or path)
         self.loaded += [d.full_name for d in descriptor.message_types_by_name.values()]
 
     def _load_library(self, name: str) -> None:
@@ -200,11 +203,20 @@ class TranslatorBinding:
         self.post(posts)
 
     def post(self, posts: Iterable[Post]) -> None:
+        posts = list(posts)
+        if posts and glog.isEnabledFor(VERBOSE):
+            glog.log(VERBOSE, "published %s", ", ".join(post.var for post in posts))
         for post in posts:
+            if glog.isEnabledFor(DEBUG1):
+                glog.log(DEBUG1, "  %s = %r", post.var, post.value)
             self.app.publish(post.var, post.value, src_aux=post.source_aux)
 
     def _created(self, messages: list[Message]) -> None:
         for message in messages:
+            if glog.isEnabledFor(VERBOSE):
+                glog.log(VERBOSE, "created %s", message.DESCRIPTOR.full_name)
+            if glog.isEnabledFor(DEBUG1):
+                glog.log(DEBUG1, "  %s", text_format.MessageToString(message, as_one_line=True))
             self.on_created(message)
 
     def _on_mail(self, msg: MOOSMessage) -> None:
