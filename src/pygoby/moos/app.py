@@ -376,6 +376,11 @@ class GobyMOOSApp:
             self._log_handlers.close()
             self._log_handlers = None
 
+    @property
+    def stop_requested(self) -> bool:
+        """Whether `request_stop()` was called since `start()`."""
+        return self._stop_requested is not None and self._stop_requested.is_set()
+
     def request_stop(self) -> None:
         if self._stop_requested is not None:
             self._stop_requested.set()
