@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 from pygoby.errors import ConfigError
 from pygoby.moos.appconfig import collecting_notes
 from pygoby.moos.moosfile import MissionFile
+from pygoby.util.console import quiet_broken_pipe
 
 if TYPE_CHECKING:
     from pygoby.moos.app import GobyMOOSApp
@@ -96,8 +97,7 @@ def run_app(
     known, rest = parser.parse_known_args(args_in)
     name = known.moos_name or known.alias or program
     if known.example_config:
-        sys.stdout.write(app_class.example_config(name))
-        return 0
+        return quiet_broken_pipe(lambda: sys.stdout.write(app_class.example_config(name)) and 0)
     try:
         overrides = parse_overrides(rest)
     except ValueError as err:
@@ -111,7 +111,7 @@ def run_app(
     except ConfigError as err:
         print(f"{name}: fatal configuration error: {err}", file=sys.stderr)
         return 1
-    return run_until_signal(app)
+    return quiet_broken_pipe(lambda: run_until_signal(app))
 
 
 def run_until_signal(app: GobyMOOSApp) -> int:

@@ -318,6 +318,8 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
             value = _quote(opts.example) if field.type == FieldDescriptor.TYPE_STRING else opts.example
         elif field.type == FieldDescriptor.TYPE_STRING:
             value = '""'
+        elif field.is_required:  # goby3 prints nothing, which does not parse when copied
+            value = _placeholder(field)
         else:
             value = ""
         if field.type == FieldDescriptor.TYPE_ENUM:
@@ -329,6 +331,17 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
             comment += f' (can also set MOOS global "{opts.moos_global}=")'
         out.extend(_wrap(f"{indent}{name}: {value}  ", comment))
     return out
+
+
+def _placeholder(field: FieldDescriptor) -> str:
+    """A value of the field's type that parses (the first enumerator, 0, false, "")."""
+    if field.type == FieldDescriptor.TYPE_ENUM:
+        return field.enum_type.values[0].name
+    if field.type == FieldDescriptor.TYPE_BOOL:
+        return "false"
+    if field.type == FieldDescriptor.TYPE_BYTES:
+        return '""'
+    return "0"
 
 
 def example_config(config_class: type[Message], app_name: str) -> str:
