@@ -182,7 +182,8 @@ async def test_show_gui_live_view(tmp_path):
 
 async def test_show_gui_off_a_terminal_keeps_plain_text(tmp_path):
     """goby3-examples' missions say show_gui: true; under antler or a pipe that must not break
-    the output: one line says so and the log goes on as text."""
+    the output: one line says so and the log goes on as text (here at -vv: DEBUG1, above the
+    mission's VERBOSE)."""
     async with MOOSDB(port=0) as db:
         mission = tmp_path / "gui.moos"
         common = "log: false verbosity: VERBOSE show_gui: true"
@@ -190,7 +191,8 @@ async def test_show_gui_off_a_terminal_keeps_plain_text(tmp_path):
         recorder = Recorder("watcher", db.port)
         await recorder.start(["MODEM_ID"])
         proc = await asyncio.create_subprocess_exec(
-            PACOMMSHANDLER, str(mission), stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.STDOUT
+            PACOMMSHANDLER, str(mission), "-vv", stdout=asyncio.subprocess.PIPE,
+            stderr=asyncio.subprocess.STDOUT,
         )
         try:
             await recorder.wait_for("MODEM_ID", timeout=30)
@@ -203,4 +205,5 @@ async def test_show_gui_off_a_terminal_keeps_plain_text(tmp_path):
     assert has(lines, r"^pAcommsHandler \[.*\]: show_gui: standard output is not a terminal; the log "
                       r"stays plain text$")
     assert has(lines, r"\{goby::acomms::amac::1\}: MAC MAC_FIXED_DECENTRALIZED started")
+    assert has(lines, r"\{goby::acomms::amac::1\}: cycle of 2 slots")  # DEBUG1: -vv
     assert not any("\x1b" in line for line in lines)
