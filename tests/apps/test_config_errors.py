@@ -75,10 +75,13 @@ def test_a_queue_for_a_type_that_is_not_loaded_names_the_loaded_types(tmp_path):
         ("../build/lib/libmy_messages.so", '"../build/lib/libmy_messages.so": pygoby cannot load '
          "compiled C++ libraries; use load_proto_file with the .proto file(s) the library was "
          "built from instead"),
-        ("libdccl_ccl_compat.so", '"libdccl_ccl_compat.so": pygoby has no built-in equivalent of '
-         "these DCCL codecs yet"),
-        ("libgoby_frontseat_bluefin.so.30", '"libgoby_frontseat_bluefin.so.30" is a frontseat '
-         "driver, not a message library"),
+        ("/home/toby/dccl/build/lib/libdccl_ccl_compat.so", None),  # pygoby.dccl's built-ins
+        ("libdccl_arithmetic.so.31", None),
+        ("libdccl_no_such_codecs.so", '"libdccl_no_such_codecs.so": pygoby has no built-in '
+         "equivalent of this DCCL codec library (built in: libdccl_ccl_compat.so, "
+         "libdccl_arithmetic.so, libdccl_native_protobuf.so, libdccl.so)"),
+        ("libgoby_frontseat_bluefin.so.30", '"libgoby_frontseat_bluefin.so.30": this library is a '
+         "frontseat driver, not messages"),
     ],
 )
 def test_load_shared_library_of_upstream_libraries(tmp_path, library, error):
@@ -94,7 +97,7 @@ def test_upstream_library_table():
         FRONTSEAT_DRIVER, "basic_simulator"
     )
     assert builtin_for("libgoby_acomms.so.25") == Builtin(MESSAGES, "")
-    assert builtin_for("libdccl_arithmetic.so") == Builtin(DCCL_CODECS, "")  # (not yet built in)
+    assert builtin_for("/x/libdccl_ccl_compat.so.31") == Builtin(DCCL_CODECS, "dccl_ccl_compat")
     assert builtin_for("libgobyexample_protobuf.so") is None
     assert builtin_for("my_messages_pb2") is None  # a Python module: not a shared library
 
