@@ -183,7 +183,7 @@ def test_real_time_cli_run_ends_cleanly_and_counts_external_deliveries(tmp_path)
     ), lines
     progress = [line for line in done.stderr.splitlines() if line.startswith("simulated ")]
     assert progress and all(
-        re.fullmatch(r"simulated [\d,]+/48 s \(\d+%\): packets \d+, messages \d+, [\d.,]+x real time", p)
+        re.fullmatch(r"simulated [\d,]+/48 s \(\d+%\): packets \d+, messages \d+, [\d.,]+x real time(, ETA \d+ s)?", p)
         for p in progress
     ), progress
     nodes = [e for e in read_events(log) if e["event"] == "node"]
