@@ -10,8 +10,9 @@ from pathlib import Path
 
 import pytest
 
+from pygoby.acomms import DriverNotFoundError
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.drivers import DriverNotFound, make_driver
+from pygoby.acomms.drivers import make_driver
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.errors import ConfigError
 from pygoby.util.libraries import DCCL_CODECS, FRONTSEAT_DRIVER, MESSAGES, Builtin, builtin_for
@@ -103,8 +104,9 @@ def test_upstream_library_table():
 
 
 def test_driver_type_not_implemented_lists_those_that_are():
-    with pytest.raises(DriverNotFound) as info:
+    with pytest.raises(DriverNotFoundError) as info:
         make_driver(acomms_pb.DriverConfig(driver_type=8))  # DRIVER_IRIDIUM
+    assert info.value.status == acomms_pb.ModemDriverStatus.INVALID_CONFIGURATION
     assert str(info.value) == (
         "driver_type DRIVER_IRIDIUM is not implemented in pygoby; available: DRIVER_NONE, "
         "DRIVER_WHOI_MICROMODEM, DRIVER_ABC_EXAMPLE_MODEM, DRIVER_UFIELD_SIM_DRIVER, "
@@ -115,7 +117,7 @@ def test_driver_type_not_implemented_lists_those_that_are():
 
 def test_compiled_driver_plugins_are_named_in_the_error(monkeypatch):
     monkeypatch.setenv("PACOMMSHANDLER_PLUGINS", "/usr/lib/libmy_modem_driver.so")
-    with pytest.raises(DriverNotFound) as info:
+    with pytest.raises(DriverNotFoundError) as info:
         make_driver(acomms_pb.DriverConfig(driver_name="my_modem"))
     assert str(info.value).endswith(
         "$PACOMMSHANDLER_PLUGINS lists compiled C++ plug-ins (/usr/lib/libmy_modem_driver.so), "

@@ -62,16 +62,18 @@ async def test_log_lines_at_each_verbosity_on_a_two_vehicle_run(tmp_path):
                     PACOMMSHANDLER, str(mission), stdout=sink, stderr=asyncio.subprocess.STDOUT))  # fmt: skip
         r1, r2 = Recorder("r1", dbs[0].port), Recorder("r2", dbs[1].port)
         for recorder in (r1, r2):
-            await recorder.start(["ACOMMS_ACK", "COMMAND_IN", "MODEM_ID"])
+            await recorder.start(["ACOMMS_ACK", "COMMAND_IN", "ACOMMS_NMEA_IN", "ACOMMS_MAC_SLOT_START",
+                                  "DB_TIME"])
             stack.push_async_callback(recorder.close)
         try:
-            await r1.wait_for("MODEM_ID")
-            await r2.wait_for("MODEM_ID")
+            for recorder in (r1, r2):  # both apps running, their modems answering, and DB_TIME
+                for var in ("ACOMMS_NMEA_IN", "ACOMMS_MAC_SLOT_START", "DB_TIME"):  # (a time)
+                    await recorder.wait_for(var, timeout=60)
             for var, value in NAV.items():
                 r1.client.publish(var, value)
             r1.client.publish("COMMAND_OUT", "dest=2,command_id=7,heading=90,speed=1.5,depth=20")
-            await r2.wait_for("COMMAND_IN", timeout=30)
-            await r1.wait_for("ACOMMS_ACK", timeout=30)
+            await r2.wait_for("COMMAND_IN", timeout=60)
+            await r1.wait_for("ACOMMS_ACK", timeout=60)
         finally:
             for proc in procs:
                 proc.send_signal(2)

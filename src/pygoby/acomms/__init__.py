@@ -31,6 +31,7 @@ The classes and functions named above (and the errors) are also importable from
 from pygoby.acomms.errors import (
     ABCParseError,
     AcommsError,
+    DriverNotFoundError,
     HandlerError,
     ModemDriverError,
     QueueError,
@@ -59,6 +60,7 @@ __all__ = [
     "ABCParseError",
     "AcommsError",
     "AcommsHandler",
+    "DriverNotFoundError",
     "HandlerError",
     "MACManager",
     "ModemDriverBase",

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
 
-from pygoby.moos.errors import MissionFileError
+from pygoby.moos.errors import AntlerError, MissionFileError
 from pygoby.moos.moosfile import AntlerRun, MissionFile
 from pygoby.moos.protocol import DEFAULT_PORT
 
@@ -37,10 +37,6 @@ log = logging.getLogger(__name__)
 
 COLOURS = ("36", "33", "35", "32", "34", "31", "96", "93", "95", "92")  # ANSI, one per program
 DB_NAME = "MOOSDB"
-
-
-class AntlerError(Exception):
-    """The mission cannot be started (e.g. its DB port is taken)."""
 
 
 def db_listening(host: str, port: int, timeout: float = 0.5) -> bool:

@@ -25,7 +25,7 @@ from collections.abc import Callable
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
-from pygoby.acomms.errors import ModemDriverError
+from pygoby.acomms.errors import DriverNotFoundError
 from pygoby.util.clock import Clock
 from pygoby.util.libraries import is_shared_library
 from pygoby.util.plugins import PluginGroup, import_object
@@ -34,7 +34,6 @@ __all__ = [
     "BUILTIN_DRIVERS",
     "ENTRY_POINT_GROUP",
     "PLUGINS_ENV",
-    "DriverNotFound",
     "driver_factory",
     "implemented_types",
     "make_driver",
@@ -60,14 +59,7 @@ Factory = Callable[[Clock | None], ModemDriverBase]
 _DRIVER_TYPE = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
 
 
-class DriverNotFound(ModemDriverError):
-    """No driver of that type or name (an INVALID_CONFIGURATION driver failure)."""
-
-    def __init__(self, message: str) -> None:
-        super().__init__(message, acomms_pb.ModemDriverStatus.INVALID_CONFIGURATION)
-
-
-INSTALLED = PluginGroup(ENTRY_POINT_GROUP, "modem driver", PLUGIN_FACTORY, DriverNotFound)
+INSTALLED = PluginGroup(ENTRY_POINT_GROUP, "modem driver", PLUGIN_FACTORY, DriverNotFoundError)
 
 
 def driver_type_name(cfg) -> str:
@@ -81,7 +73,7 @@ def implemented_types() -> list[str]:
 
 
 def driver_factory(cfg) -> Factory:
-    """The factory of the driver `cfg` (DriverConfig) selects; DriverNotFound otherwise."""
+    """The factory of the driver `cfg` (DriverConfig) selects; DriverNotFoundError otherwise."""
     if cfg.WhichOneof("driver") == "driver_name":
         return plugin_factory(cfg.driver_name)
     type_name = driver_type_name(cfg)
@@ -91,7 +83,7 @@ def driver_factory(cfg) -> Factory:
     installed = INSTALLED.entry_point(type_name)
     if installed is not None:
         return installed
-    raise DriverNotFound(
+    raise DriverNotFoundError(
         f"driver_type {type_name} is not implemented in pygoby; available: "
         f"{', '.join(implemented_types())} (or a driver_name of {ENTRY_POINT_GROUP} "
         f"entry points or ${PLUGINS_ENV} modules)"
@@ -119,7 +111,7 @@ def plugin_factory(name: str) -> Factory:
             f"; ${PLUGINS_ENV} lists compiled C++ plug-ins ({', '.join(compiled)}), which pygoby "
             "cannot load: list Python modules or .py files there"
         )
-    raise DriverNotFound(
+    raise DriverNotFoundError(
         f"no driver plugin named {name!r}: not an entry point of {ENTRY_POINT_GROUP} "
         f"({', '.join(INSTALLED.names()) or 'none installed'}) nor the goby_driver_name() of a "
         f"module in ${PLUGINS_ENV} ({', '.join(listed) or 'empty'}){hint}"
