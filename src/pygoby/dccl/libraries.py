@@ -94,5 +94,5 @@ def split_libraries(
         except DcclLoadError as err:
             if error is None:
                 raise
-            raise error(str(err).removeprefix(f'"{name}": '), name) from None
+            raise error(str(err), name) from None
     return libraries, others
