@@ -31,7 +31,6 @@ ProcessConfig = pAcommsHandler
                      role {{ type: SOURCE_ID field: "src" }} role {{ type: DESTINATION_ID field: "dest" }} }}
     message_entry {{ protobuf_name: "{COMMAND}" ttl: 2
                      role {{ type: SOURCE_ID field: "src" }} role {{ type: DESTINATION_ID field: "dest" }} }}
-    message_entry {{ protobuf_name: "not.a.LoadedType" }}
   }}
   load_proto_file: "{PROTO}"
   dccl_frontseat_forward_name: "{STATUS}"

@@ -370,3 +370,18 @@ async def test_packets_cut_anywhere_by_tcp_are_all_delivered():
         got = [(await _expect(sink, "CUT")).dval for _ in expected]
         assert got == expected
         writer.close()
+async def test_close_while_the_connection_is_being_lost_returns():
+    """close() at any point of the DB going away (here: 0..15 loop turns after it closed the
+    connections) ends the client instead of leaving it reconnecting (antler's SIGINT reaches
+    the DB and the apps at once)."""
+    for turns in range(16):
+        db = MOOSDB(port=0)
+        await db.start()
+        client = MOOSClient(f"closing{turns}", port=db.port, reconnect_interval=0.05)
+        await client.connect()
+        await db.stop()
+        for _ in range(turns):
+            await asyncio.sleep(0)
+        closing = asyncio.ensure_future(client.close())
+        done, _ = await asyncio.wait([closing], timeout=2)  # (wait_for would cancel and rescue it)
+        assert done, f"close() hangs: the client goes on reconnecting ({turns} turns)"

@@ -31,6 +31,7 @@ The classes and functions named above (and the errors) are also importable from
 from pygoby.acomms.errors import (
     ABCParseError,
     AcommsError,
+    DriverNotFoundError,
     HandlerError,
     ModemDriverError,
     QueueError,
@@ -60,6 +61,7 @@ __all__ = [
     "ABCParseError",
     "AcommsError",
     "AcommsHandler",
+    "DriverNotFoundError",
     "HandlerError",
     "MACManager",
     "ModemDriverBase",

@@ -3,6 +3,8 @@ raises on purpose."""
 
 from pygoby.errors import PygobyError
 
+INVALID_CONFIGURATION = 4  # goby.acomms.protobuf.ModemDriverStatus.INVALID_CONFIGURATION
+
 
 class AcommsError(PygobyError):
     """Base class of every acomms error."""
@@ -23,6 +25,13 @@ class QueueError(AcommsError):
 class RoleError(AcommsError, ValueError):
     """A role in the queue configuration is invalid for its message type (or a message's role
     field holds a value the role cannot use)."""
+
+
+class DriverNotFoundError(ModemDriverError):
+    """No driver of that type or name (an INVALID_CONFIGURATION driver failure)."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(message, INVALID_CONFIGURATION)
 
 
 class HandlerError(AcommsError):

@@ -18,17 +18,14 @@ The queue's and the MAC's own signals are used directly (`handler.queue.signal_r
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
 import logging
-import os
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
+from pygoby.acomms import drivers
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.bind import bind, unbind
 from pygoby.acomms.driver_base import ModemDriverBase, driver_name
@@ -40,7 +37,6 @@ from pygoby.dccl import Codec, DcclError
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
 from pygoby.util.clock import Clock
-from pygoby.util.modules import import_module_or_file
 from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
@@ -48,14 +44,8 @@ log = logging.getLogger(__name__)
 Status = acomms_pb.ModemDriverStatus
 DriverType = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type.values_by_name
 DRIVER_NONE = DriverType["DRIVER_NONE"].number
+UFIELD = DriverType["DRIVER_UFIELD_SIM_DRIVER"].number
 
-# Built-in drivers: DriverType name -> "module:class" (imported when first used).
-BUILTIN_DRIVERS = {
-    "DRIVER_WHOI_MICROMODEM": "pygoby.acomms.drivers.micromodem:MMDriver",
-    "DRIVER_UDP": "pygoby.acomms.drivers.udp:UDPDriver",
-    "DRIVER_STORE_SERVER": "pygoby.acomms.drivers.store_server:StoreServerDriver",
-}
-PLUGINS_ENV = "PACOMMSHANDLER_PLUGINS"
 ROUTE_COMMAND = RouteCommand.DESCRIPTOR.full_name
 
 CONTINUALLY_RESTART_DRIVER = 1
@@ -65,32 +55,6 @@ DISABLE_AND_MOVE_LISTEN_DRIVER_TO_PRIMARY = 3
 
 # --------------------------------------------------------------------------------------------
 # Drivers
-
-
-def _import_object(spec: str):
-    module, _, name = spec.partition(":")
-    return getattr(importlib.import_module(module), name)
-
-
-def plugin_driver_factory(driver_name: str) -> Callable[[Clock], ModemDriverBase]:
-    """`goby_make_driver` of the plugin (listed in $PACOMMSHANDLER_PLUGINS, separated by any of
-    `;`, `:`, `,`) whose `goby_driver_name()` is `driver_name`."""
-    listed = [p for p in re.split(r"[;:,]", os.environ.get(PLUGINS_ENV, "")) if p.strip()]
-    for name in listed:
-        try:
-            module = import_module_or_file(name.strip())
-        except (ImportError, OSError, SyntaxError) as exc:
-            raise HandlerError(f"cannot load driver plugin {name!r}: {exc}") from None
-        namer = getattr(module, "goby_driver_name", None)
-        if namer is None or namer() != driver_name:
-            continue
-        factory = getattr(module, "goby_make_driver", None)
-        if factory is None:
-            raise HandlerError(f"driver plugin {name!r} has no goby_make_driver()")
-        return factory
-    raise HandlerError(
-        f"no driver plugin named {driver_name!r} in ${PLUGINS_ENV} ({', '.join(listed) or 'empty'})"
-    )
 
 
 def _check_slot_rates(mac_cfg, driver: ModemDriverBase) -> None:
@@ -107,24 +71,26 @@ def _check_slot_rates(mac_cfg, driver: ModemDriverBase) -> None:
 
 
 def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
-    """The driver selected by `cfg` (DriverConfig), or None for DRIVER_NONE."""
-    if cfg.WhichOneof("driver") == "driver_name":
-        factory = plugin_driver_factory(cfg.driver_name)
-        try:
-            return factory(clock)
-        except TypeError:
-            return factory()
-    if cfg.driver_type == DRIVER_NONE:
+    """The driver selected by `cfg` (DriverConfig, through pygoby.acomms.drivers' registry), or
+    None for DRIVER_NONE."""
+    if cfg.WhichOneof("driver") != "driver_name" and cfg.driver_type == DRIVER_NONE:
         return None
-    type_name = (
-        acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"]
-        .enum_type.values_by_number[cfg.driver_type]
-        .name
-    )
-    spec = BUILTIN_DRIVERS.get(type_name)
-    if spec is None:
-        raise HandlerError(f"driver_type {type_name} is not implemented in pygoby")
-    return _import_object(spec)(clock)
+    return drivers.make_driver(cfg, clock)
+
+
+def wire_driver_cfg(driver_cfg, cfg) -> None:
+    """pAcommsHandler's special wiring (spec goby-moos-apps.md 4.3): the uField driver gets the
+    top-level `modem_id_lookup_path` and, where its own are unset, the MOOSDB of `common` (so a
+    mission on a ServerPort other than 9000 needs no `moos_port`)."""
+    if driver_cfg.WhichOneof("driver") == "driver_type" and driver_cfg.driver_type == UFIELD:
+        ufld = driver_cfg.Extensions[acomms_pb.UFLD_CONFIG]
+        lookup = getattr(cfg, "modem_id_lookup_path", "")
+        if lookup and not ufld.HasField("modem_id_lookup_path"):
+            ufld.modem_id_lookup_path = lookup
+        common = getattr(cfg, "common", None)
+        for ours, theirs in (("moos_server", "server_host"), ("moos_port", "server_port")):
+            if common is not None and common.HasField(theirs) and not ufld.HasField(ours):
+                setattr(ufld, ours, getattr(common, theirs))
 
 
 @dataclass(eq=False)
@@ -175,6 +141,7 @@ class AcommsHandler:
             own.CopyFrom(driver_cfg)
             if not own.HasField("modem_id"):
                 own.modem_id = self.modem_id
+            wire_driver_cfg(own, cfg)
             try:
                 driver = driver_factory(own, clock)
             except ModemDriverError as exc:

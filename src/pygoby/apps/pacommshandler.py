@@ -19,8 +19,11 @@ import functools
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.handler import AcommsHandler, HandlerError
+from pygoby.acomms.driver_base import ModemDriverBase, driver_name
+from pygoby.acomms.drivers.ufield import UFldDriver
+from pygoby.acomms.handler import AcommsHandler, HandlerError, make_driver
 from pygoby.apps.pacommshandler_goby11 import Goby11Variables
+from pygoby.apps.ufield_link import MOOSMailLink
 from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
@@ -30,6 +33,14 @@ from pygoby.moos.translator_binding import TranslatorBinding
 from pygoby.topside.acomms_config import PACOMMSHANDLER_CONFIG, AcommsMessageSet
 
 IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
+
+
+def _make_driver(cfg, clock) -> ModemDriverBase | None:
+    """The handler's drivers; a uField driver gets its own MOOS connection."""
+    driver = make_driver(cfg, clock)
+    if isinstance(driver, UFldDriver):
+        driver.mail = MOOSMailLink()
+    return driver
 
 
 class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
@@ -42,10 +53,16 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.ifs_data_out = getattr(cfg.moos_var, IFS_DATA_OUT)
         # load_proto_file, load_shared_library, and the Goby 1.1 XML message files (-> DCCL
         # types, queue and translator entries)
-        self.messages = AcommsMessageSet.load(cfg, self.find_file)
+        self.messages = AcommsMessageSet.load(
+            cfg, self.find_file, search_dirs=self.search_dirs(), config_error=self.config_error
+        )
         self.message_types = self.messages.types
+        if cfg.modem_id_lookup_path:  # for the translator and the uField driver
+            cfg.modem_id_lookup_path = self.find_file(cfg.modem_id_lookup_path)
         try:
-            self.acomms = AcommsHandler(cfg, self.clock, self.messages.loader)
+            self.acomms = AcommsHandler(
+                cfg, self.clock, self.messages.loader, driver_factory=_make_driver
+            )
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         except ConfigError as err:
@@ -54,21 +71,17 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
         self.messages.apply_libraries(self.acomms.codec)
-        lookup = cfg.modem_id_lookup_path
         self.binding = TranslatorBinding(
             self, cfg.translator_entry, self.message_types, on_created=self._created,
             multiplex_vars=cfg.multiplex_create_moos_var,
-            modem_id_lookup_path=self.find_file(lookup) if lookup else "",
+            modem_id_lookup_path=cfg.modem_id_lookup_path,
         )  # fmt: skip
         self.translator = self.binding.translator
         self.messages.read_named_values(self.translator)
         self._connect_signals()
         self.goby11 = Goby11Variables(self, self.acomms, cfg.queue_cfg, enabled=bool(
             cfg.queue_cfg.queue or cfg.transitional_cfg.message_file))  # fmt: skip
-        try:
-            self.acomms.configure_queue(self.message_types)  # types not loaded: no queue
-        except HandlerError as err:
-            raise ConfigError(str(err)) from None
+        self._configure_queue()
         self._subscribe_all()
         self.frontseat_forward = self.messages.require(cfg.dccl_frontseat_forward_name,
                                                        "dccl_frontseat_forward_name")  # fmt: skip
@@ -77,6 +90,19 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             from pygoby.topside.liaison import Liaison  # imported only when asked for (web stack)
 
             self.liaison = Liaison.embedded(self, self.messages)
+
+    def _configure_queue(self) -> None:
+        try:
+            skipped = self.acomms.configure_queue(self.message_types)
+        except HandlerError as err:
+            raise ConfigError(str(err)) from None
+        if skipped:  # goby3 skips them silently: an operator never learns why nothing is sent
+            loaded = ", ".join(self.messages.loaded()) or "none"
+            raise self.config_error(
+                f'"{skipped[0]}" is not a loaded message type; the types load_proto_file and '
+                f"load_shared_library loaded are: {loaded}",
+                "queue_cfg.message_entry.protobuf_name", skipped[0],
+            )  # fmt: skip
 
     # ------------------------------------------------------------------ wiring
     def _connect_signals(self) -> None:
@@ -132,6 +158,23 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             await self.liaison.stop()
         await super().stop()
 
+    def status_lines(self) -> list[str]:
+        """show_gui's panel: the drivers, the MAC's current slot, every queue's size."""
+        lines = super().status_lines()
+        for slot in self.acomms.slots:
+            state = "running" if slot.running else f"restarts at {slot.restart_at:.0f}"
+            role = "primary" if slot is self.acomms.primary else "listen"
+            lines.append(f"{role} driver {driver_name(slot.cfg)}: {state}")
+        mac = self.acomms.mac
+        if mac.running and mac.slots:
+            now = mac.slots[(mac.current - 1) % len(mac.slots)]
+            lines.append(f"MAC slot {now.slot_index} ({now.src}->{now.dest}, rate {now.rate}, "
+                         f"{now.slot_seconds:g} s); next in {mac.next_slot_time - self.clock.now():.1f} s")  # fmt: skip
+        else:
+            lines.append("MAC: not running")
+        lines += [f"queue {q.name} ({q.dccl_id}): {len(q)}" for q in self.queue.queues.values()]
+        return lines
+
     def loop(self) -> None:
         self.binding.tick(self.clock.now())
         self._stop_on_failure(self.acomms.do_work)
@@ -141,6 +184,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             work()
         except HandlerError as err:
             self.log.critical("%s; stopping", err)
+            self.exit_status = 1
             self.request_stop()
 
     # ------------------------------------------------------------------ MOOS -> acomms

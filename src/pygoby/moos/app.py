@@ -58,8 +58,11 @@ The base provides
   not parse) and `subscribe_pb(var, cls, handler, ignore_own=False)` (`handler(message)` for
   each value that parses).
 * `find_file(path)`: a relative path from the configuration, looked up next to the mission
-  file when it does not exist from the working directory.
-* Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`.
+  file when it does not exist from the working directory (`search_dirs()` lists both).
+* `config_error(reason, field, value="")`: a ConfigError for a problem found after parsing
+  (an unknown type, a missing file), located at the mission line that sets `field`.
+* Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`,
+  `status_lines()` (the state shown by `common.show_gui`'s live view, pygoby.moos.appgui).
 * `exit_status`: what `main` returns once the app has stopped (0; an app that stops itself on a
   fatal error sets it, then calls `request_stop()`).
 * Mail older than the app's start time is stored in `dynamic_vars` but not handed to the
@@ -87,6 +90,7 @@ from pygoby.moos import appcli
 from pygoby.moos import protocol as p
 from pygoby.moos.appconfig import (
     collecting_notes,
+    config_line,
     example_config,
     initializer_posts,
     read_configuration,
@@ -229,6 +233,7 @@ class GobyMOOSApp:
         self._stop_requested: asyncio.Event | None = None
         self._stopping = False  # a disconnect during stop() is expected, not a lost connection
         self._log_handlers: AppLogHandlers | None = None
+        self.terminal_handler: logging.Handler | None = None  # instead of stdout (show_gui)
         self._status = StatusReport()
         self.iterations = 0
         self.exit_status = 0
@@ -287,6 +292,20 @@ class GobyMOOSApp:
         and does not exist from the working directory (MissionFile.find_file)."""
         return self.mission.find_file(path) if self.mission is not None else path
 
+    def search_dirs(self) -> list[str]:
+        """The folders `find_file` looks in, in order (for "not found" errors)."""
+        return self.mission.search_dirs() if self.mission is not None else [os.getcwd()]
+
+    def config_error(self, reason: str, field: str, value: str = "") -> ConfigError:
+        """A ConfigError for a problem found after parsing, located at the mission file line
+        that sets `field` (to `value`) in this app's block when there is one."""
+        file = line = None
+        if self.mission is not None and self.mission.path is not None:
+            file = str(self.mission.path)
+            block = self.mission.goby_block(self.name)
+            line = config_line(block, field, value) if block is not None else None
+        return ConfigError(reason, file=file, line=line, field=field)
+
     # -- protobuf messages on MOOS variables (the app-internal technique) ----------------------
 
     def publish_pb(self, var: str, message: Message) -> None:
@@ -327,7 +346,9 @@ class GobyMOOSApp:
     async def start(self, connect_timeout: float | None = None) -> None:
         """Start logging, the comms and the tick loop. With `connect_timeout`, wait for the
         first connection (TimeoutError otherwise); without, carry on and keep trying."""
-        self._log_handlers = AppLogHandlers.open(self.log, self.name, self.common)
+        self._log_handlers = AppLogHandlers.open(
+            self.log, self.name, self.common, terminal=self.terminal_handler
+        )
         if self.config_notes:
             self.log.info("Goby 1.1/2 configuration forms mapped onto today's:\n  %s",
                           "\n  ".join(self.config_notes))  # fmt: skip
@@ -355,17 +376,40 @@ class GobyMOOSApp:
             self._log_handlers.close()
             self._log_handlers = None
 
+    @property
+    def stop_requested(self) -> bool:
+        """Whether `request_stop()` was called since `start()`."""
+        return self._stop_requested is not None and self._stop_requested.is_set()
+
     def request_stop(self) -> None:
         if self._stop_requested is not None:
             self._stop_requested.set()
 
     async def run(self) -> None:
+        gui = None
+        if self.common.show_gui:
+            from pygoby.moos.appgui import gui_for  # textual, only when asked for
+
+            gui = gui_for(self)
+            if gui is not None:
+                self.terminal_handler = gui.handler
         await self.start()
         assert self._stop_requested is not None
+        if self.common.show_gui and gui is None:
+            self.log.info("show_gui: standard output is not a terminal; the log stays plain text")
         try:
-            await self._stop_requested.wait()
+            if gui is not None:
+                await gui.run_until(self._stop_requested)
+            else:
+                await self._stop_requested.wait()
         finally:
             await self.stop()
+
+    def status_lines(self) -> list[str]:
+        """The app's state in a few lines (show_gui's status panel). Override to add yours."""
+        state = "connected" if self.connected else "not connected"
+        return [f"MOOSDB {self.client.host}:{self.client.port}: {state}",
+                f"up {self.clock.now() - self.start_time:.0f} s, {self.iterations} iterations"]  # fmt: skip
 
     async def __aenter__(self) -> GobyMOOSApp:
         await self.start(connect_timeout=5.0)

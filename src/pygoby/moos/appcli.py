@@ -3,7 +3,8 @@
     APP [options] mission.moos [moos_name]
 
 `-c/--moos_file` and `-a/--moos_name` are the two positionals by name, `-e/--example_config`
-prints a ProcessConfig block, `-V/--version` the version, and `--<field> <value>` (or
+prints a ProcessConfig block, `-V/--version` the version, `-v/--verbose` (repeated: -vvv)
+raises the terminal's verbosity, and `--<field> <value>` (or
 `--<field>=<value>`) overrides any top-level configuration field. `run_app(app_class, argv)` is
 what `GobyMOOSApp.main` does: read the configuration (a configuration error prints one clear
 message and exits 1 before connecting), then run the app until SIGINT/SIGTERM or until it stops
@@ -24,11 +25,13 @@ from typing import TYPE_CHECKING
 from pygoby.errors import ConfigError
 from pygoby.moos.appconfig import collecting_notes
 from pygoby.moos.moosfile import MissionFile
+from pygoby.util.console import quiet_broken_pipe
 
 if TYPE_CHECKING:
     from pygoby.moos.app import GobyMOOSApp
 
 Overrides = list[tuple[str, str]]
+VERBOSE_ENUM = 4  # goby.util.protobuf.GLogConfig.Verbosity.VERBOSE
 
 
 def package_version() -> str:
@@ -54,6 +57,9 @@ def argument_parser(program: str) -> argparse.ArgumentParser:
     parser.add_argument("-a", "--moos_name", help="same as the alias positional")
     parser.add_argument("-e", "--example_config", action="store_true", help="print an example ProcessConfig block and exit")
     parser.add_argument("-V", "--version", action="version", version=f"%(prog)s {package_version()}")
+    parser.add_argument("-v", "--verbose", action="count", default=0,
+                        help="terminal verbosity: -v VERBOSE, -vv DEBUG1, -vvv DEBUG2, -vvvv DEBUG3 "
+                        "(overrides common.verbosity)")  # fmt: skip
     return parser
 
 
@@ -96,8 +102,7 @@ def run_app(
     known, rest = parser.parse_known_args(args_in)
     name = known.moos_name or known.alias or program
     if known.example_config:
-        sys.stdout.write(app_class.example_config(name))
-        return 0
+        return quiet_broken_pipe(lambda: sys.stdout.write(app_class.example_config(name)) and 0)
     try:
         overrides = parse_overrides(rest)
     except ValueError as err:
@@ -106,12 +111,14 @@ def run_app(
     try:
         with collecting_notes() as notes:
             cfg = app_class.read_config(mission, name, overrides)
+        if known.verbose:  # Verbosity enum: VERBOSE=4, DEBUG1=5, DEBUG2=6, DEBUG3=7
+            cfg.common.verbosity = VERBOSE_ENUM + min(known.verbose, 4) - 1
         app = app_class(cfg, name=name, mission=mission)
         app.config_notes = notes
     except ConfigError as err:
         print(f"{name}: fatal configuration error: {err}", file=sys.stderr)
         return 1
-    return run_until_signal(app)
+    return quiet_broken_pipe(lambda: run_until_signal(app))
 
 
 def run_until_signal(app: GobyMOOSApp) -> int:

@@ -8,6 +8,8 @@
 * `example_config(config_class, app_name)`: the `--example_config` text.
 * `initializer_posts(common, mission)`: what `common.initializer` posts on every connect.
 * `prefixed_var_names(moos_var)`: an app's `moos_var { prefix: ... }` block as full names.
+* `config_line(block, field, value)`: the file line where a field (with that value) is set, for
+  errors found after parsing.
 * `goby_field_options(field)`: a field's `(goby.field)` options (description, example,
   moos_global, cfg.action), read from its serialized options so that it works for classes from
   any descriptor pool.
@@ -19,6 +21,7 @@ import contextlib
 import functools
 import logging
 import math
+import re
 from collections.abc import Callable, Iterator, Sequence
 from contextvars import ContextVar
 
@@ -27,7 +30,7 @@ from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
-from pygoby.moos.moosfile import MissionFile, parse_number
+from pygoby.moos.moosfile import GobyBlock, MissionFile, parse_number
 from pygoby.protobuf import builtin_class
 from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
 from pygoby.protobuf.wire import length_delimited
@@ -71,6 +74,17 @@ def locate(err: ConfigError, mission: MissionFile | None, app_name: str) -> Conf
 def parse_block(config: Message, text: str, first_line: int, source: str) -> None:
     """Merge TextFormat `text` into `config`; errors give the file line and the field."""
     merge_config_text(text, config, file=source, first_line=first_line)
+
+
+def config_line(block: GobyBlock, field: str, value: str = "") -> int | None:
+    """The file line of the first `field:` (the last part of a dotted name) in `block` whose line
+    also contains `value`; None when there is none (e.g. set from the command line)."""
+    name = re.escape(field.rsplit(".", 1)[-1])
+    pattern = re.compile(rf"(?<![\w.]){name}\s*:")
+    for index, text in enumerate(block.text.splitlines(), start=1):
+        if pattern.search(text) and value in text:
+            return block.file_line(index)
+    return None
 
 
 def apply_moos_globals(config: Message, mission: MissionFile) -> None:
@@ -302,6 +316,8 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
             value = _quote(opts.example) if field.type == FieldDescriptor.TYPE_STRING else opts.example
         elif field.type == FieldDescriptor.TYPE_STRING:
             value = '""'
+        elif field.is_required:  # goby3 prints nothing, which does not parse when copied
+            value = _placeholder(field)
         else:
             value = ""
         if field.type == FieldDescriptor.TYPE_ENUM:
@@ -313,6 +329,17 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
             comment += f' (can also set MOOS global "{opts.moos_global}=")'
         out.extend(_wrap(f"{indent}{name}: {value}  ", comment))
     return out
+
+
+def _placeholder(field: FieldDescriptor) -> str:
+    """A value of the field's type that parses (the first enumerator, 0, false, "")."""
+    if field.type == FieldDescriptor.TYPE_ENUM:
+        return field.enum_type.values[0].name
+    if field.type == FieldDescriptor.TYPE_BOOL:
+        return "false"
+    if field.type == FieldDescriptor.TYPE_BYTES:
+        return '""'
+    return "0"
 
 
 def example_config(config_class: type[Message], app_name: str) -> str:

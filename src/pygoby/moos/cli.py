@@ -73,7 +73,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     antler = subparsers.add_parser("antler", help="launch a mission's ANTLER block (and a MOOSDB)")
     antler.add_argument("mission")
-    antler.add_argument("--no-db", action="store_true", help="never start the embedded MOOSDB")
+    antler.add_argument("--no-db", action="store_true",
+                        help="do not start the embedded MOOSDB: use the one listening on ServerPort")  # fmt: skip
+    antler.add_argument("--logs", metavar="DIR",
+                        help="write each program's output to DIR/<name>.log instead of the terminal")  # fmt: skip
+    antler.add_argument("--color", choices=("auto", "always", "never"), default="auto",
+                        help="coloured name prefixes for NewConsole = true programs (auto: on a terminal)")  # fmt: skip
     antler.set_defaults(func=_run_antler)
 
 
@@ -123,7 +128,8 @@ async def _serve(db: MOOSDB) -> int:
     loop = asyncio.get_running_loop()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
-    print(f"MOOSDB {db.community} listening on {db.host}:{db.port}", flush=True)
+    if not logging.getLogger("pygoby.moos.db").isEnabledFor(logging.INFO):  # else it logs it
+        print(f"MOOSDB {db.community} listening on {db.host}:{db.port}", flush=True)
     await stop.wait()
     await db.stop()
     return 0
@@ -255,4 +261,5 @@ async def _watch(args: argparse.Namespace) -> int:
 def _run_antler(args: argparse.Namespace) -> int:
     from pygoby.moos.antler import run_antler
 
-    return run_antler(args.mission, start_db=not args.no_db)
+    colour = {"auto": None, "always": True, "never": False}[args.color]
+    return run_antler(args.mission, start_db=not args.no_db, logs=args.logs, colour=colour)

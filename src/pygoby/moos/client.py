@@ -124,10 +124,9 @@ class MOOSClient:
 
     async def close(self) -> None:
         if self._task is not None:
-            self._task.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await self._task
-            self._task = None
+            task, self._task = self._task, None
+            task.cancel()
+            await asyncio.wait([task])  # a cancellation of close() itself still propagates
 
     async def __aenter__(self) -> MOOSClient:
         await self.connect()
@@ -342,8 +341,14 @@ class MOOSClient:
             await self._read_loop(reader, framer, early)
         finally:
             write_task.cancel()
-            with contextlib.suppress(asyncio.CancelledError, OSError):
-                await write_task
+            # asyncio.wait, not `await write_task` under suppress(CancelledError): that would
+            # also swallow a cancellation of this task (close() during a lost connection), and
+            # the client would go on reconnecting while close() waits for it
+            await asyncio.wait([write_task])
+            if not write_task.cancelled():
+                error = write_task.exception()
+                if error is not None and not isinstance(error, OSError):
+                    raise error
 
     def _resend_registrations(self) -> None:
         pending = list(self._outbox)

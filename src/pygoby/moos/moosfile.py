@@ -126,9 +126,17 @@ class MissionFile:
     def from_text(cls, text: str) -> MissionFile:
         return cls(text.splitlines())
 
+    def search_dirs(self) -> list[str]:
+        """Where relative file names in the mission are looked up: the working directory, then
+        the mission file's folder (so that missions can be run from anywhere)."""
+        dirs = [str(Path.cwd())]
+        if self.path:
+            dirs.append(str(Path(self.path).resolve().parent))
+        return list(dict.fromkeys(dirs))
+
     def find_file(self, path: str) -> str:
         """A relative path that does not exist from the working directory is looked up next to
-        the mission file (so that missions can be run from anywhere)."""
+        the mission file; `path` unchanged when it is found in neither."""
         given = Path(path)
         if given.is_absolute() or given.exists() or not self.path:
             return path

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -88,6 +89,7 @@ class PhysicsChannel:
         self._endpoints: dict[int, ChannelEndpoint] = {}
         self._answering: tuple[int, float] | None = None  # (port, owtt) of a ping being heard
         self._last_poll = -math.inf
+        self.delivered: Counter[int] = Counter()  # packets handed to each port's modem
 
     # -- the mmsim Channel interface -----------------------------------------------------------
 
@@ -175,6 +177,7 @@ class PhysicsChannel:
             self._log_reception(r, sent, delivered, travel_time)
         if not delivered:
             return
+        self.delivered[r.receiver] += 1
         assert endpoint is not None
         reception = ModemReception(
             arrival_time=r.arrival,

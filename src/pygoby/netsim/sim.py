@@ -62,6 +62,7 @@ DRIVER_WHOI_MICROMODEM = 2
 SLOT_EPSILON = 1e-3  # s: a MAC slot fires once the clock is past its start
 STARTUP_STEP = 0.01  # s: drivers set the modem clock just after a whole second
 STARTUP_LIMIT = 120.0  # s of simulated time for every driver to finish its start-up
+PROGRESS_STEPS = 512  # discrete-event steps between progress reports (a report reads the clock)
 MAX_EXCHANGES = 10_000  # driver <-> emulator sentences at one instant before giving up
 LOCAL_IP = "127.0.0.1"
 
@@ -148,6 +149,8 @@ class RunSummary:
     outcomes: Counter
     status_sent: int
     status_received: int
+    external_deliveries: dict[int, int] = field(default_factory=dict)  # modem id -> packets
+    interrupted: bool = False
 
     @property
     def speedup(self) -> float:
@@ -160,7 +163,17 @@ class RunSummary:
             "events: " + ", ".join(f"{k} {v}" for k, v in sorted(self.events.items())),
             "receptions: " + ", ".join(f"{k} {v}" for k, v in sorted(self.outcomes.items())),
             f"status messages: {self.status_sent} queued, {self.status_received} delivered",
+            *self._external_lines(),
+            *(["interrupted before the end of the scenario"] if self.interrupted else []),
         ]
+
+    def _external_lines(self) -> list[str]:
+        """External stacks (e.g. pAcommsHandler with iNetSimManager): what the channel handed
+        to their modems, as this side cannot see their messages."""
+        if not self.external_deliveries:
+            return []
+        counts = ", ".join(f"modem {i}: {n}" for i, n in sorted(self.external_deliveries.items()))
+        return [f"packets delivered to external stacks' modems: {counts}"]
 
 
 class Simulation:
@@ -208,6 +221,11 @@ class Simulation:
         driver.signal_receive.connect(lambda msg, n=node: self._modem_heard(n, msg))
 
     def start_macs(self) -> None:
+        """Start the run's traffic: a `node` event per node (its port and modem id, for the
+        report), then every in-process stack's MAC and first status message."""
+        for node in self.nodes:
+            self._event({"event": "node", "t": self.clock.now(), "port": node.port,
+                         "modem_id": node.modem_id, "external": node.driver is None})  # fmt: skip
         for node in self.nodes:
             if node.mac is not None:
                 node.mac.startup(mac_config(self.scenario, node.modem_id))
@@ -302,8 +320,19 @@ class Simulation:
             events=Counter(self.events),
             outcomes=Counter(self.outcomes),
             status_sent=self.status_sent,
-            status_received=sum(sum(n.received.values()) for n in self.nodes),
+            status_received=self.status_received,
+            external_deliveries={
+                n.modem_id: self.physics.delivered[n.port] for n in self.nodes if n.driver is None
+            },
         )
+
+    @property
+    def status_received(self) -> int:
+        return sum(sum(n.received.values()) for n in self.nodes)
+
+    @property
+    def packets_delivered(self) -> int:
+        return sum(self.physics.delivered.values())
 
     # -- discrete-event run ----------------------------------------------------------------------
 
@@ -315,9 +344,11 @@ class Simulation:
             driver.startup(driver_config(node.modem_id))
             self.attach_stack(node, driver)
 
-    def run_virtual(self, until: float | None = None) -> RunSummary:
+    def run_virtual(
+        self, until: float | None = None, progress: Callable[[], None] | None = None
+    ) -> RunSummary:
         """Build, start and run to `until` (default: the scenario's duration) on the virtual
-        clock, jumping from event to event."""
+        clock, jumping from event to event; `progress()` is called every few hundred steps."""
         if not isinstance(self.clock, VirtualClock):
             raise TypeError("run_virtual needs a VirtualClock")
         clock = self.clock
@@ -333,6 +364,7 @@ class Simulation:
         next_housekeeping = clock.now() + housekeeping
         macs = [n.mac for n in self.nodes if n.mac is not None]
         nodes, waiting = self.nodes, self._waiting
+        steps = 0
         while True:
             now = clock.now()
             t = min(end, next_position, next_housekeeping)
@@ -367,6 +399,10 @@ class Simulation:
                     self._pump(nodes[index])
             if now >= end:
                 return self.summary()
+            if progress is not None:
+                steps += 1
+                if not steps % PROGRESS_STEPS:
+                    progress()
 
     def _start_drivers(self, clock: VirtualClock) -> None:
         deadline = clock.now() + STARTUP_LIMIT

@@ -61,14 +61,19 @@ class AcommsMessageSet:
     find: Callable[[str], str] = str
 
     @classmethod
-    def load(cls, cfg: Message, find: Callable[[str], str] = str) -> AcommsMessageSet:
+    def load(
+        cls, cfg: Message, find: Callable[[str], str] = str, search_dirs: Sequence[str] = (),
+        config_error: Callable[[str, str, str], ConfigError] | None = None,
+    ) -> AcommsMessageSet:  # fmt: skip
         """Load `cfg`'s message files; `find` resolves relative file names (the mission's
-        find_file). The XML files' entries are appended to `cfg`, so load a configuration once.
-        ConfigError for files that cannot be used."""
-        try:  # C++ DCCL codec libraries (libdccl_ccl_compat.so, ...) are pygoby built-ins
-            dccl_libraries, modules = split_libraries(cfg.load_shared_library)
-        except DcclError as err:
-            raise ConfigError(f"load_shared_library: {err}") from None
+        find_file), `search_dirs` are the folders it looks in (for "not found" errors). The XML
+        files' entries are appended to `cfg`, so load a configuration once. ConfigError for
+        files that cannot be used, made by `config_error(reason, field, value)` (located at the
+        mission line: GobyMOOSApp.config_error) when given."""
+        error = config_error or (lambda reason, field, value: ConfigError(reason, field=field))
+        dccl_libraries, modules = split_libraries(
+            cfg.load_shared_library, lambda reason, name: error(reason, "load_shared_library", name)
+        )
         loader = ProtoLoader()
         transitional = TransitionalMessages.expand(cfg, loader, find)
         types = MessageTypes(
@@ -77,8 +82,16 @@ class AcommsMessageSet:
             [find(module) for module in modules],
             fallback=acomms_pb.goby_message_class,
             loader=loader,
+            search_dirs=search_dirs,
+            config_error=config_error,
         )  # fmt: skip
         return cls(cfg, loader, types, transitional, dccl_libraries, find)
+
+    def loaded(self) -> list[str]:
+        """The message types the files, modules, libraries and XML files define."""
+        from_libraries = [name for library in self.dccl_libraries for name in library.messages]
+        xml = [name for message_set in self.transitional.sets for name in message_set.names]
+        return [*self.types.loaded, *from_libraries, *xml]
 
     @classmethod
     def of_app(

@@ -14,8 +14,9 @@ import argparse
 import logging
 import shutil
 import sys
-import time
 from pathlib import Path
+
+from pygoby.util.progress import RunProgress
 
 
 def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
@@ -77,8 +78,8 @@ def sweep_command(args: argparse.Namespace) -> int:
     print(f"sweep: {len(plan.runs)} runs on {executor.description}; results in {output}",
           flush=True)  # fmt: skip
     try:
-        with ProgressDisplay() as progress:
-            outcome = run_sweep(plan, store, executor, progress)
+        with RunProgress("sweep", unit="runs") as progress:
+            outcome = run_sweep(plan, store, executor, lambda done, total: progress.update(done, total))
     except KeyboardInterrupt:
         stored = len(store.stored() & {r.run_id for r in plan.runs})
         print(f"\ninterrupted: {stored} of {len(plan.runs)} runs are stored in {output}; "
@@ -96,60 +97,6 @@ def sweep_command(args: argparse.Namespace) -> int:
               file=sys.stderr)  # fmt: skip
         return 1
     return 0
-
-
-class ProgressDisplay:
-    """Runs done/total with the ETA: a rich progress bar on a terminal, else a plain line at
-    every tenth of the sweep (logs and CI)."""
-
-    def __init__(self, stream=None) -> None:
-        self.stream = stream if stream is not None else sys.stderr
-        self._bar = None
-        self._task = None
-        self._first: tuple[float, int] | None = None
-        self._printed = -1
-
-    def __enter__(self) -> ProgressDisplay:
-        if self.stream.isatty():
-            from rich.console import Console
-            from rich.progress import (
-                BarColumn,
-                MofNCompleteColumn,
-                Progress,
-                TextColumn,
-                TimeElapsedColumn,
-                TimeRemainingColumn,
-            )
-
-            self._bar = Progress(
-                TextColumn("runs"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                TextColumn("ETA"), TimeRemainingColumn(), console=Console(file=self.stream),
-            )  # fmt: skip
-            self._bar.start()
-        return self
-
-    def __exit__(self, *exc) -> None:
-        if self._bar is not None:
-            self._bar.stop()
-
-    def __call__(self, done: int, total: int) -> None:
-        if self._bar is not None:
-            if self._task is None:
-                self._task = self._bar.add_task("runs", total=total, completed=done)
-            self._bar.update(self._task, completed=done)
-            return
-        now = time.monotonic()
-        if self._first is None:
-            self._first = (now, done)
-        tenth = done * 10 // max(total, 1)
-        if tenth == self._printed and done < total:
-            return
-        self._printed = tenth
-        start, first_done = self._first
-        eta = ""
-        if done > first_done and done < total:
-            eta = f", ETA {(now - start) / (done - first_done) * (total - done):.0f} s"
-        print(f"runs {done}/{total}{eta}", file=self.stream, flush=True)
 
 
 def sweep_report_command(args: argparse.Namespace) -> int:
