@@ -149,7 +149,7 @@ async def test_ccl_and_dccl_simple_status_reaches_mm2(tmp_path):
 
 # Example 2 carries REMUS State frames only (CCL id 14, mm2 -> mm1); the Redirect command needs
 # a CCL queue for id 7 on both nodes, on pREMUSCodec's default Redirect variables (README,
-# "pREMUSCodec").
+# "pREMUSCodec": with value_base 10 it beats SIMPLE_STATUS's queue after 18 s of waiting).
 REDIRECT_QUEUE = """queue_cfg
 {
     queue
@@ -158,6 +158,7 @@ REDIRECT_QUEUE = """queue_cfg
         in_pubsub_var: "IN_REMUS_REDIRECT_HEX_30B"
         out_pubsub_var: "OUT_REMUS_REDIRECT_HEX_30B"
         name: "Remus_Redirect"
+        value_base: 10
     }
 """
 REDIRECT = ("MessageType=CCL_REDIRECT,DestinationPlatformId=2,Latitude=42.36,Longitude=-70.94,"
