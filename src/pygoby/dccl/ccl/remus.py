@@ -17,6 +17,11 @@ source of these frames) differed, this module follows C++ DCCL and says so:
 * latitude/longitude are sign-extended (Goby 1.1's decoder was not: Quirk Q19);
 * Redirect row_length keeps all 16 bits (1.1's decoder kept 13).
 
+Inputs beyond a field's range follow C++ DCCL too: depths saturate at 0 and 6000 m, speeds at
++-127 steps, GFI and oil at 0 and 100 %, and a pitch of +90 degrees or more wraps to -91.4
+(6 signed bits). Values a field cannot hold at all (a latitude beyond +-90, a velocity beyond
+its byte, an integer out of its bytes) raise CCLEncodeError.
+
 Multi-byte fields are little-endian, except the Ranger's BCD fields (most significant digit
 first). Frames longer than 32 bytes are read up to byte 31; a frame may be shorter than 32 bytes
 as long as it holds every field its type reads (the rest counts as zeros).
@@ -560,11 +565,14 @@ class Alert(_AlertBase):
     CONTACT = AlertContact
 
 
-Alert.LAYOUT = (
+_ALERT_HEAD = (  # both alert forms: id byte, OASIS time, position
     _uint("mode", (0,)),
     _uint("oasis_time", (1, 2, 3, 4)),
     _latlon("latitude", (5, 6, 7), 90.0),
     _latlon("longitude", (8, 9, 10), 180.0),
+)
+Alert.LAYOUT = (
+    *_ALERT_HEAD,
     _heading("heading", (11,)),
     *_alert_layout(_ALERT_CONTACT, (12, 18, 24)),
 )
@@ -586,10 +594,7 @@ class Alert2(_AlertBase):
 
 
 Alert2.LAYOUT = (
-    _uint("mode", (0,)),
-    _uint("oasis_time", (1, 2, 3, 4)),
-    _latlon("latitude", (5, 6, 7), 90.0),
-    _latlon("longitude", (8, 9, 10), 180.0),
+    *_ALERT_HEAD,
     *_alert_layout(_ALERT2_CONTACT, (11, 18, 25)),
 )
 
