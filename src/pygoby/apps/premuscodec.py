@@ -18,23 +18,22 @@ from __future__ import annotations
 import math
 from functools import partial
 
-from google.protobuf import text_format
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.apps.pacommshandler_goby11 import GOBY11_TECHNIQUE, parse_goby11
 from pygoby.apps.premuscodec_reports import RemusReports
 from pygoby.dccl import DcclError
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.moos.translator import serialize_for_moos
+from pygoby.moos.translator import Technique, TranslatorError, parse_for_moos, serialize_for_moos
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup, atoi
 
 STATUS_INTERVAL = 10.0  # seconds between our State frames (Goby 1.1's fixed interval)
 NAV_VARS = ("NAV_X", "NAV_Y", "NAV_DEPTH", "NAV_SPEED", "NAV_HEADING")
 COMMAND_VAR = "OUTGOING_COMMAND"
+TEXT = Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT  # Goby 1.1's ModemDataTransmission on MOOS
 
 
 class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
@@ -90,8 +89,8 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
             return
         transmission = acomms_pb.V1ModemDataTransmission()
         try:
-            parse_goby11(msg.value, transmission)
-        except text_format.ParseError as err:
+            parse_for_moos(msg.value, transmission, TEXT)
+        except TranslatorError as err:
             self.log.warning("%s: not a ModemDataTransmission (%s); skipped", msg.key, err)
             return
         data = transmission.data
@@ -110,7 +109,7 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
     def _send(self, var: str, frame: bytes, dest: int) -> None:
         transmission = acomms_pb.V1ModemDataTransmission(data=frame)
         transmission.base.src, transmission.base.dest = self.modem_id, dest
-        text = serialize_for_moos(transmission, GOBY11_TECHNIQUE)
+        text = serialize_for_moos(transmission, TEXT)
         self.log.info("publishing to %s: %s", var, text)
         self.publish(var, text)
 
