@@ -27,6 +27,7 @@ from pygoby.dccl.ccl.remus import (
     Ranger,
     Redirect,
     State,
+    TimeDate,
 )
 from pygoby.errors import ConfigError
 from pygoby.moos.client import MOOSClient
@@ -247,7 +248,9 @@ async def test_create_status_every_10_s_once_all_nav_arrived(tmp_path):
     assert states[0].latitude == pytest.approx(lat, abs=1.1e-5) and states[0].longitude == pytest.approx(lon, abs=1.1e-5)
     assert (states[0].heading, states[0].depth) == (32 * 360 / 255, 111.0)
     gaps = [b.time - a.time for a, b in zip(posts, posts[1:], strict=False)]
-    assert all(gap >= 10.0 for gap in gaps)  # MOOS (warped) seconds
+    assert all(gap >= 10.0 for gap in gaps)  # MOOS (warped) seconds; each post has its frame's time
+    for post, state in zip(posts, states, strict=True):
+        assert state.time == TimeDate.at(post.time)._replace(second=TimeDate.at(post.time).second // 4 * 4)
 
 
 async def test_outgoing_command_becomes_a_redirect_frame(tmp_path, capsys):

@@ -106,12 +106,12 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
             self.publish(var, value)
 
     # ------------------------------------------------------------------ frames out
-    def _send(self, var: str, frame: bytes, dest: int) -> None:
+    def _send(self, var: str, frame: bytes, dest: int, time: float | None = None) -> None:
         transmission = acomms_pb.V1ModemDataTransmission(data=frame)
         transmission.base.src, transmission.base.dest = self.modem_id, dest
         text = serialize_for_moos(transmission, TEXT)
         self.log.info("publishing to %s: %s", var, text)
-        self.publish(var, text)
+        self.publish(var, text, time=time)
 
     def _nav(self) -> list[float] | None:
         """NAV_X, NAV_Y, NAV_DEPTH, NAV_SPEED, NAV_HEADING once all are doubles."""
@@ -134,7 +134,7 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
         except DcclError as err:
             self.log.warning("cannot encode our State from NAV_*: %s", err)
             return
-        self._send(self.cfg.mdat_state_out, frame, dest=0)
+        self._send(self.cfg.mdat_state_out, frame, dest=0, time=now)  # stamped with the frame's time
 
     def _on_command(self, msg: MOOSMessage) -> None:
         if msg.is_double:

@@ -10,10 +10,12 @@
   (`pygoby.dccl.identifier`).
 """
 
+from pygoby.dccl.ccl.remus import CCLEncodeError, CCLFrameError
+
 CCL_PROTO = "dccl/ccl/protobuf/ccl.proto"
 CCL_MESSAGES = tuple(
     f"dccl.legacyccl.protobuf.CCLMDAT{name}"
     for name in ("Empty", "Redirect", "Bathy", "CTD", "State", "Command", "Error")
 )
 
-__all__ = ["CCL_MESSAGES", "CCL_PROTO", "codecs", "fields", "remus"]
+__all__ = ["CCL_MESSAGES", "CCL_PROTO", "CCLEncodeError", "CCLFrameError", "codecs", "fields", "remus"]
