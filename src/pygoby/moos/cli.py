@@ -9,7 +9,6 @@ import json
 import logging
 import os
 import re
-import signal
 import sys
 from collections.abc import Coroutine
 from typing import Any
@@ -26,6 +25,7 @@ from pygoby.moos.db import (
 )
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.timewarp import moos_clock
+from pygoby.util.aiorun import StopSignals
 
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
@@ -120,12 +120,10 @@ async def _serve(db: MOOSDB) -> int:
         print(f"moosdb: cannot listen on {db.host}:{db.port}: {err.strerror}", file=sys.stderr)
         return 1
     stop = asyncio.Event()
-    loop = asyncio.get_running_loop()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        loop.add_signal_handler(sig, stop.set)
-    print(f"MOOSDB {db.community} listening on {db.host}:{db.port}", flush=True)
-    await stop.wait()
-    await db.stop()
+    with StopSignals(asyncio.get_running_loop(), stop.set, "moosdb"):
+        print(f"MOOSDB {db.community} listening on {db.host}:{db.port}", flush=True)
+        await stop.wait()
+        await db.stop()
     return 0
 
 

@@ -119,7 +119,8 @@ class RealTimeRun:
                 if housekeeping and node.queue is not None:
                     node.queue.do_work()
             with contextlib.suppress(TimeoutError):
-                await asyncio.wait_for(self._stop.wait(), WORK_PERIOD)
+                async with asyncio.timeout(WORK_PERIOD):
+                    await self._stop.wait()
         return sim.summary()
 
     async def close(self) -> None:

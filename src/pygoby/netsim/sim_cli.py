@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import logging
 import sys
 
@@ -89,6 +88,7 @@ def run_command(args: argparse.Namespace) -> int:
 
 async def _run_real_time(scenario, log):
     from pygoby.netsim.realtime import RealTimeRun
+    from pygoby.util.aiorun import StopSignals
 
     run = RealTimeRun(scenario, on_event=log)
     async with run:
@@ -100,14 +100,9 @@ async def _run_real_time(scenario, log):
                 + (" with in-process driver/MAC/queue" if node.driver is not None else ""),
                 flush=True,
             )
-        task = asyncio.ensure_future(run.run())
-        try:
-            return await task
-        except asyncio.CancelledError:
-            run.request_stop()
-            with contextlib.suppress(asyncio.CancelledError):
-                return await task
-            raise
+        # SIGINT/SIGTERM end the run early, with its summary and a complete event log
+        with StopSignals(asyncio.get_running_loop(), run.request_stop, "pygoby netsim run"):
+            return await run.run()
 
 
 def report_command(args: argparse.Namespace) -> int:
