@@ -46,7 +46,7 @@ The base provides
 * Running: `await app.start()` / `await app.stop()`, or `async with app:`, or `await app.run()`
   (until `app.request_stop()`). Mail is handled and `loop()` runs every 1/app_tick seconds
   (warped); while disconnected `loop()` and the timers are not called (as CMOOSApp), unless
-  the class sets `run_while_disconnected = True` (its posts are then queued and delivered
+  the class sets `iterate_without_comms = True` (its posts are then queued and delivered
   when the DB is back).
 * `subscribe(var, handler=None, blackout=0.0)`, `subscribe_pattern(var_pattern, app_pattern,
   handler)`, `publish(var, value, src_aux="", time=None)` (queued while disconnected, sent on
@@ -153,9 +153,10 @@ class GobyMOOSApp:
     config_proto: ClassVar[tuple[str, str] | None] = None
     default_name: ClassVar[str] = ""
     ignore_stale: ClassVar[bool] = True
-    # loop() and the timers also run while the MOOSDB is away (CMOOSApp pauses them): for apps
-    # driving hardware or a schedule that must not stop with the DB (pAcommsHandler's modem)
-    run_while_disconnected: ClassVar[bool] = False
+    # loop() and the timers also run while the MOOSDB is away (CMOOSApp's
+    # SetIterateWithoutComms): for apps driving hardware or a schedule that must not stop with
+    # the DB (pAcommsHandler's modem and MAC, iFrontSeat's frontseat link)
+    iterate_without_comms: ClassVar[bool] = False
 
     # -- configuration -------------------------------------------------------------------------
 
@@ -485,7 +486,7 @@ class GobyMOOSApp:
         self._handle_mail()
         if self.client.connected:
             self._post_status()
-        elif not self.run_while_disconnected:
+        elif not self.iterate_without_comms:
             return
         try:
             self.loop()
