@@ -126,6 +126,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def on_stop(self) -> None:
         self.acomms.shutdown()
+        self.acomms.close()
 
     async def start(self, connect_timeout: float | None = None) -> None:
         await super().start(connect_timeout)
