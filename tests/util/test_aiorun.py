@@ -116,3 +116,31 @@ async def test_cancel_and_wait_raises_what_the_task_failed_with():
     with pytest.raises(OSError, match="disk gone"):
         await cancel_and_wait(task)
     await cancel_and_wait(None)
+
+
+CHOKED_PROGRAM = """
+import asyncio, sys
+from pygoby.util.aiorun import run_until_signal
+
+async def serve():
+    try:
+        print("ready", flush=True)
+        await asyncio.Future()
+    finally:
+        sys.stderr.write("x" * 10_000_000)  # into a pipe nobody reads: blocks for ever
+        sys.stderr.flush()
+
+run_until_signal(serve(), name="choked_server")
+"""
+
+
+def test_a_program_blocked_on_a_full_stderr_pipe_still_ends():
+    proc = subprocess.Popen([sys.executable, "-c", CHOKED_PROGRAM], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        assert proc.stdout.readline() == "ready\n"
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=STOP_GRACE + 5) == 128 + signal.SIGTERM  # stderr still unread
+    finally:
+        proc.kill()
+        proc.communicate()

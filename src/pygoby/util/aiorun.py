@@ -86,8 +86,12 @@ class StopSignals:
         self.loop.call_soon_threadsafe(self.request_stop)
 
     def _force(self, why: str, signum: int) -> None:
-        # os.write: no buffered stream's lock, which a stuck main thread may hold
-        os.write(sys.stderr.fileno(), f"{self.name}: {why}; exiting now\n".encode())
+        # os.write: no buffered stream's lock, which a stuck main thread may hold; from a thread
+        # of its own: stderr may be a full pipe nobody reads, and the exit must not wait on it
+        line = f"{self.name}: {why}; exiting now\n".encode()
+        writer = threading.Thread(target=os.write, args=(sys.stderr.fileno(), line), daemon=True)
+        writer.start()
+        writer.join(0.5)
         os._exit(128 + signum)
 
 
