@@ -50,7 +50,7 @@ from pygoby.moos.client import MAX_REFUSED_BACKOFF, MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.util.aiorun import STOP_GRACE
 from pygoby.util.nmea import with_checksum
-from tests.apps.acomms_mission import Recorder, mission_text
+from tests.apps.acomms_mission import Recorder, mission_text, modem_and_db
 from tests.faults import CuttableRelay
 
 Scenario = Callable[[float, Path], Awaitable[Figures]]
@@ -278,21 +278,15 @@ async def pacommshandler_kill9(seconds: float, workdir: Path) -> Figures:
     """Vehicle 1's pAcommsHandler (a process, persistent queue) is sent commands and killed
     with SIGKILL at random moments; vehicle 2 (in this process) receives. lost = commands
     whose queuing vehicle 1 reported (ACOMMS_QSIZE) that never reached vehicle 2."""
-    from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
-    from pygoby.acomms.mmsim.server import MMSimServer
+    from pygoby.acomms.mmsim import LoopbackChannel
     from pygoby.apps.pacommshandler import pAcommsHandler
     from pygoby.util.clock import WallClock
 
     figures = Figures()
     channel, clock = LoopbackChannel(), WallClock()
     async with contextlib.AsyncExitStack() as stack:
-        sims, dbs = [], []
-        for modem_id in (1, 2):
-            sim = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
-            await sim.start()
-            stack.push_async_callback(sim.close)
-            sims.append(sim)
-            dbs.append(await stack.enter_async_context(MOOSDB(port=0, community=f"vehicle{modem_id}")))
+        sims, dbs = zip(*[await modem_and_db(stack, modem_id, channel, clock) for modem_id in (1, 2)],
+                        strict=True)  # fmt: skip
         text = mission_text(1, dbs[0].port, sims[0].port).replace(
             "  queue_cfg {\n", '  queue_cfg {\n    persistent_queue_file: "queue.sqlite"\n', 1)
         (workdir / "vehicle1.moos").write_text(text)

@@ -154,6 +154,18 @@ WATCHED = [
 ]  # fmt: skip
 
 
+async def modem_and_db(
+    stack: contextlib.AsyncExitStack, modem_id: int, channel, clock
+) -> tuple[MMSimServer, MOOSDB]:
+    """An emulated Micro-Modem served on loopback TCP and the MOOSDB of community
+    `vehicle<modem_id>`, both closed with `stack`."""
+    sim = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
+    await sim.start()
+    stack.push_async_callback(sim.close)
+    db = await stack.enter_async_context(MOOSDB(port=0, community=f"vehicle{modem_id}"))
+    return sim, db
+
+
 class TwoCommunities:
     """Emulators + DBs + pAcommsHandlers + recorders; `extra` adds config to both apps."""
 
@@ -166,11 +178,7 @@ class TwoCommunities:
         clock = WallClock()
         self.sims, self.dbs, self.apps, self.recorders = [], [], [], []
         for modem_id in (1, 2):
-            sim = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
-            await sim.start()
-            self.stack.push_async_callback(sim.close)
-            db = MOOSDB(port=0, community=f"vehicle{modem_id}")
-            await self.stack.enter_async_context(db)
+            sim, db = await modem_and_db(self.stack, modem_id, channel, clock)
             path = self.tmp_path / f"vehicle{modem_id}.moos"
             path.write_text(mission_text(modem_id, db.port, sim.port, self.extra, self.slots))
             app = pAcommsHandler.from_mission(path, "pAcommsHandler")

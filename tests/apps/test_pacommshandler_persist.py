@@ -14,14 +14,13 @@ import signal
 import sys
 from pathlib import Path
 
-from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
-from pygoby.acomms.mmsim.server import MMSimServer
+from pygoby.acomms.mmsim import LoopbackChannel
 from pygoby.acomms.queue.persist import QueueStore
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.db import MOOSDB
 from pygoby.util.clock import WallClock
 
-from .acomms_mission import Recorder, mission_text
+from .acomms_mission import Recorder, mission_text, modem_and_db
 
 PACOMMSHANDLER = str(Path(sys.executable).with_name("pAcommsHandler"))
 TTL = 12  # s: the first command outlives the first kill, the second one does not
@@ -67,10 +66,7 @@ def command_ids(recorder: Recorder) -> list[str]:
 async def test_queued_commands_survive_kill_9(tmp_path):
     channel, clock = LoopbackChannel(), WallClock()
     async with contextlib.AsyncExitStack() as stack:
-        sim1 = MMSimServer(MicroModemModel(1, clock, channel), channel)
-        await sim1.start()
-        stack.push_async_callback(sim1.close)
-        db1 = await stack.enter_async_context(MOOSDB(port=0, community="vehicle1"))
+        sim1, db1 = await modem_and_db(stack, 1, channel, clock)
         text = mission_text(1, db1.port, sim1.port).replace("  queue_cfg {\n", PERSIST, 1)
         mission = tmp_path / "vehicle1.moos"
         mission.write_text(text.replace("ack: true  value_base: 5  ttl: 600", f"ack: true  value_base: 5  ttl: {TTL}"))
@@ -97,10 +93,7 @@ async def test_queued_commands_survive_kill_9(tmp_path):
         await asyncio.sleep(first_queued + TTL + 1 - loop.time())  # 11 expires, 22 does not
 
         # Vehicle 2 joins; vehicle 1 restarts: 11 expires at once, 22 is sent and acked.
-        sim2 = MMSimServer(MicroModemModel(2, clock, channel), channel)
-        await sim2.start()
-        stack.push_async_callback(sim2.close)
-        db2 = await stack.enter_async_context(MOOSDB(port=0, community="vehicle2"))
+        sim2, db2 = await modem_and_db(stack, 2, channel, clock)
         path2 = tmp_path / "vehicle2.moos"
         path2.write_text(mission_text(2, db2.port, sim2.port))
         r2 = Recorder("recorder2", db2.port)

@@ -237,21 +237,22 @@ async def test_command_line_and_example_config_as_a_program(tmp_path):
             assert await asyncio.wait_for(proc.wait(), 10) == 0
 
 
-async def _app_process(script: str, path: Path, name: str) -> asyncio.subprocess.Process:
+async def _app_process(tmp_path: Path, db_port: int, script: str = "example_app.py") -> asyncio.subprocess.Process:
+    """`script` run as a program on a mission whose DB is at `db_port` (pipes for its output)."""
+    path = tmp_path / "m.moos"
+    path.write_text(_mission(db_port, BLOCK))
     return await asyncio.create_subprocess_exec(
-        sys.executable, str(HERE / script), str(path), name,
+        sys.executable, str(HERE / script), str(path), "pTestApp",
         stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE,
     )  # fmt: skip
 
 
 async def test_a_second_instance_with_a_taken_name_exits_with_a_clear_error(tmp_path):
     async with MOOSDB(port=0) as db:
-        path = tmp_path / "m.moos"
-        path.write_text(_mission(db.port, BLOCK))
-        first = await _app_process("example_app.py", path, "pTestApp")
+        first = await _app_process(tmp_path, db.port)
         try:
             await _wait_for(lambda: "pTestApp" in db.client_names, timeout=10)
-            second = await _app_process("example_app.py", path, "pTestApp")
+            second = await _app_process(tmp_path, db.port)
             _, err = await asyncio.wait_for(second.communicate(), 10)
             assert second.returncode == 1
             assert 'A client of this name ("pTestApp") already exists' in err.decode()
@@ -268,9 +269,7 @@ async def test_an_app_refused_on_reconnect_keeps_trying(tmp_path):
     async with MOOSDB(port=0, client_timeout=1.5) as db, MOOSClient("tester", port=db.port) as tester:
         relay = CuttableRelay(db.port)
         await relay.start()
-        path = tmp_path / "m.moos"
-        path.write_text(_mission(relay.port, BLOCK))
-        proc = await _app_process("example_app.py", path, "pTestApp")
+        proc = await _app_process(tmp_path, relay.port)
         try:
             tester.subscribe("ECHO")
             await _wait_for(lambda: "pTestApp" in db.client_names, timeout=10)
@@ -283,7 +282,7 @@ async def test_an_app_refused_on_reconnect_keeps_trying(tmp_path):
             assert (msg.value, msg.src) == (8.0, "pTestApp")
         finally:
             proc.terminate()
-            out, _ = await asyncio.wait_for(proc.communicate(), 10)
+            await asyncio.wait_for(proc.communicate(), 10)
             await relay.close()
         assert proc.returncode == 0
 
@@ -291,9 +290,7 @@ async def test_an_app_refused_on_reconnect_keeps_trying(tmp_path):
 @pytest.mark.parametrize("signals", [["SIGTERM"], ["SIGINT"], ["SIGTERM", "SIGINT"]])
 async def test_a_signal_ends_an_app_whose_stop_hangs(tmp_path, signals):
     async with MOOSDB(port=0) as db:
-        path = tmp_path / "m.moos"
-        path.write_text(_mission(db.port, BLOCK))
-        proc = await _app_process("stuck_app.py", path, "pTestApp")
+        proc = await _app_process(tmp_path, db.port, "stuck_app.py")
         try:
             await _wait_for(lambda: "pTestApp" in db.client_names, timeout=10)
             loop = asyncio.get_running_loop()

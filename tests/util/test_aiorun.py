@@ -15,7 +15,7 @@ import pytest
 from pygoby.util.aiorun import STOP_GRACE, cancel_and_wait
 
 PROGRAM = """
-import asyncio
+import asyncio, sys, time
 from pygoby.util.aiorun import run_until_signal
 
 async def serve():
@@ -23,23 +23,35 @@ async def serve():
         print("ready", flush=True)
         await asyncio.Future()
     finally:
-        print("closed", flush=True)
+        CLEANUP
 
-run_until_signal(serve())
+run_until_signal(serve(), name="a_server")
 """
+CLEAN = 'print("closed", flush=True)'
+STUCK = "time.sleep(3600)  # a cleanup that blocks the event loop"
+CHOKED = 'sys.stderr.write("x" * 10_000_000); sys.stderr.flush()  # into a pipe nobody reads'
+
+
+def signalled(cleanup: str, signum: int, read_stderr: bool = True) -> tuple[subprocess.Popen, str, float]:
+    """The program with `cleanup`, sent `signum` once ready: (process, stderr, seconds to end)."""
+    proc = subprocess.Popen([sys.executable, "-c", PROGRAM.replace("CLEANUP", cleanup)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        assert proc.stdout.readline() == "ready\n"
+        started = time.monotonic()
+        proc.send_signal(signum)
+        if not read_stderr:  # stderr stays full until the process has ended
+            proc.wait(timeout=STOP_GRACE + 5)
+        _, err = proc.communicate(timeout=STOP_GRACE + 5)
+        return proc, err, time.monotonic() - started
+    finally:
+        proc.kill()
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_a_signal_ends_the_program_cleanly(signum):
-    proc = subprocess.Popen([sys.executable, "-c", PROGRAM], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
-    try:
-        assert proc.stdout.readline() == "ready\n"
-        proc.send_signal(signum)
-        out, err = proc.communicate(timeout=10)
-    finally:
-        proc.kill()
-    assert (proc.returncode, out, err) == (0, "closed\n", "")
+    proc, err, _ = signalled(CLEAN, signum)
+    assert (proc.returncode, err) == (0, "")
 
 
 def test_an_error_of_the_program_propagates():
@@ -52,34 +64,16 @@ def test_an_error_of_the_program_propagates():
         run_until_signal(fails())
 
 
-STUCK_PROGRAM = """
-import asyncio, time
-from pygoby.util.aiorun import run_until_signal
-
-async def serve():
-    try:
-        print("ready", flush=True)
-        await asyncio.Future()
-    finally:
-        time.sleep(3600)  # a cleanup that blocks the event loop
-
-run_until_signal(serve(), name="stuck_server")
-"""
-
-
 def test_a_program_whose_cleanup_hangs_still_ends_after_the_grace():
-    proc = subprocess.Popen([sys.executable, "-c", STUCK_PROGRAM], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
-    try:
-        assert proc.stdout.readline() == "ready\n"
-        started = time.monotonic()
-        proc.send_signal(signal.SIGTERM)
-        _, err = proc.communicate(timeout=STOP_GRACE + 10)
-    finally:
-        proc.kill()
-    assert time.monotonic() - started >= STOP_GRACE
+    proc, err, took = signalled(STUCK, signal.SIGTERM)
+    assert took >= STOP_GRACE
     assert proc.returncode == 128 + signal.SIGTERM
-    assert err == f"stuck_server: did not stop within {STOP_GRACE:g} s; exiting now\n"
+    assert err == f"a_server: did not stop within {STOP_GRACE:g} s; exiting now\n"
+
+
+def test_a_program_blocked_on_a_full_stderr_pipe_still_ends():
+    proc, _, _ = signalled(CHOKED, signal.SIGTERM, read_stderr=False)
+    assert proc.returncode == 128 + signal.SIGTERM
 
 
 async def test_cancel_and_wait_does_not_swallow_the_callers_cancellation():
@@ -117,30 +111,3 @@ async def test_cancel_and_wait_raises_what_the_task_failed_with():
         await cancel_and_wait(task)
     await cancel_and_wait(None)
 
-
-CHOKED_PROGRAM = """
-import asyncio, sys
-from pygoby.util.aiorun import run_until_signal
-
-async def serve():
-    try:
-        print("ready", flush=True)
-        await asyncio.Future()
-    finally:
-        sys.stderr.write("x" * 10_000_000)  # into a pipe nobody reads: blocks for ever
-        sys.stderr.flush()
-
-run_until_signal(serve(), name="choked_server")
-"""
-
-
-def test_a_program_blocked_on_a_full_stderr_pipe_still_ends():
-    proc = subprocess.Popen([sys.executable, "-c", CHOKED_PROGRAM], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
-    try:
-        assert proc.stdout.readline() == "ready\n"
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=STOP_GRACE + 5) == 128 + signal.SIGTERM  # stderr still unread
-    finally:
-        proc.kill()
-        proc.communicate()
