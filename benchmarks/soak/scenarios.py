@@ -316,7 +316,7 @@ async def pacommshandler_kill9(seconds: float, workdir: Path) -> Figures:
                 with contextlib.suppress(TimeoutError):
                     await r1.wait_for("ACOMMS_QSIZE", lambda v: "dccl_id: 21" in v, timeout=3, start=seen)
                     queued.add(command_id)
-            await asyncio.sleep(random.uniform(0.0, 4.0))
+            await asyncio.sleep(random.uniform(0.0, 2.0))  # often before its next slot (3 s TDMA)
             await vehicle1.kill9()
             kills += 1
             crossed |= queued - {_command_id(v) for v in r2.values("COMMAND_IN")}

@@ -23,6 +23,7 @@ from pygoby.moos.db import (
     DEFAULT_PACKET_TIMEOUT,
     MOOSDB,
 )
+from pygoby.moos.errors import MoosRefusedError
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.timewarp import moos_clock
 from pygoby.util.aiorun import StopSignals
@@ -139,7 +140,7 @@ async def _connected(client: MOOSClient, args: argparse.Namespace) -> bool:
     try:
         await client.connect(timeout=args.connect_timeout)
         return True
-    except (TimeoutError, ConnectionError) as err:
+    except (TimeoutError, ConnectionError, MoosRefusedError) as err:
         print(f"cannot connect to a MOOSDB at {args.host}:{args.port}: {err}", file=sys.stderr)
         await client.close()
         return False
