@@ -1,19 +1,8 @@
 """The soak's scenarios (issue 16): hostile clients beside a measured one, kill -9 of servers
 and apps, and signals and link cuts that used to leave apps behind or disconnected.
 
-Each entry of SCENARIOS is `name: async (seconds, workdir) -> Figures`.
-
-The MOOSDB's hostile clients of issue 16 items 1 and 5 belong to the moosdb-speed branch, not
-landed when this was written; once it has, each is one line here, e.g.
-
-    "MOOSDB: backtracking wildcard (16.1)": hostile(MOOSDB_SPEC, moos_round_trip,
-        [MoosHostile(wildcard_hog)]),
-    "MOOSDB: trickled 16 MB packets (16.5)": hostile(MOOSDB_SPEC, moos_round_trip,
-        [Trickle(moos_handshake("hog") + struct.pack("<iiB", 16 << 20, 1, 0))] * 20),
-    "MOOSDB: connection flood (16.5)": hostile(MOOSDB_SPEC, moos_round_trip, [IdleConnections(3000)]),
-
-with `async def wildcard_hog(client)` registering "*a*a*a*a*a*a*a*a*a*a*b" and posting a variable
-with a 64-character name (MoosHostile runs it on a connected MOOSClient).
+Each entry of SCENARIOS is `name: async (seconds, workdir) -> Figures`; a hostile-client one is
+a line `hostile(SERVER_SPEC, probe, [hostile clients])` (kit.hostile).
 """
 
 from __future__ import annotations
@@ -22,6 +11,7 @@ import asyncio
 import contextlib
 import random
 import signal
+import struct
 import time
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
@@ -59,6 +49,9 @@ Scenario = Callable[[float, Path], Awaitable[Figures]]
 
 MOOSDB_SPEC = ServerSpec("moosdb", venv_command("pygoby", "moosdb", "--port", "{port}"),
                          r"listening on 127\.0\.0\.1:(\d+)")  # fmt: skip
+# a 64 MB budget for partial packets and unsent output, a packet deadline the run reaches
+MOOSDB_BUDGET = ServerSpec("moosdb", venv_command("pygoby", "moosdb", "--port", "{port}", "--memory-budget", "64",
+                                                  "--packet-timeout", "5"), MOOSDB_SPEC.ready)  # fmt: skip
 STORE_SERVER = ServerSpec(
     "store_server",
     venv_command("pygoby", "store_server", "--host", "127.0.0.1", "--port", "{port}", "--db", "store.db"),
@@ -213,20 +206,38 @@ def moos_handshake(name: str) -> bytes:
 
 @dataclass
 class MoosHostile(Hostile):
-    """A MOOS client that does `action(client)` once connected, then stays."""
+    """A MOOS client running `action(client, stop)` once connected."""
 
-    action: Callable[[MOOSClient], Awaitable[None]]
+    action: Callable[[MOOSClient, asyncio.Event], Awaitable[None]]
 
     async def run(self, port: int, stop: asyncio.Event) -> None:
         async with MOOSClient(f"soak_hostile_{random.randint(0, 1 << 30)}", port=port) as client:
-            await self.action(client)
+            await self.action(client, stop)
             await stop.wait()
 
 
-async def _post_bulk(client: MOOSClient) -> None:
-    for _ in range(200):  # 20 MB for the non-readers that subscribed to it
+async def post_bulk(client: MOOSClient, stop: asyncio.Event) -> None:
+    """20 MB for the non-readers that subscribed to SOAK_BULK."""
+    for _ in range(200):
         client.publish("SOAK_BULK", b"\0" * 100_000)
         await client.flush()
+
+
+async def wildcard_hog(client: MOOSClient, stop: asyncio.Event) -> None:
+    """A pattern a backtracking matcher takes exponential time on, and new 64-character names
+    (a pattern is tested when a variable is first written) every 0.1 s."""
+    client.subscribe_wildcard("*a*a*a*a*a*a*a*a*a*a*b", "*")
+    k = 0
+    while not stop.is_set():
+        client.publish(f"{k:a>64}".replace("0", "a")[:64], 1.0)
+        k += 1
+        await asyncio.sleep(0.1)
+
+
+def packet_hogs(count: int, sent: int) -> list[Trickle]:
+    """MOOS clients announcing a 16 MB packet, sending `sent` bytes of it, then one a while."""
+    return [Trickle(moos_handshake(f"soak_hog{i}") + struct.pack("<iiB", 16 << 20, 1, 0) + bytes(sent))
+            for i in range(count)]  # fmt: skip
 
 
 MOOS_REGISTER_BULK = moos_handshake("soak_sleeper") + p.encode_packet(
@@ -585,7 +596,14 @@ SCENARIOS: dict[str, Scenario] = {
     "netsim_manager: 64 clients x 10 Hz, garbage clients beside": netsim_manager_hostile,
     "MOOSDB: garbage, non-reading and idle clients beside a round trip": hostile(
         MOOSDB_SPEC, moos_round_trip,
-        [Garbage(GARBAGE), NonReader(MOOS_REGISTER_BULK), MoosHostile(_post_bulk), IdleConnections(200)]),
+        [Garbage(GARBAGE), NonReader(MOOS_REGISTER_BULK), MoosHostile(post_bulk), IdleConnections(200)]),
+    "MOOSDB: backtracking wildcard and 64-character names (16.1)": hostile(
+        MOOSDB_SPEC, moos_round_trip, [MoosHostile(wildcard_hog)]),
+    "MOOSDB: 20 clients trickling 4 MB of 16 MB packets, 64 MB budget (16.5)": hostile(
+        MOOSDB_BUDGET, moos_round_trip, packet_hogs(20, 4 << 20)),
+    "MOOSDB: 400 idle connections and unread output, 64 MB budget (16.5)": hostile(
+        MOOSDB_BUDGET, moos_round_trip,
+        [IdleConnections(400), NonReader(MOOS_REGISTER_BULK), MoosHostile(post_bulk), MoosHostile(post_bulk)]),
     "store_server: garbage, trickling and idle clients beside two modems": hostile(
         STORE_SERVER, store_round_trips,
         [Garbage(GARBAGE), Trickle(b"\x01" * 1000), IdleConnections(200),
