@@ -164,6 +164,28 @@ WATCHED = [
 ]  # fmt: skip
 
 
+async def start_modem(
+    stack: contextlib.AsyncExitStack, modem_id: int, channel, clock
+) -> MMSimServer:
+    """An emulated Micro-Modem served on loopback TCP, closed with `stack`."""
+    sim = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
+    await sim.start()
+    stack.push_async_callback(sim.close)
+    return sim
+
+
+async def start_db(stack: contextlib.AsyncExitStack, modem_id: int) -> MOOSDB:
+    """The MOOSDB of community `vehicle<modem_id>`, closed with `stack`."""
+    return await stack.enter_async_context(MOOSDB(port=0, community=f"vehicle{modem_id}"))
+
+
+async def modem_and_db(
+    stack: contextlib.AsyncExitStack, modem_id: int, channel, clock
+) -> tuple[MMSimServer, MOOSDB]:
+    """An emulated Micro-Modem and the MOOSDB of community `vehicle<modem_id>`."""
+    return await start_modem(stack, modem_id, channel, clock), await start_db(stack, modem_id)
+
+
 class MicroModemLink:
     """Micro-Modem emulators on loopback TCP sharing one perfect acoustic channel."""
 
@@ -172,11 +194,9 @@ class MicroModemLink:
         self.channel = LoopbackChannel()
 
     async def start(self, stack: contextlib.AsyncExitStack, dbs: list[MOOSDB]) -> None:
+        clock = WallClock()
         for modem_id in (1, 2):
-            sim = MMSimServer(MicroModemModel(modem_id, WallClock(), self.channel), self.channel)
-            await sim.start()
-            stack.push_async_callback(sim.close)
-            self.sims.append(sim)
+            self.sims.append(await start_modem(stack, modem_id, self.channel, clock))
 
     def driver_cfg(self, modem_id: int) -> str:
         return micromodem_driver(self.sims[modem_id - 1].port)
@@ -206,9 +226,7 @@ class TwoCommunities:
     async def __aenter__(self) -> TwoCommunities:
         self.dbs, self.apps, self.recorders = [], [], []
         for modem_id in (1, 2):
-            db = MOOSDB(port=0, community=f"vehicle{modem_id}")
-            await self.stack.enter_async_context(db)
-            self.dbs.append(db)
+            self.dbs.append(await start_db(self.stack, modem_id))
         await self.link.start(self.stack, self.dbs)
         for modem_id, db in zip((1, 2), self.dbs, strict=True):
             path = self.tmp_path / f"vehicle{modem_id}.moos"

@@ -19,6 +19,7 @@ The queue's and the MAC's own signals are used directly (`handler.queue.signal_r
 from __future__ import annotations
 
 import logging
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -32,6 +33,7 @@ from pygoby.acomms.driver_base import ModemDriverBase, driver_name
 from pygoby.acomms.errors import HandlerError, ModemDriverError, QueueError
 from pygoby.acomms.mac import MACManager
 from pygoby.acomms.queue import QueueManager
+from pygoby.acomms.queue.persist import QueueStore
 from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
 from pygoby.dccl import Codec, DcclError
 from pygoby.errors import ConfigError
@@ -209,7 +211,17 @@ class AcommsHandler:
                 raise HandlerError(
                     f"queue_cfg message_entry {entry.protobuf_name}: {exc}"
                 ) from None
+        if self.queue_cfg.persistent_queue_file:
+            self._open_persistent_queue(self.queue_cfg.persistent_queue_file)
         return skipped
+
+    def _open_persistent_queue(self, path: str) -> None:
+        try:
+            store = QueueStore(path)
+        except QueueError as exc:
+            raise HandlerError(f"queue_cfg persistent_queue_file: {exc}") from None
+        restored = self.queue.attach_store(store)
+        log.info("persistent queue %s: %d queued message(s) restored", os.path.abspath(path), restored)
 
     def start(self) -> None:
         """Drivers start at the next `do_work`; the MAC starts its cycle now."""
@@ -223,6 +235,11 @@ class AcommsHandler:
             if slot.running:
                 self._shutdown_driver(slot)
             slot.restart_at = 0.0
+
+    def close(self) -> None:
+        """After `shutdown`: let go of the persistent queue's file, if any."""
+        if self.queue.store is not None:
+            self.queue.store.close()
 
     # ------------------------------------------------------------------ main loop (§4.9 3-6)
     def do_work(self) -> None:

@@ -87,7 +87,6 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
         """The MOOS app and the terminal UI in one loop; either one ending stops both."""
         await self.start()
         ui = asyncio.create_task(self.tui.run_async())
-        assert self._stop_requested is not None
         stop = asyncio.create_task(self._stop_requested.wait())
         try:
             await asyncio.wait({ui, stop}, return_when=asyncio.FIRST_COMPLETED)

@@ -4,6 +4,8 @@ Translator entries create DCCL messages from MOOS variables and push them into t
 queue; the MAC opens the slots, the driver asks the queue for frames; messages received over
 the link are published through the same entries' publish rules and posted on
 ACOMMS_QUEUE_RECEIVE. Every ACOMMS_* variable of the spec's table is published or handled.
+The modem, the MAC and the queue keep working while the MOOSDB is away (upstream's stop with
+it); their posts are delivered when it is back.
 The acomms wiring itself is `pygoby.acomms.handler.AcommsHandler`; this module maps the
 configuration, the translator and the MOOS variables onto it.
 
@@ -46,6 +48,9 @@ def _make_driver(cfg, clock) -> ModemDriverBase | None:
 class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
     config_proto = PACOMMSHANDLER_CONFIG
     default_name = "pAcommsHandler"
+    # the modem, the MAC and the queue keep going through a MOOSDB outage; what they post
+    # meanwhile is delivered when the DB is back
+    iterate_without_comms = True
 
     def __init__(self, cfg: Message, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
@@ -147,6 +152,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def on_stop(self) -> None:
         self.acomms.shutdown()
+        self.acomms.close()
 
     async def start(self, connect_timeout: float | None = None) -> None:
         await super().start(connect_timeout)
@@ -176,16 +182,15 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         return lines
 
     def loop(self) -> None:
-        self.binding.tick(self.clock.now())
+        if self.connected:  # time triggers create from MOOS values: not while the DB is away
+            self.binding.tick(self.clock.now())
         self._stop_on_failure(self.acomms.do_work)
 
     def _stop_on_failure(self, work) -> None:
         try:
             work()
         except HandlerError as err:
-            self.log.critical("%s; stopping", err)
-            self.exit_status = 1
-            self.request_stop()
+            self.fail(str(err))
 
     # ------------------------------------------------------------------ MOOS -> acomms
     def _created(self, message: Message) -> None:

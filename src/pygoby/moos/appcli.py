@@ -8,14 +8,13 @@ raises the terminal's verbosity, and `--<field> <value>` (or
 `--<field>=<value>`) overrides any top-level configuration field. `run_app(app_class, argv)` is
 what `GobyMOOSApp.main` does: read the configuration (a configuration error prints one clear
 message and exits 1 before connecting), then run the app until SIGINT/SIGTERM or until it stops
-itself, and return its exit status.
+itself, and return its exit status. A signal always ends the app within a few seconds.
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
-import signal
 import sys
 from collections.abc import Sequence
 from importlib.metadata import PackageNotFoundError, version
@@ -25,6 +24,7 @@ from typing import TYPE_CHECKING
 from pygoby.errors import ConfigError
 from pygoby.moos.appconfig import collecting_notes
 from pygoby.moos.moosfile import MissionFile
+from pygoby.util.aiorun import StopSignals
 from pygoby.util.console import quiet_broken_pipe
 
 if TYPE_CHECKING:
@@ -122,17 +122,18 @@ def run_app(
 
 
 def run_until_signal(app: GobyMOOSApp) -> int:
-    """Run `app` until SIGINT/SIGTERM asks it to stop (it stops cleanly) or it stops itself;
-    its exit status, 130 after a KeyboardInterrupt outside the loop."""
+    """Run `app` until SIGINT/SIGTERM asks it to stop (it stops cleanly, or the process ends
+    after `STOP_GRACE` s whatever it is doing: pygoby.util.aiorun.StopSignals) or it stops
+    itself; its exit status (its `failure`, if any, printed on stderr)."""
 
     async def runner() -> None:
-        loop = asyncio.get_running_loop()
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            loop.add_signal_handler(sig, app.request_stop)
-        await app.run()
+        with StopSignals(asyncio.get_running_loop(), app.request_stop, app.name):
+            await app.run()
 
     try:
         asyncio.run(runner())
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # before the handlers were in place
         return 130
+    if app.failure:
+        print(f"{app.name}: {app.failure}", file=sys.stderr)
     return app.exit_status

@@ -9,7 +9,6 @@ import json
 import logging
 import os
 import re
-import signal
 import sys
 from collections.abc import Coroutine
 from typing import Any
@@ -24,8 +23,10 @@ from pygoby.moos.db import (
     DEFAULT_PACKET_TIMEOUT,
     MOOSDB,
 )
+from pygoby.moos.errors import MoosRefusedError
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.timewarp import moos_clock
+from pygoby.util.aiorun import StopSignals
 
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
@@ -125,13 +126,11 @@ async def _serve(db: MOOSDB) -> int:
         print(f"moosdb: cannot listen on {db.host}:{db.port}: {err.strerror}", file=sys.stderr)
         return 1
     stop = asyncio.Event()
-    loop = asyncio.get_running_loop()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        loop.add_signal_handler(sig, stop.set)
-    if not logging.getLogger("pygoby.moos.db").isEnabledFor(logging.INFO):  # else it logs it
-        print(f"MOOSDB {db.community} listening on {db.host}:{db.port}", flush=True)
-    await stop.wait()
-    await db.stop()
+    with StopSignals(asyncio.get_running_loop(), stop.set, "moosdb"):
+        if not logging.getLogger("pygoby.moos.db").isEnabledFor(logging.INFO):  # else it logs it
+            print(f"MOOSDB {db.community} listening on {db.host}:{db.port}", flush=True)
+        await stop.wait()
+        await db.stop()
     return 0
 
 
@@ -147,7 +146,7 @@ async def _connected(client: MOOSClient, args: argparse.Namespace) -> bool:
     try:
         await client.connect(timeout=args.connect_timeout)
         return True
-    except (TimeoutError, ConnectionError) as err:
+    except (TimeoutError, ConnectionError, MoosRefusedError) as err:
         print(f"cannot connect to a MOOSDB at {args.host}:{args.port}: {err}", file=sys.stderr)
         await client.close()
         return False

@@ -123,7 +123,8 @@ class RealTimeRun:
             if progress is not None:
                 progress()
             with contextlib.suppress(TimeoutError):
-                await asyncio.wait_for(self._stop.wait(), WORK_PERIOD)
+                async with asyncio.timeout(WORK_PERIOD):
+                    await self._stop.wait()
         summary = sim.summary()
         summary.interrupted = self._stop.is_set()
         return summary

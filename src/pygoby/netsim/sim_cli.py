@@ -14,9 +14,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import logging
-import signal
 import sys
 
 from pygoby.util.progress import RunProgress
@@ -106,11 +104,9 @@ def _report(progress: RunProgress, sim) -> None:
 
 async def _run_real_time(scenario, log, progress: RunProgress):
     from pygoby.netsim.realtime import RealTimeRun
+    from pygoby.util.aiorun import StopSignals
 
     run = RealTimeRun(scenario, on_event=log)
-    loop = asyncio.get_running_loop()
-    for sig in (signal.SIGINT, signal.SIGTERM):  # the run ends, its summary is printed
-        loop.add_signal_handler(sig, run.request_stop)
     async with run:
         print(f"netsim_manager on {run.host}:{run.manager_port}", flush=True)
         for node in run.sim.nodes:
@@ -120,14 +116,9 @@ async def _run_real_time(scenario, log, progress: RunProgress):
                 + (" with in-process driver/MAC/queue" if node.driver is not None else ""),
                 flush=True,
             )
-        task = asyncio.ensure_future(run.run(lambda: _report(progress, run.sim)))
-        try:
-            return await task
-        except asyncio.CancelledError:
-            run.request_stop()
-            with contextlib.suppress(asyncio.CancelledError):
-                return await task
-            raise
+        # SIGINT/SIGTERM end the run early, with its summary and a complete event log
+        with StopSignals(asyncio.get_running_loop(), run.request_stop, "pygoby netsim run"):
+            return await run.run(lambda: _report(progress, run.sim))
 
 
 def report_command(args: argparse.Namespace) -> int:

@@ -144,7 +144,8 @@ class _StreamLinkBase:
         return bool(self._transports)
 
     async def wait_open(self, timeout: float = 10.0) -> None:
-        await asyncio.wait_for(self._open_event.wait(), timeout)
+        async with asyncio.timeout(timeout):
+            await self._open_event.wait()
 
     def read_lines(self) -> list[str]:
         lines = list(self._lines)

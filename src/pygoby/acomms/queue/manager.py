@@ -9,11 +9,14 @@ logs, and in which group, is pygoby.acomms.queue.log.
 
 from __future__ import annotations
 
+from google.protobuf.message import DecodeError
+
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import QueueError
 from pygoby.acomms.queue import ccl
 from pygoby.acomms.queue.ccl import CCLQueue
 from pygoby.acomms.queue.log import QueueLog
+from pygoby.acomms.queue.persist import QueueStore
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
 from pygoby.dccl import DcclError
@@ -31,6 +34,7 @@ class QueueManager:
         self.queues: dict[int, MessageQueue] = {}  # by DCCL id, kept in ascending order
         self._by_name: dict[str, MessageQueue] = {}
         self.ccl_queues: dict[int, CCLQueue] = {}  # Goby 1.1 raw CCL queues, by CCL id
+        self.store: QueueStore | None = None  # the persistent queue (attach_store)
         self.signal_receive = Signal()  # (message)
         self.signal_receive_ccl = Signal()  # (Goby 1.1 ModemDataTransmission of a CCL frame)
         self.signal_ack = Signal()  # (ack ModemTransmission, original message)
@@ -93,7 +97,8 @@ class QueueManager:
             existing.entry, existing.roles = copy, roles
             existing.manipulators = frozenset(copy.manipulator)
             return existing
-        queue = MessageQueue(copy, compiled.id, self.clock.now(), roles)
+        queue = MessageQueue(copy, compiled.id, self.clock.now(), roles, message_class=message_class)
+        queue.journal = self.store
         self.queues = dict(sorted({**self.queues, compiled.id: queue}.items()))
         self._by_name[entry.protobuf_name] = queue
         self._size_changed(queue)
@@ -122,7 +127,8 @@ class QueueManager:
         if existing is not None:
             existing.entry = entry
             return existing
-        queue = CCLQueue(entry, ccl_id, self.clock.now())
+        queue = CCLQueue(entry, ccl_id, self.clock.now(), message_class=acomms_pb.V1ModemDataTransmission)
+        queue.journal = self.store
         self.ccl_queues[ccl_id] = queue
         return queue
 
@@ -152,6 +158,42 @@ class QueueManager:
 
     def _all_queues(self) -> list[MessageQueue]:
         return [*self.queues.values(), *self.ccl_queues.values()]
+
+    # ------------------------------------------------------------------ persistence
+    def attach_store(self, store: QueueStore) -> int:
+        """Keep every queued message in `store` (pygoby.acomms.queue.persist) from now on, after
+        queuing again, oldest first, what it holds; returns how many messages were restored.
+        Call it once the queues are configured. Stored messages expired meanwhile expire now
+        (signal_expire); those of a type with no queue now stay stored, with a warning."""
+        self.store = store
+        queues = {queue.name: queue for queue in self._all_queues()}
+        for queue in queues.values():
+            queue.journal = store
+        restored = 0
+        for stored in store.items():
+            queue = queues.get(stored.queue)
+            if queue is None or queue.message_class is None:
+                self.log.push.warning(
+                    "persistent queue %s: a stored %s is kept, but not sent (no such queue is "
+                    "configured)", store.path, stored.queue,
+                )  # fmt: skip
+                continue
+            try:
+                message = queue.message_class.FromString(stored.message)
+            except DecodeError as exc:
+                self.log.push.warning(
+                    "persistent queue %s: a stored %s does not parse (%s); dropped",
+                    store.path, stored.queue, exc,
+                )  # fmt: skip
+                store.forget(stored.key)
+                continue
+            item = QueuedItem(message, stored.encoded, stored.src, stored.dest, stored.time,
+                              stored.ack_requested, key=stored.key)  # fmt: skip
+            queue.push(item)
+            self._size_changed(queue)
+            restored += 1
+        self.do_work()  # what expired while we were away goes now, before any slot
+        return restored
 
     def _size_changed(self, queue: MessageQueue) -> None:
         if isinstance(queue, CCLQueue):

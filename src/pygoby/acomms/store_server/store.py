@@ -11,12 +11,12 @@ recipient has read past it) once it is older than the retention time.
 from __future__ import annotations
 
 import logging
-import sqlite3
 from pathlib import Path
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import StoreServerAuthError
 from pygoby.acomms.rudics import embedded_size
+from pygoby.util.sqlite import open_durable
 
 log = logging.getLogger(__name__)
 
@@ -54,7 +54,7 @@ class TransmissionStore:
         retention_seconds: float = 3600.0,
         lock_timeout_seconds: float = 5.0,
     ) -> None:
-        self.db = sqlite3.connect(str(path), timeout=lock_timeout_seconds)
+        self.db = open_durable(path, lock_timeout_seconds)
         self.db.executescript(_SCHEMA)
         self.max_lookback = max_lookback_seconds
         self.retention = retention_seconds

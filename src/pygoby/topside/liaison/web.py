@@ -37,6 +37,7 @@ from starlette.staticfiles import StaticFiles
 from pygoby.errors import PygobyError
 from pygoby.topside.commander import CommanderError, FieldValueError, SaveFileError
 from pygoby.topside.liaison.state import LiaisonState, field_view, outgoing_view, record_view
+from pygoby.util.aiorun import cancel_and_wait
 
 log = logging.getLogger("pygoby.liaison")
 STATIC = Path(__file__).parent / "static"
@@ -104,7 +105,8 @@ def make_app(
                 data = state.page(name, state.now(), pattern)
                 yield f"data: {json.dumps(data, default=_json_default)}\n\n"
                 with contextlib.suppress(TimeoutError):
-                    await asyncio.wait_for(stopping.wait(), update_period)
+                    async with asyncio.timeout(update_period):
+                        await stopping.wait()
 
         return StreamingResponse(stream(), media_type="text/event-stream",
                                  headers={"Cache-Control": "no-store"})  # fmt: skip
@@ -225,6 +227,11 @@ class WebServer:
             return
         self._stopping.set()
         self._server.should_exit = True
-        with contextlib.suppress(asyncio.CancelledError, Exception):
-            await asyncio.wait_for(self._task, 5)
-        self._task = None
+        task, self._task = self._task, None
+        # not wait_for in a suppress(CancelledError): that swallowed our caller's cancellation
+        done, _ = await asyncio.wait({task}, timeout=5)
+        if not done:
+            with contextlib.suppress(Exception):  # the server's own errors are logged by it
+                await cancel_and_wait(task)
+        elif not task.cancelled():
+            task.exception()  # retrieved; the server logs its own errors
