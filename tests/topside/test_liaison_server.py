@@ -5,8 +5,13 @@ from __future__ import annotations
 
 import asyncio
 import json
+import shutil
+import socket
+import subprocess
+import sys
 import urllib.error
 import urllib.request
+from pathlib import Path
 
 import pytest
 
@@ -78,3 +83,23 @@ async def test_embedded_liaison_offers_the_goby11_xml_messages(tmp_path):
                                              "OUTGOING_COMMAND: Destination=2,type=goto,goto_x=150"]  # fmt: skip
         fields = {f["name"]: f for f in reply["fields"]}
         assert fields["new_instructions"]["editable"] and fields["new_instructions"]["source"] == "SPECIAL_INSTRUCTIONS"
+
+
+def test_a_taken_http_port_is_a_configuration_error(tmp_path):
+    """`pygoby liaison` on a port another program holds: one line saying so and status 1 (it
+    was uvicorn's traceback and SystemExit(3) from inside the running app)."""
+    examples = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles"
+    for name in ("topside.moos", "two_vehicles.proto", "modemidlookup.txt"):
+        shutil.copy(examples / name, tmp_path / name)
+    with socket.create_server(("127.0.0.1", 0)) as taken:
+        port = taken.getsockname()[1]
+        mission = tmp_path / "topside.moos"
+        text = mission.read_text()
+        assert text.count('liaison { node_report_var') == 1
+        mission.write_text(text.replace('liaison { node_report_var', f'liaison {{ http_port: {port} node_report_var'))
+        pygoby = str(Path(sys.executable).with_name("pygoby"))
+        done = subprocess.run([pygoby, "liaison", "topside.moos"], cwd=tmp_path, capture_output=True,
+                              text=True, timeout=60)  # fmt: skip
+    assert done.returncode == 1, done.stderr
+    assert "Traceback" not in done.stderr
+    assert f"liaison: fatal configuration error: liaison: cannot serve the pages on 127.0.0.1:{port}" in done.stderr
