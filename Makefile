@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench lint clean screenshots
+.PHONY: demo test bench soak figures lint clean screenshots
 
 # liaison's browser tests drive Debian's chromium (Playwright's own browser download is not used)
 CHROMIUM ?= /usr/bin/chromium
@@ -32,6 +32,20 @@ screenshots: $(STAMP) $(CHROMIUM)
 
 bench: $(STAMP)
 	$(PY) -m pytest benchmarks -q -o addopts="" --benchmark-only --benchmark-columns=min,mean,ops,rounds
+
+# issue 16's hostile-client and kill -9 scenarios on loopback, with their figures (not in `test`);
+# SOAK_SECONDS per scenario
+SOAK_SECONDS ?= 20
+soak: $(STAMP)
+	$(PY) benchmarks/soak/run.py --seconds $(SOAK_SECONDS)
+
+# Figures of the examples' READMEs, regenerated from their sources (commit the result).
+EXAMPLE_SWEEP := examples/netsim/sweep_range_rate
+figures: $(STAMP)
+	rm -rf $(EXAMPLE_SWEEP)_results
+	$(VENV)/bin/pygoby netsim sweep $(EXAMPLE_SWEEP).pb.cfg -o $(EXAMPLE_SWEEP)_results
+	$(VENV)/bin/pygoby netsim sweep-report $(EXAMPLE_SWEEP)_results -o examples/netsim/figures
+	rm -rf $(EXAMPLE_SWEEP)_results
 
 lint: $(STAMP)
 	$(PY) -m ruff check src tests benchmarks

@@ -79,3 +79,19 @@ def test_acked_pop_and_ack_with_100k_queued(benchmark):
 
     benchmark(pop_and_ack)
     assert qm.size(20) < QUEUED
+
+
+@pytest.mark.parametrize("direction", ["serialize", "parse"])
+def test_rudics_largest_packet(benchmark, direction):
+    """One store-server packet at the size limit (64 KiB): the longest the server's event loop
+    is held by one request's framing (the digit-by-digit conversion took ~4 s)."""
+    import os
+
+    from pygoby.acomms.rudics import max_data_bytes, parse_rudics_packet, serialize_rudics_packet
+
+    data = os.urandom(max_data_bytes())
+    if direction == "serialize":
+        benchmark.pedantic(serialize_rudics_packet, (data,), rounds=3)
+    else:
+        packet = serialize_rudics_packet(data)
+        assert benchmark.pedantic(parse_rudics_packet, (packet,), rounds=3) == data

@@ -20,7 +20,7 @@ from pygoby.moos.translator import TranslatorConfigError
 from pygoby.netsim import NetsimError, ScenarioError
 from pygoby.protobuf import ProtoError
 from pygoby.topside import TopsideError
-from pygoby.util import LinkClosedError, NMEAError, PtyError
+from pygoby.util import LinkClosedError, NMEAError, PluginError, PtyError
 
 # the root(s) every error class of a package derives from
 PACKAGE_ROOTS: dict[str, tuple[type[BaseException], ...]] = {
@@ -31,7 +31,7 @@ PACKAGE_ROOTS: dict[str, tuple[type[BaseException], ...]] = {
     "pygoby.netsim": (NetsimError,),
     "pygoby.protobuf": (ProtoError,),
     "pygoby.topside": (TopsideError,),
-    "pygoby.util": (NMEAError, LinkClosedError, PtyError),  # independent helpers: one root per kind
+    "pygoby.util": (NMEAError, LinkClosedError, PtyError, PluginError),  # one root per kind
     "pygoby.errors": (PygobyError,),
 }
 
@@ -120,16 +120,15 @@ def test_located_fills_only_what_is_missing():
 
 
 def test_a_text_format_parse_error_names_the_line_of_the_file():
-    from google.protobuf import text_format
-
     from pygoby.netsim.config import config_class
+    from pygoby.protobuf.textconfig import merge_config_text
 
-    with pytest.raises(text_format.ParseError) as parse_error:
-        text_format.Parse("manager_tcp_port: 1\n  nope: 2\n", config_class()())
-    err = ConfigError.from_parse_error(parse_error.value, "configuration", file="m.cfg",
-                                       first_line=10)  # fmt: skip
-    assert err.file == "m.cfg" and err.line == 11
-    assert str(err).startswith('m.cfg:11: cannot parse configuration: Message type "')
+    with pytest.raises(ConfigError) as info:
+        merge_config_text("manager_tcp_port: 1\n  nope: 2\n", config_class()(), file="m.cfg",
+                          first_line=10)  # fmt: skip
+    err = info.value
+    assert (err.file, err.line, err.field) == ("m.cfg", 11, "nope")
+    assert str(err).startswith('m.cfg:11: nope: Message type "')
     assert 'no field named "nope"' in str(err)
 
 
@@ -144,7 +143,7 @@ def test_configuration_errors_from_files_carry_file_and_line(tmp_path):
     with pytest.raises(ScenarioError) as info:
         load_scenario(scenario)
     assert (info.value.file, info.value.line) == (str(scenario), 3)
-    assert str(info.value).startswith(f"{scenario}:3: cannot parse scenario: ")
+    assert str(info.value).startswith(f"{scenario}:3: speed: Expected string")
 
     mission = tmp_path / "m.moos"
     mission.write_text("ProcessConfig = pApp\n{\n  app_tick: soon\n}\n")

@@ -7,6 +7,9 @@ import importlib
 import sys
 from collections.abc import Sequence
 
+from pygoby import __version__
+from pygoby.util.console import quiet_broken_pipe
+
 # Each module has `register(subparsers)`, which adds parsers whose `func(args) -> int` runs them.
 SUBCOMMAND_MODULES = [
     "pygoby.dccl.cli",
@@ -19,6 +22,7 @@ SUBCOMMAND_MODULES = [
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="pygoby", description=__doc__)
+    parser.add_argument("-V", "--version", action="version", version=f"pygoby {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in SUBCOMMAND_MODULES:
         importlib.import_module(name).register(subparsers)
@@ -27,10 +31,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    try:
-        return int(args.func(args) or 0)
-    except KeyboardInterrupt:
-        return 130
+
+    def run() -> int:
+        try:
+            return int(args.func(args) or 0)
+        except KeyboardInterrupt:
+            return 130
+
+    return quiet_broken_pipe(run)
 
 
 if __name__ == "__main__":

@@ -19,15 +19,6 @@ where (file:line) and which field. Standard mix-ins let callers catch the usual 
 from __future__ import annotations
 
 from os import PathLike
-from typing import Protocol, Self
-
-
-class TextFormatParseError(Protocol):
-    """What `ConfigError.from_parse_error` reads of google.protobuf.text_format.ParseError."""
-
-    def GetLine(self) -> int | None: ...  # noqa: N802 - protobuf's name
-
-    def GetColumn(self) -> int | None: ...  # noqa: N802 - protobuf's name
 
 
 class PygobyError(Exception):
@@ -54,25 +45,6 @@ class ConfigError(PygobyError, ValueError):
         self.line = line
         self.field = field
         super().__init__(self._text())
-
-    @classmethod
-    def from_parse_error(
-        cls,
-        err: TextFormatParseError,
-        what: str,
-        *,
-        file: str | PathLike[str] | None = None,
-        first_line: int = 1,
-    ) -> Self:
-        """The error for a protobuf TextFormat ParseError in text that starts at `first_line` of
-        `file`: "file:line: cannot parse {what}: reason" (the reason without protobuf's own
-        `line:column : ` prefix)."""
-        line = err.GetLine()
-        reason = str(err)
-        if line is not None:
-            reason = reason.split(" : ", 1)[-1]
-            line += first_line - 1
-        return cls(f"cannot parse {what}: {reason}", file=file, line=line)
 
     def _text(self) -> str:
         where = ""

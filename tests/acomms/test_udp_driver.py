@@ -116,3 +116,20 @@ def test_multicast_queue_to_queue_with_ack():
     finally:
         for d in drivers:
             d.shutdown()
+
+
+def test_a_broadcast_without_a_broadcast_remote_is_reported_once(caplog):
+    d = UDPDriver(VirtualClock(0.0))
+    d.startup(udp_cfg(1, 0, [(2, 9)]))  # a remote for modem 2 only
+    try:
+        frame = acomms_pb.ModemTransmission(src=1, dest=0, frame=[b"x"])
+        with caplog.at_level(logging.WARNING):
+            d.handle_initiate_transmission(frame)
+            d.handle_initiate_transmission(frame)
+        warnings = [r.getMessage() for r in caplog.records if "no remote" in r.getMessage()]
+        assert warnings == [
+            "UDP driver: no remote for destination 0 (remotes configured for modem ids [2]); "
+            "a broadcast (0) reaches only the remotes whose modem_id is 0"
+        ]
+    finally:
+        d.shutdown()

@@ -66,9 +66,27 @@ TRANSLATOR_ENTRIES = f"""\
 """
 
 
+def micromodem_driver(modem_port: int) -> str:
+    return f"""\
+  driver_cfg {{
+    driver_type: DRIVER_WHOI_MICROMODEM
+    connection_type: CONNECTION_TCP_AS_CLIENT
+    tcp_server: "127.0.0.1"
+    tcp_port: {modem_port}
+    reconnect_interval: 1
+    [goby.acomms.micromodem.protobuf.config] {{ query_cfg_on_startup: false }}
+  }}
+"""
+
+
 def mission_text(
-    modem_id: int, db_port: int, modem_port: int, extra: str = "", slots: str | None = None
+    modem_id: int, db_port: int, modem_port: int, extra: str = "", slots: str | None = None,
+    driver: str | None = None, common: str = "log: false  app_tick: 20  verbosity: WARN",
 ) -> str:
+    """vehicle<modem_id>'s mission: `driver` (a driver_cfg block; default: a Micro-Modem on
+    `modem_port`), TDMA slots for 1 and 2, the status and command queues and translators."""
+    if driver is None:
+        driver = micromodem_driver(modem_port)
     if slots is None:
         slots = "".join(
             f"    slot {{ src: {src} dest: -1 rate: 0 type: DATA slot_seconds: {SLOT_SECONDS} }}\n"
@@ -81,17 +99,9 @@ Community  = vehicle{modem_id}
 
 ProcessConfig = pAcommsHandler
 {{
-  common {{ log: false  app_tick: 20  verbosity: WARN }}
+  common {{ {common} }}
   modem_id: {modem_id}
-  driver_cfg {{
-    driver_type: DRIVER_WHOI_MICROMODEM
-    connection_type: CONNECTION_TCP_AS_CLIENT
-    tcp_server: "127.0.0.1"
-    tcp_port: {modem_port}
-    reconnect_interval: 1
-    [goby.acomms.micromodem.protobuf.config] {{ query_cfg_on_startup: false }}
-  }}
-  mac_cfg {{
+{driver}  mac_cfg {{
     type: MAC_FIXED_DECENTRALIZED
 {slots}  }}
   load_proto_file: "{PROTO}"
@@ -154,32 +164,82 @@ WATCHED = [
 ]  # fmt: skip
 
 
-class TwoCommunities:
-    """Emulators + DBs + pAcommsHandlers + recorders; `extra` adds config to both apps."""
+async def start_modem(
+    stack: contextlib.AsyncExitStack, modem_id: int, channel, clock
+) -> MMSimServer:
+    """An emulated Micro-Modem served on loopback TCP, closed with `stack`."""
+    sim = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
+    await sim.start()
+    stack.push_async_callback(sim.close)
+    return sim
 
-    def __init__(self, tmp_path: Path, extra: str = "", slots: str | None = None) -> None:
+
+async def start_db(stack: contextlib.AsyncExitStack, modem_id: int) -> MOOSDB:
+    """The MOOSDB of community `vehicle<modem_id>`, closed with `stack`."""
+    return await stack.enter_async_context(MOOSDB(port=0, community=f"vehicle{modem_id}"))
+
+
+async def modem_and_db(
+    stack: contextlib.AsyncExitStack, modem_id: int, channel, clock
+) -> tuple[MMSimServer, MOOSDB]:
+    """An emulated Micro-Modem and the MOOSDB of community `vehicle<modem_id>`."""
+    return await start_modem(stack, modem_id, channel, clock), await start_db(stack, modem_id)
+
+
+class MicroModemLink:
+    """Micro-Modem emulators on loopback TCP sharing one perfect acoustic channel."""
+
+    def __init__(self) -> None:
+        self.sims: list[MMSimServer] = []
+        self.channel = LoopbackChannel()
+
+    async def start(self, stack: contextlib.AsyncExitStack, dbs: list[MOOSDB]) -> None:
+        clock = WallClock()
+        for modem_id in (1, 2):
+            self.sims.append(await start_modem(stack, modem_id, self.channel, clock))
+
+    def driver_cfg(self, modem_id: int) -> str:
+        return micromodem_driver(self.sims[modem_id - 1].port)
+
+    def modem_port(self, modem_id: int) -> int:
+        return self.sims[modem_id - 1].port
+
+
+class TwoCommunities:
+    """Link (default: emulated Micro-Modems) + DBs + pAcommsHandlers + recorders; `extra` adds
+    config to both apps. A link has `start(stack, dbs)` and `driver_cfg(modem_id)` (the
+    driver_cfg block of that vehicle's mission)."""
+
+    def __init__(
+        self, tmp_path: Path, extra: str = "", slots: str | None = None, link=None,
+        common: str | None = None,
+    ) -> None:  # fmt: skip
         self.tmp_path, self.extra, self.slots = tmp_path, extra, slots
+        self.link = link if link is not None else MicroModemLink()
+        self.common = common
         self.stack = contextlib.AsyncExitStack()
 
+    @property
+    def sims(self) -> list[MMSimServer]:
+        return self.link.sims
+
     async def __aenter__(self) -> TwoCommunities:
-        channel = LoopbackChannel()
-        clock = WallClock()
-        self.sims, self.dbs, self.apps, self.recorders = [], [], [], []
+        self.dbs, self.apps, self.recorders = [], [], []
         for modem_id in (1, 2):
-            sim = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
-            await sim.start()
-            self.stack.push_async_callback(sim.close)
-            db = MOOSDB(port=0, community=f"vehicle{modem_id}")
-            await self.stack.enter_async_context(db)
+            self.dbs.append(await start_db(self.stack, modem_id))
+        await self.link.start(self.stack, self.dbs)
+        for modem_id, db in zip((1, 2), self.dbs, strict=True):
             path = self.tmp_path / f"vehicle{modem_id}.moos"
-            path.write_text(mission_text(modem_id, db.port, sim.port, self.extra, self.slots))
+            options = {} if self.common is None else {"common": self.common}
+            path.write_text(mission_text(
+                modem_id, db.port, 0, self.extra, self.slots, self.link.driver_cfg(modem_id),
+                **options,
+            ))  # fmt: skip
             app = pAcommsHandler.from_mission(path, "pAcommsHandler")
             recorder = Recorder(f"recorder{modem_id}", db.port)
             await recorder.start(WATCHED)
             self.stack.push_async_callback(recorder.close)
             await self.stack.enter_async_context(app)
-            self.sims.append(sim)
-            self.dbs.append(db)
             self.apps.append(app)
             self.recorders.append(recorder)
         return self
@@ -188,10 +248,15 @@ class TwoCommunities:
         await self.stack.aclose()
 
     async def ready(self, timeout: float = 20) -> None:
-        """Both drivers started and both apps have DB_TIME (the messages' time source)."""
+        """Both drivers started (and linked) and both apps have DB_TIME (the messages' time
+        source)."""
+
+        def started(app) -> bool:
+            primary = app.acomms.primary
+            driver = primary.driver
+            link_open = driver.link is None or driver.link.is_open
+            return primary.running and link_open and getattr(driver, "startup_complete", True)
+
         async with asyncio.timeout(timeout):
-            while not all(
-                app.acomms.primary.driver.startup_complete and "DB_TIME" in app.dynamic_vars
-                for app in self.apps
-            ):
+            while not all(started(app) and "DB_TIME" in app.dynamic_vars for app in self.apps):
                 await asyncio.sleep(0.05)

@@ -42,7 +42,7 @@ def test_plugins_by_file_path_and_separators(monkeypatch):
     handler = AcommsHandler(config(f"modem_id: 4 driver_cfg {{ {SCRIPTED} }}"), VirtualClock())
     assert type(handler.primary.driver).__name__ == "ScriptedDriver"
     monkeypatch.setenv("PACOMMSHANDLER_PLUGINS", "no.such.module")
-    with pytest.raises(HandlerError, match="cannot load driver plugin 'no.such.module'"):
+    with pytest.raises(HandlerError, match="unknown modem driver 'no.such.module'"):
         AcommsHandler(config(f"modem_id: 4 driver_cfg {{ {SCRIPTED} }}"), VirtualClock())
 
 

@@ -269,3 +269,31 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
         line.startswith(("START", "CMD,HEADING:90,SPEED:2,DEPTH:10"))
         for line in simulator.sim.received
     )
+
+
+async def test_the_frontseat_link_is_served_through_a_moosdb_outage(tmp_path):
+    # The MOOSDB goes away: iFrontSeat keeps reading its frontseat and running the interface,
+    # so it sees the helm fall silent (HELM_ERROR) instead of freezing in COMMAND.
+    simulator = Simulator()
+    sim_port = await simulator.start()
+    async with contextlib.AsyncExitStack() as stack:
+        stack.push_async_callback(lambda: simulator.stop())
+        db = MOOSDB(port=0, clock=moos_clock(WARP))
+        await db.start()
+        stack.push_async_callback(lambda: db.stop())
+        helm = ScriptedHelm(db.port)
+        await helm.start()
+        stack.push_async_callback(helm.close)
+        path = tmp_path / "auv1.moos"
+        path.write_text(MISSION.format(db_port=db.port, warp=WARP, sim_port=sim_port))
+        app = await stack.enter_async_context(iFrontSeat.from_mission(path))
+        helm.run()
+        await until(lambda: app.interface.state == frontseat_pb.INTERFACE_COMMAND)
+        port = db.port
+        await db.stop()
+        await until(lambda: app.interface.state == frontseat_pb.INTERFACE_HELM_ERROR)
+        assert not app.connected
+        assert app.interface.status().helm_error == frontseat_pb.ERROR_HELM_NOT_RUNNING
+        db = MOOSDB(port=port, clock=moos_clock(WARP))
+        await db.start()
+        await until(lambda: app.interface.state == frontseat_pb.INTERFACE_COMMAND)

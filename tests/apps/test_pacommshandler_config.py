@@ -100,7 +100,7 @@ def test_goby_messages_resolve_for_translator_entries(tmp_path):
         (("modem_id: 1", "modem_id: 0"), "broadcast"),
         (("modem_id: 1", ""), "missing required configuration fields: modem_id"),
         (("DRIVER_WHOI_MICROMODEM", "DRIVER_BENTHOS_ATM900"), "not implemented"),
-        (('load_proto_file: "@PROTO@"', 'load_proto_file: "no/such.proto"'), "cannot load message"),
+        (('load_proto_file: "@PROTO@"', 'load_proto_file: "no/such.proto"'), "no/such.proto\" not found; searched: "),
         (("moos_var {", 'dccl_frontseat_forward_name: "no.Such"\n  moos_var {'), "no.Such"),
         (("period: 15", "period: 0"), "TRIGGER_TIME needs a period"),
         (("common {", "common { moos_parser_technique: TECHNIQUE_FORMAT "), "Non-PROTOBUF"),

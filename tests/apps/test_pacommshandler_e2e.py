@@ -1,14 +1,16 @@
 """pAcommsHandler end to end: two communities (embedded MOOSDB + pAcommsHandler each) talking
-through emulated Micro-Modems over real loopback TCP, with TDMA slots."""
+through emulated Micro-Modems over real loopback TCP, with TDMA slots, through a modem link
+outage and a MOOSDB outage."""
 
 from __future__ import annotations
 
 import asyncio
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.moos.db import MOOSDB
 from pygoby.moos.translator import parse_for_moos, serialize_for_moos
 
-from .acomms_mission import COMMAND, STATUS, TwoCommunities
+from .acomms_mission import COMMAND, SLOT_SECONDS, STATUS, TwoCommunities
 
 NAV = {"NAV_X": 100.0, "NAV_Y": -50.0, "NAV_SPEED": 1.5, "NAV_HEADING": -90.0, "NAV_DEPTH": 10.0}
 
@@ -92,3 +94,42 @@ async def test_acked_command_survives_a_modem_link_outage(tmp_path):
         assert "command_id: 9" in original
         assert r2.values("DESIRED_HEADING") == [45.0]  # delivered once
         assert app1.queue.size(21) == 0
+
+
+async def test_the_acoustic_link_keeps_working_through_a_moosdb_outage(tmp_path):
+    async with TwoCommunities(tmp_path) as net:
+        (r1, r2), (app1, _) = net.recorders, net.apps
+        await net.ready()
+        for recorder in (r1, r2):
+            for var, value in NAV.items():
+                recorder.client.publish(var, value)
+        r1.client.publish("SEND_STATUS", "now")  # queued on vehicle 1 before its DB goes away
+        await r1.wait_for("ACOMMS_QSIZE", lambda v: "dccl_id: 20 size: 1" in v)
+        heard_before = len(r2.values("STATUS_REPORT_IN"))
+        db1 = net.dbs[0]
+        port = db1.port
+        loop = asyncio.get_running_loop()
+        await db1.stop()
+        outage_start = app1.clock.now()
+        # vehicle 1's MAC and modem go on: its status goes out in its next slot ...
+        report = await r2.wait_for("STATUS_REPORT_IN", lambda v: v.startswith("src=1,"),
+                                   timeout=15, start=heard_before)  # fmt: skip
+        assert report == "src=1,x=100,y=-50,speed=1.5,heading=270,depth=10"
+        # ... and it hears vehicle 2's status while its DB is still down
+        r2.client.publish("SEND_STATUS", "now")
+        await asyncio.sleep(2 * 2 * SLOT_SECONDS)  # two TDMA cycles
+        assert not app1.connected
+        outage_end = app1.clock.now()
+        db1 = MOOSDB(port=port, community="vehicle1")
+        await db1.start()
+        try:
+            started = loop.time()
+            # what vehicle 1 posted meanwhile reaches its DB once it is back
+            await r1.wait_for("STATUS_REPORT_IN", lambda v: v.startswith("src=2,"), timeout=15)
+            heard = [m for m in r1.seen["STATUS_REPORT_IN"] if m.string.startswith("src=2,")]
+            assert outage_start < heard[0].time < outage_end  # posted when it was heard
+            slots = [m.time for m in r1.seen["ACOMMS_MAC_INITIATE_TRANSMISSION"]]
+            assert any(outage_start < t < outage_end for t in slots)
+            assert loop.time() - started < 15
+        finally:
+            await db1.stop()

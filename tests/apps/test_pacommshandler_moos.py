@@ -1,16 +1,19 @@
 """pAcommsHandler's MOOS interface with DRIVER_NONE (one community, no modem): injected
 receptions, queue flush/expire/size, MAC updates, config request, frontseat forwarding,
-multiplexing, renamed variables and bad input."""
+multiplexing, renamed variables and bad input; a fatal driver failure as a process."""
 
 from __future__ import annotations
 
 import asyncio
 import base64
 import logging
+import sys
+from pathlib import Path
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.dccl import Codec
+from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.translator import parse_for_moos, serialize_for_moos
 
@@ -31,7 +34,6 @@ ProcessConfig = pAcommsHandler
                      role {{ type: SOURCE_ID field: "src" }} role {{ type: DESTINATION_ID field: "dest" }} }}
     message_entry {{ protobuf_name: "{COMMAND}" ttl: 2
                      role {{ type: SOURCE_ID field: "src" }} role {{ type: DESTINATION_ID field: "dest" }} }}
-    message_entry {{ protobuf_name: "not.a.LoadedType" }}
   }}
   load_proto_file: "{PROTO}"
   dccl_frontseat_forward_name: "{STATUS}"
@@ -238,3 +240,29 @@ async def test_received_route_command_replaces_the_route(tmp_path):
         finally:
             await app.stop()
             await r.close()
+
+
+async def test_a_fatal_driver_failure_ends_the_process_with_status_1(tmp_path):
+    # The primary driver fails (a manual reset) under MOVE_LISTEN_DRIVER_TO_PRIMARY with no
+    # listen driver to replace it: pAcommsHandler stops, and says so with its exit status.
+    extra = """  driver_cfg { driver_type: DRIVER_UDP  [goby.acomms.udp.protobuf.config] { local { port: 0 } } }
+  driver_failure_approach { technique: MOVE_LISTEN_DRIVER_TO_PRIMARY }"""
+    async with MOOSDB(port=0, community="alpha") as db:
+        path = tmp_path / "alpha.moos"
+        path.write_text(MISSION.replace("@PORT@", str(db.port)).replace("@EXTRA@", extra))
+        proc = await asyncio.create_subprocess_exec(
+            str(Path(sys.executable).with_name("pAcommsHandler")), str(path),
+            stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.PIPE,
+        )  # fmt: skip
+        try:
+            async with MOOSClient("tester", port=db.port) as tester:
+                async with asyncio.timeout(15):
+                    while "pAcommsHandler" not in db.client_names:
+                        await asyncio.sleep(0.05)
+                tester.publish("ACOMMS_DRIVER_RESET", "now")
+                _, err = await asyncio.wait_for(proc.communicate(), 15)
+        finally:
+            if proc.returncode is None:
+                proc.kill()
+    assert proc.returncode == 1
+    assert "no listen driver to replace it" in err.decode()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -13,10 +14,10 @@ PROTO = str(DCCL_VECTORS / "example.proto")
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))  # the installed console script
 
 
-def pygoby(*args: str, stdin: str = "") -> subprocess.CompletedProcess:
+def pygoby(*args: str, stdin: str = "", env: dict | None = None) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, "-m", "pygoby.cli", *args], input=stdin, capture_output=True, text=True,
-        timeout=60,
+        timeout=60, env=env,
     )
 
 
@@ -94,3 +95,24 @@ def test_encode_and_decode_trace_each_field_to_stderr() -> None:
                       stdin="040500\n")
     assert decoded.stdout == "a: 5\n"
     assert "decode example.Tiny body: c = not set (2 bits: 00)" in decoded.stderr.splitlines()
+
+
+def test_passphrase_from_a_file_or_the_environment_not_the_command_line(tmp_path) -> None:
+    """Issue 16 item 15: the key need not appear in the process list."""
+    secret_file = tmp_path / "secret"
+    secret_file.write_text("my secret\n")  # as `echo "my secret" > secret` writes it
+    encrypted = "d10723025d66fced5d\n"
+    out = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.LongId",
+                 "--passphrase-file", str(secret_file), stdin=encrypted)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith('src: 3 dest: 17 payload: "\\001\\002" t: ')
+    env = {**os.environ, "PYGOBY_DCCL_PASSPHRASE": "my secret"}
+    out = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.LongId",
+                 stdin=encrypted, env=env)
+    assert out.stdout.startswith('src: 3 dest: 17 payload: "\\001\\002" t: ')
+    wrong = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.LongId",
+                   stdin=encrypted)  # no passphrase: the body does not decode to the same
+    assert not wrong.stdout.startswith('src: 3 dest: 17 payload: "\\001\\002" t: ')
+    missing = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.LongId",
+                     "--passphrase-file", str(tmp_path / "nope"), stdin=encrypted)
+    assert missing.returncode == 2 and "nope" in missing.stderr and "Traceback" not in missing.stderr

@@ -143,7 +143,7 @@ def test_wrong_name_lists_the_drivers_found(name) -> None:
 def test_module_with_broken_import_is_reported(tmp_path, monkeypatch) -> None:
     (tmp_path / "broken_fs_driver.py").write_text("import no_such_dependency_xyz\n")
     monkeypatch.syspath_prepend(str(tmp_path))
-    with pytest.raises(DriverLoadError, match="cannot import driver module 'broken_fs_driver'"):
+    with pytest.raises(DriverLoadError, match="cannot import frontseat driver module 'broken_fs_driver'"):
         load_driver("broken_fs_driver", cfg())
 
 

@@ -60,6 +60,7 @@ def test_notes_name_the_file_lines_of_the_changed_fields():
                                           ("VERBOSITY_GUI", "VERBOSE")])  # fmt: skip
 def test_every_app_common_accepts_goby_1_1_verbosity(old, new):
     cfg, notes = read(f"common {{ verbosity: {old} log: false }}", PTRANSLATOR, "pTranslator")
+    assert cfg.common.show_gui == (old == "VERBOSITY_GUI")  # Goby 2's mapping: the live view
     assert cfg.common.verbosity == VERBOSITY[new].number
     assert len(notes) == 1
 

@@ -16,6 +16,7 @@ from google.protobuf import text_format
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.client import MOOSClient
+from pygoby.moos.timewarp import moos_clock
 from pygoby.util.geodesy import UTMGeodesy
 from tests.goby11.seed_listings import EXAMPLES, LISTINGS, printed
 
@@ -125,8 +126,7 @@ async def test_basic_ccl_bytes_reach_mm2(tmp_path):
 
 async def test_ccl_and_dccl_simple_status_reaches_mm2(tmp_path):
     """Example 2, DCCL half: mm1's SIMPLE_STATUS (simple_status.xml, the initializers' NAV_*)
-    decoded on mm2 and published as the XML says. The REMUS half needs pREMUSCodec (its own
-    issue): antler reports it as not available and runs the rest."""
+    decoded on mm2 and published as the XML says (the REMUS half: the test below)."""
     directory, ports = localize(tmp_path, "ccl_and_dccl")
 
     async def check():
@@ -144,7 +144,81 @@ async def test_ccl_and_dccl_simple_status_reaches_mm2(tmp_path):
     lat, lon = UTMGeodesy(42.35, -70.95).to_geo(100, 300)
     assert (node["NAME"], node["TYPE"], node["X"], node["Y"], node["HDG"]) == ("mm1", "topside", "100", "300", "150")
     assert float(node["LAT"]) == pytest.approx(lat, abs=1e-9) and float(node["LON"]) == pytest.approx(lon, abs=1e-9)
-    assert any("pREMUSCodec is not available" in err for err in run_pair.stderr)
+    assert not any("is not available" in err for err in run_pair.stderr)
+
+
+# Example 2 carries REMUS State frames only (CCL id 14, mm2 -> mm1); the Redirect command needs
+# a CCL queue for id 7 on both nodes, on pREMUSCodec's default Redirect variables (README,
+# "pREMUSCodec": with value_base 10 it beats SIMPLE_STATUS's queue after 18 s of waiting).
+REDIRECT_QUEUE = """queue_cfg
+{
+    queue
+    {
+        key { type: QUEUE_CCL id: 7 }
+        in_pubsub_var: "IN_REMUS_REDIRECT_HEX_30B"
+        out_pubsub_var: "OUT_REMUS_REDIRECT_HEX_30B"
+        name: "Remus_Redirect"
+        value_base: 10
+    }
+"""
+REDIRECT = ("MessageType=CCL_REDIRECT,DestinationPlatformId=2,Latitude=42.36,Longitude=-70.94,"
+            "SpeedDepthFlags=88,TransitSpeed=1.5,TransitDepth=10,TransitCommand=1,SurveySpeed=1.0,"
+            "SurveyDepth=20,SurveyCommand=2,NumberOfRows=4,RowLength=200,RowSpacing0=20,"
+            "RowSpacing1=30,RowHeading=90,StartLatitude=42.35,StartLongitude=-70.95")  # fmt: skip
+
+
+def key_values(text: str) -> dict[str, str]:
+    return dict(item.split("=", 1) for item in text.split(","))
+
+
+async def test_ccl_and_dccl_remus_state_reaches_mm1_and_a_redirect_reaches_mm2(tmp_path):
+    """Example 2, REMUS half: mm2's pREMUSCodec (create_status) encodes its NAV_* (the
+    initializers: x 123, y 321, heading 45, speed 1.2, depth 111) as a CCL State frame every 10 s;
+    the CCL queue (id 14), MAC, Micro-Modem driver and iModemSim carry it to mm1, whose
+    pREMUSCodec posts NODE_REPORT and MM2_NAV_*. An OUTGOING_COMMAND CCL_REDIRECT on mm1 reaches
+    mm2 as CCL_REDIRECT_IN with the values sent."""
+    directory, ports = localize(tmp_path, "ccl_and_dccl")
+    for node in ("mm1", "mm2"):
+        path = directory / f"{node}.moos"
+        text = path.read_text()
+        start = text.index("queue_cfg")
+        end = text.index("{", start) + 1
+        path.write_text(text[:start] + REDIRECT_QUEUE + text[end:])
+
+    async def check():
+        report = key_values(await wait_for(ports["mm1"], "NODE_REPORT", lambda v: "NAME=mm2" in str(v)))
+        contacts = {var: await wait_for(ports["mm1"], f"MM2_NAV_{var}", lambda v: isinstance(v, float))
+                    for var in ("X", "Y", "SPEED", "HEADING", "DEPTH", "LAT", "LONG")}  # fmt: skip
+        status = key_values(await wait_for(ports["mm1"], "STATUS_REPORT_IN", lambda v: "CCL_STATUS" in str(v)))
+        async with MOOSClient("operator", port=ports["mm1"], clock=moos_clock(WARP)) as operator:
+            operator.publish("OUTGOING_COMMAND", REDIRECT)
+            await operator.flush()
+        redirect = key_values(await wait_for(ports["mm2"], "CCL_REDIRECT_IN", lambda v: isinstance(v, str)))
+        return report, contacts, status, redirect
+
+    report, contacts, status, redirect = await run_pair(directory, ports, check)
+    assert (report["NAME"], report["TYPE"], report["MODE"], report["MOOSDB_TIME"]) == ("mm2", "auv", "NOMOOS", "-1")
+    # what mm2 sent, within the frame's resolution (lat/lon ~2 m, heading 360/255, 2.5 cm/s)
+    sent = {"X": 123.0, "Y": 321.0, "SPEED": 1.2, "HEADING": 45.0, "DEPTH": 111.0}
+    within = {"X": 2.5, "Y": 2.5, "SPEED": 0.02, "HEADING": 360 / 255 / 2, "DEPTH": 0.1}
+    for var, value in sent.items():
+        assert contacts[var] == pytest.approx(value, abs=within[var]), var
+    for key, var in (("X", "X"), ("Y", "Y"), ("SPD", "SPEED"), ("HDG", "HEADING"), ("DEPTH", "DEPTH"),
+                     ("LAT", "LAT"), ("LON", "LONG")):  # fmt: skip
+        assert float(report[key]) == contacts[var], key  # the same numbers, 17 digits
+    lat, lon = UTMGeodesy(42.35, -70.95).to_geo(123, 321)
+    assert contacts["LAT"] == pytest.approx(lat, abs=2.2e-5) and contacts["LONG"] == pytest.approx(lon, abs=2.2e-5)
+    assert float(report["YAW"]) == pytest.approx(float(report["HDG"]) - 360)
+    assert (status["Node"], float(status["Speed"]), float(status["Depth"])) == ("2", contacts["SPEED"], 111.0)
+    assert redirect["DestinationPlatformId"] == "2" and redirect["SpeedDepthFlags"] == "88"
+    expected = key_values(REDIRECT)
+    for key in ("Latitude", "Longitude", "StartLatitude", "StartLongitude"):
+        assert float(redirect[key]) == pytest.approx(float(expected[key]), abs=1.1e-5), key
+    for key in ("TransitSpeed", "TransitDepth", "SurveySpeed", "SurveyDepth"):
+        assert float(redirect[key]) == float(expected[key]), key  # on a step: exact
+    for key in ("TransitCommand", "SurveyCommand", "NumberOfRows", "RowLength", "RowSpacing0", "RowSpacing1"):
+        assert redirect[key] == expected[key], key
+    assert float(redirect["RowHeading"]) == pytest.approx(90, abs=360 / 255 / 2)
 
 
 def test_antler_block_of_the_seed_with_xconfig_and_geometry_lines():

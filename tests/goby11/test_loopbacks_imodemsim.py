@@ -200,3 +200,20 @@ def test_imodemsim_port_that_cannot_be_made(tmp_path):
     path.write_text(path.read_text().replace(f"Port = {tmp_path}/ttyLOOPA1", f"Port = {tmp_path}/modem"))
     with pytest.raises(ConfigError, match="only loopback names ending in 1 or 2"):
         iModemSim.from_mission(path)
+
+
+async def test_example_config_is_a_block_imodemsim_reads(tmp_path):
+    """`iModemSim --example_config` prints its own `name = value` lines (not the TextFormat
+    `common` block of Goby apps), and that block, pasted into a mission, runs."""
+    block = iModemSim.example_config()
+    assert block.startswith("ProcessConfig = iModemSim\n{\n") and "common" not in block
+    udp = free_udp_port()
+    block = block.replace("/tmp/ttyLOOPA1", f"{tmp_path}/ttyLOOPA1").replace("49234", str(udp))
+    path = tmp_path / "example.moos"
+    path.write_text(f"ServerPort = 1\nCommunity = ex\n{block}")
+    app = iModemSim.from_mission(path)
+    try:
+        assert (app.port_path, app.channel.port, app.position) == (f"{tmp_path}/ttyLOOPA1", udp, [0.0, 0.0, 0.0])
+        assert (app.cfg.common.app_tick, app.cfg.common.comm_tick) == (4, 4)
+    finally:
+        app.pair.close()

@@ -148,3 +148,17 @@ def test_app_configuration_error_names_the_mission(tmp_path):
     with pytest.raises(ConfigError, match=r"bad\.moos: uTimerScript: EVENT 'var=X' has no val="):
         uTimerScript.from_mission(path)
     assert asyncio.iscoroutinefunction(uTimerScript.start)
+
+
+def test_example_config_is_a_block_utimerscript_reads(tmp_path):
+    """`uTimerScript --example_config` prints MOOS-IvP's `name = value` lines, which load and
+    post as their comments say."""
+    block = uTimerScript.example_config("uTimerScript")
+    assert block.startswith("ProcessConfig = uTimerScript\n{\n") and "common" not in block
+    path = tmp_path / "example.moos"
+    path.write_text(f"ServerPort = 1\nCommunity = ex\n{block}")
+    ts = TimerScript(MissionFile.read(path).process_config("uTimerScript", keep_quotes=True))
+    assert not ts.warnings
+    ts.on_mail("DEPLOY", "true")
+    posts = run(ts, [0, 10, 30])
+    assert [(t, var, value) for t, var, value in posts] == [(10, "OUT_TEST", 3.5), (30, "OUT_TEXT", 'data: "x"')]

@@ -4,6 +4,7 @@ mail handling, ticks, timers and the command line, against the embedded MOOSDB."
 from __future__ import annotations
 
 import asyncio
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -17,6 +18,8 @@ from pygoby.moos.appconfig import ConfigError
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.moosfile import MissionFile
+from pygoby.util.aiorun import STOP_GRACE
+from tests.faults import CuttableRelay
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from example_app import pTestApp  # noqa: E402
@@ -110,7 +113,7 @@ def test_main_stops_on_config_error_before_connecting(tmp_path, capsys):
     path.write_text(_mission(1, "  common { app_tick: many }\n  out_var: \"X\""))
     assert pTestApp.main([str(path)], prog="pTestApp") == 1
     err = capsys.readouterr().err
-    assert "fatal configuration error" in err and 'field "app_tick"' in err and "m.moos:13:" in err
+    assert "fatal configuration error" in err and "m.moos:13: app_tick: Couldn't parse integer" in err
 
 
 def test_example_config():
@@ -232,6 +235,90 @@ async def test_command_line_and_example_config_as_a_program(tmp_path):
         finally:
             proc.terminate()
             assert await asyncio.wait_for(proc.wait(), 10) == 0
+
+
+async def _app_process(tmp_path: Path, db_port: int, script: str = "example_app.py") -> asyncio.subprocess.Process:
+    """`script` run as a program on a mission whose DB is at `db_port` (pipes for its output)."""
+    path = tmp_path / "m.moos"
+    path.write_text(_mission(db_port, BLOCK))
+    return await asyncio.create_subprocess_exec(
+        sys.executable, str(HERE / script), str(path), "pTestApp",
+        stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE,
+    )  # fmt: skip
+
+
+async def test_a_second_instance_with_a_taken_name_exits_with_a_clear_error(tmp_path):
+    async with MOOSDB(port=0) as db:
+        first = await _app_process(tmp_path, db.port)
+        try:
+            await _wait_for(lambda: "pTestApp" in db.client_names, timeout=10)
+            second = await _app_process(tmp_path, db.port)
+            _, err = await asyncio.wait_for(second.communicate(), 10)
+            assert second.returncode == 1
+            assert 'A client of this name ("pTestApp") already exists' in err.decode()
+            assert "is another pTestApp running?" in err.decode()
+            assert first.returncode is None and "pTestApp" in db.client_names
+        finally:
+            first.terminate()
+            assert await asyncio.wait_for(first.wait(), 10) == 0
+
+
+async def test_an_app_refused_on_reconnect_keeps_trying(tmp_path):
+    # The app's link to the DB breaks without the DB noticing (it keeps the stale session for
+    # its client timeout and refuses the name meanwhile): the app must come back by itself.
+    async with MOOSDB(port=0, client_timeout=1.5) as db, MOOSClient("tester", port=db.port) as tester:
+        relay = CuttableRelay(db.port)
+        await relay.start()
+        proc = await _app_process(tmp_path, relay.port)
+        try:
+            tester.subscribe("ECHO")
+            await _wait_for(lambda: "pTestApp" in db.client_names, timeout=10)
+            relay.cut()
+            await asyncio.sleep(1.0)  # the app has been refused at least once by now
+            await _wait_for(lambda: "pTestApp" in db.client_names, timeout=15)
+            await asyncio.sleep(0.5)
+            tester.publish("NAV_X", 4.0)
+            msg = await _expect_key(tester, "ECHO", 5)
+            assert (msg.value, msg.src) == (8.0, "pTestApp")
+        finally:
+            proc.terminate()
+            await asyncio.wait_for(proc.communicate(), 10)
+            await relay.close()
+        assert proc.returncode == 0
+
+
+@pytest.mark.parametrize("signals", [["SIGTERM"], ["SIGINT"], ["SIGTERM", "SIGINT"]])
+async def test_a_signal_ends_an_app_whose_stop_hangs(tmp_path, signals):
+    async with MOOSDB(port=0) as db:
+        proc = await _app_process(tmp_path, db.port, "stuck_app.py")
+        try:
+            await _wait_for(lambda: "pTestApp" in db.client_names, timeout=10)
+            loop = asyncio.get_running_loop()
+            started = loop.time()
+            proc.send_signal(getattr(signal, signals[0]))
+            assert await asyncio.wait_for(proc.stdout.readline(), 5) == b"stopping\n"
+            for name in signals[1:]:  # a second signal: at once
+                proc.send_signal(getattr(signal, name))
+            _, err = await asyncio.wait_for(proc.communicate(), STOP_GRACE + 5)
+        finally:
+            if proc.returncode is None:
+                proc.kill()
+        took = loop.time() - started
+        last = getattr(signal, signals[-1])
+        assert proc.returncode == 128 + last
+        if len(signals) == 1:
+            assert f"pTestApp: did not stop within {STOP_GRACE:g} s; exiting now" in err.decode()
+            assert took >= STOP_GRACE
+        else:
+            assert "pTestApp: second SIGINT; exiting now" in err.decode()
+            assert took < STOP_GRACE
+
+
+async def _expect_key(client: MOOSClient, key: str, timeout: float):
+    async with asyncio.timeout(timeout):
+        while (msg := await client.receive()).key != key:
+            pass
+    return msg
 
 
 def test_subclass_without_config_is_an_error():

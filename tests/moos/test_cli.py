@@ -91,6 +91,16 @@ def test_poke_without_db_fails_cleanly():
     assert done.returncode == 1 and "cannot connect" in done.stderr
 
 
+def test_a_taken_name_fails_cleanly(moosdb):
+    async def poke_as_a_taken_name() -> subprocess.CompletedProcess[str]:
+        async with MOOSClient("taken", port=moosdb):
+            return await asyncio.to_thread(_pygoby, "moos", "poke", "--port", str(moosdb), "--name", "taken", "X=1")
+
+    done = asyncio.run(poke_as_a_taken_name())
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert 'A client of this name ("taken") already exists' in done.stderr
+
+
 def test_bad_assignment_is_usage_error():
     done = _pygoby("moos", "poke", "--port", "1", "novalue")
     assert done.returncode == 2 and "VAR=value" in done.stderr

@@ -16,6 +16,7 @@ import pytest
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient, MoosRefusedError
 from pygoby.moos.db import MOOSDB
+from tests.faults import CuttableRelay
 from tests.moos.rawclient import closed_by_peer, raw_connect
 
 
@@ -117,6 +118,51 @@ async def test_name_collision_is_refused():
         with pytest.raises(MoosRefusedError, match="already exists"):
             await second.connect(timeout=3)
         await second.close()
+
+
+async def test_refused_on_reconnect_keeps_trying_until_the_stale_session_is_gone(caplog):
+    # The link to the DB breaks without the DB noticing: it keeps the client's session until its
+    # client timeout and refuses the name meanwhile. The client must not give up.
+    async with MOOSDB(port=0, client_timeout=1.5) as db, MOOSClient("tester", port=db.port) as tester:
+        relay = CuttableRelay(db.port)
+        await relay.start()
+        app = MOOSClient("app", port=relay.port, reconnect_interval=0.1)
+        try:
+            await app.connect()
+            app.subscribe("CMD")
+            await app.flush()
+            relay.cut()
+            async with asyncio.timeout(3):
+                while app.connected:
+                    await asyncio.sleep(0.01)
+            app.publish("STATUS", "after the cut")
+            tester.subscribe("STATUS")
+            await app.wait_connected(10)  # refused at first, accepted once the DB dropped the old one
+            assert (await _expect(tester, "STATUS", 3)).string == "after the cut"
+            assert "already exists" in caplog.text and "trying again in" in caplog.text
+            assert app.failure is None and app.connections == 2
+            tester.publish("CMD", 1.0)  # subscriptions made again
+            assert (await _expect(app, "CMD", 3)).dval == 1.0
+        finally:
+            await app.close()
+            await relay.close()
+
+
+async def test_close_ends_the_client_at_any_moment_of_a_lost_connection():
+    # close() landing in the few loop iterations in which the client wound up a lost session
+    # had its cancellation swallowed: the client went on reconnecting forever (and the app
+    # owning it ignored SIGTERM). Try every iteration of that window.
+    for turns in range(12):
+        db = MOOSDB(port=0)
+        await db.start()
+        client = MOOSClient("app", port=db.port, reconnect_interval=0.05)
+        await client.connect()
+        await db.stop()
+        for _ in range(turns):
+            await asyncio.sleep(0)
+        closing = asyncio.ensure_future(client.close())
+        done, _ = await asyncio.wait({closing}, timeout=2)
+        assert done, f"close() {turns} loop iterations after the drop never returned"
 
 
 async def test_reconnect_resubscribe_and_queue_while_away():
@@ -370,3 +416,18 @@ async def test_packets_cut_anywhere_by_tcp_are_all_delivered():
         got = [(await _expect(sink, "CUT")).dval for _ in expected]
         assert got == expected
         writer.close()
+async def test_close_while_the_connection_is_being_lost_returns():
+    """close() at any point of the DB going away (here: 0..15 loop turns after it closed the
+    connections) ends the client instead of leaving it reconnecting (antler's SIGINT reaches
+    the DB and the apps at once)."""
+    for turns in range(16):
+        db = MOOSDB(port=0)
+        await db.start()
+        client = MOOSClient(f"closing{turns}", port=db.port, reconnect_interval=0.05)
+        await client.connect()
+        await db.stop()
+        for _ in range(turns):
+            await asyncio.sleep(0)
+        closing = asyncio.ensure_future(client.close())
+        done, _ = await asyncio.wait([closing], timeout=2)  # (wait_for would cancel and rescue it)
+        assert done, f"close() hangs: the client goes on reconnecting ({turns} turns)"

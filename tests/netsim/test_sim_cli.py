@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import json
+import re
 import struct
 from pathlib import Path
 
@@ -18,7 +19,7 @@ from pygoby.moos.timewarp import moos_clock
 from pygoby.netsim.eventlog import read_events
 from pygoby.netsim.protocol import LineDecoder, encode_line, request_class, response_names
 from pygoby.netsim.realtime import RealTimeRun
-from pygoby.netsim.report import bin_success
+from pygoby.netsim.report import bin_success, node_labels, timeline_window
 from pygoby.netsim.scenario import ScenarioError, parse_scenario
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "netsim" / "tdma8.pb.cfg"
@@ -117,6 +118,7 @@ async def test_real_time_run_over_tcp():
         heard_by_3 = await modem_r.read(65536)
         modem_w.close()
     assert summary.status_received >= 2  # nodes 1 and 2 heard each other (driver over TCP)
+    assert summary.external_deliveries[3] >= 1  # counted for node 3's external stack
     assert b"$CARXD" in heard_by_3  # and the channel delivered to node 3's emulator
     assert any(e["event"] == "rx" and e["port"] == 62002 for e in events)
 
@@ -146,3 +148,57 @@ def test_fuzz_event_log_reader_skips_what_is_not_an_event(tmp_path_factory, line
     path.write_text(text, encoding="utf-8")
     events = read_events(path)
     assert all(isinstance(e, dict) and isinstance(e.get("event"), str) for e in events)
+
+
+EXTERNAL = """speed: "8"
+duration: 48
+origin { lat: 42 lon: -70 }
+real_time { ephemeral_ports: true }
+mac { slot_seconds: 6 rate: 1 }
+node { modem_id: 1 track { waypoint { x: 0 depth: 5 } } }
+node { modem_id: 2 track { waypoint { x: 1500 depth: 5 } } }
+node { modem_id: 3 in_process_stack: false track { waypoint { x: 700 depth: 5 } } }
+"""
+
+
+def test_real_time_cli_run_ends_cleanly_and_counts_external_deliveries(tmp_path):
+    """`pygoby netsim run` in real time (8x): no traceback when it ends, progress on stderr
+    (not a terminal: a line per tenth once it has run a few seconds), and the summary counts
+    what reached the external stack's modem (node 3: nobody in process reads its queue)."""
+    import subprocess
+    import sys
+
+    scenario = tmp_path / "external.pb.cfg"
+    scenario.write_text(EXTERNAL)
+    log = tmp_path / "events.jsonl"
+    pygoby = Path(sys.executable).with_name("pygoby")
+    done = subprocess.run([pygoby, "netsim", "run", scenario, "--event-log", log],
+                          capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr and "Exception" not in done.stderr, done.stderr
+    lines = done.stdout.splitlines()
+    external = [line for line in lines if line.startswith("packets delivered to external")]
+    assert len(external) == 1 and re.fullmatch(
+        r"packets delivered to external stacks' modems: modem 3: [1-9]\d*", external[0]
+    ), lines
+    progress = [line for line in done.stderr.splitlines() if line.startswith("simulated ")]
+    assert progress and all(
+        re.fullmatch(r"simulated [\d,]+/48 s \(\d+%\): packets \d+, messages \d+, [\d.,]+x real time(, ETA \d+ s)?", p)
+        for p in progress
+    ), progress
+    nodes = [e for e in read_events(log) if e["event"] == "node"]
+    assert [(e["port"], e["modem_id"], e["external"]) for e in nodes] == [
+        (62000, 1, False), (62001, 2, False), (62002, 3, True)
+    ]
+
+
+def test_timeline_covers_the_run_and_names_nodes_by_modem_id():
+    events = [
+        {"event": "node", "t": 100.0, "port": 62000, "modem_id": 7, "external": False},
+        {"event": "tx", "t": 110.0, "port": 62000, "src": 7, "kind": "data", "duration": 3.0},
+        {"event": "tx", "t": 7000.0, "port": 62005, "src": 4, "kind": "data", "duration": 3.0},
+        {"event": "rx", "t": 7300.0, "arrival": 7299.0, "port": 62009, "outcome": "good"},
+    ]
+    assert node_labels(events) == {62000: "modem 7", 62005: "modem 4", 62009: "port 62009"}
+    assert timeline_window(events, None) == (100.0, (0.0, 7200.0))  # the whole run
+    assert timeline_window(events, (10.0, 20.0)) == (100.0, (10.0, 20.0))

@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import serialize_for_moos
+from pygoby.topside.acomms_config import read_acomms_config
 from pygoby.topside.commander import (
     MULTIPLEX,
     Commander,
@@ -56,7 +56,7 @@ def commands(tmp_path) -> CommandSet:
     path = tmp_path / "m.moos"
     path.write_text(MISSION)
     mission = MissionFile.read(path)
-    return CommandSet.from_pacommshandler(pAcommsHandler.read_config(mission, "pAcommsHandler"))
+    return CommandSet.from_pacommshandler(read_acomms_config(mission))
 
 
 def make(commands, posts, **kwargs) -> Commander:
@@ -190,6 +190,10 @@ def test_save_file_round_trip_with_commas(commands, tmp_path):
     warnings = other.load(tmp_path / "bad.txt")
     assert warnings[0] == "Nope: not a message of this mission"
     assert "above the maximum 360" in warnings[1]
+    # a Latin-1 save file (issue 16 item 10's class: bytes that are not UTF-8) loads
+    (tmp_path / "latin1.txt").write_bytes(f"{savefile.HEADER_PREFIX}x caf\xe9\nmessage::Command\n"
+                                          "COMMAND_OUT:=dest=3\n".encode("latin-1"))  # fmt: skip
+    assert other.load(tmp_path / "latin1.txt") == [] and other.open("Command").values["dest"] == "3"
 
 
 @given(st.text(max_size=300))

@@ -4,6 +4,8 @@ import asyncio
 import os
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from pygoby.util.errors import LinkClosedError
 from pygoby.util.linebased import (
@@ -114,3 +116,53 @@ def test_memory_link_counts_connections():
     link.close()
     link.open()
     assert link.connections == 2
+
+
+def test_splitter_drops_an_over_long_line_whole_and_keeps_the_next():
+    """An over-long line is dropped up to its delimiter: no tail of it comes out as a line."""
+    s = LineSplitter("\r\n", max_line_bytes=8)
+    assert s.feed(b"ok\r\n0123456") == ["ok"]
+    assert s.feed(b"789abcdef") == [] and s.discarded == 1
+    assert s.feed(b"tail-of-the-long-line\r") == []
+    assert s.feed(b"\nnext\r\n") == ["next"]
+    assert s.feed(b"0123456789\r\nafter\r\n") == ["after"] and s.discarded == 2
+    assert s.feed(b"12345678\r\n") == ["12345678"]  # exactly the limit is a line
+    assert s.feed(b"12345678\r") == [] and s.feed(b"\n") == ["12345678"]  # split delimiter
+
+
+def test_splitter_scans_each_byte_once():
+    """A long line trickled in small pieces costs time in proportion to its length."""
+    s = LineSplitter("\r", max_line_bytes=1 << 20)
+    calls = 0
+    real_find = bytearray.find
+
+    class CountingBuffer(bytearray):
+        def find(self, sub, start=0, *args):
+            nonlocal calls
+            calls += len(self) - start
+            return real_find(self, sub, start, *args)
+
+    s._buffer = CountingBuffer()
+    for _ in range(2000):
+        s.feed(b"x" * 100)
+    assert s.feed(b"\r") == ["x" * 200_000]
+    assert calls < 3 * 200_000  # rescanning from the start each time would be ~2000x more
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    stream=st.lists(st.sampled_from([b"a", b"bc", b"\r", b"\n", b"\r\n", b"xyz" * 5])).map(b"".join),
+    cuts=st.lists(st.integers(min_value=0, max_value=200)),
+    delimiter=st.sampled_from(["\r", "\r\n"]),
+)
+def test_splitter_same_lines_however_the_stream_is_cut(stream, cuts, delimiter):
+    limit = 6
+    splitter = LineSplitter(delimiter, max_line_bytes=limit)
+    got = []
+    start = 0
+    for cut in sorted(cuts) + [len(stream)]:
+        got += splitter.feed(stream[start:cut])
+        start = max(start, cut)
+    complete = stream.split(delimiter.encode())[:-1]
+    assert got == [line.decode("latin-1") for line in complete if len(line) <= limit]
+    assert splitter.discarded == sum(len(line) > limit for line in complete) + splitter._discarding

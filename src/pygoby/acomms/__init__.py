@@ -31,11 +31,13 @@ The classes and functions named above (and the errors) are also importable from
 from pygoby.acomms.errors import (
     ABCParseError,
     AcommsError,
+    DriverNotFoundError,
     HandlerError,
     ModemDriverError,
     QueueError,
     RoleError,
     RudicsPacketError,
+    StoreServerAuthError,
 )
 from pygoby.util.modules import lazy_exports
 
@@ -59,6 +61,7 @@ __all__ = [
     "ABCParseError",
     "AcommsError",
     "AcommsHandler",
+    "DriverNotFoundError",
     "HandlerError",
     "MACManager",
     "ModemDriverBase",
@@ -68,6 +71,7 @@ __all__ = [
     "RoleError",
     "RouteManager",
     "RudicsPacketError",
+    "StoreServerAuthError",
     "bind",
     "make_driver",
     "unbind",

@@ -1,4 +1,9 @@
-"""ABC modem simulator (spec acomms.md §9.3): each TCP client is one modem; no delay, no loss."""
+"""ABC modem simulator (spec acomms.md §9.3): each TCP client is one modem; no delay, no loss.
+
+Bad lines are logged and skipped, one line per client per turn of the event loop, and a modem
+that does not read what is sent to it loses packets (as an acoustic modem out of range would)
+instead of growing the simulator's memory.
+"""
 
 from __future__ import annotations
 
@@ -7,9 +12,12 @@ import logging
 from collections.abc import Hashable
 
 from pygoby.acomms.abc_protocol import format_abc, parse_abc
-from pygoby.acomms.errors import ABCParseError
+from pygoby.util.linebased import LineSplitter
 
 log = logging.getLogger(__name__)
+
+READ_SIZE = 4096
+MAX_UNREAD_BYTES = 1 << 20  # a modem this far behind in reading loses what is sent to it
 
 
 class ABCSimulator:
@@ -23,10 +31,13 @@ class ABCSimulator:
 
     def handle(self, endpoint: Hashable, line: str) -> list[tuple[Hashable, str]]:
         try:
-            key, fields = parse_abc(line)
-        except ABCParseError as exc:
-            log.error("%s", exc)
+            return self._handle(endpoint, line)
+        except ValueError as exc:  # ABCParseError, or a number field that is not a number
+            log.error("ignoring %r: %s", line[:80], exc)
             return []
+
+    def _handle(self, endpoint: Hashable, line: str) -> list[tuple[Hashable, str]]:
+        key, fields = parse_abc(line)
         if key == "CONF" and "MAC" in fields:
             self.modems[int(fields["MAC"])] = endpoint
             return []
@@ -51,12 +62,20 @@ class ABCSimulator:
 
 async def serve_abc(sim: ABCSimulator, host: str = "127.0.0.1", port: int = 0) -> asyncio.Server:
     async def client(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        splitter = LineSplitter("\n")
         try:
-            while line := await reader.readline():
-                for target, text in sim.handle(writer, line.decode("latin-1")):
-                    target.write(text.encode("latin-1"))
+            while data := await reader.read(READ_SIZE):
+                for line in splitter.feed(data):
+                    for target, text in sim.handle(writer, line + "\n"):
+                        if target.transport.get_write_buffer_size() > MAX_UNREAD_BYTES:
+                            log.warning("dropping a packet for a modem that does not read")
+                            continue
+                        target.write(text.encode("latin-1"))
+                    await asyncio.sleep(0)  # every other client's line comes next
         except ConnectionError:
             pass
+        except asyncio.CancelledError:  # shutting down: end quietly (asyncio 3.11 would log
+            pass  # the cancellation of a client task as an unhandled exception)
         finally:
             sim.forget(writer)
             writer.close()

@@ -7,6 +7,7 @@ import asyncio
 import logging
 import sys
 
+from pygoby.errors import ConfigError
 from pygoby.util.aiorun import run_until_signal
 
 
@@ -40,10 +41,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Store server for DRIVER_STORE_SERVER clients (RUDICS packets over TCP).",
     )
     s.add_argument("--port", type=int, default=11244, help="TCP port (default %(default)s)")
-    s.add_argument("--host", default="0.0.0.0", help="address to bind (default %(default)s)")
+    s.add_argument("--host", default="127.0.0.1",
+                   help="address to bind (default %(default)s; 0.0.0.0: every interface)")  # fmt: skip
     s.add_argument("--db", default="goby_store_server.db", help="SQLite file (default %(default)s)")
     s.add_argument("--max-lookback", type=float, default=3600.0,
                    help="seconds of history a new client receives (default %(default)s)")  # fmt: skip
+    s.add_argument("--retention", type=float, default=3600.0,
+                   help="seconds a delivered transmission is kept (default %(default)s)")  # fmt: skip
+    s.add_argument("--lock-timeout", type=float, default=5.0,
+                   help="seconds to wait for a database locked by another process before "
+                        "answering the client with an error (default %(default)s)")  # fmt: skip
+    s.add_argument("--secrets", metavar="FILE",
+                   help="'MODEM_ID SECRET' per line: each modem id's requests must be signed "
+                        "with its secret, ids not listed are refused (default: no check)")  # fmt: skip
     s.set_defaults(func=run_store_server)
 
     lb = subparsers.add_parser(
@@ -134,15 +144,21 @@ def run_loopbacks(args: argparse.Namespace) -> int:
 
 def run_store_server(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
-    run_until_signal(_serve_store(args))
+    try:
+        run_until_signal(_serve_store(args))
+    except (ConfigError, OSError) as exc:
+        print(f"store_server: {exc}", file=sys.stderr)
+        return 1
     return 0
 
 
 async def _serve_store(args: argparse.Namespace) -> None:
     from pygoby.acomms.store_server import StoreServer, TransmissionStore, serve_store
+    from pygoby.acomms.store_server.auth import read_secrets
 
-    store = TransmissionStore(args.db, args.max_lookback)
-    server = await serve_store(StoreServer(store), args.host, args.port)
+    secrets = read_secrets(args.secrets) if args.secrets else None
+    store = TransmissionStore(args.db, args.max_lookback, args.retention, args.lock_timeout)
+    server = await serve_store(StoreServer(store, secrets=secrets), args.host, args.port)
     port = server.sockets[0].getsockname()[1]
     print(f"store_server listening on {args.host}:{port} (database {args.db})", flush=True)
     try:

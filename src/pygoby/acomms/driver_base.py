@@ -17,6 +17,7 @@ from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import ModemDriverError
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.errors import LinkClosedError
+from pygoby.util.glog import DEBUG1, group_logger
 from pygoby.util.linebased import LineLink, SerialLink, TCPClientLink, TCPServerLink
 from pygoby.util.signal import Signal
 
@@ -40,6 +41,7 @@ class ModemDriverBase(ABC):
 
     DEFAULT_SERIAL_BAUD: int | None = None
     DEFAULT_LINE_DELIMITER: str | None = None  # overrides DriverConfig's default when unset
+    RATES: range | None = None  # the transmission rates the modem has (None: any number)
 
     def __init__(self, clock: Clock | None = None, link: LineLink | None = None) -> None:
         self.clock: Clock = clock if clock is not None else WallClock()
@@ -53,6 +55,8 @@ class ModemDriverBase(ABC):
         self.link: LineLink | None = link
         self._injected_link = link is not None
         self._raw_log: IO[str] | None = None
+        self._traffic_logs: tuple[logging.Logger, logging.Logger] = (log, log)
+        self._traffic_logs_for: object = None  # the cfg the traffic loggers are named for
 
     # --- the interface -------------------------------------------------------------------
     @abstractmethod
@@ -123,7 +127,10 @@ class ModemDriverBase(ABC):
             return TCPClientLink(cfg.tcp_server, cfg.tcp_port, delimiter, cfg.reconnect_interval)
         if not cfg.HasField("tcp_port"):
             raise ModemDriverError("tcp_port is required", Status.INVALID_CONFIGURATION)
-        return TCPServerLink(cfg.tcp_port, delimiter=delimiter)
+        # A modem (or serial-to-TCP box) elsewhere on the network connects to this server, so,
+        # as upstream, every interface unless `tcp_server` names the address to bind.
+        host = cfg.tcp_server if cfg.HasField("tcp_server") else "0.0.0.0"
+        return TCPServerLink(cfg.tcp_port, host=host, delimiter=delimiter)
 
     def modem_read(self) -> list[str]:
         if self.link is None:
@@ -156,6 +163,12 @@ class ModemDriverBase(ABC):
             self._raw_log.flush()
 
     def emit_raw(self, incoming: bool, raw: bytes | str, description: str = "") -> None:
+        """Every driver reports its traffic here (its text edge): the raw signals, and the
+        DEBUG1 log `<< line` (from the modem) / `>> line` (to the modem) in the groups
+        `goby::acomms::modemdriver::in::<driver name>` / `...::out::<driver name>`."""
+        traffic = self._traffic_log(incoming)
+        if traffic.isEnabledFor(DEBUG1):
+            traffic.log(DEBUG1, "%s %s", "<<" if incoming else ">>", _printable(raw))
         signal = self.signal_raw_incoming if incoming else self.signal_raw_outgoing
         if not signal:
             return  # nobody listens: skip building a ModemRaw for every line
@@ -164,6 +177,29 @@ class ModemDriverBase(ABC):
         if description:
             msg.description = description
         signal.emit(msg)
+
+
+    def _traffic_log(self, incoming: bool) -> logging.Logger:
+        if self._traffic_logs_for is not self.cfg:  # a new configuration: maybe a new name
+            name = driver_name(self.cfg)
+            self._traffic_logs = tuple(
+                group_logger(f"goby::acomms::modemdriver::{way}::{name}") for way in ("out", "in")
+            )
+            self._traffic_logs_for = self.cfg
+        return self._traffic_logs[incoming]
+
+
+def _printable(raw: bytes | str) -> str:
+    """Text as it is; binary (UDP datagrams, RUDICS packets) as its size and hex."""
+    if isinstance(raw, str):
+        return raw
+    try:
+        text = raw.decode("ascii")
+    except UnicodeDecodeError:
+        text = ""
+    if text.isprintable() and text:
+        return text
+    return f"<{len(raw)} B> {raw[:64].hex()}{'...' if len(raw) > 64 else ''}"
 
 
 class NoDriver(ModemDriverBase):

@@ -3,6 +3,8 @@ raises on purpose."""
 
 from pygoby.errors import PygobyError
 
+INVALID_CONFIGURATION = 4  # goby.acomms.protobuf.ModemDriverStatus.INVALID_CONFIGURATION
+
 
 class AcommsError(PygobyError):
     """Base class of every acomms error."""
@@ -25,12 +27,23 @@ class RoleError(AcommsError, ValueError):
     field holds a value the role cannot use)."""
 
 
+class DriverNotFoundError(ModemDriverError):
+    """No driver of that type or name (an INVALID_CONFIGURATION driver failure)."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(message, INVALID_CONFIGURATION)
+
+
 class HandlerError(AcommsError):
     """The handler's configuration cannot be used, or a failure it cannot recover from."""
 
 
+class StoreServerAuthError(AcommsError):
+    """A store-server request is not signed with its modem id's secret, or replays an older one."""
+
+
 class RudicsPacketError(AcommsError, ValueError):
-    """A RUDICS packet is too short or fails its CRC."""
+    """A RUDICS packet is too short, too long or fails its CRC."""
 
 
 class ABCParseError(AcommsError, ValueError):

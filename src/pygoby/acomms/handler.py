@@ -18,28 +18,27 @@ The queue's and the MAC's own signals are used directly (`handler.queue.signal_r
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
 import logging
 import os
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
+from pygoby.acomms import drivers
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.bind import bind, unbind
 from pygoby.acomms.driver_base import ModemDriverBase, driver_name
 from pygoby.acomms.errors import HandlerError, ModemDriverError, QueueError
 from pygoby.acomms.mac import MACManager
 from pygoby.acomms.queue import QueueManager
+from pygoby.acomms.queue.persist import QueueStore
 from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
 from pygoby.dccl import Codec, DcclError
+from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
 from pygoby.util.clock import Clock
-from pygoby.util.modules import import_module_or_file
 from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
@@ -47,14 +46,8 @@ log = logging.getLogger(__name__)
 Status = acomms_pb.ModemDriverStatus
 DriverType = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type.values_by_name
 DRIVER_NONE = DriverType["DRIVER_NONE"].number
+UFIELD = DriverType["DRIVER_UFIELD_SIM_DRIVER"].number
 
-# Built-in drivers: DriverType name -> "module:class" (imported when first used).
-BUILTIN_DRIVERS = {
-    "DRIVER_WHOI_MICROMODEM": "pygoby.acomms.drivers.micromodem:MMDriver",
-    "DRIVER_UDP": "pygoby.acomms.drivers.udp:UDPDriver",
-    "DRIVER_STORE_SERVER": "pygoby.acomms.drivers.store_server:StoreServerDriver",
-}
-PLUGINS_ENV = "PACOMMSHANDLER_PLUGINS"
 ROUTE_COMMAND = RouteCommand.DESCRIPTOR.full_name
 
 CONTINUALLY_RESTART_DRIVER = 1
@@ -66,51 +59,40 @@ DISABLE_AND_MOVE_LISTEN_DRIVER_TO_PRIMARY = 3
 # Drivers
 
 
-def _import_object(spec: str):
-    module, _, name = spec.partition(":")
-    return getattr(importlib.import_module(module), name)
-
-
-def plugin_driver_factory(driver_name: str) -> Callable[[Clock], ModemDriverBase]:
-    """`goby_make_driver` of the plugin (listed in $PACOMMSHANDLER_PLUGINS, separated by any of
-    `;`, `:`, `,`) whose `goby_driver_name()` is `driver_name`."""
-    listed = [p for p in re.split(r"[;:,]", os.environ.get(PLUGINS_ENV, "")) if p.strip()]
-    for name in listed:
-        try:
-            module = import_module_or_file(name.strip())
-        except (ImportError, OSError, SyntaxError) as exc:
-            raise HandlerError(f"cannot load driver plugin {name!r}: {exc}") from None
-        namer = getattr(module, "goby_driver_name", None)
-        if namer is None or namer() != driver_name:
-            continue
-        factory = getattr(module, "goby_make_driver", None)
-        if factory is None:
-            raise HandlerError(f"driver plugin {name!r} has no goby_make_driver()")
-        return factory
-    raise HandlerError(
-        f"no driver plugin named {driver_name!r} in ${PLUGINS_ENV} ({', '.join(listed) or 'empty'})"
-    )
+def _check_slot_rates(mac_cfg, driver: ModemDriverBase) -> None:
+    """Every slot's rate is one the driver has: a wrong one would fail every cycle, not once."""
+    if driver.RATES is None:
+        return
+    for index, slot in enumerate(mac_cfg.slot):
+        if slot.type == acomms_pb.DATA and slot.rate not in driver.RATES:
+            raise ConfigError(
+                f"rate {slot.rate} is not a rate of {type(driver).__name__} "
+                f"({driver.RATES.start}-{driver.RATES.stop - 1})",
+                field=f"mac_cfg.slot[{index}].rate",
+            )
 
 
 def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
-    """The driver selected by `cfg` (DriverConfig), or None for DRIVER_NONE."""
-    if cfg.WhichOneof("driver") == "driver_name":
-        factory = plugin_driver_factory(cfg.driver_name)
-        try:
-            return factory(clock)
-        except TypeError:
-            return factory()
-    if cfg.driver_type == DRIVER_NONE:
+    """The driver selected by `cfg` (DriverConfig, through pygoby.acomms.drivers' registry), or
+    None for DRIVER_NONE."""
+    if cfg.WhichOneof("driver") != "driver_name" and cfg.driver_type == DRIVER_NONE:
         return None
-    type_name = (
-        acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"]
-        .enum_type.values_by_number[cfg.driver_type]
-        .name
-    )
-    spec = BUILTIN_DRIVERS.get(type_name)
-    if spec is None:
-        raise HandlerError(f"driver_type {type_name} is not implemented in pygoby")
-    return _import_object(spec)(clock)
+    return drivers.make_driver(cfg, clock)
+
+
+def wire_driver_cfg(driver_cfg, cfg) -> None:
+    """pAcommsHandler's special wiring (spec goby-moos-apps.md 4.3): the uField driver gets the
+    top-level `modem_id_lookup_path` and, where its own are unset, the MOOSDB of `common` (so a
+    mission on a ServerPort other than 9000 needs no `moos_port`)."""
+    if driver_cfg.WhichOneof("driver") == "driver_type" and driver_cfg.driver_type == UFIELD:
+        ufld = driver_cfg.Extensions[acomms_pb.UFLD_CONFIG]
+        lookup = getattr(cfg, "modem_id_lookup_path", "")
+        if lookup and not ufld.HasField("modem_id_lookup_path"):
+            ufld.modem_id_lookup_path = lookup
+        common = getattr(cfg, "common", None)
+        for ours, theirs in (("moos_server", "server_host"), ("moos_port", "server_port")):
+            if common is not None and common.HasField(theirs) and not ufld.HasField(ours):
+                setattr(ufld, ours, getattr(common, theirs))
 
 
 @dataclass(eq=False)
@@ -161,6 +143,7 @@ class AcommsHandler:
             own.CopyFrom(driver_cfg)
             if not own.HasField("modem_id"):
                 own.modem_id = self.modem_id
+            wire_driver_cfg(own, cfg)
             try:
                 driver = driver_factory(own, clock)
             except ModemDriverError as exc:
@@ -197,6 +180,7 @@ class AcommsHandler:
         self.mac_cfg.modem_id = self.modem_id
         self.mac = MACManager(clock)
         if self.primary is not None:
+            _check_slot_rates(self.mac_cfg, self.primary.driver)
             self.mac.signal_initiate_transmission.connect(self._initiate_on_primary)
             self.primary.driver.signal_receive.connect(self.mac.handle_modem_receive)
 
@@ -227,7 +211,17 @@ class AcommsHandler:
                 raise HandlerError(
                     f"queue_cfg message_entry {entry.protobuf_name}: {exc}"
                 ) from None
+        if self.queue_cfg.persistent_queue_file:
+            self._open_persistent_queue(self.queue_cfg.persistent_queue_file)
         return skipped
+
+    def _open_persistent_queue(self, path: str) -> None:
+        try:
+            store = QueueStore(path)
+        except QueueError as exc:
+            raise HandlerError(f"queue_cfg persistent_queue_file: {exc}") from None
+        restored = self.queue.attach_store(store)
+        log.info("persistent queue %s: %d queued message(s) restored", os.path.abspath(path), restored)
 
     def start(self) -> None:
         """Drivers start at the next `do_work`; the MAC starts its cycle now."""
@@ -241,6 +235,11 @@ class AcommsHandler:
             if slot.running:
                 self._shutdown_driver(slot)
             slot.restart_at = 0.0
+
+    def close(self) -> None:
+        """After `shutdown`: let go of the persistent queue's file, if any."""
+        if self.queue.store is not None:
+            self.queue.store.close()
 
     # ------------------------------------------------------------------ main loop (§4.9 3-6)
     def do_work(self) -> None:
@@ -261,6 +260,24 @@ class AcommsHandler:
         self.queue.do_work()
 
     # ------------------------------------------------------------------ external requests
+    def push(self, message: Message) -> bool:
+        """Queue an outgoing message; one the queue or DCCL refuses is logged and dropped
+        (False): a bad message must not stop the caller."""
+        try:
+            self.queue.push_message(message)
+        except (QueueError, DcclError, ValueError) as err:
+            log.warning("%s not queued: %s", message.DESCRIPTOR.full_name, err)
+            return False
+        return True
+
+    def encode(self, message: Message) -> bytes | None:
+        """`message`'s DCCL bytes (to forward them); None, with a warning, if it cannot go."""
+        try:
+            return self.codec.encode(message)
+        except DcclError as err:
+            log.warning("cannot encode %s: %s", message.DESCRIPTOR.full_name, err)
+            return None
+
     def initiate_transmission(self, transmission) -> None:
         """A transmission requested from outside the MAC (e.g. an ad-hoc ping)."""
         if self.primary is None:

@@ -5,18 +5,20 @@ Schemes: MAC_NONE, MAC_FIXED_DECENTRALIZED, MAC_POLLED (goby3) and MAC_AUTO_DECE
 start the MAC may emit `signal_initiate_transmission(slot)` and always emits
 `signal_slot_start(slot)`. For auto-discovery connect the driver's receptions to
 `handle_modem_receive`.
+
+Logging (group `goby::acomms::amac::<modem_id>`, pygoby.util.glog): VERBOSE the MAC starting and
+stopping, DEBUG1 the cycle after each change, DEBUG2 every slot's timing.
 """
 
 from __future__ import annotations
 
-import logging
 import math
+import time
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.util.clock import Clock
+from pygoby.util.glog import DEBUG1, DEBUG2, VERBOSE, group_logger
 from pygoby.util.signal import Signal
-
-log = logging.getLogger(__name__)
 
 SKEW_TOLERANCE = 2.0  # s late before a slot is skipped and the schedule re-anchored
 AUTO_ENTROPY = 5
@@ -27,6 +29,7 @@ MAC_NONE = MACType["MAC_NONE"].number
 MAC_FIXED_DECENTRALIZED = MACType["MAC_FIXED_DECENTRALIZED"].number
 MAC_AUTO_DECENTRALIZED = MACType["MAC_AUTO_DECENTRALIZED"].number
 MAC_POLLED = MACType["MAC_POLLED"].number
+_MAC_TYPE_NAMES = acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_number
 U = acomms_pb.MACUpdate
 
 
@@ -43,11 +46,13 @@ class MACManager:
         # auto-discovery: id -> last heard time (own id never expires)
         self.heard: dict[int, float] = {}
         self._cycle_number = 0
+        self.glog = group_logger("goby::acomms::amac::0")
 
     # ------------------------------------------------------------------ control
     def startup(self, cfg) -> None:
         self.cfg = acomms_pb.MACConfig()
         self.cfg.CopyFrom(cfg)
+        self.glog = group_logger(f"goby::acomms::amac::{cfg.modem_id}")
         self.slots = []
         if cfg.type in (MAC_FIXED_DECENTRALIZED, MAC_POLLED):
             for slot in cfg.slot:
@@ -63,9 +68,12 @@ class MACManager:
         if self.running:
             return
         self.running = True
+        self.glog.log(VERBOSE, "MAC %s started", _MAC_TYPE_NAMES[self.cfg.type].name)
         self.update()
 
     def shutdown(self) -> None:
+        if self.running:
+            self.glog.log(VERBOSE, "MAC stopped")
         self.running = False
         self.current = 0
 
@@ -85,13 +93,13 @@ class MACManager:
             return
         self._renumber()
         if not self.slots:
-            log.info("MAC cycle is empty: MAC stopped")
+            self.glog.info("MAC cycle is empty: MAC stopped")
             self.running = False
             return
         now = self.clock.now()
         length = self.cycle_duration
         if length <= 0:
-            log.warning("MAC cycle has zero length: MAC stopped")
+            self.glog.warning("MAC cycle has zero length: MAC stopped")
             self.running = False
             return
         ref = self.reference_time(now)
@@ -104,6 +112,15 @@ class MACManager:
                 t += self.slots[index].slot_seconds
                 index = (index + 1) % len(self.slots)
             self.current, self.next_slot_time = index, t
+        self._log_cycle()
+
+    def _log_cycle(self) -> None:
+        if self.glog.isEnabledFor(DEBUG1):
+            order = ", ".join(f"{s.src}->{s.dest} {s.slot_seconds:g} s" for s in self.slots)
+            self.glog.log(
+                DEBUG1, "cycle of %d slots, %g s: [%s]; next slot (%d) at %s", len(self.slots),
+                self.cycle_duration, order, self.current, _clock_text(self.next_slot_time),
+            )  # fmt: skip
 
     def _renumber(self) -> None:
         for i, slot in enumerate(self.slots):
@@ -117,7 +134,7 @@ class MACManager:
         if now <= self.next_slot_time:
             return
         if now - self.next_slot_time > SKEW_TOLERANCE:
-            log.warning(
+            self.glog.warning(
                 "clock skew: %.3f s late for a slot; re-aligning", now - self.next_slot_time
             )
             self.update()
@@ -126,7 +143,15 @@ class MACManager:
             self._auto_place_blank(self.next_slot_time)
         slot = _copy(self.slots[self.current])
         slot.time = acomms_pb.now_us(self.next_slot_time)
-        if self._initiates(slot):
+        initiates = self._initiates(slot)
+        if self.glog.isEnabledFor(DEBUG2):
+            self.glog.log(
+                DEBUG2, "slot %d (%d->%d, rate %d, %g s) starts at %s (%.3f s late)%s",
+                slot.slot_index, slot.src, slot.dest, slot.rate, slot.slot_seconds,
+                _clock_text(self.next_slot_time), now - self.next_slot_time,
+                ": ours, initiating" if initiates else "",
+            )  # fmt: skip
+        if initiates:
             self.signal_initiate_transmission.emit(slot)
         self.signal_slot_start.emit(slot)
         self.next_slot_time += self.slots[self.current].slot_seconds
@@ -165,7 +190,7 @@ class MACManager:
                 self.slots.insert(0, slot)
         elif kind in (U.POP_BACK, U.POP_FRONT):
             if not self.slots:
-                log.warning("MACUpdate pop on an empty cycle")
+                self.glog.warning("MACUpdate pop on an empty cycle")
             else:
                 self.slots.pop(-1 if kind == U.POP_BACK else 0)
         elif kind == U.INSERT:
@@ -193,7 +218,7 @@ class MACManager:
         known = transmission.src in self.heard
         self.heard[transmission.src] = self.clock.now()
         if not known:
-            log.info("MAC discovered node %d", transmission.src)
+            self.glog.info("MAC discovered node %d", transmission.src)
             self._auto_schedule()
 
     def _auto_slot(self, src: int):
@@ -211,6 +236,7 @@ class MACManager:
         ref = self.reference_time(now)
         k = math.floor((now - ref) / length) + 1
         self.current, self.next_slot_time = 0, ref + k * length
+        self._log_cycle()
 
     def _auto_place_blank(self, cycle_start: float) -> None:
         """Blank position = N-1-[(k mod 5) == (S mod 5)] (k: cycles since midnight)."""
@@ -231,8 +257,13 @@ class MACManager:
         if stale:
             for i in stale:
                 del self.heard[i]
-                log.info("MAC expired node %d", i)
+                self.glog.info("MAC expired node %d", i)
             self._auto_schedule()
+
+
+def _clock_text(t: float) -> str:
+    """A UTC time of day with milliseconds, as slot times are read against the clock."""
+    return time.strftime("%H:%M:%S", time.gmtime(t)) + f".{int(t % 1 * 1000):03d}"
 
 
 def _copy(slot):

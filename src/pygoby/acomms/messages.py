@@ -28,6 +28,7 @@ _PROTO_FILES = (
     "goby/acomms/protobuf/abc_driver.proto",
     "goby/acomms/protobuf/store_server.proto",
     "goby/acomms/protobuf/store_server_driver.proto",
+    "pygoby/acomms/store_server_auth.proto",
     "goby/moos/protobuf/ufield_sim_driver.proto",
 )
 
@@ -78,6 +79,8 @@ UDPConfig = _cls("goby.acomms.udp.protobuf.Config")
 ABCConfig = _cls("goby.acomms.abc.protobuf.Config")
 StoreServerConfig = _cls("goby.acomms.store_server.protobuf.Config")
 StoreServerTransmission = _cls("goby.acomms.store_server.protobuf.Transmission")
+StoreServerRequestAuth = _cls("pygoby.acomms.protobuf.StoreServerRequestAuth")
+StoreServerResponseStatus = _cls("pygoby.acomms.protobuf.StoreServerResponseStatus")
 UFldConfig = _cls("goby.moos.ufld.protobuf.Config")
 UFldTransmission = _cls("goby.moos.ufld.protobuf.Transmission")
 
@@ -97,6 +100,7 @@ UDP_CONFIG = extension("goby.acomms.udp.protobuf.config")
 ABC_CONFIG = extension("goby.acomms.abc.protobuf.config")
 STORE_SERVER_CONFIG = extension("goby.acomms.store_server.protobuf.config")
 STORE_SERVER_TRANSMISSION = extension("goby.acomms.store_server.protobuf.transmission")
+STORE_SERVER_AUTH = extension("pygoby.acomms.protobuf.store_server_auth")
 UFLD_CONFIG = extension("goby.moos.ufld.protobuf.config")
 UFLD_TRANSMISSION = extension("goby.moos.ufld.protobuf.transmission")
 

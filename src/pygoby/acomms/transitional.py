@@ -6,6 +6,7 @@ tools that show a pAcommsHandler's message set).
 
     messages = TransitionalMessages.expand(cfg, loader, find=str)   # ConfigError file:line
     messages.complete(created, now, modem_id)   # Goby 1.1's header defaults
+    messages.single_field_sources()             # where Goby 1.1's `name=value` rule applies
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from pathlib import Path
 
 from google.protobuf.message import Message
 
-from pygoby.dccl.xml import MessageSet, load_message_set
+from pygoby.dccl.xml import MessageSet, XmlMessage, load_message_set
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
 
@@ -26,9 +27,10 @@ log = logging.getLogger(__name__)
 class TransitionalMessages:
     """The XML message sets of a pAcommsHandler configuration."""
 
-    def __init__(self, sets: list[MessageSet], header_fields: dict[str, tuple[str, str]]) -> None:
-        self.sets = sets
-        self._header = header_fields  # message name -> (time field, source field)
+    def __init__(self) -> None:
+        self.sets: list[MessageSet] = []
+        self._header: dict[str, tuple[str, str]] = {}  # message name -> (time field, source field)
+        self._defined_in: dict[str, Path] = {}
 
     @classmethod
     def expand(
@@ -36,27 +38,46 @@ class TransitionalMessages:
     ) -> TransitionalMessages:
         """Load `cfg.transitional_cfg.message_file` (paths through `find`), register the types
         in `loader` and append their queue and translator entries to `cfg`."""
-        sets: list[MessageSet] = []
-        header: dict[str, tuple[str, str]] = {}
-        seen: dict[str, Path] = {}
-        transitional = cfg.transitional_cfg
-        for message_file in transitional.message_file:
-            message_set = load_message_set(find(message_file.path), message_file.manipulator)
-            for name in message_set.names:
-                if name in seen:
-                    raise ConfigError(f"message {name} is defined in {seen[name]} too",
-                                      file=message_set.path)  # fmt: skip
-                seen[name] = message_set.path
-            message_set.register(loader)
-            cfg.queue_cfg.message_entry.extend(message_set.queue_entries())
-            cfg.translator_entry.extend(message_set.translator_entries())
-            if transitional.generated_proto_dir:
-                written = message_set.write_proto(transitional.generated_proto_dir)
-                log.info("wrote %s (converted from %s)", written, message_set.path)
-            for msg in message_set.messages:
-                header[msg.name] = (msg.header["time"].name, msg.header["src_id"].name)
-            sets.append(message_set)
-        return cls(sets, header)
+        out = cls()
+        for message_file in cfg.transitional_cfg.message_file:
+            out.add_file(cfg, message_file, loader, find)
+        return out
+
+    def add_file(
+        self, cfg: Message, message_file: Message, loader: ProtoLoader, find: Callable[[str], str] = str
+    ) -> MessageSet:
+        """One `message_file { path manipulator }`: its types into `loader`, its queue and
+        translator entries appended to `cfg` (also how a tool imports one more file)."""
+        message_set = load_message_set(find(message_file.path), message_file.manipulator)
+        for name in message_set.names:
+            if name in self._defined_in:
+                raise ConfigError(f"message {name} is defined in {self._defined_in[name]} too",
+                                  file=message_set.path)  # fmt: skip
+        message_set.register(loader)
+        for name in message_set.names:
+            self._defined_in[name] = message_set.path
+        cfg.queue_cfg.message_entry.extend(message_set.queue_entries())
+        cfg.translator_entry.extend(message_set.translator_entries())
+        proto_dir = cfg.transitional_cfg.generated_proto_dir
+        if proto_dir:
+            written = message_set.write_proto(proto_dir)
+            log.info("wrote %s (converted from %s)", written, message_set.path)
+        for msg in message_set.messages:
+            self._header[msg.name] = (msg.header["time"].name, msg.header["src_id"].name)
+        self.sets.append(message_set)
+        return message_set
+
+    @property
+    def messages(self) -> dict[str, XmlMessage]:
+        """Every XML message by name."""
+        return {msg.name: msg for message_set in self.sets for msg in message_set.messages}
+
+    def single_field_sources(self) -> dict[str, dict[str, str]]:
+        """{message: {source variable: field name}} for the source variables that feed one field
+        (the translator reads them with a FORMAT create; the shared ones are key=value pairs
+        already). Goby 1.1 read such a variable's string as `name=value` when it holds the
+        field's name, else whole (seed 003 §2.3.8): Translator.read_named_values."""
+        return {name: msg.single_field_sources() for name, msg in self.messages.items()}
 
     @property
     def warnings(self) -> list[str]:

@@ -3,10 +3,12 @@
     iCommander mission.moos [AppName]
     iCommander --example_config
 
-The messages are the ones the mission's pAcommsHandler creates on a publish trigger
-(`commander { pacommshandler_name }`, default "pAcommsHandler"). LatOrigin/LongOrigin give the
-datum of the local x/y special; modem_id_lookup_path the modem id picker. Runs over ssh (any
-terminal); Ctrl-C or Exit quits.
+The messages are the ones the mission's pAcommsHandler creates on a publish trigger and every
+message of its Goby 1.1 XML files (`commander { pacommshandler_name }`, default
+"pAcommsHandler"), plus the XML files of this block's own `dccl_cfg`/`transitional_cfg` (Goby
+1.1's form) and those imported from the main menu. LatOrigin/LongOrigin give the datum of the
+local x/y special; modem_id_lookup_path the modem id picker. Runs over ssh (any terminal);
+Ctrl-C or Exit quits.
 """
 
 from __future__ import annotations
@@ -15,12 +17,12 @@ import asyncio
 
 from google.protobuf.message import Message
 
-from pygoby.apps.liaison import acomms_config, command_set
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.moos.translator import Post
-from pygoby.topside.commander import KEY_VALUE, MULTIPLEX, Commander, CommanderError
+from pygoby.moos.translator import MoosValues, Post
+from pygoby.topside.acomms_config import AcommsMessageSet
+from pygoby.topside.commander import KEY_VALUE, MULTIPLEX, Commander, CommanderError, CommandSet
 from pygoby.topside.icommander import ICommanderTUI
 
 SEND_MULTIPLEX = 2  # pygoby.apps.protobuf.SendStyle
@@ -31,22 +33,23 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
     config_proto = ("pygoby/apps/topside_config.proto", "pygoby.apps.protobuf.iCommanderConfig")
     default_name = "iCommander"
 
-    def __init__(self, cfg: Message, *, acomms_cfg: Message | None = None, **kwargs) -> None:
+    def __init__(self, cfg: Message, *, acomms: AcommsMessageSet | None = None, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         if not (self.common.HasField("lat_origin") and self.common.HasField("lon_origin")):
             raise ConfigError("LatOrigin and LongOrigin are required (local x/y -> lat/lon)",
                               field="common.lat_origin")  # fmt: skip
         options = cfg.commander
         self.common.verbosity = QUIET  # the terminal belongs to the screens; the log file keeps all
-        if acomms_cfg is None:
-            acomms_cfg = acomms_config(self, options.pacommshandler_name)
+        if acomms is None:
+            acomms = AcommsMessageSet.of_app(self, options.pacommshandler_name,
+                                             cfg.transitional_cfg.message_file)  # fmt: skip
         try:
             self.commander = Commander(
-                command_set(self, acomms_cfg, cfg.modem_id_lookup_path),
+                CommandSet.from_messages(acomms, cfg.modem_id_lookup_path),
                 community=self.common.community, now=self.clock.now, publish=self._post,
                 style=MULTIPLEX if options.send_style == SEND_MULTIPLEX else KEY_VALUE,
                 force_xy_only=cfg.force_xy_only or options.force_xy_only,
-                autosave_path=options.autosave_path or None,
+                autosave_path=options.autosave_path or None, values=MoosValues(self.dynamic_vars),
             )  # fmt: skip
         except CommanderError as err:
             raise ConfigError(str(err), field="commander") from None
@@ -55,9 +58,18 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
             self.subscribe(var, self._on_ack_or_expire)
         for var in cfg.show_variable:
             self.subscribe(var, self._on_show)
+        self._sources: set[str] = set()
+        self._subscribe_sources()
+        self.commander.signal_import.connect(lambda names: self._subscribe_sources())
         self.load_warnings = []
         for path in [*cfg.load, *options.load]:
             self.load_warnings += self.commander.load(path)
+
+    def _subscribe_sources(self) -> None:
+        """Keep the values of the variables a send posts to (a number goes where one is)."""
+        for var in sorted(self.commander.source_variables - self._sources):
+            self.subscribe(var)
+            self._sources.add(var)
 
     def _post(self, post: Post) -> None:
         self.publish(post.var, post.value, src_aux=post.source_aux)
@@ -75,7 +87,6 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
         """The MOOS app and the terminal UI in one loop; either one ending stops both."""
         await self.start()
         ui = asyncio.create_task(self.tui.run_async())
-        assert self._stop_requested is not None
         stop = asyncio.create_task(self._stop_requested.wait())
         try:
             await asyncio.wait({ui, stop}, return_when=asyncio.FIRST_COMPLETED)

@@ -52,6 +52,9 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         "goby.apps.moos.protobuf.iFrontSeatConfig",
     )
     default_name = "iFrontSeat"
+    # the frontseat link is served through a MOOSDB outage (its lines read, the helm's
+    # silence noticed); what the interface posts meanwhile is delivered when the DB is back
+    iterate_without_comms = True
 
     # -- configuration ---------------------------------------------------------------------
 
@@ -144,9 +147,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         try:
             self.interface.do_work()
         except FrontSeatFatalError as err:
-            self.log.critical("%s; exiting", err)
-            self.exit_status = 1
-            self.request_stop()
+            self.fail(str(err))
 
     def post_status(self) -> None:
         self.publish_pb(self.var["status"], self.interface.status())

@@ -50,6 +50,17 @@ KNOWN = {"port", "speed", "ipport", "broadcastaddr", "inputloctype", "constantpo
 
 class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
     default_name = "iModemSim"
+    example_lines = (
+        "Port = /tmp/ttyLOOPA1       // the emulated modem; the host opens /tmp/ttyLOOPA2",
+        "Speed = 19200",
+        "IPPort = 49234              // UDP port of the mission's emulators",
+        "BroadcastAddr = 127.0.0.1   // loopback: every emulator of this host hears the others",
+        f"InputLocType = constant_local   // {' | '.join(LOCATION_TYPES)}",
+        "ConstantPosX = 0",
+        "ConstantPosY = 0",
+        "ConstantDepth = 0",
+        "ModemID = 1                 // NVRAM SRC before the host configures it (pygoby)",
+    )
 
     def __init__(self, cfg, **kwargs) -> None:
         super().__init__(cfg, **kwargs)

@@ -4,6 +4,8 @@ Translator entries create DCCL messages from MOOS variables and push them into t
 queue; the MAC opens the slots, the driver asks the queue for frames; messages received over
 the link are published through the same entries' publish rules and posted on
 ACOMMS_QUEUE_RECEIVE. Every ACOMMS_* variable of the spec's table is published or handled.
+The modem, the MAC and the queue keep working while the MOOSDB is away (upstream's stop with
+it); their posts are delivered when it is back.
 The acomms wiring itself is `pygoby.acomms.handler.AcommsHandler`; this module maps the
 configuration, the translator and the MOOS variables onto it.
 
@@ -19,101 +21,93 @@ import functools
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.handler import AcommsHandler, HandlerError
-from pygoby.acomms.queue import QueueError
-from pygoby.acomms.transitional import TransitionalMessages
+from pygoby.acomms.driver_base import ModemDriverBase, driver_name
+from pygoby.acomms.drivers.ufield import UFldDriver
+from pygoby.acomms.handler import AcommsHandler, HandlerError, make_driver
 from pygoby.apps.pacommshandler_goby11 import Goby11Variables
-from pygoby.dccl import DcclError
-from pygoby.dccl.libraries import split_libraries
+from pygoby.apps.ufield_link import MOOSMailLink
 from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.appconfig import prefixed_var_names
-from pygoby.moos.protocol import MOOSMessage
-from pygoby.moos.translator import MoosValues, TranslatorError
-from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
-from pygoby.protobuf import ProtoLoader
+from pygoby.moos.appconfig import locate, prefixed_var_names
+from pygoby.moos.protocol import MOOSMessage, text_or_binary
+from pygoby.moos.translator_binding import TranslatorBinding
+from pygoby.topside.acomms_config import PACOMMSHANDLER_CONFIG, AcommsMessageSet
 
 IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
 
 
-def _raw_value(raw: bytes) -> str | bytes:
-    """Driver traffic as a MOOS string when it is text (NMEA), else as a binary string."""
-    try:
-        text = raw.decode("ascii")
-    except UnicodeDecodeError:
-        return raw
-    return text if text.isprintable() else raw
+def _make_driver(cfg, clock) -> ModemDriverBase | None:
+    """The handler's drivers; a uField driver gets its own MOOS connection."""
+    driver = make_driver(cfg, clock)
+    if isinstance(driver, UFldDriver):
+        driver.mail = MOOSMailLink()
+    return driver
 
 
 class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
-        "goby.apps.moos.protobuf.pAcommsHandlerConfig",
-    )
+    config_proto = PACOMMSHANDLER_CONFIG
     default_name = "pAcommsHandler"
+    # the modem, the MAC and the queue keep going through a MOOSDB outage; what they post
+    # meanwhile is delivered when the DB is back
+    iterate_without_comms = True
 
     def __init__(self, cfg: Message, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.var = prefixed_var_names(cfg.moos_var, skip=(IFS_DATA_OUT,))
         self.ifs_data_out = getattr(cfg.moos_var, IFS_DATA_OUT)
-        self.loader = ProtoLoader()
-        # Goby 1.1 XML message files -> DCCL types, queue and translator entries
-        self.transitional = TransitionalMessages.expand(cfg, self.loader, self.find_file)
+        # load_proto_file, load_shared_library, and the Goby 1.1 XML message files (-> DCCL
+        # types, queue and translator entries)
+        self.messages = AcommsMessageSet.load(
+            cfg, self.find_file, search_dirs=self.search_dirs(), config_error=self.config_error
+        )
+        self.message_types = self.messages.types
+        if cfg.modem_id_lookup_path:  # for the translator and the uField driver
+            cfg.modem_id_lookup_path = self.find_file(cfg.modem_id_lookup_path)
         try:
-            self.acomms = AcommsHandler(cfg, self.clock, self.loader)
+            self.acomms = AcommsHandler(
+                cfg, self.clock, self.messages.loader, driver_factory=_make_driver
+            )
         except HandlerError as err:
             raise ConfigError(str(err)) from None
+        except ConfigError as err:
+            raise locate(err, self.mission, self.name) from None
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
-        try:  # C++ DCCL codec libraries (libdccl_ccl_compat.so, ...) are pygoby built-ins
-            dccl_libraries, modules = split_libraries(cfg.load_shared_library)
-            for library in dccl_libraries:
-                library.apply(self.acomms.codec)
-        except DcclError as err:
-            raise ConfigError(f"load_shared_library: {err}") from None
-        self.message_types = MessageTypes(
-            [self.find_file(path) for path in cfg.load_proto_file],
-            [self.find_file(module) for module in modules],
-            fallback=acomms_pb.goby_message_class,
-            loader=self.loader,
-        )
-        lookup = cfg.modem_id_lookup_path
+        self.messages.apply_libraries(self.acomms.codec)
         self.binding = TranslatorBinding(
             self, cfg.translator_entry, self.message_types, on_created=self._created,
             multiplex_vars=cfg.multiplex_create_moos_var,
-            modem_id_lookup_path=self.find_file(lookup) if lookup else "",
+            modem_id_lookup_path=cfg.modem_id_lookup_path,
         )  # fmt: skip
         self.translator = self.binding.translator
+        self.messages.read_named_values(self.translator)
         self._connect_signals()
         self.goby11 = Goby11Variables(self, self.acomms, cfg.queue_cfg, enabled=bool(
             cfg.queue_cfg.queue or cfg.transitional_cfg.message_file))  # fmt: skip
         self._configure_queue()
         self._subscribe_all()
-        self.frontseat_forward = {self._loaded(name) for name in cfg.dccl_frontseat_forward_name}
+        self.frontseat_forward = self.messages.require(cfg.dccl_frontseat_forward_name,
+                                                       "dccl_frontseat_forward_name")  # fmt: skip
         self.liaison = None
         if cfg.HasField("liaison"):
-            from pygoby.apps.liaison import Liaison  # imported only when asked for (web stack)
+            from pygoby.topside.liaison import Liaison  # imported only when asked for (web stack)
 
-            self.liaison = Liaison.embedded(self)
+            self.liaison = Liaison.embedded(self, self.messages)
 
     def _configure_queue(self) -> None:
         try:
             skipped = self.acomms.configure_queue(self.message_types)
         except HandlerError as err:
             raise ConfigError(str(err)) from None
-        for name in skipped:
-            self.log.debug("queue_cfg: no queue for %s (type not loaded)", name)
-
-    def _loaded(self, name: str) -> str:
-        try:
-            self.message_types(name)
-        except Exception:
-            raise ConfigError(
-                f"dccl_frontseat_forward_name {name!r} is not a loaded type"
-            ) from None
-        return name
+        if skipped:  # goby3 skips them silently: an operator never learns why nothing is sent
+            loaded = ", ".join(self.messages.loaded()) or "none"
+            raise self.config_error(
+                f'"{skipped[0]}" is not a loaded message type; the types load_proto_file and '
+                f"load_shared_library loaded are: {loaded}",
+                "queue_cfg.message_entry.protobuf_name", skipped[0],
+            )  # fmt: skip
 
     # ------------------------------------------------------------------ wiring
     def _connect_signals(self) -> None:
@@ -158,6 +152,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def on_stop(self) -> None:
         self.acomms.shutdown()
+        self.acomms.close()
 
     async def start(self, connect_timeout: float | None = None) -> None:
         await super().start(connect_timeout)
@@ -169,42 +164,49 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             await self.liaison.stop()
         await super().stop()
 
+    def status_lines(self) -> list[str]:
+        """show_gui's panel: the drivers, the MAC's current slot, every queue's size."""
+        lines = super().status_lines()
+        for slot in self.acomms.slots:
+            state = "running" if slot.running else f"restarts at {slot.restart_at:.0f}"
+            role = "primary" if slot is self.acomms.primary else "listen"
+            lines.append(f"{role} driver {driver_name(slot.cfg)}: {state}")
+        mac = self.acomms.mac
+        if mac.running and mac.slots:
+            now = mac.slots[(mac.current - 1) % len(mac.slots)]
+            lines.append(f"MAC slot {now.slot_index} ({now.src}->{now.dest}, rate {now.rate}, "
+                         f"{now.slot_seconds:g} s); next in {mac.next_slot_time - self.clock.now():.1f} s")  # fmt: skip
+        else:
+            lines.append("MAC: not running")
+        lines += [f"queue {q.name} ({q.dccl_id}): {len(q)}" for q in self.queue.queues.values()]
+        return lines
+
     def loop(self) -> None:
-        self.binding.tick(self.clock.now())
+        if self.connected:  # time triggers create from MOOS values: not while the DB is away
+            self.binding.tick(self.clock.now())
         self._stop_on_failure(self.acomms.do_work)
 
     def _stop_on_failure(self, work) -> None:
         try:
             work()
         except HandlerError as err:
-            self.log.critical("%s; stopping", err)
-            self.request_stop()
+            self.fail(str(err))
 
     # ------------------------------------------------------------------ MOOS -> acomms
     def _created(self, message: Message) -> None:
-        self._push(self.transitional.complete(message, self.clock.now(), self.cfg.modem_id))
+        self.acomms.push(self.messages.transitional.complete(message, self.clock.now(), self.cfg.modem_id))
 
     def _on_mac_update(self, msg: MOOSMessage) -> None:
         """Today's MACUpdate, or Goby 1.1's (ADD/REMOVE/REPLACE with SLOT_* slots)."""
         if not self.goby11.apply_mac_update(msg) and (update := self.parse_pb(msg, acomms_pb.MACUpdate)):
             self.acomms.apply_mac_update(update)
 
-    def _push(self, message: Message) -> None:
-        try:
-            self.queue.push_message(message)
-        except (QueueError, DcclError, ValueError) as err:
-            self.log.warning("%s not queued: %s", message.DESCRIPTOR.full_name, err)
-
     def _on_data_on_demand(self, request, message: Message) -> None:
         """ON_DEMAND: a fresh message from the current variables, queued here (so a bad one is
         logged and skipped); `message` is left empty so the queue does not push it again."""
-        name = message.DESCRIPTOR.full_name
-        try:
-            created = self.translator.create(name, MoosValues(self.dynamic_vars))
-        except TranslatorError as err:
-            self.log.warning("on-demand %s not created: %s", name, err)
-            return
-        self._push(created)
+        created = self.binding.create(message.DESCRIPTOR.full_name)
+        if created is not None:
+            self.acomms.push(created)
 
     def _on_config_request(self, msg: MOOSMessage) -> None:
         self.publish(
@@ -220,7 +222,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def _post_raw(self, incoming: bool, raw) -> None:
         self.publish(
-            self.var["driver_raw_in" if incoming else "driver_raw_out"], _raw_value(raw.raw)
+            self.var["driver_raw_in" if incoming else "driver_raw_out"], text_or_binary(raw.raw)
         )
         self.publish_pb(self.var["driver_raw_msg_in" if incoming else "driver_raw_msg_out"], raw)
 
@@ -229,22 +231,12 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.publish_pb(self.var["queue_ack_original_msg"], original)
 
     def _on_queue_receive(self, message: Message) -> None:
-        name = message.DESCRIPTOR.full_name
         self.binding.publish(message)
-        if name in self.frontseat_forward:
-            self._forward_to_frontseat(message)
+        name = message.DESCRIPTOR.full_name
+        if name in self.frontseat_forward and (data := self.acomms.encode(message)) is not None:
+            self.publish_pb(self.ifs_data_out, InterfaceData(dccl_message=data))  # to iFrontSeat
         self.acomms.apply_route_command(message)
         self.publish_pb(self.var["queue_receive"], message)
-
-    def _forward_to_frontseat(self, message: Message) -> None:
-        """`dccl_frontseat_forward_name`: the message's DCCL bytes to iFrontSeat."""
-        name = message.DESCRIPTOR.full_name
-        try:
-            data = self.acomms.codec.encode(message)
-        except DcclError as err:
-            self.log.warning("cannot forward %s to the frontseat: %s", name, err)
-        else:
-            self.publish_pb(self.ifs_data_out, InterfaceData(dccl_message=data))
 
 
 def main(argv=None) -> int:

@@ -9,9 +9,7 @@ from __future__ import annotations
 
 from google.protobuf.message import Message
 
-from pygoby.dccl import DcclError
 from pygoby.dccl.libraries import split_libraries
-from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
 
@@ -25,12 +23,14 @@ class pTranslator(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def __init__(self, cfg: Message, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
-        try:  # C++ DCCL codec libraries (libdccl_ccl_compat.so, ...) are pygoby built-ins
-            dccl_libraries, modules = split_libraries(cfg.load_shared_library)
-        except DcclError as err:
-            raise ConfigError(f"load_shared_library: {err}") from None
-        protos = [p for library in dccl_libraries for p in library.proto_files]
-        types = MessageTypes([*protos, *cfg.load_proto_file], modules)
+        libraries, others = split_libraries(  # C++ DCCL codec libraries: pygoby's built-ins
+            cfg.load_shared_library,
+            lambda reason, name: self.config_error(reason, "load_shared_library", name),
+        )
+        types = MessageTypes(
+            [*(p for library in libraries for p in library.proto_files), *cfg.load_proto_file],
+            others, search_dirs=self.search_dirs(), config_error=self.config_error,
+        )  # fmt: skip
         self.binding = TranslatorBinding(
             self,
             cfg.translator_entry,

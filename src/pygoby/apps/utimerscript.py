@@ -17,6 +17,15 @@ STATUS_PERIOD = 5.0
 class uTimerScript(ClassicMOOSApp):  # noqa: N801 - the program's name
     default_name = "uTimerScript"
     keep_quotes = True  # MOOS-IvP's uTimerScript reads values with their quotes
+    example_lines = (
+        "EVENT = var=OUT_TEST, val=3.5, time=10           // a double 10 s after the start",
+        'EVENT = var=OUT_TEXT, val="data: \\"x\\"", time=20:30  // a string (\\" is "), at random in [20, 30] s',
+        "RESET_TIME = end        // start again after the last event (all-posted, none, SECONDS)",
+        "RESET_MAX = nolimit     // or a count of resets",
+        "PAUSED = false          // UTS_PAUSE = true/false/toggle pauses it",
+        "CONDITION = DEPLOY = true   // post only while this holds (repeatable)",
+        "UPON_AWAKE = n/a        // reset or restart when a CONDITION turns true again",
+    )
 
     def __init__(self, cfg, **kwargs) -> None:
         super().__init__(cfg, **kwargs)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from collections.abc import Callable, Iterable
 
@@ -16,6 +17,8 @@ from pygoby.dccl.errors import DcclError
 from pygoby.dccl.libraries import builtin_library
 from pygoby.dccl.trace import log as trace_log
 from pygoby.errors import ConfigError
+
+PASSPHRASE_ENV = "PYGOBY_DCCL_PASSPHRASE"
 
 
 def register(subparsers) -> None:
@@ -32,7 +35,13 @@ def register(subparsers) -> None:
                              "analyze without it shows every message of the file)")
     parser.add_argument("--write-proto", metavar="DIR",
                         help="with --xml: also write the converted .proto file into DIR")
-    parser.add_argument("--passphrase", help="encrypt/decrypt the body with this passphrase")
+    secret = parser.add_mutually_exclusive_group()
+    secret.add_argument("--passphrase-file", metavar="FILE",
+                        help="encrypt/decrypt the body with the passphrase in FILE (one trailing "
+                        f"newline ignored); without a passphrase option, ${PASSPHRASE_ENV} is used")
+    secret.add_argument("--passphrase",
+                        help="the passphrase itself (visible to every user in the process list: "
+                        "prefer --passphrase-file or the environment variable)")
     parser.add_argument("--strict", action="store_true",
                         help="refuse out-of-range values instead of degrading them")
     parser.add_argument("--source", action="store_true",
@@ -75,8 +84,9 @@ def run(args: argparse.Namespace) -> int:
         handler.setFormatter(logging.Formatter("%(message)s"))
         trace_log.addHandler(handler)
         trace_log.setLevel(logging.DEBUG)
-    codec = Codec(passphrase=args.passphrase, strict=args.strict, trace=args.trace)
     try:
+        passphrase = read_passphrase(args)
+        codec = Codec(passphrase=passphrase, strict=args.strict, trace=args.trace)
         for name in args.library:
             builtin_library(name).apply(codec)
         for path in args.arithmetic_model:
@@ -85,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
             classes = _load_xml(codec, args)
         else:
             classes = [codec.load_proto(args.proto, args.message, args.include)]
-    except (DcclError, ConfigError) as exc:
+    except (DcclError, ConfigError, OSError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     if args.action == "analyze":
@@ -107,6 +117,18 @@ def run(args: argparse.Namespace) -> int:
         return text_format.MessageToString(codec.decode(data, cls), as_one_line=True)
 
     return process_lines(sys.stdin, encode if args.action == "encode" else decode)
+
+
+def read_passphrase(args: argparse.Namespace) -> str | bytes | None:
+    """--passphrase-file (its bytes), else --passphrase, else the environment variable."""
+    if args.passphrase_file is not None:
+        with open(args.passphrase_file, "rb") as file:
+            secret = file.read()
+        # `echo secret > FILE` adds a newline that is not part of the passphrase
+        return secret.removesuffix(b"\n")
+    if args.passphrase is not None:
+        return args.passphrase
+    return os.environ.get(PASSPHRASE_ENV) or None
 
 
 def process_lines(lines: Iterable[str], convert: Callable[[str], str]) -> int:

@@ -4,22 +4,20 @@ goby3 and Goby 2 missions load DCCL add-ons with `load_shared_library: ".../libd
 (or `libdccl_arithmetic.so`, `libdccl_native_protobuf.so`). pygoby has these codecs built in:
 `builtin_library(name)` says what such a name stands for, and `.apply(codec)` does to a Codec
 what loading the C++ library does (the legacy CCL one also loads its seven message types and
-switches the Codec to the CCL identifier codec). Any other shared library is C++ code pygoby
-cannot run: the error says to give its messages' .proto files (`load_proto_file`) instead.
+switches the Codec to the CCL identifier codec). Names go through pygoby.util.libraries, the
+one table of the upstream library names pygoby stands in for; any other shared library is C++
+code pygoby cannot run: the error says to give its messages' .proto files (`load_proto_file`).
 """
 
 from __future__ import annotations
 
-import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from pathlib import PurePath
 from typing import Any
 
 from pygoby.dccl.ccl import CCL_MESSAGES, CCL_PROTO
 from pygoby.dccl.errors import DcclLoadError
-
-_LIBRARY_FILE = re.compile(r"^(?:lib)?(?P<stem>[\w.+-]+?)(?:\.so(?:\.\d+)*|\.dylib|\.dll)$")
+from pygoby.util.libraries import DCCL_CODECS, builtin_for, unavailable
 
 
 @dataclass(frozen=True)
@@ -64,39 +62,37 @@ BUILTIN_LIBRARIES = {
 }
 
 
-def library_stem(name: str) -> str | None:
-    """`/x/libdccl_ccl_compat.so.31` -> `dccl_ccl_compat`; None if `name` is not a shared
-    library file name."""
-    match = _LIBRARY_FILE.match(PurePath(name).name)
-    return match.group("stem") if match else None
-
-
-def is_shared_library(name: str) -> bool:
-    return library_stem(name) is not None
-
-
 def builtin_library(name: str) -> BuiltinLibrary:
     """The pygoby built-in standing for a C++ DCCL library (path or file name, any version
     suffix). Raises DcclLoadError, saying what to use instead, for any other library."""
-    stem = library_stem(name)
-    library = BUILTIN_LIBRARIES.get(stem or "")
+    builtin = builtin_for(name)
+    library = None
+    if builtin is not None and builtin.kind == DCCL_CODECS:
+        library = BUILTIN_LIBRARIES.get(builtin.name)
     if library is None:
         known = ", ".join(f"lib{n}.so" for n in BUILTIN_LIBRARIES)
-        raise DcclLoadError(
-            f"{name}: pygoby cannot load C++ shared libraries; give the .proto files of its"
-            f" messages with load_proto_file instead (built in: {known})"
-        )
+        raise DcclLoadError(f'"{name}": {unavailable(name, DCCL_CODECS)} (built in: {known})')
     return library
 
 
-def split_libraries(names: Iterable[str]) -> tuple[list[BuiltinLibrary], list[str]]:
-    """A `load_shared_library` list as (pygoby built-ins for C++ DCCL codec libraries, the other
-    names: Python modules or .py files of generated message code). A shared library that is not
-    a DCCL codec library is a DcclLoadError saying what to use instead."""
+def split_libraries(
+    names: Iterable[str], error: Callable[[str, str], Exception] | None = None
+) -> tuple[list[BuiltinLibrary], list[str]]:
+    """A `load_shared_library` list as (pygoby built-ins for its C++ DCCL codec libraries, the
+    other names: Python modules or .py files of generated message code, and other upstream
+    libraries, which the app's MessageTypes accepts or refuses). An unknown DCCL library is a
+    DcclLoadError saying what to use instead, or `error(reason, name)` when given (an app's
+    located ConfigError)."""
     libraries, others = [], []
     for name in names:
-        if is_shared_library(name):
-            libraries.append(builtin_library(name))
-        else:
+        builtin = builtin_for(name)
+        if builtin is None or builtin.kind != DCCL_CODECS:
             others.append(name)
+            continue
+        try:
+            libraries.append(builtin_library(name))
+        except DcclLoadError as err:
+            if error is None:
+                raise
+            raise error(str(err), name) from None
     return libraries, others

@@ -14,12 +14,19 @@ MoosError family; configuration problems are `pygoby.errors.ConfigError`s).
 
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
-from pygoby.moos.errors import MissionFileError, MoosError, MoosProtocolError, MoosRefusedError
+from pygoby.moos.errors import (
+    AntlerError,
+    MissionFileError,
+    MoosError,
+    MoosProtocolError,
+    MoosRefusedError,
+)
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.timewarp import moos_clock
 
 __all__ = [
+    "AntlerError",
     "MOOSDB",
     "MOOSClient",
     "MOOSMessage",

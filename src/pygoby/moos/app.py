@@ -45,7 +45,9 @@ The base provides
   `common.time_warp_multiplier`.
 * Running: `await app.start()` / `await app.stop()`, or `async with app:`, or `await app.run()`
   (until `app.request_stop()`). Mail is handled and `loop()` runs every 1/app_tick seconds
-  (warped); while disconnected `loop()` is not called (as CMOOSApp).
+  (warped); while disconnected `loop()` and the timers are not called (as CMOOSApp), unless
+  the class sets `iterate_without_comms = True` (its posts are then queued and delivered
+  when the DB is back).
 * `subscribe(var, handler=None, blackout=0.0)`, `subscribe_pattern(var_pattern, app_pattern,
   handler)`, `publish(var, value, src_aux="", time=None)` (queued while disconnected, sent on
   reconnect), `register_timer(period, callback)` (fires on multiples of `period` since the
@@ -58,10 +60,16 @@ The base provides
   not parse) and `subscribe_pb(var, cls, handler, ignore_own=False)` (`handler(message)` for
   each value that parses).
 * `find_file(path)`: a relative path from the configuration, looked up next to the mission
-  file when it does not exist from the working directory.
-* Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`.
+  file when it does not exist from the working directory (`search_dirs()` lists both).
+* `config_error(reason, field, value="")`: a ConfigError for a problem found after parsing
+  (an unknown type, a missing file), located at the mission line that sets `field`.
+* Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`,
+  `status_lines()` (the state shown by `common.show_gui`'s live view, pygoby.moos.appgui).
 * `exit_status`: what `main` returns once the app has stopped (0; an app that stops itself on a
-  fatal error sets it, then calls `request_stop()`).
+  fatal error calls `fail(reason)`, which sets it to 1 and keeps `reason` in `failure`).
+* The MOOSDB refusing the app's name at its first connection (another process has it) is
+  such a fatal error; a refusal on a reconnection is not (the DB still holds the old session
+  until its client timeout): the client keeps trying (pygoby.moos.client).
 * Mail older than the app's start time is stored in `dynamic_vars` but not handed to the
   subscription's handler (`ignore_stale = True`, Goby's rule; snapshots of old values
   therefore do not trigger handlers). Pattern handlers always run.
@@ -87,6 +95,7 @@ from pygoby.moos import appcli
 from pygoby.moos import protocol as p
 from pygoby.moos.appconfig import (
     collecting_notes,
+    config_line,
     example_config,
     initializer_posts,
     read_configuration,
@@ -105,6 +114,7 @@ from pygoby.moos.translator import (
     post_for_moos,
 )
 from pygoby.protobuf import builtin_class
+from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock
 
 Handler = Callable[[MOOSMessage], None]
@@ -147,6 +157,10 @@ class GobyMOOSApp:
     config_proto: ClassVar[tuple[str, str] | None] = None
     default_name: ClassVar[str] = ""
     ignore_stale: ClassVar[bool] = True
+    # loop() and the timers also run while the MOOSDB is away (CMOOSApp's
+    # SetIterateWithoutComms): for apps driving hardware or a schedule that must not stop with
+    # the DB (pAcommsHandler's modem and MAC, iFrontSeat's frontseat link)
+    iterate_without_comms: ClassVar[bool] = False
 
     # -- configuration -------------------------------------------------------------------------
 
@@ -217,6 +231,7 @@ class GobyMOOSApp:
         self.client = MOOSClient(self.name, host, port, clock=self.clock, on_message=self._mail.append)
         self.client.signal_connect.connect(self._connected)
         self.client.signal_disconnect.connect(self._disconnected)
+        self.client.signal_refused.connect(self._refused)
         self.log = logging.getLogger(f"pygoby.app.{self.name}")
         self.start_time = self.clock.now()
         self.dynamic_vars: dict[str, MOOSMessage] = {}
@@ -226,14 +241,16 @@ class GobyMOOSApp:
         self._timers: list[_Timer] = []
         self._published: set[str] = set()
         self._task: asyncio.Task[None] | None = None
-        self._stop_requested: asyncio.Event | None = None
+        self._stop_requested = asyncio.Event()  # set by request_stop(), even before run()
         self._stopping = False  # a disconnect during stop() is expected, not a lost connection
         self._log_handlers: AppLogHandlers | None = None
+        self.terminal_handler: logging.Handler | None = None  # instead of stdout (show_gui)
         self._status = StatusReport()
         self.iterations = 0
         self.exit_status = 0
         # Goby 1.1/2 configuration forms mapped at load (appconfig.collecting_notes), logged once
         self.config_notes: list[str] = []
+        self.failure: str | None = None
 
     # -- API for subclasses --------------------------------------------------------------------
 
@@ -287,6 +304,20 @@ class GobyMOOSApp:
         and does not exist from the working directory (MissionFile.find_file)."""
         return self.mission.find_file(path) if self.mission is not None else path
 
+    def search_dirs(self) -> list[str]:
+        """The folders `find_file` looks in, in order (for "not found" errors)."""
+        return self.mission.search_dirs() if self.mission is not None else [os.getcwd()]
+
+    def config_error(self, reason: str, field: str, value: str = "") -> ConfigError:
+        """A ConfigError for a problem found after parsing, located at the mission file line
+        that sets `field` (to `value`) in this app's block when there is one."""
+        file = line = None
+        if self.mission is not None and self.mission.path is not None:
+            file = str(self.mission.path)
+            block = self.mission.goby_block(self.name)
+            line = config_line(block, field, value) if block is not None else None
+        return ConfigError(reason, file=file, line=line, field=field)
+
     # -- protobuf messages on MOOS variables (the app-internal technique) ----------------------
 
     def publish_pb(self, var: str, message: Message) -> None:
@@ -327,11 +358,12 @@ class GobyMOOSApp:
     async def start(self, connect_timeout: float | None = None) -> None:
         """Start logging, the comms and the tick loop. With `connect_timeout`, wait for the
         first connection (TimeoutError otherwise); without, carry on and keep trying."""
-        self._log_handlers = AppLogHandlers.open(self.log, self.name, self.common)
+        self._log_handlers = AppLogHandlers.open(
+            self.log, self.name, self.common, terminal=self.terminal_handler
+        )
         if self.config_notes:
             self.log.info("Goby 1.1/2 configuration forms mapped onto today's:\n  %s",
                           "\n  ".join(self.config_notes))  # fmt: skip
-        self._stop_requested = asyncio.Event()
         self._stopping = False
         self.start_time = self.clock.now()
         self.on_start()
@@ -343,10 +375,8 @@ class GobyMOOSApp:
     async def stop(self) -> None:
         self._stopping = True
         if self._task is not None:
-            self._task.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await self._task
-            self._task = None
+            task, self._task = self._task, None
+            await cancel_and_wait(task)
             self.on_stop()
         with contextlib.suppress(Exception):
             await self.client.flush(timeout=1.0)
@@ -354,18 +384,49 @@ class GobyMOOSApp:
         if self._log_handlers is not None:
             self._log_handlers.close()
             self._log_handlers = None
+        self._stop_requested.clear()
+
+    @property
+    def stop_requested(self) -> bool:
+        """Whether `request_stop()` was called since `start()`."""
+        return self._stop_requested.is_set()
 
     def request_stop(self) -> None:
-        if self._stop_requested is not None:
-            self._stop_requested.set()
+        """Make `run()` stop the app (also when called before `run()`)."""
+        self._stop_requested.set()
+
+    def fail(self, reason: str, exit_status: int = 1) -> None:
+        """Stop because of a fatal error: `reason` is logged (critical) and kept in `failure`
+        (the command line prints it on stderr), and `main` returns `exit_status`."""
+        self.log.critical("%s; stopping", reason)
+        self.failure = reason
+        self.exit_status = exit_status
+        self.request_stop()
 
     async def run(self) -> None:
+        gui = None
+        if self.common.show_gui:
+            from pygoby.moos.appgui import gui_for  # textual, only when asked for
+
+            gui = gui_for(self)
+            if gui is not None:
+                self.terminal_handler = gui.handler
         await self.start()
-        assert self._stop_requested is not None
+        if self.common.show_gui and gui is None:
+            self.log.info("show_gui: standard output is not a terminal; the log stays plain text")
         try:
-            await self._stop_requested.wait()
+            if gui is not None:
+                await gui.run_until(self._stop_requested)
+            else:
+                await self._stop_requested.wait()
         finally:
             await self.stop()
+
+    def status_lines(self) -> list[str]:
+        """The app's state in a few lines (show_gui's status panel). Override to add yours."""
+        state = "connected" if self.connected else "not connected"
+        return [f"MOOSDB {self.client.host}:{self.client.port}: {state}",
+                f"up {self.clock.now() - self.start_time:.0f} s, {self.iterations} iterations"]  # fmt: skip
 
     async def __aenter__(self) -> GobyMOOSApp:
         await self.start(connect_timeout=5.0)
@@ -392,6 +453,10 @@ class GobyMOOSApp:
             self.on_disconnect()
         except Exception:
             self.log.exception("on_disconnect failed")
+
+    def _refused(self, err: Exception) -> None:
+        self.fail(f"{err}: is another {self.name} running? (give this one another name: "
+                  f"`APP mission.moos OtherName`)")  # fmt: skip
 
     def _post_initializers(self) -> None:
         for var, value in initializer_posts(self.common, self.mission, self.log):
@@ -463,9 +528,10 @@ class GobyMOOSApp:
 
     def _tick(self) -> None:
         self._handle_mail()
-        if not self.client.connected:
+        if self.client.connected:
+            self._post_status()
+        elif not self.iterate_without_comms:
             return
-        self._post_status()
         try:
             self.loop()
         except Exception:

@@ -3,18 +3,18 @@
     APP [options] mission.moos [moos_name]
 
 `-c/--moos_file` and `-a/--moos_name` are the two positionals by name, `-e/--example_config`
-prints a ProcessConfig block, `-V/--version` the version, and `--<field> <value>` (or
+prints a ProcessConfig block, `-V/--version` the version, `-v/--verbose` (repeated: -vvv)
+raises the terminal's verbosity, and `--<field> <value>` (or
 `--<field>=<value>`) overrides any top-level configuration field. `run_app(app_class, argv)` is
 what `GobyMOOSApp.main` does: read the configuration (a configuration error prints one clear
 message and exits 1 before connecting), then run the app until SIGINT/SIGTERM or until it stops
-itself, and return its exit status.
+itself, and return its exit status. A signal always ends the app within a few seconds.
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
-import signal
 import sys
 from collections.abc import Sequence
 from importlib.metadata import PackageNotFoundError, version
@@ -24,11 +24,14 @@ from typing import TYPE_CHECKING
 from pygoby.errors import ConfigError
 from pygoby.moos.appconfig import collecting_notes
 from pygoby.moos.moosfile import MissionFile
+from pygoby.util.aiorun import StopSignals
+from pygoby.util.console import quiet_broken_pipe
 
 if TYPE_CHECKING:
     from pygoby.moos.app import GobyMOOSApp
 
 Overrides = list[tuple[str, str]]
+VERBOSE_ENUM = 4  # goby.util.protobuf.GLogConfig.Verbosity.VERBOSE
 
 
 def package_version() -> str:
@@ -54,6 +57,9 @@ def argument_parser(program: str) -> argparse.ArgumentParser:
     parser.add_argument("-a", "--moos_name", help="same as the alias positional")
     parser.add_argument("-e", "--example_config", action="store_true", help="print an example ProcessConfig block and exit")
     parser.add_argument("-V", "--version", action="version", version=f"%(prog)s {package_version()}")
+    parser.add_argument("-v", "--verbose", action="count", default=0,
+                        help="terminal verbosity: -v VERBOSE, -vv DEBUG1, -vvv DEBUG2, -vvvv DEBUG3 "
+                        "(overrides common.verbosity)")  # fmt: skip
     return parser
 
 
@@ -96,8 +102,7 @@ def run_app(
     known, rest = parser.parse_known_args(args_in)
     name = known.moos_name or known.alias or program
     if known.example_config:
-        sys.stdout.write(app_class.example_config(name))
-        return 0
+        return quiet_broken_pipe(lambda: sys.stdout.write(app_class.example_config(name)) and 0)
     try:
         overrides = parse_overrides(rest)
     except ValueError as err:
@@ -106,26 +111,29 @@ def run_app(
     try:
         with collecting_notes() as notes:
             cfg = app_class.read_config(mission, name, overrides)
+        if known.verbose:  # Verbosity enum: VERBOSE=4, DEBUG1=5, DEBUG2=6, DEBUG3=7
+            cfg.common.verbosity = VERBOSE_ENUM + min(known.verbose, 4) - 1
         app = app_class(cfg, name=name, mission=mission)
         app.config_notes = notes
     except ConfigError as err:
         print(f"{name}: fatal configuration error: {err}", file=sys.stderr)
         return 1
-    return run_until_signal(app)
+    return quiet_broken_pipe(lambda: run_until_signal(app))
 
 
 def run_until_signal(app: GobyMOOSApp) -> int:
-    """Run `app` until SIGINT/SIGTERM asks it to stop (it stops cleanly) or it stops itself;
-    its exit status, 130 after a KeyboardInterrupt outside the loop."""
+    """Run `app` until SIGINT/SIGTERM asks it to stop (it stops cleanly, or the process ends
+    after `STOP_GRACE` s whatever it is doing: pygoby.util.aiorun.StopSignals) or it stops
+    itself; its exit status (its `failure`, if any, printed on stderr)."""
 
     async def runner() -> None:
-        loop = asyncio.get_running_loop()
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            loop.add_signal_handler(sig, app.request_stop)
-        await app.run()
+        with StopSignals(asyncio.get_running_loop(), app.request_stop, app.name):
+            await app.run()
 
     try:
         asyncio.run(runner())
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # before the handlers were in place
         return 130
+    if app.failure:
+        print(f"{app.name}: {app.failure}", file=sys.stderr)
     return app.exit_status

@@ -8,6 +8,8 @@
 * `example_config(config_class, app_name)`: the `--example_config` text.
 * `initializer_posts(common, mission)`: what `common.initializer` posts on every connect.
 * `prefixed_var_names(moos_var)`: an app's `moos_var { prefix: ... }` block as full names.
+* `config_line(block, field, value)`: the file line where a field (with that value) is set, for
+  errors found after parsing.
 * `goby_field_options(field)`: a field's `(goby.field)` options (description, example,
   moos_global, cfg.action), read from its serialized options so that it works for classes from
   any descriptor pool.
@@ -23,14 +25,14 @@ import re
 from collections.abc import Callable, Iterator, Sequence
 from contextvars import ContextVar
 
-from google.protobuf import text_format
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
-from pygoby.moos.moosfile import MissionFile, parse_number
+from pygoby.moos.moosfile import GobyBlock, MissionFile, parse_number
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
 from pygoby.protobuf.wire import length_delimited
 
 log = logging.getLogger(__name__)
@@ -59,30 +61,30 @@ def goby_field_options(field: FieldDescriptor) -> Message:
 # Reading
 
 
-def _field_near(line_text: str, column: int) -> str | None:
-    names = re.findall(r"([A-Za-z_][\w.]*|\[[\w.]+\])\s*[:{]", line_text[: max(column, 1)])
-    return names[-1] if names else None
+def locate(err: ConfigError, mission: MissionFile | None, app_name: str) -> ConfigError:
+    """`err` (about the field at `err.field` of the app's configuration) with the mission file
+    and the line of that field in the app's ProcessConfig block filled in."""
+    block = mission.goby_block(app_name) if mission is not None else None
+    if block is None or err.field is None:
+        return err
+    path = mission.path if mission.path else "mission file"
+    return err.located(file=path, line=line_of_field(block.text, err.field, block.first_line))
 
 
 def parse_block(config: Message, text: str, first_line: int, source: str) -> None:
     """Merge TextFormat `text` into `config`; errors give the file line and the field."""
-    try:
-        text_format.Merge(text, config)
-    except text_format.ParseError as err:
-        line, column = err.GetLine(), err.GetColumn()
-        if line is None:
-            raise ConfigError(str(err), file=source) from None
-        lines = text.splitlines()
-        line_text = lines[line - 1] if 0 < line <= len(lines) else ""
-        detail = str(err).split(" : ", 1)[-1]
-        quoted = f"'{line_text}': "
-        if detail.startswith(quoted):
-            detail = detail[len(quoted) :]
-        field = _field_near(line_text, column or 0)
-        where = f' in field "{field}"' if field and field not in detail else ""
-        raise ConfigError(
-            f"{detail}{where}\n    {line_text.strip()}", file=source, line=first_line + line - 1
-        ) from None
+    merge_config_text(text, config, file=source, first_line=first_line)
+
+
+def config_line(block: GobyBlock, field: str, value: str = "") -> int | None:
+    """The file line of the first `field:` (the last part of a dotted name) in `block` whose line
+    also contains `value`; None when there is none (e.g. set from the command line)."""
+    name = re.escape(field.rsplit(".", 1)[-1])
+    pattern = re.compile(rf"(?<![\w.]){name}\s*:")
+    for index, text in enumerate(block.text.splitlines(), start=1):
+        if pattern.search(text) and value in text:
+            return block.file_line(index)
+    return None
 
 
 def apply_moos_globals(config: Message, mission: MissionFile) -> None:
@@ -110,10 +112,16 @@ def apply_moos_globals(config: Message, mission: MissionFile) -> None:
             log.info("MOOS global %s=%s ignored: %s is set in the ProcessConfig block",
                      name, value, field.full_name)  # fmt: skip
             continue
-        _set_from_global(config, field, name, value)
+        try:
+            _set_from_global(config, field, name, value)
+        except ConfigError as err:
+            path = mission.path if mission.path else "mission file"
+            raise err.located(file=path, line=mission.global_line(name)) from None
 
 
 def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: str) -> None:
+    """A MOOS global's text as the field's value; text that is no value of its type is an
+    error (MOOS would read "abc" as 0: a mistyped ServerPort must not mean port 9000)."""
     kind = field.type
     if kind == FieldDescriptor.TYPE_STRING:
         setattr(config, field.name, value)
@@ -129,16 +137,17 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
                 f'invalid enumeration "{value}" (MOOS global {name})', field=field.name
             )
         setattr(config, field.name, enum_value.number)
+    elif (number := parse_number(value)) is None:
+        raise ConfigError(f"{name} = {value} is not a number", field=field.full_name)
     elif kind in (FieldDescriptor.TYPE_DOUBLE, FieldDescriptor.TYPE_FLOAT):
-        if (number := parse_number(value)) is not None:
-            setattr(config, field.name, number)
-    elif (number := parse_number(value)) is not None:
+        setattr(config, field.name, number)
+    elif number != int(number):
+        raise ConfigError(f"{name} = {value} is not a whole number", field=field.full_name)
+    else:
         try:
             setattr(config, field.name, int(number))
         except ValueError:
-            raise ConfigError(
-                f"MOOS global {name}={value} is out of range", field=field.name
-            ) from None
+            raise ConfigError(f"{name} = {value} is out of range", field=field.full_name) from None
 
 
 def apply_overrides(config: Message, overrides: Sequence[tuple[str, str]]) -> None:
@@ -217,6 +226,8 @@ def read_configuration(
     missing = config.FindInitializationErrors()
     if missing:
         raise ConfigError(f"missing required configuration fields: {', '.join(missing)}")
+    block_text, first_line = (block.text, block.first_line) if mission is not None else ("", 1)
+    check_config_values(config, block_text, file=source, first_line=first_line)
     return config
 
 
@@ -305,6 +316,8 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
             value = _quote(opts.example) if field.type == FieldDescriptor.TYPE_STRING else opts.example
         elif field.type == FieldDescriptor.TYPE_STRING:
             value = '""'
+        elif field.is_required:  # goby3 prints nothing, which does not parse when copied
+            value = _placeholder(field)
         else:
             value = ""
         if field.type == FieldDescriptor.TYPE_ENUM:
@@ -316,6 +329,17 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
             comment += f' (can also set MOOS global "{opts.moos_global}=")'
         out.extend(_wrap(f"{indent}{name}: {value}  ", comment))
     return out
+
+
+def _placeholder(field: FieldDescriptor) -> str:
+    """A value of the field's type that parses (the first enumerator, 0, false, "")."""
+    if field.type == FieldDescriptor.TYPE_ENUM:
+        return field.enum_type.values[0].name
+    if field.type == FieldDescriptor.TYPE_BOOL:
+        return "false"
+    if field.type == FieldDescriptor.TYPE_BYTES:
+        return '""'
+    return "0"
 
 
 def example_config(config_class: type[Message], app_name: str) -> str:

@@ -1,11 +1,14 @@
 """A Goby MOOS application's log (spec goby-moos-apps.md section 2.8): the terminal at
 `common.verbosity`, and with `common.log` a text file `<name>_<community>_<UTC stamp>.txt` in
 `common.log_path` (else ./) at `common.log_verbosity`, with a `<name>_<community>_latest.txt`
-symlink to the newest one.
+symlink to the newest one. Both get the app's own lines and every group of the library (the
+`pygoby` loggers: queue, MAC, driver traffic, ...), in goby's layout (pygoby.util.glog).
 
-    handlers = AppLogHandlers.open(log, name, common)   # attached to `log` and pygoby.moos
+    handlers = AppLogHandlers.open(log, name, common)   # attached to `log` and `pygoby`
     ...
     handlers.close()
+
+`terminal=` replaces the terminal handler (show_gui's live view).
 """
 
 from __future__ import annotations
@@ -18,26 +21,38 @@ from pathlib import Path
 from typing import Any
 
 from pygoby.errors import ConfigError
+from pygoby.util.glog import DEBUG1, LIBRARY_ROOT, GobyFormatter, level_for
 
-# goby.util.protobuf.GLogConfig.Verbosity -> logging level
-VERBOSITY_LEVELS = {1: logging.CRITICAL + 10, 2: logging.WARNING, 4: logging.INFO,
-                    5: logging.DEBUG, 6: logging.DEBUG, 7: logging.DEBUG}  # fmt: skip
+# The library's log lines (client connection, queue, MAC, driver traffic) go to the app's
+# handlers too.
+LIBRARY_LOGGER = LIBRARY_ROOT
 
-# The library's own log lines (client connection, ...) go to the app's handlers too.
-LIBRARY_LOGGER = "pygoby.moos"
+
+class QuietStreamHandler(logging.StreamHandler):
+    """A terminal handler that stops writing once its reader has gone (`| head`)."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if self.stream is not None:
+            super().emit(record)
+
+    def handleError(self, record: logging.LogRecord) -> None:  # noqa: N802 - logging's name
+        if isinstance(sys.exc_info()[1], BrokenPipeError):
+            self.stream = None
+            return
+        super().handleError(record)
 
 
 def terminal_handler(name: str, verbosity: int) -> logging.Handler:
-    terminal = logging.StreamHandler(sys.stdout)
-    terminal.setLevel(VERBOSITY_LEVELS.get(verbosity, logging.INFO))
-    terminal.setFormatter(logging.Formatter(f"{name} [%(asctime)s]: %(message)s"))
+    terminal = QuietStreamHandler(sys.stdout)
+    terminal.setLevel(level_for(verbosity))
+    terminal.setFormatter(GobyFormatter(name, colour=sys.stdout.isatty()))
     return terminal
 
 
 def file_handler(path: Path, verbosity: int) -> logging.Handler:
     handler = logging.FileHandler(path)
-    handler.setLevel(VERBOSITY_LEVELS.get(verbosity, logging.DEBUG))
-    handler.setFormatter(logging.Formatter("[ %(asctime)s ] {%(levelname)s}: %(message)s"))
+    handler.setLevel(level_for(verbosity))
+    handler.setFormatter(GobyFormatter())
     return handler
 
 
@@ -68,26 +83,40 @@ def _link_latest(latest: Path, path: Path) -> None:
 class AppLogHandlers:
     """The handlers of one running app's log, attached to its logger and the library's."""
 
-    def __init__(self, log: logging.Logger, handlers: list[logging.Handler]) -> None:
+    def __init__(
+        self, log: logging.Logger, handlers: list[logging.Handler], library_level: int
+    ) -> None:
         self.log = log
         self.handlers = handlers
+        self._library_level = library_level  # restored on close
 
     @classmethod
-    def open(cls, log: logging.Logger, name: str, common: Any) -> AppLogHandlers:
+    def open(
+        cls, log: logging.Logger, name: str, common: Any, terminal: logging.Handler | None = None
+    ) -> AppLogHandlers:
         """Set up `log` (an app's logger) for the configuration `common` (GobyMOOSAppConfig)."""
-        log.setLevel(logging.DEBUG)
-        log.propagate = False
-        handlers = [terminal_handler(name, common.verbosity)]
+        handlers = [terminal if terminal is not None else terminal_handler(name, common.verbosity)]
         if common.log:
             handlers.append(file_handler(open_log_file(name, common, log), common.log_verbosity))
+        # warnings always pass (as without any configuration: other handlers may want them);
+        # below that, only the levels some handler shows are made at all
+        lowest = min(*(handler.level for handler in handlers), logging.WARNING)
+        log.setLevel(min(lowest, DEBUG1))  # the app's own lines are few: all reach handlers
+        log.propagate = False
+        library = logging.getLogger(LIBRARY_LOGGER)
+        saved = library.level
+        if library.getEffectiveLevel() > lowest:  # the groups' lines must reach the handlers
+            library.setLevel(lowest)
         for handler in handlers:
             log.addHandler(handler)
-            logging.getLogger(LIBRARY_LOGGER).addHandler(handler)
-        return cls(log, handlers)
+            library.addHandler(handler)
+        return cls(log, handlers, saved)
 
     def close(self) -> None:
+        library = logging.getLogger(LIBRARY_LOGGER)
         for handler in self.handlers:
             self.log.removeHandler(handler)
-            logging.getLogger(LIBRARY_LOGGER).removeHandler(handler)
+            library.removeHandler(handler)
             handler.close()
         self.handlers = []
+        library.setLevel(self._library_level)

@@ -3,6 +3,7 @@
     class uExample(ClassicMOOSApp):
         default_name = "uExample"
         keep_quotes = False            # True: read values with their double quotes
+        example_lines = ("Param = value   // what it does",)   # --example_config
         def __init__(self, cfg, **kwargs):
             super().__init__(cfg, **kwargs)
             self.params                # [(name, value), ...] of the ProcessConfig block
@@ -30,6 +31,15 @@ from pygoby.moos.moosfile import MissionFile, parse_number
 class ClassicMOOSApp(GobyMOOSApp):
     config_proto = ("pygoby/moos/classic_app.proto", "pygoby.moos.protobuf.ClassicMOOSAppConfig")
     keep_quotes: ClassVar[bool] = False
+    # the block's own `name = value` lines, as `--example_config` prints them
+    example_lines: ClassVar[tuple[str, ...]] = ()
+
+    @classmethod
+    def example_config(cls, name: str | None = None) -> str:
+        """The ProcessConfig block as this app reads it (MOOS-IvP style lines, not TextFormat)."""
+        lines = ["AppTick = 4", "CommsTick = 4", *cls.example_lines]
+        body = "".join(f"  {line}\n" for line in lines)
+        return f"ProcessConfig = {name or cls.default_name or cls.__name__}\n{{\n{body}}}\n"
 
     @classmethod
     def read_config(

@@ -9,11 +9,11 @@ import json
 import logging
 import os
 import re
-import signal
 import sys
 from collections.abc import Coroutine
 from typing import Any
 
+from pygoby.errors import ConfigError
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import (
@@ -23,8 +23,10 @@ from pygoby.moos.db import (
     DEFAULT_PACKET_TIMEOUT,
     MOOSDB,
 )
+from pygoby.moos.errors import MoosRefusedError
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.timewarp import moos_clock
+from pygoby.util.aiorun import StopSignals
 
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
@@ -72,7 +74,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     antler = subparsers.add_parser("antler", help="launch a mission's ANTLER block (and a MOOSDB)")
     antler.add_argument("mission")
-    antler.add_argument("--no-db", action="store_true", help="never start the embedded MOOSDB")
+    antler.add_argument("--no-db", action="store_true",
+                        help="do not start the embedded MOOSDB: use the one listening on ServerPort")  # fmt: skip
+    antler.add_argument("--logs", metavar="DIR",
+                        help="write each program's output to DIR/<name>.log instead of the terminal")  # fmt: skip
+    antler.add_argument("--color", choices=("auto", "always", "never"), default="auto",
+                        help="coloured name prefixes for NewConsole = true programs (auto: on a terminal)")  # fmt: skip
     antler.set_defaults(func=_run_antler)
 
 
@@ -97,7 +104,11 @@ def _run_moosdb(args: argparse.Namespace) -> int:
             print(f"moosdb: cannot read {args.mission} ({err.strerror}); using defaults", file=sys.stderr)
     port = args.port
     if port is None:
-        port = mission.get_int("ServerPort") if mission else None
+        try:
+            port = mission.get_port("ServerPort") if mission else None
+        except ConfigError as err:
+            print(f"moosdb: {err}", file=sys.stderr)
+            return 1
         port = p.DEFAULT_PORT if port is None else port
     community = args.community or (mission and mission.get_value("Community")) or p.DEFAULT_COMMUNITY
     warp = args.time_warp or (mission and mission.get_float("MOOSTimeWarp")) or 1.0
@@ -115,12 +126,11 @@ async def _serve(db: MOOSDB) -> int:
         print(f"moosdb: cannot listen on {db.host}:{db.port}: {err.strerror}", file=sys.stderr)
         return 1
     stop = asyncio.Event()
-    loop = asyncio.get_running_loop()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        loop.add_signal_handler(sig, stop.set)
-    print(f"MOOSDB {db.community} listening on {db.host}:{db.port}", flush=True)
-    await stop.wait()
-    await db.stop()
+    with StopSignals(asyncio.get_running_loop(), stop.set, "moosdb"):
+        if not logging.getLogger("pygoby.moos.db").isEnabledFor(logging.INFO):  # else it logs it
+            print(f"MOOSDB {db.community} listening on {db.host}:{db.port}", flush=True)
+        await stop.wait()
+        await db.stop()
     return 0
 
 
@@ -136,7 +146,7 @@ async def _connected(client: MOOSClient, args: argparse.Namespace) -> bool:
     try:
         await client.connect(timeout=args.connect_timeout)
         return True
-    except (TimeoutError, ConnectionError) as err:
+    except (TimeoutError, ConnectionError, MoosRefusedError) as err:
         print(f"cannot connect to a MOOSDB at {args.host}:{args.port}: {err}", file=sys.stderr)
         await client.close()
         return False
@@ -250,4 +260,5 @@ async def _watch(args: argparse.Namespace) -> int:
 def _run_antler(args: argparse.Namespace) -> int:
     from pygoby.moos.antler import run_antler
 
-    return run_antler(args.mission, start_db=not args.no_db)
+    colour = {"auto": None, "always": True, "never": False}[args.color]
+    return run_antler(args.mission, start_db=not args.no_db, logs=args.logs, colour=colour)

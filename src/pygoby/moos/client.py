@@ -11,8 +11,13 @@ Behaviour: a `T` timing message leads a packet at least once a second (keep-aliv
 sync); everything queued is sent in one packet as soon as the event loop runs the writer. The
 client reconnects by itself (every `reconnect_interval` s) after a lost connection, sends its
 subscriptions again, emits `signal_connect`, then sends publications queued while it
-was away (bounded by `outbox_limit`; the oldest are dropped beyond it, with a warning). A `K`
-(name already in use) ends the client with `MoosRefusedError`: no retry, as in C++.
+was away (bounded by `outbox_limit`; the oldest are dropped beyond it, with a warning).
+
+A `K` (name already in use) at the first connection ends the client with `MoosRefusedError`
+(another process has the name: no retry, as in C++). A `K` on a reconnection means the DB still
+holds this client's previous session, which it drops after its client timeout: the client
+tries again, backing off from `reconnect_interval` to 10 s, with a warning each time (the C++
+client gives up there and leaves a live process disconnected forever).
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ from collections.abc import AsyncIterator, Callable
 from pygoby.moos import protocol as p
 from pygoby.moos.errors import MoosProtocolError, MoosRefusedError
 from pygoby.moos.protocol import MOOSMessage, Value
+from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.signal import Signal
 
@@ -34,6 +40,8 @@ log = logging.getLogger(__name__)
 
 TIMING_PERIOD = 1.0
 MAX_PACKET_MESSAGES = 4096
+HANDSHAKE_TIMEOUT = 5.0  # s for the DB's answer to the handshake
+MAX_REFUSED_BACKOFF = 10.0  # s between attempts while the DB refuses the name on reconnect
 
 
 class MOOSClient:
@@ -44,9 +52,10 @@ class MOOSClient:
     None, messages go to the inbox read by `receive()`), reconnect_interval (s), outbox_limit,
     inbox_limit (messages), max_packet_size (bytes accepted from the DB).
 
-    Signals (`pygoby.util.signal.Signal`, no arguments): `signal_connect` after each
-    (re)connection, once the subscriptions are sent again (a raising slot is logged);
-    `signal_disconnect` when a connection is lost.
+    Signals (`pygoby.util.signal.Signal`): `signal_connect()` after each (re)connection, once
+    the subscriptions are sent again (a raising slot is logged); `signal_disconnect()` when a
+    connection is lost; `signal_refused(MoosRefusedError)` when the DB refuses the name at the
+    first connection (the client then stops; `failure` holds the error).
     """
 
     def __init__(
@@ -72,6 +81,7 @@ class MOOSClient:
         # a failing connect slot is logged (the session goes on); disconnect slots' errors propagate
         self.signal_connect = Signal(contain_errors=True, logger=log)
         self.signal_disconnect = Signal()
+        self.signal_refused = Signal(contain_errors=True, logger=log)
         self.reconnect_interval = reconnect_interval
         self.outbox_limit = outbox_limit
         self.inbox_limit = inbox_limit
@@ -123,11 +133,8 @@ class MOOSClient:
             raise TimeoutError(f"{self.name}: no connection to {self.host}:{self.port}")
 
     async def close(self) -> None:
-        if self._task is not None:
-            self._task.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await self._task
-            self._task = None
+        task, self._task = self._task, None
+        await cancel_and_wait(task)
 
     async def __aenter__(self) -> MOOSClient:
         await self.connect()
@@ -204,7 +211,8 @@ class MOOSClient:
         self._queue(MOOSMessage(p.SERVER_REQUEST, p.STRING, name, self.time(), src=self.name,
                                 id=p.SERVER_REQUEST_ID))  # fmt: skip
         try:
-            return await asyncio.wait_for(future, timeout)
+            async with asyncio.timeout(timeout):
+                return await future
         except TimeoutError:
             return []
         finally:
@@ -274,6 +282,7 @@ class MOOSClient:
         self._inbox_ready.set()
 
     async def _run(self) -> None:
+        refusals = 0  # in a row, on reconnection
         try:
             while True:
                 try:
@@ -282,20 +291,31 @@ class MOOSClient:
                     log.debug("%s: cannot connect to %s:%d: %s", self.name, self.host, self.port, err)
                     await asyncio.sleep(self.reconnect_interval)
                     continue
+                delay = self.reconnect_interval
+                connections = self.connections
                 try:
                     await self._session(reader, writer)
                 except MoosRefusedError as err:
-                    log.error("%s: %s", self.name, err)
-                    self.failure = err
-                    self._stopped.set()
-                    return
+                    if not self.connections:
+                        log.error("%s: %s", self.name, err)
+                        self.failure = err
+                        self.signal_refused.emit(err)
+                        return
+                    # The DB still holds our previous session (it has not noticed that the
+                    # connection is gone): it drops it after its client timeout.
+                    refusals += 1
+                    delay = min(self.reconnect_interval * 2**refusals, MAX_REFUSED_BACKOFF)
+                    log.warning("%s: %s (the MOOSDB still holds the previous session?); "
+                                "trying again in %.1f s", self.name, err, delay)  # fmt: skip
                 except (OSError, EOFError, TimeoutError, MoosProtocolError) as err:
                     log.warning("%s: connection to %s:%d lost: %s", self.name, self.host,
                                 self.port, err or type(err).__name__)  # fmt: skip
                 finally:
                     writer.close()
                     self._on_lost()
-                await asyncio.sleep(self.reconnect_interval)
+                if self.connections > connections:
+                    refusals = 0
+                await asyncio.sleep(delay)
         finally:
             self._on_lost()
             self._stopped.set()
@@ -321,7 +341,8 @@ class MOOSClient:
         writer.write(p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(self.name, self.time())]))
         await writer.drain()
         framer = p.PacketFramer(self.max_packet_size)
-        welcome, early = await asyncio.wait_for(self._read_first_packet(reader, framer), 5.0)
+        async with asyncio.timeout(HANDSHAKE_TIMEOUT):
+            welcome, early = await self._read_first_packet(reader, framer)
         if welcome.msg_type == p.POISON:
             raise MoosRefusedError(f"MOOSDB refused {self.name!r}: {welcome.string}")
         if welcome.msg_type != p.WELCOME:
@@ -341,9 +362,8 @@ class MOOSClient:
         try:
             await self._read_loop(reader, framer, early)
         finally:
-            write_task.cancel()
-            with contextlib.suppress(asyncio.CancelledError, OSError):
-                await write_task
+            with contextlib.suppress(OSError):  # a write error is the lost connection itself
+                await cancel_and_wait(write_task)
 
     def _resend_registrations(self) -> None:
         pending = list(self._outbox)
@@ -418,8 +438,11 @@ class MOOSClient:
             wait = last_timing + TIMING_PERIOD - loop.time()
             if not self._outbox and wait > 0:
                 self._wake.clear()
+                # asyncio.timeout, not wait_for: Python 3.11's wait_for can swallow a
+                # cancellation that arrives as the wait ends
                 with contextlib.suppress(TimeoutError):
-                    await asyncio.wait_for(self._wake.wait(), wait)
+                    async with asyncio.timeout(wait):
+                        await self._wake.wait()
             batch: list[MOOSMessage] = []
             now = loop.time()
             if now - last_timing >= TIMING_PERIOD:

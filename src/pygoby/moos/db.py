@@ -26,6 +26,7 @@ import socket
 from pygoby.moos import protocol as p
 from pygoby.moos.dbcore import DBCore
 from pygoby.moos.errors import MoosProtocolError
+from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
@@ -264,11 +265,8 @@ class MOOSDB:
         log.info("MOOSDB %s listening on %s:%d", self.community, self.host, self.port)
 
     async def stop(self) -> None:
-        if self._sweeper is not None:
-            self._sweeper.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await self._sweeper
-            self._sweeper = None
+        sweeper, self._sweeper = self._sweeper, None
+        await cancel_and_wait(sweeper)
         if self._server is not None:
             self._server.close()
             for conn in list(self._connections):

@@ -17,5 +17,9 @@ class MoosRefusedError(MoosError):
     """The DB refused the handshake (poison message); carries the DB's reason."""
 
 
+class AntlerError(MoosError):
+    """A mission cannot be started by antler (e.g. its DB port is taken)."""
+
+
 class MissionFileError(MoosError, ConfigError):
     """A .moos mission file lacks what is asked of it (e.g. the ANTLER block)."""

@@ -9,7 +9,7 @@ app logs once at VERBOSE.
 
 | Goby 1.1 / 2 form | becomes |
 |---|---|
-| `verbosity: VERBOSITY_QUIET/WARN/VERBOSE/DEBUG/GUI` | `QUIET/WARN/VERBOSE/DEBUG1/VERBOSE` (no NCurses GUI) |
+| `verbosity: VERBOSITY_QUIET/WARN/VERBOSE/DEBUG/GUI` | `QUIET/WARN/VERBOSE/DEBUG1/VERBOSE` (GUI: and `show_gui: true`) |
 | `[MicroModemConfig.X]`, `[micromodem.protobuf.Config.X]` | `[goby.acomms.micromodem.protobuf.config] { X }` |
 | `[UDPDriverConfig.X]`, `[ABCDriverConfig.X]` | `[goby.acomms.udp/abc.protobuf.config] { X }` |
 | slot `type: SLOT_DATA/PING/REMUS_LBL/NARROWBAND_LBL` | `DATA` / `DRIVER_SPECIFIC` + Micro-Modem transmission type |
@@ -193,10 +193,15 @@ def _verbosity(f: Field, notes: list[str]) -> list[Field] | None:
     new = VERBOSITY.get(old)
     if new is None:
         return None
-    extra = " (pygoby has no NCurses GUI; the terminal shows VERBOSE output)" if old == "VERBOSITY_GUI" else ""
+    gui = old == "VERBOSITY_GUI" and f.key == "verbosity"  # Goby 2 made it show_gui: true
+    extra = " and show_gui: true" if gui else ""
     notes.append(f"line {f.name.line}: {f.key}: {old} -> {new}{extra}")
     f.value = [_synthetic(new, f.value[0].line)]
-    return [f]
+    if not gui:
+        return [f]
+    line = f.name.line
+    show_gui = Field(_synthetic("show_gui", line), _synthetic(":", line), [_synthetic("true", line)])
+    return [f, show_gui]
 
 
 def _driver_extension(f: Field, notes: list[str]) -> list[Field] | None:

@@ -17,6 +17,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from pygoby.errors import ConfigError
 from pygoby.moos.errors import MissionFileError
 
 _NUMERIC = re.compile(r"[0-9.eE+\-]+")
@@ -125,9 +126,17 @@ class MissionFile:
     def from_text(cls, text: str) -> MissionFile:
         return cls(text.splitlines())
 
+    def search_dirs(self) -> list[str]:
+        """Where relative file names in the mission are looked up: the working directory, then
+        the mission file's folder (so that missions can be run from anywhere)."""
+        dirs = [str(Path.cwd())]
+        if self.path:
+            dirs.append(str(Path(self.path).resolve().parent))
+        return list(dict.fromkeys(dirs))
+
     def find_file(self, path: str) -> str:
         """A relative path that does not exist from the working directory is looked up next to
-        the mission file (so that missions can be run from anywhere)."""
+        the mission file; `path` unchanged when it is found in neither."""
         given = Path(path)
         if given.is_absolute() or given.exists() or not self.path:
             return path
@@ -184,6 +193,31 @@ class MissionFile:
             if sep and key.lower() == wanted:
                 return value
         return None
+
+    def global_line(self, name: str, outside_blocks: bool = True) -> int | None:
+        """The file line (1-based) of the `name = value` line that get_value reads."""
+        wanted = name.lower()
+        for number, (line, in_block) in enumerate(zip(self.lines, self._in_block, strict=True)):
+            if outside_blocks and in_block:
+                continue
+            key, sep, _ = _no_space(line).partition("=")
+            if sep and key.lower() == wanted:
+                return number + 1
+        return None
+
+    def get_port(self, name: str = "ServerPort") -> int | None:
+        """A port number global (None if absent); anything but 0-65535 is a ConfigError."""
+        value = self.get_value(name)
+        if value is None:
+            return None
+        if not value.isdigit() or int(value) > 65535:
+            raise ConfigError(
+                f"{name} = {value} is not a port number (0-65535)",
+                file=self.path if self.path else "mission file",
+                line=self.global_line(name, outside_blocks=False),
+                field=name,
+            )
+        return int(value)
 
     def get_float(self, name: str, outside_blocks: bool = False) -> float | None:
         value = self.get_value(name, outside_blocks)

@@ -69,6 +69,15 @@ def encode_text(text: str) -> bytes:
     return text.encode("utf-8", "surrogateescape")
 
 
+def text_or_binary(data: bytes) -> str | bytes:
+    """`data` as a MOOS string when it is printable ASCII (NMEA), else as a binary string."""
+    try:
+        text = data.decode("ascii")
+    except UnicodeDecodeError:
+        return data
+    return text if text.isprintable() else data
+
+
 @dataclass(slots=True)
 class MOOSMessage:
     """One CMOOSMsg. Defaults are the C++ default constructor's (moos.md 5), so that messages

@@ -1,7 +1,9 @@
 """What every Goby MOOS app with translator_entry blocks shares (pTranslator, pAcommsHandler).
 
 * `MessageTypes`: the app's message definitions: `load_shared_library` modules of generated code
-  (protobuf's default pool) and `load_proto_file` files (compiled at start-up), looked up by name.
+  (protobuf's default pool) or built-in upstream libraries (C++ DCCL codec libraries are the
+  app's to load into its Codec, pygoby.dccl.libraries), and `load_proto_file` files (compiled
+  at start-up), looked up by name.
 * `TranslatorBinding`: a `Translator` wired to a `GobyMOOSApp`: it subscribes the triggers, the
   datum variables and the multiplex variables, runs the `TranslatorRunner`, hands each created
   message to the app's callback, and posts publications.
@@ -10,13 +12,17 @@
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable, Iterable
+import logging
+import os
+from collections.abc import Callable, Iterable, Sequence
+from pathlib import Path
 
-from google.protobuf import descriptor_pool, message_factory
+from google.protobuf import descriptor_pool, message_factory, text_format
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
+from pygoby.moos.appconfig import locate
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import (
     LAT_ORIGIN_VAR,
@@ -29,12 +35,26 @@ from pygoby.moos.translator import (
     TranslatorRunner,
 )
 from pygoby.protobuf import ProtoError, ProtoLoader
+from pygoby.util.glog import DEBUG1, VERBOSE, group_logger
+from pygoby.util.libraries import DCCL_CODECS, MESSAGES, builtin_for, is_shared_library, unavailable
 from pygoby.util.modules import import_module_or_file
+
+log = logging.getLogger(__name__)
+glog = group_logger("goby::moos::translator")  # created messages and their publications
 
 
 class MessageTypes:
     """Message classes by full name: .proto files first, then generated modules, then fallbacks
-    (e.g. pygoby's own messages)."""
+    (e.g. pygoby's own messages).
+
+    `proto_files` (load_proto_file) are looked up in `search_dirs` (default: the working
+    directory), then as import names on the .proto import path. `shared_libraries`
+    (load_shared_library) are Python modules or .py files of generated code, or upstream `.so`
+    names: those pygoby has built in (pygoby.util.libraries) are accepted (a DCCL codec library
+    is the app's to apply to its Codec), any other is a ConfigError saying to use load_proto_file. `config_error(field, value)` makes the located
+    ConfigError for a bad entry (GobyMOOSApp.config_error: reason, field, value); `loaded` lists the message types the
+    files and modules define (for errors naming what is loaded).
+    """
 
     def __init__(
         self,
@@ -42,16 +62,52 @@ class MessageTypes:
         shared_libraries: Iterable[str] = (),
         fallback: Callable[[str], type[Message]] | None = None,
         loader: ProtoLoader | None = None,
+        search_dirs: Sequence[str] = (),
+        config_error: Callable[[str, str, str], ConfigError] | None = None,
     ) -> None:
         self.loader = loader if loader is not None else ProtoLoader()
         self._fallback = fallback
+        self._search_dirs = list(search_dirs) or [os.getcwd()]
+        self._error = config_error or (lambda reason, field, value: ConfigError(reason, field=field))
+        self.loaded: list[str] = []
+        for name in shared_libraries:
+            self._load_library(name)
+        for path in proto_files:
+            self._load_proto(path)
+
+    def _load_proto(self, path: str) -> None:
+        found = _find(path, self._search_dirs)
+        if found is None and not self.loader.on_import_path(path):
+            searched = [*self._search_dirs, *self.loader.import_path()]
+            raise self._error(
+                f'"{path}" not found; searched: {", ".join(searched)}', "load_proto_file", path
+            )
         try:
-            for module in shared_libraries:
-                import_module_or_file(module)
-            for path in proto_files:
-                self.loader.load_file(path)
-        except (ImportError, ProtoError, OSError, SyntaxError, TypeError) as err:
-            raise ConfigError(f"cannot load message definitions: {err}") from None
+            descriptor = self.loader.load_file(found or path)
+        except (ProtoError, OSError) as err:
+            raise self._error(f'cannot load "{path}": {err}', "load_proto_file", path) from None
+        log.info("loaded %s", found or path)
+        self.loaded += [d.full_name for d in descriptor.message_types_by_name.values()]
+
+    def _load_library(self, name: str) -> None:
+        field = "load_shared_library"
+        if is_shared_library(name):
+            builtin = builtin_for(name)
+            if builtin is not None and builtin.kind == MESSAGES:
+                log.info("load_shared_library %s: its messages are built into pygoby", name)
+            elif builtin is not None and builtin.kind == DCCL_CODECS:
+                pass  # loaded into the app's Codec through pygoby.dccl.libraries
+            else:
+                raise self._error(f'"{name}": {unavailable(name)}', field, name)
+            return
+        module_path = _find(name, self._search_dirs) if name.endswith(".py") else name
+        try:
+            module = import_module_or_file(module_path or name)
+        except (ImportError, OSError, SyntaxError, TypeError) as err:
+            raise self._error(f'cannot load "{name}": {err}', field, name) from None
+        file_descriptor = getattr(module, "DESCRIPTOR", None)
+        types = getattr(file_descriptor, "message_types_by_name", {})
+        self.loaded += [d.full_name for d in types.values()]
 
     def __call__(self, name: str) -> type[Message]:
         with contextlib.suppress(ProtoError):
@@ -62,6 +118,18 @@ class MessageTypes:
         if self._fallback is not None:
             return self._fallback(name)
         raise ProtoError(f"unknown message type {name!r}")
+
+
+def _find(path: str, search_dirs: Sequence[str]) -> str | None:
+    """`path` if absolute and a file, else the first `dir/path` that is a file."""
+    given = Path(path)
+    if given.is_absolute():
+        return path if given.is_file() else None
+    for directory in search_dirs:
+        candidate = Path(directory) / given
+        if candidate.is_file():
+            return str(candidate)
+    return None
 
 
 class TranslatorBinding:
@@ -80,16 +148,19 @@ class TranslatorBinding:
         self.on_created = on_created
         self.multiplex_vars = list(multiplex_vars)
         modem_ids = ModemIdLookup.from_file(modem_id_lookup_path) if modem_id_lookup_path else None
-        try:
-            self.translator = Translator(
-                entries,
-                resolve,
-                lat_origin=app.common.lat_origin,
-                lon_origin=app.common.lon_origin,
-                modem_ids=modem_ids,
-            )
-        except TranslatorError as err:
-            raise ConfigError(str(err)) from None
+        self.translator = Translator(
+            (),
+            resolve,
+            lat_origin=app.common.lat_origin,
+            lon_origin=app.common.lon_origin,
+            modem_ids=modem_ids,
+        )
+        for index, entry in enumerate(entries):
+            try:
+                self.translator.add_entry(entry)
+            except TranslatorError as err:
+                error = ConfigError(str(err), field=f"translator_entry[{index}]")
+                raise locate(error, app.mission, app.name) from None
         self.moos_technique = app.moos_technique
         self.runner: TranslatorRunner | None = None
 
@@ -121,6 +192,11 @@ class TranslatorBinding:
         if self.runner is not None:
             self._created(self.runner.tick(now))
 
+    def create(self, name: str) -> Message | None:
+        """`name` made now from the app's newest values (e.g. for an ON_DEMAND queue); None,
+        with a warning, when a rule fails or before `start`."""
+        return self.runner.create(name) if self.runner is not None else None
+
     def publish(self, message: Message) -> None:
         """Post a message through its entry's publish rules (warns instead of posting part)."""
         try:
@@ -131,11 +207,20 @@ class TranslatorBinding:
         self.post(posts)
 
     def post(self, posts: Iterable[Post]) -> None:
+        posts = list(posts)
+        if posts and glog.isEnabledFor(VERBOSE):
+            glog.log(VERBOSE, "published %s", ", ".join(post.var for post in posts))
         for post in posts:
+            if glog.isEnabledFor(DEBUG1):
+                glog.log(DEBUG1, "  %s = %r", post.var, post.value)
             self.app.publish(post.var, post.value, src_aux=post.source_aux)
 
     def _created(self, messages: list[Message]) -> None:
         for message in messages:
+            if glog.isEnabledFor(VERBOSE):
+                glog.log(VERBOSE, "created %s", message.DESCRIPTOR.full_name)
+            if glog.isEnabledFor(DEBUG1):
+                glog.log(DEBUG1, "  %s", text_format.MessageToString(message, as_one_line=True))
             self.on_created(message)
 
     def _on_mail(self, msg: MOOSMessage) -> None:

@@ -34,6 +34,7 @@ from pygoby.netsim.protocol import (
     request_class,
     response_names,
 )
+from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
@@ -134,14 +135,12 @@ class NetSimClient:
             self._task = asyncio.create_task(self._run(), name="netsim-client")
 
     async def wait_connected(self, timeout: float | None = None) -> None:
-        await asyncio.wait_for(self._connected.wait(), timeout)
+        async with asyncio.timeout(timeout):
+            await self._connected.wait()
 
     async def close(self) -> None:
-        if self._task is not None:
-            self._task.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await self._task
-            self._task = None
+        task, self._task = self._task, None
+        await cancel_and_wait(task)
 
     def send_request(self, request: Message) -> asyncio.Future[Message] | None:
         """Write a request built with `tracker.build`; a future for its response, or None if

@@ -8,6 +8,7 @@ the parts pygoby uses are still caught.
 
 from __future__ import annotations
 
+import os
 from functools import cache
 
 from google.protobuf import text_format
@@ -16,6 +17,7 @@ from google.protobuf.message import Message
 from pygoby.errors import ConfigError
 from pygoby.netsim.channel.settings import environment_channel_configs
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
 
 CONFIG_PROTO = "netsim/messages/manager_config.proto"
 CONFIG_TYPE = "netsim.protobuf.NetSimManagerConfig"
@@ -34,7 +36,7 @@ env_bounds { environment_id: 0 lat_min: 41.5 lon_min: -71.0 lat_max: 42.5 lon_ma
              depth_min: 0 depth_max: 200 }
 manager_tcp_port: 61999          # default 61999
 # pygoby-only settings:
-listen_address: "0.0.0.0"        # IPv4 address to listen on
+listen_address: "127.0.0.1"      # IPv4 address to listen on ("0.0.0.0": every interface)
 reject_nonfinite_position: true  # NaN/inf lat, lon or depth -> OUT_OF_DEFINED_REGION
 max_line_length: 1048576         # longer NETSIM lines are discarded
 # Channel model of environment 0 (every field optional; defaults shown or described).
@@ -72,15 +74,21 @@ class _Parser(text_format._Parser):  # noqa: SLF001 - per-message control of unk
         super()._MergeField(tokenizer, message)
 
 
-def parse_config(text: str) -> Message:
-    """Parse and validate a TextFormat configuration; raises ConfigError."""
+def parse_config(text: str, file: str | os.PathLike[str] | None = None) -> Message:
+    """Parse and validate a TextFormat configuration; raises ConfigError (with `file`:line)."""
     config = config_class()()
+    merge_config_text(text, config, file=file, parser=_Parser())
+    check_config_values(config, text, file=file)
     try:
-        _Parser().ParseLines(text.split("\n"), config)
-    except text_format.ParseError as exc:
-        raise ConfigError.from_parse_error(exc, "configuration") from exc
-    validate_config(config)
+        validate_config(config)
+    except ConfigError as err:
+        raise err.located(file=file) from None
     return config
+
+
+def load_config(path: str | os.PathLike[str]) -> Message:
+    """The configuration file at `path`, whatever its bytes: ConfigError for every problem."""
+    return parse_config(read_config_file(path), path)
 
 
 def validate_config(config: Message) -> None:

@@ -102,6 +102,7 @@ class PhysicsChannel:
         self._held: dict[tuple[int, int], float] | None = {} if detections_with_receptions else None
         self.transmissions: Counter[str] = Counter()  # by kind (cycle, data, ping, ...)
         self.outcomes: Counter[str] = Counter()  # receptions by outcome
+        self.delivered: Counter[int] = Counter()  # packets handed to each port's modem
 
     # -- the mmsim Channel interface -----------------------------------------------------------
 
@@ -211,6 +212,7 @@ class PhysicsChannel:
             self._log_reception(r, sent, delivered)
         if not delivered:
             return
+        self.delivered[r.receiver] += 1
         assert endpoint is not None
         reception = ModemReception(
             arrival_time=r.arrival,

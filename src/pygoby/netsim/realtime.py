@@ -16,6 +16,7 @@ import asyncio
 import contextlib
 import logging
 import time
+from collections.abc import Callable
 
 from google.protobuf.message import Message
 
@@ -94,8 +95,9 @@ class RealTimeRun:
     def request_stop(self) -> None:
         self._stop.set()
 
-    async def run(self) -> RunSummary:
-        """Run for the scenario's duration (simulated seconds) or until `request_stop`."""
+    async def run(self, progress: Callable[[], None] | None = None) -> RunSummary:
+        """Run for the scenario's duration (simulated seconds) or until `request_stop`;
+        `progress()` is called at every round (a few hundred a second)."""
         sim = self.sim
         sim._wall_start = time.perf_counter()  # noqa: SLF001 - the run owns its summary
         end = sim.start + sim.scenario.duration
@@ -118,9 +120,14 @@ class RealTimeRun:
                     node.mac.do_work()
                 if housekeeping and node.queue is not None:
                     node.queue.do_work()
+            if progress is not None:
+                progress()
             with contextlib.suppress(TimeoutError):
-                await asyncio.wait_for(self._stop.wait(), WORK_PERIOD)
-        return sim.summary()
+                async with asyncio.timeout(WORK_PERIOD):
+                    await self._stop.wait()
+        summary = sim.summary()
+        summary.interrupted = self._stop.is_set()
+        return summary
 
     async def close(self) -> None:
         for node in self.sim.nodes:

@@ -4,7 +4,8 @@
   with the number of receptions per bin underneath;
 * `success_vs_snr.png`: the same against the SNR and the SINR (interference included);
 * `timeline.png`: one row per node: its transmissions as bars (by packet kind) and what it heard
-  as ticks coloured by outcome, over a time window (default: the first hour).
+  as ticks coloured by outcome, nodes labelled by modem id, over a time window (default: the
+  whole run).
 
 Only `rx` events of data packets count for the success plots (control packets — cycle-init,
 ACK, ping — are short and would mix two populations).
@@ -27,7 +28,6 @@ KIND_COLOURS = {"data": "tab:blue", "cycle": "tab:purple", "ack": "tab:olive",
                 "ping": "tab:orange", "ping_reply": "tab:brown", "mini": "tab:gray"}  # fmt: skip
 OUTCOME_COLOURS = {"good": "tab:green", "bad_frames": "tab:red", "receiver_busy": "tab:pink",
                    "half_duplex": "black", "not_detected": "lightgray"}  # fmt: skip
-DEFAULT_WINDOW = 3600.0
 SNR_BIN_DB = 2.0
 
 
@@ -87,7 +87,7 @@ def plot_success_vs_range(events: list[dict], path: Path) -> Path:
     ax.grid(True, alpha=0.3)
     count_ax.set_xlabel("range (km)")
     count_ax.set_ylabel("receptions")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_success_vs_snr(events: list[dict], path: Path) -> Path:
@@ -107,15 +107,39 @@ def plot_success_vs_snr(events: list[dict], path: Path) -> Path:
     ax.grid(True, alpha=0.3)
     count_ax.set_xlabel("dB")
     count_ax.set_ylabel("receptions")
-    return _save(fig, path)
+    return save_figure(fig, path)
+
+
+def node_labels(events: list[dict]) -> dict[int, str]:
+    """Modem port -> "modem <id>": from the run's `node` events, else from what each port sent
+    (logs of older runs); a port that never sent stays "port <n>"."""
+    ids: dict[int, int] = {}
+    for e in events:
+        if e.get("event") == "node":
+            ids[e["port"]] = e["modem_id"]
+        elif e.get("event") == "tx" and "src" in e:
+            ids.setdefault(e["port"], e["src"])
+    ports = {e["port"] for e in events if e.get("event") in ("tx", "rx", "node")}
+    return {p: f"modem {ids[p]}" if p in ids else f"port {p}" for p in ports}
+
+
+def timeline_window(
+    events: list[dict], window: tuple[float, float] | None
+) -> tuple[float, tuple[float, float]]:
+    """(time of the first event, (start, end) in seconds after it): `window`, else the run."""
+    times = [e["t"] for e in events if "t" in e]
+    t0 = min(times) if times else 0.0
+    if window is not None:
+        return t0, window
+    return t0, (0.0, max(max(times, default=t0) - t0, 1.0))
 
 
 def plot_timeline(events: list[dict], path: Path, window: tuple[float, float] | None) -> Path:
-    """Transmissions per node; `window` is (start, end) in seconds after the first event."""
-    times = [e["t"] for e in events if "t" in e]
-    t0 = min(times) if times else 0.0
-    start, end = window if window is not None else (0.0, DEFAULT_WINDOW)
-    ports = sorted({e["port"] for e in events if e.get("event") in ("tx", "rx")})
+    """Transmissions per node; `window` is (start, end) in seconds after the first event
+    (default: the whole run)."""
+    t0, (start, end) = timeline_window(events, window)
+    labels = node_labels(events)
+    ports = sorted(labels, key=lambda p: (labels[p].startswith("port"), _number(labels[p]), p))
     row = {port: i for i, port in enumerate(ports)}
     fig, ax = plt.subplots(figsize=(12, 1.2 + 0.45 * max(len(ports), 1)))
     bars: dict[str, list[tuple[float, float, int]]] = {}
@@ -135,18 +159,22 @@ def plot_timeline(events: list[dict], path: Path, window: tuple[float, float] | 
     for outcome, (xs, ys) in sorted(heard.items()):
         ax.scatter(xs, ys, marker="|", s=120, color=OUTCOME_COLOURS.get(outcome, "k"),
                    label=f"rx {outcome}")  # fmt: skip
-    ax.set_yticks(range(len(ports)), [str(p) for p in ports])
+    ax.set_yticks(range(len(ports)), [labels[p] for p in ports])
     ax.set_ylim(-0.6, len(ports) - 0.2)
     ax.set_xlim(start, end)
-    ax.set_ylabel("node (modem port)")
+    ax.set_ylabel("node")
     ax.set_xlabel("seconds since the first event")
     ax.set_title("Transmissions (bars) and receptions (ticks) per node")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     ax.grid(True, axis="x", alpha=0.3)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
-def _save(fig, path: Path) -> Path:
+def _number(label: str) -> int:
+    return int(label.rsplit(" ", 1)[1])
+
+
+def save_figure(fig, path: Path) -> Path:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
-from google.protobuf import text_format
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
@@ -25,9 +24,11 @@ from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, ModemTiming
 from pygoby.netsim.channel import Band, ChannelConfig, Position
 from pygoby.netsim.channel.errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
+from pygoby.netsim.channel.settings import absorption_of, propagation_of, sound_speed_of
 from pygoby.netsim.config import config_class as manager_config_class
 from pygoby.netsim.errors import ScenarioError
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
 
 SCENARIO_PROTO = "pygoby/netsim/scenario.proto"
 FIRST_MODEM_PORT = 62000
@@ -48,23 +49,17 @@ def node_status_class() -> type[Message]:
 
 
 def load_scenario(path: str | Path) -> Message:
-    try:
-        text = Path(path).read_text()
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario: {exc}") from exc
-    try:
-        return parse_scenario(text)
-    except ScenarioError as exc:
-        raise exc.located(file=path) from None
+    return parse_scenario(read_config_file(path, error=ScenarioError), path)
 
 
-def parse_scenario(text: str) -> Message:
+def parse_scenario(text: str, file: str | Path | None = None) -> Message:
     scenario = scenario_class()()
+    merge_config_text(text, scenario, file=file, error=ScenarioError)
+    check_config_values(scenario, text, file=file, error=ScenarioError)
     try:
-        text_format.Parse(text, scenario)
-    except text_format.ParseError as exc:
-        raise ScenarioError.from_parse_error(exc, "scenario") from exc
-    check_scenario(scenario)
+        check_scenario(scenario)
+    except ScenarioError as err:
+        raise err.located(file=file) from None
     return scenario
 
 
@@ -95,6 +90,8 @@ def check_scenario(scenario: Message) -> None:
     if scenario.channel.position_staleness <= scenario.position_period:
         raise ScenarioError("channel.position_staleness must exceed position_period")
     modem_timing(scenario)  # raises on a bad duration table
+    if scenario.channel.HasField("propagation"):
+        channel_config(scenario)  # raises on bad propagation settings (nothing is traced yet)
 
 
 def speed_factor(scenario: Message) -> float | None:
@@ -133,8 +130,15 @@ def channel_config(scenario: Message) -> ChannelConfig:
             p.communication_range, p.detection_range, p.interference_range,
             p.p_detection, p.p_decoding,
         )  # fmt: skip
+    sound_speed = sound_speed_of(c)
+    try:
+        propagation = propagation_of(c, sound_speed)
+    except ValueError as exc:
+        raise ScenarioError(str(exc), field="channel.propagation") from None
     return ChannelConfig(
-        sound_speed=c.sound_speed,
+        sound_speed=sound_speed,
+        absorption=absorption_of(c),
+        propagation=propagation,
         source_level=c.source_level,
         spreading=c.spreading,
         noise_level=c.noise_level if c.HasField("noise_level") else None,

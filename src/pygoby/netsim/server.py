@@ -11,10 +11,9 @@ import argparse
 import asyncio
 import logging
 import sys
-from pathlib import Path
 
 from pygoby.errors import ConfigError
-from pygoby.netsim.config import EXAMPLE_CONFIG, parse_config
+from pygoby.netsim.config import EXAMPLE_CONFIG, load_config
 from pygoby.netsim.gprmc import GpsOutputs
 from pygoby.netsim.manager import NetSimManager
 from pygoby.util.aiorun import run_until_signal
@@ -95,7 +94,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("config", nargs="?", help="configuration file (protobuf TextFormat)")
     parser.add_argument("--example_config", action="store_true", help="print an example config")
     parser.add_argument("--port", type=int, help="override manager_tcp_port")
-    parser.add_argument("--listen", help="override listen_address")
+    parser.add_argument(
+        "--host",
+        "--listen",
+        dest="host",
+        help="address to listen on, overriding listen_address (default 127.0.0.1; "
+        "0.0.0.0: every interface)",
+    )
     parser.add_argument("-v", "--verbose", action="count", default=0)
     return parser
 
@@ -121,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
     level = logging.WARNING - 10 * args.verbose
     logging.basicConfig(level=level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     try:
-        config = parse_config(Path(args.config).read_text())
+        config = load_config(args.config)
         manager = NetSimManager(config)
         if config.gps_out:
             manager.on_nav(GpsOutputs.open_serial(config, WallClock()).on_nav_update)
@@ -131,7 +136,7 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         print(f"netsim_manager: {exc}", file=sys.stderr)
         return 1
-    run_until_signal(_run(manager, args.listen, args.port))
+    run_until_signal(_run(manager, args.host, args.port))
     return 0
 
 

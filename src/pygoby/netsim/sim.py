@@ -19,7 +19,7 @@ the same objects on the wall clock over TCP.
 
 Events go to `on_event` (`summary()` counts them): `tx` and `rx` from the channel (see
 `pygoby.netsim.physics_channel`), `app_rx` when a queue delivers a status message (port of the
-receiver, src), `range` when a driver reports a ranging reply (port, src, dest, owtt list).
+receiver, src, msg_t: the message's time stamp), `range` when a driver reports a ranging reply (port, src, dest, owtt list).
 """
 
 from __future__ import annotations
@@ -65,6 +65,7 @@ DRIVER_WHOI_MICROMODEM = 2
 SLOT_EPSILON = 1e-3  # s: a MAC slot fires once the clock is past its start
 STARTUP_STEP = 0.01  # s: drivers set the modem clock just after a whole second
 STARTUP_LIMIT = 120.0  # s of simulated time for every driver to finish its start-up
+PROGRESS_STEPS = 512  # discrete-event steps between progress reports (a report reads the clock)
 MAX_EXCHANGES = 10_000  # driver <-> emulator sentences at one instant before giving up
 LOCAL_IP = "127.0.0.1"
 
@@ -109,6 +110,8 @@ class RunSummary:
     outcomes: Counter
     status_sent: int
     status_received: int
+    external_deliveries: dict[int, int] = field(default_factory=dict)  # modem id -> packets
+    interrupted: bool = False
 
     @property
     def speedup(self) -> float:
@@ -121,7 +124,17 @@ class RunSummary:
             "events: " + ", ".join(f"{k} {v}" for k, v in sorted(self.events.items())),
             "receptions: " + ", ".join(f"{k} {v}" for k, v in sorted(self.outcomes.items())),
             f"status messages: {self.status_sent} queued, {self.status_received} delivered",
+            *self._external_lines(),
+            *(["interrupted before the end of the scenario"] if self.interrupted else []),
         ]
+
+    def _external_lines(self) -> list[str]:
+        """External stacks (e.g. pAcommsHandler with iNetSimManager): what the channel handed
+        to their modems, as this side cannot see their messages."""
+        if not self.external_deliveries:
+            return []
+        counts = ", ".join(f"modem {i}: {n}" for i, n in sorted(self.external_deliveries.items()))
+        return [f"packets delivered to external stacks' modems: {counts}"]
 
 
 class Simulation:
@@ -177,6 +190,11 @@ class Simulation:
         driver.signal_receive.connect(lambda msg, n=node: self._modem_heard(n, msg))
 
     def start_macs(self) -> None:
+        """Start the run's traffic: a `node` event per node (its port and modem id, for the
+        report), then every in-process stack's MAC and first status message."""
+        for node in self.nodes:
+            self._event("node", t=self.clock.now(), port=node.port, modem_id=node.modem_id,
+                        external=node.driver is None)  # fmt: skip
         for node in self.nodes:
             if node.mac is not None:
                 node.mac.startup(mac_config(self.scenario, node.modem_id))
@@ -208,7 +226,7 @@ class Simulation:
 
     def _status_heard(self, node: SimNode, msg: Message) -> None:
         node.received[msg.src] += 1
-        self._event("app_rx", t=self.clock.now(), port=node.port, src=msg.src)
+        self._event("app_rx", t=self.clock.now(), port=node.port, src=msg.src, msg_t=msg.time)
 
     def _modem_heard(self, node: SimNode, msg: Message) -> None:
         """Ranging results the driver reports (two-way pings) become `range` events."""
@@ -271,8 +289,19 @@ class Simulation:
             ),
             outcomes=Counter(self.physics.outcomes),
             status_sent=self.status_sent,
-            status_received=sum(sum(n.received.values()) for n in self.nodes),
+            status_received=self.status_received,
+            external_deliveries={
+                n.modem_id: self.physics.delivered[n.port] for n in self.nodes if n.driver is None
+            },
         )
+
+    @property
+    def status_received(self) -> int:
+        return sum(sum(n.received.values()) for n in self.nodes)
+
+    @property
+    def packets_delivered(self) -> int:
+        return sum(self.physics.delivered.values())
 
     # -- discrete-event run ----------------------------------------------------------------------
 
@@ -284,9 +313,11 @@ class Simulation:
             driver.startup(driver_config(node.modem_id))
             self.attach_stack(node, driver)
 
-    def run_virtual(self, until: float | None = None) -> RunSummary:
+    def run_virtual(
+        self, until: float | None = None, progress: Callable[[], None] | None = None
+    ) -> RunSummary:
         """Build, start and run to `until` (default: the scenario's duration) on the virtual
-        clock, jumping from event to event."""
+        clock, jumping from event to event; `progress()` is called every few hundred steps."""
         if not isinstance(self.clock, VirtualClock):
             raise TypeError("run_virtual needs a VirtualClock")
         clock = self.clock
@@ -304,6 +335,7 @@ class Simulation:
         nodes, waiting, timeline = self.nodes, self._waiting, self.timeline
         # (a MAC's next slot changes only when it works, below)
         slot = min([mac.next_slot_time for mac in macs if mac.running], default=math.inf)
+        steps = 0
         while True:
             now = clock.now()
             t = min(end, next_position, next_housekeeping)
@@ -341,6 +373,10 @@ class Simulation:
                     self._pump(nodes[index])
             if now >= end:
                 return self.summary()
+            if progress is not None:
+                steps += 1
+                if not steps % PROGRESS_STEPS:
+                    progress()
 
     def _start_drivers(self, clock: VirtualClock) -> None:
         deadline = clock.now() + STARTUP_LIMIT

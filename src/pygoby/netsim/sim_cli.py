@@ -3,16 +3,21 @@
 `run` reads a Scenario (TextFormat, src/pygoby/protobuf/pygoby/netsim/scenario.proto), runs it
 — speed "max": everything in process on a virtual clock; a number: in real time (times that
 factor) with the netsim_manager and the Micro-Modem emulators on TCP — writes the event log
-(JSON lines) and prints a summary. `report` draws PNG plots from an event log.
+(JSON lines) and prints a summary (with what reached external stacks' modems). Progress
+(simulated time, packets and messages delivered, speed-up) shows on stderr: a bar on a
+terminal, else a line every tenth of a run that lasts. Ctrl+C ends a run early with its
+summary. `report` draws PNG plots from an event log. `sweep` and `sweep-report` run and plot
+parameter sweeps (pygoby.netsim.sweep.cli).
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import logging
 import sys
+
+from pygoby.util.progress import RunProgress
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -39,9 +44,12 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
     report.add_argument("-o", "--output", default="netsim_report", help="output directory")
     report.add_argument(
         "--window", help="timeline window START:END in seconds after the first event "
-        "(default 0:3600)",
+        "(default: the whole run)",
     )  # fmt: skip
     report.set_defaults(func=report_command)
+    from pygoby.netsim.sweep.cli import add_subcommands as add_sweep_subcommands
+
+    add_sweep_subcommands(subparsers)
 
 
 def run_command(args: argparse.Namespace) -> int:
@@ -70,21 +78,33 @@ def run_command(args: argparse.Namespace) -> int:
     except OSError as exc:
         print(f"pygoby netsim run: cannot write the event log: {exc}", file=sys.stderr)
         return 1
-    with log:
+    with log, RunProgress("simulated", scenario.duration, "s") as progress:
         if factor is None:
             from pygoby.netsim.sim import Simulation
 
-            summary = Simulation(scenario, on_event=log).run_virtual()
+            sim = Simulation(scenario, on_event=log)
+            try:
+                summary = sim.run_virtual(progress=lambda: _report(progress, sim))
+            except KeyboardInterrupt:
+                summary = sim.summary()
+                summary.interrupted = True
         else:
-            summary = asyncio.run(_run_real_time(scenario, log))
+            summary = asyncio.run(_run_real_time(scenario, log, progress))
     for line in summary.lines():
         print(line)
     print(f"event log: {scenario.event_log} ({log.count} events)")
     return 0
 
 
-async def _run_real_time(scenario, log):
+def _report(progress: RunProgress, sim) -> None:
+    progress.update(
+        sim.clock.now() - sim.start, packets=sim.packets_delivered, messages=sim.status_received
+    )
+
+
+async def _run_real_time(scenario, log, progress: RunProgress):
     from pygoby.netsim.realtime import RealTimeRun
+    from pygoby.util.aiorun import StopSignals
 
     run = RealTimeRun(scenario, on_event=log)
     async with run:
@@ -96,14 +116,9 @@ async def _run_real_time(scenario, log):
                 + (" with in-process driver/MAC/queue" if node.driver is not None else ""),
                 flush=True,
             )
-        task = asyncio.ensure_future(run.run())
-        try:
-            return await task
-        except asyncio.CancelledError:
-            run.request_stop()
-            with contextlib.suppress(asyncio.CancelledError):
-                return await task
-            raise
+        # SIGINT/SIGTERM end the run early, with its summary and a complete event log
+        with StopSignals(asyncio.get_running_loop(), run.request_stop, "pygoby netsim run"):
+            return await run.run(lambda: _report(progress, run.sim))
 
 
 def report_command(args: argparse.Namespace) -> int:

@@ -62,6 +62,15 @@ class ProtoLoader:
         unique = list(dict.fromkeys(str(d) for d in dirs))
         return [*unique, _well_known_include_dir()]
 
+    def import_path(self) -> list[str]:
+        """The folders import names are looked up in (the include dirs, then our own .proto
+        folder and protobuf's well-known types)."""
+        return self._search_path([])
+
+    def on_import_path(self, name: str) -> bool:
+        """Whether `name` is a .proto import name found on the import path."""
+        return any((Path(d) / name).is_file() for d in self.import_path())
+
     def _import_name(self, path: Path, search: Sequence[str]) -> str | None:
         for directory in search:
             try:

@@ -8,6 +8,7 @@ from pygoby.util.errors import (
     NMEAChecksumError,
     NMEAError,
     NMEAFormatError,
+    PluginError,
     PtyError,
 )
 from pygoby.util.modem_id import ModemIdLookup
@@ -21,6 +22,7 @@ __all__ = [
     "NMEAError",
     "NMEAFormatError",
     "PtyError",
+    "PluginError",
     "Signal",
     "VirtualClock",
     "WallClock",

@@ -25,3 +25,7 @@ class LinkClosedError(PygobyError, ConnectionError):
 class PtyError(PygobyError, OSError):
     """A pseudo-terminal link cannot be made (a running process owns it, or the path is not
     one we may replace)."""
+
+
+class PluginError(PygobyError):
+    """No plug-in could be found or loaded under the given name (pygoby.util.plugins)."""

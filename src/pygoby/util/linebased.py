@@ -40,27 +40,51 @@ class LineLink(Protocol):
 
 
 class LineSplitter:
-    """Splits a byte stream into text lines (delimiter removed, decoded as latin-1)."""
+    """Splits a byte stream into text lines (delimiter removed, decoded as latin-1).
 
-    def __init__(self, delimiter: str) -> None:
+    A line longer than `max_line_bytes` is dropped whole, up to and including its delimiter (so
+    its tail never comes out as a line of its own), and counted in `discarded`. Each byte is
+    scanned once, however the stream is cut into chunks.
+    """
+
+    def __init__(self, delimiter: str, max_line_bytes: int = MAX_LINE_BYTES) -> None:
         if not delimiter:
             raise ValueError("line delimiter must not be empty")
         self.delimiter = delimiter.encode("latin-1")
+        self.max_line_bytes = max_line_bytes
+        self.discarded = 0  # over-long lines dropped so far
         self._buffer = bytearray()
+        self._scanned = 0  # bytes of _buffer known to hold no delimiter
+        self._discarding = False  # inside an over-long line: drop up to the next delimiter
 
     def feed(self, data: bytes) -> list[str]:
         self._buffer += data
         lines = []
         while True:
-            end = self._buffer.find(self.delimiter)
+            end = self._buffer.find(self.delimiter, self._scanned)
             if end < 0:
                 break
-            lines.append(self._buffer[:end].decode("latin-1"))
+            if self._discarding:
+                self._discarding = False
+            elif end <= self.max_line_bytes:
+                lines.append(self._buffer[:end].decode("latin-1"))
+            else:
+                self._discard()
             del self._buffer[: end + len(self.delimiter)]
-        if len(self._buffer) > MAX_LINE_BYTES:
-            log.warning("discarding %d bytes without a line delimiter", len(self._buffer))
-            self._buffer.clear()
+            self._scanned = 0
+        # (a line at the limit may still be waiting for the rest of a split delimiter)
+        if len(self._buffer) >= self.max_line_bytes + len(self.delimiter):
+            if not self._discarding:
+                self._discard()
+                self._discarding = True
+            # keep what could be the start of a delimiter split across chunks
+            del self._buffer[: len(self._buffer) - len(self.delimiter) + 1]
+        self._scanned = max(0, len(self._buffer) - len(self.delimiter) + 1)
         return lines
+
+    def _discard(self) -> None:
+        self.discarded += 1
+        log.warning("discarding a line longer than %d bytes", self.max_line_bytes)
 
 
 class LocalLink:
@@ -127,7 +151,8 @@ class _StreamLinkBase:
         return bool(self._transports)
 
     async def wait_open(self, timeout: float = 10.0) -> None:
-        await asyncio.wait_for(self._open_event.wait(), timeout)
+        async with asyncio.timeout(timeout):
+            await self._open_event.wait()
 
     def read_lines(self) -> list[str]:
         lines = list(self._lines)
@@ -235,7 +260,7 @@ class TCPServerLink(_StreamLinkBase):
     Writes go to every connected client; lines from all clients are merged.
     """
 
-    def __init__(self, port: int, host: str = "0.0.0.0", delimiter: str = "\r\n") -> None:
+    def __init__(self, port: int, host: str = "127.0.0.1", delimiter: str = "\r\n") -> None:
         super().__init__(delimiter)
         self.host, self.port = host, port
         self._server: asyncio.Server | None = None

@@ -237,7 +237,7 @@ def test_unloadable_message_definitions_are_config_errors(tmp_path, lookup_file)
     for line in (f'  load_proto_file: "{broken}"', '  load_shared_library: "no_such_module_pb2"'):
         text = mission_text(9000, lookup_file, "").replace(f'  load_proto_file: "{PROTO}"', line)
         mission = MissionFile.from_text(text)
-        with pytest.raises(ConfigError, match="cannot load message definitions"):
+        with pytest.raises(ConfigError, match=r"load_(proto_file|shared_library): cannot load "):
             pTranslator(
                 pTranslator.read_config(mission, "pTranslator"), name="pTranslator", mission=mission
             )

@@ -14,13 +14,23 @@ from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
-from pygoby.acomms.errors import RudicsPacketError
-from pygoby.acomms.rudics import parse_rudics_packet, serialize_rudics_packet
+from pygoby.acomms.errors import ModemDriverError, RudicsPacketError
+from pygoby.acomms.rudics import (
+    embedded_size,
+    max_data_bytes,
+    parse_rudics_packet,
+    serialize_rudics_packet,
+)
+from pygoby.acomms.store_server.auth import AUTH_BYTES, read_secret_file, sign_request
+from pygoby.errors import ConfigError
 
 log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 11244
 POLL = 1  # store_server.protobuf.Transmission.STORE_SERVER_DRIVER_POLL
+# Room in a request for everything but the frames' bytes (ids, times, the transmission's other
+# fields, the request around it), so that one full transmission always fits in one packet.
+TRANSMISSION_OVERHEAD = 256
 
 
 class StoreServerDriver(ModemDriverBase):
@@ -35,6 +45,8 @@ class StoreServerDriver(ModemDriverBase):
         self._last_query = 0.0
         self._frame_counter = 0
         self._running = False
+        self._secret: bytes | None = None
+        self._in_flight: list = []  # the outbox of the request awaiting its reply
 
     def startup(self, cfg) -> None:
         cfg_copy = acomms_pb.DriverConfig()
@@ -45,6 +57,15 @@ class StoreServerDriver(ModemDriverBase):
         if not cfg.HasField("connection_type"):
             cfg.connection_type = acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT
         self.ss_cfg = cfg.Extensions[acomms_pb.STORE_SERVER_CONFIG]
+        auth = cfg.Extensions[acomms_pb.STORE_SERVER_AUTH]
+        if auth.HasField("secret_file"):
+            try:
+                self._secret = read_secret_file(auth.secret_file)
+            except ConfigError as exc:
+                raise ModemDriverError(
+                    f"store_server_auth.secret_file: {exc}",
+                    acomms_pb.ModemDriverStatus.INVALID_CONFIGURATION,
+                ) from None
         self.modem_start(cfg)
         self._running = True
 
@@ -71,11 +92,15 @@ class StoreServerDriver(ModemDriverBase):
         rate = msg.rate
         msg.frame_start = self._frame_counter
         to_bytes, to_frames = self.ss_cfg.rate_to_bytes, self.ss_cfg.rate_to_frames
-        msg.max_frame_bytes = (
-            to_bytes[rate] if 0 <= rate < len(to_bytes) else self.ss_cfg.max_frame_size
-        )
         if 0 <= rate < len(to_frames):
             msg.max_num_frames = to_frames[rate]
+        # whatever the configuration says, a transmission must fit in one RUDICS packet
+        frames = max(1, msg.max_num_frames)
+        packet_room = (max_data_bytes() - TRANSMISSION_OVERHEAD) // frames
+        msg.max_frame_bytes = min(
+            to_bytes[rate] if 0 <= rate < len(to_bytes) else self.ss_cfg.max_frame_size,
+            packet_room,
+        )
         if len(msg.frame) < msg.max_num_frames:
             self.signal_data_request.emit(msg)
         self._frame_counter += len(msg.frame)
@@ -108,22 +133,46 @@ class StoreServerDriver(ModemDriverBase):
     def _send_request(self, now: float) -> None:
         self._request_id += 1
         request = acomms_pb.StoreServerRequest(modem_id=self.modem_id, request_id=self._request_id)
-        request.outbox.extend(self._outbox)
-        packet = serialize_rudics_packet(request.SerializeToString())
+        # as much of the outbox as fits in one packet, oldest first; the rest goes next time
+        room = max_data_bytes() - request.ByteSize() - (AUTH_BYTES if self._secret else 0)
+        sent = 0
+        for t in self._outbox:
+            size = embedded_size(t.ByteSize())
+            if size > room:
+                if sent == 0:
+                    log.error("dropping a transmission of %d bytes: larger than a packet", size)
+                    sent = 1
+                break
+            room -= size
+            request.outbox.append(t)
+            sent += 1
+        payload = request.SerializeToString()
+        if self._secret is not None:
+            payload = sign_request(payload, self._secret, now)
+        packet = serialize_rudics_packet(payload)
         self.modem_write(packet.decode("latin-1"))
         self.emit_raw(False, packet)
-        self._outbox = []
+        self._in_flight = list(request.outbox)
+        self._outbox = self._outbox[sent:]
         self._waiting_since = now
         self._last_query = now
 
     def _handle_packet(self, packet: bytes) -> None:
         self.emit_raw(True, packet)
         try:
-            response = acomms_pb.StoreServerResponse.FromString(parse_rudics_packet(packet))
+            payload = parse_rudics_packet(packet)
+            response = acomms_pb.StoreServerResponse.FromString(payload)
+            status = acomms_pb.StoreServerResponseStatus.FromString(payload)
         except (RudicsPacketError, DecodeError) as exc:
             log.warning("ignoring a bad store-server response: %s", exc)
             return
         self._waiting_since = None
+        if status.error:  # nothing was stored: that outbox goes with the next request
+            log.warning("store server: %s; sending again", status.error)
+            self._outbox[:0] = self._in_flight
+            self._in_flight = []
+            return
+        self._in_flight = []
         for t in response.inbox:
             ext = t.Extensions[acomms_pb.STORE_SERVER_TRANSMISSION]
             if t.type == acomms_pb.DRIVER_SPECIFIC and ext.type == POLL:

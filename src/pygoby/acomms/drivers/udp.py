@@ -25,6 +25,7 @@ class UDPDriver(DatagramDriverBase):
         self.udp_cfg = acomms_pb.UDPConfig()
         self._remotes: dict[int, list[tuple[str, int]]] = {}
         self._ack_ids: set[int] = set()
+        self._unreachable: set[int] = set()  # destinations already warned about
 
     @property
     def local_port(self) -> int:
@@ -70,6 +71,13 @@ class UDPDriver(DatagramDriverBase):
         targets = list(self._remotes.get(acomms_pb.BROADCAST_ID, []))
         if msg.HasField("dest") and msg.dest != acomms_pb.BROADCAST_ID:
             targets += self._remotes.get(msg.dest, [])
+        if not targets and msg.dest not in self._unreachable:
+            self._unreachable.add(msg.dest)  # once per destination: it recurs every slot
+            log.warning(
+                "UDP driver: no remote for destination %d (remotes configured for modem ids "
+                "%s); a broadcast (0) reaches only the remotes whose modem_id is 0",
+                msg.dest, sorted(self._remotes) or "none",
+            )  # fmt: skip
         for address in targets:
             try:
                 self._sock.sendto(data, address)

@@ -1,9 +1,11 @@
 """uField simulation driver (DRIVER_UFIELD_SIM_DRIVER, spec acomms.md §10), MOOS-agnostic core.
 
 The driver tunnels hex-encoded ModemTransmissions through MOOS-IvP's uField toolbox. This core
-takes a `publish(variable, text)` callable for outgoing MOOS mail and is fed incoming mail with
-`handle_mail(variable, text)`; the MOOS client that connects the two is supplied by the
-application (pAcommsHandler opens one to `moos_server:moos_port`).
+takes either a `publish(variable, text)` callable for outgoing MOOS mail (then it is fed
+incoming mail with `handle_mail(variable, text)`), or a `MailLink` set as `driver.mail` before
+`startup`: the driver opens it to `moos_server:moos_port` for its variables, publishes through
+it and reads its mail in `do_work`, as goby3's driver does with its own MOOS client.
+pAcommsHandler gives it one (acomms does not import moos: the link is the app's).
 """
 
 from __future__ import annotations
@@ -11,11 +13,13 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable
+from typing import Protocol
 
 from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.acomms.errors import ModemDriverError
 from pygoby.util.modem_id import ModemIdLookup
 
 log = logging.getLogger(__name__)
@@ -34,10 +38,24 @@ def parse_moos_pairs(text: str) -> dict[str, str]:
     return pairs
 
 
+class MailLink(Protocol):
+    """The driver's own MOOS connection (goby3: a MOOS client named goby.moos.UFldDriver)."""
+
+    def open(self, host: str, port: int, variables: list[str]) -> None: ...
+
+    def publish(self, variable: str, text: str) -> None: ...
+
+    def fetch(self) -> list[tuple[str, str]]: ...
+
+    def close(self) -> None: ...
+
+
 class UFldDriver(ModemDriverBase):
     def __init__(self, clock=None, publish: Callable[[str, str], None] | None = None) -> None:
         super().__init__(clock)
+        self._injected_publish = publish
         self.publish = publish if publish is not None else (lambda var, text: None)
+        self.mail: MailLink | None = None
         self.ufld = acomms_pb.UFldConfig()
         self.lookup = ModemIdLookup()
         self._ping_target: str | None = None
@@ -47,12 +65,23 @@ class UFldDriver(ModemDriverBase):
         self.ufld = cfg.Extensions[acomms_pb.UFLD_CONFIG]
         if self.ufld.modem_id_lookup_path:
             self.lookup = ModemIdLookup.from_file(self.ufld.modem_id_lookup_path)
+        if self.mail is not None:
+            self.mail.open(self.ufld.moos_server, self.ufld.moos_port, self.subscriptions)
+            self.publish = self.mail.publish
+        elif self._injected_publish is None:
+            raise ModemDriverError(
+                "the uField driver needs a MOOS connection (pAcommsHandler gives it one)",
+                acomms_pb.ModemDriverStatus.INVALID_CONFIGURATION,
+            )
 
     def shutdown(self) -> None:
-        pass
+        if self.mail is not None:
+            self.mail.close()
 
     def do_work(self) -> None:
-        pass  # everything arrives as mail
+        if self.mail is not None:
+            for variable, text in self.mail.fetch():
+                self.handle_mail(variable, text)
 
     @property
     def subscriptions(self) -> list[str]:

@@ -72,6 +72,7 @@ class MMSimServer:
         self._writers: set[asyncio.StreamWriter] = set()
         self._server: asyncio.Server | None = None
         self._tasks: list[asyncio.Task] = []
+        self._client_tasks: set[asyncio.Task] = set()
         model.on_output = self._broadcast
 
     async def start(self) -> int | None:
@@ -100,6 +101,9 @@ class MMSimServer:
         if self._server is not None:
             self._server.close()
         self.drop_clients()
+        if self._client_tasks:  # let them see their end of file: a client task cancelled at
+            # the loop's shutdown makes asyncio's stream callback log a CancelledError traceback
+            await asyncio.wait(set(self._client_tasks), timeout=1.0)
         if self._pty_master is not None:
             asyncio.get_running_loop().remove_reader(self._pty_master)
             if self._pty is not None:
@@ -145,6 +149,10 @@ class MMSimServer:
             self.pty_dropped += len(data) - written
 
     async def _client(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        task = asyncio.current_task()
+        if task is not None:
+            self._client_tasks.add(task)
+            task.add_done_callback(self._client_tasks.discard)
         self._writers.add(writer)
         lines = _HostLines()
         try:

@@ -3,24 +3,25 @@
 Connect a driver with `driver.signal_data_request.connect(queue.handle_modem_data_request)` and
 `driver.signal_receive.connect(queue.handle_modem_receive)` (or pygoby.acomms.bind.bind). Call
 `do_work()` regularly for expiry. The per-frame contest visits the queues (one per DCCL type),
-never the queued messages, so its cost does not grow with the number of queued messages.
+never the queued messages, so its cost does not grow with the number of queued messages. What it
+logs, and in which group, is pygoby.acomms.queue.log.
 """
 
 from __future__ import annotations
 
-import logging
+from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import QueueError
 from pygoby.acomms.queue import ccl
 from pygoby.acomms.queue.ccl import CCLQueue
+from pygoby.acomms.queue.log import QueueLog
+from pygoby.acomms.queue.persist import QueueStore
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
 from pygoby.dccl import DcclError
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.signal import Signal
-
-log = logging.getLogger(__name__)
 
 
 class QueueManager:
@@ -33,6 +34,7 @@ class QueueManager:
         self.queues: dict[int, MessageQueue] = {}  # by DCCL id, kept in ascending order
         self._by_name: dict[str, MessageQueue] = {}
         self.ccl_queues: dict[int, CCLQueue] = {}  # Goby 1.1 raw CCL queues, by CCL id
+        self.store: QueueStore | None = None  # the persistent queue (attach_store)
         self.signal_receive = Signal()  # (message)
         self.signal_receive_ccl = Signal()  # (Goby 1.1 ModemDataTransmission of a CCL frame)
         self.signal_ack = Signal()  # (ack ModemTransmission, original message)
@@ -43,6 +45,7 @@ class QueueManager:
         # link packets for us are offered as (message, its bytes, its own dest, our id)
         self.signal_out_route = Signal()  # (QueuedItem, modem_id)
         self.signal_in_route = Signal()  # (message, encoded bytes, message dest, modem_id)
+        self.log = QueueLog(0)
 
     @property
     def modem_id(self) -> int:
@@ -52,6 +55,7 @@ class QueueManager:
     def set_cfg(self, cfg) -> None:
         self.cfg = acomms_pb.QueueManagerConfig()
         self.cfg.CopyFrom(cfg)
+        self.log = QueueLog(cfg.modem_id)
         self._peer_codecs = {
             rule.id: type(self.codec)(
                 passphrase=rule.crypto_passphrase, clock=self.clock, loader=self.codec.loader
@@ -93,7 +97,8 @@ class QueueManager:
             existing.entry, existing.roles = copy, roles
             existing.manipulators = frozenset(copy.manipulator)
             return existing
-        queue = MessageQueue(copy, compiled.id, self.clock.now(), roles)
+        queue = MessageQueue(copy, compiled.id, self.clock.now(), roles, message_class=message_class)
+        queue.journal = self.store
         self.queues = dict(sorted({**self.queues, compiled.id: queue}.items()))
         self._by_name[entry.protobuf_name] = queue
         self._size_changed(queue)
@@ -122,7 +127,8 @@ class QueueManager:
         if existing is not None:
             existing.entry = entry
             return existing
-        queue = CCLQueue(entry, ccl_id, self.clock.now())
+        queue = CCLQueue(entry, ccl_id, self.clock.now(), message_class=acomms_pb.V1ModemDataTransmission)
+        queue.journal = self.store
         self.ccl_queues[ccl_id] = queue
         return queue
 
@@ -153,6 +159,42 @@ class QueueManager:
     def _all_queues(self) -> list[MessageQueue]:
         return [*self.queues.values(), *self.ccl_queues.values()]
 
+    # ------------------------------------------------------------------ persistence
+    def attach_store(self, store: QueueStore) -> int:
+        """Keep every queued message in `store` (pygoby.acomms.queue.persist) from now on, after
+        queuing again, oldest first, what it holds; returns how many messages were restored.
+        Call it once the queues are configured. Stored messages expired meanwhile expire now
+        (signal_expire); those of a type with no queue now stay stored, with a warning."""
+        self.store = store
+        queues = {queue.name: queue for queue in self._all_queues()}
+        for queue in queues.values():
+            queue.journal = store
+        restored = 0
+        for stored in store.items():
+            queue = queues.get(stored.queue)
+            if queue is None or queue.message_class is None:
+                self.log.push.warning(
+                    "persistent queue %s: a stored %s is kept, but not sent (no such queue is "
+                    "configured)", store.path, stored.queue,
+                )  # fmt: skip
+                continue
+            try:
+                message = queue.message_class.FromString(stored.message)
+            except DecodeError as exc:
+                self.log.push.warning(
+                    "persistent queue %s: a stored %s does not parse (%s); dropped",
+                    store.path, stored.queue, exc,
+                )  # fmt: skip
+                store.forget(stored.key)
+                continue
+            item = QueuedItem(message, stored.encoded, stored.src, stored.dest, stored.time,
+                              stored.ack_requested, key=stored.key)  # fmt: skip
+            queue.push(item)
+            self._size_changed(queue)
+            restored += 1
+        self.do_work()  # what expired while we were away goes now, before any slot
+        return restored
+
     def _size_changed(self, queue: MessageQueue) -> None:
         if isinstance(queue, CCLQueue):
             return  # QueueSize names DCCL ids only
@@ -168,14 +210,17 @@ class QueueManager:
                 f"No queue exists for message: {msg.DESCRIPTOR.full_name}; you must configure it first."
             )
         if queue.has("LOOPBACK"):
+            self.log.not_queued(queue.name, "LOOPBACK manipulator: handed back to the receiver")
             self.signal_receive.emit(msg)
         src = self._role(queue, Role.SOURCE_ID, msg, 0)
         dest = self._role(queue, Role.DESTINATION_ID, msg, 0)
         item = QueuedItem(msg, b"", src, dest, 0, queue.entry.ack)
         self.signal_out_route.emit(item, self.modem_id)
         if queue.has("NO_QUEUE"):
+            self.log.not_queued(queue.name, "not queued: NO_QUEUE manipulator")
             return
         if item.dest == self.modem_id:
+            self.log.not_queued(queue.name, "for this node: looped back, not transmitted")
             self.signal_receive.emit(msg)
             if queue.entry.ack:
                 now = acomms_pb.now_us(self.clock.now())
@@ -191,7 +236,10 @@ class QueueManager:
         item.encoded = encoded
         if not item.encoded:
             raise QueueError(f"{queue.name}: encoded size is 0; not queued")
-        queue.push(item)
+        victim = queue.push(item)
+        self.log.pushed(queue, item, self.clock.now())
+        if victim is not None:
+            self.log.dropped(queue, victim)
         self._size_changed(queue)
 
     def message_dest(self, msg) -> int:
@@ -209,7 +257,7 @@ class QueueManager:
     def flush_queue(self, flush) -> None:
         queue = self.queues.get(flush.dccl_id)
         if queue is None:
-            log.warning("flush: no queue with DCCL id %d", flush.dccl_id)
+            self.log.push.warning("flush: no queue with DCCL id %d", flush.dccl_id)
             return
         queue.clear()
         self._size_changed(queue)
@@ -226,6 +274,7 @@ class QueueManager:
         packet_dest = request.dest
         limit = request.max_frame_bytes if request.HasField("max_frame_bytes") else None
         start = request.frame_start
+        given: list[str] = []  # for the log: what goes out
         for frame_no in range(start, start + request.max_num_frames):
             index = frame_no - start
             if index < len(request.frame):
@@ -241,6 +290,7 @@ class QueueManager:
                 continue
             while winner is not None:
                 item = self._give_data(winner, frame_no, now)
+                given.append(winner.name)
                 packet_ack |= item.ack_requested
                 if frame_no == start:
                     if request.dest == acomms_pb.QUERY_DESTINATION_ID:
@@ -256,6 +306,7 @@ class QueueManager:
                 winner = self._contest(request, used, limit, now, first=False)
             request.frame[index] = b"".join(parts)
         request.ack_requested = packet_ack
+        self.log.transmission(request, given)
 
     def _contest(
         self, request, used: int, limit: int | None, now: float, first: bool
@@ -263,40 +314,55 @@ class QueueManager:
         """The queue that sends next; CCL queues only compete for the start of a frame."""
         best: MessageQueue | None = None
         best_priority = 0.0
+        entries: list[tuple[str, str]] | None = [] if self.log.contests else None
         for queue in self._all_queues() if first and self.ccl_queues else self.queues.values():
             if queue.has("ON_DEMAND"):
                 self._refresh_on_demand(queue, request, now)
-            if len(queue) <= queue.waiting_count:
-                continue
-            if queue.last_send_time + queue.entry.blackout_time > now:
-                continue
-            item = queue.next_item()
-            if item is None:
-                continue
-            if limit is not None and len(item.encoded) > limit - used:
-                continue
-            if (
-                request.HasField("dest")
-                and request.dest != acomms_pb.QUERY_DESTINATION_ID
-                and item.dest != acomms_pb.BROADCAST_ID
-                and item.dest != request.dest
-            ):
-                continue
-            if (
-                request.HasField("ack_requested")
-                and not request.ack_requested
-                and item.ack_requested
-                and request.dest != acomms_pb.BROADCAST_ID
-            ):
+            excluded = self._excluded(queue, request, used, limit, now)
+            if excluded is not None:
+                if entries is not None:
+                    entries.append((queue.name, excluded))
                 continue
             priority = queue.priority(now)
+            if entries is not None:
+                entries.append((queue.name, f"priority {priority:.3g}"))
             if (
                 best is None
                 or priority > best_priority
                 or (priority == best_priority and queue.last_send_time < best.last_send_time)
             ):
                 best, best_priority = queue, priority
+        if entries is not None:
+            self.log.contest(request, used, entries, best)
         return best
+
+    @staticmethod
+    def _excluded(queue: MessageQueue, request, used: int, limit: int | None, now: float) -> str | None:
+        """Why `queue` cannot take part in the contest for this frame; None when it can."""
+        if len(queue) <= queue.waiting_count:
+            return "empty" if not len(queue) else "all waiting for acks"
+        if queue.last_send_time + queue.entry.blackout_time > now:
+            return "in blackout"
+        item = queue.next_item()
+        if item is None:
+            return "empty"
+        if limit is not None and len(item.encoded) > limit - used:
+            return f"next message too large ({len(item.encoded)} B)"
+        if (
+            request.HasField("dest")
+            and request.dest != acomms_pb.QUERY_DESTINATION_ID
+            and item.dest != acomms_pb.BROADCAST_ID
+            and item.dest != request.dest
+        ):
+            return f"next message for {item.dest}, not {request.dest}"
+        if (
+            request.HasField("ack_requested")
+            and not request.ack_requested
+            and item.ack_requested
+            and request.dest != acomms_pb.BROADCAST_ID
+        ):
+            return "next message needs an ack and the packet has none"
+        return None
 
     def _refresh_on_demand(self, queue: MessageQueue, request, now: float) -> None:
         newest = queue.back()
@@ -313,11 +379,13 @@ class QueueManager:
         if item.dest == acomms_pb.BROADCAST_ID:
             item.ack_requested = False
         item.last_sent = now
+        priority = queue.priority(now)
         if item.ack_requested:
             queue.wait_for_ack(item, frame_no)
         else:
             queue.remove(item)
             self._size_changed(queue)
+        self.log.popped(queue, item, frame_no, priority)
         queue.last_send_time = now
         if queue.has("LOOPBACK_AS_SENT"):
             self.signal_receive.emit(item.msg)
@@ -332,12 +400,15 @@ class QueueManager:
                 transmission.dest == self.modem_id
                 or transmission.dest in self.cfg.route_for_additional_modem_id
             )
+            names: list[str] = []
             for index, frame in enumerate(transmission.frame):
                 data = bytes(frame)
                 if data and data[0] in self.ccl_queues:
                     self._receive_ccl(transmission, data, index)
+                    names.append(f"CCL {data[0]}")
                 else:
-                    self._decode_frame(data, route)
+                    names += self._decode_frame(data, route)
+            self.log.reception(transmission, names)
 
     def _receive_ccl(self, transmission, data: bytes, index: int) -> None:
         if transmission.dest not in (acomms_pb.BROADCAST_ID, self.modem_id):
@@ -347,8 +418,9 @@ class QueueManager:
 
     def _handle_ack(self, ack) -> None:
         if ack.dest != self.modem_id:
-            log.warning("ignoring an ACK for modem %d (we are %d)", ack.dest, self.modem_id)
+            self.log.ack_for_another(ack, self.modem_id)
             return
+        released: list[str] = []
         for frame_no in ack.acked_frame:
             for queue in self._all_queues():
                 items = queue.waiting.get(frame_no)
@@ -356,25 +428,30 @@ class QueueManager:
                     continue
                 for item in list(items):
                     queue.remove(item)
+                    released.append(queue.name)
                     self._size_changed(queue)
                     self.signal_ack.emit(ack, item.msg)
                     self._network_ack(queue, item, acomms_pb.NetworkAck.ACK, ack.src)
+        self.log.acknowledged(ack, released)
 
-    def _decode_frame(self, data: bytes, route: bool = False) -> None:
+    def _decode_frame(self, data: bytes, route: bool = False) -> list[str]:
+        """Decode and deliver the frame's messages; their type names (for the log)."""
+        names = []
         offset = 0
         while offset < len(data):
             try:
                 codec = self._codec_for_source(data[offset:])
                 msg, used = codec.decode_prefix(data[offset:])
             except DcclError as exc:  # keep the messages decoded so far
-                where = "frame dropped" if offset == 0 else "rest of frame dropped"
-                log.warning("cannot decode DCCL message at byte %d (%s): %s", offset, where, exc)
-                return
+                self.log.undecodable(offset, exc)
+                break
             if route:
                 encoded = data[offset : offset + used]
                 self.signal_in_route.emit(msg, encoded, self.message_dest(msg), self.modem_id)
             offset += max(used, 1)
+            names.append(msg.DESCRIPTOR.full_name)
             self._deliver(msg)
+        return names
 
     def _codec_for_source(self, data: bytes):
         """encrypt_rule on receipt: the passphrase of the sender, read from the clear header."""
@@ -400,6 +477,7 @@ class QueueManager:
         src = self._role(queue, Role.SOURCE_ID, msg, 0)
         dest = self._role(queue, Role.DESTINATION_ID, msg, 0)
         if dest not in (acomms_pb.BROADCAST_ID, self.modem_id) and not queue.has("PROMISCUOUS"):
+            self.log.not_delivered(queue.name, f"for {dest}, not for us: dropped")
             return
         if dest == acomms_pb.BROADCAST_ID and src == self.modem_id and queue.roles.get(Role.SOURCE_ID):
             return  # our own broadcast heard back
@@ -413,6 +491,7 @@ class QueueManager:
         for queue in self._all_queues():
             while (item := queue.expired_front(now_us)) is not None:
                 queue.remove(item)
+                self.log.expired(queue, item)
                 self._size_changed(queue)
                 self.signal_expire.emit(item.msg)
                 self._network_ack(queue, item, acomms_pb.NetworkAck.EXPIRE, self.modem_id)

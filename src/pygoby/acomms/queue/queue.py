@@ -4,12 +4,17 @@ Items live in a deque in push order. Removing one from the middle (an acknowledg
 marks it; marked items are dropped when they reach either end, so push, pop from either end and
 removal are amortised O(1). Looking for the next item skips items awaiting an ack, and those are
 few (they are released at every data request).
+
+A queue with a `journal` (pygoby.acomms.queue.persist: the optional persistent queue) tells it
+of every item it takes in and lets go of, whatever the reason (sent, acknowledged, expired,
+pushed out by max_queue, flushed).
 """
 
 from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
+from typing import Protocol
 
 from pygoby.acomms import messages as acomms_pb
 
@@ -27,6 +32,17 @@ class QueuedItem:
     removed: bool = False
     last_sent: float | None = None
     waiting_frame: int | None = None
+    key: int | None = None  # its record in the queue's journal, once recorded
+
+
+class QueueJournal(Protocol):
+    """Where a queue records what it holds (pygoby.acomms.queue.persist.QueueStore)."""
+
+    def added(self, queue: MessageQueue, item: QueuedItem) -> None: ...
+
+    def removed(self, queue: MessageQueue, item: QueuedItem) -> None: ...
+
+    def cleared(self, queue: MessageQueue) -> None: ...
 
 
 @dataclass(eq=False)
@@ -37,6 +53,8 @@ class MessageQueue:
     roles: dict = field(default_factory=dict)
     waiting: dict[int, list[QueuedItem]] = field(default_factory=dict)  # frame -> items
     last_send_time: float = 0.0
+    message_class: type | None = None  # the type of its items' messages
+    journal: QueueJournal | None = None
     _items: deque[QueuedItem] = field(default_factory=deque)
     _live: int = 0
 
@@ -67,12 +85,15 @@ class MessageQueue:
         self._items.append(item)
         self._live += 1
         limit = self.entry.max_queue
+        victim = None
         if limit and self._live > limit:
             victim = self.front() if self.entry.newest_first else item
             assert victim is not None
+        if self.journal is not None and item.key is None and victim is not item:
+            self.journal.added(self, item)
+        if victim is not None:
             self.remove(victim)
-            return victim
-        return None
+        return victim
 
     def front(self) -> QueuedItem | None:
         items = self._items
@@ -105,6 +126,8 @@ class MessageQueue:
         item.removed = True
         self._live -= 1
         self._unwait(item)
+        if self.journal is not None and item.key is not None:
+            self.journal.removed(self, item)
         self.front()
         self.back()
 
@@ -114,6 +137,8 @@ class MessageQueue:
         self._items.clear()
         self._live = 0
         self.waiting.clear()
+        if self.journal is not None:
+            self.journal.cleared(self)
 
     def _unwait(self, item: QueuedItem) -> None:
         if item.waiting_frame is not None:

@@ -15,7 +15,7 @@ from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.dccl.ccl import fields
 from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec
-from pygoby.dccl.codecs.numeric import NumericCodec
+from pygoby.dccl.codecs.numeric import NumericCodec, f32
 from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_extension
 
@@ -148,7 +148,8 @@ CCL_FIELD_CODECS: dict[str, tuple[tuple[str, ...], Callable[[FieldInfo], FixedWi
         ("double",), _function_codec(24, fields.encode_latlon, fields.decode_latlon)),
     "_ccl_fix_age": (("uint32",), FixAgeCodec),
     "_ccl_time_date": (("uint64",), TimeDateCodec),
-    "_ccl_heading": (("float",), _function_codec(8, fields.encode_heading, fields.decode_heading)),
+    "_ccl_heading": (
+        ("float",), _function_codec(8, fields.encode_heading, lambda raw: f32(fields.decode_heading(raw)))),
     "_ccl_depth": (("float",), DepthCodec),
     "_ccl_velocity": (
         ("float",), _function_codec(8, fields.encode_velocity, fields.decode_velocity)),

@@ -11,7 +11,8 @@ depths) give the bytes a C++ peer sends.
 
 Widths: lat/lon 24, time/date 24, heading 8, depth 13 or 16 (the caller's choice), velocity 8,
 speed 8, watts 8, GFI/pitch/oil 16, hi-res altitude 16, salinity 8, temperature 8, sound
-speed 8, fix age 8.
+speed 8, fix age 8; the REMUS Ranger's BCD fields (pREMUSCodec's WhoiUtil): lat/lon 40
+(`DDD`, sign nibble, `MM.MMMM`), any number of decimal digits (`encode_bcd`).
 """
 
 from __future__ import annotations
@@ -100,16 +101,24 @@ def utc_year(seconds: float) -> int:
     return _civil_from_days(math.floor(seconds) // 86400)[0]
 
 
-def encode_time_date(microseconds: int) -> int:
-    """UNIX time (microseconds) to 24 bits: month 4, day 5, hour 5, minute 6, seconds / 4 (4);
-    the year is not sent."""
-    seconds = (microseconds & 0xFFFFFFFFFFFFFFFF) // 1_000_000
+def utc_parts(seconds: int) -> tuple[int, int, int, int, int]:
+    """(month, day, hour, minute, second) of a UNIX time (whole seconds, UTC)."""
     days, rest = divmod(seconds, 86400)
     _, month, day = _civil_from_days(days)
     hour, rest = divmod(rest, 3600)
     minute, second = divmod(rest, 60)
+    return month, day, hour, minute, second
+
+
+def pack_time_date(month: int, day: int, hour: int, minute: int, second: int) -> int:
+    """The 24 bits: month 4, day 5, hour 5, minute 6, seconds / 4 (4)."""
     raw = second >> 2 | minute << 4 | hour << 10 | day << 15 | month << 20
     return raw & 0xFFFFFF
+
+
+def encode_time_date(microseconds: int) -> int:
+    """UNIX time (microseconds) to 24 bits (`pack_time_date`); the year is not sent."""
+    return pack_time_date(*utc_parts((microseconds & 0xFFFFFFFFFFFFFFFF) // 1_000_000))
 
 
 def time_date_parts(raw: int) -> tuple[int, int, int, int, int]:
@@ -131,7 +140,8 @@ def encode_heading(degrees: float) -> int:
 
 
 def decode_heading(raw: int) -> float:
-    return f32(float(raw & 0xFF) * 360.0 / 255.0)
+    """A double, as WhoiUtil returns it (a DCCL float field keeps it as a float)."""
+    return float(raw & 0xFF) * 360.0 / 255.0
 
 
 def encode_velocity(meters_per_second: float) -> int:
@@ -324,3 +334,53 @@ def encode_fix_age(seconds: int) -> int:
 
 def decode_fix_age(raw: int) -> int:
     return FIX_AGE_STEP * (raw & 0xFF)
+
+
+# ------------------------------------------------------------------ REMUS Ranger (BCD)
+BCD_POSITIVE = 0xF  # sign nibble we send for north/east (a receiver reads only 0xC/0xD)
+BCD_NEGATIVE = 0xD  # south/west (0xC is read as negative too)
+_MINUTE_DIGITS = 10_000  # MM.MMMM: 4 decimals of a minute
+
+
+def encode_bcd(value: int, digits: int) -> int:
+    """A non-negative integer as `digits` BCD nibbles, most significant first (ValueError if it
+    does not fit)."""
+    if not 0 <= value < 10**digits:
+        raise ValueError(f"{value} does not fit in {digits} decimal digits")
+    raw = 0
+    for shift in range(digits):
+        value, digit = divmod(value, 10)
+        raw |= digit << 4 * shift
+    return raw
+
+
+def bcd_digits(raw: int, digits: int) -> list[int]:
+    """The nibbles of `raw`, most significant first (a nibble above 9 is not a digit)."""
+    return [raw >> 4 * shift & 0xF for shift in reversed(range(digits))]
+
+
+def decode_bcd(raw: int, digits: int) -> int:
+    """BCD nibbles to their value; a nibble above 9 counts with its face value, as the
+    reference's arithmetic does (callers check `bcd_digits` first to reject those)."""
+    value = 0
+    for digit in bcd_digits(raw, digits):
+        value = value * 10 + digit
+    return value
+
+
+def encode_ranger_latlon(degrees: float) -> int:
+    """Degrees to 40 bits: `DDD`, a sign nibble, `MMMMMM` (minutes x 10^4), most significant
+    nibble first."""
+    magnitude = abs(degrees)
+    ten_thousandths = round(magnitude * 60 * _MINUTE_DIGITS)
+    whole, minutes = divmod(ten_thousandths, 60 * _MINUTE_DIGITS)
+    sign = BCD_NEGATIVE if degrees < 0 and ten_thousandths else BCD_POSITIVE
+    return encode_bcd(whole, 3) << 28 | sign << 24 | encode_bcd(minutes, 6)
+
+
+def decode_ranger_latlon(raw: int) -> float:
+    """40 bits to degrees, summed digit by digit as the reference does (same last bit)."""
+    d100, d10, d1, sign, m10, m1, m01, m001, m0001, m00001 = bcd_digits(raw, 10)
+    degrees = d100 * 100.0 + d10 * 10.0 + d1 * 1.0
+    minutes = m10 * 10.0 + m1 * 1.0 + m01 * 0.1 + m001 * 0.01 + m0001 * 0.001 + m00001 * 0.0001
+    return (degrees + minutes / 60.0) * (-1.0 if sign in (0xC, 0xD) else 1.0)

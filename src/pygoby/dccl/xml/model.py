@@ -107,3 +107,12 @@ class XmlMessage:
 
     def var(self, name: str) -> Var | None:
         return next((v for v in self.all_vars() if v.name == name), None)
+
+    def single_field_sources(self) -> dict[str, str]:
+        """{source variable: variable name} of the source variables that feed one variable
+        (the others feed several, read as key=value pairs)."""
+        feeds: dict[str, list[str]] = {}
+        for var in self.all_vars():
+            if var.source_var:
+                feeds.setdefault(var.source_var, []).append(var.name)
+        return {source: names[0] for source, names in feeds.items() if len(names) == 1}

@@ -30,7 +30,7 @@ class SimulatorServer:
     def __init__(
         self,
         port: int,
-        host: str = "0.0.0.0",
+        host: str = "127.0.0.1",
         simulator: BasicFrontSeatSimulator | None = None,
         poll_interval: float = DEFAULT_POLL_INTERVAL,
     ) -> None:
@@ -89,7 +89,13 @@ def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
         "lines (goby3 basic_frontseat_simulator).",
     )
     parser.add_argument("port", type=int, help="TCP port to listen on (0 = any free port)")
-    parser.add_argument("--bind", default="0.0.0.0", help="address to listen on (default: all)")
+    parser.add_argument(
+        "--host",
+        "--bind",
+        dest="host",
+        default="127.0.0.1",
+        help="address to listen on (default %(default)s; 0.0.0.0: every interface)",
+    )
     parser.add_argument(
         "-v", "--verbose", action="count", default=0, help="more log output (-v: every line sent)"
     )
@@ -104,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
     )
     try:
-        run_until_signal(SimulatorServer(args.port, host=args.bind).serve())
+        run_until_signal(SimulatorServer(args.port, host=args.host).serve())
     except OSError as exc:
         print(f"{parser.prog}: {exc}", file=sys.stderr)
         return 1

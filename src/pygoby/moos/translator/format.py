@@ -9,7 +9,7 @@ specs such as `%1$05d`.
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 
 from google.protobuf import message_factory
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
@@ -236,13 +236,34 @@ def parsed_fields(descriptor: Descriptor, fmt: str) -> set[int]:
     }
 
 
-def check_serialize_format(descriptor: Descriptor, fmt: str) -> None:
-    """Reject publish formats that cannot render (bad sub-message paths, bad directives)."""
+def check_serialize_format(
+    descriptor: Descriptor, fmt: str, virtual_fields: Collection[int] = ()
+) -> None:
+    """Reject publish formats that cannot render (bad sub-message paths, bad directives) or
+    that name a field the message does not have (upstream renders such a directive as empty
+    or "unknown": a typo would be published silently). `virtual_fields`: the publish
+    algorithms' output_virtual_field numbers."""
     probe = message_factory.GetMessageClass(descriptor)()
     for match in _SUBMESSAGE_DIRECTIVE.finditer(fmt):
         spec = match.group(0).strip("%")
         _walk_path(probe, spec.split(":")[:-1], spec, create=False)
-    boostformat.parse_format(_SUBMESSAGE_DIRECTIVE.sub("%1%", _INDEXED_DIRECTIVE.sub("%1%", fmt)))
+    for match in _INDEXED_DIRECTIVE.finditer(_SUBMESSAGE_DIRECTIVE.sub("%%", fmt)):
+        number = int(match.group(0).strip("%").split(".")[0])
+        field = descriptor.fields_by_number.get(number)
+        if field is None or not field.is_repeated:
+            raise TranslatorConfigError(
+                f"format {fmt!r}: {match.group(0)} names no repeated field of {descriptor.full_name}"
+            )
+    plain = _SUBMESSAGE_DIRECTIVE.sub("%%", _INDEXED_DIRECTIVE.sub("%%", fmt))
+    for item in boostformat.parse_format(plain):
+        number = getattr(item, "argument", None)
+        if number is not None and number not in descriptor.fields_by_number and (
+            number not in virtual_fields
+        ):
+            raise TranslatorConfigError(
+                f"format {fmt!r}: %{number}% names no field of {descriptor.full_name} "
+                "(nor an algorithm's output_virtual_field)"
+            )
 
 
 def parse(

@@ -112,6 +112,7 @@ class Translator:
         self._resolve = resolve
         self._entries: dict[str, Message] = {}
         self._classes: dict[str, type[Message]] = {}
+        self._named_values: dict[str, dict[str, str]] = {}
         for entry in entries:
             self.add_entry(entry)
 
@@ -170,8 +171,17 @@ class Translator:
                     raise TranslatorConfigError(
                         f"{name}: publish to {publish.moos_var} needs a format"
                     )
-                format_technique.check_serialize_format(descriptor, publish.format)
-                format_technique.check_serialize_format(descriptor, publish.moos_var)
+                virtual = {algorithm.output_virtual_field for algorithm in publish.algorithm}
+                format_technique.check_serialize_format(descriptor, publish.format, virtual)
+                format_technique.check_serialize_format(descriptor, publish.moos_var, virtual)
+
+    def read_named_values(self, protobuf_name: str, keys: Mapping[str, str]) -> None:
+        """Goby 1.1's rule for the message's create variables in `keys` ({variable: name},
+        seed 003 §2.3.8): a string value holding `<name>=value` gives that value, any other
+        value is read whole (`NAV_X: "nav_x=3.5"` and `NAV_X: 3.5` both give 3.5). For the
+        messages of Goby 1.1 XML files, whose iCommander posted `name=value` strings."""
+        self._entry(protobuf_name)
+        self._named_values[protobuf_name] = dict(keys)
 
     def set_datum(self, lat_origin: float, lon_origin: float) -> None:
         """Re-initialise the UTM datum used by the UTM algorithms."""
@@ -222,9 +232,14 @@ class Translator:
         Raises TranslatorError if any rule fails: no partially built message comes out."""
         entry = self._entry(protobuf_name)
         msg = self._classes[protobuf_name]()
+        named = self._named_values.get(protobuf_name, {})
         for create in entry.create:
             technique = Technique(create.technique)
             source = moos_value_to_source(variables.get(create.moos_var), technique)
+            key = named.get(create.moos_var)
+            if key is not None and isinstance(source, str):
+                value = keyvalue.val_from_string(source, key)
+                source = source if value is None else value
             try:
                 self._apply_create(msg, create, technique, source, entry.use_short_enum)
             except TranslatorError as exc:
@@ -375,7 +390,7 @@ class TranslatorRunner:
             self._origin_changed = True
         if stale:
             return []
-        created = (self._create(name) for name in self.translator.triggered_by(var, value))
+        created = (self.create(name) for name in self.translator.triggered_by(var, value))
         return [msg for msg in created if msg is not None]
 
     def on_multiplex(self, value: MoosValue, technique: Technique) -> list[Post]:
@@ -402,12 +417,13 @@ class TranslatorRunner:
                 continue
             # Late by more than 1 s (clock jump): restart the schedule from now.
             self._deadlines[name] = now + period if now - deadline > 1 else deadline + period
-            msg = self._create(name)
+            msg = self.create(name)
             if msg is not None:
                 created.append(msg)
         return created
 
-    def _create(self, name: str) -> Message | None:
+    def create(self, name: str) -> Message | None:
+        """`name` made now from the newest values; None, with a warning, when a rule fails."""
         try:
             return self.translator.create(name, self.variables)
         except TranslatorError as exc:

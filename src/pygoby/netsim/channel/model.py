@@ -68,6 +68,7 @@ from pygoby.netsim.channel.levels import (
     sinr,
     transmission_loss,
 )
+from pygoby.netsim.channel.propagation import BellhopLoss
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, harmonic_mean_speed
 from pygoby.netsim.channel.timing import Interval
 
@@ -115,6 +116,9 @@ class ChannelConfig:
     # model): decoding within communication_range, any overlap of two receptions at a node
     # destroys both, no effect beyond interference_range. For MAC tests.
     protocol_model: ProtocolModel | None = None
+    # Transmission loss without absorption (`propagation.BellhopLoss`: BELLHOP ray tracing);
+    # None: the empirical spreading law k * 10 log10(r)
+    propagation: BellhopLoss | None = None
     decode_latency: float = 0.0  # s between end of reception and delivery
     position_staleness: float = 60.0  # s; older positions make the node absent
     moving_receivers: bool = True  # solve the arrival time for a moving receiver
@@ -338,8 +342,7 @@ class Channel:
                 interval=Interval(arrival, arrival + duration),
                 owtt=delay,
                 range_m=range_m,
-                received_level=config.source_level
-                - transmission_loss(range_m, alpha, config.spreading),
+                received_level=config.source_level - self._loss(tx_band, source, receiver, range_m, alpha),
                 closing_speed=closing_speed(source, receiver_now),
             )
             order = pending.arrival_order
@@ -348,6 +351,14 @@ class Channel:
             heapq.heappush(self._ends, (pending.interval.end, sequence, port, pending))
             planned.append((port, arrival))
         return planned
+
+    def _loss(self, band: Band, source: Position, receiver: Position, range_m: float,
+              alpha: float) -> float:  # fmt: skip
+        propagation = self.config.propagation
+        if propagation is None:
+            return transmission_loss(range_m, alpha, self.config.spreading)
+        loss = propagation.loss(band.carrier_hz, source.depth, receiver.depth, range_m)
+        return loss + alpha * range_m / 1000
 
     def next_delivery(self) -> float | None:
         if not self._ends:

@@ -4,6 +4,7 @@ lives per environment in the manager configuration (``environment_channel``, pyg
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 
 from google.protobuf.message import Message
 
@@ -18,7 +19,8 @@ from pygoby.netsim.channel.errors import (
     ThresholdModel,
 )
 from pygoby.netsim.channel.model import Band, ChannelConfig, PacketKind
-from pygoby.netsim.channel.soundspeed import water_profile
+from pygoby.netsim.channel.propagation import BellhopLoss, propagation_model
+from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, water_profile
 from pygoby.protobuf import builtin_class
 
 
@@ -42,23 +44,40 @@ def _rate_model(entry: Message) -> FrameErrorModel:
     raise ValueError(f"rate_model for rate {entry.rate} has no model")
 
 
-def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
-    """(ChannelConfig, seed) for a ChannelModelConfig message. Raises ValueError."""
+def sound_speed_of(settings: Message) -> float | SoundSpeedProfile:
+    """The sound speed of channel settings with `sound_speed` and `water` fields (an
+    environment's ChannelModelConfig, a scenario's ChannelSettings)."""
     if settings.HasField("water"):
         w = settings.water
         formula = w.SoundSpeedFormula.Name(w.sound_speed_formula)
-        sound_speed = water_profile(formula, w.temperature, w.salinity, w.latitude, w.longitude)
-    else:
-        sound_speed = settings.sound_speed
-    if settings.absorption == settings.FRANCOIS_GARRISON:
+        return water_profile(formula, w.temperature, w.salinity, w.latitude, w.longitude)
+    return settings.sound_speed
+
+
+def absorption_of(settings: Message) -> Callable[[float], float]:
+    """The absorption formula (f kHz -> dB/km) of settings with `absorption` and `water`."""
+    name = settings.DESCRIPTOR.fields_by_name["absorption"].enum_type.values_by_number[
+        settings.absorption
+    ].name
+    if name == "FRANCOIS_GARRISON":
         w = settings.water  # defaults apply when unset
-        absorption = functools.partial(
+        return functools.partial(
             francois_garrison, T=w.temperature, S=w.salinity, D=w.absorption_depth, pH=w.ph
         )
-    elif settings.absorption == settings.THORP_COA:
-        absorption = thorp_coa
-    else:
-        absorption = thorp
+    return thorp_coa if name == "THORP_COA" else thorp
+
+
+def propagation_of(settings: Message, sound_speed) -> BellhopLoss | None:
+    """The propagation model of settings with `propagation` and `spreading` fields."""
+    if not settings.HasField("propagation"):
+        return None
+    return propagation_model(settings.propagation, sound_speed, settings.spreading)
+
+
+def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
+    """(ChannelConfig, seed) for a ChannelModelConfig message. Raises ValueError."""
+    sound_speed = sound_speed_of(settings)
+    absorption = absorption_of(settings)
     by_rate = dict(DEFAULT_RATE_MODELS)
     by_rate.update({entry.rate: _rate_model(entry) for entry in settings.rate_model})
     protocol = None
@@ -91,6 +110,7 @@ def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
         decode_latency=settings.decode_latency,
         position_staleness=settings.position_staleness,
         protocol_model=protocol,
+        propagation=propagation_of(settings, sound_speed),
     )
     return config, settings.seed
 

@@ -10,11 +10,15 @@
 
 What "send" publishes (spec goby-moos-apps.md §6):
 
-* key=value style (Goby 1.1 iCommander): for each of the message's operator variables, the
-  message serialized with that variable's create technique (a CSV create gives the Goby 1
-  `name1=value1,name2=value2,...` string), variables in sorted order but the trigger variable
-  last (so pAcommsHandler has every other value when the trigger fires); an empty post to the
-  trigger variable (its mandatory content, if any) when no create reads it.
+* key=value style (Goby 1.1 iCommander): for a Goby 1.1 XML message, one
+  `name1=value1,name2=value2,...` string per source variable (the fields it feeds, in message
+  order, static ones included, unset ones left out), except that a variable holding a double
+  (NAV_X, ...) that feeds one numeric field gets the number: the MOOSDB refuses a string there,
+  and Goby 1.1's pAcommsHandler reads a double as the value itself; for a translator entry, the message
+  serialized with each operator variable's create technique (a CSV create gives the same
+  `name=value,...` string). Variables in sorted order but the trigger variable last (so
+  pAcommsHandler has every other value when the trigger fires); an empty post to the trigger
+  variable (its mandatory content, if any) when no field reads it.
 * multiplex style (goby3 liaison): one `@PB[<type>] <text>` post to pAcommsHandler's
   `multiplex_create_moos_var`.
 """
@@ -24,7 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -33,6 +37,7 @@ from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.moos.translator import (
+    MoosValue,
     Post,
     Technique,
     TranslatorError,
@@ -44,6 +49,7 @@ from pygoby.topside.commander import savefile, specials
 from pygoby.topside.commander.fields import FieldSpec, FieldValueError
 from pygoby.topside.commander.messageset import CommandSet, CommandType
 from pygoby.topside.errors import CommanderError
+from pygoby.util.signal import Signal
 
 KEY_VALUE = "key_value"
 MULTIPLEX = "multiplex"
@@ -130,7 +136,10 @@ class Commander:
         style: str = KEY_VALUE,
         force_xy_only: bool = False,
         autosave_path: str | Path | None = "iCommander_autosave.txt",
+        values: Mapping[str, MoosValue] | None = None,
     ) -> None:
+        """`values`: the newest value of the MOOS variables (e.g. MoosValues(app.dynamic_vars),
+        with `source_variables` subscribed), to post a number where a variable holds doubles."""
         if style not in (KEY_VALUE, MULTIPLEX):
             raise CommanderError(f"unknown send style {style!r} (key_value or multiplex)")
         if style == MULTIPLEX and not commands.multiplex_var:
@@ -149,6 +158,19 @@ class Commander:
         self.records: list[SentRecord] = []
         self.notices: list[Notice] = []
         self._ids = itertools.count(1)
+        self.values: Mapping[str, MoosValue] = values if values is not None else {}
+        self.signal_import = Signal()  # (names) after import_xml: new source variables
+
+    @property
+    def source_variables(self) -> set[str]:
+        """The variables a send of a Goby 1.1 message may post to (whose types matter)."""
+        return {var for kind in self.commands.types.values() if kind.goby11 for var in kind.operator_vars}
+
+    def import_xml(self, path: str) -> list[str]:
+        """Add the messages of a Goby 1.1 XML file; ConfigError for a file that cannot be used."""
+        names = self.commands.import_xml(path)
+        self.signal_import.emit(names)
+        return names
 
     # ------------------------------------------------------------------ drafts
     def open(self, name: str) -> Draft:
@@ -252,9 +274,11 @@ class Commander:
         except specials.SpecialError as err:
             raise FieldValueError(str(err)) from None
         msg = kind.cls()
+        values: dict[str, str] = {}  # what goes, by field
         for spec in kind.fields:
             if spec.kind == "static" and spec.static_value is not None:
                 _set_field(msg, spec, spec.static_value)
+                values[spec.name] = spec.static_value
         for spec, text in zip(editable, texts, strict=True):
             if text == "":
                 if spec.required:
@@ -265,21 +289,57 @@ class Commander:
                 _set_field(msg, spec, text)
             except (FieldValueError, ValueError) as err:
                 warnings.append(f"{err} (not sent)")
+            else:
+                values[spec.name] = text
+        # what the rules above cannot see: an element of a repeated sub-message left without a
+        # required field
+        warnings += [f"{path}: not set" for path in msg.FindInitializationErrors() if "[" in path]
         try:
-            posts = self._posts(kind, msg)
+            posts = self._posts(kind, msg, values, warnings)
         except TranslatorError as err:
             raise CommanderError(f"{kind.name} cannot be serialized: {err}") from None
+        trigger = posts[-1] if posts and posts[-1].var == kind.trigger_var else None
+        if (self.style == KEY_VALUE and trigger is not None and kind.mandatory_content
+                and kind.mandatory_content not in str(trigger.value)):  # fmt: skip
+            warnings.append(f"{kind.trigger_var} lacks its mandatory content "
+                            f"{kind.mandatory_content!r}: pAcommsHandler will not make the message")  # fmt: skip
         return Outgoing(posts, warnings, msg)
 
-    def _posts(self, kind: CommandType, msg: Message) -> list[Post]:
+    def _posts(self, kind: CommandType, msg: Message, values: dict[str, str], warnings: list[str]) -> list[Post]:
         if self.style == MULTIPLEX:
             return [make_post(self.commands.multiplex_var, serialize_for_moos(msg), _PREFIXED_TEXT, kind.name)]
-        posts = [p for p in self.commands.translator.inverse_publish(msg)
-                 if p.var in kind.operator_vars or p.var == kind.trigger_var]  # fmt: skip
+        if kind.goby11:
+            posts = self._goby11_posts(kind, values, warnings)
+        else:
+            posts = [p for p in self.commands.translator.inverse_publish(msg)
+                     if p.var in kind.operator_vars or p.var == kind.trigger_var]  # fmt: skip
         trigger = [p for p in posts if p.var == kind.trigger_var]
-        if trigger and trigger[0].value == "" and kind.mandatory_content:
+        if kind.trigger_var and (not trigger or trigger[0].value == ""):
             trigger = [Post(kind.trigger_var, kind.mandatory_content, "")]
         return [p for p in posts if p.var != kind.trigger_var] + trigger
+
+    def _goby11_posts(self, kind: CommandType, values: dict[str, str], warnings: list[str]) -> list[Post]:
+        """Goby 1.1 iCommander: `name=value,...` (message order) on each source variable,
+        sorted; repeated values in braces (`name={1,2}`), as Goby 1.1's key=value reading takes
+        them; a number where the variable holds doubles (see the module's docstring)."""
+        by_var: dict[str, list[tuple[FieldSpec, str]]] = {}
+        for spec in kind.fields:
+            text = values.get(spec.name)
+            if spec.source and text is not None:
+                by_var.setdefault(spec.source, []).append((spec, text))
+        posts = []
+        for var, items in sorted(by_var.items()):
+            if isinstance(self.values.get(var), float):
+                spec, text = items[0]
+                if var in kind.single_field_vars and spec.kind in _NUMERIC and not spec.repeated:
+                    posts.append(Post(var, _number(text), ""))
+                else:
+                    warnings.append(f"{var} holds numbers: the MOOSDB would refuse text, not sent")
+                continue
+            pairs = [f"{spec.name}={'{' + text.strip('{}') + '}' if spec.repeated else text}"
+                     for spec, text in items]  # fmt: skip
+            posts.append(Post(var, ",".join(pairs), ""))
+        return posts
 
     # ------------------------------------------------------------------ acks and expiries
     @property
@@ -333,7 +393,9 @@ class Commander:
         for kind in self.commands.types.values():
             names[kind.short_name] = names[kind.name] = [f.name for f in kind.fields]
         warnings = []
-        for message_name, values in savefile.parse(Path(path).read_text(), names):
+        # a hand-edited file in another encoding still loads (its odd bytes become U+FFFD)
+        text = Path(path).read_text(encoding="utf-8", errors="replace")
+        for message_name, values in savefile.parse(text, names):
             try:
                 draft = self.open(message_name)
             except KeyError:
@@ -347,13 +409,24 @@ class Commander:
         return warnings
 
 
-def _convert(field: FieldDescriptor, text: str, precision: int | None) -> object:
+
+
+_NUMERIC = ("int", "float", "bool")
+
+
+def _number(text: str) -> float:
+    """A checked int/float/bool text as the double Goby 1.1's pAcommsHandler reads."""
+    lowered = text.lower()
+    return 1.0 if lowered == "true" else 0.0 if lowered == "false" else float(text)
+
+
+def _convert(spec: FieldSpec, field: FieldDescriptor, text: str) -> object:
     kind = field.type
     if kind == _FD.TYPE_ENUM:
-        for value in field.enum_type.values:
-            if value.name.upper() == text.upper():
+        for value, shown in zip(field.enum_type.values, spec.enum_values, strict=True):
+            if shown.upper() == text.upper():
                 return value.number
-        raise FieldValueError(f"{field.name}: {text!r} is not one of its values")
+        raise FieldValueError(f"{spec.name}: {text!r} is not one of its values")
     if kind == _FD.TYPE_BOOL:
         return text.lower() in ("true", "1")
     if kind == _FD.TYPE_STRING:
@@ -362,17 +435,44 @@ def _convert(field: FieldDescriptor, text: str, precision: int | None) -> object
         return bytes.fromhex(text)
     if kind in (_FD.TYPE_DOUBLE, _FD.TYPE_FLOAT):
         number = float(text)
-        return round(number, precision) if precision is not None else number
+        return round(number, spec.precision) if spec.precision is not None else number
     return int(float(text)) if "." in text or "e" in text.lower() else int(text)
 
 
+def _parent(msg: Message, path: str) -> tuple[Message, str]:
+    """The (sub-)message holding the field at `path` (`pose.x`: msg.pose) and its name; reading
+    a sub-message this way does not set it."""
+    *steps, name = path.split(".")
+    for step in steps:
+        msg = getattr(msg, step)
+    return msg, name
+
+
+def _has(msg: Message, path: str) -> bool:
+    *steps, name = path.split(".")
+    for step in steps:
+        if not msg.HasField(step):
+            return False
+        msg = getattr(msg, step)
+    return msg.HasField(name)
+
+
 def _set_field(msg: Message, spec: FieldSpec, text: str) -> None:
-    field = msg.DESCRIPTOR.fields_by_name[spec.name]
+    *steps, name = spec.name.split(".")
+    items = [t.strip() for t in text.strip("{}").split(",")] if spec.repeated else [text]
+    for step in steps:
+        if msg.DESCRIPTOR.fields_by_name[step].is_repeated:  # one value per element
+            elements = getattr(msg, step)
+            for index, item in enumerate(items):
+                element = elements[index] if index < len(elements) else elements.add()
+                setattr(element, name, _convert(spec, element.DESCRIPTOR.fields_by_name[name], item))
+            return
+        msg = getattr(msg, step)
+    field = msg.DESCRIPTOR.fields_by_name[name]
     if spec.repeated:
-        getattr(msg, spec.name).extend(_convert(field, t.strip(), spec.precision)
-                                       for t in text.strip("{}").split(","))  # fmt: skip
+        getattr(msg, name).extend(_convert(spec, field, item) for item in items)
     else:
-        setattr(msg, spec.name, _convert(field, text, spec.precision))
+        setattr(msg, name, _convert(spec, field, text))
 
 
 def _close(a: object, b: object, precision: int | None) -> bool:
@@ -388,13 +488,12 @@ def _same(record: SentRecord, original: Message) -> bool:
     """Does the acknowledged/expired original carry what we sent (DCCL rounding allowed)?"""
     sent = record.message
     for spec in record.type.fields:
-        if not spec.editable or spec.repeated:
+        if not spec.editable or spec.repeated or not _has(sent, spec.name):
             continue
-        if not sent.HasField(spec.name):
-            continue
-        if not original.HasField(spec.name):
+        if not _has(original, spec.name):
             return False
-        if not _close(getattr(sent, spec.name), getattr(original, spec.name), spec.precision):
+        mine, theirs = _parent(sent, spec.name), _parent(original, spec.name)
+        if not _close(getattr(*mine), getattr(*theirs), spec.precision):
             return False
     return True
 

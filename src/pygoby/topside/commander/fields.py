@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.dccl.options import field_options
+from pygoby.moos.translator.fields import enum_name
 from pygoby.topside.commander import specials
 from pygoby.topside.errors import FieldValueError
 
@@ -72,9 +73,17 @@ class FieldSpec:
 
     @classmethod
     def from_descriptor(
-        cls, field: FieldDescriptor, source: str = "", automatic_from: str = ""
-    ) -> FieldSpec:
+        cls, field: FieldDescriptor, source: str = "", automatic_from: str = "", *,
+        path: str = "", required: bool | None = None, short_enum: bool = False,
+        elements_of: FieldDescriptor | None = None,
+    ) -> FieldSpec:  # fmt: skip
+        """`path`: the name inside the command (`pose.x` for a sub-message's field);
+        `required`: whether the message needs it (a required field of an optional sub-message
+        does not); `short_enum`: enum values without their `FIELD_` prefix (use_short_enum);
+        `elements_of`: the repeated sub-message whose elements hold the field (`track.x`
+        takes one value per element, as a repeated field does)."""
         options = field_options(field)
+        repeat = field_options(elements_of) if elements_of is not None else options
         kind = _kind(field, options.codec)
         numeric = kind in ("int", "float")
         type_name = (
@@ -86,24 +95,25 @@ class FieldSpec:
         if field.has_default_value and kind not in ("message", "static"):
             value = field.default_value
             default = (
-                field.enum_type.values_by_number[value].name if kind == "enum"
+                enum_name(field, value, short_enum) if kind == "enum"
                 else str(value).lower() if kind == "bool"
                 else _number_text(value) if numeric
                 else str(value)
             )  # fmt: skip
         return cls(
-            name=field.name,
+            name=path or field.name,
             number=field.number,
             kind=kind,
             proto_type=type_name,
-            required=field.is_required,
-            repeated=field.is_repeated,
+            required=field.is_required if required is None else required,
+            repeated=field.is_repeated or elements_of is not None,
             minimum=options.min if numeric and options.HasField("min") else None,
             maximum=options.max if numeric and options.HasField("max") else None,
             precision=(options.precision if kind == "float" else None),
             max_length=options.max_length if options.HasField("max_length") else None,
-            max_repeat=options.max_repeat if options.HasField("max_repeat") else None,
-            enum_values=tuple(v.name for v in field.enum_type.values) if kind == "enum" else (),
+            max_repeat=repeat.max_repeat if repeat.HasField("max_repeat") else None,
+            enum_values=tuple(enum_name(field, v.number, short_enum) for v in field.enum_type.values)
+            if kind == "enum" else (),
             static_value=options.static_value if kind == "static" else None,
             default=default,
             description=options.description,
@@ -121,11 +131,12 @@ class FieldSpec:
         if self.kind == "static":
             return f"(static) you cannot change the value of this field: {self.static_value}"
         if self.kind == "message":
-            return f"({self.proto_type}) sub-messages cannot be composed here"
+            what = "repeated sub-messages" if self.repeated else "recursive or deeper sub-messages"
+            return f"({self.proto_type}) {what} cannot be composed here"
         if self.automatic_from:
             return f"({self.kind}) filled by pAcommsHandler from {self.automatic_from}"
         if not self.source:
-            return f"({self.kind}) not created by pAcommsHandler's translator_entry"
+            return f"({self.kind}) pAcommsHandler reads no MOOS variable for this field"
         parts = []
         if self.minimum is not None:
             parts.append(f"min: {_number_text(self.minimum)}")

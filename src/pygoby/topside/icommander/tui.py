@@ -36,6 +36,12 @@ ACTIONS = [
 ]
 
 
+def box_id(field: str) -> str:
+    """The input box of a field (`pose.x` -> `field-pose--x`: widget ids take no dots, field
+    names no hyphens)."""
+    return "field-" + field.replace(".", "--")
+
+
 class Menu(ModalScreen[str | None]):
     """A titled list of choices; Enter picks, Escape cancels."""
 
@@ -117,7 +123,7 @@ class EditScreen(Screen):
             for number, spec in enumerate(kind.fields, start=1):
                 label = "static" if spec.kind == "static" else spec.kind
                 yield Label(f"{number}. {spec.name} ({label})", classes="field-name")
-                box = Input(value=self.draft.value(spec.name), id=f"field-{spec.name}",
+                box = Input(value=self.draft.value(spec.name), id=box_id(spec.name),
                             disabled=not spec.editable)  # fmt: skip
                 self._values[spec.name] = box.value
                 yield box
@@ -126,12 +132,12 @@ class EditScreen(Screen):
     def on_mount(self) -> None:
         editable = [s for s in self.draft.type.fields if s.editable]
         if editable:
-            self.query_one(f"#field-{editable[0].name}", Input).focus()
+            self.query_one(f"#{box_id(editable[0].name)}", Input).focus()
 
     def refresh_values(self) -> None:
         self._quiet = True
         for spec in self.draft.type.fields:
-            box = self.query_one(f"#field-{spec.name}", Input)
+            box = self.query_one(f"#{box_id(spec.name)}", Input)
             box.value = self._values[spec.name] = self.draft.value(spec.name)
         self._quiet = False
 
@@ -139,7 +145,7 @@ class EditScreen(Screen):
         self.query_one("#info", Static).update(text)
 
     def _field(self, box: Input) -> str:
-        return (box.id or "").removeprefix("field-")
+        return (box.id or "").removeprefix("field-").replace("--", ".")
 
     def on_descendant_focus(self, event) -> None:
         if isinstance(event.widget, Input) and event.widget.id and event.widget.id.startswith("field-"):
@@ -259,8 +265,8 @@ class ICommanderTUI(App):
             title = f"Choose a file to {'open' if choice == 'load' else 'save to'} (Esc to cancel):"
             self.push_screen(Prompt(title, f"{choice}-file"), lambda path: self._file(choice, path))
         elif choice == "import":
-            self._tell("XML message files are not supported yet: messages come from pAcommsHandler's "
-                       "load_proto_file and translator_entry")  # fmt: skip
+            title = "Choose an xml message file to import (Esc to cancel):"
+            self.push_screen(Prompt(title, "import-file"), lambda path: self._file("import", path))
         elif choice == "exit":
             self.exit()
             if self._on_exit is not None:
@@ -279,11 +285,14 @@ class ICommanderTUI(App):
             if what == "load":
                 warnings = self.commander.load(path)
                 self._tell(f"File read in:\n{path}" + "".join(f"\n  {w}" for w in warnings))
+            elif what == "import":
+                names = self.commander.import_xml(path)
+                self._tell(f"Imported:\n{path}\n  {', '.join(names)}")
             else:
                 self.commander.save(path)
                 self._tell(f"Message saved to:\n{path}")
         except (OSError, PygobyError) as err:
-            self._tell(f"Invalid file:\n{path}\n{err}")
+            self._tell(f"Invalid {'xml ' if what == 'import' else ''}file:\n{path}\n{err}")
 
     def _selected(self, name: str | None) -> None:
         if name is None:

@@ -1,10 +1,12 @@
 """liaison: the MOOS community in a web browser (Scope, Commander, Acomms, Map).
 
 `LiaisonState` keeps what the pages show (sans-I/O, fed MOOS mail); `WebServer` serves it with
-Starlette/uvicorn in the running asyncio loop. The MOOS app is `pygoby.apps.liaison`.
+Starlette/uvicorn in the running asyncio loop; `Liaison` is the MOOS client around them (run by
+`pygoby.apps.liaison`, or embedded in pAcommsHandler).
 """
 
+from pygoby.topside.liaison.app import Liaison
 from pygoby.topside.liaison.state import LiaisonState
 from pygoby.topside.liaison.web import WebServer, is_loopback, make_app
 
-__all__ = ["LiaisonState", "WebServer", "is_loopback", "make_app"]
+__all__ = ["Liaison", "LiaisonState", "WebServer", "is_loopback", "make_app"]

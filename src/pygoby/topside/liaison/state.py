@@ -3,12 +3,12 @@ models and the commander core, with JSON-ready views for the web layer."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 from google.protobuf.message import Message
 
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.moos.translator import Post
+from pygoby.moos.translator import MoosValue, Post
 from pygoby.topside.commander import (
     KEY_VALUE,
     MULTIPLEX,
@@ -54,7 +54,10 @@ class LiaisonState:
         now: Callable[[], float],
         publish: Callable[[Post], None],
         start_time: float,
+        values: Mapping[str, MoosValue] | None = None,
     ) -> None:
+        """`values`: the newest value of every variable (the commander posts a number where a
+        variable holds doubles)."""
         self.now = now
         self.start_time = start_time
         commander_cfg = cfg.commander
@@ -66,6 +69,7 @@ class LiaisonState:
             style=MULTIPLEX if commander_cfg.send_style == SEND_MULTIPLEX else KEY_VALUE,
             force_xy_only=commander_cfg.force_xy_only,
             autosave_path=commander_cfg.autosave_path or None,
+            values=values,
         )
         self.scope = ScopeModel(cfg.max_history_items, list(cfg.scope_subscription))
         self.acomms = AcommsModel(acomms_cfg, commands.resolve, start_time)

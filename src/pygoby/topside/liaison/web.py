@@ -18,6 +18,7 @@ import ipaddress
 import json
 import logging
 import secrets
+import socket
 from collections.abc import AsyncIterator, Callable
 from pathlib import Path
 
@@ -34,9 +35,10 @@ from starlette.responses import (
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
-from pygoby.errors import PygobyError
+from pygoby.errors import ConfigError, PygobyError
 from pygoby.topside.commander import CommanderError, FieldValueError, SaveFileError
 from pygoby.topside.liaison.state import LiaisonState, field_view, outgoing_view, record_view
+from pygoby.util.aiorun import cancel_and_wait
 
 log = logging.getLogger("pygoby.liaison")
 STATIC = Path(__file__).parent / "static"
@@ -104,7 +106,8 @@ def make_app(
                 data = state.page(name, state.now(), pattern)
                 yield f"data: {json.dumps(data, default=_json_default)}\n\n"
                 with contextlib.suppress(TimeoutError):
-                    await asyncio.wait_for(stopping.wait(), update_period)
+                    async with asyncio.timeout(update_period):
+                        await stopping.wait()
 
         return StreamingResponse(stream(), media_type="text/event-stream",
                                  headers={"Cache-Control": "no-store"})  # fmt: skip
@@ -186,8 +189,20 @@ class _EmbeddedServer(uvicorn.Server):
         yield
 
 
+def listen(address: str, port: int) -> socket.socket:
+    """The server's listening socket, bound when the app is configured, so that a taken port or
+    an address this host does not have stops the app with a configuration error."""
+    family = socket.AF_INET6 if ":" in address else socket.AF_INET
+    try:
+        return socket.create_server((address, port), family=family)
+    except OSError as err:
+        raise ConfigError(f"cannot serve the pages on {address}:{port}: {err.strerror or err} "
+                          "(set http_address / http_port)", field="liaison") from None  # fmt: skip
+
+
 class WebServer:
-    """uvicorn in the running asyncio loop; `url` once started."""
+    """uvicorn in the running asyncio loop, on a socket bound at construction; `url` once
+    started."""
 
     def __init__(self, state: LiaisonState, address: str, port: int, token: str = "",
                  update_period: float = 0.2) -> None:  # fmt: skip
@@ -201,7 +216,8 @@ class WebServer:
                                 access_log=False, timeout_graceful_shutdown=1)  # fmt: skip
         self._server = _EmbeddedServer(config)
         self._task: asyncio.Task | None = None
-        self.port = port
+        self._socket = listen(address, port)
+        self.port = self._socket.getsockname()[1]
 
     @property
     def url(self) -> str:
@@ -210,21 +226,24 @@ class WebServer:
         return f"http://{host}:{self.port}{suffix}"
 
     async def start(self) -> None:
-        self._task = asyncio.create_task(self._server.serve(), name="liaison-http")
+        self._task = asyncio.create_task(self._server.serve(sockets=[self._socket]), name="liaison-http")
         while not self._server.started:
             if self._task.done():
-                self._task.result()  # the bind failed: raise its error
+                self._task.result()  # the server failed to start: raise its error
                 raise PygobyError(f"liaison could not serve on {self.address}:{self.port}")
             await asyncio.sleep(0.01)
-        sockets = [s for server in self._server.servers for s in server.sockets]
-        if sockets:
-            self.port = sockets[0].getsockname()[1]
 
     async def stop(self) -> None:
         if self._task is None:
+            self._socket.close()  # never served (once served, the server closes it)
             return
         self._stopping.set()
         self._server.should_exit = True
-        with contextlib.suppress(asyncio.CancelledError, Exception):
-            await asyncio.wait_for(self._task, 5)
-        self._task = None
+        task, self._task = self._task, None
+        # not wait_for in a suppress(CancelledError): that swallowed our caller's cancellation
+        done, _ = await asyncio.wait({task}, timeout=5)
+        if not done:
+            with contextlib.suppress(Exception):  # the server's own errors are logged by it
+                await cancel_and_wait(task)
+        elif not task.cancelled():
+            task.exception()  # retrieved; the server logs its own errors

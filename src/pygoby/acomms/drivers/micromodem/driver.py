@@ -72,6 +72,7 @@ class Phase(Enum):
 class MMDriver(ModemDriverBase):
     DEFAULT_SERIAL_BAUD = DEFAULT_BAUD
     DEFAULT_LINE_DELIMITER = "\r"
+    RATES = range(len(RATE_NUM_FRAMES))
 
     def __init__(self, clock=None, link=None) -> None:
         super().__init__(clock, link)

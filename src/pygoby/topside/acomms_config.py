@@ -1,0 +1,152 @@
+"""pAcommsHandler's configuration and the message set it loads, as a library: for pAcommsHandler
+itself and for the tools that show or compose its messages (liaison, iCommander), so that each
+reads the same block the same way and no app imports another.
+
+    cfg = read_acomms_config(mission, "pAcommsHandler")  # Goby 1.1/2 forms translated
+    messages = AcommsMessageSet.load(cfg, mission.find_file)
+    messages.types("SIMPLE_STATUS")                      # a class of load_proto_file,
+                                                         # load_shared_library or an XML file
+    messages.import_xml("more.xml")                      # iCommander's "Import Message File"
+
+It lives here because it needs both the MOOS side (the mission file, the configuration reader,
+the message types of translator apps) and acomms (the Goby 1.1 XML message sets), and `acomms`
+never imports `moos`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from google.protobuf.message import Message
+
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.transitional import TransitionalMessages
+from pygoby.dccl import Codec, DcclError
+from pygoby.dccl.libraries import BuiltinLibrary, split_libraries
+from pygoby.errors import ConfigError
+from pygoby.moos.app import GobyMOOSApp
+from pygoby.moos.appconfig import read_configuration
+from pygoby.moos.moosfile import MissionFile
+from pygoby.moos.translator import Translator
+from pygoby.moos.translator_binding import MessageTypes
+from pygoby.protobuf import ProtoLoader, builtin_class
+
+PACOMMSHANDLER_CONFIG = (
+    "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
+    "goby.apps.moos.protobuf.pAcommsHandlerConfig",
+)
+
+
+def read_acomms_config(
+    mission: MissionFile, block: str = "pAcommsHandler", overrides: Sequence[tuple[str, str]] = ()
+) -> Message:
+    """The pAcommsHandlerConfig of `mission`'s ProcessConfig `block` (ConfigError file:line)."""
+    return read_configuration(builtin_class(*PACOMMSHANDLER_CONFIG), mission, block, overrides)
+
+
+@dataclass
+class AcommsMessageSet:
+    """The message definitions of one pAcommsHandler configuration: `cfg` (with the queue and
+    translator entries of its XML files added), the `loader` every type is in, `types` (name ->
+    class), the XML message sets (`transitional`) and the built-ins standing for C++ DCCL codec
+    libraries (their messages are in `types`; a codec also needs `apply_libraries`)."""
+
+    cfg: Message
+    loader: ProtoLoader
+    types: MessageTypes
+    transitional: TransitionalMessages
+    dccl_libraries: list[BuiltinLibrary]  # load_shared_library's C++ DCCL codec libraries
+    find: Callable[[str], str] = str
+
+    @classmethod
+    def load(
+        cls, cfg: Message, find: Callable[[str], str] = str, search_dirs: Sequence[str] = (),
+        config_error: Callable[[str, str, str], ConfigError] | None = None,
+    ) -> AcommsMessageSet:  # fmt: skip
+        """Load `cfg`'s message files; `find` resolves relative file names (the mission's
+        find_file), `search_dirs` are the folders it looks in (for "not found" errors). The XML
+        files' entries are appended to `cfg`, so load a configuration once. ConfigError for
+        files that cannot be used, made by `config_error(reason, field, value)` (located at the
+        mission line: GobyMOOSApp.config_error) when given."""
+        error = config_error or (lambda reason, field, value: ConfigError(reason, field=field))
+        dccl_libraries, modules = split_libraries(
+            cfg.load_shared_library, lambda reason, name: error(reason, "load_shared_library", name)
+        )
+        loader = ProtoLoader()
+        transitional = TransitionalMessages.expand(cfg, loader, find)
+        types = MessageTypes(
+            [*(p for library in dccl_libraries for p in library.proto_files),
+             *(find(path) for path in cfg.load_proto_file)],
+            [find(module) for module in modules],
+            fallback=acomms_pb.goby_message_class,
+            loader=loader,
+            search_dirs=search_dirs,
+            config_error=config_error,
+        )  # fmt: skip
+        return cls(cfg, loader, types, transitional, dccl_libraries, find)
+
+    def loaded(self) -> list[str]:
+        """The message types the files, modules, libraries and XML files define."""
+        from_libraries = [name for library in self.dccl_libraries for name in library.messages]
+        xml = [name for message_set in self.transitional.sets for name in message_set.names]
+        return [*self.types.loaded, *from_libraries, *xml]
+
+    @classmethod
+    def of_app(
+        cls, app: GobyMOOSApp, block: str, message_files: Sequence[Message] = ()
+    ) -> AcommsMessageSet:
+        """The message set of the pAcommsHandler block `block` of `app`'s mission, plus the
+        app's own XML `message_files` (Goby 1.1's iCommander had them; a file pAcommsHandler
+        loads already is skipped). Without the block, `message_files` alone."""
+        mission = app.mission
+        if mission is None:
+            raise ConfigError(f"{app.name} needs the mission file with the {block} ProcessConfig")
+        if message_files and mission.goby_block(block) is None:
+            out = cls.load(builtin_class(*PACOMMSHANDLER_CONFIG)(), app.find_file)
+        else:
+            out = cls.load(read_acomms_config(mission, block), app.find_file)
+        for message_file in message_files:
+            if Path(app.find_file(message_file.path)).resolve() not in out.files():
+                out.import_xml(message_file.path, message_file.manipulator)
+        return out
+
+    def files(self) -> set[Path]:
+        """The XML files loaded (resolved paths)."""
+        return {message_set.path.resolve() for message_set in self.transitional.sets}
+
+    def apply_libraries(self, codec: Codec) -> None:
+        """Give `codec` what load_shared_library's C++ DCCL codec libraries give a C++ codec
+        (pygoby's built-ins: CCL messages and id codec, ...); ConfigError if one cannot."""
+        try:
+            for library in self.dccl_libraries:
+                library.apply(codec)
+        except DcclError as err:
+            raise ConfigError(f"load_shared_library: {err}") from None
+
+    def require(self, names: Sequence[str], field: str) -> set[str]:
+        """`names` (of configuration `field`), each a loaded type, else ConfigError."""
+        for name in names:
+            try:
+                self.types(name)
+            except Exception:
+                raise ConfigError(f"{name!r} is not a loaded type", field=field) from None
+        return set(names)
+
+    def read_named_values(self, translator: Translator) -> None:
+        """Goby 1.1's `name=value` rule for the XML messages' single-field source variables."""
+        for name, keys in self.transitional.single_field_sources().items():
+            translator.read_named_values(name, keys)
+
+    def import_xml(self, path: str, manipulators: Sequence[int] = ()) -> list[str]:
+        """Add the messages of one more XML file (iCommander's "Import Message File") to the
+        set and to `cfg`; returns their names. ConfigError (file:line) for a file that cannot
+        be used or that defines a message already loaded."""
+        message_file = self.cfg.transitional_cfg.message_file.add(path=path, manipulator=manipulators)
+        try:
+            message_set = self.transitional.add_file(self.cfg, message_file, self.loader, self.find)
+        except ConfigError:
+            del self.cfg.transitional_cfg.message_file[-1]
+            raise
+        return message_set.names

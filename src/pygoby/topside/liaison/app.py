@@ -1,0 +1,72 @@
+"""liaison's MOOS client: the pages' state fed with every variable of the community, and the
+web server. Run on its own (`pygoby liaison mission.moos`, pygoby.apps.liaison) or embedded in
+a pAcommsHandler whose block has a `liaison` section (`Liaison.embedded`), then as a second
+client of the same MOOSDB sharing pAcommsHandler's message set.
+"""
+
+from __future__ import annotations
+
+from google.protobuf.message import Message
+
+from pygoby.errors import ConfigError
+from pygoby.moos.app import GobyMOOSApp
+from pygoby.moos.translator import MoosValues, Post
+from pygoby.protobuf import builtin_class
+from pygoby.topside.acomms_config import AcommsMessageSet
+from pygoby.topside.commander import CommanderError, CommandSet
+from pygoby.topside.liaison.state import LiaisonState
+from pygoby.topside.liaison.web import WebServer
+
+CONFIG = ("pygoby/apps/topside_config.proto", "pygoby.apps.protobuf.LiaisonAppConfig")
+
+
+class Liaison(GobyMOOSApp):
+    config_proto = CONFIG
+    default_name = "liaison"
+
+    def __init__(self, cfg: Message, *, acomms: AcommsMessageSet | None = None, **kwargs) -> None:
+        """`acomms`: the message set of the pAcommsHandler whose messages, queues and MAC cycle
+        the pages show (default: the `liaison.commander.pacommshandler_name` block of the
+        mission)."""
+        super().__init__(cfg, **kwargs)
+        web = cfg.liaison
+        if acomms is None:
+            acomms = AcommsMessageSet.of_app(self, web.commander.pacommshandler_name)
+        try:
+            self.state = LiaisonState(
+                web, acomms.cfg, CommandSet.from_messages(acomms, cfg.modem_id_lookup_path),
+                community=self.common.community, now=self.clock.now, publish=self._post,
+                start_time=self.start_time, values=MoosValues(self.dynamic_vars),
+            )  # fmt: skip
+        except CommanderError as err:
+            raise ConfigError(str(err), field="liaison.commander") from None
+        self.subscribe_pattern("*", "*", self.state.handle)
+        self.web = WebServer(self.state, web.http_address, web.http_port, web.token,
+                             1.0 / web.update_freq if web.update_freq > 0 else 1.0)  # fmt: skip
+
+    @classmethod
+    def embedded(cls, host: GobyMOOSApp, acomms: AcommsMessageSet) -> Liaison:
+        """The liaison a pAcommsHandler (`host`, its block's `liaison` section) serves, as its
+        own client of the host's MOOSDB, with the host's message set."""
+        cfg = builtin_class(*CONFIG)()
+        cfg.common.CopyFrom(host.common)
+        cfg.common.log = False
+        cfg.liaison.CopyFrom(acomms.cfg.liaison)
+        return cls(cfg, acomms=acomms, name=f"{host.name}_liaison", mission=host.mission,
+                   clock=host.clock, host=host.client.host, port=host.client.port)  # fmt: skip
+
+    def _post(self, post: Post) -> None:
+        self.publish(post.var, post.value, src_aux=post.source_aux)
+
+    def on_start(self) -> None:
+        self.state.start_time = self.start_time
+
+    async def start(self, connect_timeout: float | None = None) -> None:
+        await super().start(connect_timeout)
+        await self.web.start()
+        print(f"{self.name}: serving {self.web.url}", flush=True)
+        self.log.info("serving %s", self.web.url)
+
+    async def stop(self) -> None:
+        await self.web.stop()
+        await super().stop()

@@ -1,0 +1,108 @@
+"""goby3-examples' dual_status mission (tests/apps/data/dual_status, UDP multicast) run as a
+user runs it, `pygoby antler mm1.moos` and `pygoby antler mm2.moos`, with only paths changed:
+the two vehicles exchange their SimpleStatus messages."""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import random
+import re
+import shutil
+import signal
+import socket
+import sys
+from pathlib import Path
+
+import pytest
+
+from pygoby.apps.pacommshandler import pAcommsHandler
+from pygoby.errors import ConfigError
+
+from .acomms_mission import Recorder
+
+DATA = Path(__file__).resolve().parent / "data" / "dual_status"
+BIN = str(Path(sys.executable).parent)
+LIBRARY_LINE = 'load_shared_library: "../../../../../build/lib/libgobyexample_protobuf.so"'
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def copy_mission(tmp_path: Path, multicast_port: int) -> dict[int, tuple[Path, int]]:
+    """The missions in tmp_path with their ports changed (so parallel runs do not meet);
+    {modem id: (mission, ServerPort)}."""
+    shutil.copy(DATA / "simple_status.proto", tmp_path)
+    missions = {}
+    for modem_id in (1, 2):
+        text = (DATA / f"mm{modem_id}.moos").read_text()
+        port = _free_port()
+        text = re.sub(r"ServerPort = \d+", f"ServerPort = {port}", text)
+        text = text.replace("multicast_port: 50021", f"multicast_port: {multicast_port}")
+        path = tmp_path / f"mm{modem_id}.moos"
+        path.write_text(text)
+        missions[modem_id] = (path, port)
+    return missions
+
+
+def test_the_compiled_message_library_gets_one_clear_sentence(tmp_path):
+    missions = copy_mission(tmp_path, 50021)
+    with pytest.raises(ConfigError) as info:
+        pAcommsHandler.from_mission(missions[1][0])
+    lines = missions[1][0].read_text().splitlines()
+    line = next(i for i, text in enumerate(lines, 1) if "load_shared_library" in text)
+    assert str(info.value) == (
+        f'{missions[1][0]}:{line}: load_shared_library: "../../../../../build/lib/'
+        'libgobyexample_protobuf.so": pygoby cannot load compiled C++ libraries; use '
+        "load_proto_file with the .proto file(s) the library was built from instead"
+    )
+
+
+async def test_dual_status_mission_runs_with_paths_changed(tmp_path):
+    missions = copy_mission(tmp_path, random.randint(40000, 60000))
+    for path, _ in missions.values():
+        path.write_text(path.read_text().replace(LIBRARY_LINE, 'load_proto_file: "simple_status.proto"'))
+    env = {**os.environ, "PATH": f"{BIN}{os.pathsep}{os.environ.get('PATH', '')}"}
+    antlers = [
+        await asyncio.create_subprocess_exec(
+            f"{BIN}/pygoby", "antler", str(path), env=env,
+            stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.STDOUT,
+        )  # fmt: skip
+        for path, _ in missions.values()
+    ]
+    recorders = [Recorder(f"watch{i}", port) for i, (_, port) in missions.items()]
+    try:
+        for recorder in recorders:
+            async with asyncio.timeout(30):
+                while True:
+                    try:
+                        await recorder.start(["STATUS_REPORT_IN", "STATUS_REPORT_IN_PB"])
+                        break
+                    except (OSError, TimeoutError):  # antler is still starting the DB
+                        await asyncio.sleep(0.2)
+        # 10 s TDMA slots each, a status every 5 s: one cycle (20 s) plus start-up
+        from_1 = await recorders[1].wait_for("STATUS_REPORT_IN", timeout=60)
+        from_2 = await recorders[0].wait_for("STATUS_REPORT_IN", timeout=60)
+    finally:
+        for recorder in recorders:
+            await recorder.close()
+        for antler in antlers:
+            antler.send_signal(signal.SIGINT)
+        outputs = [(await asyncio.wait_for(a.communicate(), 30))[0].decode() for a in antlers]
+    # the initializers' values, across the multicast link
+    assert re.fullmatch(r"timestamp=[\d.]+,src=1,dest=2,x=150,y=200,speed=1\.4,heading=125,depth=23", from_1)
+    assert re.fullmatch(r"timestamp=[\d.]+,src=2,dest=1,x=550,y=125,speed=1\.6,heading=213,depth=20", from_2)
+    assert recorders[1].values("STATUS_REPORT_IN_PB")[0].startswith("@PB[goby.example.SimpleStatus] ")
+    for antler, out in zip(antlers, outputs, strict=True):
+        lines = out.splitlines()
+        assert antler.returncode == 0, out
+        assert ("antler: uXMS: uXMS is not available (no such program on PATH); the other "
+                "processes run without it") in lines  # MOOS-IvP's, not ours
+        assert "antler: pAcommsHandler exited with status 0" in lines
+        assert any(line.endswith("show_gui: standard output is not a terminal; the log stays plain text")
+                   for line in lines)  # fmt: skip
+        assert any(re.search(r"^pAcommsHandler \| pAcommsHandler \[.*\{goby::acomms::modemdriver::out::"
+                             r"UDP_MULTICAST::\d\}: >> <\d+ B> ", line) for line in lines)  # DEBUG1
