@@ -21,6 +21,12 @@ PROTO = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / "two
 STATUS = "pygoby.examples.SimpleStatus"
 COMMAND = "pygoby.examples.Command"
 SLOT_SECONDS = 1.5
+# slots an acknowledged packet fits in (a rate-1 frame, ~1.4 s on the water, then the 1 s
+# acknowledgement): with shorter ones the sender's next cycle comes before the ack, which the
+# driver then ignores, as goby's does
+ACK_SLOTS = "".join(
+    f"    slot {{ src: {src} dest: -1 rate: 1 type: DATA slot_seconds: 3 }}\n" for src in (1, 2)
+)
 
 QUEUE_ENTRIES = f"""\
   queue_cfg {{
