@@ -115,6 +115,22 @@ def test_driver_type_not_implemented_lists_those_that_are():
     )
 
 
+@pytest.mark.parametrize(
+    ("extra", "line", "field"),
+    [
+        ("  driver_cfg\n  {\n    driver_type: DRIVER_IRIDIUM\n  }\n", 11, "driver_cfg.driver_type"),
+        ("  driver_type: DRIVER_IRIDIUM\n", 9, "driver_type"),  # Goby 2's top-level form
+        ("  listen_driver_cfg { driver_type: DRIVER_UDP }\n"
+         "  listen_driver_cfg { driver_type: DRIVER_IRIDIUM }\n", 10, "listen_driver_cfg[1].driver_type"),
+    ],
+)  # fmt: skip
+def test_a_driver_type_not_implemented_is_located_at_its_mission_line(tmp_path, extra, line, field):
+    path = mission(tmp_path, extra=extra)
+    assert error_of(path).startswith(
+        f"{path}:{line}: {field}: driver_type DRIVER_IRIDIUM is not implemented in pygoby; available: "
+    )
+
+
 def test_compiled_driver_plugins_are_named_in_the_error(monkeypatch):
     monkeypatch.setenv("PACOMMSHANDLER_PLUGINS", "/usr/lib/libmy_modem_driver.so")
     with pytest.raises(DriverNotFoundError) as info:

@@ -68,10 +68,10 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.acomms = AcommsHandler(
                 cfg, self.clock, self.messages.loader, driver_factory=_make_driver
             )
+        except ConfigError as err:  # a field of the block (a driver, a slot's rate)
+            raise locate(err, self.mission, self.name) from None
         except HandlerError as err:
             raise ConfigError(str(err)) from None
-        except ConfigError as err:
-            raise locate(err, self.mission, self.name) from None
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
