@@ -67,6 +67,32 @@ def test_a_queue_for_a_type_that_is_not_loaded_names_the_loaded_types(tmp_path):
     )
 
 
+def test_a_translator_entry_for_a_type_that_is_not_loaded_is_located_and_names_the_loaded_types(tmp_path):
+    """As the queue_cfg error, in each app that reads translator entries: pAcommsHandler, the
+    commander tools reading its block (iCommander, liaison) and pTranslator."""
+    from pygoby.apps.icommander import iCommander
+    from pygoby.apps.ptranslator import pTranslator
+
+    entry = ('  translator_entry {\n    protobuf_name: "pygoby.examples.SimpleStatuss"\n'
+             '    trigger { type: TRIGGER_PUBLISH moos_var: "S" }\n  }\n')  # fmt: skip
+    path = mission(tmp_path, extra=entry)
+    path.write_text("LatOrigin = 42\nLongOrigin = -70\n" + path.read_text()
+                    + "ProcessConfig = iCommander\n{\n  common { log: false }\n}\n")  # fmt: skip
+    expected = (
+        f"{path}:12: translator_entry.protobuf_name: "
+        '"pygoby.examples.SimpleStatuss" is not a loaded message type; the types load_proto_file '
+        "and load_shared_library loaded are: pygoby.examples.SimpleStatus, pygoby.examples.Command"
+    )
+    for app, name in ((pAcommsHandler, "pAcommsHandler"), (iCommander, "iCommander")):
+        with pytest.raises(ConfigError) as info:
+            app.from_mission(path, name)
+        assert str(info.value) == expected
+    path.write_text(f'ProcessConfig = pTranslator\n{{\n  load_proto_file: "{PROTO}"\n{entry}}}\n')
+    with pytest.raises(ConfigError) as info:
+        pTranslator.from_mission(path, "pTranslator")
+    assert str(info.value) == expected.replace(":12:", ":5:")
+
+
 @pytest.mark.parametrize(
     ("library", "error"),
     [

@@ -117,6 +117,22 @@ class MessageTypes:
             return self._fallback(name)
         raise ProtoError(f"unknown message type {name!r}")
 
+    def require(self, name: str, field: str, loaded: Sequence[str] | None = None) -> type[Message]:
+        """The class of `name`, set in configuration `field`; else the located ConfigError that
+        lists the loaded types (`loaded`, default the ones these files and modules define)."""
+        try:
+            return self(name)
+        except ProtoError:
+            listed = self.loaded if loaded is None else loaded
+            raise self._error(not_loaded(name, listed), field, name) from None
+
+
+def not_loaded(name: str, loaded: Sequence[str]) -> str:
+    """The reason of a configuration error for a message type no file defines (typically a
+    misspelling), with the types that are there to compare."""
+    return (f'"{name}" is not a loaded message type; the types load_proto_file and '
+            f'load_shared_library loaded are: {", ".join(loaded) or "none"}')  # fmt: skip
+
 
 def not_found(path: str, searched: Sequence[str]) -> str:
     """The reason of a configuration error for a file found nowhere: the name as given and the

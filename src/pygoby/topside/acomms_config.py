@@ -99,7 +99,10 @@ class AcommsMessageSet:
             search_dirs=search_dirs,
             config_error=config_error,
         )  # fmt: skip
-        return cls(cfg, loader, types, transitional, dccl_libraries, find, search_dirs)
+        out = cls(cfg, loader, types, transitional, dccl_libraries, find, search_dirs)
+        out.require([entry.protobuf_name for entry in cfg.translator_entry],
+                    "translator_entry.protobuf_name")  # fmt: skip
+        return out
 
     def loaded(self) -> list[str]:
         """The message types the files, modules, libraries and XML files define."""
@@ -142,12 +145,10 @@ class AcommsMessageSet:
             raise ConfigError(f"load_shared_library: {err}") from None
 
     def require(self, names: Sequence[str], field: str) -> set[str]:
-        """`names` (of configuration `field`), each a loaded type, else ConfigError."""
+        """`names` (of configuration `field`), each a loaded type, else the located ConfigError
+        that lists the loaded types."""
         for name in names:
-            try:
-                self.types(name)
-            except Exception:
-                raise ConfigError(f"{name!r} is not a loaded type", field=field) from None
+            self.types.require(name, field, self.loaded())
         return set(names)
 
     def read_named_values(self, translator: Translator) -> None:
