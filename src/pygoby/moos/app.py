@@ -201,9 +201,11 @@ class GobyMOOSApp:
         return example_config(cls.load_config_class(), name or cls.default_name or cls.__name__)
 
     @classmethod
-    def main(cls, argv: Sequence[str] | None = None, prog: str | None = None) -> int:
+    def main(
+        cls, argv: Sequence[str] | None = None, prog: str | None = None, command: str | None = None
+    ) -> int:
         """Run the app from the command line (pygoby.moos.appcli); returns the exit status."""
-        return appcli.run_app(cls, argv, prog)
+        return appcli.run_app(cls, argv, prog, command)
 
     # -- construction --------------------------------------------------------------------------
 
