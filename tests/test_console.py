@@ -27,6 +27,16 @@ def test_pygoby_version():
     assert app.stdout == f"pAcommsHandler {pygoby.__version__}\n"
 
 
+def test_pygoby_subcommand_apps_show_how_they_are_typed():
+    """`pygoby liaison --help` shows `usage: pygoby liaison` (the app's name stays liaison)."""
+    shown = subprocess.run([BIN / "pygoby", "liaison", "--help"], capture_output=True, text=True, check=True)
+    assert shown.stdout.startswith("usage: pygoby liaison [-h]")
+    assert "liaison: a Goby MOOS application" in shown.stdout
+    example = subprocess.run([BIN / "pygoby", "liaison", "--example_config"], capture_output=True,
+                             text=True, check=True)  # fmt: skip
+    assert example.stdout.startswith("ProcessConfig = liaison\n")
+
+
 def _with_reader_gone(argv: list[str]) -> subprocess.CompletedProcess:
     """Run `argv` with its stdout a pipe whose reader closed before it wrote anything."""
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE)

@@ -67,6 +67,32 @@ def test_a_queue_for_a_type_that_is_not_loaded_names_the_loaded_types(tmp_path):
     )
 
 
+def test_a_translator_entry_for_a_type_that_is_not_loaded_is_located_and_names_the_loaded_types(tmp_path):
+    """As the queue_cfg error, in each app that reads translator entries: pAcommsHandler, the
+    commander tools reading its block (iCommander, liaison) and pTranslator."""
+    from pygoby.apps.icommander import iCommander
+    from pygoby.apps.ptranslator import pTranslator
+
+    entry = ('  translator_entry {\n    protobuf_name: "pygoby.examples.SimpleStatuss"\n'
+             '    trigger { type: TRIGGER_PUBLISH moos_var: "S" }\n  }\n')  # fmt: skip
+    path = mission(tmp_path, extra=entry)
+    path.write_text("LatOrigin = 42\nLongOrigin = -70\n" + path.read_text()
+                    + "ProcessConfig = iCommander\n{\n  common { log: false }\n}\n")  # fmt: skip
+    expected = (
+        f"{path}:12: translator_entry.protobuf_name: "
+        '"pygoby.examples.SimpleStatuss" is not a loaded message type; the types load_proto_file '
+        "and load_shared_library loaded are: pygoby.examples.SimpleStatus, pygoby.examples.Command"
+    )
+    for app, name in ((pAcommsHandler, "pAcommsHandler"), (iCommander, "iCommander")):
+        with pytest.raises(ConfigError) as info:
+            app.from_mission(path, name)
+        assert str(info.value) == expected
+    path.write_text(f'ProcessConfig = pTranslator\n{{\n  load_proto_file: "{PROTO}"\n{entry}}}\n')
+    with pytest.raises(ConfigError) as info:
+        pTranslator.from_mission(path, "pTranslator")
+    assert str(info.value) == expected.replace(":12:", ":5:")
+
+
 @pytest.mark.parametrize(
     ("library", "error"),
     [
@@ -112,6 +138,22 @@ def test_driver_type_not_implemented_lists_those_that_are():
         "DRIVER_WHOI_MICROMODEM, DRIVER_ABC_EXAMPLE_MODEM, DRIVER_UFIELD_SIM_DRIVER, "
         "DRIVER_STORE_SERVER, DRIVER_UDP, DRIVER_UDP_MULTICAST (or a driver_name of "
         "pygoby.acomms_drivers entry points or $PACOMMSHANDLER_PLUGINS modules)"
+    )
+
+
+@pytest.mark.parametrize(
+    ("extra", "line", "field"),
+    [
+        ("  driver_cfg\n  {\n    driver_type: DRIVER_IRIDIUM\n  }\n", 11, "driver_cfg.driver_type"),
+        ("  driver_type: DRIVER_IRIDIUM\n", 9, "driver_type"),  # Goby 2's top-level form
+        ("  listen_driver_cfg { driver_type: DRIVER_UDP }\n"
+         "  listen_driver_cfg { driver_type: DRIVER_IRIDIUM }\n", 10, "listen_driver_cfg[1].driver_type"),
+    ],
+)  # fmt: skip
+def test_a_driver_type_not_implemented_is_located_at_its_mission_line(tmp_path, extra, line, field):
+    path = mission(tmp_path, extra=extra)
+    assert error_of(path).startswith(
+        f"{path}:{line}: {field}: driver_type DRIVER_IRIDIUM is not implemented in pygoby; available: "
     )
 
 

@@ -61,10 +61,22 @@ def test_analyze_prints_the_field_table() -> None:
     assert "pos.lat      body  dccl.default4           25" in out.stdout
 
 
-def test_unknown_message_is_a_clear_error() -> None:
+def test_analyze_without_message_shows_every_dccl_message_of_the_file() -> None:
+    out = pygoby("dccl", "analyze", "--proto", PROTO)
+    assert out.returncode == 0, out.stderr
+    shown = [line.split(":")[0] for line in out.stdout.splitlines() if line.startswith("message ")]
+    assert shown == ["message example.Example", "message example.Tiny", "message example.LongId"]
+    assert pygoby("dccl", "encode", "--proto", PROTO).returncode == 2  # encode needs --message
+
+
+def test_unknown_message_is_a_clear_error_with_close_names() -> None:
     out = pygoby("dccl", "analyze", "--proto", PROTO, "--message", "example.Nope")
     assert out.returncode == 2
-    assert "unknown message type 'example.Nope'" in out.stderr
+    assert out.stderr == ("error: unknown message type 'example.Nope'; there are: example.Position, "
+                          "example.Example, example.Tiny, example.LongId\n")  # fmt: skip
+    for typed in ("example.Exampel", "Example", "exmaple.example"):
+        out = pygoby("dccl", "encode", "--proto", PROTO, "--message", typed)
+        assert out.stderr == f"error: unknown message type {typed!r}; did you mean example.Example?\n"
 
 
 def console(*args: str, stdin: str = "") -> subprocess.CompletedProcess:

@@ -180,18 +180,21 @@ async def test_imodemsim_uses_a_pair_made_by_loopbacks(tmp_path):
 
 
 @pytest.mark.parametrize(("extra", "reason"), [
-    ("IPPort = 70000\n", "IPPort 70000 is not a UDP port"),
-    ("BroadcastAddr = far.away\n", "BroadcastAddr 'far.away' is not an IPv4 address"),
-    ("InputLocType = gps\n", "InputLocType 'gps' is not one of"),
-    ("Speed = fast\n", "speed must be a number"),
+    ("IPPort = 70000\n", "IPPort: 70000 is not a UDP port"),
+    ("BroadcastAddr = far.away\n", "BroadcastAddr: 'far.away' is not an IPv4 address"),
+    ("InputLocType = gps\n", "InputLocType: 'gps' is not one of"),
+    ("Speed = fast\n", "Speed: must be a number, not 'fast'"),
 ])  # fmt: skip
 def test_imodemsim_configuration_errors(tmp_path, extra, reason):
+    """Each names the mission line of the setting (the house rule: file:line: field: reason)."""
     path = imodemsim_mission(tmp_path, "A", 40000, extra)
     text = path.read_text()
     key = extra.split("=")[0].strip()
-    path.write_text("\n".join(line for line in text.splitlines() if not line.strip().startswith(key + " ")
-                              or line.strip() + "\n" == extra) + "\n")  # fmt: skip
-    with pytest.raises(ConfigError, match=reason):
+    lines = [line for line in text.splitlines() if not line.strip().startswith(key + " ")
+             or line.strip() + "\n" == extra]  # fmt: skip
+    path.write_text("\n".join(lines) + "\n")
+    line = next(n for n, text in enumerate(lines, start=1) if text.strip() + "\n" == extra)
+    with pytest.raises(ConfigError, match=rf"^{path}:{line}: {reason}"):
         iModemSim.from_mission(path)
 
 

@@ -15,13 +15,13 @@ from pygoby.errors import ConfigError
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.logic import LogicCondition
-from pygoby.moos.moosfile import MissionFile
+from pygoby.moos.moosfile import MissionFile, Setting
 from pygoby.moos.timerscript import TimerScript, parse_value, split_quoted
 from tests.goby11.seed_listings import EXAMPLES
 
 
 def script(*lines: str, seed: int = 1) -> TimerScript:
-    return TimerScript([tuple(s.strip() for s in line.split("=", 1)) for line in lines], random.Random(seed))
+    return TimerScript([Setting(*(s.strip() for s in line.split("=", 1))) for line in lines], random.Random(seed))
 
 
 def run(ts: TimerScript, times) -> list[tuple[float, str, object]]:
@@ -107,9 +107,9 @@ def test_logic_conditions(condition, values, expected):
 @pytest.mark.parametrize(("setting", "reason"), [
     ("EVENT = var=A, time=1", "has no val="), ("EVENT = val=1, time=1", "has no var="),
     ("EVENT = var=A, val=1, time=5:2", "need 0 <= A <= B"), ("EVENT = var=A, val=1, when=2", "unknown field 'when'"),
-    ("EVENT = var=A, val=1, amt=0", "amt must be a positive count"), ("RESET_TIME = soon", "RESET_TIME must be"),
-    ("RESET_MAX = many", "RESET_MAX must be"), ("PAUSED = maybe", "PAUSED must be true or false"),
-    ("UPON_AWAKE = sleep", "UPON_AWAKE must be"), ("CONDITION = (X = 1", "unbalanced parentheses"),
+    ("EVENT = var=A, val=1, amt=0", "amt must be a positive count"), ("RESET_TIME = soon", "RESET_TIME: must be"),
+    ("RESET_MAX = many", "RESET_MAX: must be"), ("PAUSED = maybe", "PAUSED: must be true or false"),
+    ("UPON_AWAKE = sleep", "UPON_AWAKE: must be"), ("CONDITION = (X = 1", "unbalanced parentheses"),
     ("CONDITION = X", "is not a relation"), ("STATUS_VAR = a b", "must be a variable name"),
 ])  # fmt: skip
 def test_configuration_errors(setting, reason):
@@ -142,10 +142,17 @@ async def test_app_posts_the_seed_script_on_the_embedded_moosdb(tmp_path):
         assert got["UTS_STATUS"][0].startswith("name=unnamed, elapsed_time=")
 
 
-def test_app_configuration_error_names_the_mission(tmp_path):
+def test_app_configuration_error_names_the_mission_line_and_setting(tmp_path):
     path = tmp_path / "bad.moos"
-    path.write_text("ServerPort = 9000\nProcessConfig = uTimerScript\n{\n  EVENT = var=X\n}\n")
-    with pytest.raises(ConfigError, match=r"bad\.moos: uTimerScript: EVENT 'var=X' has no val="):
+    path.write_text("ServerPort = 9000\nProcessConfig = uTimerScript\n{\n  EVENT = var=X, val=1\n"
+                    "  EVENT = var=OUT, vla=3, time=1\n}\n")  # fmt: skip
+    with pytest.raises(ConfigError) as caught:
+        uTimerScript.from_mission(path)
+    assert str(caught.value) == (f"{path}:5: EVENT: 'var=OUT, vla=3, time=1': unknown field 'vla' "
+                                 "(var, val, time, amt, quit)")  # fmt: skip
+    assert (caught.value.line, caught.value.field) == (5, "EVENT")
+    path.write_text("ServerPort = 9000\nProcessConfig = uTimerScript\n{\n  AppTick = fast\n}\n")
+    with pytest.raises(ConfigError, match=rf"^{path}:4: AppTick: must be a positive number, not 'fast'$"):
         uTimerScript.from_mission(path)
     assert asyncio.iscoroutinefunction(uTimerScript.start)
 

@@ -68,8 +68,10 @@ def test_globals():
 def test_process_config_keeps_order_and_spaces():
     m = MissionFile.from_text(MISSION)
     cfg = m.process_config("PHELMIVP")
-    assert cfg == [("AppTick", "4"), ("behaviors", "alpha bravo.bhv"),
+    assert [(s.name, s.value) for s in cfg] == [("AppTick", "4"), ("behaviors", "alpha bravo.bhv"),
                    ("domain", "course:0:359:360"), ("domain", "speed:0:4:41")]  # fmt: skip
+    lines = MISSION.splitlines()
+    assert [lines[s.line - 1].strip().split()[0] for s in cfg] == ["AppTick", "behaviors", "domain", "domain"]
     assert m.block_value("pHelmIvP", "apptick") == "4"
     assert m.process_config("nothere") is None
 

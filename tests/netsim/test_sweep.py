@@ -112,8 +112,9 @@ axis { field: "seed" value: "7" value: "8" }
         ('field: "mac.nonsense" value: "1"', "MACConfig has no field 'nonsense'"),
         ('field: "node.modem_id" value: "1"', "node is repeated: give an index"),
         ('field: "node[5].modem_id" value: "1"', "node[5] does not exist"),
-        ('field: "mac.rate" value: "fast"', "could not convert"),
-        ('field: "mac.rate" value: "1.5"', "not an integer"),
+        ('field: "mac.rate" value: "fast"', "mac.rate: expects an integer, not 'fast'"),
+        ('field: "mac.rate" value: "1.5"', "mac.rate: expects an integer, not '1.5'"),
+        ('field: "channel.spreading" value: "x"', "channel.spreading: expects a number, not 'x'"),
         ('field: "mac.type" value: "ALOHA"', "is not one of"),
         ('field: "channel" value: "1"', "must end at a number"),
         ('field: "mac.rate"', "give either values or a span"),
@@ -283,7 +284,11 @@ def test_sweep_report_draws_the_figures_and_the_page(tmp_path, capsys):
     close = next(p for p in points if p.rate == 1 and p.range_m == 1000)
     assert close.sent == sum(r["sent"] for r in rows if r["rate"] == 1 and round(r["range_m"]) == 1000)
     assert close.success > 0.9  # 1 km at spreading 2: SNR far above rate 1's table
+    capsys.readouterr()
     assert main(["netsim", "sweep-report", str(tmp_path / "nothing")]) == 1
+    assert f"{tmp_path / 'nothing'} does not exist: give the output folder of `pygoby netsim sweep`" in capsys.readouterr().err
+    assert main(["netsim", "sweep-report", str(tmp_path)]) == 1
+    assert f"no results.parquet in {tmp_path}: " in capsys.readouterr().err
 
 
 def test_example_sweep_plans_and_its_readme_shows_the_figures(capsys):

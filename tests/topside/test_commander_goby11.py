@@ -275,3 +275,30 @@ def test_icommander_block_in_goby11_form(tmp_path):
     alone.write_text("LatOrigin = 42.35\nLongOrigin = -70.95\n" + ICOMMANDER_11)
     app = iCommander.from_mission(alone, "iCommander")
     assert sorted(app.commander.commands.types) == ["GoToCommand", "SIMPLE_STATUS", "VehicleStatus"]
+
+
+def test_an_xml_file_found_nowhere_is_located_like_load_proto_file(tmp_path, monkeypatch):
+    """A misspelled message_file names the mission line and the folders searched, in
+    pAcommsHandler's block (read by pAcommsHandler and iCommander) and in iCommander's own."""
+    from pygoby.apps.icommander import iCommander
+    from pygoby.apps.pacommshandler import pAcommsHandler
+
+    root = tmp_path / "goby1.1"
+    shutil.copytree(EXAMPLES, root)
+    mission = root / "MOOS" / "ccl_and_dccl" / "mm1.moos"
+    text = mission.read_text().replace("simple_status.xml", "simple_stats.xml")
+    mission.write_text(text + "\nProcessConfig = iCommander\n{\n  common { log: false }\n}\n")
+    line = text.splitlines().index('    message_file { path: "../../xml/simple_stats.xml" }') + 1
+    monkeypatch.chdir(tmp_path)
+    searched = f"searched: {tmp_path}, {mission.parent}"
+    expected = f'{mission}:{line}: message_file.path: "../../xml/simple_stats.xml" not found; {searched}'
+    for app in (pAcommsHandler, iCommander):
+        with pytest.raises(ConfigError) as caught:
+            app.from_mission(mission, app.default_name)
+        assert str(caught.value) == expected
+    mission.write_text(text.replace("simple_stats.xml", "simple_status.xml")
+                       + ICOMMANDER_11.replace("example1.xml", "exampel1.xml"))  # fmt: skip
+    line = mission.read_text().splitlines().index('    message_file { path: "../../xml/exampel1.xml" }') + 1
+    with pytest.raises(ConfigError) as caught:
+        iCommander.from_mission(mission, "iCommander")
+    assert str(caught.value) == f'{mission}:{line}: message_file.path: "../../xml/exampel1.xml" not found; {searched}'

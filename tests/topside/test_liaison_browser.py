@@ -52,7 +52,27 @@ async def browser(tmp_path):
         await browser.close()
 
 
+# every table and panel of the shown page whose content is wider than the box that clips it
+# (the nearest ancestor that does not let it overflow), and a page wider than the window
+CUT_OFF = """() => {
+  const out = [];
+  const section = document.querySelector('main section:not([hidden])');
+  for (const el of section.querySelectorAll('table, .panel, pre, .slots')) {
+    let clip = el.parentElement;
+    while (clip !== document.body && getComputedStyle(clip).overflowX === 'visible') clip = clip.parentElement;
+    const right = el.getBoundingClientRect().right, limit = clip.getBoundingClientRect().right;
+    if (right > limit + 0.5 || el.scrollWidth > el.clientWidth + 1) out.push(el.id || el.className);
+  }
+  if (document.documentElement.scrollWidth > innerWidth) out.push('page');
+  return out;
+}"""
+
+
 async def shot(page, name: str, tmp_path: Path) -> None:
+    """The page at 1000 and 1200 px wide shows every column; the picture is taken at 1200."""
+    for width in (1000, 1200):
+        await page.set_viewport_size({"width": width, "height": 760})
+        assert await page.evaluate(CUT_OFF) == [], f"{name} at {width} px cuts off content"
     folder = Path(os.environ.get(SCREENSHOTS_ENV) or tmp_path / "screenshots")
     folder.mkdir(parents=True, exist_ok=True)
     await page.screenshot(path=str(folder / f"liaison-{name}.png"))

@@ -31,6 +31,7 @@ The classes and functions named above (and the errors) are also importable from
 from pygoby.acomms.errors import (
     ABCParseError,
     AcommsError,
+    DriverConfigError,
     DriverNotFoundError,
     HandlerError,
     ModemDriverError,
@@ -61,6 +62,7 @@ __all__ = [
     "ABCParseError",
     "AcommsError",
     "AcommsHandler",
+    "DriverConfigError",
     "DriverNotFoundError",
     "HandlerError",
     "MACManager",

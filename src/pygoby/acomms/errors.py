@@ -1,7 +1,7 @@
 """The AcommsError family: what goby-acomms (drivers, queue, MAC, handler, wire formats)
 raises on purpose."""
 
-from pygoby.errors import PygobyError
+from pygoby.errors import ConfigError, PygobyError
 
 INVALID_CONFIGURATION = 4  # goby.acomms.protobuf.ModemDriverStatus.INVALID_CONFIGURATION
 
@@ -36,6 +36,12 @@ class DriverNotFoundError(ModemDriverError):
 
 class HandlerError(AcommsError):
     """The handler's configuration cannot be used, or a failure it cannot recover from."""
+
+
+class DriverConfigError(HandlerError, ConfigError):
+    """A driver configuration the handler cannot use (a driver_type or driver_name with no
+    driver, a driver refusing its settings); `field` is where in the handler's configuration
+    (`driver_cfg.driver_type`, `listen_driver_cfg[1].driver_name`, ...), for the mission line."""
 
 
 class StoreServerAuthError(AcommsError):

@@ -30,7 +30,13 @@ from pygoby.acomms import drivers
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.bind import bind, unbind
 from pygoby.acomms.driver_base import ModemDriverBase, driver_name
-from pygoby.acomms.errors import HandlerError, ModemDriverError, QueueError
+from pygoby.acomms.errors import (
+    DriverConfigError,
+    DriverNotFoundError,
+    HandlerError,
+    ModemDriverError,
+    QueueError,
+)
 from pygoby.acomms.mac import MACManager
 from pygoby.acomms.queue import QueueManager
 from pygoby.acomms.queue.persist import QueueStore
@@ -136,7 +142,8 @@ class AcommsHandler:
         self.signal_modem_transmit = Signal()  # (ModemTransmission) transmit result
         primary_cfg = acomms_pb.DriverConfig()
         primary_cfg.CopyFrom(cfg.driver_cfg)
-        if primary_cfg.WhichOneof("driver") is None and cfg.HasField("driver_type"):
+        top_level = primary_cfg.WhichOneof("driver") is None and cfg.HasField("driver_type")
+        if top_level:
             primary_cfg.driver_type = cfg.driver_type  # Goby 2 style top-level driver_type
         for index, driver_cfg in enumerate([primary_cfg, *cfg.listen_driver_cfg]):
             own = acomms_pb.DriverConfig()
@@ -147,7 +154,11 @@ class AcommsHandler:
             try:
                 driver = driver_factory(own, clock)
             except ModemDriverError as exc:
-                raise HandlerError(f"driver configuration: {exc}") from None
+                block = "driver_cfg" if index == 0 else f"listen_driver_cfg[{index - 1}]"
+                field = block
+                if isinstance(exc, DriverNotFoundError):
+                    field = "driver_type" if top_level else f"{block}.{own.WhichOneof('driver')}"
+                raise DriverConfigError(str(exc), field=field) from None
             if driver is None:
                 continue
             slot = DriverSlot(driver, own)

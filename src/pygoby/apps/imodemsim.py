@@ -25,12 +25,12 @@ from __future__ import annotations
 import dataclasses
 import ipaddress
 import logging
+from typing import NoReturn
 
 from pygoby.acomms.mmsim.model import MicroModemModel
 from pygoby.acomms.mmsim.multicast_channel import BroadcastChannel, MulticastChannel
 from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
-from pygoby.errors import ConfigError
 from pygoby.moos.classic_app import ClassicMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.util.pty import PtyError, PtyPair, is_live, partner_of
@@ -44,8 +44,9 @@ LOCATION_TYPES = {
     "moos_local": ("NAV_X", "NAV_Y", "NAV_DEPTH"),
     "moos_global": ("NAV_LAT", "NAV_LONG", "NAV_DEPTH"),
 }
-KNOWN = {"port", "speed", "ipport", "broadcastaddr", "inputloctype", "constantposx", "constantposy",
-         "constantdepth", "constantlat", "constantlon", "modemid"}  # fmt: skip
+KNOWN_NAMES = ("Port", "Speed", "IPPort", "BroadcastAddr", "InputLocType", "ConstantPosX", "ConstantPosY",
+               "ConstantDepth", "ConstantLat", "ConstantLon", "ModemID")  # fmt: skip
+KNOWN = {name.lower() for name in KNOWN_NAMES}
 
 
 class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
@@ -64,53 +65,61 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
 
     def __init__(self, cfg, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
-        settings = {k.lower(): v for k, v in self.params}
-        for key, _ in self.params:
-            if key.lower() not in KNOWN:
-                self.log.warning("unknown iModemSim parameter %r ignored", key)
-        self.port_path = settings.get("port") or self._error("Port (the serial device) is required")
-        speed = int(self._number(settings, "speed", 19200))
+        self.settings = {s.name.lower(): s for s in self.params}  # the last of a name wins
+        for setting in self.params:
+            if setting.name.lower() not in KNOWN:
+                self.log.warning("unknown iModemSim parameter %r ignored", setting.name)
+        self.port_path = self._text("port", "")
+        if not self.port_path:
+            self._error("port", "the serial device is required")
+        speed = int(self._number("speed", 19200))
         if speed <= 0:
-            self._error(f"Speed {speed} is not a baud rate")
-        udp_port = int(self._number(settings, "ipport", 49234))
+            self._error("speed", f"{speed} is not a baud rate")
+        udp_port = int(self._number("ipport", 49234))
         if not 0 < udp_port < 65536:
-            self._error(f"IPPort {udp_port} is not a UDP port")
-        address = settings.get("broadcastaddr", "127.0.0.1")
+            self._error("ipport", f"{udp_port} is not a UDP port")
+        address = self._text("broadcastaddr", "127.0.0.1")
         try:
             loopback = ipaddress.ip_address(address).is_loopback
         except ValueError:
-            self._error(f"BroadcastAddr {address!r} is not an IPv4 address")
+            self._error("broadcastaddr", f"{address!r} is not an IPv4 address")
         # (the channel's deliveries on the app's clock, which MOOSTimeWarp speeds up)
         self.channel = (MulticastChannel(MULTICAST_GROUP, udp_port, self.clock) if loopback
                         else BroadcastChannel(address, udp_port, self.clock))  # fmt: skip
-        location = settings.get("inputloctype", "constant_local").lower()
+        location = self._text("inputloctype", "constant_local").lower()
         if location not in LOCATION_TYPES:
-            self._error(f"InputLocType {location!r} is not one of {', '.join(LOCATION_TYPES)}")
+            self._error("inputloctype", f"{location!r} is not one of {', '.join(LOCATION_TYPES)}")
         self.position = [0.0, 0.0, 0.0]
         if location.startswith("constant"):
             names = LOCATION_TYPES[location]
-            self.position = [self._number(settings, n.lower(), 0.0) for n in names]
+            self.position = [self._number(n.lower(), 0.0) for n in names]
         else:
             for index, var in enumerate(LOCATION_TYPES[location]):
                 self.subscribe(var, lambda msg, i=index: self._on_position(i, msg))
-        modem_id = int(self._number(settings, "modemid", 1))
+        modem_id = int(self._number("modemid", 1))
         self.pair = self._make_pair()
         self.model = MicroModemModel(modem_id, self.clock, self.channel, name=f"{self.name}:{self.port_path}",
                                      timing=dataclasses.replace(DEFAULT_TIMING, baud=speed))
         self.server = MMSimServer(self.model, self.channel, port=None, serial_path=self.port_path)
 
-    def _error(self, reason: str):
-        raise ConfigError(f"{self.name}: {reason}", file=self.mission.path if self.mission else None)
+    def _error(self, key: str, reason: str) -> NoReturn:
+        """A ConfigError at the line of the setting `key` (lower case), or naming it if unset."""
+        setting = self.settings.get(key)
+        name = next(n for n in KNOWN_NAMES if n.lower() == key)
+        raise self.setting_error(reason, setting if setting is not None else name)
 
-    def _number(self, settings: dict[str, str], key: str, default: float) -> float:
-        text = settings.get(key)
-        if text is None:
+    def _text(self, key: str, default: str) -> str:
+        setting = self.settings.get(key)
+        return default if setting is None else setting.value
+
+    def _number(self, key: str, default: float) -> float:
+        setting = self.settings.get(key)
+        if setting is None:
             return default
         try:
-            return float(text)
+            return float(setting.value)
         except ValueError:
-            self._error(f"{key} must be a number, not {text!r}")
-            raise  # unreachable: _error raises
+            self._error(key, f"must be a number, not {setting.value!r}")
 
     def _make_pair(self) -> PtyPair | None:
         """The Goby 1.1 loopback pair, made here unless a running process (pygoby loopbacks,
@@ -120,13 +129,13 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
             return None
         partner = partner_of(self.port_path)
         if partner is None:
-            self._error(f"Port {self.port_path} does not exist, and only loopback names ending "
+            self._error("port", f"{self.port_path} does not exist, and only loopback names ending "
                         "in 1 or 2 (/tmp/ttyLOOPA1 <-> /tmp/ttyLOOPA2) can be made here; run "
                         "`pygoby loopbacks` or give a real serial device")  # fmt: skip
         try:
             pair = PtyPair(self.port_path, partner).open()
         except (PtyError, OSError) as err:
-            self._error(f"cannot make the loopback {self.port_path} <-> {partner}: {err}")
+            self._error("port", f"cannot make the loopback {self.port_path} <-> {partner}: {err}")
         self.log.info("made the loopback %s <-> %s (the host opens %s)", self.port_path, partner, partner)
         return pair
 

@@ -17,7 +17,7 @@ from pygoby.topside.liaison.app import Liaison
 
 
 def main(argv=None) -> int:
-    return Liaison.main(argv, prog="liaison")
+    return Liaison.main(argv, prog="liaison", command="pygoby liaison")
 
 
 if __name__ == "__main__":

@@ -31,7 +31,7 @@ from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import locate, prefixed_var_names
 from pygoby.moos.protocol import MOOSMessage, text_or_binary
-from pygoby.moos.translator_binding import TranslatorBinding
+from pygoby.moos.translator_binding import TranslatorBinding, not_loaded
 from pygoby.topside.acomms_config import PACOMMSHANDLER_CONFIG, AcommsMessageSet
 
 IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
@@ -68,10 +68,10 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.acomms = AcommsHandler(
                 cfg, self.clock, self.messages.loader, driver_factory=_make_driver
             )
+        except ConfigError as err:  # a field of the block (a driver, a slot's rate)
+            raise locate(err, self.mission, self.name) from None
         except HandlerError as err:
             raise ConfigError(str(err)) from None
-        except ConfigError as err:
-            raise locate(err, self.mission, self.name) from None
         self.queue = self.acomms.queue
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
@@ -102,12 +102,8 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         if skipped:  # goby3 skips them silently: an operator never learns why nothing is sent
-            loaded = ", ".join(self.messages.loaded()) or "none"
-            raise self.config_error(
-                f'"{skipped[0]}" is not a loaded message type; the types load_proto_file and '
-                f"load_shared_library loaded are: {loaded}",
-                "queue_cfg.message_entry.protobuf_name", skipped[0],
-            )  # fmt: skip
+            raise self.config_error(not_loaded(skipped[0], self.messages.loaded()),
+                                    "queue_cfg.message_entry.protobuf_name", skipped[0])  # fmt: skip
 
     # ------------------------------------------------------------------ wiring
     def _connect_signals(self) -> None:

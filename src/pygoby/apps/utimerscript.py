@@ -6,7 +6,6 @@ pygoby.moos.timerscript), so that missions run without MOOS-IvP installed.
 
 from __future__ import annotations
 
-from pygoby.errors import ConfigError
 from pygoby.moos.classic_app import ClassicMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.timerscript import TimerScript
@@ -29,10 +28,7 @@ class uTimerScript(ClassicMOOSApp):  # noqa: N801 - the program's name
 
     def __init__(self, cfg, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
-        try:
-            self.script = TimerScript(self.params)
-        except ConfigError as err:
-            raise ConfigError(f"{self.name}: {err}", file=self.mission.path if self.mission else None) from None
+        self.script = TimerScript(self.params, file=self.mission_path)
         for warning in self.script.warnings:
             self.log.warning("%s", warning)
         for var in self.script.subscriptions():

@@ -17,6 +17,7 @@ from pygoby.dccl.errors import DcclError
 from pygoby.dccl.libraries import builtin_library
 from pygoby.dccl.trace import log as trace_log
 from pygoby.errors import ConfigError
+from pygoby.util.names import did_you_mean
 
 PASSPHRASE_ENV = "PYGOBY_DCCL_PASSPHRASE"
 
@@ -32,7 +33,7 @@ def register(subparsers) -> None:
                         help="include directory for imports (repeatable)")
     parser.add_argument("--message", metavar="FULL.NAME",
                         help="fully qualified message name (with --xml: the XML <name>; "
-                             "analyze without it shows every message of the file)")
+                             "analyze without it shows every DCCL message of the file)")
     parser.add_argument("--write-proto", metavar="DIR",
                         help="with --xml: also write the converted .proto file into DIR")
     secret = parser.add_mutually_exclusive_group()
@@ -67,8 +68,8 @@ def _load_xml(codec: Codec, args: argparse.Namespace) -> list:
     if args.message is None:
         return classes
     if args.message not in message_set.names:
-        raise ConfigError(f"no message named {args.message!r} (the file has "
-                          f"{', '.join(message_set.names)})", file=args.xml)  # fmt: skip
+        raise ConfigError(f"no message named {args.message!r}"
+                          f"{did_you_mean(args.message, message_set.names)}", file=args.xml)  # fmt: skip
     return [classes[message_set.names.index(args.message)]]
 
 
@@ -76,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
     if args.write_proto and not args.xml:
         print("error: --write-proto needs --xml", file=sys.stderr)
         return 2
-    if args.message is None and not (args.xml and args.action == "analyze"):
+    if args.message is None and args.action != "analyze":
         print("error: --message is required", file=sys.stderr)
         return 2
     if args.trace:
@@ -93,6 +94,8 @@ def run(args: argparse.Namespace) -> int:
             codec.set_arithmetic_model(load_model_file(path))
         if args.xml:
             classes = _load_xml(codec, args)
+        elif args.message is None:
+            classes = codec.load_proto_file(args.proto, args.include)
         else:
             classes = [codec.load_proto(args.proto, args.message, args.include)]
     except (DcclError, ConfigError, OSError) as exc:

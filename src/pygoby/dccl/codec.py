@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 import os
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 
 from google.protobuf import message_factory
 from google.protobuf.descriptor import Descriptor
@@ -21,10 +21,12 @@ from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError, DcclError, Dccl
 from pygoby.dccl.hashing import definition_hash, hash_codecs
 from pygoby.dccl.identifier import DefaultIdCodec, is_ccl_id
 from pygoby.dccl.identifier import id_codec as lookup_id_codec
+from pygoby.dccl.options import message_options
 from pygoby.dccl.plan import Part, Planner, root_options
 from pygoby.dccl.registry import DEFAULT_REGISTRY, CodecRegistry
 from pygoby.protobuf import ProtoError, ProtoLoader
 from pygoby.util.clock import Clock
+from pygoby.util.names import did_you_mean
 
 # Exceptions that bad values or bad bytes can provoke inside generated code or codecs.
 _VALUE_ERRORS = (ValueError, TypeError, OverflowError, KeyError, IndexError, UnicodeError)
@@ -146,13 +148,32 @@ class Codec:
         full_name: str,
         include_dirs: Iterable[str | os.PathLike[str]] = (),
     ) -> type[Message]:
-        """Compile a .proto file at run time and load one of its message types."""
+        """Compile a .proto file at run time and load one of its message types (an unknown
+        name: DcclLoadError suggesting the file's close names)."""
         try:
-            self.loader.load_file(path, include_dirs)
-            cls = self.loader.message_class(full_name)
+            file = self.loader.load_file(path, include_dirs)
         except ProtoError as exc:
             raise DcclLoadError(str(exc)) from exc
+        try:
+            cls = self.loader.message_class(full_name)
+        except ProtoError as exc:
+            defined = [d.full_name for d in _messages_of(file.message_types_by_name.values())]
+            raise DcclLoadError(f"{exc}{did_you_mean(full_name, defined)}") from exc
         return self.load(cls)
+
+    def load_proto_file(
+        self, path: str | os.PathLike[str], include_dirs: Iterable[str | os.PathLike[str]] = ()
+    ) -> list[type[Message]]:
+        """Compile a .proto file and load each of its top-level DCCL messages (those with
+        (dccl.msg) options; the others are their parts); DcclLoadError if there is none."""
+        try:
+            file = self.loader.load_file(path, include_dirs)
+        except ProtoError as exc:
+            raise DcclLoadError(str(exc)) from exc
+        dccl = [d for d in file.message_types_by_name.values() if message_options(d).ListFields()]
+        if not dccl:
+            raise DcclLoadError(f"{path}: no message has (dccl.msg) options")
+        return [self.load(self.loader.message_class(d.full_name)) for d in dccl]
 
     def unload(self, message_type: type[Message] | Descriptor) -> None:
         descriptor = getattr(message_type, "DESCRIPTOR", message_type)
@@ -326,3 +347,10 @@ class Codec:
         except _VALUE_ERRORS as exc:
             raise DcclDecodeError(f"{compiled.name}: cannot decode: {exc}") from exc
         return msg, head_bytes + (used + 7) // 8
+
+
+def _messages_of(descriptors: Iterable[Descriptor]) -> Iterator[Descriptor]:
+    """`descriptors` and every message type nested in them."""
+    for descriptor in descriptors:
+        yield descriptor
+        yield from _messages_of(descriptor.nested_types)

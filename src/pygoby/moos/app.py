@@ -61,8 +61,9 @@ The base provides
   each value that parses).
 * `find_file(path)`: a relative path from the configuration, looked up next to the mission
   file when it does not exist from the working directory (`search_dirs()` lists both).
-* `config_error(reason, field, value="")`: a ConfigError for a problem found after parsing
-  (an unknown type, a missing file), located at the mission line that sets `field`.
+* `config_error(reason, field, value="", block=None)`: a ConfigError for a problem found after
+  parsing (an unknown type, a missing file), located at the mission line that sets `field` in
+  this app's ProcessConfig block (or in `block`, another app's that it reads).
 * Hooks: `loop()`, `on_connect()`, `on_disconnect()`, `on_start()`, `on_stop()`,
   `status_lines()` (the state shown by `common.show_gui`'s live view, pygoby.moos.appgui).
 * `exit_status`: what `main` returns once the app has stopped (0; an app that stops itself on a
@@ -200,9 +201,11 @@ class GobyMOOSApp:
         return example_config(cls.load_config_class(), name or cls.default_name or cls.__name__)
 
     @classmethod
-    def main(cls, argv: Sequence[str] | None = None, prog: str | None = None) -> int:
+    def main(
+        cls, argv: Sequence[str] | None = None, prog: str | None = None, command: str | None = None
+    ) -> int:
         """Run the app from the command line (pygoby.moos.appcli); returns the exit status."""
-        return appcli.run_app(cls, argv, prog)
+        return appcli.run_app(cls, argv, prog, command)
 
     # -- construction --------------------------------------------------------------------------
 
@@ -308,14 +311,17 @@ class GobyMOOSApp:
         """The folders `find_file` looks in, in order (for "not found" errors)."""
         return self.mission.search_dirs() if self.mission is not None else [os.getcwd()]
 
-    def config_error(self, reason: str, field: str, value: str = "") -> ConfigError:
+    def config_error(
+        self, reason: str, field: str, value: str = "", block: str | None = None
+    ) -> ConfigError:
         """A ConfigError for a problem found after parsing, located at the mission file line
-        that sets `field` (to `value`) in this app's block when there is one."""
+        that sets `field` (to `value`) in this app's block, or in the ProcessConfig `block`
+        (another app's that this one reads), when there is one."""
         file = line = None
         if self.mission is not None and self.mission.path is not None:
             file = str(self.mission.path)
-            block = self.mission.goby_block(self.name)
-            line = config_line(block, field, value) if block is not None else None
+            found = self.mission.goby_block(block or self.name)
+            line = config_line(found, field, value) if found is not None else None
         return ConfigError(reason, file=file, line=line, field=field)
 
     # -- protobuf messages on MOOS variables (the app-internal technique) ----------------------

@@ -49,8 +49,11 @@ def program_name(app_class: type[GobyMOOSApp], argv0: str) -> str:
     return base
 
 
-def argument_parser(program: str) -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=program, description=f"{program}: a Goby MOOS application")
+def argument_parser(program: str, command: str | None = None) -> argparse.ArgumentParser:
+    """The app's command line; `command` is how it is typed when that is not `program` (e.g.
+    `pygoby liaison`), for the usage and --version lines."""
+    parser = argparse.ArgumentParser(prog=command or program,
+                                     description=f"{program}: a Goby MOOS application")  # fmt: skip
     parser.add_argument("mission", nargs="?", help=".moos mission file")
     parser.add_argument("alias", nargs="?", help="name to use with the MOOSDB and ProcessConfig")
     parser.add_argument("-c", "--moos_file", help="same as the mission positional")
@@ -92,13 +95,17 @@ def read_mission(path: str | None, name: str) -> MissionFile | None:
 
 
 def run_app(
-    app_class: type[GobyMOOSApp], argv: Sequence[str] | None = None, prog: str | None = None
+    app_class: type[GobyMOOSApp],
+    argv: Sequence[str] | None = None,
+    prog: str | None = None,
+    command: str | None = None,
 ) -> int:
     """`app_class.main`: parse the command line (`sys.argv` without `argv`), build the app and
-    run it; returns the exit status."""
+    run it; returns the exit status. `prog` is the program's name (the default app name),
+    `command` how it is typed when that differs (a pygoby subcommand)."""
     args_in = list(sys.argv[1:] if argv is None else argv)
     program = prog or program_name(app_class, sys.argv[0] if argv is None else "")
-    parser = argument_parser(program)
+    parser = argument_parser(program, command)
     known, rest = parser.parse_known_args(args_in)
     name = known.moos_name or known.alias or program
     if known.example_config:

@@ -6,7 +6,8 @@
         example_lines = ("Param = value   // what it does",)   # --example_config
         def __init__(self, cfg, **kwargs):
             super().__init__(cfg, **kwargs)
-            self.params                # [(name, value), ...] of the ProcessConfig block
+            self.params                # [Setting(name, value, line), ...] of the block
+            raise self.setting_error("must be a number", setting)   # file:line: name: reason
 
 The block's AppTick and CommsTick and the mission's globals (ServerHost, ServerPort, Community,
 MOOSTimeWarp, LatOrigin, ...) fill the `common` settings Goby apps share, so the app runs with
@@ -25,7 +26,7 @@ from google.protobuf.message import Message
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import apply_moos_globals
-from pygoby.moos.moosfile import MissionFile, parse_number
+from pygoby.moos.moosfile import MissionFile, Setting, parse_number
 
 
 class ClassicMOOSApp(GobyMOOSApp):
@@ -52,14 +53,14 @@ class ClassicMOOSApp(GobyMOOSApp):
         if mission is None:
             return cfg
         apply_moos_globals(cfg, mission)
-        for key, value in mission.process_config(name) or []:
-            field = {"apptick": "app_tick", "commstick": "comm_tick"}.get(key.lower())
+        for setting in mission.process_config(name) or []:
+            field = {"apptick": "app_tick", "commstick": "comm_tick"}.get(setting.name.lower())
             if field is None:
                 continue
-            number = parse_number(value)
+            number = parse_number(setting.value)
             if number is None or number <= 0:
-                raise ConfigError(f"{key} must be a positive number, not {value!r}",
-                                  file=mission.path, field=name)  # fmt: skip
+                raise ConfigError(f"must be a positive number, not {setting.value!r}",
+                                  file=mission.path, line=setting.line, field=setting.name)  # fmt: skip
             setattr(cfg.common, field, max(1, math.ceil(number)))
         return cfg
 
@@ -68,6 +69,18 @@ class ClassicMOOSApp(GobyMOOSApp):
         block = self.mission.process_config(self.name, self.keep_quotes) if self.mission else None
         if block is None:
             self.log.warning("no ProcessConfig = %s block; running with the defaults", self.name)
-        self.params: list[tuple[str, str]] = [
-            (k, v) for k, v in (block or []) if k.lower() not in ("apptick", "commstick")
+        self.params: list[Setting] = [
+            s for s in (block or []) if s.name.lower() not in ("apptick", "commstick")
         ]
+
+    @property
+    def mission_path(self) -> str | None:
+        """The mission file the settings come from (for errors)."""
+        return str(self.mission.path) if self.mission and self.mission.path else None
+
+    def setting_error(self, reason: str, setting: Setting | str) -> ConfigError:
+        """A ConfigError about one setting of the block (a Setting: at its line; a name: a
+        setting that is missing), as `mission.moos:LINE: Name: reason`."""
+        if isinstance(setting, str):
+            return ConfigError(reason, file=self.mission_path, field=setting)
+        return ConfigError(reason, file=self.mission_path, line=setting.line, field=setting.name)

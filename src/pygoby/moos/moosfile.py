@@ -5,7 +5,7 @@ and the Goby TextFormat block (goby-moos-apps.md 2.2).
     mission.get_value("ServerPort")          # "9000": first match anywhere, white space removed
     mission.get_value("LatOrigin", outside_blocks=True)   # only lines outside ProcessConfig blocks
     mission.get_float("LatOrigin")           # None unless numeric
-    mission.process_config("pHelmIvP")       # [(name, value), ...] in file order (or None)
+    mission.process_config("pHelmIvP")       # [Setting(name, value, line), ...] in file order
     mission.goby_block("pAcommsHandler")     # GobyBlock(text, first_line) for TextFormat parsing
     mission.antler()                         # AntlerConfig with its Run entries
 """
@@ -16,12 +16,22 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 from pygoby.errors import ConfigError
 from pygoby.moos.errors import MissionFileError
 
 _NUMERIC = re.compile(r"[0-9.eE+\-]+")
 _MACRO_USE = re.compile(r"\$\{([^}]*)\}")
+
+
+class Setting(NamedTuple):
+    """One `name = value` line of a ProcessConfig block; `line` is its file line (1-based),
+    for errors that say where (None when the setting did not come from a file)."""
+
+    name: str
+    value: str
+    line: int | None = None
 
 
 def strip_comment(line: str) -> str:
@@ -238,7 +248,8 @@ class MissionFile:
 
     # -- ProcessConfig blocks (moos.md 17.3) ---------------------------------------------------
 
-    def _block_lines(self, app: str, keep_quotes: bool = False) -> list[str] | None:
+    def _block_lines(self, app: str, keep_quotes: bool = False) -> list[tuple[int, str]] | None:
+        """The block's lines as (file line, text)."""
         header = f"PROCESSCONFIG={app}".upper()
         lines = self.quoted_lines if keep_quotes else self.lines
         for i, line in enumerate(lines):
@@ -252,35 +263,35 @@ class MissionFile:
             body = []
             first = lines[j].strip()[1:].strip()
             if first:
-                body.append(first)
-            for line in lines[j + 1 :]:
+                body.append((j + 1, first))
+            for number, line in enumerate(lines[j + 1 :], start=j + 2):
                 if line.strip().startswith("}"):
                     break
-                body.append(line)
+                body.append((number, line))
             return body
         return None
 
-    def process_config(self, app: str, keep_quotes: bool = False) -> list[tuple[str, str]] | None:
+    def process_config(self, app: str, keep_quotes: bool = False) -> list[Setting] | None:
         """The block's `name = value` settings in file order, names and values trimmed
-        (GetConfigurationAndPreserveSpace); None if there is no such block. MOOS's reader
-        removes the first pair of double quotes of a line ("verbatim quoting"); apps that
-        disable it (uTimerScript) pass `keep_quotes=True`."""
+        (GetConfigurationAndPreserveSpace), each with its file line; None if there is no such
+        block. MOOS's reader removes the first pair of double quotes of a line ("verbatim
+        quoting"); apps that disable it (uTimerScript) pass `keep_quotes=True`."""
         body = self._block_lines(app, keep_quotes)
         if body is None:
             return None
         out = []
-        for line in body:
+        for number, line in body:
             name, sep, value = line.strip().partition("=")
             if not sep:
                 continue
             value = value.strip()
             if not value and "[" not in line and "]" not in line:
                 continue
-            out.append((name.strip(), value))
+            out.append(Setting(name.strip(), value, number))
         return out
 
     def block_value(self, app: str, name: str) -> str | None:
-        for key, value in self.process_config(app) or []:
+        for key, value, _ in self.process_config(app) or []:
             if key.lower() == name.lower():
                 return value
         return None
@@ -316,7 +327,7 @@ class MissionFile:
             raise MissionFileError(
                 "no ProcessConfig = ANTLER block in the mission file", file=self.path
             )
-        compact = [(_no_space(k), _no_space(v)) for k, v in settings]
+        compact = [(_no_space(k), _no_space(v)) for k, v, _ in settings]
         lookup = {k.lower(): v for k, v in reversed(compact)}  # first occurrence wins
         runs = []
         for key, value in compact:

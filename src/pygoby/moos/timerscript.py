@@ -13,6 +13,9 @@ The subset missions use (MOOS-IvP ivp/src/uTimerScript):
   `TIME_WARP`, `STATUS_VAR`, `PAUSE_VAR`, `RESET_VAR`, `FORWARD_VAR`, `VERBOSE`.
 * Mail: UTS_PAUSE (true/false/toggle), UTS_RESET (reset/true), UTS_FORWARD (seconds; 0 jumps
   to the next event); the variables of the conditions. Status: UTS_STATUS.
+
+The settings are the block's `Setting`s (MissionFile.process_config); a bad one is a ConfigError
+at its line: `mission.moos:12: EVENT: 'var=X, vla=3': unknown field 'vla' (...)`.
 """
 
 from __future__ import annotations
@@ -21,9 +24,11 @@ import random
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
+from os import PathLike
 
 from pygoby.errors import ConfigError
 from pygoby.moos.logic import LogicCondition, Value
+from pygoby.moos.moosfile import Setting
 
 
 @dataclass
@@ -78,31 +83,39 @@ def _is_number(text: str) -> bool:
     return re.fullmatch(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)", text) is not None
 
 
-def _range(text: str, what: str) -> tuple[float, float]:
+def _range(text: str, what: str = "") -> tuple[float, float]:
+    """A number or a range A:B; `what` goes in front of the errors (an EVENT's part)."""
+    where = f"{what} " if what else ""
     low, sep, high = text.partition(":")
     try:
         a = float(low)
         b = float(high) if sep else a
     except ValueError:
-        raise ConfigError(f"{what} {text!r} is not a number or a range A:B") from None
+        raise ConfigError(f"{where}{text!r} is not a number or a range A:B") from None
     if a < 0 or b < a:
-        raise ConfigError(f"{what} {text!r}: need 0 <= A <= B")
+        raise ConfigError(f"{where}{text!r}: need 0 <= A <= B")
     return a, b
 
 
-def _boolean(text: str, what: str) -> bool:
+def _boolean(text: str) -> bool:
     lowered = text.strip().lower()
     if lowered in ("true", "1", "yes"):
         return True
     if lowered in ("false", "0", "no"):
         return False
-    raise ConfigError(f"{what} must be true or false, not {text!r}")
+    raise ConfigError(f"must be true or false, not {text!r}")
 
 
 class TimerScript:
-    """Feed `on_mail(var, value)` and call `tick(now)`; both return the posts to make."""
+    """Feed `on_mail(var, value)` and call `tick(now)`; both return the posts to make.
+    `file` is where `settings` come from, for the errors."""
 
-    def __init__(self, settings: Iterable[tuple[str, str]], rng: random.Random | None = None) -> None:
+    def __init__(
+        self,
+        settings: Iterable[Setting],
+        rng: random.Random | None = None,
+        file: str | PathLike[str] | None = None,
+    ) -> None:
         self.rng = rng or random.Random()
         self.events: list[Event] = []
         self.conditions: list[LogicCondition] = []
@@ -118,8 +131,12 @@ class TimerScript:
         self.var_status, self.var_pause = "UTS_STATUS", "UTS_PAUSE"
         self.var_reset, self.var_forward = "UTS_RESET", "UTS_FORWARD"
         self.warnings: list[str] = []
-        for name, value in settings:
-            self._configure(name.strip().lower(), value.strip())
+        for setting in settings:
+            try:
+                self._configure(setting.name.strip().lower(), setting.value.strip())
+            except ConfigError as err:
+                raise ConfigError(err.reason, file=file, line=setting.line,
+                                  field=setting.name.strip()) from None  # fmt: skip
         self.quit = False
         self.values: dict[str, Value] = {}
         self.conditions_ok = not self.conditions
@@ -145,34 +162,34 @@ class TimerScript:
             elif _is_number(value) and float(value) > 0:
                 self.reset_time = float(value)
             else:
-                raise ConfigError(f"RESET_TIME must be end, all-posted, none or seconds, not {value!r}")
+                raise ConfigError(f"must be end, all-posted, none or seconds, not {value!r}")
         elif name == "reset_max":
             if value.lower() in ("any", "unlimited", "nolimit"):
                 self.reset_max = None
             elif value.isdigit():
                 self.reset_max = int(value)
             else:
-                raise ConfigError(f"RESET_MAX must be a count or nolimit, not {value!r}")
+                raise ConfigError(f"must be a count or nolimit, not {value!r}")
         elif name == "paused":
-            self.paused = _boolean(value, "PAUSED")
+            self.paused = _boolean(value)
         elif name == "condition":
             self.conditions.append(LogicCondition(value))
         elif name == "upon_awake":
             if value.lower() not in ("reset", "restart", "n/a"):
-                raise ConfigError(f"UPON_AWAKE must be reset, restart or n/a, not {value!r}")
+                raise ConfigError(f"must be reset, restart or n/a, not {value!r}")
             self.upon_awake = value.lower()
         elif name == "shuffle":
-            self.shuffle = _boolean(value, "SHUFFLE")
+            self.shuffle = _boolean(value)
         elif name == "script_name":
             self.script_name = value
         elif name in ("delay_start", "delay_reset", "time_warp"):
-            setattr(self, name, _range(value, name.upper()))
+            setattr(self, name, _range(value))
             if name == "time_warp" and self.time_warp[0] <= 0:
-                raise ConfigError("TIME_WARP must be positive")
+                raise ConfigError("must be positive")
         elif name in ("status_var", "pause_var", "pause_variable", "reset_var", "reset_variable",
                       "forward_var", "forward_variable"):  # fmt: skip
             if not value or any(c.isspace() for c in value):
-                raise ConfigError(f"{name.upper()} must be a variable name, not {value!r}")
+                raise ConfigError(f"must be a variable name, not {value!r}")
             setattr(self, "var_" + name.split("_")[0], value)
         elif name in ("verbose", "appcast", "apptick", "commstick", "maxappticks"):
             pass  # terminal and scheduling settings
@@ -188,25 +205,25 @@ class TimerScript:
             key, sep, raw = part.partition("=")
             key = key.strip().lower()
             if not sep:
-                raise ConfigError(f"EVENT {text!r}: {part.strip()!r} is not key=value")
+                raise ConfigError(f"{text!r}: {part.strip()!r} is not key=value")
             if key == "var":
                 var = raw.strip()
                 if not var or any(c.isspace() for c in var):
-                    raise ConfigError(f"EVENT {text!r}: var must be a variable name")
+                    raise ConfigError(f"{text!r}: var must be a variable name")
             elif key == "val":
                 value, quoted = parse_value(raw)
             elif key == "time":
-                times = _range(raw.strip(), f"EVENT {text!r}: time")
+                times = _range(raw.strip(), f"{text!r}: time")
             elif key == "amt":
                 if not raw.strip().isdigit() or int(raw) < 1:
-                    raise ConfigError(f"EVENT {text!r}: amt must be a positive count")
+                    raise ConfigError(f"{text!r}: amt must be a positive count")
                 amount = int(raw)
             else:
-                raise ConfigError(f"EVENT {text!r}: unknown field {key!r} (var, val, time, amt, quit)")
+                raise ConfigError(f"{text!r}: unknown field {key!r} (var, val, time, amt, quit)")
         if not var:
-            raise ConfigError(f"EVENT {text!r} has no var=")
+            raise ConfigError(f"{text!r} has no var=")
         if value is None or value == "":
-            raise ConfigError(f"EVENT {text!r} has no val=")
+            raise ConfigError(f"{text!r} has no val=")
         for _ in range(amount):
             self.events.append(Event(var, value, times[0], times[1], quoted, quit_app))
 

@@ -79,9 +79,7 @@ class MessageTypes:
         found = _find(path, self._search_dirs)
         if found is None and not self.loader.on_import_path(path):
             searched = [*self._search_dirs, *self.loader.import_path()]
-            raise self._error(
-                f'"{path}" not found; searched: {", ".join(searched)}', "load_proto_file", path
-            )
+            raise self._error(not_found(path, searched), "load_proto_file", path)
         try:
             descriptor = self.loader.load_file(found or path)
         except (ProtoError, OSError) as err:
@@ -118,6 +116,28 @@ class MessageTypes:
         if self._fallback is not None:
             return self._fallback(name)
         raise ProtoError(f"unknown message type {name!r}")
+
+    def require(self, name: str, field: str, loaded: Sequence[str] | None = None) -> type[Message]:
+        """The class of `name`, set in configuration `field`; else the located ConfigError that
+        lists the loaded types (`loaded`, default the ones these files and modules define)."""
+        try:
+            return self(name)
+        except ProtoError:
+            listed = self.loaded if loaded is None else loaded
+            raise self._error(not_loaded(name, listed), field, name) from None
+
+
+def not_loaded(name: str, loaded: Sequence[str]) -> str:
+    """The reason of a configuration error for a message type no file defines (typically a
+    misspelling), with the types that are there to compare."""
+    return (f'"{name}" is not a loaded message type; the types load_proto_file and '
+            f'load_shared_library loaded are: {", ".join(loaded) or "none"}')  # fmt: skip
+
+
+def not_found(path: str, searched: Sequence[str]) -> str:
+    """The reason of a configuration error for a file found nowhere: the name as given and the
+    folders (in order) it was looked for in, so that a user sees which relative base applies."""
+    return f'"{path}" not found; searched: {", ".join(searched)}'
 
 
 def _find(path: str, search_dirs: Sequence[str]) -> str | None:

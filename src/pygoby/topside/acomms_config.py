@@ -3,7 +3,7 @@ itself and for the tools that show or compose its messages (liaison, iCommander)
 reads the same block the same way and no app imports another.
 
     cfg = read_acomms_config(mission, "pAcommsHandler")  # Goby 1.1/2 forms translated
-    messages = AcommsMessageSet.load(cfg, mission.find_file)
+    messages = AcommsMessageSet.load(cfg, mission.find_file, mission.search_dirs())
     messages.types("SIMPLE_STATUS")                      # a class of load_proto_file,
                                                          # load_shared_library or an XML file
     messages.import_xml("more.xml")                      # iCommander's "Import Message File"
@@ -15,8 +15,10 @@ never imports `moos`.
 
 from __future__ import annotations
 
+import functools
+import os
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from google.protobuf.message import Message
@@ -30,13 +32,20 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import Translator
-from pygoby.moos.translator_binding import MessageTypes
+from pygoby.moos.translator_binding import MessageTypes, not_found
 from pygoby.protobuf import ProtoLoader, builtin_class
 
 PACOMMSHANDLER_CONFIG = (
     "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
     "goby.apps.moos.protobuf.pAcommsHandlerConfig",
 )
+XML_PATH_FIELD = "message_file.path"  # dccl_cfg/queue_cfg/transitional_cfg all name it so
+
+ErrorMaker = Callable[[str, str, str], ConfigError]  # (reason, field, value): GobyMOOSApp.config_error
+
+
+def _unlocated(reason: str, field: str, value: str) -> ConfigError:
+    return ConfigError(reason, field=field)
 
 
 def read_acomms_config(
@@ -59,23 +68,28 @@ class AcommsMessageSet:
     transitional: TransitionalMessages
     dccl_libraries: list[BuiltinLibrary]  # load_shared_library's C++ DCCL codec libraries
     find: Callable[[str], str] = str
+    search_dirs: Sequence[str] = field(default_factory=list)  # where `find` looks (for errors)
 
     @classmethod
     def load(
         cls, cfg: Message, find: Callable[[str], str] = str, search_dirs: Sequence[str] = (),
-        config_error: Callable[[str, str, str], ConfigError] | None = None,
+        config_error: ErrorMaker | None = None,
     ) -> AcommsMessageSet:  # fmt: skip
         """Load `cfg`'s message files; `find` resolves relative file names (the mission's
-        find_file), `search_dirs` are the folders it looks in (for "not found" errors). The XML
-        files' entries are appended to `cfg`, so load a configuration once. ConfigError for
-        files that cannot be used, made by `config_error(reason, field, value)` (located at the
-        mission line: GobyMOOSApp.config_error) when given."""
-        error = config_error or (lambda reason, field, value: ConfigError(reason, field=field))
+        find_file), `search_dirs` are the folders it looks in (for "not found" errors; default
+        the working directory). The XML files' entries are appended to `cfg`, so load a
+        configuration once. ConfigError for files that cannot be used, made by
+        `config_error(reason, field, value)` (located at the mission line:
+        GobyMOOSApp.config_error) when given."""
+        error = config_error or _unlocated
         dccl_libraries, modules = split_libraries(
             cfg.load_shared_library, lambda reason, name: error(reason, "load_shared_library", name)
         )
         loader = ProtoLoader()
-        transitional = TransitionalMessages.expand(cfg, loader, find)
+        search_dirs = list(search_dirs) or [os.getcwd()]
+        transitional = TransitionalMessages.expand(
+            cfg, loader, _xml_finder(find, search_dirs, error)
+        )
         types = MessageTypes(
             [*(p for library in dccl_libraries for p in library.proto_files),
              *(find(path) for path in cfg.load_proto_file)],
@@ -85,7 +99,10 @@ class AcommsMessageSet:
             search_dirs=search_dirs,
             config_error=config_error,
         )  # fmt: skip
-        return cls(cfg, loader, types, transitional, dccl_libraries, find)
+        out = cls(cfg, loader, types, transitional, dccl_libraries, find, search_dirs)
+        out.require([entry.protobuf_name for entry in cfg.translator_entry],
+                    "translator_entry.protobuf_name")  # fmt: skip
+        return out
 
     def loaded(self) -> list[str]:
         """The message types the files, modules, libraries and XML files define."""
@@ -104,12 +121,14 @@ class AcommsMessageSet:
         if mission is None:
             raise ConfigError(f"{app.name} needs the mission file with the {block} ProcessConfig")
         if message_files and mission.goby_block(block) is None:
-            out = cls.load(builtin_class(*PACOMMSHANDLER_CONFIG)(), app.find_file)
+            cfg = builtin_class(*PACOMMSHANDLER_CONFIG)()
         else:
-            out = cls.load(read_acomms_config(mission, block), app.find_file)
+            cfg = read_acomms_config(mission, block)
+        out = cls.load(cfg, app.find_file, app.search_dirs(),
+                       config_error=functools.partial(app.config_error, block=block))  # fmt: skip
         for message_file in message_files:
             if Path(app.find_file(message_file.path)).resolve() not in out.files():
-                out.import_xml(message_file.path, message_file.manipulator)
+                out.import_xml(message_file.path, message_file.manipulator, app.config_error)
         return out
 
     def files(self) -> set[Path]:
@@ -126,12 +145,10 @@ class AcommsMessageSet:
             raise ConfigError(f"load_shared_library: {err}") from None
 
     def require(self, names: Sequence[str], field: str) -> set[str]:
-        """`names` (of configuration `field`), each a loaded type, else ConfigError."""
+        """`names` (of configuration `field`), each a loaded type, else the located ConfigError
+        that lists the loaded types."""
         for name in names:
-            try:
-                self.types(name)
-            except Exception:
-                raise ConfigError(f"{name!r} is not a loaded type", field=field) from None
+            self.types.require(name, field, self.loaded())
         return set(names)
 
     def read_named_values(self, translator: Translator) -> None:
@@ -139,14 +156,32 @@ class AcommsMessageSet:
         for name, keys in self.transitional.single_field_sources().items():
             translator.read_named_values(name, keys)
 
-    def import_xml(self, path: str, manipulators: Sequence[int] = ()) -> list[str]:
+    def import_xml(
+        self, path: str, manipulators: Sequence[int] = (), config_error: ErrorMaker | None = None
+    ) -> list[str]:
         """Add the messages of one more XML file (iCommander's "Import Message File") to the
         set and to `cfg`; returns their names. ConfigError (file:line) for a file that cannot
-        be used or that defines a message already loaded."""
+        be used or that defines a message already loaded; one not found is located by
+        `config_error` when the path comes from a configuration."""
         message_file = self.cfg.transitional_cfg.message_file.add(path=path, manipulator=manipulators)
+        find = _xml_finder(self.find, self.search_dirs, config_error or _unlocated)
         try:
-            message_set = self.transitional.add_file(self.cfg, message_file, self.loader, self.find)
+            message_set = self.transitional.add_file(self.cfg, message_file, self.loader, find)
         except ConfigError:
             del self.cfg.transitional_cfg.message_file[-1]
             raise
         return message_set.names
+
+
+def _xml_finder(
+    find: Callable[[str], str], search_dirs: Sequence[str], error: ErrorMaker
+) -> Callable[[str], str]:
+    """`find` for XML message files, with load_proto_file's error for a file found nowhere."""
+
+    def find_xml(path: str) -> str:
+        found = find(path)
+        if not Path(found).is_file():
+            raise error(not_found(path, search_dirs), XML_PATH_FIELD, path)
+        return found
+
+    return find_xml

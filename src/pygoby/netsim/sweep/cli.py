@@ -100,13 +100,19 @@ def sweep_command(args: argparse.Namespace) -> int:
 
 
 def sweep_report_command(args: argparse.Namespace) -> int:
-    from pygoby.netsim.sweep.report import read_results, write_sweep_report
+    from pygoby.netsim.sweep.report import read_results, results_path, write_sweep_report
+    from pygoby.netsim.sweep.store import RESULTS_FILE
 
     source = Path(args.results)
+    table_path = results_path(source)
+    if not table_path.is_file():
+        missing = f"no {RESULTS_FILE} in {source}" if source.is_dir() else f"{source} does not exist"
+        return _fail("sweep-report", f"{missing}: give the output folder of `pygoby netsim sweep` "
+                                     f"(it writes {RESULTS_FILE} there); run the sweep first")  # fmt: skip
     try:
-        table = read_results(source)
+        table = read_results(table_path)
     except OSError as exc:
-        return _fail("sweep-report", f"cannot read {source}: {exc}")
+        return _fail("sweep-report", f"cannot read {table_path}: {exc}")
     if table.num_rows == 0:
         return _fail("sweep-report", f"no results in {source}")
     out = Path(args.output) if args.output else (source if source.is_dir() else source.parent) / "report"

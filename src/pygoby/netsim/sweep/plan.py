@@ -191,13 +191,17 @@ def parse_value(field: FieldDescriptor, text: str) -> Value:
         if text.lower() in ("false", "f", "0"):
             return False
         raise ValueError(f"{text!r} is not true or false")
-    if kind is int:
-        number = float(text)
-        if number != int(number):
-            raise ValueError(f"{text!r} is not an integer")
+    if kind in (int, float):
+        expected = "an integer" if kind is int else "a number"
+        try:
+            number = float(text)
+        except ValueError:
+            raise ValueError(f"expects {expected}, not {text!r}") from None
+        if kind is float:
+            return number
+        if not number.is_integer():
+            raise ValueError(f"expects {expected}, not {text!r}")
         return int(number)
-    if kind is float:
-        return float(text)
     return text
 
 

@@ -30,6 +30,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from pygoby.netsim.report import plt, save_figure
+from pygoby.netsim.sweep.store import RESULTS_FILE
 
 Z95 = 1.959963984540054  # standard normal 97.5 % quantile
 MAX_DISTINCT_RANGES = 30
@@ -47,9 +48,14 @@ def wilson_interval(successes: int, trials: int, z: float = Z95) -> tuple[float,
     return (max(0.0, centre - half), min(1.0, centre + half))
 
 
-def read_results(source: str | Path) -> pa.Table:
+def results_path(source: str | Path) -> Path:
+    """The table of `source`: a sweep's output folder or the table file itself."""
     path = Path(source)
-    return pq.read_table(path / "results.parquet" if path.is_dir() else path)
+    return path / RESULTS_FILE if path.is_dir() else path
+
+
+def read_results(source: str | Path) -> pa.Table:
+    return pq.read_table(results_path(source))
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,8 @@ import pyarrow.parquet as pq
 
 from pygoby.netsim.sweep.plan import AxisColumn, RunSpec
 
+RESULTS_FILE = "results.parquet"  # the sweep's table, in its output folder
+
 _ARROW = {int: pa.int64(), float: pa.float64(), bool: pa.bool_(), str: pa.string()}
 
 HEAD_COLUMNS = [("run_id", pa.string()), ("point", pa.int64()), ("replicate", pa.int64()),
@@ -73,7 +75,7 @@ class ResultStore:
 
     @property
     def table_path(self) -> Path:
-        return self.directory / "results.parquet"
+        return self.directory / RESULTS_FILE
 
     def run_path(self, run_id: str) -> Path:
         return self.runs_dir / f"{run_id}.parquet"
