@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
+from textual.css.query import NoMatches
 from textual.widgets import Footer, Header, OptionList, RichLog, Static
 from textual.widgets.option_list import Option
 
@@ -92,7 +93,11 @@ class AppGUI(App[None]):
         self.refresh_view()
 
     def refresh_view(self) -> None:
-        self.query_one("#status", Static).update("\n".join(self.moos_app.status_lines()))
+        try:
+            status = self.query_one("#status", Static)
+        except NoMatches:  # a tick of the interval while the app shuts down: the widgets are gone
+            return
+        status.update("\n".join(self.moos_app.status_lines()))
         groups = sorted(self.handler.groups)
         if groups != self._listed:
             self._listed = groups
