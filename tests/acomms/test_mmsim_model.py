@@ -233,6 +233,17 @@ def test_time_query_set_and_clock_query():
     assert w.say(1, "$CCALQ,0")[0].fields[1:] == ("pygoby-mmsim", "11")
 
 
+def test_a_moos_time_warped_clock_is_accepted():
+    """iModemSim's host under MOOSTimeWarp 20 sets the modem to year 3108 (MOOS time = epoch x
+    warp); refusing it made every driver start-up retry $CCTMS and give up."""
+    w = Water(ids=(1,))
+    assert w.say(1, "$CCTMS,3108-05-12T13:20:11Z,0") == []  # (no $CAERR)
+    w.run(2)
+    ((_, tms),) = w.said(1, "TMS")
+    assert tms.fields[1] == "0" and tms.fields[2].startswith("3108-05-12T13:20:1")
+    assert w.say(1, "$CCCLQ,0,0")[0].fields[1:4] == ("3108", "5", "12")
+
+
 @pytest.mark.parametrize(
     "bad",
     ["$CCTMS,0001-01-01T00:00:00Z,0", "$CCTMS,9999-12-31T23:59:59Z,0", "$CCTMS,2024-01-02T03:04:05+02:00,0",
@@ -309,6 +320,22 @@ def test_third_party_poll_makes_the_polled_modem_send():
     w.say(2, "$CCTXD,2,1,1,")  # no more
     w.run(10)
     assert [s[5] for _, s in w.said(1, "RXD")] == ["beef"]
+
+
+def test_a_rate_0_poll_heard_before_the_host_spoke_goes_on_the_water_at_once():
+    """Regression: a modem polled acoustically before its host had sent it anything (two
+    iModemSims of a mission both have ModemID 1 until their hosts configure them) started its
+    cycle-init at -inf; the $CACST of its reception then raised OverflowError and wedged the
+    emulator."""
+    w = Water(range_m=0.0)
+    w.say(1, "$CCCYC,0,2,1,0,0,1")  # 1 polls 2 at rate 0; 2's host has said nothing
+    w.run(5)
+    (heard_poll,) = [t for t, _ in w.said(2, "CYC")]
+    assert heard_poll == pytest.approx(1.012, abs=1e-3)  # the line, then 1 s of cycle-init
+    # 2's own cycle-init goes out as it hears the poll; its host is asked for data as it ends
+    assert [t for t, _ in w.said(1, "CYC")][1:] == [pytest.approx(heard_poll + 1.0, abs=1e-6)]
+    assert [t for t, _ in w.said(2, "DRQ")] == [pytest.approx(heard_poll + 1.0, abs=1e-6)]
+    assert w.say(2, "$CCMSC,1,1,0")[0].sentence_id == "REV"  # and it still answers its host
 
 
 def test_channel_statistics_reach_cacst():

@@ -55,7 +55,10 @@ NMEA_API_LEVEL = 11  # what pyacomms assumes for a Micro-Modem 2 (time queries n
 APPLICATION_NAME = "pygoby-mmsim"
 MAX_ADDRESS = 127
 INT32 = (-(2**31), 2**31 - 1)
-YEARS = (1970, 2099)  # clock settings the emulator accepts
+# clock settings the emulator accepts: up to year 9998, since a MOOSTimeWarp clock (MOOS time =
+# epoch x warp) is centuries ahead (year 3108 at warp 20) and iModemSim's host sets it; 9999 is
+# refused so that the modem's time plus any offset stays a date
+YEARS = (1970, 9998)
 TMS_EXTPPS_TIMEOUT = 3.0  # s: $CCTMS mode 1 waits for an external PPS edge (pyacomms: "up to 3 s")
 CST_VERSION_MM2 = 6  # $CACST / $CAXST with a version field and dated times (Micro-Modem 2)
 
@@ -324,9 +327,9 @@ class MicroModemModel:
             cycle = AcousticPacket(
                 PacketKind.CYCLE, tx.src, tx.dest, 0, tx.ack, num_frames=tx.num_frames
             )
-            self._send(
-                cycle, self.timing.mini_packet, lambda: self._request_frame(tx), self._line_done
-            )
+            # (polled acoustically before the host said anything, the line has no time yet: now)
+            start = max(self._line_done, self.clock.now())
+            self._send(cycle, self.timing.mini_packet, lambda: self._request_frame(tx), start)
         else:
             self._request_frame(tx)
 
