@@ -7,6 +7,7 @@ input makes a decoder raise anything else."""
 from __future__ import annotations
 
 import math
+import struct
 
 import pytest
 from hypothesis import given, settings
@@ -34,6 +35,11 @@ from tests.dccl.remus_cpp import from_json, message_class, read_records, to_mess
 
 ALL_TYPES = (State, Redirect, Ranger, Position, Alert, Alert2)
 HALF_HEADING = 360 / 255 / 2
+
+
+def f32(value: float) -> float:
+    """The value as a C float holds it."""
+    return struct.unpack("f", struct.pack("f", value))[0]
 
 
 def le(value: int, count: int) -> bytes:
@@ -214,7 +220,12 @@ def test_state_round_trip_within_resolution(state):
         assert getattr(back, name) == getattr(state, name)
     gpo, sent = back.gfi_pitch_oil, state.gfi_pitch_oil
     assert abs(gpo.gfi - sent.gfi) <= 100 / 31 + 1 and abs(gpo.oil - sent.oil) <= 100 / 31 + 1e-3
-    assert abs(gpo.pitch - sent.pitch) <= 180 / 63 / 2 + 1e-3  # (+90 itself wraps to -91.4, as in C++)
+    if f32(f32(sent.pitch * 0.35) + 0.5) >= 32:
+        # as in C++, a pitch whose 32-bit scaled value rounds up to +32 steps (+90 itself, and
+        # anything within float rounding of it) wraps to -32 steps
+        assert gpo.pitch == pytest.approx(-32 * 180 / 63, abs=1e-4)
+    else:
+        assert abs(gpo.pitch - sent.pitch) <= 180 / 63 / 2 + 1e-3
 
 
 @given(st.builds(Redirect, latitude=lat, longitude=lon, message_number=byte, speed_depth_flags=byte,
