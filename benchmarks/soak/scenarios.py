@@ -40,7 +40,7 @@ from pygoby.moos.client import MAX_REFUSED_BACKOFF, MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.util.aiorun import STOP_GRACE
 from pygoby.util.nmea import with_checksum
-from tests.apps.acomms_mission import ACK_SLOTS, Recorder, mission_text, modem_and_db
+from tests.apps.acomms_mission import Recorder, mission_text, modem_and_db
 from tests.faults import CuttableRelay
 
 Scenario = Callable[[float, Path], Awaitable[Figures]]
@@ -298,10 +298,10 @@ async def pacommshandler_kill9(seconds: float, workdir: Path) -> Figures:
     async with contextlib.AsyncExitStack() as stack:
         sims, dbs = zip(*[await modem_and_db(stack, modem_id, channel, clock) for modem_id in (1, 2)],
                         strict=True)  # fmt: skip
-        text = mission_text(1, dbs[0].port, sims[0].port, slots=ACK_SLOTS).replace(
+        text = mission_text(1, dbs[0].port, sims[0].port).replace(
             "  queue_cfg {\n", '  queue_cfg {\n    persistent_queue_file: "queue.sqlite"\n', 1)
         (workdir / "vehicle1.moos").write_text(text)
-        (workdir / "vehicle2.moos").write_text(mission_text(2, dbs[1].port, sims[1].port, slots=ACK_SLOTS))
+        (workdir / "vehicle2.moos").write_text(mission_text(2, dbs[1].port, sims[1].port))
         vehicle2 = pAcommsHandler.from_mission(workdir / "vehicle2.moos", "pAcommsHandler")
         await stack.enter_async_context(vehicle2)
         r1, r2 = Recorder("soak1", dbs[0].port), Recorder("soak2", dbs[1].port)

@@ -124,9 +124,9 @@ async def test_acked_message_queued_during_link_outage_is_delivered_after_reconn
     clock = WallClock()
     q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
     q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
-    mac = MACManager(clock)  # node 1 owns every 1 s slot
+    mac = MACManager(clock)  # node 1 owns every slot, one a rate-1 packet and its ack fit in
     mac.startup(acomms_pb.MACConfig(modem_id=1, type=MAC_FIXED_DECENTRALIZED,
-                            slot=[acomms_pb.ModemTransmission(src=1, dest=-1, rate=0, slot_seconds=1)]))  # fmt: skip
+                            slot=[acomms_pb.ModemTransmission(src=1, dest=-1, rate=1, slot_seconds=3)]))  # fmt: skip
     bind(d1, q1, mac)
     bind(d2, q2)
     received, acked = [], []

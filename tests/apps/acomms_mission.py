@@ -20,12 +20,15 @@ from pygoby.util.clock import WallClock
 PROTO = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / "two_vehicles.proto"
 STATUS = "pygoby.examples.SimpleStatus"
 COMMAND = "pygoby.examples.Command"
-SLOT_SECONDS = 1.5
-# slots an acknowledged packet fits in (a rate-1 frame, ~1.4 s on the water, then the 1 s
-# acknowledgement): with shorter ones the sender's next cycle comes before the ack, which the
-# driver then ignores, as goby's does
-ACK_SLOTS = "".join(
-    f"    slot {{ src: {src} dest: -1 rate: 1 type: DATA slot_seconds: 3 }}\n" for src in (1, 2)
+# TDMA slots a packet and its acknowledgement fit in with the emulated modem's timing: a rate-1
+# packet of one frame is ~1.3 s on the water (with the host's sentences on the serial line) and
+# the acknowledgement 1 s more. Shorter slots are not a mission a real modem could run: the
+# modem's transmissions would queue behind each other, later every cycle (a rate-0 packet alone,
+# cycle-init and data, is ~4.3 s), and the sender's next cycle would come before the ack.
+SLOT_SECONDS = 3
+SLOTS = "".join(
+    f"    slot {{ src: {src} dest: -1 rate: 1 type: DATA slot_seconds: {SLOT_SECONDS} }}\n"
+    for src in (1, 2)
 )
 
 QUEUE_ENTRIES = f"""\
@@ -94,10 +97,7 @@ def mission_text(
     if driver is None:
         driver = micromodem_driver(modem_port)
     if slots is None:
-        slots = "".join(
-            f"    slot {{ src: {src} dest: -1 rate: 0 type: DATA slot_seconds: {SLOT_SECONDS} }}\n"
-            for src in (1, 2)
-        )
+        slots = SLOTS
     return f"""\
 ServerHost = localhost
 ServerPort = {db_port}
@@ -190,6 +190,27 @@ async def modem_and_db(
 ) -> tuple[MMSimServer, MOOSDB]:
     """An emulated Micro-Modem and the MOOSDB of community `vehicle<modem_id>`."""
     return await start_modem(stack, modem_id, channel, clock), await start_db(stack, modem_id)
+
+
+@contextlib.asynccontextmanager
+async def two_vehicle_missions(tmp_path: Path, mission, watched: list[str], channel, clock):
+    """Vehicles 1 and 2, each an emulated Micro-Modem on `channel`, a MOOSDB, the pAcommsHandler
+    of the mission file `mission(modem_id, db_port, modem_port)` writes and a recorder of
+    `watched`: yields ([app1, app2], [recorder1, recorder2])."""
+    async with contextlib.AsyncExitStack() as stack:
+        apps, recorders = [], []
+        for modem_id in (1, 2):
+            sim, db = await modem_and_db(stack, modem_id, channel, clock)
+            path = tmp_path / f"mm{modem_id}.moos"
+            path.write_text(mission(modem_id, db.port, sim.port))
+            app = pAcommsHandler.from_mission(path, "pAcommsHandler")
+            recorder = Recorder(f"recorder{modem_id}", db.port)
+            await recorder.start(watched)
+            stack.push_async_callback(recorder.close)
+            await stack.enter_async_context(app)
+            apps.append(app)
+            recorders.append(recorder)
+        yield apps, recorders
 
 
 class MicroModemLink:

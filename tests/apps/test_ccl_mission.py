@@ -7,20 +7,17 @@ from a .proto file (the example loads it from a C++ library)."""
 from __future__ import annotations
 
 import asyncio
-import contextlib
 
 import pytest
 
 from pygoby.acomms import messages as m
-from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
-from pygoby.acomms.mmsim.server import MMSimServer
+from pygoby.acomms.mmsim import LoopbackChannel
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.appconfig import ConfigError
-from pygoby.moos.db import MOOSDB
 from pygoby.moos.translator import parse_for_moos
 from pygoby.util.clock import WallClock
 
-from .acomms_mission import PROTO, Recorder
+from .acomms_mission import PROTO, Recorder, two_vehicle_missions
 
 STATE = "dccl.legacyccl.protobuf.CCLMDATState"
 STATUS = "pygoby.examples.SimpleStatus"
@@ -62,8 +59,8 @@ ProcessConfig = pAcommsHandler
   }}
   mac_cfg {{
     type: MAC_FIXED_DECENTRALIZED
-    slot {{ src: 1 type: DATA slot_seconds: 1.5 }}
-    slot {{ src: 2 type: DATA slot_seconds: 1.5 }}
+    slot {{ src: 1 type: DATA rate: 1 slot_seconds: 3 }}
+    slot {{ src: 2 type: DATA rate: 1 slot_seconds: 3 }}
   }}
   queue_cfg {{
     message_entry {{ protobuf_name: "{STATE}" ack: false blackout_time: 1 ttl: 300 value_base: 1.5
@@ -95,27 +92,9 @@ ProcessConfig = pAcommsHandler
 """
 
 
-@contextlib.asynccontextmanager
-async def two_vehicles(tmp_path):
-    channel, clock = LoopbackChannel(), WallClock()
-    async with contextlib.AsyncExitStack() as stack:
-        apps, recorders = [], []
-        for modem_id in (1, 2):
-            sim = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
-            await sim.start()
-            stack.push_async_callback(sim.close)
-            db = await stack.enter_async_context(MOOSDB(port=0, community=f"mm{modem_id}"))
-            path = tmp_path / f"mm{modem_id}.moos"
-            path.write_text(mission(modem_id, db.port, sim.port))
-            app = pAcommsHandler.from_mission(path, "pAcommsHandler")
-            recorder = Recorder(f"uXMS{modem_id}", db.port)
-            await recorder.start(["REMUS_STATUS_REPORT_IN", "STATUS_REPORT_IN_PB",
-                                  "ACOMMS_MODEM_TRANSMIT"])
-            stack.push_async_callback(recorder.close)
-            await stack.enter_async_context(app)
-            apps.append(app)
-            recorders.append(recorder)
-        yield apps, recorders
+def two_vehicles(tmp_path):
+    watched = ["REMUS_STATUS_REPORT_IN", "STATUS_REPORT_IN_PB", "ACOMMS_MODEM_TRANSMIT"]
+    return two_vehicle_missions(tmp_path, mission, watched, LoopbackChannel(), WallClock())
 
 
 async def test_ccl_state_and_dccl_status_between_two_vehicles(tmp_path):

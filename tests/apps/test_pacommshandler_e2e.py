@@ -10,7 +10,7 @@ from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.translator import parse_for_moos, serialize_for_moos
 
-from .acomms_mission import ACK_SLOTS, COMMAND, SLOT_SECONDS, STATUS, TwoCommunities
+from .acomms_mission import COMMAND, SLOT_SECONDS, STATUS, TwoCommunities
 
 NAV = {"NAV_X": 100.0, "NAV_Y": -50.0, "NAV_SPEED": 1.5, "NAV_HEADING": -90.0, "NAV_DEPTH": 10.0}
 
@@ -78,9 +78,7 @@ async def test_status_and_acked_command_between_two_vehicles(tmp_path):
 
 
 async def test_acked_command_survives_a_modem_link_outage(tmp_path):
-    # (slots an acknowledged packet fits in: in 1.5 s rate-0 slots the sender's next cycle can
-    # come before the ack and send the command again)
-    async with TwoCommunities(tmp_path, slots=ACK_SLOTS) as net:
+    async with TwoCommunities(tmp_path) as net:
         (r1, r2), (app1, _) = net.recorders, net.apps
         await net.ready()
         driver = app1.acomms.primary.driver

@@ -20,7 +20,7 @@ from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.db import MOOSDB
 from pygoby.util.clock import WallClock
 
-from .acomms_mission import ACK_SLOTS, Recorder, mission_text, modem_and_db
+from .acomms_mission import Recorder, mission_text, modem_and_db
 
 PACOMMSHANDLER = str(Path(sys.executable).with_name("pAcommsHandler"))
 TTL = 20  # s: the first command outlives the first kill, the second one does not (and has time
@@ -68,7 +68,7 @@ async def test_queued_commands_survive_kill_9(tmp_path):
     channel, clock = LoopbackChannel(), WallClock()
     async with contextlib.AsyncExitStack() as stack:
         sim1, db1 = await modem_and_db(stack, 1, channel, clock)
-        text = mission_text(1, db1.port, sim1.port, slots=ACK_SLOTS).replace("  queue_cfg {\n", PERSIST, 1)
+        text = mission_text(1, db1.port, sim1.port).replace("  queue_cfg {\n", PERSIST, 1)
         mission = tmp_path / "vehicle1.moos"
         mission.write_text(text.replace("ack: true  value_base: 5  ttl: 600", f"ack: true  value_base: 5  ttl: {TTL}"))
         r1 = Recorder("recorder1", db1.port)
@@ -96,7 +96,7 @@ async def test_queued_commands_survive_kill_9(tmp_path):
         # Vehicle 2 joins; vehicle 1 restarts: 11 expires at once, 22 is sent and acked.
         sim2, db2 = await modem_and_db(stack, 2, channel, clock)
         path2 = tmp_path / "vehicle2.moos"
-        path2.write_text(mission_text(2, db2.port, sim2.port, slots=ACK_SLOTS))
+        path2.write_text(mission_text(2, db2.port, sim2.port))
         r2 = Recorder("recorder2", db2.port)
         await r2.start(["COMMAND_IN"])
         stack.push_async_callback(r2.close)

@@ -5,7 +5,6 @@ ACOMMS_RANGE_COMMAND/RESPONSE, ACOMMS_POLLER_UPDATE, 1.1 MACUpdates), notes and 
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import subprocess
 import sys
 from pathlib import Path
@@ -13,14 +12,11 @@ from pathlib import Path
 from google.protobuf import text_format
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
+from pygoby.acomms.mmsim import LoopbackChannel
 from pygoby.acomms.mmsim.channel import DEFAULT_SOUND_SPEED
-from pygoby.acomms.mmsim.server import MMSimServer
-from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.client import MOOSClient
-from pygoby.moos.db import MOOSDB
 from pygoby.util.clock import WallClock
-from tests.apps.acomms_mission import Recorder
+from tests.apps.acomms_mission import two_vehicle_missions
 from tests.goby11.seed_listings import EXAMPLES
 
 SIMPLE_STATUS = EXAMPLES / "xml" / "simple_status.xml"
@@ -71,27 +67,10 @@ ProcessConfig = pAcommsHandler
 WATCHED = ["STATUS_REPORT_IN", "ACOMMS_INCOMING_DATA", "ACOMMS_RANGE_RESPONSE", "ACOMMS_NMEA_OUT"]
 
 
-@contextlib.asynccontextmanager
-async def two_nodes(tmp_path: Path):
+def two_nodes(tmp_path: Path):
     clock = WallClock()
     channel = LoopbackChannel(clock, range_m=0.25 * DEFAULT_SOUND_SPEED)  # 0.25 s away
-    async with contextlib.AsyncExitStack() as stack:
-        apps, recorders = [], []
-        for modem_id in (1, 2):
-            sim = MMSimServer(MicroModemModel(modem_id, clock, channel), channel)
-            await sim.start()
-            stack.push_async_callback(sim.close)
-            db = await stack.enter_async_context(MOOSDB(port=0, community=f"mm{modem_id}"))
-            path = tmp_path / f"mm{modem_id}.moos"
-            path.write_text(mission(modem_id, db.port, sim.port))
-            app = pAcommsHandler.from_mission(path, "pAcommsHandler")
-            recorder = Recorder(f"recorder{modem_id}", db.port)
-            await recorder.start(WATCHED)
-            stack.push_async_callback(recorder.close)
-            await stack.enter_async_context(app)
-            apps.append(app)
-            recorders.append(recorder)
-        yield apps, recorders
+    return two_vehicle_missions(tmp_path, mission, WATCHED, channel, clock)
 
 
 async def test_goby11_configuration_runs_with_the_11_variables(tmp_path):
