@@ -69,8 +69,8 @@ def cluster(tmp_path_factory):
             if process.poll() is None:
                 process.terminate()
         for process in processes:
-            try:
-                process.wait(timeout=30)
+            try:  # (a worker whose scheduler has gone can sit out its reconnect time: no need)
+                process.wait(timeout=5)
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
