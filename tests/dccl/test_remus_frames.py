@@ -7,7 +7,6 @@ input makes a decoder raise anything else."""
 from __future__ import annotations
 
 import math
-import struct
 
 import pytest
 from hypothesis import given, settings
@@ -31,15 +30,11 @@ from pygoby.dccl.ccl.remus import (
     TimeDate,
     decode_frame,
 )
+from pygoby.dccl.codecs.numeric import f32
 from tests.dccl.remus_cpp import from_json, message_class, read_records, to_message
 
 ALL_TYPES = (State, Redirect, Ranger, Position, Alert, Alert2)
 HALF_HEADING = 360 / 255 / 2
-
-
-def f32(value: float) -> float:
-    """The value as a C float holds it."""
-    return struct.unpack("f", struct.pack("f", value))[0]
 
 
 def le(value: int, count: int) -> bytes:
