@@ -73,8 +73,10 @@ def publish(args: argparse.Namespace) -> None:
     start = time.monotonic()
     last_timing = -1.0
     sent = 0
-    batch = [p.notify(args.var, payload, time=time.time(), src=args.name, msg_id=i)
-             for i in range(args.batch)]  # fmt: skip
+    batch = [
+        p.notify(args.var, payload, time=time.time(), src=args.name, msg_id=i)
+        for i in range(args.batch)
+    ]
     packet = p.encode_packet(batch)  # encoded once, sent again and again (flood, paced batches)
     period = 0.0 if args.rate is None else args.batch / args.rate
     next_send = start
@@ -88,8 +90,9 @@ def publish(args: argparse.Namespace) -> None:
             last_timing = time.monotonic()
         n = min(args.batch, args.count - sent)
         if args.batch == 1:  # stamped at sending, for latency
-            packet = p.encode_packet([p.notify(args.var, payload, time=time.time(), src=args.name,
-                                               msg_id=sent)])  # fmt: skip
+            packet = p.encode_packet(
+                [p.notify(args.var, payload, time=time.time(), src=args.name, msg_id=sent)]
+            )
         elif n < args.batch:
             packet = p.encode_packet(batch[:n])
         sock.sendall(packet)
@@ -119,8 +122,14 @@ def subscribe(args: argparse.Namespace) -> None:
     sock = _connect(args.port, args.name)
     register = p.MOOSMessage(p.REGISTER, p.DOUBLE, args.var, time.time(), 0.0, src=args.name)
     # the Q's reply comes after the registration is in place: then we are ready
-    request = p.MOOSMessage(p.SERVER_REQUEST, p.STRING, "VAR_SUMMARY", time.time(),
-                            src=args.name, id=p.SERVER_REQUEST_ID)  # fmt: skip
+    request = p.MOOSMessage(
+        p.SERVER_REQUEST,
+        p.STRING,
+        "VAR_SUMMARY",
+        time.time(),
+        src=args.name,
+        id=p.SERVER_REQUEST_ID,
+    )
     sock.sendall(p.encode_packet([p.timing_message(time.time()), register, request]))
     reader = _PacketReader(sock)
     while not any(m.id == p.SERVER_REQUEST_ID for m in p.decode_packet(reader.next_packet())):
@@ -158,11 +167,16 @@ def subscribe(args: argparse.Namespace) -> None:
             last = arrived
             if args.latency:
                 wall = time.time()
-                latencies.extend(wall - m.time for m in p.decode_packet(buf, start, end)
-                                 if m.msg_type == p.NOTIFY)  # fmt: skip
+                latencies.extend(
+                    wall - m.time
+                    for m in p.decode_packet(buf, start, end)
+                    if m.msg_type == p.NOTIFY
+                )
     sock.close()
-    print(json.dumps({"received": received, "first": first, "last": last,
-                      "latencies": latencies}), flush=True)  # fmt: skip
+    print(
+        json.dumps({"received": received, "first": first, "last": last, "latencies": latencies}),
+        flush=True,
+    )
 
 
 def main() -> None:

@@ -72,10 +72,13 @@ def test_acked_pop_and_ack_with_100k_queued(benchmark):
     def pop_and_ack():
         clock.advance(0.001)
         n = next(frame)
-        request = acomms_pb.ModemTransmission(src=1, dest=-1, max_num_frames=1, max_frame_bytes=32,
-                                      frame_start=n)  # fmt: skip
+        request = acomms_pb.ModemTransmission(
+            src=1, dest=-1, max_num_frames=1, max_frame_bytes=32, frame_start=n
+        )
         qm.handle_modem_data_request(request)
-        qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[n]))
+        qm.handle_modem_receive(
+            acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[n])
+        )
 
     benchmark(pop_and_ack)
     assert qm.size(20) < QUEUED

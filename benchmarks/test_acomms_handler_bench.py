@@ -37,5 +37,7 @@ def test_two_vehicle_mission_messages_per_simulated_hour(benchmark, warp):
         messages_per_simulated_hour=round(result.per_simulated_hour),
         acked_commands=sum(v.acked["command"] for v in result.vehicles),
     )
-    print(f"\nwarp {warp}: {result.delivered} messages in {result.simulated_seconds:.0f} simulated s "
-          f"({result.real_seconds:.1f} s wall) = {result.per_simulated_hour:.0f} per simulated hour")  # fmt: skip
+    print(
+        f"\nwarp {warp}: {result.delivered} messages in {result.simulated_seconds:.0f} simulated s "
+        f"({result.real_seconds:.1f} s wall) = {result.per_simulated_hour:.0f} per simulated hour"
+    )

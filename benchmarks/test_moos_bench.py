@@ -58,8 +58,11 @@ def moosdb():
     """(port, pid) of a MOOSDB process for the whole module."""
     port = _free_port()
     template = os.environ.get("PYGOBY_BENCH_MOOSDB", f"{PYGOBY} moosdb --port {{port}}")
-    proc = subprocess.Popen(shlex.split(template.format(port=port)), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)  # fmt: skip
+    proc = subprocess.Popen(
+        shlex.split(template.format(port=port)),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     deadline = time.monotonic() + 10
     while True:
         try:
@@ -82,8 +85,9 @@ def _cpu_seconds(pid: int) -> float:
 
 def _spawn(*args: str) -> subprocess.Popen:
     command = shlex.split(os.environ.get("PYGOBY_BENCH_LOADGEN", "")) or [sys.executable, LOAD]
-    return subprocess.Popen([*command, *args], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                            text=True)  # fmt: skip
+    return subprocess.Popen(
+        [*command, *args], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
 
 
 def _wait_ready(procs: list[subprocess.Popen]) -> None:
@@ -103,18 +107,43 @@ def _percentile(values: list[float], q: float) -> float:
     return ordered[min(int(q * len(ordered)), len(ordered) - 1)] if ordered else float("nan")
 
 
-def run_load(port: int, db_pid: int, n_pub: int, n_sub: int, per_pub: int,
-             rate: float | None = None) -> dict:  # fmt: skip
+def run_load(
+    port: int, db_pid: int, n_pub: int, n_sub: int, per_pub: int, rate: float | None = None
+) -> dict:
     tag = f"{n_pub}x{n_sub}_{time.monotonic_ns()}"
     var = f"BENCH_{tag}"
     expect = n_pub * per_pub
-    subs = [_spawn("sub", "--port", str(port), "--name", f"s{i}_{tag}", "--var", var,
-                   "--expect", str(expect), *(["--latency"] if rate else []))
-            for i in range(n_sub)]  # fmt: skip
+    subs = [
+        _spawn(
+            "sub",
+            "--port",
+            str(port),
+            "--name",
+            f"s{i}_{tag}",
+            "--var",
+            var,
+            "--expect",
+            str(expect),
+            *(["--latency"] if rate else []),
+        )
+        for i in range(n_sub)
+    ]
     _wait_ready(subs)
-    pubs = [_spawn("pub", "--port", str(port), "--name", f"p{i}_{tag}", "--var", var,
-                   "--count", str(per_pub), *(["--rate", str(rate), "--batch", "1"] if rate else []))
-            for i in range(n_pub)]  # fmt: skip
+    pubs = [
+        _spawn(
+            "pub",
+            "--port",
+            str(port),
+            "--name",
+            f"p{i}_{tag}",
+            "--var",
+            var,
+            "--count",
+            str(per_pub),
+            *(["--rate", str(rate), "--batch", "1"] if rate else []),
+        )
+        for i in range(n_pub)
+    ]
     _wait_ready(pubs)
     cpu0 = _cpu_seconds(db_pid)
     for pub in pubs:
@@ -147,12 +176,15 @@ def test_moosdb_flood(benchmark, moosdb, n_pub, n_sub):
     per_pub = FLOOD_DELIVERIES // (n_pub * n_sub)
     result = benchmark.pedantic(
         lambda: _median_of_three(lambda: run_load(port, pid, n_pub, n_sub, per_pub)),
-        rounds=1, iterations=1,
-    )  # fmt: skip
+        rounds=1,
+        iterations=1,
+    )
     benchmark.extra_info.update(result)
-    print(f"\n{n_pub} pub x {n_sub} sub flood: {result['per_second']:,.0f} notifications/s, "
-          f"server CPU {result['server_cpu_us']:.2f} us/notification "
-          f"({result['delivered']}/{result['expected']} delivered)")  # fmt: skip
+    print(
+        f"\n{n_pub} pub x {n_sub} sub flood: {result['per_second']:,.0f} notifications/s, "
+        f"server CPU {result['server_cpu_us']:.2f} us/notification "
+        f"({result['delivered']}/{result['expected']} delivered)"
+    )
 
 
 def test_moosdb_paced_latency(benchmark, moosdb):
@@ -160,11 +192,14 @@ def test_moosdb_paced_latency(benchmark, moosdb):
     count = int(PACED_RATE * PACED_SECONDS)
     result = benchmark.pedantic(
         lambda: _median_of_three(lambda: run_load(port, pid, 1, 1, count, PACED_RATE)),
-        rounds=1, iterations=1,
-    )  # fmt: skip
+        rounds=1,
+        iterations=1,
+    )
     benchmark.extra_info.update(result)
-    print(f"\n1 pub x 1 sub paced at {PACED_RATE:.0f}/s: latency p50 {result['p50_ms']:.3f} ms, "
-          f"p99 {result['p99_ms']:.3f} ms ({result['delivered']}/{result['expected']} delivered)")  # fmt: skip
+    print(
+        f"\n1 pub x 1 sub paced at {PACED_RATE:.0f}/s: latency p50 {result['p50_ms']:.3f} ms, "
+        f"p99 {result['p99_ms']:.3f} ms ({result['delivered']}/{result['expected']} delivered)"
+    )
 
 
 APP_FLOOD_RATE = 100_000
@@ -197,9 +232,21 @@ async def _app_flood(port: int) -> dict:
     await app.start(connect_timeout=5.0)
     await asyncio.sleep(0.5)
     count = int(APP_FLOOD_RATE * APP_FLOOD_SECONDS)
-    pub = _spawn("pub", "--port", str(port), "--name", f"flooder_{time.monotonic_ns()}",
-                 "--var", "FLOOD", "--count", str(count), "--rate", str(APP_FLOOD_RATE),
-                 "--batch", "500")  # fmt: skip
+    pub = _spawn(
+        "pub",
+        "--port",
+        str(port),
+        "--name",
+        f"flooder_{time.monotonic_ns()}",
+        "--var",
+        "FLOOD",
+        "--count",
+        str(count),
+        "--rate",
+        str(APP_FLOOD_RATE),
+        "--batch",
+        "500",
+    )
     await asyncio.to_thread(_wait_ready, [pub])
     rss = [_rss_bytes()]
     cpu0 = time.process_time()
@@ -235,10 +282,12 @@ def test_goby_moos_app_under_a_flood(benchmark, moosdb):
     port, _ = moosdb
     result = benchmark.pedantic(lambda: asyncio.run(_app_flood(port)), rounds=1, iterations=1)
     benchmark.extra_info.update(result)
-    print(f"\nGobyMOOSApp, {APP_FLOOD_RATE:,} notifications/s for {APP_FLOOD_SECONDS:g} s "
-          f"({result['offered_per_second']:,.0f}/s offered): handled {result['handled']}/"
-          f"{result['sent']} at {result['app_cpu_us']:.2f} us CPU each (client + app), "
-          f"{result['behind_at_end']} behind when "
-          f"the publisher stopped, all handled {result['caught_up_s']:.2f} s after; RSS "
-          f"{result['rss_start_mb']:.1f} MB at start, {result['rss_1s_mb']:.1f} MB after 1 s, "
-          f"{result['rss_peak_mb']:.1f} MB peak, {result['rss_end_mb']:.1f} MB at the end")  # fmt: skip
+    print(
+        f"\nGobyMOOSApp, {APP_FLOOD_RATE:,} notifications/s for {APP_FLOOD_SECONDS:g} s "
+        f"({result['offered_per_second']:,.0f}/s offered): handled {result['handled']}/"
+        f"{result['sent']} at {result['app_cpu_us']:.2f} us CPU each (client + app), "
+        f"{result['behind_at_end']} behind when "
+        f"the publisher stopped, all handled {result['caught_up_s']:.2f} s after; RSS "
+        f"{result['rss_start_mb']:.1f} MB at start, {result['rss_1s_mb']:.1f} MB after 1 s, "
+        f"{result['rss_peak_mb']:.1f} MB peak, {result['rss_end_mb']:.1f} MB at the end"
+    )

@@ -54,20 +54,29 @@ def test_200_run_sweep_local_processes_against_one_process(benchmark, tmp_path):
     load_before = os.getloadavg()[0]  # (a shared machine: other work slows both measurements)
     one = sweep_once(plan, tmp_path / "one", 1)
     jobs = default_jobs()
-    many = benchmark.pedantic(lambda: sweep_once(plan, tmp_path / "many", jobs), rounds=1,
-                              iterations=1, warmup_rounds=0)  # fmt: skip
+    many = benchmark.pedantic(
+        lambda: sweep_once(plan, tmp_path / "many", jobs), rounds=1, iterations=1, warmup_rounds=0
+    )
     assert deterministic(one.table).equals(deterministic(many.table))
     rate_one, rate_many = 200 / one.wall_s, 200 / many.wall_s
-    benchmark.extra_info.update({
-        "runs": 200, "jobs": jobs, "one_process_s": round(one.wall_s, 2),
-        "local_processes_s": round(many.wall_s, 2), "one_process_runs_per_s": round(rate_one, 2),
-        "local_runs_per_s": round(rate_many, 2), "speedup": round(rate_many / rate_one, 2),
-        "load_average_1min": [round(load_before, 2), round(os.getloadavg()[0], 2)],
-    })  # fmt: skip
-    print(f"\n    200 runs (8 nodes, 1 simulated hour each): one process {one.wall_s:.1f} s "
-          f"({rate_one:.2f} runs/s); {jobs} local processes {many.wall_s:.1f} s "
-          f"({rate_many:.2f} runs/s): speed-up {rate_many / rate_one:.2f}x (load average "
-          f"{load_before:.1f} before, {os.getloadavg()[0]:.1f} after)")  # fmt: skip
+    benchmark.extra_info.update(
+        {
+            "runs": 200,
+            "jobs": jobs,
+            "one_process_s": round(one.wall_s, 2),
+            "local_processes_s": round(many.wall_s, 2),
+            "one_process_runs_per_s": round(rate_one, 2),
+            "local_runs_per_s": round(rate_many, 2),
+            "speedup": round(rate_many / rate_one, 2),
+            "load_average_1min": [round(load_before, 2), round(os.getloadavg()[0], 2)],
+        }
+    )
+    print(
+        f"\n    200 runs (8 nodes, 1 simulated hour each): one process {one.wall_s:.1f} s "
+        f"({rate_one:.2f} runs/s); {jobs} local processes {many.wall_s:.1f} s "
+        f"({rate_many:.2f} runs/s): speed-up {rate_many / rate_one:.2f}x (load average "
+        f"{load_before:.1f} before, {os.getloadavg()[0]:.1f} after)"
+    )
 
 
 BELLHOP_SCENARIO = """duration: 3600
@@ -83,7 +92,8 @@ mac {{ slot_seconds: 10 rate: 1 }}
 def bellhop_scenario(model: str):
     nodes = "\n".join(
         f"node {{ modem_id: {i + 1} track {{ waypoint {{ x: {1000 * (i % 4)} y: {1000 * (i // 4)} "
-        f"depth: {5 + 10 * i} }} }} }}" for i in range(8)
+        f"depth: {5 + 10 * i} }} }} }}"
+        for i in range(8)
     )
     return parse_scenario(BELLHOP_SCENARIO.format(model=model, nodes=nodes))
 
@@ -111,14 +121,21 @@ def test_bellhop_model_cost_per_simulated_hour(benchmark):
     assert model.traced == 8 and receptions > 0
     cached_cpu = bellhop_cpu - model.tracing_cpu_seconds
     per_reception_us = (cached_cpu - empirical_cpu) / receptions * 1e6
-    benchmark.extra_info.update({
-        "simulated_s": 3600, "empirical_cpu_s": round(empirical_cpu, 3),
-        "bellhop_cpu_s": round(bellhop_cpu, 3), "fields_traced": model.traced,
-        "tracing_cpu_s": round(model.tracing_cpu_seconds, 3),
-        "tracing_wall_s": round(model.tracing_seconds, 3), "receptions": receptions,
-        "extra_us_per_reception_cached": round(per_reception_us, 2),
-    })  # fmt: skip
-    print(f"\n    one simulated hour, 8 nodes at 8 depths, {receptions} receptions (CPU time): "
-          f"empirical {empirical_cpu:.2f} s; BELLHOP {bellhop_cpu:.2f} s = {model.traced} fields "
-          f"traced in {model.tracing_cpu_seconds:.2f} s + {cached_cpu:.2f} s simulation "
-          f"({per_reception_us:+.1f} us per reception once cached)")  # fmt: skip
+    benchmark.extra_info.update(
+        {
+            "simulated_s": 3600,
+            "empirical_cpu_s": round(empirical_cpu, 3),
+            "bellhop_cpu_s": round(bellhop_cpu, 3),
+            "fields_traced": model.traced,
+            "tracing_cpu_s": round(model.tracing_cpu_seconds, 3),
+            "tracing_wall_s": round(model.tracing_seconds, 3),
+            "receptions": receptions,
+            "extra_us_per_reception_cached": round(per_reception_us, 2),
+        }
+    )
+    print(
+        f"\n    one simulated hour, 8 nodes at 8 depths, {receptions} receptions (CPU time): "
+        f"empirical {empirical_cpu:.2f} s; BELLHOP {bellhop_cpu:.2f} s = {model.traced} fields "
+        f"traced in {model.tracing_cpu_seconds:.2f} s + {cached_cpu:.2f} s simulation "
+        f"({per_reception_us:+.1f} us per reception once cached)"
+    )

@@ -9,8 +9,17 @@ from pygoby.dccl.ccl.remus import Ranger, State, TimeDate
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup
 
-STATE = State(latitude=42.35, longitude=-70.95, time=TimeDate(11, 14, 22, 13, 20), heading=45, depth=111,
-              est_velocity=1.2, lat_goal=42.4, lon_goal=-70.9, battery_percent=80)  # fmt: skip
+STATE = State(
+    latitude=42.35,
+    longitude=-70.95,
+    time=TimeDate(11, 14, 22, 13, 20),
+    heading=45,
+    depth=111,
+    est_velocity=1.2,
+    lat_goal=42.4,
+    lon_goal=-70.9,
+    battery_percent=80,
+)
 
 
 def test_encode_state(benchmark) -> None:

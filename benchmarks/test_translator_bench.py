@@ -28,7 +28,9 @@ def setup():
         entry_class()(),
     )
     translator = Translator([entry], loader.message_class)
-    report = loader.message_class(NAME)(Name="unicorn", x=550, y=1023.5, heading=240, repeat=[1, 2, 3])
+    report = loader.message_class(NAME)(
+        Name="unicorn", x=550, y=1023.5, heading=240, repeat=[1, 2, 3]
+    )
     return translator, report
 
 

@@ -21,19 +21,26 @@ PROTO = Path(__file__).resolve().parent.parent / "examples" / "two_vehicles" / "
 
 
 def test_pygoby_version():
-    shown = subprocess.run([BIN / "pygoby", "--version"], capture_output=True, text=True, check=True)
+    shown = subprocess.run(
+        [BIN / "pygoby", "--version"], capture_output=True, text=True, check=True
+    )
     assert shown.stdout == f"pygoby {pygoby.__version__}\n"
-    app = subprocess.run([BIN / "pAcommsHandler", "--version"], capture_output=True, text=True, check=True)
+    app = subprocess.run(
+        [BIN / "pAcommsHandler", "--version"], capture_output=True, text=True, check=True
+    )
     assert app.stdout == f"pAcommsHandler {pygoby.__version__}\n"
 
 
 def test_pygoby_subcommand_apps_show_how_they_are_typed():
     """`pygoby liaison --help` shows `usage: pygoby liaison` (the app's name stays liaison)."""
-    shown = subprocess.run([BIN / "pygoby", "liaison", "--help"], capture_output=True, text=True, check=True)
+    shown = subprocess.run(
+        [BIN / "pygoby", "liaison", "--help"], capture_output=True, text=True, check=True
+    )
     assert shown.stdout.startswith("usage: pygoby liaison [-h]")
     assert "liaison: a Goby MOOS application" in shown.stdout
-    example = subprocess.run([BIN / "pygoby", "liaison", "--example_config"], capture_output=True,
-                             text=True, check=True)  # fmt: skip
+    example = subprocess.run(
+        [BIN / "pygoby", "liaison", "--example_config"], capture_output=True, text=True, check=True
+    )
     assert example.stdout.startswith("ProcessConfig = liaison\n")
 
 
@@ -49,7 +56,15 @@ def _with_reader_gone(argv: list[str]) -> subprocess.CompletedProcess:
 def test_output_into_a_closed_pipe_ends_quietly(tmp_path):
     for argv in (
         [BIN / "pAcommsHandler", "--example_config"],
-        [BIN / "pygoby", "dccl", "--proto", str(PROTO), "--message", "pygoby.examples.SimpleStatus", "analyze"],
+        [
+            BIN / "pygoby",
+            "dccl",
+            "--proto",
+            str(PROTO),
+            "--message",
+            "pygoby.examples.SimpleStatus",
+            "analyze",
+        ],
     ):
         done = _with_reader_gone([str(a) for a in argv])
         assert done.stderr == "", done.stderr  # no BrokenPipeError traceback
@@ -59,12 +74,15 @@ def test_output_into_a_closed_pipe_ends_quietly(tmp_path):
 async def test_a_running_app_whose_reader_went_away_carries_on(tmp_path):
     async with MOOSDB(port=0) as db:
         mission = tmp_path / "m.moos"
-        mission.write_text(f"ServerPort = {db.port}\nProcessConfig = pAcommsHandler\n"
-                           "{\n common { log: false verbosity: DEBUG2 }\n modem_id: 1\n"
-                           " mac_cfg { type: MAC_FIXED_DECENTRALIZED slot { src: 1 slot_seconds: 0.5 } }"
-                           "\n}\n")  # fmt: skip
-        proc = subprocess.Popen([BIN / "pAcommsHandler", mission], stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE)  # fmt: skip
+        mission.write_text(
+            f"ServerPort = {db.port}\nProcessConfig = pAcommsHandler\n"
+            "{\n common { log: false verbosity: DEBUG2 }\n modem_id: 1\n"
+            " mac_cfg { type: MAC_FIXED_DECENTRALIZED slot { src: 1 slot_seconds: 0.5 } }"
+            "\n}\n"
+        )
+        proc = subprocess.Popen(
+            [BIN / "pAcommsHandler", mission], stdout=subprocess.PIPE, stderr=subprocess.PIPE
+        )
         assert proc.stdout is not None
         await asyncio.to_thread(proc.stdout.readline)  # it is logging ...
         proc.stdout.close()  # ... and its reader goes away

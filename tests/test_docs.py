@@ -10,7 +10,11 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-DOCUMENTS = [REPO / "README.md", REPO / "ARCHITECTURE.md", *sorted((REPO / "examples").rglob("README.md"))]
+DOCUMENTS = [
+    REPO / "README.md",
+    REPO / "ARCHITECTURE.md",
+    *sorted((REPO / "examples").rglob("README.md")),
+]
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 
 

@@ -54,7 +54,9 @@ ERRORS = _all_error_classes()
 
 
 def _package_of(cls: type) -> str:
-    return next(p for p in PACKAGE_ROOTS if cls.__module__ == p or cls.__module__.startswith(p + "."))
+    return next(
+        p for p in PACKAGE_ROOTS if cls.__module__ == p or cls.__module__.startswith(p + ".")
+    )
 
 
 def test_the_family_is_found():
@@ -107,8 +109,11 @@ def test_config_error_says_file_line_and_field(where, text):
     err = ConfigError("bad value", **where)
     assert str(err) == text
     assert (err.reason, err.file, err.line, err.field) == (
-        "bad value", where.get("file"), where.get("line"), where.get("field")
-    )  # fmt: skip
+        "bad value",
+        where.get("file"),
+        where.get("line"),
+        where.get("field"),
+    )
 
 
 def test_located_fills_only_what_is_missing():
@@ -124,8 +129,9 @@ def test_a_text_format_parse_error_names_the_line_of_the_file():
     from pygoby.protobuf.textconfig import merge_config_text
 
     with pytest.raises(ConfigError) as info:
-        merge_config_text("manager_tcp_port: 1\n  nope: 2\n", config_class()(), file="m.cfg",
-                          first_line=10)  # fmt: skip
+        merge_config_text(
+            "manager_tcp_port: 1\n  nope: 2\n", config_class()(), file="m.cfg", first_line=10
+        )
     err = info.value
     assert (err.file, err.line, err.field) == ("m.cfg", 11, "nope")
     assert str(err).startswith('m.cfg:11: nope: Message type "')

@@ -54,8 +54,11 @@ async def test_store_server_listens_on_loopback_by_default():
 
 def test_other_pygoby_servers_default_to_loopback():
     parser = pygoby_parser()
-    for argv in (["mmsim", "--port", "0", "--id", "1"], ["abc_modem_simulator", "--port", "0"],
-                 ["moosdb"]):  # fmt: skip
+    for argv in (
+        ["mmsim", "--port", "0", "--id", "1"],
+        ["abc_modem_simulator", "--port", "0"],
+        ["moosdb"],
+    ):
         assert parser.parse_args(argv).host == LOOPBACK, argv
 
 
@@ -68,8 +71,12 @@ async def test_line_server_link_defaults_to_loopback_and_a_driver_binds_tcp_serv
     finally:
         link.close()
     # a driver serving a networked modem binds `tcp_server` when given (all interfaces if not)
-    cfg = m.DriverConfig(modem_id=1, tcp_port=0, tcp_server="127.0.0.2",
-                         connection_type=m.DriverConfig.CONNECTION_TCP_AS_SERVER)  # fmt: skip
+    cfg = m.DriverConfig(
+        modem_id=1,
+        tcp_port=0,
+        tcp_server="127.0.0.2",
+        connection_type=m.DriverConfig.CONNECTION_TCP_AS_SERVER,
+    )
     driver = StoreServerDriver()
     assert driver._make_link(cfg, "\r").host == "127.0.0.2"
     cfg.ClearField("tcp_server")

@@ -69,7 +69,9 @@ class Figures:
     def judge(self) -> None:
         """The generic promises: every request answered, no freeze, bounded memory, no loss."""
         if self.answered < self.requests:
-            self.failures.append(f"{self.requests - self.answered} of {self.requests} requests unanswered")
+            self.failures.append(
+                f"{self.requests - self.answered} of {self.requests} requests unanswered"
+            )
         p99 = self.p99_ms
         if p99 is not None and p99 > 1000 * self.latency_limit:
             self.failures.append(f"latency p99 {p99:.0f} ms (more than {self.latency_limit:g} s)")
@@ -85,12 +87,13 @@ class Figures:
             return "-" if value is None else format(value, fmt)
 
         rss = f"{number(self.rss_before_mb, '.0f')} -> {number(self.rss_after_mb, '.0f')}"
-        return (f"{self.requests:>9} {self.answered:>9} {number(self.p50_ms, '.1f'):>8} "
-                f"{number(self.p99_ms, '.1f'):>8} {rss:>12} {number(self.lost, 'd'):>5}")  # fmt: skip
+        return (
+            f"{self.requests:>9} {self.answered:>9} {number(self.p50_ms, '.1f'):>8} "
+            f"{number(self.p99_ms, '.1f'):>8} {rss:>12} {number(self.lost, 'd'):>5}"
+        )
 
 
-HEADER = (f"{'requests':>9} {'answered':>9} {'p50 ms':>8} {'p99 ms':>8} "
-          f"{'RSS MB':>12} {'lost':>5}")  # fmt: skip
+HEADER = f"{'requests':>9} {'answered':>9} {'p50 ms':>8} {'p99 ms':>8} {'RSS MB':>12} {'lost':>5}"
 
 
 # -- processes -------------------------------------------------------------------------------
@@ -288,7 +291,9 @@ class IdleConnections(Hostile):
 Probe = Callable[[int, float, Figures], Awaitable[None]]  # (port, seconds, figures)
 
 
-def hostile(spec: ServerSpec, probe: Probe, hostiles: Sequence[Hostile]) -> Callable[[float, Path], Awaitable[Figures]]:
+def hostile(
+    spec: ServerSpec, probe: Probe, hostiles: Sequence[Hostile]
+) -> Callable[[float, Path], Awaitable[Figures]]:
     """A scenario: `spec`'s server, `probe` measuring it for the run's seconds while `hostiles`
     misbehave beside it; then SIGTERM must end the server."""
 
@@ -326,7 +331,9 @@ async def stop_or_fail(server: ServerProcess, figures: Figures) -> None:
         return
     took = await server.terminate()
     if took is None:
-        figures.failures.append(f"{server.spec.name} did not end within {STOP_WITHIN:g} s of SIGTERM")
+        figures.failures.append(
+            f"{server.spec.name} did not end within {STOP_WITHIN:g} s of SIGTERM"
+        )
     else:
         figures.notes.append(f"ended {took:.2f} s after SIGTERM")
 
@@ -340,4 +347,3 @@ async def paced(seconds: float, period: float, step: Callable[[int], Awaitable[N
         await step(k)
         k += 1
         await asyncio.sleep(max(0.0, begin + k * period - loop.time()))
-

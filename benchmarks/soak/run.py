@@ -44,7 +44,9 @@ async def run_one(name: str, seconds: float) -> Figures:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seconds", type=float, default=20.0, help="per scenario (default %(default)s)")
+    parser.add_argument(
+        "--seconds", type=float, default=20.0, help="per scenario (default %(default)s)"
+    )
     parser.add_argument("--only", help="run the scenarios whose name contains this text")
     parser.add_argument("--list", action="store_true", help="list the scenarios and exit")
     args = parser.parse_args(argv)

@@ -47,22 +47,35 @@ Scenario = Callable[[float, Path], Awaitable[Figures]]
 
 # -- servers ---------------------------------------------------------------------------------
 
-MOOSDB_SPEC = ServerSpec("moosdb", venv_command("pygoby", "moosdb", "--port", "{port}"),
-                         r"listening on 127\.0\.0\.1:(\d+)")  # fmt: skip
+MOOSDB_SPEC = ServerSpec(
+    "moosdb",
+    venv_command("pygoby", "moosdb", "--port", "{port}"),
+    r"listening on 127\.0\.0\.1:(\d+)",
+)
 # a 64 MB budget for partial packets and unsent output, a packet deadline the run reaches
-MOOSDB_BUDGET = ServerSpec("moosdb", venv_command("pygoby", "moosdb", "--port", "{port}", "--memory-budget", "64",
-                                                  "--packet-timeout", "5"), MOOSDB_SPEC.ready)  # fmt: skip
+MOOSDB_BUDGET = ServerSpec(
+    "moosdb",
+    venv_command(
+        "pygoby", "moosdb", "--port", "{port}", "--memory-budget", "64", "--packet-timeout", "5"
+    ),
+    MOOSDB_SPEC.ready,
+)
 STORE_SERVER = ServerSpec(
     "store_server",
-    venv_command("pygoby", "store_server", "--host", "127.0.0.1", "--port", "{port}", "--db", "store.db"),
+    venv_command(
+        "pygoby", "store_server", "--host", "127.0.0.1", "--port", "{port}", "--db", "store.db"
+    ),
     r"listening on 127\.0\.0\.1:(\d+)",
 )
 
 
 def mmsim_spec() -> ServerSpec:
     group = f"239.255.42.99:{random.randint(40000, 49999)}"  # a channel of its own
-    return ServerSpec("mmsim", venv_command("pygoby", "mmsim", "--port", "{port}", "--id", "1",
-                                            "--channel-group", group), r"listening on [\d.]+:(\d+)")  # fmt: skip
+    return ServerSpec(
+        "mmsim",
+        venv_command("pygoby", "mmsim", "--port", "{port}", "--id", "1", "--channel-group", group),
+        r"listening on [\d.]+:(\d+)",
+    )
 
 
 # -- probes: a well-behaved client, measured ---------------------------------------------------
@@ -79,7 +92,9 @@ class StoreClient:
 
     async def exchange(self, outbox=()) -> acomms_pb.StoreServerResponse:
         if self.writer is None:
-            self.reader, self.writer = await asyncio.open_connection("127.0.0.1", self.port, limit=1 << 22)
+            self.reader, self.writer = await asyncio.open_connection(
+                "127.0.0.1", self.port, limit=1 << 22
+            )
         assert self.reader is not None
         self.request_id += 1
         request = acomms_pb.StoreServerRequest(modem_id=self.modem_id, request_id=self.request_id)
@@ -100,7 +115,9 @@ class StoreClient:
 
 
 def numbered(k: int) -> acomms_pb.ModemTransmission:
-    return acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DATA, frame=[k.to_bytes(4, "big")])
+    return acomms_pb.ModemTransmission(
+        src=1, dest=2, type=acomms_pb.DATA, frame=[k.to_bytes(4, "big")]
+    )
 
 
 @dataclass
@@ -114,8 +131,13 @@ class Mailbox:
         self.read.update(int.from_bytes(t.frame[0], "big") for t in response.inbox if t.frame)
 
 
-async def store_round_trips(port: int, seconds: float, figures: Figures, mailbox: Mailbox | None = None,
-                            on_error: Callable[[], Awaitable[None]] | None = None) -> Mailbox:  # fmt: skip
+async def store_round_trips(
+    port: int,
+    seconds: float,
+    figures: Figures,
+    mailbox: Mailbox | None = None,
+    on_error: Callable[[], Awaitable[None]] | None = None,
+) -> Mailbox:
     """Modem 1 posts a numbered transmission every 0.1 s, modem 2 reads; every exchange is a
     request. A post whose answer did not come is sent again with the next one (as the driver
     does). At the end modem 2 reads until nothing is missing (2 s at most): lost = posted but
@@ -236,8 +258,10 @@ async def wildcard_hog(client: MOOSClient, stop: asyncio.Event) -> None:
 
 def packet_hogs(count: int, sent: int) -> list[Trickle]:
     """MOOS clients announcing a 16 MB packet, sending `sent` bytes of it, then one a while."""
-    return [Trickle(moos_handshake(f"soak_hog{i}") + struct.pack("<iiB", 16 << 20, 1, 0) + bytes(sent))
-            for i in range(count)]  # fmt: skip
+    return [
+        Trickle(moos_handshake(f"soak_hog{i}") + struct.pack("<iiB", 16 << 20, 1, 0) + bytes(sent))
+        for i in range(count)
+    ]
 
 
 MOOS_REGISTER_BULK = moos_handshake("soak_sleeper") + p.encode_packet(
@@ -296,10 +320,13 @@ async def pacommshandler_kill9(seconds: float, workdir: Path) -> Figures:
     figures = Figures()
     channel, clock = LoopbackChannel(), WallClock()
     async with contextlib.AsyncExitStack() as stack:
-        sims, dbs = zip(*[await modem_and_db(stack, modem_id, channel, clock) for modem_id in (1, 2)],
-                        strict=True)  # fmt: skip
+        sims, dbs = zip(
+            *[await modem_and_db(stack, modem_id, channel, clock) for modem_id in (1, 2)],
+            strict=True,
+        )
         text = mission_text(1, dbs[0].port, sims[0].port).replace(
-            "  queue_cfg {\n", '  queue_cfg {\n    persistent_queue_file: "queue.sqlite"\n', 1)
+            "  queue_cfg {\n", '  queue_cfg {\n    persistent_queue_file: "queue.sqlite"\n', 1
+        )
         (workdir / "vehicle1.moos").write_text(text)
         (workdir / "vehicle2.moos").write_text(mission_text(2, dbs[1].port, sims[1].port))
         vehicle2 = pAcommsHandler.from_mission(workdir / "vehicle2.moos", "pAcommsHandler")
@@ -309,7 +336,9 @@ async def pacommshandler_kill9(seconds: float, workdir: Path) -> Figures:
         await r2.start(["COMMAND_IN"])
         stack.push_async_callback(r1.close)
         stack.push_async_callback(r2.close)
-        vehicle1 = AppProcess(["pAcommsHandler", "vehicle1.moos"], workdir, dbs[0], "pAcommsHandler")
+        vehicle1 = AppProcess(
+            ["pAcommsHandler", "vehicle1.moos"], workdir, dbs[0], "pAcommsHandler"
+        )
         stack.push_async_callback(vehicle1.kill9)
         queued: set[int] = set()
         crossed: set[int] = set()  # still to deliver when vehicle 1 was killed
@@ -323,9 +352,13 @@ async def pacommshandler_kill9(seconds: float, workdir: Path) -> Figures:
             for _ in range(random.randint(1, 3)):
                 command_id += 1
                 seen = len(r1.values("ACOMMS_QSIZE"))
-                r1.client.publish("COMMAND_OUT", f"dest=2,command_id={command_id},heading=1,speed=1,depth=1")
+                r1.client.publish(
+                    "COMMAND_OUT", f"dest=2,command_id={command_id},heading=1,speed=1,depth=1"
+                )
                 with contextlib.suppress(TimeoutError):
-                    await r1.wait_for("ACOMMS_QSIZE", lambda v: "dccl_id: 21" in v, timeout=3, start=seen)
+                    await r1.wait_for(
+                        "ACOMMS_QSIZE", lambda v: "dccl_id: 21" in v, timeout=3, start=seen
+                    )
                     queued.add(command_id)
             await asyncio.sleep(random.uniform(0.0, 2.0))  # often before its next slot (6 s TDMA)
             await vehicle1.kill9()
@@ -340,8 +373,10 @@ async def pacommshandler_kill9(seconds: float, workdir: Path) -> Figures:
         received = [_command_id(v) for v in r2.values("COMMAND_IN")]
         figures.requests, figures.answered = len(queued), len(queued & delivered)
         figures.lost = len(queued - delivered)
-        figures.notes.append(f"{kills} kills; {len(crossed)} commands crossed a kill; "
-                             f"{len(received) - len(set(received))} duplicates (at-least-once)")  # fmt: skip
+        figures.notes.append(
+            f"{kills} kills; {len(crossed)} commands crossed a kill; "
+            f"{len(received) - len(set(received))} duplicates (at-least-once)"
+        )
     figures.judge()
     return figures
 
@@ -360,9 +395,11 @@ class AppProcess:
 
     async def start(self) -> None:
         self.proc = await asyncio.create_subprocess_exec(
-            *venv_command(*self.argv), cwd=self.workdir,
-            stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.DEVNULL,
-        )  # fmt: skip
+            *venv_command(*self.argv),
+            cwd=self.workdir,
+            stdout=asyncio.subprocess.DEVNULL,
+            stderr=asyncio.subprocess.DEVNULL,
+        )
         if self.db is not None:
             async with asyncio.timeout(30):
                 while self.name not in self.db.client_names:
@@ -433,14 +470,18 @@ async def moosdb_kill9(seconds: float, workdir: Path) -> Figures:
                 up = time.time()
                 outages.append((down, up))
                 started = time.perf_counter()
-                watch.subscribe("ACOMMS_MAC_SLOT_START")  # on every connection, posts kept meanwhile
+                watch.subscribe(
+                    "ACOMMS_MAC_SLOT_START"
+                )  # on every connection, posts kept meanwhile
                 back = await _all_in(watch, APPS, 20)
                 figures.requests += len(APPS)
                 for name in back:
                     figures.answer(back[name] - started)
                 await asyncio.sleep(1.0)
                 slot_times += [m.time for m in watch.fetch() if m.key == "ACOMMS_MAC_SLOT_START"]
-        alive = [app.argv[0] for app in apps if app.proc is not None and app.proc.returncode is None]
+        alive = [
+            app.argv[0] for app in apps if app.proc is not None and app.proc.returncode is None
+        ]
         if len(alive) != len(apps):
             figures.failures.append(f"apps died: {sorted(set(APPS) - set(alive))}")
         kept = sum(any(down < t < up for down, up in outages) for t in slot_times)
@@ -595,27 +636,60 @@ MMSIM_HOSTILE_LINES = [
 SCENARIOS: dict[str, Scenario] = {
     "netsim_manager: 64 clients x 10 Hz, garbage clients beside": netsim_manager_hostile,
     "MOOSDB: garbage, non-reading and idle clients beside a round trip": hostile(
-        MOOSDB_SPEC, moos_round_trip,
-        [Garbage(GARBAGE), NonReader(MOOS_REGISTER_BULK), MoosHostile(post_bulk), IdleConnections(200)]),
+        MOOSDB_SPEC,
+        moos_round_trip,
+        [
+            Garbage(GARBAGE),
+            NonReader(MOOS_REGISTER_BULK),
+            MoosHostile(post_bulk),
+            IdleConnections(200),
+        ],
+    ),
     "MOOSDB: backtracking wildcard and 64-character names (16.1)": hostile(
-        MOOSDB_SPEC, moos_round_trip, [MoosHostile(wildcard_hog)]),
+        MOOSDB_SPEC, moos_round_trip, [MoosHostile(wildcard_hog)]
+    ),
     "MOOSDB: 20 clients trickling 4 MB of 16 MB packets, 64 MB budget (16.5)": hostile(
-        MOOSDB_BUDGET, moos_round_trip, packet_hogs(20, 4 << 20)),
+        MOOSDB_BUDGET, moos_round_trip, packet_hogs(20, 4 << 20)
+    ),
     "MOOSDB: 400 idle connections and unread output, 64 MB budget (16.5)": hostile(
-        MOOSDB_BUDGET, moos_round_trip,
-        [IdleConnections(400), NonReader(MOOS_REGISTER_BULK), MoosHostile(post_bulk), MoosHostile(post_bulk)]),
+        MOOSDB_BUDGET,
+        moos_round_trip,
+        [
+            IdleConnections(400),
+            NonReader(MOOS_REGISTER_BULK),
+            MoosHostile(post_bulk),
+            MoosHostile(post_bulk),
+        ],
+    ),
     "store_server: garbage, trickling and idle clients beside two modems": hostile(
-        STORE_SERVER, store_round_trips,
-        [Garbage(GARBAGE), Trickle(b"\x01" * 1000), IdleConnections(200),
-         Garbage([serialize_rudics_packet(acomms_pb.StoreServerRequest(modem_id=9).SerializeToString())
-                  * 3000], pause=0.0)]),
+        STORE_SERVER,
+        store_round_trips,
+        [
+            Garbage(GARBAGE),
+            Trickle(b"\x01" * 1000),
+            IdleConnections(200),
+            Garbage(
+                [
+                    serialize_rudics_packet(
+                        acomms_pb.StoreServerRequest(modem_id=9).SerializeToString()
+                    )
+                    * 3000
+                ],
+                pause=0.0,
+            ),
+        ],
+    ),
     "mmsim: hostile NMEA and a non-reading client beside a querying one": hostile(
-        mmsim_spec(), mmsim_queries,
-        [Garbage(MMSIM_HOSTILE_LINES + GARBAGE), NonReader((with_checksum("$CCCFQ,ALL") + "\r\n").encode())]),
+        mmsim_spec(),
+        mmsim_queries,
+        [
+            Garbage(MMSIM_HOSTILE_LINES + GARBAGE),
+            NonReader((with_checksum("$CCCFQ,ALL") + "\r\n").encode()),
+        ],
+    ),
     "store_server: kill -9 every ~3 s under two modems": store_server_kill9,
     "pAcommsHandler: kill -9 at random with a persistent queue": pacommshandler_kill9,
     "MOOSDB: kill -9 every ~3 s under uSimVehicle, pAcommsHandler, pTranslator": moosdb_kill9,
     "apps: SIGTERM as the MOOSDB goes away": sigterm_on_drop,
     "apps: link cut, the DB keeps a stale session": stale_session,
-}  # fmt: skip
-
+}

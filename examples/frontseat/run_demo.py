@@ -65,8 +65,11 @@ async def demo(warp: float, duration: float) -> bool:
         db = await stack.enter_async_context(MOOSDB(port=0, clock=clock))
         overrides = [
             ("common", f"time_warp_multiplier: {warp:g}  verbosity: WARN"),
-            ("frontseat_cfg", f"[{SIMULATOR_CONFIG}] {{ tcp_address: \"127.0.0.1\"  tcp_port: {sim_port} }}"),
-        ]  # fmt: skip
+            (
+                "frontseat_cfg",
+                f'[{SIMULATOR_CONFIG}] {{ tcp_address: "127.0.0.1"  tcp_port: {sim_port} }}',
+            ),
+        ]
         app = iFrontSeat.from_mission(MISSION, overrides=overrides, port=db.port)
         await stack.enter_async_context(app)
 
@@ -95,8 +98,10 @@ async def demo(warp: float, duration: float) -> bool:
             leg_start, heading, speed, depth = leg_at(elapsed)
             state = frontseat_pb.InterfaceState.Name(app.interface.state).removeprefix("INTERFACE_")
             nav = [latest.get(var, float("nan")) for var in NAV]
-            print(f"{elapsed:5.0f}s {state:10s} {heading:5.0f} {speed:4.1f} {depth:5.1f}    "
-                  f"{nav[0]:7.1f} {nav[1]:4.2f} {nav[2]:5.1f}   {nav[3]:8.1f} {nav[4]:8.1f}")  # fmt: skip
+            print(
+                f"{elapsed:5.0f}s {state:10s} {heading:5.0f} {speed:4.1f} {depth:5.1f}    "
+                f"{nav[0]:7.1f} {nav[1]:4.2f} {nav[2]:5.1f}   {nav[3]:8.1f} {nav[4]:8.1f}"
+            )
             if elapsed - leg_start >= SETTLE_S:
                 settled = (
                     state == "COMMAND"
@@ -108,9 +113,12 @@ async def demo(warp: float, duration: float) -> bool:
 
         print(
             "iFrontSeat demo: "
-            + ("OK, the vehicle follows the helm in COMMAND" if settled
-               else "FAILED: the vehicle is not on the helm's course in COMMAND")
-        )  # fmt: skip
+            + (
+                "OK, the vehicle follows the helm in COMMAND"
+                if settled
+                else "FAILED: the vehicle is not on the helm's course in COMMAND"
+            )
+        )
         return settled
 
 

@@ -44,9 +44,16 @@ MODEM_PORTS = {"topside": 62101, "unicorn": 62102}
 NAV = ("NAV_X", "NAV_Y", "NAV_DEPTH", "NAV_SPEED", "NAV_HEADING")
 SHORT_NAMES = {"pygoby.examples.SimpleStatus": "status", "pygoby.examples.Command": "command"}
 WATCHED = (
-    "ACOMMS_MAC_SLOT_START", "ACOMMS_MODEM_TRANSMIT", "ACOMMS_QUEUE_RECEIVE", "ACOMMS_ACK_ORIGINAL",
-    "ACOMMS_QSIZE", "STATUS_REPORT_IN", "COMMAND_IN", "COMMAND_OUT", *NAV,
-)  # fmt: skip
+    "ACOMMS_MAC_SLOT_START",
+    "ACOMMS_MODEM_TRANSMIT",
+    "ACOMMS_QUEUE_RECEIVE",
+    "ACOMMS_ACK_ORIGINAL",
+    "ACOMMS_QSIZE",
+    "STATUS_REPORT_IN",
+    "COMMAND_IN",
+    "COMMAND_OUT",
+    *NAV,
+)
 # The acoustic environment: spherical spreading and a noisy harbour (100 dB re 1 uPa of ambient
 # noise in the modem's band), so that rate-0 packets fail beyond 2-3.5 km, within reach of the AUV
 # in a demo of minutes (netsim's default channel carries them to about 9.5 km). The channel has no
@@ -64,13 +71,22 @@ def dccl_demo() -> None:
     )
     print(describe(codec.compiled(status_cls)))
     status = status_cls(
-        time=float(int(time.time())), src=3, nav_x=1234.4, nav_y=-567.8, nav_depth=42.25,
-        nav_heading=271.6, nav_speed=1.46, mode=status_cls.MODE_SURVEY, note="all good",
-    )  # fmt: skip
+        time=float(int(time.time())),
+        src=3,
+        nav_x=1234.4,
+        nav_y=-567.8,
+        nav_depth=42.25,
+        nav_heading=271.6,
+        nav_speed=1.46,
+        mode=status_cls.MODE_SURVEY,
+        note="all good",
+    )
     plain = codec.encode(status)
     print("\nstatus:    ", text_format.MessageToString(status, as_one_line=True))
-    print(f"encoded:    {plain.hex()}  ({len(plain)} bytes;"
-          f" protobuf would use {len(status.SerializeToString())})")  # fmt: skip
+    print(
+        f"encoded:    {plain.hex()}  ({len(plain)} bytes;"
+        f" protobuf would use {len(status.SerializeToString())})"
+    )
     print("decoded:   ", text_format.MessageToString(codec.decode(plain), as_one_line=True))
     secret = Codec(passphrase="demo passphrase")
     encrypted = secret.encode(status)
@@ -160,10 +176,12 @@ class Monitor:
 
         self.stats, self.codec, self.say, self.on_nav = stats, codec, say, on_nav
         self.nav: dict[str, float] = {}
-        self.id_names = {codec.compiled(cls).id: SHORT_NAMES[cls.DESCRIPTOR.full_name]
-                         for cls in codec.loaded()}  # fmt: skip
-        self.client = MOOSClient(f"uDemoMonitor_{stats.name}", port=port, clock=clock,
-                                 on_message=self._on_mail)  # fmt: skip
+        self.id_names = {
+            codec.compiled(cls).id: SHORT_NAMES[cls.DESCRIPTOR.full_name] for cls in codec.loaded()
+        }
+        self.client = MOOSClient(
+            f"uDemoMonitor_{stats.name}", port=port, clock=clock, on_message=self._on_mail
+        )
         self.slot: tuple[int, int] | None = None  # (slot index, slot src) of the newest slot
 
     async def start(self) -> None:
@@ -194,7 +212,9 @@ class Monitor:
             slot := self._parse(acomms_pb.ModemTransmission, value)
         ):
             self.slot = (slot.slot_index, slot.src)
-        elif msg.key == "ACOMMS_MODEM_TRANSMIT" and (tx := self._parse(acomms_pb.ModemTransmission, value)):
+        elif msg.key == "ACOMMS_MODEM_TRANSMIT" and (
+            tx := self._parse(acomms_pb.ModemTransmission, value)
+        ):
             for frame in tx.frame:
                 s.sent.update(self._types_in(bytes(frame)))
         elif msg.key == "ACOMMS_QUEUE_RECEIVE" and isinstance(value, str):
@@ -252,9 +272,11 @@ def summary_line(
     parts = [f"t={t:4.0f} s  {owner:<17} {_link(newest)}"]
     for v in vehicles:
         queued = "/".join(str(v.queued.get(name, 0)) for name in SHORT_NAMES.values())
-        parts.append(f"{v.name}: sent {_counts(v.sent)} rcvd {_counts(v.received)} "
-                     f"acked {v.acked['command']} queue {queued} "
-                     f"lost {v.packets_lost}/{v.packets_in}")  # fmt: skip
+        parts.append(
+            f"{v.name}: sent {_counts(v.sent)} rcvd {_counts(v.received)} "
+            f"acked {v.acked['command']} queue {queued} "
+            f"lost {v.packets_lost}/{v.packets_in}"
+        )
     return " | ".join(parts)
 
 
@@ -312,9 +334,11 @@ async def run_mission(
             writer = stack.enter_context(EventLogWriter(event_log))
         tally = AcousticTally({MODEM_PORTS[v.name]: v for v in stats}, writer)
         channel = PhysicsChannel(
-            Channel(_channel_config(), seed=PHYSICS_SEED), clock,
-            ports=MODEM_PORTS, on_event=tally,
-        )  # fmt: skip
+            Channel(_channel_config(), seed=PHYSICS_SEED),
+            clock,
+            ports=MODEM_PORTS,
+            on_event=tally,
+        )
         for vehicle_stats in stats:
             name, modem_id = vehicle_stats.name, vehicle_stats.modem_id
             mission = MissionFile.read(mission_dir / f"{name}.moos")
@@ -381,10 +405,17 @@ other through netsim's acoustic physics in a noisy harbour (spreading factor {sp
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--warp", type=int, default=25, help="MOOS time warp (default %(default)s)")
-    parser.add_argument("--duration", type=float, default=720.0,
-                        help="simulated seconds of the mission (default %(default)s)")  # fmt: skip
-    parser.add_argument("--event-log", type=Path,
-                        help="acoustic event log to write (default: in a new temporary folder)")  # fmt: skip
+    parser.add_argument(
+        "--duration",
+        type=float,
+        default=720.0,
+        help="simulated seconds of the mission (default %(default)s)",
+    )
+    parser.add_argument(
+        "--event-log",
+        type=Path,
+        help="acoustic event log to write (default: in a new temporary folder)",
+    )
     parser.add_argument("--skip-dccl", action="store_true", help="skip the DCCL part")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR, format="%(name)s: %(message)s")
@@ -394,20 +425,28 @@ def main(argv: list[str] | None = None) -> int:
     if not args.skip_dccl:
         print("== pygoby demo 1/2: DCCL ==\n")
         dccl_demo()
-    print(f"\n== pygoby demo 2/2: two vehicles, pAcommsHandler + Micro-Modem emulators + TDMA "
-          f"(time warp {args.warp:g}) ==")  # fmt: skip
+    print(
+        f"\n== pygoby demo 2/2: two vehicles, pAcommsHandler + Micro-Modem emulators + TDMA "
+        f"(time warp {args.warp:g}) =="
+    )
     print(MISSION_INTRO.format(**CHANNEL_SETTINGS, **RATE0_FRAME_ERRORS))
     result = asyncio.run(run_mission(args.warp, args.duration, say=_say, event_log=event_log))
-    print(f"\n{result.simulated_seconds:.0f} simulated seconds in {result.real_seconds:.1f} s: "
-          f"{result.delivered} messages delivered end to end "
-          f"({result.per_simulated_hour:.0f} per simulated hour)")  # fmt: skip
+    print(
+        f"\n{result.simulated_seconds:.0f} simulated seconds in {result.real_seconds:.1f} s: "
+        f"{result.delivered} messages delivered end to end "
+        f"({result.per_simulated_hour:.0f} per simulated hour)"
+    )
     for v in result.vehicles:
-        print(f"  {v.name}: decoded {v.packets_in - v.packets_lost} of {v.packets_in} acoustic "
-              f"packets; the last one: {_link(v)}")  # fmt: skip
+        print(
+            f"  {v.name}: decoded {v.packets_in - v.packets_lost} of {v.packets_in} acoustic "
+            f"packets; the last one: {_link(v)}"
+        )
         print(f"  {'':{len(v.name)}}  last status heard: {v.last_report or '-'}")
-    print(f"acoustic event log: {event_log}\n"
-          f"  plot it (success vs range and SNR, timeline): "
-          f"pygoby netsim report {event_log} -o DIR")  # fmt: skip
+    print(
+        f"acoustic event log: {event_log}\n"
+        f"  plot it (success vs range and SNR, timeline): "
+        f"pygoby netsim report {event_log} -o DIR"
+    )
     topside, unicorn = result.vehicles
     ok = (
         topside.received["status"] > 0

@@ -18,9 +18,13 @@ TCP_CLIENT = acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT
 
 def mm_config(modem_id: int, port: int, **mm) -> object:
     cfg = acomms_pb.DriverConfig(
-        driver_type=DRIVER_WHOI_MICROMODEM, modem_id=modem_id, connection_type=TCP_CLIENT,
-        tcp_server="127.0.0.1", tcp_port=port, reconnect_interval=1,
-    )  # fmt: skip
+        driver_type=DRIVER_WHOI_MICROMODEM,
+        modem_id=modem_id,
+        connection_type=TCP_CLIENT,
+        tcp_server="127.0.0.1",
+        tcp_port=port,
+        reconnect_interval=1,
+    )
     ext = cfg.Extensions[acomms_pb.MM_CONFIG]
     ext.query_cfg_on_startup = mm.pop("query", False)
     for key, value in mm.items():

@@ -54,7 +54,11 @@ def main() -> None:
     # time: set (pyacomms prints "...ZZ"), then query
     target = dt.datetime(2030, 1, 2, 3, 4, 5)
     answer = a.set_time(target)
-    report("set_time", time=answer.time if answer else None, timed_out=answer.timed_out if answer else None)
+    report(
+        "set_time",
+        time=answer.time if answer else None,
+        timed_out=answer.timed_out if answer else None,
+    )
     time.sleep(1.2)
     info = a.get_time_info(timeout=2)
     report("get_time", time=info[0] if info else None, sources=list(info[1:]) if info else None)
@@ -84,8 +88,13 @@ def main() -> None:
     a.send_tdp(dest_id=b.id, databytes=bytearray(payload), rate_num=1)
     try:
         packet = fdp.get(timeout=15)
-        report("fdp", received=bytes(packet.databytes).hex(), good=packet.packet_is_good,
-               stats=packet.cyclestats is not None, sent=payload.hex())  # fmt: skip
+        report(
+            "fdp",
+            received=bytes(packet.databytes).hex(),
+            good=packet.packet_is_good,
+            stats=packet.cyclestats is not None,
+            sent=payload.hex(),
+        )
     except Empty:
         report("fdp", received=None, sent=payload.hex())
     a.disconnect()

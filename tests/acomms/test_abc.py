@@ -16,7 +16,9 @@ from .queue_helpers import status_link
 
 def test_parse_and_simulator_rules():
     assert parse_abc("SEND,TO:2,FROM:1,HEX:0102abcd,BITRATE:100,ACK:TRUE\r\n") == (
-        "SEND", {"TO": "2", "FROM": "1", "HEX": "0102abcd", "BITRATE": "100", "ACK": "TRUE"})  # fmt: skip
+        "SEND",
+        {"TO": "2", "FROM": "1", "HEX": "0102abcd", "BITRATE": "100", "ACK": "TRUE"},
+    )
     with pytest.raises(ABCParseError):
         parse_abc("SEND,TO2")
     sim = ABCSimulator()
@@ -24,7 +26,9 @@ def test_parse_and_simulator_rules():
     sim.handle("b", "CONF,MAC:2")
     sim.handle("c", "CONF,MAC:3")
     assert sim.handle("a", "SEND,TO:2,FROM:1,HEX:0102abcd,BITRATE:100,ACK:TRUE") == [
-        ("b", "RECV,FROM:1,TO:2,HEX:0102abcd,BITRATE:100\r\n"), ("a", "ACKN,FROM:2,TO:1\r\n")]  # fmt: skip
+        ("b", "RECV,FROM:1,TO:2,HEX:0102abcd,BITRATE:100\r\n"),
+        ("a", "ACKN,FROM:2,TO:1\r\n"),
+    ]
     assert sorted(e for e, _ in sim.handle("a", "SEND,TO:0,FROM:1,HEX:00,BITRATE:100")) == [
         "b",
         "c",
@@ -34,8 +38,13 @@ def test_parse_and_simulator_rules():
 
 
 def abc_cfg(modem_id, port):
-    return acomms_pb.DriverConfig(driver_type=3, modem_id=modem_id, tcp_server="127.0.0.1", tcp_port=port,
-                          connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT)  # fmt: skip
+    return acomms_pb.DriverConfig(
+        driver_type=3,
+        modem_id=modem_id,
+        tcp_server="127.0.0.1",
+        tcp_port=port,
+        connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT,
+    )
 
 
 async def test_abc_driver_queue_to_queue_with_ack():

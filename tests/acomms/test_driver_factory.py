@@ -28,7 +28,9 @@ def test_factory_and_driver_none():
 
 def test_driver_name_and_missing_settings():
     assert driver_name(acomms_pb.DriverConfig(driver_type=2, modem_id=1)) == "WHOI_MICROMODEM::1"
-    assert driver_name(acomms_pb.DriverConfig(driver_name="my_plugin", modem_id=3)) == "my_plugin::3"
+    assert (
+        driver_name(acomms_pb.DriverConfig(driver_name="my_plugin", modem_id=3)) == "my_plugin::3"
+    )
     d = MMDriver(VirtualClock(0))
     with pytest.raises(ModemDriverError) as info:
         d.startup(acomms_pb.DriverConfig(driver_type=2))  # no modem_id
@@ -36,5 +38,10 @@ def test_driver_name_and_missing_settings():
     with pytest.raises(ModemDriverError):
         d.startup(acomms_pb.DriverConfig(driver_type=2, modem_id=1))  # SERIAL without serial_port
     with pytest.raises(ModemDriverError):
-        d.startup(acomms_pb.DriverConfig(driver_type=2, modem_id=1,
-                                 connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT))  # fmt: skip
+        d.startup(
+            acomms_pb.DriverConfig(
+                driver_type=2,
+                modem_id=1,
+                connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT,
+            )
+        )

@@ -56,9 +56,12 @@ def test_without_start_in_middle_waits_for_cycle_start():
 
 def test_fixed_reference():
     clock, mac, _, _ = make(
-        MAC_FIXED_DECENTRALIZED, [slot(1, seconds=7)] * 3, now=1000.0,
-        ref_time_type=acomms_pb.MACConfig.REFERENCE_FIXED, fixed_ref_time=990,
-    )  # fmt: skip
+        MAC_FIXED_DECENTRALIZED,
+        [slot(1, seconds=7)] * 3,
+        now=1000.0,
+        ref_time_type=acomms_pb.MACConfig.REFERENCE_FIXED,
+        fixed_ref_time=990,
+    )
     assert (mac.current, mac.next_slot_time) == (2, 1004.0)
 
 
@@ -134,8 +137,14 @@ class Water:
         self.sent: dict[int, list] = {}
         for i in ids:
             mac = MACManager(self.clock)
-            mac.startup(acomms_pb.MACConfig(modem_id=i, type=MAC_AUTO_DECENTRALIZED,
-                                    slot_seconds=slot_seconds, expire_cycles=expire_cycles))  # fmt: skip
+            mac.startup(
+                acomms_pb.MACConfig(
+                    modem_id=i,
+                    type=MAC_AUTO_DECENTRALIZED,
+                    slot_seconds=slot_seconds,
+                    expire_cycles=expire_cycles,
+                )
+            )
             mac.signal_initiate_transmission.connect(self.sent.setdefault(i, []).append)
             self.macs[i] = mac
         self.pending: list[int] = []
@@ -159,8 +168,23 @@ class Water:
 
 
 # doc 003 Table 2.1 (who transmits in each 15 s slot); rows 30, 195 and 210 differ, see below
-TABLE_2_1 = {0: (1, 2), 15: (), 30: (2,), 45: (), 60: (2,), 75: (), 90: (1,), 105: (), 120: (),
-             135: (1,), 150: (2,), 165: (), 180: (1,), 195: (), 210: (2,)}  # fmt: skip
+TABLE_2_1 = {
+    0: (1, 2),
+    15: (),
+    30: (2,),
+    45: (),
+    60: (2,),
+    75: (),
+    90: (1,),
+    105: (),
+    120: (),
+    135: (1,),
+    150: (2,),
+    165: (),
+    180: (1,),
+    195: (),
+    210: (2,),
+}
 
 
 def test_auto_discovery_converges_as_in_table_2_1():

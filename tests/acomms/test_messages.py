@@ -9,11 +9,23 @@ def _numbers(cls) -> dict[str, int]:
 
 def test_modem_transmission_fields_and_defaults():
     assert _numbers(acomms_pb.ModemTransmission) == {
-        "src": 1, "dest": 2, "time": 3, "time_source": 5, "rate": 6, "type": 7,
-        "max_num_frames": 11, "max_frame_bytes": 12, "ack_requested": 13, "frame": 14,
-        "frame_start": 15, "acked_frame": 20, "slot_seconds": 30, "unique_id": 31,
-        "always_initiate": 32, "slot_index": 33,
-    }  # fmt: skip
+        "src": 1,
+        "dest": 2,
+        "time": 3,
+        "time_source": 5,
+        "rate": 6,
+        "type": 7,
+        "max_num_frames": 11,
+        "max_frame_bytes": 12,
+        "ack_requested": 13,
+        "frame": 14,
+        "frame_start": 15,
+        "acked_frame": 20,
+        "slot_seconds": 30,
+        "unique_id": 31,
+        "always_initiate": 32,
+        "slot_index": 33,
+    }
     t = acomms_pb.ModemTransmission()
     assert (t.src, t.dest, t.rate, t.type, t.max_num_frames) == (-1, -1, 0, acomms_pb.DATA, 1)
     assert t.ack_requested is True and t.slot_seconds == 10
@@ -22,8 +34,15 @@ def test_modem_transmission_fields_and_defaults():
 
 def test_udp_example_bytes_match_protobuf_wire_format():
     # spec §8.2 example datagram 1; the field tags are those of goby3's modem_message.proto
-    t = acomms_pb.ModemTransmission(src=1, dest=2, rate=0, type=acomms_pb.DATA, max_frame_bytes=1400,
-                            ack_requested=True, frame_start=7)  # fmt: skip
+    t = acomms_pb.ModemTransmission(
+        src=1,
+        dest=2,
+        rate=0,
+        type=acomms_pb.DATA,
+        max_frame_bytes=1400,
+        ack_requested=True,
+        frame_start=7,
+    )
     t.frame.append(b"\x01\x02\x03\x04\x05")
     wire = t.SerializeToString()
     assert wire.startswith(b"\x08\x01\x10\x02")  # field 1 varint 1, field 2 varint 2
@@ -47,7 +66,12 @@ def test_micromodem_extension_round_trip():
 def test_queue_entry_defaults():
     e = acomms_pb.QueuedMessageEntry(protobuf_name="x.Y")
     assert (e.ack, e.blackout_time, e.max_queue, e.newest_first, e.ttl, e.value_base) == (
-        True, 0, 100, True, 1800, 1.0,
-    )  # fmt: skip
+        True,
+        0,
+        100,
+        True,
+        1800,
+        1.0,
+    )
     assert acomms_pb.DriverConfig().line_delimiter == "\r\n"
     assert acomms_pb.DriverConfig().reconnect_interval == 10

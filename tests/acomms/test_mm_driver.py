@@ -28,9 +28,12 @@ class Harness:
         self.received, self.results = [], []
         self.driver.signal_receive.connect(self.received.append)
         self.driver.signal_transmit_result.connect(self.results.append)
-        self.cfg = acomms_pb.DriverConfig(driver_type=acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name[
-            "driver_type"].enum_type.values_by_name["DRIVER_WHOI_MICROMODEM"].number,
-            modem_id=modem_id)  # fmt: skip
+        self.cfg = acomms_pb.DriverConfig(
+            driver_type=acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"]
+            .enum_type.values_by_name["DRIVER_WHOI_MICROMODEM"]
+            .number,
+            modem_id=modem_id,
+        )
         self.cfg.Extensions[acomms_pb.MM_CONFIG].query_cfg_on_startup = mm.pop("query", False)
         for k, v in mm.items():
             setattr(self.cfg.Extensions[acomms_pb.MM_CONFIG], k, v)
@@ -91,7 +94,9 @@ def test_startup_queries_all_nvram_until_two_seconds_of_silence():
 
 def test_nvram_cfg_entries_and_reset():
     h = Harness(reset_nvram=True)
-    h.cfg.Extensions[acomms_pb.MM_CONFIG].nvram_cfg.extend(["dqf,1", "psk.packet.mod_hdr_version,1"])
+    h.cfg.Extensions[acomms_pb.MM_CONFIG].nvram_cfg.extend(
+        ["dqf,1", "psk.packet.mod_hdr_version,1"]
+    )
     h.driver.startup(h.cfg)
     sent = []
     for _ in range(5):
@@ -100,8 +105,16 @@ def test_nvram_cfg_entries_and_reset():
         if line:
             s = NMEASentence.parse(line[0])
             h.link.feed(cs("$CACFG," + ",".join(s.fields[1:])) + "\r")
-    assert sent == [cs(x) for x in ["$CCCFG,ALL,0", "$CCCFG,CST,1", "$CCCFG,DQF,1",
-                                   "$CCCFG,psk.packet.mod_hdr_version,1", "$CCCFG,SRC,1"]]  # fmt: skip
+    assert sent == [
+        cs(x)
+        for x in [
+            "$CCCFG,ALL,0",
+            "$CCCFG,CST,1",
+            "$CCCFG,DQF,1",
+            "$CCCFG,psk.packet.mod_hdr_version,1",
+            "$CCCFG,SRC,1",
+        ]
+    ]
 
 
 def test_local_data_transmission_rate0_with_ack():
@@ -150,8 +163,10 @@ def test_drq_without_data_gets_empty_txd():
     assert h.modem("$CADRQ,120000,1,2,1,64,2") == ["$CCTXD,1,2,1,*7A"]
 
 
-CST_GOOD = ("$CACST,0,221320.5000,0,1,20,100,150,0,0,0,0,0,0,1,2,0,1,1,0,100,10,12,30,-10,200,"
-            "0.0,50,25000,5000")  # fmt: skip
+CST_GOOD = (
+    "$CACST,0,221320.5000,0,1,20,100,150,0,0,0,0,0,0,1,2,0,1,1,0,100,10,12,30,-10,200,"
+    "0.0,50,25000,5000"
+)
 
 
 def test_reception_rate0_two_csts_and_bad_crc():
@@ -220,7 +235,9 @@ def test_two_way_ping_and_ping_heard():
     h.modem("$CAMPA,3,1")
     assert (
         h.received[1].src == 3
-        and not h.received[1].Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply.one_way_travel_time
+        and not h.received[1]
+        .Extensions[acomms_pb.MM_TRANSMISSION]
+        .ranging_reply.one_way_travel_time
     )
 
 
@@ -313,7 +330,9 @@ def test_lbl_pings_and_travel_times():
     ext = r.Extensions[acomms_pb.MM_TRANSMISSION]
     assert ext.type == acomms_pb.MICROMODEM_REMUS_LBL_RANGING and r.src == 1
     assert list(ext.ranging_reply.one_way_travel_time) == [0.5, 1.25, 0.0, 2.0]
-    assert r.time == int((T0 + 0.5) * 1e6) and r.time_source == acomms_pb.ModemTransmission.MODEM_TIME
+    assert (
+        r.time == int((T0 + 0.5) * 1e6) and r.time_source == acomms_pb.ModemTransmission.MODEM_TIME
+    )
     nb = acomms_pb.MMConfig().narrowband_lbl
     nb.transmit_freq, nb.transmit_ping_ms, nb.receive_ping_ms, nb.turnaround_ms = 26000, 5, 5, 50
     nb.receive_freq.extend([25000, 25500])
@@ -337,7 +356,11 @@ def test_hardware_control_sweep_and_m_sequence_commands():
     h.modem("$CASWP,250005,260000,999,1000,1,10000")
     seq = acomms_pb.MMTransmission().m_sequence
     seq.seqlen_bits, seq.number_repetitions, seq.carrier_cycles_per_chip, seq.carrier_freq = (
-        1023, 3, 4, 25000)  # fmt: skip
+        1023,
+        3,
+        4,
+        25000,
+    )
     h.driver.handle_initiate_transmission(special(10, m_sequence=seq))
     assert h.work() == [cs("$CCMSQ,1023,3,4,25000")]
 
@@ -445,7 +468,9 @@ def test_nvram_remembered_from_the_modem_is_bounded():
 def test_update_cfg_sends_the_new_nvram_entries():
     h = Harness().start()
     update = acomms_pb.DriverConfig()
-    update.Extensions[acomms_pb.MM_CONFIG].nvram_cfg.extend(["agn,200", "psk.packet.mod_hdr_version,1"])
+    update.Extensions[acomms_pb.MM_CONFIG].nvram_cfg.extend(
+        ["agn,200", "psk.packet.mod_hdr_version,1"]
+    )
     h.driver.update_cfg(update)
     assert h.work() == [cs("$CCCFG,AGN,200")]
     assert h.modem("$CACFG,AGN,200") == [cs("$CCCFG,psk.packet.mod_hdr_version,1")]
@@ -453,14 +478,52 @@ def test_update_cfg_sends_the_new_nvram_entries():
     assert list(h.driver.mm_cfg.nvram_cfg) == ["agn,200", "psk.packet.mod_hdr_version,1"]
 
 
-MODEM_IDS = ["REV", "ERR", "CFG", "CLK", "TMS", "TMQ", "CYC", "DRQ", "XST", "ACK", "RXD", "MSG",
-             "CST", "MPR", "MPA", "RDP", "MUA", "MER", "TTA", "RXP", "TXF", "XYZ"]  # fmt: skip
+MODEM_IDS = [
+    "REV",
+    "ERR",
+    "CFG",
+    "CLK",
+    "TMS",
+    "TMQ",
+    "CYC",
+    "DRQ",
+    "XST",
+    "ACK",
+    "RXD",
+    "MSG",
+    "CST",
+    "MPR",
+    "MPA",
+    "RDP",
+    "MUA",
+    "MER",
+    "TTA",
+    "RXP",
+    "TXF",
+    "XYZ",
+]
 FIELD = st.one_of(
     st.integers(-(2**80), 2**80).map(str),
-    st.sampled_from(["", "0", "1", "6", "AUV", "INIT", "NMEA", "BAD_CRC", "1;2;0102", "nan",
-                     "221320.5", "20231114221320.5", "2023-11-14T22:13:20Z", "0.94.0.00"]),
+    st.sampled_from(
+        [
+            "",
+            "0",
+            "1",
+            "6",
+            "AUV",
+            "INIT",
+            "NMEA",
+            "BAD_CRC",
+            "1;2;0102",
+            "nan",
+            "221320.5",
+            "20231114221320.5",
+            "2023-11-14T22:13:20Z",
+            "0.94.0.00",
+        ]
+    ),
     st.text(alphabet="0123456789abcdef.;-:TZ ", max_size=30),
-)  # fmt: skip
+)
 
 
 @settings(max_examples=300, deadline=None)

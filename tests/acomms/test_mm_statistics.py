@@ -27,11 +27,30 @@ DAY = dt.date(2023, 11, 14)
 MIDNIGHT_US = int(dt.datetime(2023, 11, 14, tzinfo=dt.UTC).timestamp()) * 1_000_000
 CST = "$CACST,0,221330.6675,0,1000,29,16383,134,250,0,0,0,0,0,7,0,0,1,0,0,58,30,25,30,-30,255,0.0,36,25000,5000"
 INTS = (
-    "mfd_peak", "mfd_power", "mfd_ratio", "spl", "shf_agn", "shf_ainpshift", "shf_ainshift",
-    "shf_mfdshift", "shf_p2bshift", "rate", "source", "dest", "number_frames",
-    "number_bad_frames", "snr_rss", "snr_in", "snr_out", "snr_symbols", "mse_equalizer",
-    "data_quality_factor", "stddev_noise", "carrier_freq", "bandwidth",
-)  # fmt: skip
+    "mfd_peak",
+    "mfd_power",
+    "mfd_ratio",
+    "spl",
+    "shf_agn",
+    "shf_ainpshift",
+    "shf_ainshift",
+    "shf_mfdshift",
+    "shf_p2bshift",
+    "rate",
+    "source",
+    "dest",
+    "number_frames",
+    "number_bad_frames",
+    "snr_rss",
+    "snr_in",
+    "snr_out",
+    "snr_symbols",
+    "mse_equalizer",
+    "data_quality_factor",
+    "stddev_noise",
+    "carrier_freq",
+    "bandwidth",
+)
 
 
 @settings(max_examples=200, deadline=None)
@@ -49,10 +68,15 @@ def test_format_then_parse_gives_the_statistics_back(
     toa_us, mode, clock_mode, psk_error_code, packet_type, ints, doppler_tenths, version
 ):
     stat = acomms_pb.ReceiveStatistics(
-        version=version, mode=mode, time=MIDNIGHT_US + toa_us, clock_mode=clock_mode,
-        psk_error_code=psk_error_code, packet_type=packet_type, doppler=doppler_tenths / 10,
+        version=version,
+        mode=mode,
+        time=MIDNIGHT_US + toa_us,
+        clock_mode=clock_mode,
+        psk_error_code=psk_error_code,
+        packet_type=packet_type,
+        doppler=doppler_tenths / 10,
         **dict(zip(INTS, ints, strict=True)),
-    )  # fmt: skip
+    )
     sentence = format_cst(stat, version)
     as_mapping = {field.name: value for field, value in stat.ListFields()}
     assert format_cst(as_mapping, version) == sentence
@@ -132,9 +156,19 @@ def test_toa_text_prints_the_utc_time_of_day_and_parse_toa_reads_it(time_us, wit
 
 @pytest.mark.parametrize(
     "text",
-    ["240000.0", "236000", "225960.5", "12345", "1234567", "12a456", "20231314221320.5",
-     "00000000221320", "20230229000000", "2023111422132"],
-)  # fmt: skip
+    [
+        "240000.0",
+        "236000",
+        "225960.5",
+        "12345",
+        "1234567",
+        "12a456",
+        "20231314221320.5",
+        "00000000221320",
+        "20230229000000",
+        "2023111422132",
+    ],
+)
 def test_parse_toa_refuses_what_is_not_a_time_of_day(text):
     with pytest.raises(ValueError):
         parse_toa(text, DAY)
@@ -163,9 +197,21 @@ def test_parse_xst_fields_enum_ranges_and_short_sentences(caplog):
 
 
 def test_format_xst_prints_what_parse_xst_reads():
-    values = dict(clock_mode=1, mode=0, probe_length=0, bandwidth=5000, carrier_freq=25000,
-                  rate=5, source=1, dest=2, ack_requested=True, number_frames_expected=8,
-                  number_frames_sent=8, packet_type=3, number_bytes=2048)  # fmt: skip
+    values = dict(
+        clock_mode=1,
+        mode=0,
+        probe_length=0,
+        bandwidth=5000,
+        carrier_freq=25000,
+        rate=5,
+        source=1,
+        dest=2,
+        ack_requested=True,
+        number_frames_expected=8,
+        number_frames_sent=8,
+        packet_type=3,
+        number_bytes=2048,
+    )
     for version in (0, 6):
         xst = parse_xst(NMEASentence.parse(format_xst(1_700_000_000.25, values, version).message()))
         assert (xst.version, xst.date, xst.time) == (version, "20231114", "221320.2500")

@@ -61,7 +61,9 @@ async def test_polled_transmission_rate0_over_tcp():
         got1 = []
         d1.signal_receive.connect(got1.append)
         d2.signal_data_request.connect(lambda msg: msg.frame.append(b"\x2a" * 32))
-        d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=2, dest=1, rate=0))  # poll node 2
+        d1.handle_initiate_transmission(
+            acomms_pb.ModemTransmission(src=2, dest=1, rate=0)
+        )  # poll node 2
         await run_until(lambda: any(t.frame for t in got1), [d1, d2])
         (rx,) = [t for t in got1 if t.frame]
         assert (rx.src, rx.dest, list(rx.frame)) == (2, 1, [b"\x2a" * 32])
@@ -100,7 +102,9 @@ async def test_driver_over_serial_pty():
     channel = LoopbackChannel()
     sim = MMSimServer(MicroModemModel(3, WallClock(), channel), channel, pty_path=ANONYMOUS_PTY)
     await sim.start()
-    cfg = acomms_pb.DriverConfig(driver_type=2, modem_id=3, serial_port=sim.pty_path, serial_baud=19200)
+    cfg = acomms_pb.DriverConfig(
+        driver_type=2, modem_id=3, serial_port=sim.pty_path, serial_baud=19200
+    )
     cfg.Extensions[acomms_pb.MM_CONFIG].query_cfg_on_startup = False
     driver = MMDriver(WallClock())
     driver.startup(cfg)
@@ -125,8 +129,13 @@ async def test_acked_message_queued_during_link_outage_is_delivered_after_reconn
     q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
     q2, _ = manager(clock, modem_id=2, entries=[entry("Status")])
     mac = MACManager(clock)  # node 1 owns every slot, one a rate-1 packet and its ack fit in
-    mac.startup(acomms_pb.MACConfig(modem_id=1, type=MAC_FIXED_DECENTRALIZED,
-                            slot=[acomms_pb.ModemTransmission(src=1, dest=-1, rate=1, slot_seconds=3)]))  # fmt: skip
+    mac.startup(
+        acomms_pb.MACConfig(
+            modem_id=1,
+            type=MAC_FIXED_DECENTRALIZED,
+            slot=[acomms_pb.ModemTransmission(src=1, dest=-1, rate=1, slot_seconds=3)],
+        )
+    )
     bind(d1, q1, mac)
     bind(d2, q2)
     received, acked = [], []
@@ -160,7 +169,9 @@ async def test_application_acks_over_tcp():
         d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=1))
         await run_until(lambda: bool(got), [d1, d2])
         assert [x.value for x in got] == [77] and acked == []  # the ack is owed, not sent yet
-        d2.handle_initiate_transmission(acomms_pb.ModemTransmission(src=2, dest=-1, rate=1))  # no data
+        d2.handle_initiate_transmission(
+            acomms_pb.ModemTransmission(src=2, dest=-1, rate=1)
+        )  # no data
         await run_until(lambda: bool(acked), [d1, d2])  # the ack-only packet acknowledges
         assert acked == [77] and q1.size(20) == 0
     finally:

@@ -78,8 +78,13 @@ def test_cfg_cfq_accept_only_the_modems_parameters():
     assert ids(w.say(4, "$CCCFG,SRC,7")) == ["$CACFG"] and w.modems[4].modem_id == 7
     assert w.say(4, "$CCCFQ,SRC")[0].fields == ("$CACFG", "SRC", "7")
     assert w.say(4, "$CCCFG,dto,5")[0].fields == ("$CACFG", "DTO", "5")  # three letters: any case
-    for bad in ("$CCCFG,FOO,1", "$CCCFG,info.firmware_version,3", "$CCCFG,SRC,128",
-                "$CCCFG,SRC,x", "$CCCFQ,nothing"):  # fmt: skip
+    for bad in (
+        "$CCCFG,FOO,1",
+        "$CCCFG,info.firmware_version,3",
+        "$CCCFG,SRC,128",
+        "$CCCFG,SRC,x",
+        "$CCCFQ,nothing",
+    ):
         (err,) = w.say(4, bad)
         assert err.fields[0] == "$CAERR" and err[2] == "NMEA"
     assert "FOO" not in w.modems[4].nvram  # (regression: the table accepted any key)
@@ -112,14 +117,17 @@ def test_rate0_cycle_init_then_data_with_their_air_times_and_travel_time():
     assert ids(w.say(1, "$CCCYC,0,1,2,0,1,1")) == ["$CACYC"]
     ci = round(serial("$CCCYC,0,1,2,0,1,1"), 6)  # the FSK cycle-init leaves once it has come
     w.run(1.5)
-    (drq_t, drq), = w.said(1, "DRQ")
+    ((drq_t, drq),) = w.said(1, "DRQ")
     assert drq_t == ci + 1.0 and drq.fields[2:] == ("1", "2", "1", "32", "1")  # cycle-init sent
     w.say(1, "$CCTXD,1,2,1,0102030405")
     w.run(20)
     data = round(1.5 + serial("$CCTXD,1,2,1,0102030405"), 6)  # (the DRQ was across by 1.5)
     assert on_air(w, 1) == [(ci, ci + 1.0), (data, pytest.approx(data + 3.2))]  # 80 bit/s
     xst = [s for _, s in w.said(1, "XST")]
-    assert [s[3] for s in xst] == [f"221320.{int(ci * 1e4):04d}", f"221321.{int((data - 1) * 1e4):04d}"]
+    assert [s[3] for s in xst] == [
+        f"221320.{int(ci * 1e4):04d}",
+        f"221321.{int((data - 1) * 1e4):04d}",
+    ]
     heard = [(t, s.fields[0]) for t, s in w.heard[2]]
     assert heard[:3] == [(ci + 1.0, "$CARXP"), (ci + 2.0, "$CACYC"), (ci + 2.0, "$CACST")]
     end = round(data + 4.2, 6)
@@ -130,15 +138,20 @@ def test_rate0_cycle_init_then_data_with_their_air_times_and_travel_time():
     assert [c.packet_type for c in csts] == [2, 1]  # FSK mini-packet, FSK
     # the receiver acknowledges (a mini-packet) once the data has been heard
     assert on_air(w, 2) == [(end, end + 1.0)]
-    (ack_t, ack), = w.said(1, "ACK")
+    ((ack_t, ack),) = w.said(1, "ACK")
     assert ack_t == end + 2.0 and ack.fields[1:] == ("2", "1", "1", "1")
 
 
 @pytest.mark.parametrize(
     "rate, frames, size, seconds",
-    [(1, 1, 64, 0.3 + 2.95 / 3), (1, 3, 64, 3.25), (3, 2, 256, 3.25), (5, 8, 256, 2048 * 8 / 5000),
-     (5, 1, 256, 0.3 + (2048 * 8 / 5000 - 0.3) / 8)],
-)  # fmt: skip
+    [
+        (1, 1, 64, 0.3 + 2.95 / 3),
+        (1, 3, 64, 3.25),
+        (3, 2, 256, 3.25),
+        (5, 8, 256, 2048 * 8 / 5000),
+        (5, 1, 256, 0.3 + (2048 * 8 / 5000 - 0.3) / 8),
+    ],
+)
 def test_psk_air_time_per_rate_and_frame_count(rate, frames, size, seconds):
     w = Water(range_m=0.0)
     cyc = f"$CCCYC,0,1,2,{rate},0,{frames}"
@@ -174,7 +187,7 @@ def test_a_host_that_never_answers_gets_data_timeout():
     w.say(1, "$CCCYC,0,1,2,1,0,2")
     w.say(1, "$CCTXD,1,2,0,aa")  # frame 2 never comes
     w.run(10)
-    (err_t, err), = w.said(1, "ERR")
+    ((err_t, err),) = w.said(1, "ERR")
     assert err_t == 2.0 and err[2:4] == ("DATA_TIMEOUT", "2")  # NVRAM DTO: 2 s
     assert [s[5] for _, s in w.said(2, "RXD")] == ["aa"]  # what it had goes out
 
@@ -185,12 +198,16 @@ def test_a_second_transmission_waits_for_the_transducer():
     w.say(1, "$CCTXD,1,2,0,aa")
     w.say(1, "$CCMUC,1,2,0123")  # while the data is on the water
     w.run(10)
-    start = serial("$CCCYC,0,1,2,1,0,1") + serial("$CADRQ,221320,1,2,0,64,1") + serial(
-        "$CCTXD,1,2,0,aa"
+    start = (
+        serial("$CCCYC,0,1,2,1,0,1")
+        + serial("$CADRQ,221320,1,2,0,64,1")
+        + serial("$CCTXD,1,2,0,aa")
     )
     end = start + 0.3 + 2.95 / 3
-    assert on_air(w, 1) == [(pytest.approx(start, abs=2e-6), pytest.approx(end, abs=2e-6)),
-                            (pytest.approx(end, abs=2e-6), pytest.approx(end + 1, abs=2e-6))]  # fmt: skip
+    assert on_air(w, 1) == [
+        (pytest.approx(start, abs=2e-6), pytest.approx(end, abs=2e-6)),
+        (pytest.approx(end, abs=2e-6), pytest.approx(end + 1, abs=2e-6)),
+    ]
     assert w.said(2, "MUA")[0][1].fields[1:] == ("1", "2", "0123")
 
 
@@ -202,9 +219,9 @@ def test_ping_reply_after_two_way_travel_and_turnaround(range_m, tat):
     assert ids(w.say(1, "$CCMPC,1,2")) == ["$CAMPC"]
     w.run(20)
     owtt, start = range_m / 1490.0, serial("$CCMPC,1,2")
-    (mpa_t, mpa), = w.said(2, "MPA")
+    ((mpa_t, mpa),) = w.said(2, "MPA")
     assert mpa_t == pytest.approx(start + owtt + 0.5) and mpa.fields[1:] == ("1", "2")
-    (mpr_t, mpr), = w.said(1, "MPR")
+    ((mpr_t, mpr),) = w.said(1, "MPR")
     assert mpr_t == pytest.approx(start + 2 * owtt + 2 * 0.5 + tat / 1000)
     assert mpr.fields[1:3] == ("2", "1") and float(mpr[3]) == pytest.approx(owtt, abs=1e-4)
 
@@ -214,14 +231,18 @@ def test_time_query_set_and_clock_query():
     w.clock.set(T0 + 0.07)
     assert w.say(1, "$CCTMQ,0") == []
     w.run(1)
-    (tmq_t, tmq), = w.said(1, "TMQ")
+    ((tmq_t, tmq),) = w.said(1, "TMQ")
     # answered 0.5 s later with the time of the query, its clock and PPS sources (pyacomms
     # reads three fields)
-    assert tmq_t == pytest.approx(0.57) and tmq.fields[1:] == ("2023-11-14T22:13:20.0Z", "RTC", "RTC")
+    assert tmq_t == pytest.approx(0.57) and tmq.fields[1:] == (
+        "2023-11-14T22:13:20.0Z",
+        "RTC",
+        "RTC",
+    )
     # pyacomms' set_time prints "...ZZ"; the time applies at the modem's next whole second
     w.say(1, "$CCTMS,2024-01-02T03:04:05ZZ,0")
     w.run(1)
-    (tms_t, tms), = w.said(1, "TMS")
+    ((tms_t, tms),) = w.said(1, "TMS")
     assert tms_t == 2.0 and tms.fields[1:] == ("0", "2024-01-02T03:04:05.0Z")
     assert w.say(1, "$CCCLQ,0,0")[0].fields[1:] == ("2024", "1", "2", "3", "4", "5")
     w.say(1, "$CCTMQ,0")
@@ -246,9 +267,15 @@ def test_a_moos_time_warped_clock_is_accepted():
 
 @pytest.mark.parametrize(
     "bad",
-    ["$CCTMS,0001-01-01T00:00:00Z,0", "$CCTMS,9999-12-31T23:59:59Z,0", "$CCTMS,2024-01-02T03:04:05+02:00,0",
-     "$CCCLK,2024,1,2,3,4,99999999999999999999999", "$CCCLK,2024,2,30,0,0,0", "$CCCLK,1,1,1,0,0,0"],
-)  # fmt: skip
+    [
+        "$CCTMS,0001-01-01T00:00:00Z,0",
+        "$CCTMS,9999-12-31T23:59:59Z,0",
+        "$CCTMS,2024-01-02T03:04:05+02:00,0",
+        "$CCCLK,2024,1,2,3,4,99999999999999999999999",
+        "$CCCLK,2024,2,30,0,0,0",
+        "$CCCLK,1,1,1,0,0,0",
+    ],
+)
 def test_bad_clock_settings_are_refused_and_the_modem_keeps_working(bad):
     """Regressions: a year-1 time wedged the emulator for every client; a huge $CCCLK field
     raised OverflowError."""
@@ -265,7 +292,7 @@ def test_clk_sets_the_clock_at_the_next_second():
     w.clock.set(T0 + 0.07)
     w.say(1, "$CCCLK,2023,11,14,22,13,21")
     w.run(1)
-    (t, clk), = w.said(1, "CLK")
+    ((t, clk),) = w.said(1, "CLK")
     assert t == 1.0 and clk.fields[1:] == ("2023", "11", "14", "22", "13", "21")
 
 
@@ -274,9 +301,9 @@ def test_flexible_data_packet_as_pyacomms_sends_it():
     echo = w.say(2, "$CCTDP,1,5,False,False,c0ffee")  # pyacomms prints Python's booleans
     assert echo[0].fields[0] == "$CATDP"
     w.run(10)
-    (rdp_t, rdp), = w.said(1, "RDP")
+    ((rdp_t, rdp),) = w.said(1, "RDP")
     assert rdp.fields[1:] == ("2", "1", "5", "0", "0", "1;3;c0ffee", "")
-    (cst_t, cst), = w.said(1, "CST")
+    ((cst_t, cst),) = w.said(1, "CST")
     assert cst_t == rdp_t and parse_cst(cst, None).packet_type == 5
     w.modems[1].nvram["recv.base64data"] = 1
     w.say(2, "$CCTDP,1,1,0,0," + "ab" * 150)  # two 64-byte frames and some
@@ -290,7 +317,7 @@ def test_navigation_pings_echo_and_report_no_transponders_at_the_timeout():
     w = Water(ids=(1,))
     assert w.say(1, "$CCPDT,1,2,0,0,1383,1,1,1,1")[0].fields[0] == "$SNPDT"
     w.run(3)
-    (t, tta), = w.said(1, "TTA")
+    ((t, tta),) = w.said(1, "TTA")
     start = serial("$CCPDT,1,2,0,0,1383,1,1,1,1")  # the ping leaves once the command is in
     assert t == pytest.approx(start + 1.383) and tta.fields[1:] == ("", "", "", "", "221320.01")
     assert w.say(1, "$CCPNT,26000,5,5,2716,25000,25500,0,0,1")[0].fields[0] == "$SNPNT"
@@ -341,8 +368,12 @@ def test_a_rate_0_poll_heard_before_the_host_spoke_goes_on_the_water_at_once():
 def test_channel_statistics_reach_cacst():
     model = MicroModemModel(2, VirtualClock(T0), firmware="0.94.0.00")
     packet = AcousticPacket(PacketKind.DATA, 1, 2, rate=1, frames=[b"a", b"b"], duration=1.0)
-    model.receive(packet, Reception(T0 + 0.25, frame_ok=[True, False],
-                                    stats={"snr_in": 7.6, "doppler": -0.44, "bogus": 1}))  # fmt: skip
+    model.receive(
+        packet,
+        Reception(
+            T0 + 0.25, frame_ok=[True, False], stats={"snr_in": 7.6, "doppler": -0.44, "bogus": 1}
+        ),
+    )
     lines = [_text(s) for s in model.take_output()]
     assert [s.sentence_id for s in lines] == ["CYC", "RXD", "MSG", "CST"]
     cst = lines[-1]
@@ -359,14 +390,52 @@ def test_mm2_statistics_carry_their_version_and_date():
     assert fields[1:4] == ("6", "0", "20231114221320.2500")
 
 
-HOST_COMMANDS = ["CFG", "CFQ", "MSC", "CLK", "CLQ", "TMS", "TMQ", "ALQ", "CYC", "TXD", "MPC",
-                 "MUC", "TDP", "MEC", "PDT", "PNT", "PGT", "SWP", "MSQ", "RSP", "XYZ"]  # fmt: skip
+HOST_COMMANDS = [
+    "CFG",
+    "CFQ",
+    "MSC",
+    "CLK",
+    "CLQ",
+    "TMS",
+    "TMQ",
+    "ALQ",
+    "CYC",
+    "TXD",
+    "MPC",
+    "MUC",
+    "TDP",
+    "MEC",
+    "PDT",
+    "PNT",
+    "PGT",
+    "SWP",
+    "MSQ",
+    "RSP",
+    "XYZ",
+]
 FIELDS = st.one_of(
     st.integers(-(2**70), 2**70).map(str),
-    st.sampled_from(["", "0", "1", "ALL", "SRC", "TOP", "info", "False", "ab", "0123", "ZZ",
-                     "2024-01-02T03:04:05Z", "0001-01-01T00:00:00Z", "nan", "1e999"]),
+    st.sampled_from(
+        [
+            "",
+            "0",
+            "1",
+            "ALL",
+            "SRC",
+            "TOP",
+            "info",
+            "False",
+            "ab",
+            "0123",
+            "ZZ",
+            "2024-01-02T03:04:05Z",
+            "0001-01-01T00:00:00Z",
+            "nan",
+            "1e999",
+        ]
+    ),
     st.text(alphabet="0123456789abcdefABCDEF.-:TZ;", max_size=40),
-)  # fmt: skip
+)
 
 
 @settings(max_examples=400, deadline=None)
@@ -394,10 +463,19 @@ def test_fuzz_host_lines_only_get_answers(lines):
 
 async def test_pygoby_mmsim_command_answers_over_tcp():
     proc = await asyncio.create_subprocess_exec(
-        sys.executable, "-m", "pygoby.cli", "mmsim", "--port", "0", "--id", "5",
-        "--channel-group", "239.255.42.98:0",
-        stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.DEVNULL,
-    )  # fmt: skip
+        sys.executable,
+        "-m",
+        "pygoby.cli",
+        "mmsim",
+        "--port",
+        "0",
+        "--id",
+        "5",
+        "--channel-group",
+        "239.255.42.98:0",
+        stdout=asyncio.subprocess.PIPE,
+        stderr=asyncio.subprocess.DEVNULL,
+    )
     try:
         async with asyncio.timeout(20):
             line = (await proc.stdout.readline()).decode()
@@ -422,10 +500,22 @@ async def test_two_mmsim_processes_hear_each_other_over_their_range(tmp_path):
         for modem_id in (1, 2):
             extra = ["--pty", str(pty_link)] if modem_id == 1 else []
             proc = await asyncio.create_subprocess_exec(
-                sys.executable, "-m", "pygoby.cli", "mmsim", "--port", "0", "--id", str(modem_id),
-                "--channel-group", group, "--range", "750", *extra,
-                stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.DEVNULL,
-            )  # fmt: skip
+                sys.executable,
+                "-m",
+                "pygoby.cli",
+                "mmsim",
+                "--port",
+                "0",
+                "--id",
+                str(modem_id),
+                "--channel-group",
+                group,
+                "--range",
+                "750",
+                *extra,
+                stdout=asyncio.subprocess.PIPE,
+                stderr=asyncio.subprocess.DEVNULL,
+            )
             procs.append(proc)
             line = (await asyncio.wait_for(proc.stdout.readline(), 20)).decode()
             ports.append(int(line.rsplit(":", 1)[1]))
@@ -465,7 +555,13 @@ async def test_two_mmsim_processes_hear_each_other_over_their_range(tmp_path):
 
 def test_timing_table_documents_its_rates():
     assert {r: (t.frames, t.frame_bytes) for r, t in DEFAULT_TIMING.rates.items()} == {
-        0: (1, 32), 1: (3, 64), 2: (3, 64), 3: (2, 256), 4: (2, 256), 5: (8, 256), 6: (6, 32),
-    }  # fmt: skip
+        0: (1, 32),
+        1: (3, 64),
+        2: (3, 64),
+        3: (2, 256),
+        4: (2, 256),
+        5: (8, 256),
+        6: (6, 32),
+    }
     assert DEFAULT_TIMING.data(0, 1) == pytest.approx(3.2)
     assert DEFAULT_TIMING.data(6, 6) == pytest.approx(3.25)

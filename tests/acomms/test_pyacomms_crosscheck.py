@@ -48,9 +48,14 @@ async def test_pyacomms_drives_two_emulators_through_their_api(tmp_path):
     for server in servers:
         await server.start()
     proc = await asyncio.create_subprocess_exec(
-        sys.executable, str(SESSION), *map(str, links), str(tmp_path),
-        stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE, cwd=tmp_path,
-    )  # fmt: skip
+        sys.executable,
+        str(SESSION),
+        *map(str, links),
+        str(tmp_path),
+        stdout=asyncio.subprocess.PIPE,
+        stderr=asyncio.subprocess.PIPE,
+        cwd=tmp_path,
+    )
     steps: dict[str, list[dict]] = {}
     try:
         async with asyncio.timeout(150):
@@ -113,9 +118,14 @@ async def test_pyacomms_talks_to_emulator_and_our_driver():
     driver.signal_receive.connect(got.append)
     driver.signal_data_request.connect(lambda msg: msg.frame.append(b"to pyacomms"))
     proc = await asyncio.create_subprocess_exec(
-        sys.executable, str(CLIENT), sim1.pty_path, "2", stdout=asyncio.subprocess.PIPE,
-        stderr=asyncio.subprocess.DEVNULL, cwd="/tmp",
-    )  # fmt: skip
+        sys.executable,
+        str(CLIENT),
+        sim1.pty_path,
+        "2",
+        stdout=asyncio.subprocess.PIPE,
+        stderr=asyncio.subprocess.DEVNULL,
+        cwd="/tmp",
+    )
     try:
         connected = json.loads(await asyncio.wait_for(proc.stdout.readline(), 20))
         assert connected == {"event": "connected", "id": 1}  # parsed our $CACFG,SRC,1

@@ -17,7 +17,9 @@ T0 = 1_700_000_000.0
 
 
 def request(dest=-1, frames=1, max_bytes=None, frame_start=0, **kw):
-    r = acomms_pb.ModemTransmission(src=-1, dest=dest, max_num_frames=frames, frame_start=frame_start, **kw)
+    r = acomms_pb.ModemTransmission(
+        src=-1, dest=dest, max_num_frames=frames, frame_start=frame_start, **kw
+    )
     if max_bytes is not None:
         r.max_frame_bytes = max_bytes
     return r
@@ -44,8 +46,10 @@ def clock():
 
 def test_priority_contest_spec_example(clock):
     # spec §5.3: A (1, 1800) and B (4, 1000), both last sent 100 s ago -> B (0.4 > 0.056)
-    qm, (Status, Bulk, Note) = manager(clock, entries=[
-        entry("Status", value_base=1, ttl=1800), entry("Bulk", value_base=4, ttl=1000)])  # fmt: skip
+    qm, (Status, Bulk, Note) = manager(
+        clock,
+        entries=[entry("Status", value_base=1, ttl=1800), entry("Bulk", value_base=4, ttl=1000)],
+    )
     clock.advance(100)
     qm.push_message(Status(src=1, dest=2, value=1))
     qm.push_message(Bulk(src=1, dest=2, payload=b"b"))
@@ -113,8 +117,9 @@ def test_ttl_expiry_and_infinite_ttl(clock):
     "newest_first, kept, order", [(True, [2, 3], [3, 2]), (False, [1, 2], [1, 2])]
 )
 def test_max_queue_and_newest_first(clock, newest_first, kept, order):
-    qm, (Status, *_) = manager(clock, entries=[
-        entry("Status", max_queue=2, newest_first=newest_first, ack=False)])  # fmt: skip
+    qm, (Status, *_) = manager(
+        clock, entries=[entry("Status", max_queue=2, newest_first=newest_first, ack=False)]
+    )
     sizes = []
     qm.signal_queue_size_change.connect(lambda qs: sizes.append(qs.size))
     for v in (1, 2, 3):
@@ -142,11 +147,17 @@ def test_ack_keeps_message_until_acknowledged_and_reoffers_it(clock):
     clock.advance(1)
     r2 = fill(qm, frame_start=2)  # no ack came: offered again
     assert r2.frame[0] == r1.frame[0]
-    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=3, acked_frame=[2]))
+    qm.handle_modem_receive(
+        acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=3, acked_frame=[2])
+    )
     assert acks == [] and qm.size(20) == 1  # not for us
-    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[0]))
+    qm.handle_modem_receive(
+        acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[0])
+    )
     assert acks == []  # the wait for frame 0 was released by the second request
-    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[2]))
+    qm.handle_modem_receive(
+        acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[2])
+    )
     assert acks == [([2], 7)] and qm.size(20) == 0 and sizes[-1] == 0
 
 
@@ -159,8 +170,9 @@ def test_broadcast_never_requests_ack(clock):
 
 
 def test_packing_several_messages_per_frame_and_frames_per_packet(clock):
-    qm, (Status, Bulk, Note) = manager(clock, entries=[entry("Status", ack=False),
-                                                       entry("Bulk", ack=False)])  # fmt: skip
+    qm, (Status, Bulk, Note) = manager(
+        clock, entries=[entry("Status", ack=False), entry("Bulk", ack=False)]
+    )
     for v in range(5):
         qm.push_message(Status(src=1, dest=2, value=v))
     qm.push_message(Bulk(src=1, dest=2, payload=b"z" * 16))
@@ -187,21 +199,30 @@ def test_destination_and_ack_rules(clock):
 
 
 def test_receive_filters_and_manipulators(clock):
-    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name[
+        "manipulator"
+    ].enum_type.values_by_name
     bulk = entry("Bulk")
     bulk.manipulator.append(Manip["PROMISCUOUS"].number)
     note = entry("Note", roles=False)
     note.manipulator.append(Manip["NO_DEQUEUE"].number)
     qm, (Status, Bulk, Note) = manager(clock, modem_id=2, entries=[entry("Status"), bulk, note])
     enc = qm.codec.encode
-    frame = enc(Status(src=1, dest=2, value=1)) + enc(Status(src=1, dest=5, value=2)) + enc(
-        Bulk(src=1, dest=5, payload=b"p")) + enc(Note(value=3)) + enc(Status(src=2, dest=0, value=4))  # fmt: skip
+    frame = (
+        enc(Status(src=1, dest=2, value=1))
+        + enc(Status(src=1, dest=5, value=2))
+        + enc(Bulk(src=1, dest=5, payload=b"p"))
+        + enc(Note(value=3))
+        + enc(Status(src=2, dest=0, value=4))
+    )
     got = decoded(qm, frame)
     assert [(x.DESCRIPTOR.name, x.src) for x in got] == [("Status", 1), ("Bulk", 1)]
 
 
 def test_push_to_self_loopback_and_errors(clock):
-    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name[
+        "manipulator"
+    ].enum_type.values_by_name
     loop = entry("Bulk")
     loop.manipulator.extend([Manip["LOOPBACK"].number, Manip["NO_QUEUE"].number])
     qm, (Status, Bulk, Note) = manager(clock, entries=[entry("Status"), loop])
@@ -217,7 +238,9 @@ def test_push_to_self_loopback_and_errors(clock):
 
 
 def test_on_demand(clock):
-    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name[
+        "manipulator"
+    ].enum_type.values_by_name
     e = entry("Status", ack=False)
     e.manipulator.append(Manip["ON_DEMAND"].number)
     qm, (Status, *_) = manager(clock, entries=[e])
@@ -280,29 +303,47 @@ FUZZ = manager(VirtualClock(T0), modem_id=2, entries=[entry("Status"), entry("Bu
 
 
 def test_network_acks_for_configured_sources(clock):
-    qm, (Status, *_) = manager(clock, entries=[entry("Status", ttl=60)],
-                               make_network_ack_for_src_id=[1])  # fmt: skip
+    qm, (Status, *_) = manager(
+        clock, entries=[entry("Status", ttl=60)], make_network_ack_for_src_id=[1]
+    )
     got = []
     qm.signal_receive.connect(got.append)
     qm.push_message(Status(src=1, dest=2, value=1))
     qm.push_message(Status(src=1, dest=2, value=2))
     clock.advance(1)
     fill(qm, max_bytes=7)
-    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[0]))
+    qm.handle_modem_receive(
+        acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[0])
+    )
     clock.advance(100)
     qm.do_work()
     kinds = [(a.ack_type, a.ack_src, a.message_src, a.message_dest, a.message_dccl_id) for a in got]
-    assert kinds == [(acomms_pb.NetworkAck.ACK, 2, 1, 2, 20), (acomms_pb.NetworkAck.EXPIRE, 1, 1, 2, 20)]
+    assert kinds == [
+        (acomms_pb.NetworkAck.ACK, 2, 1, 2, 20),
+        (acomms_pb.NetworkAck.EXPIRE, 1, 1, 2, 20),
+    ]
 
 
 def test_encrypt_rules_per_peer(clock):
     rule = acomms_pb.QueueManagerConfig.EncryptRule
-    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")],
-                               encrypt_rule=[rule(id=2, crypto_passphrase="two")])  # fmt: skip
-    q2, _ = manager(clock, modem_id=2, entries=[entry("Status")],
-                    encrypt_rule=[rule(id=1, crypto_passphrase="two")])  # fmt: skip
-    q2_wrong, _ = manager(clock, modem_id=2, entries=[entry("Status")],
-                          encrypt_rule=[rule(id=1, crypto_passphrase="other")])  # fmt: skip
+    q1, (Status, *_) = manager(
+        clock,
+        modem_id=1,
+        entries=[entry("Status")],
+        encrypt_rule=[rule(id=2, crypto_passphrase="two")],
+    )
+    q2, _ = manager(
+        clock,
+        modem_id=2,
+        entries=[entry("Status")],
+        encrypt_rule=[rule(id=1, crypto_passphrase="two")],
+    )
+    q2_wrong, _ = manager(
+        clock,
+        modem_id=2,
+        entries=[entry("Status")],
+        encrypt_rule=[rule(id=1, crypto_passphrase="other")],
+    )
     msg = Status(src=1, dest=2, value=321)
     q1.push_message(msg)
     clock.advance(1)
@@ -313,7 +354,9 @@ def test_encrypt_rules_per_peer(clock):
 
 
 def test_loopback_as_sent_minimum_ack_wait_and_flush(clock):
-    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+    Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name[
+        "manipulator"
+    ].enum_type.values_by_name
     e = entry("Status")
     e.manipulator.append(Manip["LOOPBACK_AS_SENT"].number)
     qm, (Status, *_) = manager(clock, entries=[e], minimum_ack_wait_seconds=10)

@@ -37,14 +37,17 @@ def restart(clock, path, entries):
 def sent_values(qm, Status, frame_start=0):
     """The values of what the next one-message data request carries."""
     one = len(qm.codec.encode(Status(src=1, dest=2, value=1, time=T0)))
-    r = acomms_pb.ModemTransmission(src=-1, dest=-1, max_num_frames=1, frame_start=frame_start,
-                                    max_frame_bytes=one)  # fmt: skip
+    r = acomms_pb.ModemTransmission(
+        src=-1, dest=-1, max_num_frames=1, frame_start=frame_start, max_frame_bytes=one
+    )
     qm.handle_modem_data_request(r)
     return [qm.codec.decode(r.frame[0]).value] if r.frame[0] else []
 
 
 def ack(qm, frame):
-    qm.handle_modem_receive(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[frame]))
+    qm.handle_modem_receive(
+        acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=2, dest=1, acked_frame=[frame])
+    )
 
 
 def test_queued_messages_come_back_once_and_acked_ones_do_not(clock, tmp_path):
@@ -63,7 +66,13 @@ def test_queued_messages_come_back_once_and_acked_ones_do_not(clock, tmp_path):
     qm, (Status, *_), expired = restart(clock, path, entries)
     assert qm.size(20) == 2 and expired == []
     item = qm.queues[20].items()[0]
-    assert (item.msg.value, item.msg.time, item.src, item.dest, item.ack_requested) == (1, T0 + 1, 1, 2, True)
+    assert (item.msg.value, item.msg.time, item.src, item.dest, item.ack_requested) == (
+        1,
+        T0 + 1,
+        1,
+        2,
+        True,
+    )
     assert item.time == int((T0 + 1) * 1e6)
     assert sent_values(qm, Status) == [2]
     ack(qm, 0)

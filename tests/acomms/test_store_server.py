@@ -91,12 +91,19 @@ def test_store_keeps_messages_across_restart(tmp_path):
     assert list(store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 102.0).inbox) == []  # seen
     store.close()
     store = TransmissionStore(db)
-    assert list(store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 103.0).inbox) == []  # cursor kept
+    assert (
+        list(store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 103.0).inbox) == []
+    )  # cursor kept
 
 
 def store_cfg(modem_id, port):
-    cfg = acomms_pb.DriverConfig(driver_type=5, modem_id=modem_id, tcp_server="127.0.0.1", tcp_port=port,
-                         connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT)  # fmt: skip
+    cfg = acomms_pb.DriverConfig(
+        driver_type=5,
+        modem_id=modem_id,
+        tcp_server="127.0.0.1",
+        tcp_port=port,
+        connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT,
+    )
     cfg.Extensions[acomms_pb.STORE_SERVER_CONFIG].query_interval_seconds = 0.05
     return cfg
 
@@ -171,7 +178,9 @@ def test_driver_requests_stay_within_a_packet():
     driver._send_request(1.0)
     packets = [text.encode("latin-1") for text in link.take_written()]
     assert all(len(p) <= MAX_PACKET_BYTES for p in packets)
-    outboxes = [acomms_pb.StoreServerRequest.FromString(parse_rudics_packet(p)).outbox for p in packets]
+    outboxes = [
+        acomms_pb.StoreServerRequest.FromString(parse_rudics_packet(p)).outbox for p in packets
+    ]
     assert [len(o) for o in outboxes] == [2, 1] and driver._outbox == []
 
 
@@ -197,7 +206,9 @@ async def test_a_garbage_line_and_a_pipelining_client_do_not_hold_up_others():
         while server.requests_answered < 2:  # A's requests are being served
             await asyncio.sleep(0)
         b_reader, b_writer = await asyncio.open_connection("127.0.0.1", port)
-        b_writer.write(serialize_rudics_packet(acomms_pb.StoreServerRequest(modem_id=2).SerializeToString()))
+        b_writer.write(
+            serialize_rudics_packet(acomms_pb.StoreServerRequest(modem_id=2).SerializeToString())
+        )
         await b_writer.drain()
         await asyncio.wait_for(b_reader.readuntil(b"\r"), 60)
         served_before_b = server.requests_answered - 2
@@ -211,6 +222,7 @@ async def test_a_garbage_line_and_a_pipelining_client_do_not_hold_up_others():
 
 # -- issue 16 item 13: who may read a modem's mail, a locked database, pruning -------------------
 
+
 def signed(modem_id: int, secret: bytes | None, now: float, **fields) -> bytes:
     from pygoby.acomms.store_server.auth import sign_request
 
@@ -223,8 +235,10 @@ def signed(modem_id: int, secret: bytes | None, now: float, **fields) -> bytes:
 def answer(server: StoreServer, packet: bytes):
     """(response, error) for a request packet."""
     payload = parse_rudics_packet(server.handle_packet(packet))
-    return (acomms_pb.StoreServerResponse.FromString(payload),
-            acomms_pb.StoreServerResponseStatus.FromString(payload).error)  # fmt: skip
+    return (
+        acomms_pb.StoreServerResponse.FromString(payload),
+        acomms_pb.StoreServerResponseStatus.FromString(payload).error,
+    )
 
 
 def test_only_the_holder_of_a_modem_ids_secret_reads_its_mail():
@@ -237,8 +251,12 @@ def test_only_the_holder_of_a_modem_ids_secret_reads_its_mail():
     response, error = answer(server, signed(1, b"one", 1000.0, outbox=[mail]))
     assert error == "" and server.requests_answered == 1
     # an unsigned request, a wrong secret, an unknown id, a stale time: refused, nothing taken
-    for packet in (signed(2, None, 1000.0), signed(2, b"one", 1000.0), signed(3, b"x", 1000.0),
-                   signed(2, b"two", 1000.0 - 301)):  # fmt: skip
+    for packet in (
+        signed(2, None, 1000.0),
+        signed(2, b"one", 1000.0),
+        signed(3, b"x", 1000.0),
+        signed(2, b"two", 1000.0 - 301),
+    ):
         response, error = answer(server, packet)
         assert error == "not authenticated for this modem id" and not response.inbox
     assert server.requests_refused == 4
@@ -295,7 +313,9 @@ def test_delivered_transmissions_are_pruned_after_the_retention_time():
     request = acomms_pb.StoreServerRequest(modem_id=1)
     request.outbox.extend([bulk(1, 1, dest=2), bulk(1, 2, dest=3), bulk(1, 3, dest=0)])
     store.exchange(request, 0.0)
-    store.exchange(acomms_pb.StoreServerRequest(modem_id=2), 10.0)  # 2 reads its mail and the broadcast
+    store.exchange(
+        acomms_pb.StoreServerRequest(modem_id=2), 10.0
+    )  # 2 reads its mail and the broadcast
     store.exchange(acomms_pb.StoreServerRequest(modem_id=3), 10.0)  # 3 too
     store.exchange(acomms_pb.StoreServerRequest(modem_id=4), 10.0)  # 4 only knows the broadcast
     assert store.prune(50.0) == 0  # delivered, but within the retention time
@@ -314,14 +334,17 @@ async def test_signed_drivers_exchange_mail_through_a_server_with_secrets(tmp_pa
     (tmp_path / "secrets").write_text("# modem secrets\n1 alpha\n2 bravo\n")
     from pygoby.acomms.store_server.auth import read_secrets
 
-    tcp = await serve_store(StoreServer(store, secrets=read_secrets(tmp_path / "secrets")),
-                            "127.0.0.1", 0)  # fmt: skip
+    tcp = await serve_store(
+        StoreServer(store, secrets=read_secrets(tmp_path / "secrets")), "127.0.0.1", 0
+    )
     port = tcp.sockets[0].getsockname()[1]
     drivers = []
     for modem_id, secret in ((1, "alpha"), (2, "bravo")):
         (tmp_path / f"{modem_id}.secret").write_text(secret + "\n")
         cfg = store_cfg(modem_id, port)
-        cfg.Extensions[acomms_pb.STORE_SERVER_AUTH].secret_file = str(tmp_path / f"{modem_id}.secret")
+        cfg.Extensions[acomms_pb.STORE_SERVER_AUTH].secret_file = str(
+            tmp_path / f"{modem_id}.secret"
+        )
         driver = StoreServerDriver(clock)
         driver.startup(cfg)
         drivers.append(driver)
@@ -345,9 +368,23 @@ def test_store_server_refuses_a_bad_secrets_file(tmp_path):
     import sys
 
     (tmp_path / "secrets").write_text("1 alpha\ntwo bravo\n")
-    run = subprocess.run([sys.executable, "-m", "pygoby.cli", "store_server", "--port", "0",
-                          "--db", str(tmp_path / "s.db"), "--secrets", str(tmp_path / "secrets")],
-                         capture_output=True, text=True, timeout=30)  # fmt: skip
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pygoby.cli",
+            "store_server",
+            "--port",
+            "0",
+            "--db",
+            str(tmp_path / "s.db"),
+            "--secrets",
+            str(tmp_path / "secrets"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
     assert run.returncode == 1 and "secrets:2: expected MODEM_ID SECRET" in run.stderr
 
 
@@ -357,16 +394,31 @@ def test_store_server_stops_cleanly_on_sigint_with_a_client_connected(tmp_path):
     import subprocess
     import sys
 
-    proc = subprocess.Popen([sys.executable, "-m", "pygoby.cli", "store_server", "--port", "0",
-                             "--db", str(tmp_path / "s.db")],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "pygoby.cli",
+            "store_server",
+            "--port",
+            "0",
+            "--db",
+            str(tmp_path / "s.db"),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         line = proc.stdout.readline()
         assert "listening on 127.0.0.1:" in line
         port = int(line.split("127.0.0.1:")[1].split()[0])
         with socket.create_connection(("127.0.0.1", port)) as client:
-            client.sendall(serialize_rudics_packet(
-                acomms_pb.StoreServerRequest(modem_id=1).SerializeToString()))  # fmt: skip
+            client.sendall(
+                serialize_rudics_packet(
+                    acomms_pb.StoreServerRequest(modem_id=1).SerializeToString()
+                )
+            )
             assert client.recv(100)  # answered: its task is running
             proc.send_signal(signal.SIGINT)
             assert proc.wait(timeout=10) == 0

@@ -73,7 +73,9 @@ def test_datagram_is_plain_protobuf_and_garbage_is_skipped(caplog):
         d.signal_data_request.connect(lambda msg: msg.frame.append(b"\x01\x02\x03\x04\x05"))
         d.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=2, rate=0))
         data, _ = listener.recvfrom(65535)
-        expected = acomms_pb.ModemTransmission(src=1, dest=2, rate=0, max_frame_bytes=1400, frame_start=0)
+        expected = acomms_pb.ModemTransmission(
+            src=1, dest=2, rate=0, max_frame_bytes=1400, frame_start=0
+        )
         expected.frame.append(b"\x01\x02\x03\x04\x05")
         assert acomms_pb.ModemTransmission.FromString(data) == expected
         got = []

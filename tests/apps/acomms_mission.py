@@ -89,8 +89,13 @@ def micromodem_driver(modem_port: int) -> str:
 
 
 def mission_text(
-    modem_id: int, db_port: int, modem_port: int, extra: str = "", slots: str | None = None,
-    driver: str | None = None, common: str = "log: false  app_tick: 20  verbosity: WARN",
+    modem_id: int,
+    db_port: int,
+    modem_port: int,
+    extra: str = "",
+    slots: str | None = None,
+    driver: str | None = None,
+    common: str = "log: false  app_tick: 20  verbosity: WARN",
 ) -> str:
     """vehicle<modem_id>'s mission: `driver` (a driver_cfg block; default: a Micro-Modem on
     `modem_port`), TDMA slots for 1 and 2, the status and command queues and translators."""
@@ -162,12 +167,26 @@ class Recorder:
 
 
 WATCHED = [
-    "STATUS_REPORT_IN", "DESIRED_HEADING", "COMMAND_IN", "MODEM_ID", "VEHICLE_ID",
-    "ACOMMS_NMEA_IN", "ACOMMS_NMEA_OUT", "ACOMMS_RAW_INCOMING", "ACOMMS_RAW_OUTGOING",
-    "ACOMMS_MODEM_RECEIVE", "ACOMMS_MODEM_TRANSMIT", "ACOMMS_QUEUE_RECEIVE", "ACOMMS_ACK",
-    "ACOMMS_ACK_ORIGINAL", "ACOMMS_EXPIRE", "ACOMMS_QSIZE", "ACOMMS_MAC_INITIATE_TRANSMISSION",
-    "ACOMMS_MAC_SLOT_START", "ACOMMS_CONFIG",
-]  # fmt: skip
+    "STATUS_REPORT_IN",
+    "DESIRED_HEADING",
+    "COMMAND_IN",
+    "MODEM_ID",
+    "VEHICLE_ID",
+    "ACOMMS_NMEA_IN",
+    "ACOMMS_NMEA_OUT",
+    "ACOMMS_RAW_INCOMING",
+    "ACOMMS_RAW_OUTGOING",
+    "ACOMMS_MODEM_RECEIVE",
+    "ACOMMS_MODEM_TRANSMIT",
+    "ACOMMS_QUEUE_RECEIVE",
+    "ACOMMS_ACK",
+    "ACOMMS_ACK_ORIGINAL",
+    "ACOMMS_EXPIRE",
+    "ACOMMS_QSIZE",
+    "ACOMMS_MAC_INITIATE_TRANSMISSION",
+    "ACOMMS_MAC_SLOT_START",
+    "ACOMMS_CONFIG",
+]
 
 
 async def start_modem(
@@ -238,9 +257,13 @@ class TwoCommunities:
     driver_cfg block of that vehicle's mission)."""
 
     def __init__(
-        self, tmp_path: Path, extra: str = "", slots: str | None = None, link=None,
+        self,
+        tmp_path: Path,
+        extra: str = "",
+        slots: str | None = None,
+        link=None,
         common: str | None = None,
-    ) -> None:  # fmt: skip
+    ) -> None:
         self.tmp_path, self.extra, self.slots = tmp_path, extra, slots
         self.link = link if link is not None else MicroModemLink()
         self.common = common
@@ -258,10 +281,17 @@ class TwoCommunities:
         for modem_id, db in zip((1, 2), self.dbs, strict=True):
             path = self.tmp_path / f"vehicle{modem_id}.moos"
             options = {} if self.common is None else {"common": self.common}
-            path.write_text(mission_text(
-                modem_id, db.port, 0, self.extra, self.slots, self.link.driver_cfg(modem_id),
-                **options,
-            ))  # fmt: skip
+            path.write_text(
+                mission_text(
+                    modem_id,
+                    db.port,
+                    0,
+                    self.extra,
+                    self.slots,
+                    self.link.driver_cfg(modem_id),
+                    **options,
+                )
+            )
             app = pAcommsHandler.from_mission(path, "pAcommsHandler")
             recorder = Recorder(f"recorder{modem_id}", db.port)
             await recorder.start(WATCHED)

@@ -74,7 +74,9 @@ class LoopbackFrontSeat(InterfaceBase):
         status.speed.over_ground = self.course.speed
         status.source.position = frontseat_pb.Source.GPS
         self.compute_missing(status)
-        self.signal_raw_from_frontseat(frontseat_pb.Raw(raw=f"NAV,HEADING:{status.pose.heading:g}".encode()))
+        self.signal_raw_from_frontseat(
+            frontseat_pb.Raw(raw=f"NAV,HEADING:{status.pose.heading:g}".encode())
+        )
         self.signal_data_from_frontseat(frontseat_pb.InterfaceData(node_status=status))
 
 

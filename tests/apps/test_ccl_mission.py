@@ -23,10 +23,10 @@ STATE = "dccl.legacyccl.protobuf.CCLMDATState"
 STATUS = "pygoby.examples.SimpleStatus"
 # as the example writes it in the mission file (quotes and backslashes escaped in the sval)
 STATE_TEXT = (
-    r'latitude: 42.5  longitude: -10.56  fix_age: 3  time_date: 1360620606000000  heading: 195'
-    r'  depth: 345  mission_mode: NORMAL  faults: \"\\000\\000\\000\\000\" faults_2: \"0\"'
-    r'  mission_leg: 1  est_velocity: 1.5  objective_index: \"\\000\" watts: 20  lat_goal: 42.49'
-    r'  lon_goal: -10.54  battery_percent: 85  gfi_pitch_oil { gfi: 0  pitch: 3  oil: 80 }'
+    r"latitude: 42.5  longitude: -10.56  fix_age: 3  time_date: 1360620606000000  heading: 195"
+    r"  depth: 345  mission_mode: NORMAL  faults: \"\\000\\000\\000\\000\" faults_2: \"0\""
+    r"  mission_leg: 1  est_velocity: 1.5  objective_index: \"\\000\" watts: 20  lat_goal: 42.49"
+    r"  lon_goal: -10.54  battery_percent: 85  gfi_pitch_oil { gfi: 0  pitch: 3  oil: 80 }"
 )
 
 

@@ -50,7 +50,9 @@ def test_a_proto_file_not_found_lists_every_folder_searched(tmp_path, monkeypatc
     monkeypatch.chdir("/")
     path = mission(tmp_path, proto="messages/status.proto")
     text = error_of(path)
-    head = f'{path}:8: load_proto_file: "messages/status.proto" not found; searched: /, {tmp_path}, '
+    head = (
+        f'{path}:8: load_proto_file: "messages/status.proto" not found; searched: /, {tmp_path}, '
+    )
     assert text.startswith(head), text  # the working directory, then the mission's folder
     assert "pygoby/protobuf" in text  # and the import path
     (tmp_path / "messages").mkdir()
@@ -67,17 +69,24 @@ def test_a_queue_for_a_type_that_is_not_loaded_names_the_loaded_types(tmp_path):
     )
 
 
-def test_a_translator_entry_for_a_type_that_is_not_loaded_is_located_and_names_the_loaded_types(tmp_path):
+def test_a_translator_entry_for_a_type_that_is_not_loaded_is_located_and_names_the_loaded_types(
+    tmp_path,
+):
     """As the queue_cfg error, in each app that reads translator entries: pAcommsHandler, the
     commander tools reading its block (iCommander, liaison) and pTranslator."""
     from pygoby.apps.icommander import iCommander
     from pygoby.apps.ptranslator import pTranslator
 
-    entry = ('  translator_entry {\n    protobuf_name: "pygoby.examples.SimpleStatuss"\n'
-             '    trigger { type: TRIGGER_PUBLISH moos_var: "S" }\n  }\n')  # fmt: skip
+    entry = (
+        '  translator_entry {\n    protobuf_name: "pygoby.examples.SimpleStatuss"\n'
+        '    trigger { type: TRIGGER_PUBLISH moos_var: "S" }\n  }\n'
+    )
     path = mission(tmp_path, extra=entry)
-    path.write_text("LatOrigin = 42\nLongOrigin = -70\n" + path.read_text()
-                    + "ProcessConfig = iCommander\n{\n  common { log: false }\n}\n")  # fmt: skip
+    path.write_text(
+        "LatOrigin = 42\nLongOrigin = -70\n"
+        + path.read_text()
+        + "ProcessConfig = iCommander\n{\n  common { log: false }\n}\n"
+    )
     expected = (
         f"{path}:12: translator_entry.protobuf_name: "
         '"pygoby.examples.SimpleStatuss" is not a loaded message type; the types load_proto_file '
@@ -99,16 +108,24 @@ def test_a_translator_entry_for_a_type_that_is_not_loaded_is_located_and_names_t
         ("/usr/lib/libgoby_moos.so.30", None),  # messages built into pygoby
         ("libgoby.so", None),
         ("libdccl.so.4", None),
-        ("../build/lib/libmy_messages.so", '"../build/lib/libmy_messages.so": pygoby cannot load '
-         "compiled C++ libraries; use load_proto_file with the .proto file(s) the library was "
-         "built from instead"),
+        (
+            "../build/lib/libmy_messages.so",
+            '"../build/lib/libmy_messages.so": pygoby cannot load '
+            "compiled C++ libraries; use load_proto_file with the .proto file(s) the library was "
+            "built from instead",
+        ),
         ("/home/toby/dccl/build/lib/libdccl_ccl_compat.so", None),  # pygoby.dccl's built-ins
         ("libdccl_arithmetic.so.31", None),
-        ("libdccl_no_such_codecs.so", '"libdccl_no_such_codecs.so": pygoby has no built-in '
-         "equivalent of this DCCL codec library (built in: libdccl_ccl_compat.so, "
-         "libdccl_arithmetic.so, libdccl_native_protobuf.so, libdccl.so)"),
-        ("libgoby_frontseat_bluefin.so.30", '"libgoby_frontseat_bluefin.so.30": this library is a '
-         "frontseat driver, not messages"),
+        (
+            "libdccl_no_such_codecs.so",
+            '"libdccl_no_such_codecs.so": pygoby has no built-in '
+            "equivalent of this DCCL codec library (built in: libdccl_ccl_compat.so, "
+            "libdccl_arithmetic.so, libdccl_native_protobuf.so, libdccl.so)",
+        ),
+        (
+            "libgoby_frontseat_bluefin.so.30",
+            '"libgoby_frontseat_bluefin.so.30": this library is a frontseat driver, not messages',
+        ),
     ],
 )
 def test_load_shared_library_of_upstream_libraries(tmp_path, library, error):
@@ -146,10 +163,14 @@ def test_driver_type_not_implemented_lists_those_that_are():
     [
         ("  driver_cfg\n  {\n    driver_type: DRIVER_IRIDIUM\n  }\n", 11, "driver_cfg.driver_type"),
         ("  driver_type: DRIVER_IRIDIUM\n", 9, "driver_type"),  # Goby 2's top-level form
-        ("  listen_driver_cfg { driver_type: DRIVER_UDP }\n"
-         "  listen_driver_cfg { driver_type: DRIVER_IRIDIUM }\n", 10, "listen_driver_cfg[1].driver_type"),
+        (
+            "  listen_driver_cfg { driver_type: DRIVER_UDP }\n"
+            "  listen_driver_cfg { driver_type: DRIVER_IRIDIUM }\n",
+            10,
+            "listen_driver_cfg[1].driver_type",
+        ),
     ],
-)  # fmt: skip
+)
 def test_a_driver_type_not_implemented_is_located_at_its_mission_line(tmp_path, extra, line, field):
     path = mission(tmp_path, extra=extra)
     assert error_of(path).startswith(
@@ -170,8 +191,13 @@ def test_compiled_driver_plugins_are_named_in_the_error(monkeypatch):
 def test_the_console_script_prints_one_line_and_exits_1(tmp_path):
     path = mission(tmp_path, queued="no.Such")
     env = {**os.environ, "PYTHONWARNINGS": "ignore"}
-    done = subprocess.run([Path(sys.executable).with_name("pAcommsHandler"), path],
-                          capture_output=True, text=True, timeout=60, env=env)  # fmt: skip
+    done = subprocess.run(
+        [Path(sys.executable).with_name("pAcommsHandler"), path],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
     assert done.returncode == 1
     assert done.stderr.splitlines() == [
         f"pAcommsHandler: fatal configuration error: {path}:6: "

@@ -20,8 +20,9 @@ from pygoby.netsim.scenario import ScenarioError, load_scenario, parse_scenario
 from .acomms_mission import PROTO
 from .test_pacommshandler_config import EXAMPLE, write
 
-FUZZ = settings(max_examples=200, deadline=None,
-                suppress_health_check=[HealthCheck.function_scoped_fixture])  # fmt: skip
+FUZZ = settings(
+    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 
 
 def line_of(path, text: str) -> int:
@@ -43,17 +44,31 @@ def load_error(tmp_path, old: str, new: str) -> tuple[ConfigError, object]:
 @pytest.mark.parametrize(
     ("old", "new", "marker", "field", "reason"),
     [
-        ('serial_baud: 19200', 'serial_baud: 19200\n    tcp_port: 70000', "tcp_port",
-         "driver_cfg.tcp_port", "70000 is not a port number"),
-        ("slot { src: 2 dest: -1 rate: 0", "slot { src: 2 dest: -1 rate: 9", "rate: 9",
-         "mac_cfg.slot[1].rate", "rate 9 is not a rate of MMDriver (0-5)"),
-        ('moos_var: "NODE_REPORT_IN" }',
-         'moos_var: "NODE_REPORT_IN" }\n    publish { technique: TECHNIQUE_FORMAT moos_var: "X" format: "%77%" }',
-         "translator_entry {", "translator_entry[0]", "77"),
+        (
+            "serial_baud: 19200",
+            "serial_baud: 19200\n    tcp_port: 70000",
+            "tcp_port",
+            "driver_cfg.tcp_port",
+            "70000 is not a port number",
+        ),
+        (
+            "slot { src: 2 dest: -1 rate: 0",
+            "slot { src: 2 dest: -1 rate: 9",
+            "rate: 9",
+            "mac_cfg.slot[1].rate",
+            "rate 9 is not a rate of MMDriver (0-5)",
+        ),
+        (
+            'moos_var: "NODE_REPORT_IN" }',
+            'moos_var: "NODE_REPORT_IN" }\n    publish { technique: TECHNIQUE_FORMAT moos_var: "X" format: "%77%" }',
+            "translator_entry {",
+            "translator_entry[0]",
+            "77",
+        ),
         ('format: "%11%"', 'format: "%11"', "translator_entry {", "translator_entry[0]", "%11"),
     ],
     ids=["tcp_port", "slot_rate", "publish_format", "create_format"],
-)  # fmt: skip
+)
 def test_mistakes_are_load_time_errors_with_file_line_and_field(
     tmp_path, old, new, marker, field, reason
 ):
@@ -71,8 +86,12 @@ def test_a_server_port_that_is_not_a_number_is_an_error_at_its_line(tmp_path):
     assert "ServerPort = abc is not a number" in str(info.value)
     with pytest.raises(ConfigError, match=r"mission.moos:2: ServerPort: .*not a port number"):
         MissionFile.read(path).get_port("ServerPort")
-    moosdb = subprocess.run([sys.executable, "-m", "pygoby.cli", "moosdb", str(path)],
-                            capture_output=True, text=True, timeout=30)  # fmt: skip
+    moosdb = subprocess.run(
+        [sys.executable, "-m", "pygoby.cli", "moosdb", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
     assert moosdb.returncode == 1 and "mission.moos:2: ServerPort" in moosdb.stderr
 
 
@@ -92,28 +111,38 @@ def test_non_utf8_bytes_in_a_mission_file(tmp_path):
 
 def test_netsim_config_errors_say_file_line_and_field(tmp_path):
     path = tmp_path / "netsim.cfg"
-    path.write_bytes(EXAMPLE_CONFIG.replace("manager_tcp_port: 61999", "manager_tcp_port: 70000")
-                     .encode())  # fmt: skip
+    path.write_bytes(
+        EXAMPLE_CONFIG.replace("manager_tcp_port: 61999", "manager_tcp_port: 70000").encode()
+    )
     with pytest.raises(ConfigError) as info:
         load_config(path)
     assert (info.value.file, info.value.line, info.value.field) == (
-        str(path), line_of(path, "manager_tcp_port"), "manager_tcp_port")
+        str(path),
+        line_of(path, "manager_tcp_port"),
+        "manager_tcp_port",
+    )
     # a Latin-1 comment loads; a Latin-1 string is an error at its line
     path.write_bytes(EXAMPLE_CONFIG.encode() + b"# r\xe9sum\xe9\n")
     assert load_config(path).manager_tcp_port == 61999
-    path.write_bytes(EXAMPLE_CONFIG.encode().replace(b'"127.0.0.1"      #', b'"127.0.0.\xe9"      #'))
+    path.write_bytes(
+        EXAMPLE_CONFIG.encode().replace(b'"127.0.0.1"      #', b'"127.0.0.\xe9"      #')
+    )
     with pytest.raises(ConfigError, match=r"netsim.cfg:\d+: listen_address: string is not valid"):
         load_config(path)
     # the console script: one clear line, exit 1, no traceback
-    run = subprocess.run([sys.executable, "-m", "pygoby.netsim.server", str(path)],
-                         capture_output=True, text=True, timeout=30)  # fmt: skip
+    run = subprocess.run(
+        [sys.executable, "-m", "pygoby.netsim.server", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
     assert run.returncode == 1 and "Traceback" not in run.stderr
     assert f"{path}:{line_of(path, 'listen_address')}: listen_address" in run.stderr
 
 
 def test_netsim_scenario_with_non_utf8_bytes(tmp_path):
     path = tmp_path / "scenario.pb.cfg"
-    path.write_bytes(b"# \xff\nnode { modem_id: 1 track { speed: 1 } }\nevent_log: \"\xff\"\n")
+    path.write_bytes(b'# \xff\nnode { modem_id: 1 track { speed: 1 } }\nevent_log: "\xff"\n')
     with pytest.raises(ScenarioError) as info:
         load_scenario(path)
     assert (info.value.file, info.value.line, info.value.field) == (str(path), 3, "event_log")
@@ -123,11 +152,33 @@ def test_netsim_scenario_with_non_utf8_bytes(tmp_path):
 
 textformat_bytes = st.one_of(
     st.binary(max_size=120),
-    st.lists(st.sampled_from([b"manager_tcp_port: ", b"70000", b"1", b"listen_address: ",
-                              b'"', b"\xe9", b"\xff", b"{", b"}", b"#", b"\n", b"sim_env_pair",
-                              b"node", b"modem_id: ", b"\\", b"[", b"]", b"-", b"1e99"]),
-             max_size=30).map(b"".join),
-)  # fmt: skip
+    st.lists(
+        st.sampled_from(
+            [
+                b"manager_tcp_port: ",
+                b"70000",
+                b"1",
+                b"listen_address: ",
+                b'"',
+                b"\xe9",
+                b"\xff",
+                b"{",
+                b"}",
+                b"#",
+                b"\n",
+                b"sim_env_pair",
+                b"node",
+                b"modem_id: ",
+                b"\\",
+                b"[",
+                b"]",
+                b"-",
+                b"1e99",
+            ]
+        ),
+        max_size=30,
+    ).map(b"".join),
+)
 
 
 @FUZZ

@@ -144,7 +144,9 @@ class EntryPointLink(UDPLink):
 def installed_test_driver(monkeypatch, tmp_path):
     dist_info = tmp_path / "site" / "pygoby_test_modem-1.0.dist-info"
     dist_info.mkdir(parents=True)
-    (dist_info / "METADATA").write_text("Metadata-Version: 2.1\nName: pygoby-test-modem\nVersion: 1.0\n")
+    (dist_info / "METADATA").write_text(
+        "Metadata-Version: 2.1\nName: pygoby-test-modem\nVersion: 1.0\n"
+    )
     (dist_info / "entry_points.txt").write_text(
         f"[{ENTRY_POINT_GROUP}]\ntest_udp = pygoby.acomms.drivers.udp:UDPDriver\n"
     )

@@ -64,13 +64,19 @@ def test_the_compiled_message_library_gets_one_clear_sentence(tmp_path):
 async def test_dual_status_mission_runs_with_paths_changed(tmp_path):
     missions = copy_mission(tmp_path, random.randint(40000, 60000))
     for path, _ in missions.values():
-        path.write_text(path.read_text().replace(LIBRARY_LINE, 'load_proto_file: "simple_status.proto"'))
+        path.write_text(
+            path.read_text().replace(LIBRARY_LINE, 'load_proto_file: "simple_status.proto"')
+        )
     env = {**os.environ, "PATH": f"{BIN}{os.pathsep}{os.environ.get('PATH', '')}"}
     antlers = [
         await asyncio.create_subprocess_exec(
-            f"{BIN}/pygoby", "antler", str(path), env=env,
-            stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.STDOUT,
-        )  # fmt: skip
+            f"{BIN}/pygoby",
+            "antler",
+            str(path),
+            env=env,
+            stdout=asyncio.subprocess.PIPE,
+            stderr=asyncio.subprocess.STDOUT,
+        )
         for path, _ in missions.values()
     ]
     recorders = [Recorder(f"watch{i}", port) for i, (_, port) in missions.items()]
@@ -93,16 +99,32 @@ async def test_dual_status_mission_runs_with_paths_changed(tmp_path):
             antler.send_signal(signal.SIGINT)
         outputs = [(await asyncio.wait_for(a.communicate(), 30))[0].decode() for a in antlers]
     # the initializers' values, across the multicast link
-    assert re.fullmatch(r"timestamp=[\d.]+,src=1,dest=2,x=150,y=200,speed=1\.4,heading=125,depth=23", from_1)
-    assert re.fullmatch(r"timestamp=[\d.]+,src=2,dest=1,x=550,y=125,speed=1\.6,heading=213,depth=20", from_2)
-    assert recorders[1].values("STATUS_REPORT_IN_PB")[0].startswith("@PB[goby.example.SimpleStatus] ")
+    assert re.fullmatch(
+        r"timestamp=[\d.]+,src=1,dest=2,x=150,y=200,speed=1\.4,heading=125,depth=23", from_1
+    )
+    assert re.fullmatch(
+        r"timestamp=[\d.]+,src=2,dest=1,x=550,y=125,speed=1\.6,heading=213,depth=20", from_2
+    )
+    assert (
+        recorders[1].values("STATUS_REPORT_IN_PB")[0].startswith("@PB[goby.example.SimpleStatus] ")
+    )
     for antler, out in zip(antlers, outputs, strict=True):
         lines = out.splitlines()
         assert antler.returncode == 0, out
-        assert ("antler: uXMS: uXMS is not available (no such program on PATH); the other "
-                "processes run without it") in lines  # MOOS-IvP's, not ours
+        assert (
+            "antler: uXMS: uXMS is not available (no such program on PATH); the other "
+            "processes run without it"
+        ) in lines  # MOOS-IvP's, not ours
         assert "antler: pAcommsHandler exited with status 0" in lines
-        assert any(line.endswith("show_gui: standard output is not a terminal; the log stays plain text")
-                   for line in lines)  # fmt: skip
-        assert any(re.search(r"^pAcommsHandler \| pAcommsHandler \[.*\{goby::acomms::modemdriver::out::"
-                             r"UDP_MULTICAST::\d\}: >> <\d+ B> ", line) for line in lines)  # DEBUG1
+        assert any(
+            line.endswith("show_gui: standard output is not a terminal; the log stays plain text")
+            for line in lines
+        )
+        assert any(
+            re.search(
+                r"^pAcommsHandler \| pAcommsHandler \[.*\{goby::acomms::modemdriver::out::"
+                r"UDP_MULTICAST::\d\}: >> <\d+ B> ",
+                line,
+            )
+            for line in lines
+        )  # DEBUG1

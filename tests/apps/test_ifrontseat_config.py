@@ -85,8 +85,10 @@ def test_the_environment_wins_over_driver_library(monkeypatch, tmp_path):
 def test_driver_library_names_a_driver_whose_block_is_in_the_config(tmp_path):
     # The loopback driver's extension is only known once its module is imported: the
     # driver_library field is read first, then the block is parsed with it.
-    body = (f'  driver_library: "{LOOPBACK}"\n'
-            "  frontseat_cfg { [pygoby.test.loopback_config] { nav_period: 0.25 } }")  # fmt: skip
+    body = (
+        f'  driver_library: "{LOOPBACK}"\n'
+        "  frontseat_cfg { [pygoby.test.loopback_config] { nav_period: 0.25 } }"
+    )
     app = iFrontSeat.from_mission(mission(tmp_path, body))
     assert app.interface.settings.nav_period == 0.25
 
@@ -116,8 +118,9 @@ def test_goby2_abc_config_is_read_as_the_basic_simulator_block(tmp_path, caplog)
 
 @pytest.mark.parametrize("option", ["subscribe_acomms_raw", "pub_sub_bf_commands"])
 def test_bluefin_legacy_options_are_refused(tmp_path, capsys, option):
-    body = (f'  driver_library: "{LOOPBACK}"\n  frontseat_cfg {{ }}\n'
-            f"  legacy_cfg {{ {option}: true }}")  # fmt: skip
+    body = (
+        f'  driver_library: "{LOOPBACK}"\n  frontseat_cfg {{ }}\n  legacy_cfg {{ {option}: true }}'
+    )
     assert iFrontSeat.main([str(mission(tmp_path, body))]) == 1
     err = capsys.readouterr().err
     assert f"{option}: true" in err and "Bluefin" in err and "does not implement" in err
@@ -135,10 +138,13 @@ async def test_exit_on_error_stops_the_process_with_status_1(tmp_path):
         env = {**os.environ, "PYTHONPATH": str(REPO)}
         env.pop("IFRONTSEAT_DRIVER_LIBRARY", None)
         process = await asyncio.create_subprocess_exec(
-            str(Path(sys.executable).with_name("iFrontSeat")), str(path),
-            cwd=tmp_path, env=env,
-            stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.STDOUT,
-        )  # fmt: skip
+            str(Path(sys.executable).with_name("iFrontSeat")),
+            str(path),
+            cwd=tmp_path,
+            env=env,
+            stdout=asyncio.subprocess.PIPE,
+            stderr=asyncio.subprocess.STDOUT,
+        )
         try:
             async with asyncio.timeout(30):
                 output, _ = await process.communicate()
@@ -153,8 +159,9 @@ async def test_exit_on_error_stops_the_process_with_status_1(tmp_path):
 
 
 def test_the_example_mission_reads():
-    cfg = iFrontSeat.read_config(MissionFile.read(REPO / "examples/frontseat/abc_auv.moos"),
-                                 "iFrontSeat")  # fmt: skip
+    cfg = iFrontSeat.read_config(
+        MissionFile.read(REPO / "examples/frontseat/abc_auv.moos"), "iFrontSeat"
+    )
     assert cfg.driver_library == "abc" and cfg.legacy_cfg.publish_fs_bs_ready
     sim = cfg.frontseat_cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
     assert (sim.tcp_port, sim.start.lat) == (54321, 44.0888889)
@@ -162,9 +169,15 @@ def test_the_example_mission_reads():
 
 async def test_the_example_demo_converges():
     process = await asyncio.create_subprocess_exec(
-        sys.executable, str(REPO / "examples/frontseat/run_demo.py"), "--warp", "10",
-        "--duration", "15", stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.STDOUT,
-    )  # fmt: skip
+        sys.executable,
+        str(REPO / "examples/frontseat/run_demo.py"),
+        "--warp",
+        "10",
+        "--duration",
+        "15",
+        stdout=asyncio.subprocess.PIPE,
+        stderr=asyncio.subprocess.STDOUT,
+    )
     try:
         async with asyncio.timeout(60):
             output, _ = await process.communicate()

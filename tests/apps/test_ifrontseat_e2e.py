@@ -53,8 +53,17 @@ ProcessConfig = iFrontSeat
 }}
 """
 
-WATCH = ["IFS_STATUS", "IFS_NODE_STATUS", "IFS_RAW_IN", "IFS_COMMAND_RESPONSE",
-         "NAV_X", "NAV_Y", "NAV_HEADING", "NAV_SPEED", "NAV_DEPTH"]  # fmt: skip
+WATCH = [
+    "IFS_STATUS",
+    "IFS_NODE_STATUS",
+    "IFS_RAW_IN",
+    "IFS_COMMAND_RESPONSE",
+    "NAV_X",
+    "NAV_Y",
+    "NAV_HEADING",
+    "NAV_SPEED",
+    "NAV_DEPTH",
+]
 
 
 class RecordingSimulator(BasicFrontSeatSimulator):
@@ -174,8 +183,12 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
         course.time, course.heading, course.speed, course.depth = 1.0, 180.0, 1.0, 30.0
         helm.client.publish("IFS_COMMAND_REQUEST", serialize_for_moos(request))
         helm.client.publish("DESIRED_SPEED", 1.0)
-        await until(lambda: app.dynamic_vars.get("IFS_COMMAND_REQUEST", None) is not None
-                    and app.dynamic_vars["IFS_COMMAND_REQUEST"].src == "iFrontSeat")  # fmt: skip
+        await until(
+            lambda: (
+                app.dynamic_vars.get("IFS_COMMAND_REQUEST", None) is not None
+                and app.dynamic_vars["IFS_COMMAND_REQUEST"].src == "iFrontSeat"
+            )
+        )
         await asyncio.sleep(0.3)  # a few more of the app's ticks
         assert interface.state == frontseat_pb.INTERFACE_LISTEN
         assert simulator.sim.commands() == []
@@ -190,14 +203,20 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
         await recorder.wait_for("NAV_DEPTH", lambda v: v == 10.0)
         assert recorder.values("NAV_HEADING")[-1] == 90.0
         node = frontseat_pb.NodeStatus()
-        parse_for_moos(await recorder.wait_for("IFS_NODE_STATUS", lambda v: "depth: 10 " in v
-                                               and "over_ground: 2 " in v), node)  # fmt: skip
+        parse_for_moos(
+            await recorder.wait_for(
+                "IFS_NODE_STATUS", lambda v: "depth: 10 " in v and "over_ground: 2 " in v
+            ),
+            node,
+        )
         assert node.name == "auv1" and node.global_fix.depth == 10.0
         assert node.local_fix.x > 0 and math.isclose(node.global_fix.lat, 42.5, abs_tol=1e-3)
         response = frontseat_pb.CommandResponse()
         parse_for_moos(await recorder.wait_for("IFS_COMMAND_RESPONSE"), response)
         assert response.request_successful and response.request_id >= 65536
-        await recorder.wait_for("IFS_STATUS", lambda v: status_of(v).state == frontseat_pb.INTERFACE_COMMAND)
+        await recorder.wait_for(
+            "IFS_STATUS", lambda v: status_of(v).state == frontseat_pb.INTERFACE_COMMAND
+        )
 
         # Garbage from the simulator is seen raw, skipped, and changes nothing.
         simulator.server.link.write("NAV,LAT:north,LON:-70\r\nnot a message\r\n")
@@ -237,13 +256,19 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
         await simulator.stop()
         await until(lambda: in_state(frontseat_pb.INTERFACE_FS_ERROR))
         assert interface.status().frontseat_error == frontseat_pb.ERROR_FRONTSEAT_NOT_CONNECTED
-        await recorder.wait_for("IFS_STATUS", lambda v: status_of(v).state == frontseat_pb.INTERFACE_FS_ERROR)
+        await recorder.wait_for(
+            "IFS_STATUS", lambda v: status_of(v).state == frontseat_pb.INTERFACE_FS_ERROR
+        )
         mark = len(states)
         simulator = Simulator(sim_port)
         await simulator.start()
         await until(lambda: in_state(frontseat_pb.INTERFACE_COMMAND))
-        assert states[mark - 1 :] == [frontseat_pb.INTERFACE_FS_ERROR, frontseat_pb.INTERFACE_STANDBY,
-                                      frontseat_pb.INTERFACE_LISTEN, frontseat_pb.INTERFACE_COMMAND]  # fmt: skip
+        assert states[mark - 1 :] == [
+            frontseat_pb.INTERFACE_FS_ERROR,
+            frontseat_pb.INTERFACE_STANDBY,
+            frontseat_pb.INTERFACE_LISTEN,
+            frontseat_pb.INTERFACE_COMMAND,
+        ]
         assert simulator.sim.received[0].startswith("START,")
         vehicle = simulator.sim.vehicle
         await until(lambda: (vehicle.heading, vehicle.speed, vehicle.z) == (90.0, 2.0, -10.0))
@@ -253,8 +278,11 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
         # wall). iFrontSeat sends nothing in FS_ERROR; an operator's START on the
         # simulator brings the data back, and the interface back to COMMAND.
         start = "START,LAT:42.5,LON:-70.5,DURATION:1,FREQ:2,WARP:10"
-        recorder.client.publish("IFS_RAW_OUT", serialize_for_moos(frontseat_pb.Raw(raw=start.encode())),
-                                time=app.moos_time())  # fmt: skip
+        recorder.client.publish(
+            "IFS_RAW_OUT",
+            serialize_for_moos(frontseat_pb.Raw(raw=start.encode())),
+            time=app.moos_time(),
+        )
         await until(lambda: in_state(frontseat_pb.INTERFACE_FS_ERROR))
         assert interface.status().frontseat_error == frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
         assert start in simulator.sim.received
@@ -263,7 +291,11 @@ async def test_helm_simulator_round_trip_and_faults(tmp_path):
         operator.write(b"START,LAT:42.5,LON:-70.5,FREQ:2,WARP:10\r\n")
         await until(lambda: in_state(frontseat_pb.INTERFACE_COMMAND))
         operator.close()
-        assert states[mark:] == [frontseat_pb.INTERFACE_STANDBY, frontseat_pb.INTERFACE_LISTEN, frontseat_pb.INTERFACE_COMMAND]
+        assert states[mark:] == [
+            frontseat_pb.INTERFACE_STANDBY,
+            frontseat_pb.INTERFACE_LISTEN,
+            frontseat_pb.INTERFACE_COMMAND,
+        ]
 
     assert all(
         line.startswith(("START", "CMD,HEADING:90,SPEED:2,DEPTH:10"))

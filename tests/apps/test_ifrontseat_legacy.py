@@ -30,9 +30,12 @@ def node_status(**pose):
 def test_nav_posts_minimal_solution():
     posts = nav_posts(node_status())
     assert posts == [
-        ("NAV_X", 10.5), ("NAV_Y", -3.25), ("NAV_LAT", 42.5), ("NAV_LONG", -70.25),
+        ("NAV_X", 10.5),
+        ("NAV_Y", -3.25),
+        ("NAV_LAT", 42.5),
+        ("NAV_LONG", -70.25),
         ("NAV_SPEED", 1.5),
-    ]  # fmt: skip
+    ]
 
 
 def test_nav_posts_full_solution_with_gps():
@@ -43,9 +46,20 @@ def test_nav_posts_full_solution_with_gps():
     status.source.position = frontseat_pb.Source.GPS
     posts = dict(nav_posts(status))
     assert [var for var, _ in nav_posts(status)] == [
-        "NAV_X", "NAV_Y", "NAV_LAT", "NAV_LONG", "NAV_Z", "NAV_DEPTH", "NAV_HEADING", "NAV_YAW",
-        "NAV_SPEED", "NAV_PITCH", "NAV_ROLL", "NAV_ALTITUDE", "GPS_UPDATE_RECEIVED",
-    ]  # fmt: skip
+        "NAV_X",
+        "NAV_Y",
+        "NAV_LAT",
+        "NAV_LONG",
+        "NAV_Z",
+        "NAV_DEPTH",
+        "NAV_HEADING",
+        "NAV_YAW",
+        "NAV_SPEED",
+        "NAV_PITCH",
+        "NAV_ROLL",
+        "NAV_ALTITUDE",
+        "GPS_UPDATE_RECEIVED",
+    ]
     assert posts["NAV_Z"] == -12.0 and posts["NAV_DEPTH"] == 12.0
     assert posts["NAV_HEADING"] == 90.0
     assert math.isclose(posts["NAV_YAW"], -math.pi / 2)

@@ -41,11 +41,26 @@ ProcessConfig = iFrontSeat
 """
 
 WATCH = [
-    "IFS_STATUS", "IFS_NODE_STATUS", "IFS_DATA_IN", "IFS_RAW_IN", "IFS_RAW_OUT",
-    "IFS_COMMAND_REQUEST", "IFS_COMMAND_RESPONSE", "NAV_X", "NAV_Y", "NAV_LAT", "NAV_LONG",
-    "NAV_DEPTH", "NAV_HEADING", "NAV_YAW", "NAV_SPEED", "NAV_PITCH", "GPS_UPDATE_RECEIVED",
-    "FRONTSEAT_READY", "BACKSEAT_READY",
-]  # fmt: skip
+    "IFS_STATUS",
+    "IFS_NODE_STATUS",
+    "IFS_DATA_IN",
+    "IFS_RAW_IN",
+    "IFS_RAW_OUT",
+    "IFS_COMMAND_REQUEST",
+    "IFS_COMMAND_RESPONSE",
+    "NAV_X",
+    "NAV_Y",
+    "NAV_LAT",
+    "NAV_LONG",
+    "NAV_DEPTH",
+    "NAV_HEADING",
+    "NAV_YAW",
+    "NAV_SPEED",
+    "NAV_PITCH",
+    "GPS_UPDATE_RECEIVED",
+    "FRONTSEAT_READY",
+    "BACKSEAT_READY",
+]
 
 PB = "@PB[goby.middleware.frontseat.protobuf.{}] "
 
@@ -127,7 +142,10 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
         data = parsed(frontseat_pb.InterfaceData, await r.wait_for("IFS_DATA_IN"))
         assert data.node_status.global_fix.lon == -70.5
         raw = await r.wait_for("IFS_RAW_IN")
-        assert raw.startswith(PB.format("Raw")) and parsed(frontseat_pb.Raw, raw).raw == b"NAV,HEADING:0"
+        assert (
+            raw.startswith(PB.format("Raw"))
+            and parsed(frontseat_pb.Raw, raw).raw == b"NAV,HEADING:0"
+        )
         assert await r.wait_for("NAV_LAT") == 42.51 and await r.wait_for("NAV_LONG") == -70.5
         x, y = UTMGeodesy(42.5, -70.5).to_local(42.51, -70.5)  # 0.01 deg north of the datum
         assert await r.wait_for("NAV_X") == x and await r.wait_for("NAV_Y") == y
@@ -146,12 +164,16 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
             ("DESIRED_SPEED", 1.5),
         ):
             c.post(var, value, c.helm)
-        legacy = parsed(frontseat_pb.CommandRequest, await r.wait_for("IFS_COMMAND_REQUEST",
-                                                              lambda v: "65536" in v))  # fmt: skip
+        legacy = parsed(
+            frontseat_pb.CommandRequest,
+            await r.wait_for("IFS_COMMAND_REQUEST", lambda v: "65536" in v),
+        )
         assert legacy.response_requested and legacy.request_id == 65536
         assert (legacy.desired_course.heading, legacy.desired_course.speed) == (90.0, 1.5)
         await c.handled("IFS_COMMAND_REQUEST", "iFrontSeat")
-        c.post("IFS_DATA_OUT", serialize_for_moos(frontseat_pb.InterfaceData(dccl_message=b"\x01\x02")))
+        c.post(
+            "IFS_DATA_OUT", serialize_for_moos(frontseat_pb.InterfaceData(dccl_message=b"\x01\x02"))
+        )
         async with asyncio.timeout(5):
             while not driver.data:
                 await asyncio.sleep(0.01)
@@ -163,8 +185,14 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
         c.post("IVPHELM_STATE", "DRIVE", c.helm)
         await c.state(frontseat_pb.INTERFACE_COMMAND)
         assert await r.wait_for("BACKSEAT_READY", lambda v: v == 1.0) == 1.0
-        await r.wait_for("IFS_STATUS", status_is(frontseat_pb.INTERFACE_COMMAND, helm_state=frontseat_pb.HELM_DRIVE,
-                                                 frontseat_state=frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS))  # fmt: skip
+        await r.wait_for(
+            "IFS_STATUS",
+            status_is(
+                frontseat_pb.INTERFACE_COMMAND,
+                helm_state=frontseat_pb.HELM_DRIVE,
+                frontseat_state=frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS,
+            ),
+        )
         await asyncio.sleep(1.05)
         c.post("DESIRED_SPEED", 1.2, c.helm)
         response = await r.wait_for("IFS_COMMAND_RESPONSE")
@@ -199,8 +227,10 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
 
         # PARK -> HELM_ERROR; commands are dropped; DRIVE -> STANDBY -> LISTEN -> COMMAND.
         c.post("IVPHELM_STATE", "PARK", c.helm)
-        await r.wait_for("IFS_STATUS", status_is(frontseat_pb.INTERFACE_HELM_ERROR,
-                                                 helm_error=frontseat_pb.ERROR_HELM_PARKED))  # fmt: skip
+        await r.wait_for(
+            "IFS_STATUS",
+            status_is(frontseat_pb.INTERFACE_HELM_ERROR, helm_error=frontseat_pb.ERROR_HELM_PARKED),
+        )
         c.post("IFS_COMMAND_REQUEST", serialize_for_moos(request))
         await c.handled("IFS_COMMAND_REQUEST", "tester")
         assert len(driver.commands) == 1
@@ -214,16 +244,26 @@ async def test_ifs_variables_and_the_state_machine(tmp_path, caplog):
 
         # IVPHELM_STATE from any other process: the helm is not running -> HELM_ERROR.
         c.post("IVPHELM_STATE", "DRIVE")
-        await r.wait_for("IFS_STATUS", status_is(frontseat_pb.INTERFACE_HELM_ERROR,
-                                                 helm_error=frontseat_pb.ERROR_HELM_NOT_RUNNING,
-                                                 helm_state=frontseat_pb.HELM_NOT_RUNNING))  # fmt: skip
+        await r.wait_for(
+            "IFS_STATUS",
+            status_is(
+                frontseat_pb.INTERFACE_HELM_ERROR,
+                helm_error=frontseat_pb.ERROR_HELM_NOT_RUNNING,
+                helm_state=frontseat_pb.HELM_NOT_RUNNING,
+            ),
+        )
         c.post("IVPHELM_STATE", "DRIVE", c.helm)
         await c.state(frontseat_pb.INTERFACE_COMMAND)
 
         # The frontseat falls silent -> FS_ERROR (not providing data); back -> COMMAND.
         driver.online = False
-        await r.wait_for("IFS_STATUS", status_is(
-            frontseat_pb.INTERFACE_FS_ERROR, frontseat_error=frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA))  # fmt: skip
+        await r.wait_for(
+            "IFS_STATUS",
+            status_is(
+                frontseat_pb.INTERFACE_FS_ERROR,
+                frontseat_error=frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA,
+            ),
+        )
         driver.online = True
         await c.state(frontseat_pb.INTERFACE_COMMAND)
 
@@ -249,14 +289,19 @@ async def test_renamed_variables_ctd_samples_and_no_helm_required(tmp_path):
             r.client.subscribe(var)
         # require_helm: false -> COMMAND without a helm.
         status = await r.wait_for("FS_STAT", status_is(frontseat_pb.INTERFACE_COMMAND), timeout=10)
-        assert parsed(frontseat_pb.InterfaceStatus, status).helm_state == frontseat_pb.HELM_NOT_RUNNING
+        assert (
+            parsed(frontseat_pb.InterfaceStatus, status).helm_state == frontseat_pb.HELM_NOT_RUNNING
+        )
         await r.wait_for("FS_NODE_STATUS")
         assert r.values("IFS_STATUS") == [] and r.values("NAV_LAT") == []  # publish_nav: false
 
         # CTD_*: each CTD_TEMPERATURE makes a sample at the last fix, completed, posted on
         # the renamed data_to_frontseat variable, and (LISTEN/COMMAND) given to the driver.
-        for var, value in (("CTD_CONDUCTIVITY", 4.2914), ("CTD_PRESSURE", 100.0),
-                           ("CTD_TEMPERATURE", 15.0)):  # fmt: skip
+        for var, value in (
+            ("CTD_CONDUCTIVITY", 4.2914),
+            ("CTD_PRESSURE", 100.0),
+            ("CTD_TEMPERATURE", 15.0),
+        ):
             c.post(var, value)
         posted = frontseat_pb.InterfaceData()
         parse_for_moos(await r.wait_for("FS_TO_VEHICLE"), posted)

@@ -47,23 +47,36 @@ async def test_log_lines_at_each_verbosity_on_a_two_vehicle_run(tmp_path):
     async with contextlib.AsyncExitStack() as stack:
         dbs = []
         for modem_id in (1, 2):
-            dbs.append(await stack.enter_async_context(MOOSDB(port=0, community=f"vehicle{modem_id}")))
+            dbs.append(
+                await stack.enter_async_context(MOOSDB(port=0, community=f"vehicle{modem_id}"))
+            )
         link = MicroModemLink()
         await link.start(stack, dbs)
         procs, outputs = [], []
         for modem_id, db in zip((1, 2), dbs, strict=True):
             mission = tmp_path / f"vehicle{modem_id}.moos"
-            mission.write_text(mission_text(modem_id, db.port, 0, driver=link.driver_cfg(modem_id),
-                                            common=f"app_tick: 20 {commons[modem_id]}"))  # fmt: skip
+            mission.write_text(
+                mission_text(
+                    modem_id,
+                    db.port,
+                    0,
+                    driver=link.driver_cfg(modem_id),
+                    common=f"app_tick: 20 {commons[modem_id]}",
+                )
+            )
             out = tmp_path / f"vehicle{modem_id}.out"
             outputs.append(out)
             with open(out, "wb") as sink:
-                procs.append(await asyncio.create_subprocess_exec(
-                    PACOMMSHANDLER, str(mission), stdout=sink, stderr=asyncio.subprocess.STDOUT))  # fmt: skip
+                procs.append(
+                    await asyncio.create_subprocess_exec(
+                        PACOMMSHANDLER, str(mission), stdout=sink, stderr=asyncio.subprocess.STDOUT
+                    )
+                )
         r1, r2 = Recorder("r1", dbs[0].port), Recorder("r2", dbs[1].port)
         for recorder in (r1, r2):
-            await recorder.start(["ACOMMS_ACK", "COMMAND_IN", "ACOMMS_NMEA_IN", "ACOMMS_MAC_SLOT_START",
-                                  "DB_TIME"])
+            await recorder.start(
+                ["ACOMMS_ACK", "COMMAND_IN", "ACOMMS_NMEA_IN", "ACOMMS_MAC_SLOT_START", "DB_TIME"]
+            )
             stack.push_async_callback(recorder.close)
         try:
             for recorder in (r1, r2):  # both apps running, their modems answering, and DB_TIME
@@ -86,14 +99,26 @@ async def test_log_lines_at_each_verbosity_on_a_two_vehicle_run(tmp_path):
 
     # VERBOSE (vehicle 1's terminal): the message's journey, one line per step
     assert has(v1, head + r"\{goby::moos::translator\}: created pygoby\.examples\.Command$")
-    assert has(v1, head + r"\{goby::acomms::queue::push::1\}: pushed pygoby\.examples\.Command "
-                          r"\(1->2, \d+ B, ack requested\): queue size 1/100, priority [\d.e-]+$")
-    assert has(v1, r"\{goby::acomms::queue::pop::1\}: popped pygoby\.examples\.Command \(1->2, "
-                   r"\d+ B\) for frame 0 at priority [\d.e-]+; kept until acknowledged")
-    assert has(v1, r"\{goby::acomms::queue::out::1\}: transmit slot 0: 1->2, rate 1, \d frame\(s\), "
-                   r"\d+ B: pygoby\.examples\.Command \(ack requested\)$")
-    assert has(v1, r"\{goby::acomms::queue::in::1\}: received ACK 2->1 for frame\(s\) \[0\]: "
-                   r"acknowledges pygoby\.examples\.Command$")
+    assert has(
+        v1,
+        head + r"\{goby::acomms::queue::push::1\}: pushed pygoby\.examples\.Command "
+        r"\(1->2, \d+ B, ack requested\): queue size 1/100, priority [\d.e-]+$",
+    )
+    assert has(
+        v1,
+        r"\{goby::acomms::queue::pop::1\}: popped pygoby\.examples\.Command \(1->2, "
+        r"\d+ B\) for frame 0 at priority [\d.e-]+; kept until acknowledged",
+    )
+    assert has(
+        v1,
+        r"\{goby::acomms::queue::out::1\}: transmit slot 0: 1->2, rate 1, \d frame\(s\), "
+        r"\d+ B: pygoby\.examples\.Command \(ack requested\)$",
+    )
+    assert has(
+        v1,
+        r"\{goby::acomms::queue::in::1\}: received ACK 2->1 for frame\(s\) \[0\]: "
+        r"acknowledges pygoby\.examples\.Command$",
+    )
     assert has(v1, r"\{goby::acomms::amac::1\}: MAC MAC_FIXED_DECENTRALIZED started$")
     # ... and nothing of the levels below it
     assert not has(v1, r" [<>]{2} \$") and not has(v1, r"amac::1\}: slot|contest for")
@@ -102,19 +127,30 @@ async def test_log_lines_at_each_verbosity_on_a_two_vehicle_run(tmp_path):
     assert has(v2, r"\{goby::acomms::modemdriver::out::WHOI_MICROMODEM::2\}: >> \$CCCFG,SRC,2\*")
     assert has(v2, r"\{goby::acomms::modemdriver::in::WHOI_MICROMODEM::2\}: << \$CARXD,")
     # (rate: goby3 reads no rate from a received packet, so the received transmission says 0)
-    assert has(v2, r"\{goby::acomms::queue::in::2\}: received 1->2, rate 0, \d frame\(s\), \d+ B: "
-                   r"pygoby\.examples\.Command \(ack requested\)$")
+    assert has(
+        v2,
+        r"\{goby::acomms::queue::in::2\}: received 1->2, rate 0, \d frame\(s\), \d+ B: "
+        r"pygoby\.examples\.Command \(ack requested\)$",
+    )
     assert has(v2, r"\{goby::moos::translator\}: published COMMAND_IN, DESIRED_HEADING$")
     assert not has(v2, r"amac::2\}: slot|contest for")
 
     # DEBUG2 (vehicle 1's file log): MAC slot timing and the priority contests, NMEA too
     file_head = r"^\[ \d{4}-\d\d-\d\d \d\d:\d\d:\d\d\.\d{3} \] "
-    assert has(v1_file, file_head + r"\{goby::acomms::amac::1\}: slot 0 \(1->-1, rate 1, 3 s\) "
-                                    r"starts at \d\d:\d\d:\d\d\.\d{3} \([\d.]+ s late\): ours, initiating$")
-    assert has(v1_file, r"\{goby::acomms::amac::1\}: cycle of 2 slots, 6 s: \[1->-1 3 s, 2->-1 3 s\]")
-    assert has(v1_file, r"\{goby::acomms::queue::priority::1\}: contest for 1->-1 \(0 B used\): "
-                        r"pygoby\.examples\.SimpleStatus: empty; pygoby\.examples\.Command: priority "
-                        r"[\d.e-]+ -> winner pygoby\.examples\.Command$")
+    assert has(
+        v1_file,
+        file_head + r"\{goby::acomms::amac::1\}: slot 0 \(1->-1, rate 1, 3 s\) "
+        r"starts at \d\d:\d\d:\d\d\.\d{3} \([\d.]+ s late\): ours, initiating$",
+    )
+    assert has(
+        v1_file, r"\{goby::acomms::amac::1\}: cycle of 2 slots, 6 s: \[1->-1 3 s, 2->-1 3 s\]"
+    )
+    assert has(
+        v1_file,
+        r"\{goby::acomms::queue::priority::1\}: contest for 1->-1 \(0 B used\): "
+        r"pygoby\.examples\.SimpleStatus: empty; pygoby\.examples\.Command: priority "
+        r"[\d.e-]+ -> winner pygoby\.examples\.Command$",
+    )
     assert has(v1_file, r"modemdriver::out::WHOI_MICROMODEM::1\}: >> \$CCCYC,")
     assert not any("\x1b[" in line for line in v1 + v1_file)  # no colour codes off a terminal
 
@@ -128,23 +164,37 @@ def test_queue_expiry_and_max_queue_drops_are_logged(caplog):
     entry = acomms_pb.QueuedMessageEntry(protobuf_name=STATUS, max_queue=1, ttl=5, ack=False)
     entry.role.add(type=acomms_pb.QueuedMessageEntry.Role.SOURCE_ID, field="src")
     queue.add_queue(entry, status)
-    report = {"src": 1, "time": clock.now(), "nav_x": 1, "nav_y": 2, "speed": 0, "heading": 0, "depth": 0}
+    report = {
+        "src": 1,
+        "time": clock.now(),
+        "nav_x": 1,
+        "nav_y": 2,
+        "speed": 0,
+        "heading": 0,
+        "depth": 0,
+    }
     with caplog.at_level("INFO", logger="pygoby.acomms.queue"):
         queue.push_message(status(**report))
         queue.push_message(status(**report))
         clock.advance(10)
         queue.do_work()
     lines = [(r.name, r.getMessage()) for r in caplog.records]
-    assert ("pygoby.acomms.queue.push.1", f"{STATUS} queue full (max_queue 1): dropped the oldest "
-            "message (1->0)") in lines  # fmt: skip
-    assert ("pygoby.acomms.queue.pop.1", f"expired {STATUS} (1->0) after its ttl of 5 s; "
-            "queue size 0") in lines  # fmt: skip
+    assert (
+        "pygoby.acomms.queue.push.1",
+        f"{STATUS} queue full (max_queue 1): dropped the oldest message (1->0)",
+    ) in lines
+    assert (
+        "pygoby.acomms.queue.pop.1",
+        f"expired {STATUS} (1->0) after its ttl of 5 s; queue size 0",
+    ) in lines
 
 
 async def test_show_gui_live_view(tmp_path):
     """show_gui's view (textual's pilot): the status panel with the queues and the MAC slot,
     the log of every group and of one group chosen in the list; `q` stops the app."""
-    async with TwoCommunities(tmp_path, common="log: false  app_tick: 20  verbosity: VERBOSE") as net:
+    async with TwoCommunities(
+        tmp_path, common="log: false  app_tick: 20  verbosity: VERBOSE"
+    ) as net:
         app = net.apps[0]
         gui = AppGUI(app)
         for logger in (app.log, logging.getLogger(LIBRARY_ROOT)):  # as run() does at start
@@ -194,7 +244,10 @@ async def test_show_gui_off_a_terminal_keeps_plain_text(tmp_path):
         recorder = Recorder("watcher", db.port)
         await recorder.start(["MODEM_ID"])
         proc = await asyncio.create_subprocess_exec(
-            PACOMMSHANDLER, str(mission), "-vv", stdout=asyncio.subprocess.PIPE,
+            PACOMMSHANDLER,
+            str(mission),
+            "-vv",
+            stdout=asyncio.subprocess.PIPE,
             stderr=asyncio.subprocess.STDOUT,
         )
         try:
@@ -205,8 +258,11 @@ async def test_show_gui_off_a_terminal_keeps_plain_text(tmp_path):
             await recorder.close()
     lines = out.decode().splitlines()
     assert proc.returncode == 0
-    assert has(lines, r"^pAcommsHandler \[.*\]: show_gui: standard output is not a terminal; the log "
-                      r"stays plain text$")
+    assert has(
+        lines,
+        r"^pAcommsHandler \[.*\]: show_gui: standard output is not a terminal; the log "
+        r"stays plain text$",
+    )
     assert has(lines, r"\{goby::acomms::amac::1\}: MAC MAC_FIXED_DECENTRALIZED started")
     assert has(lines, r"\{goby::acomms::amac::1\}: cycle of 2 slots")  # DEBUG1: -vv
     assert not any("\x1b" in line for line in lines)

@@ -100,7 +100,10 @@ def test_goby_messages_resolve_for_translator_entries(tmp_path):
         (("modem_id: 1", "modem_id: 0"), "broadcast"),
         (("modem_id: 1", ""), "missing required configuration fields: modem_id"),
         (("DRIVER_WHOI_MICROMODEM", "DRIVER_BENTHOS_ATM900"), "not implemented"),
-        (('load_proto_file: "@PROTO@"', 'load_proto_file: "no/such.proto"'), "no/such.proto\" not found; searched: "),
+        (
+            ('load_proto_file: "@PROTO@"', 'load_proto_file: "no/such.proto"'),
+            'no/such.proto" not found; searched: ',
+        ),
         (("moos_var {", 'dccl_frontseat_forward_name: "no.Such"\n  moos_var {'), "no.Such"),
         (("period: 15", "period: 0"), "TRIGGER_TIME needs a period"),
         (("common {", "common { moos_parser_technique: TECHNIQUE_FORMAT "), "Non-PROTOBUF"),
@@ -126,15 +129,29 @@ def test_relative_paths_are_found_next_to_the_mission(tmp_path, monkeypatch):
 def test_example_config_command_line():
     done = subprocess.run(
         [sys.executable, "-m", "pygoby.apps.pacommshandler", "--example_config"],
-        capture_output=True, text=True, timeout=60,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 0
     out = done.stdout
     assert out.startswith("ProcessConfig = pAcommsHandler\n{")
-    for needle in ("modem_id: 1", "driver_cfg {", "listen_driver_cfg {", "mac_cfg {", "queue_cfg {",
-                   "dccl_cfg {", "route_cfg {", "moos_var {", 'prefix: "ACOMMS_"',
-                   "translator_entry {", "multiplex_create_moos_var:", "modem_id_lookup_path:",
-                   "driver_failure_approach {", "load_proto_file:"):  # fmt: skip
+    for needle in (
+        "modem_id: 1",
+        "driver_cfg {",
+        "listen_driver_cfg {",
+        "mac_cfg {",
+        "queue_cfg {",
+        "dccl_cfg {",
+        "route_cfg {",
+        "moos_var {",
+        'prefix: "ACOMMS_"',
+        "translator_entry {",
+        "multiplex_create_moos_var:",
+        "modem_id_lookup_path:",
+        "driver_failure_approach {",
+        "load_proto_file:",
+    ):
         assert needle in out, needle
 
 
@@ -158,7 +175,9 @@ ProcessConfig = pAcommsHandler
         time=float(int(time.time())), src=1, dest=3, command_id=7, heading=90, speed=1, depth=5
     )
     app.acomms.queue.push_message(command)
-    request = acomms_pb.ModemTransmission(src=1, dest=acomms_pb.QUERY_DESTINATION_ID, type=acomms_pb.DATA, max_frame_bytes=32)
+    request = acomms_pb.ModemTransmission(
+        src=1, dest=acomms_pb.QUERY_DESTINATION_ID, type=acomms_pb.DATA, max_frame_bytes=32
+    )
     app.acomms.queue.handle_modem_data_request(request)
     assert request.dest == 2
     assert list(request.frame)  # the command is in the frame

@@ -53,10 +53,13 @@ async def test_status_and_acked_command_between_two_vehicles(tmp_path):
         assert any(t.src == 1 and t.frame for t in sent)
         heard = [parsed(acomms_pb.ModemTransmission, v) for v in r2.values("ACOMMS_MODEM_RECEIVE")]
         assert any(t.src == 1 and t.type == acomms_pb.DATA and t.frame for t in heard)
-        starts = [parsed(acomms_pb.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_SLOT_START")]
+        starts = [
+            parsed(acomms_pb.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_SLOT_START")
+        ]
         assert {s.src for s in starts} == {1, 2}  # every slot, own or not
         initiated = [
-            parsed(acomms_pb.ModemTransmission, v) for v in r1.values("ACOMMS_MAC_INITIATE_TRANSMISSION")
+            parsed(acomms_pb.ModemTransmission, v)
+            for v in r1.values("ACOMMS_MAC_INITIATE_TRANSMISSION")
         ]
         assert initiated and {s.src for s in initiated} == {1}  # own slots only
         sizes = [parsed(acomms_pb.QueueSize, v) for v in r1.values("ACOMMS_QSIZE")]
@@ -112,8 +115,9 @@ async def test_the_acoustic_link_keeps_working_through_a_moosdb_outage(tmp_path)
         await db1.stop()
         outage_start = app1.clock.now()
         # vehicle 1's MAC and modem go on: its status goes out in its next slot ...
-        report = await r2.wait_for("STATUS_REPORT_IN", lambda v: v.startswith("src=1,"),
-                                   timeout=15, start=heard_before)  # fmt: skip
+        report = await r2.wait_for(
+            "STATUS_REPORT_IN", lambda v: v.startswith("src=1,"), timeout=15, start=heard_before
+        )
         assert report == "src=1,x=100,y=-50,speed=1.5,heading=270,depth=10"
         # ... and it hears vehicle 2's status while its DB is still down
         r2.client.publish("SEND_STATUS", "now")

@@ -44,10 +44,18 @@ ProcessConfig = pAcommsHandler
 """
 
 WATCH = [
-    "MODEM_ID", "STATUS_REPORT_IN", "IFS_DATA_OUT", "ACOMMS_QUEUE_RECEIVE", "ACOMMS_QSIZE",
-    "ACOMMS_EXPIRE", "ACOMMS_CONFIG", "ACOMMS_MAC_SLOT_START", "ACOMMS_MAC_INITIATE_TRANSMISSION",
-    "AC_QSIZE", "AC_MAC_SLOT_START",
-]  # fmt: skip
+    "MODEM_ID",
+    "STATUS_REPORT_IN",
+    "IFS_DATA_OUT",
+    "ACOMMS_QUEUE_RECEIVE",
+    "ACOMMS_QSIZE",
+    "ACOMMS_EXPIRE",
+    "ACOMMS_CONFIG",
+    "ACOMMS_MAC_SLOT_START",
+    "ACOMMS_MAC_INITIATE_TRANSMISSION",
+    "AC_QSIZE",
+    "AC_MAC_SLOT_START",
+]
 
 
 def qsize(dccl_id: int, size: int):
@@ -98,7 +106,9 @@ async def test_moos_interface_without_a_modem(tmp_path, caplog):
             # Queue: a command is queued, flushed; another expires (ttl 2 s).
             r.client.publish("COMMAND_OUT", "dest=2,command_id=4,heading=1,speed=1,depth=1")
             await r.wait_for("ACOMMS_QSIZE", qsize(21, 1))
-            r.client.publish("ACOMMS_FLUSH_QUEUE", serialize_for_moos(acomms_pb.QueueFlush(dccl_id=21)))
+            r.client.publish(
+                "ACOMMS_FLUSH_QUEUE", serialize_for_moos(acomms_pb.QueueFlush(dccl_id=21))
+            )
             async with asyncio.timeout(5):
                 while app.queue.size(21):
                     await asyncio.sleep(0.02)
@@ -108,9 +118,11 @@ async def test_moos_interface_without_a_modem(tmp_path, caplog):
 
             # Multiplexed creation (goby_liaison): posted back to the create variables, queued.
             seen = len(r.values("ACOMMS_QSIZE"))
-            r.client.publish("LIAISON_COMMANDER_OUT",
-                             f"@PB[{COMMAND}] time: 1.8e9 src: 1 dest: 2 command_id: 6 "
-                             "heading: 10 speed: 1 depth: 2")  # fmt: skip
+            r.client.publish(
+                "LIAISON_COMMANDER_OUT",
+                f"@PB[{COMMAND}] time: 1.8e9 src: 1 dest: 2 command_id: 6 "
+                "heading: 10 speed: 1 depth: 2",
+            )
             await r.wait_for("ACOMMS_QSIZE", qsize(21, 1), timeout=5, start=seen)
             assert app.queue.queues[21].next_item().msg.command_id == 6
 
@@ -128,8 +140,12 @@ async def test_moos_interface_without_a_modem(tmp_path, caplog):
                 )
                 update = acomms_pb.MACUpdate(src=2, dest=5, update_type=acomms_pb.MACUpdate.CLEAR)
                 r.client.publish("ACOMMS_MAC_CYCLE_UPDATE", serialize_for_moos(update))
-                update = acomms_pb.MACUpdate(src=2, dest=1, update_type=acomms_pb.MACUpdate.PUSH_BACK,
-                                     slot=[acomms_pb.ModemTransmission(src=1, slot_seconds=1)])  # fmt: skip
+                update = acomms_pb.MACUpdate(
+                    src=2,
+                    dest=1,
+                    update_type=acomms_pb.MACUpdate.PUSH_BACK,
+                    slot=[acomms_pb.ModemTransmission(src=1, slot_seconds=1)],
+                )
                 r.client.publish("ACOMMS_MAC_CYCLE_UPDATE", serialize_for_moos(update))
                 async with asyncio.timeout(5):
                     while len(app.acomms.mac.slots) != 3:
@@ -251,9 +267,11 @@ async def test_a_fatal_driver_failure_ends_the_process_with_status_1(tmp_path):
         path = tmp_path / "alpha.moos"
         path.write_text(MISSION.replace("@PORT@", str(db.port)).replace("@EXTRA@", extra))
         proc = await asyncio.create_subprocess_exec(
-            str(Path(sys.executable).with_name("pAcommsHandler")), str(path),
-            stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.PIPE,
-        )  # fmt: skip
+            str(Path(sys.executable).with_name("pAcommsHandler")),
+            str(path),
+            stdout=asyncio.subprocess.DEVNULL,
+            stderr=asyncio.subprocess.PIPE,
+        )
         try:
             async with MOOSClient("tester", port=db.port) as tester:
                 async with asyncio.timeout(15):

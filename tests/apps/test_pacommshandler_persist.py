@@ -70,7 +70,11 @@ async def test_queued_commands_survive_kill_9(tmp_path):
         sim1, db1 = await modem_and_db(stack, 1, channel, clock)
         text = mission_text(1, db1.port, sim1.port).replace("  queue_cfg {\n", PERSIST, 1)
         mission = tmp_path / "vehicle1.moos"
-        mission.write_text(text.replace("ack: true  value_base: 5  ttl: 600", f"ack: true  value_base: 5  ttl: {TTL}"))
+        mission.write_text(
+            text.replace(
+                "ack: true  value_base: 5  ttl: 600", f"ack: true  value_base: 5  ttl: {TTL}"
+            )
+        )
         r1 = Recorder("recorder1", db1.port)
         await r1.start(["ACOMMS_QSIZE", "ACOMMS_EXPIRE", "ACOMMS_ACK_ORIGINAL", "DB_TIME"])
         stack.push_async_callback(r1.close)
@@ -106,7 +110,9 @@ async def test_queued_commands_survive_kill_9(tmp_path):
         expired = await r1.wait_for("ACOMMS_EXPIRE", start=seen, timeout=10)
         assert "command_id: 11" in expired, vehicle1.output()
         assert "command_id=22" in await r2.wait_for("COMMAND_IN", timeout=20)
-        original = await r1.wait_for("ACOMMS_ACK_ORIGINAL", lambda v: "command_id: 22" in v, timeout=10)
+        original = await r1.wait_for(
+            "ACOMMS_ACK_ORIGINAL", lambda v: "command_id: 22" in v, timeout=10
+        )
         assert original
         await asyncio.sleep(0.5)  # the ack's removal is committed at once; let the posts out
 

@@ -15,7 +15,10 @@ from pygoby.protobuf import builtin_class
 
 DATA = Path(__file__).parent / "data" / "remus_frames.jsonl"
 CCL_PROTO = "dccl/ccl/protobuf/ccl.proto"
-MESSAGE = {"State": "dccl.legacyccl.protobuf.CCLMDATState", "Redirect": "dccl.legacyccl.protobuf.CCLMDATRedirect"}
+MESSAGE = {
+    "State": "dccl.legacyccl.protobuf.CCLMDATState",
+    "Redirect": "dccl.legacyccl.protobuf.CCLMDATRedirect",
+}
 FRAME = {"State": remus.State, "Redirect": remus.Redirect}
 
 
@@ -28,29 +31,54 @@ def to_message(frame: remus.State | remus.Redirect, now: float) -> Message:
     decoded time_date takes)."""
     if isinstance(frame, remus.State):
         msg = message_class("State")(
-            latitude=frame.latitude, longitude=frame.longitude, fix_age=frame.fix_age,
+            latitude=frame.latitude,
+            longitude=frame.longitude,
+            fix_age=frame.fix_age,
             time_date=fields.timegm(fields.utc_year(now), *frame.time) * 1_000_000,
-            heading=frame.heading, depth=frame.depth, mission_mode=frame.mission_mode,
-            faults=frame.faults.to_bytes(4, "little"), faults_2=bytes([frame.faults_2]),
-            mission_leg=frame.mission_leg, est_velocity=frame.est_velocity,
-            objective_index=bytes([frame.objective_index]), watts=frame.watts,
-            lat_goal=frame.lat_goal, lon_goal=frame.lon_goal, battery_percent=frame.battery_percent,
-        )  # fmt: skip
+            heading=frame.heading,
+            depth=frame.depth,
+            mission_mode=frame.mission_mode,
+            faults=frame.faults.to_bytes(4, "little"),
+            faults_2=bytes([frame.faults_2]),
+            mission_leg=frame.mission_leg,
+            est_velocity=frame.est_velocity,
+            objective_index=bytes([frame.objective_index]),
+            watts=frame.watts,
+            lat_goal=frame.lat_goal,
+            lon_goal=frame.lon_goal,
+            battery_percent=frame.battery_percent,
+        )
         gpo = frame.gfi_pitch_oil
-        msg.gfi_pitch_oil.gfi, msg.gfi_pitch_oil.pitch, msg.gfi_pitch_oil.oil = gpo.gfi, gpo.pitch, gpo.oil
+        msg.gfi_pitch_oil.gfi, msg.gfi_pitch_oil.pitch, msg.gfi_pitch_oil.oil = (
+            gpo.gfi,
+            gpo.pitch,
+            gpo.oil,
+        )
         return msg
     flags = frame.speed_depth_flags
     return message_class("Redirect")(
-        message_number=frame.message_number, latitude=frame.latitude, longitude=frame.longitude,
-        transit_vertical_mode=flags & 7, transit_thrust_mode=flags >> 3 & 1,
-        survey_vertical_mode=flags >> 4 & 7, survey_thrust_mode=flags >> 7 & 1,
-        depth_goal_transit=frame.transit_depth, speed_transit=frame.transit_speed,
-        device_cmd_transit=frame.transit_command, depth_goal_survey=frame.survey_depth,
-        speed_survey=frame.survey_speed, device_cmd_survey=frame.survey_command,
-        num_rows=frame.num_rows, row_length=frame.row_length, spacing_0=frame.spacing_0,
-        spacing_1=frame.spacing_1, heading=frame.row_heading, lat_start=frame.start_latitude,
-        lon_start=frame.start_longitude, spare=b"\0\0\0",
-    )  # fmt: skip
+        message_number=frame.message_number,
+        latitude=frame.latitude,
+        longitude=frame.longitude,
+        transit_vertical_mode=flags & 7,
+        transit_thrust_mode=flags >> 3 & 1,
+        survey_vertical_mode=flags >> 4 & 7,
+        survey_thrust_mode=flags >> 7 & 1,
+        depth_goal_transit=frame.transit_depth,
+        speed_transit=frame.transit_speed,
+        device_cmd_transit=frame.transit_command,
+        depth_goal_survey=frame.survey_depth,
+        speed_survey=frame.survey_speed,
+        device_cmd_survey=frame.survey_command,
+        num_rows=frame.num_rows,
+        row_length=frame.row_length,
+        spacing_0=frame.spacing_0,
+        spacing_1=frame.spacing_1,
+        heading=frame.row_heading,
+        lat_start=frame.start_latitude,
+        lon_start=frame.start_longitude,
+        spare=b"\0\0\0",
+    )
 
 
 def to_json(frame: remus.State | remus.Redirect) -> dict:
@@ -59,8 +87,11 @@ def to_json(frame: remus.State | remus.Redirect) -> dict:
 
 def from_json(kind: str, values: dict) -> remus.State | remus.Redirect:
     if kind == "State":
-        values = dict(values, time=remus.TimeDate(*values["time"]),
-                      gfi_pitch_oil=remus.GFIPitchOil(*values["gfi_pitch_oil"]))  # fmt: skip
+        values = dict(
+            values,
+            time=remus.TimeDate(*values["time"]),
+            gfi_pitch_oil=remus.GFIPitchOil(*values["gfi_pitch_oil"]),
+        )
     return FRAME[kind](**values)
 
 

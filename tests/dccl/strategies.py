@@ -71,7 +71,8 @@ def message_strategy(desc: Descriptor, now: float = 1_700_000_000.0) -> st.Searc
             value = st.none() | value
         singles[f.name] = value
     oneof_choices = [
-        st.none() | st.sampled_from(fs).flatmap(
+        st.none()
+        | st.sampled_from(fs).flatmap(
             lambda f, now=now: _scalar(f, now).map(lambda v, f=f: (f.name, v))
         )
         for fs in members.values()

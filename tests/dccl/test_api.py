@@ -36,7 +36,10 @@ def load(tmp_path: Path, body: str, name: str, codec: Codec | None = None):
         ("message M { option (dccl.msg) = { max_bytes: 4 codec_version: 4 }; }", "missing"),
         ("message M { option (dccl.msg) = { id: 1 codec_version: 4 }; }", "max_bytes"),
         ("message M { option (dccl.msg) = { id: 1 max_bytes: 4 }; }", "codec_version"),
-        ("message M { option (dccl.msg) = { id: 40000 max_bytes: 4 codec_version: 4 }; }", "0..32767"),
+        (
+            "message M { option (dccl.msg) = { id: 40000 max_bytes: 4 codec_version: 4 }; }",
+            "0..32767",
+        ),
         (
             "message M { option (dccl.msg) = { id: 1 max_bytes: 2 codec_version: 4 };"
             " required uint32 a = 1 [(dccl.field) = { min: 0 max: 255 }];"
@@ -122,9 +125,16 @@ def test_max_bytes_exactly_enough_loads(tmp_path: Path) -> None:
 
 
 def test_duplicate_ids_are_refused(tmp_path: Path) -> None:
-    codec, _ = load(tmp_path, "message A { option (dccl.msg) = { id: 9 max_bytes: 4 codec_version: 4 }; }", "A")
+    codec, _ = load(
+        tmp_path, "message A { option (dccl.msg) = { id: 9 max_bytes: 4 codec_version: 4 }; }", "A"
+    )
     with pytest.raises(DcclLoadError, match="already used"):
-        load(tmp_path, "message B { option (dccl.msg) = { id: 9 max_bytes: 4 codec_version: 4 }; }", "B", codec)
+        load(
+            tmp_path,
+            "message B { option (dccl.msg) = { id: 9 max_bytes: 4 codec_version: 4 }; }",
+            "B",
+            codec,
+        )
 
 
 def test_required_field_missing_is_an_encode_error() -> None:

@@ -16,14 +16,25 @@ PYGOBY = str(Path(sys.executable).with_name("pygoby"))  # the installed console 
 
 def pygoby(*args: str, stdin: str = "", env: dict | None = None) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "pygoby.cli", *args], input=stdin, capture_output=True, text=True,
-        timeout=60, env=env,
+        [sys.executable, "-m", "pygoby.cli", *args],
+        input=stdin,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
     )
 
 
 def test_encode_lines_with_a_bad_line_in_the_middle() -> None:
-    out = pygoby("dccl", "encode", "--proto", PROTO, "--message", "example.Tiny",
-                 stdin="a: 5 b: 3 c: true\nnot text format\na: 9\n")
+    out = pygoby(
+        "dccl",
+        "encode",
+        "--proto",
+        PROTO,
+        "--message",
+        "example.Tiny",
+        stdin="a: 5 b: 3 c: true\nnot text format\na: 9\n",
+    )
     lines = out.stdout.splitlines()
     assert lines[0] == "042501"
     assert lines[1].startswith("error: ") and "not" in lines[1]
@@ -32,15 +43,25 @@ def test_encode_lines_with_a_bad_line_in_the_middle() -> None:
 
 
 def test_strict_encode_reports_the_field() -> None:
-    out = pygoby("dccl", "encode", "--strict", "--proto", PROTO, "--message", "example.Tiny",
-                 stdin="a: 9\n")
+    out = pygoby(
+        "dccl", "encode", "--strict", "--proto", PROTO, "--message", "example.Tiny", stdin="a: 9\n"
+    )
     assert out.stdout.startswith("error: example.Tiny.a: value 9 is out of range")
     assert out.returncode == 1
 
 
 def test_decode_with_passphrase() -> None:
-    out = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.LongId",
-                 "--passphrase", "my secret", stdin="d10723025d66fced5d\n")
+    out = pygoby(
+        "dccl",
+        "decode",
+        "--proto",
+        PROTO,
+        "--message",
+        "example.LongId",
+        "--passphrase",
+        "my secret",
+        stdin="d10723025d66fced5d\n",
+    )
     assert out.returncode == 0
     assert out.stdout.startswith('src: 3 dest: 17 payload: "\\001\\002" t: ')
 
@@ -48,7 +69,9 @@ def test_decode_with_passphrase() -> None:
 def test_decode_all_good_exits_zero_and_bad_hex_is_reported() -> None:
     good = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.Tiny", stdin="042501\n")
     assert (good.returncode, good.stdout) == (0, "a: 5 b: 3 c: true\n")
-    bad = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.Tiny", stdin="04zz\n0425\n")
+    bad = pygoby(
+        "dccl", "decode", "--proto", PROTO, "--message", "example.Tiny", stdin="04zz\n0425\n"
+    )
     assert bad.stdout.splitlines()[0] == "error: not a hex string: '04zz'"
     assert "truncated" in bad.stdout.splitlines()[1]
     assert bad.returncode == 1
@@ -72,11 +95,15 @@ def test_analyze_without_message_shows_every_dccl_message_of_the_file() -> None:
 def test_unknown_message_is_a_clear_error_with_close_names() -> None:
     out = pygoby("dccl", "analyze", "--proto", PROTO, "--message", "example.Nope")
     assert out.returncode == 2
-    assert out.stderr == ("error: unknown message type 'example.Nope'; there are: example.Position, "
-                          "example.Example, example.Tiny, example.LongId\n")  # fmt: skip
+    assert out.stderr == (
+        "error: unknown message type 'example.Nope'; there are: example.Position, "
+        "example.Example, example.Tiny, example.LongId\n"
+    )
     for typed in ("example.Exampel", "Example", "exmaple.example"):
         out = pygoby("dccl", "encode", "--proto", PROTO, "--message", typed)
-        assert out.stderr == f"error: unknown message type {typed!r}; did you mean example.Example?\n"
+        assert (
+            out.stderr == f"error: unknown message type {typed!r}; did you mean example.Example?\n"
+        )
 
 
 def console(*args: str, stdin: str = "") -> subprocess.CompletedProcess:
@@ -94,8 +121,16 @@ def test_analyze_source_prints_the_generated_python() -> None:
 
 
 def test_encode_and_decode_trace_each_field_to_stderr() -> None:
-    encoded = console("dccl", "encode", "--trace", "--proto", PROTO, "--message", "example.Tiny",
-                      stdin="a: 5 b: 3 c: true\n")
+    encoded = console(
+        "dccl",
+        "encode",
+        "--trace",
+        "--proto",
+        PROTO,
+        "--message",
+        "example.Tiny",
+        stdin="a: 5 b: 3 c: true\n",
+    )
     assert encoded.stdout == "042501\n"
     assert encoded.stderr.splitlines() == [
         "encode example.Tiny head: (id) = 2 (8 bits: 00000100)",
@@ -103,8 +138,9 @@ def test_encode_and_decode_trace_each_field_to_stderr() -> None:
         "encode example.Tiny body: b = 3 (4 bits: 0100)",
         "encode example.Tiny body: c = True (2 bits: 10)",
     ]
-    decoded = console("dccl", "decode", "--trace", "--proto", PROTO, "--message", "example.Tiny",
-                      stdin="040500\n")
+    decoded = console(
+        "dccl", "decode", "--trace", "--proto", PROTO, "--message", "example.Tiny", stdin="040500\n"
+    )
     assert decoded.stdout == "a: 5\n"
     assert "decode example.Tiny body: c = not set (2 bits: 00)" in decoded.stderr.splitlines()
 
@@ -114,17 +150,39 @@ def test_passphrase_from_a_file_or_the_environment_not_the_command_line(tmp_path
     secret_file = tmp_path / "secret"
     secret_file.write_text("my secret\n")  # as `echo "my secret" > secret` writes it
     encrypted = "d10723025d66fced5d\n"
-    out = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.LongId",
-                 "--passphrase-file", str(secret_file), stdin=encrypted)
+    out = pygoby(
+        "dccl",
+        "decode",
+        "--proto",
+        PROTO,
+        "--message",
+        "example.LongId",
+        "--passphrase-file",
+        str(secret_file),
+        stdin=encrypted,
+    )
     assert out.returncode == 0, out.stderr
     assert out.stdout.startswith('src: 3 dest: 17 payload: "\\001\\002" t: ')
     env = {**os.environ, "PYGOBY_DCCL_PASSPHRASE": "my secret"}
-    out = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.LongId",
-                 stdin=encrypted, env=env)
+    out = pygoby(
+        "dccl", "decode", "--proto", PROTO, "--message", "example.LongId", stdin=encrypted, env=env
+    )
     assert out.stdout.startswith('src: 3 dest: 17 payload: "\\001\\002" t: ')
-    wrong = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.LongId",
-                   stdin=encrypted)  # no passphrase: the body does not decode to the same
+    wrong = pygoby(
+        "dccl", "decode", "--proto", PROTO, "--message", "example.LongId", stdin=encrypted
+    )  # no passphrase: the body does not decode to the same
     assert not wrong.stdout.startswith('src: 3 dest: 17 payload: "\\001\\002" t: ')
-    missing = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.LongId",
-                     "--passphrase-file", str(tmp_path / "nope"), stdin=encrypted)
-    assert missing.returncode == 2 and "nope" in missing.stderr and "Traceback" not in missing.stderr
+    missing = pygoby(
+        "dccl",
+        "decode",
+        "--proto",
+        PROTO,
+        "--message",
+        "example.LongId",
+        "--passphrase-file",
+        str(tmp_path / "nope"),
+        stdin=encrypted,
+    )
+    assert (
+        missing.returncode == 2 and "nope" in missing.stderr and "Traceback" not in missing.stderr
+    )

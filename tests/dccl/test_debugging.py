@@ -52,9 +52,14 @@ class RefusingCodec(FixedWidthCodec):
 def test_a_failing_user_codec_on_decode_shows_its_field(tmp_path: Path) -> None:
     codec = Codec()
     codec.registry.register("dbg.refusing", ["uint32"], RefusingCodec)
-    cls = load(tmp_path, """
+    cls = load(
+        tmp_path,
+        """
         message Refused { option (dccl.msg) = { id: 3 max_bytes: 4 codec_version: 4 };
-          required uint32 depth = 1 [(dccl.field).codec = 'dbg.refusing']; }""", "Refused", codec)
+          required uint32 depth = 1 [(dccl.field).codec = 'dbg.refusing']; }""",
+        "Refused",
+        codec,
+    )
     with pytest.raises(DcclDecodeError, match="raw value 1 refused") as caught:
         codec.decode(codec.encode(cls(depth=1)))
     text = traceback_text(caught.value)
@@ -82,14 +87,18 @@ def test_source_is_kept_per_part_and_registered_with_linecache() -> None:
 
 def test_slot_names_follow_nested_and_repeated_fields_and_stay_unique(tmp_path: Path) -> None:
     codec = Codec()
-    cls = load(tmp_path, """
+    cls = load(
+        tmp_path,
+        """
         message Inner { optional uint32 lat = 1 [(dccl.field) = { min: 0 max: 7 }]; }
         message Names { option (dccl.msg) = { id: 4 max_bytes: 16 codec_version: 4 };
           optional Inner pos = 1;
           optional uint32 pos_lat = 2 [(dccl.field) = { min: 0 max: 7 }];
           repeated Inner list = 3 [(dccl.field).max_repeat = 2];
           repeated uint32 values = 4 [(dccl.field) = { min: 0 max: 3 max_repeat: 2 }]; }""",
-        "Names", codec)
+        "Names",
+        codec,
+    )
     source = codec.compiled(cls).source
     assert "acc |= enc_pos_lat(m_pos.lat, strict) << pos" in source["encode_body"]
     assert "acc |= enc_pos_lat_2(m0.pos_lat, strict) << pos" in source["encode_body"]
@@ -166,7 +175,10 @@ def test_trace_logs_each_field_with_its_value_and_bits(caplog) -> None:
     assert codec.decode(bytes.fromhex("040500")) == cls(a=5)
     records = [r for r in caplog.records if r.name == "pygoby.dccl.trace"]
     assert [(r.dccl_field, r.dccl_value, r.dccl_bits) for r in records] == [
-        ("(id)", 2, 8), ("a", 5, 3), ("b", None, 4), ("c", None, 2),
+        ("(id)", 2, 8),
+        ("a", 5, 3),
+        ("b", None, 4),
+        ("c", None, 2),
     ]
     assert records[2].getMessage() == "decode example.Tiny body: b = not set (4 bits: 0000)"
 
@@ -175,19 +187,33 @@ def test_trace_shows_enum_names_nested_and_repeated_fields(caplog) -> None:
     codec = Codec(trace=True)
     cls = codec.load(message_class("example.proto", "example.Example"))
     caplog.set_level(logging.DEBUG, logger="pygoby.dccl.trace")
-    codec.encode(cls(count=1, temperature=2, flag=True, mode=5, readings=[1, 2],
-                     pos={"lat": 41.5, "lon": -70.25}))
+    codec.encode(
+        cls(
+            count=1,
+            temperature=2,
+            flag=True,
+            mode=5,
+            readings=[1, 2],
+            pos={"lat": 41.5, "lon": -70.25},
+        )
+    )
     lines = trace_lines(caplog)
     assert "encode example.Example body: mode = MODE_TRANSIT (2 bits: 10)" in lines
     assert "encode example.Example body: flag = True (1 bit: 1)" in lines
     assert "encode example.Example body: readings = [1, 2] (19 bits: 0000001000000001010)" in lines
-    assert "encode example.Example body: pos.lat = 41.5 (25 bits: 0110010001010011100110000)" in lines
+    assert (
+        "encode example.Example body: pos.lat = 41.5 (25 bits: 0110010001010011100110000)" in lines
+    )
     nested = [line for line in lines if ": pos" in line]
     assert [line.split(" = ")[0] for line in nested] == [
-        "encode example.Example body: pos.lat", "encode example.Example body: pos.lon",
-        "encode example.Example body: pos.depth", "encode example.Example body: pos",
+        "encode example.Example body: pos.lat",
+        "encode example.Example body: pos.lon",
+        "encode example.Example body: pos.depth",
+        "encode example.Example body: pos",
     ]
-    assert nested[-1].startswith("encode example.Example body: pos = {lat: 41.5 lon: -70.25} (62 bits")
+    assert nested[-1].startswith(
+        "encode example.Example body: pos = {lat: 41.5 lon: -70.25} (62 bits"
+    )
 
 
 def test_without_trace_nothing_is_logged_even_at_debug(caplog) -> None:

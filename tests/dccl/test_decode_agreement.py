@@ -89,7 +89,8 @@ def test_non_utf8_repeated_strings_keep_their_order(codec) -> None:
 
 def test_proto3_string_that_is_not_utf8_is_a_decode_error(tmp_path: Path) -> None:
     path = tmp_path / "p3.proto"
-    path.write_text(textwrap.dedent("""\
+    path.write_text(
+        textwrap.dedent("""\
         syntax = "proto3";
         import "dccl/option_extensions.proto";
         package p3;
@@ -97,7 +98,8 @@ def test_proto3_string_that_is_not_utf8_is_a_decode_error(tmp_path: Path) -> Non
           option (dccl.msg) = { id: 7 max_bytes: 16 codec_version: 4 };
           string s = 1 [(dccl.field).max_length = 4];
         }
-    """))
+    """)
+    )
     codec = Codec()
     cls = codec.load_proto(path, "p3.T")
     data = codec.encode(cls(s="\u00ff"))  # the bytes c3 bf, after a 3-bit length

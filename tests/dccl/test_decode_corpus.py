@@ -35,8 +35,13 @@ def test_corpus_covers_every_case() -> None:
     errors = [r["error"] for r in CORPUS if r["result"] == "error"]
     assert sum("traverse mutable" in e for e in errors) >= 10  # message count > max_repeat
     # strings that are not UTF-8, as C++ decodes them
-    assert sum(r["message"].startswith("agree.Text") and "\\3" in (r.get("decoded") or "")
-               for r in CORPUS) >= 10
+    assert (
+        sum(
+            r["message"].startswith("agree.Text") and "\\3" in (r.get("decoded") or "")
+            for r in CORPUS
+        )
+        >= 10
+    )
 
 
 @pytest.mark.parametrize("key", list(GROUPS), ids=[f"{k[1]}-{k[2]}" for k in GROUPS])
@@ -60,9 +65,13 @@ def test_decode_agrees_with_cpp(key: tuple) -> None:
             if _documented_decode(cls, decoded, record["error"]):
                 documented += 1
             else:
-                disagreements.append(f"{record['message']} {record['hex']}: C++ {record['error'][:80]}")
+                disagreements.append(
+                    f"{record['message']} {record['hex']}: C++ {record['error'][:80]}"
+                )
         elif decoded != decoded_message(cls, record):
-            disagreements.append(f"{record['message']} {record['hex']}: {decoded} != {record['decoded']}")
+            disagreements.append(
+                f"{record['message']} {record['hex']}: {decoded} != {record['decoded']}"
+            )
     assert not disagreements, "\n".join(disagreements[:10])
     if not key[1].startswith(("arith", "dyncond", "native")):
         assert documented == 0

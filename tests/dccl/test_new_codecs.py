@@ -51,10 +51,24 @@ def test_ccl_state_is_a_32_byte_ccl_frame_and_switches_the_id_codec() -> None:
     cls = codec.load_proto("dccl/ccl/protobuf/ccl.proto", STATE)  # no include dir needed
     assert codec.id_codec == "dccl.ccl.id"
     assert codec.encode(status(x=1.5))[:2] == b"\x20\x04"  # DCCL among CCL: 0x20 first
-    msg = cls(latitude=41.5, longitude=-70.25, fix_age=16, time_date=1_699_999_996_000_000,
-              heading=90, depth=12.5, mission_mode=cls.NORMAL, faults=b"\0" * 4,
-              faults_2=b"\0", mission_leg=2, est_velocity=1.2, objective_index=b"\0",
-              watts=40, lat_goal=41.6, lon_goal=-70.2, battery_percent=80)
+    msg = cls(
+        latitude=41.5,
+        longitude=-70.25,
+        fix_age=16,
+        time_date=1_699_999_996_000_000,
+        heading=90,
+        depth=12.5,
+        mission_mode=cls.NORMAL,
+        faults=b"\0" * 4,
+        faults_2=b"\0",
+        mission_leg=2,
+        est_velocity=1.2,
+        objective_index=b"\0",
+        watts=40,
+        lat_goal=41.6,
+        lon_goal=-70.2,
+        battery_percent=80,
+    )
     msg.gfi_pitch_oil.gfi, msg.gfi_pitch_oil.pitch, msg.gfi_pitch_oil.oil = 0, 3, 80
     data = codec.encode(msg)
     assert len(data) == 32 and data[0] == 0x0E  # MDAT_STATE mode byte
@@ -86,9 +100,14 @@ def test_ccl_depth_roundtrip_within_its_step(depth: float) -> None:
 @given(st.floats(allow_nan=True, allow_infinity=True, width=32))
 def test_ccl_field_functions_take_any_float(value: float) -> None:
     for encode, bits in [
-        (fields.encode_heading, 8), (fields.encode_velocity, 8), (fields.encode_watts, 8),
-        (fields.encode_hires_altitude, 16), (fields.encode_salinity, 8),
-        (fields.encode_temperature, 8), (fields.encode_sound_speed, 8), (fields.encode_depth, 16),
+        (fields.encode_heading, 8),
+        (fields.encode_velocity, 8),
+        (fields.encode_watts, 8),
+        (fields.encode_hires_altitude, 16),
+        (fields.encode_salinity, 8),
+        (fields.encode_temperature, 8),
+        (fields.encode_sound_speed, 8),
+        (fields.encode_depth, 16),
         (fields.encode_latlon, 24),
         (lambda v: fields.encode_speed(v, fields.SPEED_MODE_RPM), 8),
         (lambda v: fields.encode_gfi_pitch_oil(v, v, v), 16),
@@ -99,12 +118,30 @@ def test_ccl_field_functions_take_any_float(value: float) -> None:
 def test_ccl_speed_follows_the_thrust_mode() -> None:
     codec = Codec()
     cls = codec.load_proto("dccl/ccl/protobuf/ccl.proto", "dccl.legacyccl.protobuf.CCLMDATRedirect")
-    msg = cls(transit_thrust_mode=cls.METERS_PER_SECOND, speed_transit=1.5,
-              survey_thrust_mode=cls.RPM, speed_survey=50)
-    for name in ("message_number", "latitude", "longitude", "transit_vertical_mode",
-                 "survey_vertical_mode", "depth_goal_transit", "device_cmd_transit",
-                 "depth_goal_survey", "device_cmd_survey", "num_rows", "row_length",
-                 "spacing_0", "spacing_1", "heading", "lat_start", "lon_start"):
+    msg = cls(
+        transit_thrust_mode=cls.METERS_PER_SECOND,
+        speed_transit=1.5,
+        survey_thrust_mode=cls.RPM,
+        speed_survey=50,
+    )
+    for name in (
+        "message_number",
+        "latitude",
+        "longitude",
+        "transit_vertical_mode",
+        "survey_vertical_mode",
+        "depth_goal_transit",
+        "device_cmd_transit",
+        "depth_goal_survey",
+        "device_cmd_survey",
+        "num_rows",
+        "row_length",
+        "spacing_0",
+        "spacing_1",
+        "heading",
+        "lat_start",
+        "lon_start",
+    ):
         setattr(msg, name, getattr(msg, name))
     msg.spare = b"\0\0\0"
     decoded = codec.decode(codec.encode(msg))
@@ -114,7 +151,9 @@ def test_ccl_speed_follows_the_thrust_mode() -> None:
 
 # ------------------------------------------------------------------ library names
 def test_cpp_library_names_map_to_builtins() -> None:
-    assert builtin_library("/home/toby/dccl/build/lib/libdccl_ccl_compat.so").name == "dccl_ccl_compat"
+    assert (
+        builtin_library("/home/toby/dccl/build/lib/libdccl_ccl_compat.so").name == "dccl_ccl_compat"
+    )
     assert builtin_library("libdccl_arithmetic.so.31").name == "dccl_arithmetic"
     assert builtin_library("libdccl_native_protobuf.so.4.2.0").name == "dccl_native_protobuf"
     with pytest.raises(DcclLoadError, match="load_proto_file"):
@@ -193,30 +232,61 @@ def test_adaptive_models_are_per_codec_and_per_direction() -> None:
 
 def test_cli_arithmetic_model_and_ccl_without_include(tmp_path: Path) -> None:
     def run(*args: str, stdin: str) -> subprocess.CompletedProcess:
-        return subprocess.run([sys.executable, "-m", "pygoby.cli", "dccl", *args], input=stdin,
-                              capture_output=True, text=True, timeout=60)
+        return subprocess.run(
+            [sys.executable, "-m", "pygoby.cli", "dccl", *args],
+            input=stdin,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
 
-    result = run("encode", "--proto", str(TEST_PROTOS / "arith.proto"), "--message", "arith.Ints",
-                 "--arithmetic-model", str(MODELS / "ints.txt"), stdin="v: 1 v: 2 tail: 3\n")
+    result = run(
+        "encode",
+        "--proto",
+        str(TEST_PROTOS / "arith.proto"),
+        "--message",
+        "arith.Ints",
+        "--arithmetic-model",
+        str(MODELS / "ints.txt"),
+        stdin="v: 1 v: 2 tail: 3\n",
+    )
     assert result.returncode == 0, result.stderr
     data = result.stdout.strip()
-    result = run("decode", "--proto", str(TEST_PROTOS / "arith.proto"), "--message", "arith.Ints",
-                 "--arithmetic-model", str(MODELS / "ints.txt"), stdin=data + "\n")
+    result = run(
+        "decode",
+        "--proto",
+        str(TEST_PROTOS / "arith.proto"),
+        "--message",
+        "arith.Ints",
+        "--arithmetic-model",
+        str(MODELS / "ints.txt"),
+        stdin=data + "\n",
+    )
     assert result.stdout.strip() == "v: 1 v: 2 tail: 3"
-    result = run("encode", "--proto", "dccl/ccl/protobuf/ccl.proto", "--message",
-                 "dccl.legacyccl.protobuf.CCLMDATError", stdin='message: "hello"\n')
+    result = run(
+        "encode",
+        "--proto",
+        "dccl/ccl/protobuf/ccl.proto",
+        "--message",
+        "dccl.legacyccl.protobuf.CCLMDATError",
+        stdin='message: "hello"\n',
+    )
     assert result.returncode == 0 and result.stdout.startswith("0f68656c6c6f"), result
 
 
 # ------------------------------------------------------------------ native_protobuf
 def test_native_protobuf_is_protobufs_own_encoding(tmp_path: Path) -> None:
-    codec, cls = load(tmp_path, """
+    codec, cls = load(
+        tmp_path,
+        """
         message N {
           option (dccl.msg) = { id: 3 max_bytes: 40 codec_version: 4 };
           required int32 a = 1 [(dccl.field).codec = "dccl.native_protobuf"];
           required sint64 b = 2 [(dccl.field).codec = "dccl.native_protobuf"];
           required double c = 3 [(dccl.field).codec = "dccl.native_protobuf"];
-        }""", "N")
+        }""",
+        "N",
+    )
     msg = cls(a=-1, b=-2, c=0.5)
     data = codec.encode(msg)
     # int32 -1: a 10-byte varint; sint64 -2: zigzag 3; double: 8 bytes (no tags, no presence bits)
@@ -225,7 +295,9 @@ def test_native_protobuf_is_protobufs_own_encoding(tmp_path: Path) -> None:
 
 
 # ------------------------------------------------------------------ dynamic conditions
-def test_dynamic_conditions_without_lupa_are_a_clear_load_error(tmp_path: Path, monkeypatch) -> None:
+def test_dynamic_conditions_without_lupa_are_a_clear_load_error(
+    tmp_path: Path, monkeypatch
+) -> None:
     real_import = builtins.__import__
 
     def no_lupa(name, *args, **kwargs):
@@ -240,12 +312,16 @@ def test_dynamic_conditions_without_lupa_are_a_clear_load_error(tmp_path: Path, 
 
 def test_dynamic_condition_that_is_not_lua_is_a_load_error(tmp_path: Path) -> None:
     with pytest.raises(DcclLoadError, match="not valid Lua"):
-        load(tmp_path, """
+        load(
+            tmp_path,
+            """
             message D {
               option (dccl.msg) = { id: 3 max_bytes: 8 codec_version: 4 };
               optional int32 a = 1 [(dccl.field) = { min: 0 max: 3
                 dynamic_conditions { omit_if: "this.b ==" } }];
-            }""", "D")
+            }""",
+            "D",
+        )
 
 
 def test_dynamic_conditions_omit_require_and_bound(tmp_path: Path) -> None:
@@ -261,12 +337,16 @@ def test_dynamic_conditions_omit_require_and_bound(tmp_path: Path) -> None:
 
 
 def test_lua_error_at_encode_is_an_encode_error(tmp_path: Path) -> None:
-    codec, cls = load(tmp_path, """
+    codec, cls = load(
+        tmp_path,
+        """
         message E {
           option (dccl.msg) = { id: 3 max_bytes: 8 codec_version: 4 };
           optional int32 a = 1 [(dccl.field) = { min: 0 max: 3
             dynamic_conditions { omit_if: "this.missing.x > 1" } }];
-        }""", "E")
+        }""",
+        "E",
+    )
     with pytest.raises(DcclError, match="dynamic_conditions omit_if"):
         codec.encode(cls(a=1))
 
@@ -293,8 +373,22 @@ def test_hash_field_sends_the_definition_hash_and_refuses_another(tmp_path: Path
 NEW_TYPES = [("dccl/ccl/protobuf/ccl.proto", name) for name in CCL_MESSAGES] + [
     (TEST_PROTOS / proto, f"{package}.{name}")
     for proto, package, names in [
-        ("arith.proto", "arith",
-         ["Ints", "Doubles", "EnumBool", "Singles", "Adaptive", "NoEof", "Long", "V2", "V3", "Nested"]),
+        (
+            "arith.proto",
+            "arith",
+            [
+                "Ints",
+                "Doubles",
+                "EnumBool",
+                "Singles",
+                "Adaptive",
+                "NoEof",
+                "Long",
+                "V2",
+                "V3",
+                "Nested",
+            ],
+        ),
         ("native.proto", "native", ["AllTypes", "Lists", "Mixed4", "Mixed3", "Mixed2", "Head"]),
         ("dyncond.proto", "dyn", ["Basic", "Lists", "V3", "Choice", "InHead"]),
         ("hash.proto", "hashing", ["Plain", "Rich", "Head", "V3", "V2", "Arith", "Group"]),

@@ -53,7 +53,8 @@ def _empty_singular_arithmetic(cls, msg) -> bool:
     """C++ DCCL 4.2 fails the whole decode when a singular arithmetic field decodes to no value
     (an unset optional one always does); pygoby leaves the field unset."""
     return any(
-        not f.is_repeated and not msg.HasField(f.name)
+        not f.is_repeated
+        and not msg.HasField(f.name)
         and field_options(f).codec in ("dccl.arithmetic", "_arithmetic")
         for f in cls.DESCRIPTOR.fields
     )
@@ -80,7 +81,9 @@ def _bounds_fail_on_empty(cls) -> bool:
 
 def _documented_decode(cls, decoded, error: str) -> bool:
     """A message C++ DCCL 4.2 could not decode but pygoby does, for a documented reason."""
-    return _empty_singular_arithmetic(cls, decoded) or ("lua" in error and _bounds_fail_on_empty(cls))
+    return _empty_singular_arithmetic(cls, decoded) or (
+        "lua" in error and _bounds_fail_on_empty(cls)
+    )
 
 
 def _replay(records: list[dict]) -> tuple[int, list[str]]:
@@ -96,7 +99,9 @@ def _replay(records: list[dict]) -> tuple[int, list[str]]:
             # fresh state. pygoby writes the last symbol (C++ reading that: test_cpp_reads_pygoby)
             codecs.drop(record)
             fresh = codecs.get(record)
-            fresh.decode(fresh.encode(msg), cls)  # no endless loop; the rest in test_cpp_reads_pygoby
+            fresh.decode(
+                fresh.encode(msg), cls
+            )  # no endless loop; the rest in test_cpp_reads_pygoby
             codecs.drop(record)
             continue
         if record["status"] == "error":
@@ -122,12 +127,16 @@ def _replay(records: list[dict]) -> tuple[int, list[str]]:
                 pass
             else:
                 if not _documented_decode(cls, decoded, record["error"]):
-                    problems.append(f"decode {where}: C++ failed ({record['error'][:60]}), pygoby {decoded}")
+                    problems.append(
+                        f"decode {where}: C++ failed ({record['error'][:60]}), pygoby {decoded}"
+                    )
         checked += 1
     return checked, problems
 
 
-@pytest.mark.parametrize(("suite", "key", "group"), GROUPS, ids=[f"{s}-{k[1]}-{k[2]}" for s, k, _ in GROUPS])
+@pytest.mark.parametrize(
+    ("suite", "key", "group"), GROUPS, ids=[f"{s}-{k[1]}-{k[2]}" for s, k, _ in GROUPS]
+)
 def test_recorded_vectors(suite: str, key: tuple, group: list[dict]) -> None:
     checked, problems = _replay(group)
     assert not problems, f"{len(problems)} of {len(group)}:\n" + "\n".join(problems[:10])
@@ -178,7 +187,10 @@ def test_adaptive_model_session(session: dict) -> None:
 HASHES = read_records("definition_hashes.jsonl")
 # C++ DCCL's ccl.proto carries (dccl.field).description texts on some fields of these two types,
 # which ours does not have; a description changes the hash (no CCL type has a hash field).
-DESCRIBED_UPSTREAM = {"dccl.legacyccl.protobuf.CCLMDATRedirect", "dccl.legacyccl.protobuf.CCLMDATState"}
+DESCRIBED_UPSTREAM = {
+    "dccl.legacyccl.protobuf.CCLMDATRedirect",
+    "dccl.legacyccl.protobuf.CCLMDATState",
+}
 
 
 def test_definition_hash_of_every_test_type() -> None:
@@ -189,7 +201,9 @@ def test_definition_hash_of_every_test_type() -> None:
             continue
         codec = codecs.get(record["proto"])
         if codec is None:
-            codec = codecs[record["proto"]] = new_codec({**record, "passphrase": None}, VirtualClock(0))
+            codec = codecs[record["proto"]] = new_codec(
+                {**record, "passphrase": None}, VirtualClock(0)
+            )
         cls = message_class(record["where"], record["proto"], record["message"])
         assert str(codec.definition_hash(cls)) == record["hash"], record["message"]
         compared += 1

@@ -42,7 +42,8 @@ def test_encode_vector(record: dict) -> None:
 
 
 @pytest.mark.parametrize(
-    "record", [r for r in ENCODE_VECTORS if r["hex"] is not None],
+    "record",
+    [r for r in ENCODE_VECTORS if r["hex"] is not None],
     ids=_ids([r for r in ENCODE_VECTORS if r["hex"] is not None]),
 )
 def test_decode_vector(record: dict) -> None:

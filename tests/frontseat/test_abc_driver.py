@@ -64,7 +64,9 @@ def connect(driver: AbcFrontSeat, link: MemoryLink) -> list[str]:
 
 def request(request_id: int, heading=260.0, speed=1.5, depth=100.0, response=True):
     return frontseat_pb.CommandRequest(
-        desired_course=frontseat_pb.DesiredCourse(time=T0, heading=heading, speed=speed, depth=depth),
+        desired_course=frontseat_pb.DesiredCourse(
+            time=T0, heading=heading, speed=speed, depth=depth
+        ),
         response_requested=response,
         request_id=request_id,
     )

@@ -71,7 +71,9 @@ async def test_session_start_nav_command_timeout_and_reconnect():
         assert driver.link.is_open
 
         # connect -> START -> CTRL,STATE:PAYLOAD -> ACCEPTING_COMMANDS; NAV -> LISTEN
-        await run_until(driver, lambda: driver.frontseat_state() == frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS)
+        await run_until(
+            driver, lambda: driver.frontseat_state() == frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS
+        )
         assert raw_out[0] == (
             "START,LAT:42.35,LON:-70.95,DURATION:0,FREQ:10,ACCEL:0.5,HDG_RATE:45,Z_RATE:2,WARP:10"
         )
@@ -92,13 +94,17 @@ async def test_session_start_nav_command_timeout_and_reconnect():
             )
         )
         await run_until(driver, lambda: bool(responses))
-        assert responses == [frontseat_pb.CommandResponse(request_successful=True, request_id=65536)]
+        assert responses == [
+            frontseat_pb.CommandResponse(request_successful=True, request_id=65536)
+        ]
         await run_until(driver, lambda: data[-1].node_status.speed.over_ground > 0.5)
         assert data[-1].node_status.local_fix.x > 0  # heading east
 
         # simulator stopped: NOT_CONNECTED at once; no data 10 s later (interface clock)
         await shut(serving)
-        await run_until(driver, lambda: driver.frontseat_state() == frontseat_pb.FRONTSEAT_NOT_CONNECTED)
+        await run_until(
+            driver, lambda: driver.frontseat_state() == frontseat_pb.FRONTSEAT_NOT_CONNECTED
+        )
         assert driver.frontseat_providing_data()
         driver.clock.advance(10.0)
         driver.do_work()
@@ -134,7 +140,8 @@ async def test_start_gives_up_after_the_timeout_but_keeps_trying():
         _, serving = await serve(port)
         try:
             await run_until(
-                driver, lambda: driver.frontseat_state() == frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS
+                driver,
+                lambda: driver.frontseat_state() == frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS,
             )
         finally:
             await shut(serving)

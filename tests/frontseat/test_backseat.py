@@ -38,9 +38,12 @@ def bring_to(seat: Backseat, state: int) -> None:
 
 @pytest.mark.parametrize(
     ("state", "command", "send"),
-    [(frontseat_pb.INTERFACE_STANDBY, False, False), (frontseat_pb.INTERFACE_LISTEN, False, True),
-     (frontseat_pb.INTERFACE_COMMAND, True, True)],
-)  # fmt: skip
+    [
+        (frontseat_pb.INTERFACE_STANDBY, False, False),
+        (frontseat_pb.INTERFACE_LISTEN, False, True),
+        (frontseat_pb.INTERFACE_COMMAND, True, True),
+    ],
+)
 def test_what_may_go_to_the_frontseat_in_each_state(state, command, send, caplog):
     seat = backseat()
     if state != frontseat_pb.INTERFACE_STANDBY:

@@ -9,7 +9,11 @@ from hypothesis import strategies as st
 from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.helm import helm_state_from_ivphelm
 
-NOT_RUNNING, DRIVE, PARK = frontseat_pb.HELM_NOT_RUNNING, frontseat_pb.HELM_DRIVE, frontseat_pb.HELM_PARK
+NOT_RUNNING, DRIVE, PARK = (
+    frontseat_pb.HELM_NOT_RUNNING,
+    frontseat_pb.HELM_DRIVE,
+    frontseat_pb.HELM_PARK,
+)
 ALL = (NOT_RUNNING, DRIVE, PARK)
 
 

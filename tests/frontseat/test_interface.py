@@ -24,11 +24,19 @@ from .scripted_driver import ScriptedFrontSeat
 START = 1000.0
 ERRORS = (frontseat_pb.INTERFACE_HELM_ERROR, frontseat_pb.INTERFACE_FS_ERROR)
 
-STANDBY, LISTEN, COMMAND = frontseat_pb.INTERFACE_STANDBY, frontseat_pb.INTERFACE_LISTEN, frontseat_pb.INTERFACE_COMMAND
+STANDBY, LISTEN, COMMAND = (
+    frontseat_pb.INTERFACE_STANDBY,
+    frontseat_pb.INTERFACE_LISTEN,
+    frontseat_pb.INTERFACE_COMMAND,
+)
 HELM_ERROR, FS_ERROR = frontseat_pb.INTERFACE_HELM_ERROR, frontseat_pb.INTERFACE_FS_ERROR
 NOT_CONNECTED, IDLE = frontseat_pb.FRONTSEAT_NOT_CONNECTED, frontseat_pb.FRONTSEAT_IDLE
 ACCEPTING, IN_CONTROL = frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS, frontseat_pb.FRONTSEAT_IN_CONTROL
-NOT_RUNNING, DRIVE, PARK = frontseat_pb.HELM_NOT_RUNNING, frontseat_pb.HELM_DRIVE, frontseat_pb.HELM_PARK
+NOT_RUNNING, DRIVE, PARK = (
+    frontseat_pb.HELM_NOT_RUNNING,
+    frontseat_pb.HELM_DRIVE,
+    frontseat_pb.HELM_PARK,
+)
 PARKED, HELM_NOT_RUNNING_ERR = frontseat_pb.ERROR_HELM_PARKED, frontseat_pb.ERROR_HELM_NOT_RUNNING
 FS_NOT_CONNECTED_ERR = frontseat_pb.ERROR_FRONTSEAT_NOT_CONNECTED
 NOT_PROVIDING_ERR = frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
@@ -133,7 +141,17 @@ ROWS = [
         cfg={"helm_running_timeout": 30},
     ),
     Row("T2 E3 in grace", "STANDBY", DRIVE, NOT_CONNECTED, False, STANDBY, at=10),
-    Row("T2 E3", "STANDBY", DRIVE, NOT_CONNECTED, False, FS_ERROR, None, FS_NOT_CONNECTED_ERR, at=10.5),
+    Row(
+        "T2 E3",
+        "STANDBY",
+        DRIVE,
+        NOT_CONNECTED,
+        False,
+        FS_ERROR,
+        None,
+        FS_NOT_CONNECTED_ERR,
+        at=10.5,
+    ),
     Row(
         "T2 E3 no helm",
         "STANDBY",
@@ -146,7 +164,16 @@ ROWS = [
         at=11,
         cfg=NO_HELM,
     ),
-    Row("T2 E2 before E3", "STANDBY", NOT_RUNNING, NOT_CONNECTED, False, HELM_ERROR, HELM_NOT_RUNNING_ERR, at=11),
+    Row(
+        "T2 E2 before E3",
+        "STANDBY",
+        NOT_RUNNING,
+        NOT_CONNECTED,
+        False,
+        HELM_ERROR,
+        HELM_NOT_RUNNING_ERR,
+        at=11,
+    ),
     Row(
         "T2 E3 sooner than E2",
         "STANDBY",
@@ -175,12 +202,42 @@ ROWS = [
     Row("T4 E2 in grace", "LISTEN", NOT_RUNNING, IDLE, True, LISTEN, at=10),
     Row("T4 E2", "LISTEN", NOT_RUNNING, IDLE, True, HELM_ERROR, HELM_NOT_RUNNING_ERR, at=10.5),
     Row("T4 E2 no helm", "LISTEN", NOT_RUNNING, IDLE, True, LISTEN, at=1e6, cfg=NO_HELM),
-    Row("T4 E3 no grace", "LISTEN", DRIVE, NOT_CONNECTED, True, FS_ERROR, None, FS_NOT_CONNECTED_ERR),
+    Row(
+        "T4 E3 no grace", "LISTEN", DRIVE, NOT_CONNECTED, True, FS_ERROR, None, FS_NOT_CONNECTED_ERR
+    ),
     Row("T4 E4", "LISTEN", DRIVE, IDLE, False, FS_ERROR, None, NOT_PROVIDING_ERR),
-    Row("T4 E4 no helm", "LISTEN", NOT_RUNNING, IDLE, False, FS_ERROR, None, NOT_PROVIDING_ERR, cfg=NO_HELM),
+    Row(
+        "T4 E4 no helm",
+        "LISTEN",
+        NOT_RUNNING,
+        IDLE,
+        False,
+        FS_ERROR,
+        None,
+        NOT_PROVIDING_ERR,
+        cfg=NO_HELM,
+    ),
     Row("T4 E1 before E3/E4", "LISTEN", PARK, NOT_CONNECTED, False, HELM_ERROR, PARKED),
-    Row("T4 E3 before E4", "LISTEN", DRIVE, NOT_CONNECTED, False, FS_ERROR, None, FS_NOT_CONNECTED_ERR),
-    Row("T4 E2 before E4", "LISTEN", NOT_RUNNING, IDLE, False, HELM_ERROR, HELM_NOT_RUNNING_ERR, at=11),
+    Row(
+        "T4 E3 before E4",
+        "LISTEN",
+        DRIVE,
+        NOT_CONNECTED,
+        False,
+        FS_ERROR,
+        None,
+        FS_NOT_CONNECTED_ERR,
+    ),
+    Row(
+        "T4 E2 before E4",
+        "LISTEN",
+        NOT_RUNNING,
+        IDLE,
+        False,
+        HELM_ERROR,
+        HELM_NOT_RUNNING_ERR,
+        at=11,
+    ),
     # T5: COMMAND -> LISTEN, the helm not consulted
     Row("T5 idle", "COMMAND", DRIVE, IDLE, True, LISTEN),
     Row("T5 in control", "COMMAND", DRIVE, IN_CONTROL, True, LISTEN),
@@ -191,26 +248,97 @@ ROWS = [
     # T6: COMMAND -> error, E1-E4 (E2 without grace period)
     Row("T6 E1", "COMMAND", PARK, ACCEPTING, True, HELM_ERROR, PARKED),
     Row("T6 E1 no helm", "COMMAND", PARK, ACCEPTING, True, HELM_ERROR, PARKED, cfg=NO_HELM),
-    Row("T6 E2 no grace", "COMMAND", NOT_RUNNING, ACCEPTING, True, HELM_ERROR, HELM_NOT_RUNNING_ERR, at=0),
+    Row(
+        "T6 E2 no grace",
+        "COMMAND",
+        NOT_RUNNING,
+        ACCEPTING,
+        True,
+        HELM_ERROR,
+        HELM_NOT_RUNNING_ERR,
+        at=0,
+    ),
     Row("T6 E2 no helm", "COMMAND", NOT_RUNNING, ACCEPTING, True, COMMAND, at=1e6, cfg=NO_HELM),
     Row("T6 E3", "COMMAND", DRIVE, NOT_CONNECTED, True, FS_ERROR, None, FS_NOT_CONNECTED_ERR),
     Row("T6 E4", "COMMAND", DRIVE, ACCEPTING, False, FS_ERROR, None, NOT_PROVIDING_ERR),
-    Row("T6 E2 before E3", "COMMAND", NOT_RUNNING, NOT_CONNECTED, False, HELM_ERROR, HELM_NOT_RUNNING_ERR),
+    Row(
+        "T6 E2 before E3",
+        "COMMAND",
+        NOT_RUNNING,
+        NOT_CONNECTED,
+        False,
+        HELM_ERROR,
+        HELM_NOT_RUNNING_ERR,
+    ),
     # T7: HELM_ERROR -> STANDBY only when the helm drives
     Row("T7", "HELM_PARKED", DRIVE, IDLE, False, STANDBY),
     Row("T7 from not running", "HELM_NOT_RUNNING", DRIVE, ACCEPTING, True, STANDBY),
     Row("T7 still parked", "HELM_PARKED", PARK, ACCEPTING, True, HELM_ERROR, PARKED, at=1e6),
     Row("T7 not running", "HELM_PARKED", NOT_RUNNING, ACCEPTING, True, HELM_ERROR, PARKED),
-    Row("T7 no helm: not running", "HELM_PARKED", NOT_RUNNING, ACCEPTING, True, HELM_ERROR, PARKED, cfg=NO_HELM),
+    Row(
+        "T7 no helm: not running",
+        "HELM_PARKED",
+        NOT_RUNNING,
+        ACCEPTING,
+        True,
+        HELM_ERROR,
+        PARKED,
+        cfg=NO_HELM,
+    ),
     Row("T7 no helm: drive", "HELM_PARKED", DRIVE, NOT_CONNECTED, False, STANDBY, cfg=NO_HELM),
-    Row("T7 still not running", "HELM_NOT_RUNNING", NOT_RUNNING, ACCEPTING, True, HELM_ERROR, HELM_NOT_RUNNING_ERR),
+    Row(
+        "T7 still not running",
+        "HELM_NOT_RUNNING",
+        NOT_RUNNING,
+        ACCEPTING,
+        True,
+        HELM_ERROR,
+        HELM_NOT_RUNNING_ERR,
+    ),
     # T8: FS_ERROR -> STANDBY when the cause of the last frontseat error is gone
     Row("T8 connected", "FS_NOT_CONNECTED", PARK, IDLE, False, STANDBY),
-    Row("T8 still not connected", "FS_NOT_CONNECTED", DRIVE, NOT_CONNECTED, True, FS_ERROR, None, FS_NOT_CONNECTED_ERR),
+    Row(
+        "T8 still not connected",
+        "FS_NOT_CONNECTED",
+        DRIVE,
+        NOT_CONNECTED,
+        True,
+        FS_ERROR,
+        None,
+        FS_NOT_CONNECTED_ERR,
+    ),
     Row("T8 data again", "FS_NOT_PROVIDING", PARK, NOT_CONNECTED, True, STANDBY),
-    Row("T8 still no data", "FS_NOT_PROVIDING", DRIVE, ACCEPTING, False, FS_ERROR, None, NOT_PROVIDING_ERR),
-    Row("T8 ignoring: no exit", "FS_IGNORING", DRIVE, ACCEPTING, True, FS_ERROR, None, IGNORING_ERR, at=1e6),
-    Row("T8 ignoring: no exit (idle)", "FS_IGNORING", DRIVE, IDLE, True, FS_ERROR, None, IGNORING_ERR),
+    Row(
+        "T8 still no data",
+        "FS_NOT_PROVIDING",
+        DRIVE,
+        ACCEPTING,
+        False,
+        FS_ERROR,
+        None,
+        NOT_PROVIDING_ERR,
+    ),
+    Row(
+        "T8 ignoring: no exit",
+        "FS_IGNORING",
+        DRIVE,
+        ACCEPTING,
+        True,
+        FS_ERROR,
+        None,
+        IGNORING_ERR,
+        at=1e6,
+    ),
+    Row(
+        "T8 ignoring: no exit (idle)",
+        "FS_IGNORING",
+        DRIVE,
+        IDLE,
+        True,
+        FS_ERROR,
+        None,
+        IGNORING_ERR,
+    ),
 ]
 
 
@@ -247,7 +375,11 @@ def test_initial_state() -> None:
     assert driver.helm_state == NOT_RUNNING
     assert driver.start_time == START
     status = driver.status()
-    assert (status.state, status.frontseat_state, status.helm_state) == (STANDBY, NOT_CONNECTED, NOT_RUNNING)
+    assert (status.state, status.frontseat_state, status.helm_state) == (
+        STANDBY,
+        NOT_CONNECTED,
+        NOT_RUNNING,
+    )
     assert errors(driver) == (None, None)
 
 
@@ -333,7 +465,9 @@ def test_a_full_session_signals_each_change_once() -> None:
 # --- T9: errors raised by the driver's loop() ---------------------------------------------
 
 
-@pytest.mark.parametrize("where", ["STANDBY", "LISTEN", "COMMAND", "HELM_PARKED", "FS_NOT_PROVIDING"])
+@pytest.mark.parametrize(
+    "where", ["STANDBY", "LISTEN", "COMMAND", "HELM_PARKED", "FS_NOT_PROVIDING"]
+)
 @pytest.mark.parametrize(
     ("exc_args", "expect"),
     [
@@ -486,7 +620,15 @@ _steps = st.lists(
         st.booleans(),
         st.sampled_from([0.0, 0.5, 3.0, 11.0]),
         st.sampled_from(
-            [None, None, None, None, ("helm", PARKED), ("fs", IGNORING_ERR), ("fs", NOT_PROVIDING_ERR)]
+            [
+                None,
+                None,
+                None,
+                None,
+                ("helm", PARKED),
+                ("fs", IGNORING_ERR),
+                ("fs", NOT_PROVIDING_ERR),
+            ]
         ),
     ),
     max_size=40,

@@ -133,7 +133,11 @@ def test_type_default_is_auv_and_given_values_are_kept() -> None:
     status = global_status(42.5, -70.5)
     status.name, status.type, status.time = "other", frontseat_pb.VehicleType.Value("USV"), 5.0
     driver.compute_missing(status)
-    assert (status.name, status.type, status.time) == ("other", frontseat_pb.VehicleType.Value("USV"), 5.0)
+    assert (status.name, status.type, status.time) == (
+        "other",
+        frontseat_pb.VehicleType.Value("USV"),
+        5.0,
+    )
     fresh = global_status(42.5, -70.5)
     driver.compute_missing(fresh)
     assert fresh.type == frontseat_pb.VehicleType.Value("AUV")

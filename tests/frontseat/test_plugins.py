@@ -37,7 +37,9 @@ def scripted_entry_point(monkeypatch, tmp_path):
     sys.path, as pip-installed driver packages are): the test driver module and a broken one."""
     dist_info = tmp_path / "pygoby_test_drivers-1.0.dist-info"
     dist_info.mkdir()
-    (dist_info / "METADATA").write_text("Metadata-Version: 2.1\nName: pygoby-test-drivers\nVersion: 1.0\n")
+    (dist_info / "METADATA").write_text(
+        "Metadata-Version: 2.1\nName: pygoby-test-drivers\nVersion: 1.0\n"
+    )
     (dist_info / "entry_points.txt").write_text(
         f"[{ENTRY_POINT_GROUP}]\n"
         f"scripted = {TEST_MODULE}:frontseat_driver_load\n"
@@ -143,7 +145,9 @@ def test_wrong_name_lists_the_drivers_found(name) -> None:
 def test_module_with_broken_import_is_reported(tmp_path, monkeypatch) -> None:
     (tmp_path / "broken_fs_driver.py").write_text("import no_such_dependency_xyz\n")
     monkeypatch.syspath_prepend(str(tmp_path))
-    with pytest.raises(DriverLoadError, match="cannot import frontseat driver module 'broken_fs_driver'"):
+    with pytest.raises(
+        DriverLoadError, match="cannot import frontseat driver module 'broken_fs_driver'"
+    ):
         load_driver("broken_fs_driver", cfg())
 
 

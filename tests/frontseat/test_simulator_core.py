@@ -149,8 +149,13 @@ def test_heading_exactly_opposite_turns_clockwise():
 
 def test_wrap_heading():
     assert [wrap_heading(h) for h in (0.0, 360.0, 370.0, -10.0, -720.0, 359.5)] == [
-        0.0, 0.0, 10.0, 350.0, 0.0, 359.5,
-    ]  # fmt: skip
+        0.0,
+        0.0,
+        10.0,
+        350.0,
+        0.0,
+        359.5,
+    ]
     assert wrap_heading(-1e-20) == 0.0  # 360 - 1e-20 rounds to 360
 
 

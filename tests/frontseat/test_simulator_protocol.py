@@ -72,8 +72,12 @@ def test_parse_line_splits_key_and_fields_and_trims_the_line():
     msg = parse_line("  NAV,LAT:42.1234,LON:-72.5435,DEPTH:200,HEADING:223,SPEED:1.4\r\n")
     assert msg.key == "NAV"
     assert dict(msg.fields) == {
-        "LAT": "42.1234", "LON": "-72.5435", "DEPTH": "200", "HEADING": "223", "SPEED": "1.4",
-    }  # fmt: skip
+        "LAT": "42.1234",
+        "LON": "-72.5435",
+        "DEPTH": "200",
+        "HEADING": "223",
+        "SPEED": "1.4",
+    }
     assert parse_line("CTRL") == Message("CTRL", {})
     assert parse_line("") == Message("", {})
 
@@ -119,9 +123,15 @@ def test_format_line_and_parse_line_round_trip(key, fields):
 
 def test_start_defaults_and_goby2_form():
     assert Start.from_message(parse_line("START,LAT:42.1234,LON:-72,DURATION:600")) == Start(
-        lat=42.1234, lon=-72.0, duration=600, freq=10, accel=0.5, hdg_rate=45.0, z_rate=2.0,
+        lat=42.1234,
+        lon=-72.0,
+        duration=600,
+        freq=10,
+        accel=0.5,
+        hdg_rate=45.0,
+        z_rate=2.0,
         warp=1,
-    )  # fmt: skip
+    )
 
 
 def test_start_to_line_has_all_eight_fields_in_upstream_order():

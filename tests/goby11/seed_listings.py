@@ -13,12 +13,30 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "goby1.1"
 # shipped file -> (caption printed before the listing, number of lines)
 LISTINGS = {
     "xml/example1.xml": ("Let’s call this file `example1.xml`", 95),
-    "MOOS/basic_ccl/mm1.moos": ("*MOOS file for Node 1: goby/share/cfg/MOOS/basic\\_ccl/mm1.moos*", 98),
-    "MOOS/basic_ccl/mm2.moos": ("*MOOS file for Node 2: goby/share/cfg/MOOS/basic\\_ccl/mm2.moos*", 88),
-    "MOOS/ccl_and_dccl/mm1.moos": ("*MOOS file for Node 1: goby/share/cfg/MOOS/ccl\\_and\\_dccl/mm1.moos*", 111),
-    "MOOS/ccl_and_dccl/mm2.moos": ("MOOS file for Node 2: *goby/share/cfg/MOOS/ccl\\_and\\_dccl/mm2.moos*", 112),
-    "xml/simple_status.xml": ("*XML definition of Simple Status: goby/xml/simple\\_status.xml*", 89),
-    "MOOS/ccl_and_dccl/modemidlookup.txt": ("*Modem Lookup Table: goby/share/cfg/MOOS/ccl\\_and\\_dccl/modemidlookup.txt*", 2),
+    "MOOS/basic_ccl/mm1.moos": (
+        "*MOOS file for Node 1: goby/share/cfg/MOOS/basic\\_ccl/mm1.moos*",
+        98,
+    ),
+    "MOOS/basic_ccl/mm2.moos": (
+        "*MOOS file for Node 2: goby/share/cfg/MOOS/basic\\_ccl/mm2.moos*",
+        88,
+    ),
+    "MOOS/ccl_and_dccl/mm1.moos": (
+        "*MOOS file for Node 1: goby/share/cfg/MOOS/ccl\\_and\\_dccl/mm1.moos*",
+        111,
+    ),
+    "MOOS/ccl_and_dccl/mm2.moos": (
+        "MOOS file for Node 2: *goby/share/cfg/MOOS/ccl\\_and\\_dccl/mm2.moos*",
+        112,
+    ),
+    "xml/simple_status.xml": (
+        "*XML definition of Simple Status: goby/xml/simple\\_status.xml*",
+        89,
+    ),
+    "MOOS/ccl_and_dccl/modemidlookup.txt": (
+        "*Modem Lookup Table: goby/share/cfg/MOOS/ccl\\_and\\_dccl/modemidlookup.txt*",
+        2,
+    ),
 }
 
 

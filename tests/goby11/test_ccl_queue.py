@@ -27,8 +27,9 @@ def frame(data: bytes, dest: int = 2):
 
 
 def request(dest=2, max_bytes=32):
-    return acomms_pb.ModemTransmission(src=1, dest=dest, type=acomms_pb.DATA, max_num_frames=1,
-                               max_frame_bytes=max_bytes)  # fmt: skip
+    return acomms_pb.ModemTransmission(
+        src=1, dest=dest, type=acomms_pb.DATA, max_num_frames=1, max_frame_bytes=max_bytes
+    )
 
 
 @pytest.fixture
@@ -37,8 +38,12 @@ def clock():
 
 
 def test_ccl_frame_travels_alone_and_arrives_on_its_queue(clock):
-    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status", ack=False)],
-                               queue=[ccl_cfg(ack=False, value_base=10)])  # fmt: skip
+    q1, (Status, *_) = manager(
+        clock,
+        modem_id=1,
+        entries=[entry("Status", ack=False)],
+        queue=[ccl_cfg(ack=False, value_base=10)],
+    )
     q2, _ = manager(clock, modem_id=2, entries=[entry("Status", ack=False)], queue=[ccl_cfg()])
     q1.push_message(Status(src=1, dest=2, value=5))
     q1.push_ccl(14, frame(STATE))
@@ -64,8 +69,12 @@ def test_ccl_frame_travels_alone_and_arrives_on_its_queue(clock):
 
 
 def test_a_dccl_message_winning_first_keeps_the_ccl_frame_out_of_its_frame(clock):
-    q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status", ack=False, value_base=10)],
-                               queue=[ccl_cfg(ack=False)])  # fmt: skip
+    q1, (Status, *_) = manager(
+        clock,
+        modem_id=1,
+        entries=[entry("Status", ack=False, value_base=10)],
+        queue=[ccl_cfg(ack=False)],
+    )
     q1.push_message(Status(src=1, dest=2, value=5))
     q1.push_ccl(14, frame(bytes([14, 1, 2])))
     clock.advance(10)
@@ -79,11 +88,17 @@ def test_frames_for_other_modems_and_unknown_first_bytes(clock, caplog):
     q2, _ = manager(clock, modem_id=2, queue=[ccl_cfg()])
     got = []
     q2.signal_receive_ccl.connect(got.append)
-    q2.handle_modem_receive(acomms_pb.ModemTransmission(src=1, dest=3, type=acomms_pb.DATA, frame=[STATE]))
+    q2.handle_modem_receive(
+        acomms_pb.ModemTransmission(src=1, dest=3, type=acomms_pb.DATA, frame=[STATE])
+    )
     assert got == []
-    q2.handle_modem_receive(acomms_pb.ModemTransmission(src=1, dest=0, type=acomms_pb.DATA, frame=[STATE]))
+    q2.handle_modem_receive(
+        acomms_pb.ModemTransmission(src=1, dest=0, type=acomms_pb.DATA, frame=[STATE])
+    )
     assert len(got) == 1
-    q2.handle_modem_receive(acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DATA, frame=[bytes([15, 1])]))
+    q2.handle_modem_receive(
+        acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DATA, frame=[bytes([15, 1])])
+    )
     assert len(got) == 1 and "cannot decode DCCL" in caplog.text
 
 
@@ -128,7 +143,9 @@ def test_acks_expiry_and_loopback(clock):
     sent = request()
     q.handle_modem_data_request(sent)
     assert sent.ack_requested and len(q.ccl_queues[14]) == 1  # waits for the ack
-    q.handle_modem_receive(acomms_pb.ModemTransmission(src=2, dest=1, type=acomms_pb.ACK, acked_frame=[0]))
+    q.handle_modem_receive(
+        acomms_pb.ModemTransmission(src=2, dest=1, type=acomms_pb.ACK, acked_frame=[0])
+    )
     assert acked == [STATE] and len(q.ccl_queues[14]) == 0
     q.push_ccl(14, frame(bytes([14, 9]), dest=2))
     clock.advance(31)

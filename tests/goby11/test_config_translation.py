@@ -13,22 +13,32 @@ from pygoby.moos.moosfile import MissionFile
 from pygoby.protobuf import builtin_class
 from tests.goby11.seed_listings import EXAMPLES
 
-PACOMMS = builtin_class("goby/apps/moos/protobuf/pAcommsHandler_config.proto",
-                        "goby.apps.moos.protobuf.pAcommsHandlerConfig")  # fmt: skip
-VERBOSITY = PACOMMS.DESCRIPTOR.fields_by_name["common"].message_type.fields_by_name[
-    "verbosity"].enum_type.values_by_name
-PTRANSLATOR = builtin_class("goby/apps/moos/protobuf/pTranslator_config.proto",
-                            "goby.apps.moos.protobuf.pTranslatorConfig")  # fmt: skip
+PACOMMS = builtin_class(
+    "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
+    "goby.apps.moos.protobuf.pAcommsHandlerConfig",
+)
+VERBOSITY = (
+    PACOMMS.DESCRIPTOR.fields_by_name["common"]
+    .message_type.fields_by_name["verbosity"]
+    .enum_type.values_by_name
+)
+PTRANSLATOR = builtin_class(
+    "goby/apps/moos/protobuf/pTranslator_config.proto", "goby.apps.moos.protobuf.pTranslatorConfig"
+)
 
 
 def read(block: str, cls=PACOMMS, app="pAcommsHandler"):
-    mission = MissionFile.from_text(f"ServerPort = 9000\n\nProcessConfig = {app}\n{{\n{block}\n}}\n")
+    mission = MissionFile.from_text(
+        f"ServerPort = 9000\n\nProcessConfig = {app}\n{{\n{block}\n}}\n"
+    )
     notes: list[str] = []
     return read_configuration(cls, mission, app, notes=notes), notes
 
 
-@pytest.mark.parametrize("example", ["basic_ccl/mm1.moos", "basic_ccl/mm2.moos",
-                                     "ccl_and_dccl/mm1.moos", "ccl_and_dccl/mm2.moos"])  # fmt: skip
+@pytest.mark.parametrize(
+    "example",
+    ["basic_ccl/mm1.moos", "basic_ccl/mm2.moos", "ccl_and_dccl/mm1.moos", "ccl_and_dccl/mm2.moos"],
+)
 def test_seed_examples_read_verbatim(example):
     path = EXAMPLES / "MOOS" / example
     notes: list[str] = []
@@ -42,22 +52,35 @@ def test_seed_examples_read_verbatim(example):
     assert all(n.startswith(f"{path}:") for n in notes)
     if "ccl_and_dccl" in example:
         assert cfg.common.verbosity == VERBOSITY["VERBOSE"].number
-        assert [f.path for f in cfg.transitional_cfg.message_file] == ["../../xml/simple_status.xml"]
+        assert [f.path for f in cfg.transitional_cfg.message_file] == [
+            "../../xml/simple_status.xml"
+        ]
         assert not cfg.dccl_cfg.message_file
         assert any("VERBOSITY_GUI -> VERBOSE" in n for n in notes)
 
 
 def test_notes_name_the_file_lines_of_the_changed_fields():
-    _, notes = read("modem_id: 1\ncommon { verbosity: VERBOSITY_WARN }\n"
-                    "driver_cfg {\n  [MicroModemConfig.nvram_cfg]: \"DQF,1\"\n}")  # fmt: skip
-    assert notes == ["mission file:6: verbosity: VERBOSITY_WARN -> WARN",
-                     "mission file:8: [MicroModemConfig.nvram_cfg] -> "
-                     "[goby.acomms.micromodem.protobuf.config] { nvram_cfg }"]  # fmt: skip
+    _, notes = read(
+        "modem_id: 1\ncommon { verbosity: VERBOSITY_WARN }\n"
+        'driver_cfg {\n  [MicroModemConfig.nvram_cfg]: "DQF,1"\n}'
+    )
+    assert notes == [
+        "mission file:6: verbosity: VERBOSITY_WARN -> WARN",
+        "mission file:8: [MicroModemConfig.nvram_cfg] -> "
+        "[goby.acomms.micromodem.protobuf.config] { nvram_cfg }",
+    ]
 
 
-@pytest.mark.parametrize(("old", "new"), [("VERBOSITY_QUIET", "QUIET"), ("VERBOSITY_WARN", "WARN"),
-                                          ("VERBOSITY_VERBOSE", "VERBOSE"), ("VERBOSITY_DEBUG", "DEBUG1"),
-                                          ("VERBOSITY_GUI", "VERBOSE")])  # fmt: skip
+@pytest.mark.parametrize(
+    ("old", "new"),
+    [
+        ("VERBOSITY_QUIET", "QUIET"),
+        ("VERBOSITY_WARN", "WARN"),
+        ("VERBOSITY_VERBOSE", "VERBOSE"),
+        ("VERBOSITY_DEBUG", "DEBUG1"),
+        ("VERBOSITY_GUI", "VERBOSE"),
+    ],
+)
 def test_every_app_common_accepts_goby_1_1_verbosity(old, new):
     cfg, notes = read(f"common {{ verbosity: {old} log: false }}", PTRANSLATOR, "pTranslator")
     assert cfg.common.show_gui == (old == "VERBOSITY_GUI")  # Goby 2's mapping: the live view
@@ -78,14 +101,25 @@ def test_slot_types_and_dropped_forms():
     ping, remus, narrowband = cfg.mac_cfg.slot
     assert [s.type for s in cfg.mac_cfg.slot] == [acomms_pb.DRIVER_SPECIFIC] * 3
     assert [s.Extensions[acomms_pb.MM_TRANSMISSION].type for s in cfg.mac_cfg.slot] == [
-        acomms_pb.MICROMODEM_TWO_WAY_PING, acomms_pb.MICROMODEM_REMUS_LBL_RANGING, acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING]
+        acomms_pb.MICROMODEM_TWO_WAY_PING,
+        acomms_pb.MICROMODEM_REMUS_LBL_RANGING,
+        acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING,
+    ]
     assert cfg.dccl_cfg.crypto_passphrase == "secret"
     assert [(f.path, list(f.manipulator)) for f in cfg.transitional_cfg.message_file] == [
-        ("a.xml", []), ("b.xml", [5])]  # fmt: skip
+        ("a.xml", []),
+        ("b.xml", [5]),
+    ]
     text = "\n".join(notes)
-    for word in ("last_heard_time dropped", "dccl_cfg.modem_id dropped", "TCP_SHARE_IN dropped",
-                 "tcp_share_enable dropped", "tcp_share_port dropped", "tcp_share_to_ip dropped",
-                 "2 XML message file(s)"):  # fmt: skip
+    for word in (
+        "last_heard_time dropped",
+        "dccl_cfg.modem_id dropped",
+        "TCP_SHARE_IN dropped",
+        "tcp_share_enable dropped",
+        "tcp_share_port dropped",
+        "tcp_share_to_ip dropped",
+        "2 XML message file(s)",
+    ):
         assert word in text, word
 
 
@@ -104,16 +138,18 @@ def test_goby2_forms():
 
 
 def test_goby3_configuration_is_left_alone():
-    block = 'modem_id: 1\ncommon { verbosity: DEBUG2 }\ndriver_cfg { [goby.acomms.micromodem.protobuf.config] { reset_nvram: true } }'
+    block = "modem_id: 1\ncommon { verbosity: DEBUG2 }\ndriver_cfg { [goby.acomms.micromodem.protobuf.config] { reset_nvram: true } }"
     translation = goby11_config.translate(block, PACOMMS.DESCRIPTOR)
     assert translation == goby11_config.Translation(block, [])
 
 
 def test_errors_after_translated_fields_keep_their_line():
     with pytest.raises(ConfigError, match=r"mission file:9: .*no_such_field"):
-        read("modem_id: 1\ncommon { verbosity: VERBOSITY_GUI }\n"
-             "driver_cfg { [MicroModemConfig.reset_nvram]: false }\n"
-             "mac_cfg { slot { type: SLOT_PING } }\nno_such_field: 3")  # fmt: skip
+        read(
+            "modem_id: 1\ncommon { verbosity: VERBOSITY_GUI }\n"
+            "driver_cfg { [MicroModemConfig.reset_nvram]: false }\n"
+            "mac_cfg { slot { type: SLOT_PING } }\nno_such_field: 3"
+        )
 
 
 def test_unparsable_text_is_left_to_protobuf():
@@ -125,16 +161,35 @@ def test_goby11_mac_updates_become_todays():
     from pygoby.apps.pacommshandler_goby11 import mac_update_from_goby11
 
     U = acomms_pb.MACUpdate.UpdateType
-    current = [acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DATA, slot_seconds=10),
-               acomms_pb.ModemTransmission(src=2, dest=1, type=acomms_pb.DATA, slot_seconds=10)]  # fmt: skip
+    current = [
+        acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DATA, slot_seconds=10),
+        acomms_pb.ModemTransmission(src=2, dest=1, type=acomms_pb.DATA, slot_seconds=10),
+    ]
     add = mac_update_from_goby11(
-        "dest: 1 update_type: ADD slot { src: 1 dest: 3 rate: 0 slot_seconds: 15 type: SLOT_DATA }", current, 1)
+        "dest: 1 update_type: ADD slot { src: 1 dest: 3 rate: 0 slot_seconds: 15 type: SLOT_DATA }",
+        current,
+        1,
+    )
     assert (add.src, add.dest, add.update_type) == (1, 1, U.Value("PUSH_BACK"))
-    assert (add.slot[0].dest, add.slot[0].type, add.slot[0].slot_seconds) == (3, acomms_pb.DATA, 15.0)
+    assert (add.slot[0].dest, add.slot[0].type, add.slot[0].slot_seconds) == (
+        3,
+        acomms_pb.DATA,
+        15.0,
+    )
     remove = mac_update_from_goby11(
-        "dest: 1 update_type: REMOVE slot { src: 2 dest: 1 slot_seconds: 10 type: SLOT_DATA }", current, 1)
-    assert remove.update_type == U.Value("ASSIGN") and [(s.src, s.dest) for s in remove.slot] == [(1, 2)]
-    replace = mac_update_from_goby11("dest: 1 slot { src: 1 type: SLOT_PING slot_seconds: 5 }", current, 1)
+        "dest: 1 update_type: REMOVE slot { src: 2 dest: 1 slot_seconds: 10 type: SLOT_DATA }",
+        current,
+        1,
+    )
+    assert remove.update_type == U.Value("ASSIGN") and [(s.src, s.dest) for s in remove.slot] == [
+        (1, 2)
+    ]
+    replace = mac_update_from_goby11(
+        "dest: 1 slot { src: 1 type: SLOT_PING slot_seconds: 5 }", current, 1
+    )
     assert replace.update_type == U.Value("ASSIGN")
-    assert replace.slot[0].Extensions[acomms_pb.MM_TRANSMISSION].type == acomms_pb.MICROMODEM_TWO_WAY_PING
+    assert (
+        replace.slot[0].Extensions[acomms_pb.MM_TRANSMISSION].type
+        == acomms_pb.MICROMODEM_TWO_WAY_PING
+    )
     assert mac_update_from_goby11("src: 1 dest: 1 update_type: PUSH_BACK", current, 1) is None

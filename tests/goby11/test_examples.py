@@ -23,16 +23,21 @@ from tests.goby11.seed_listings import EXAMPLES, LISTINGS, printed
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))
 WARP = 20
 # upstream Goby's line where the print is cut off (and shows %3$.01f / %6$1f for %3$.0lf / %6$lf)
-SIMPLE_STATUS_FORMAT = ("        <format>NAME=%1%,TYPE=%2%,UTC_TIME=%3$.0lf,X=%4%,Y=%5%,LAT=%6$lf,"
-                        "LON=%7$lf,SPD=%8%,HDG=%9%,DEPTH=%10%</format>")  # fmt: skip
+SIMPLE_STATUS_FORMAT = (
+    "        <format>NAME=%1%,TYPE=%2%,UTC_TIME=%3$.0lf,X=%4%,Y=%5%,LAT=%6$lf,"
+    "LON=%7$lf,SPD=%8%,HDG=%9%,DEPTH=%10%</format>"
+)
 
 
 @pytest.mark.parametrize("name", sorted(LISTINGS))
 def test_shipped_files_are_the_printed_ones(name):
     shipped = (EXAMPLES / name).read_text().splitlines()
     seed = printed(name).splitlines()
-    changed = [line for line in difflib.unified_diff(seed, shipped, lineterm="", n=0)
-               if line[:1] in "+-" and not line.startswith(("+++", "---"))]  # fmt: skip
+    changed = [
+        line
+        for line in difflib.unified_diff(seed, shipped, lineterm="", n=0)
+        if line[:1] in "+-" and not line.startswith(("+++", "---"))
+    ]
     if name == "xml/simple_status.xml":  # the one documented fix (README, Coming from Goby 1.1)
         assert changed == ["-" + seed[67], "+" + SIMPLE_STATUS_FORMAT]
         assert seed[67].endswith("HDG=%9%,DEP")
@@ -57,10 +62,12 @@ def localize(tmp_path: Path, example: str) -> tuple[Path, dict[str, int]]:
         path = root / "MOOS" / example / f"{node}.moos"
         text = path.read_text()
         ports[node] = free_port()
-        for old, new, count in ((f"ServerPort = {default}", f"ServerPort = {ports[node]}", 1),
-                                ("/tmp/ttyLOOP", f"{tmp_path}/ttyLOOP", 2),
-                                ("IPPort = 49234", f"IPPort = {udp}", 1),
-                                (f"Community = {node}", f"Community = {node}\nMOOSTimeWarp = {WARP}", 1)):  # fmt: skip
+        for old, new, count in (
+            (f"ServerPort = {default}", f"ServerPort = {ports[node]}", 1),
+            ("/tmp/ttyLOOP", f"{tmp_path}/ttyLOOP", 2),
+            ("IPPort = 49234", f"IPPort = {udp}", 1),
+            (f"Community = {node}", f"Community = {node}\nMOOSTimeWarp = {WARP}", 1),
+        ):
             assert text.count(old) == count, (node, old)
             text = text.replace(old, new)
         path.write_text(text)
@@ -88,9 +95,16 @@ async def run_pair(directory: Path, ports: dict[str, int], check):
     procs = []
     try:
         for node in ("mm1", "mm2"):
-            procs.append(await asyncio.create_subprocess_exec(
-                PYGOBY, "antler", f"{node}.moos", cwd=directory, stdout=asyncio.subprocess.DEVNULL,
-                stderr=asyncio.subprocess.PIPE))  # fmt: skip
+            procs.append(
+                await asyncio.create_subprocess_exec(
+                    PYGOBY,
+                    "antler",
+                    f"{node}.moos",
+                    cwd=directory,
+                    stdout=asyncio.subprocess.DEVNULL,
+                    stderr=asyncio.subprocess.PIPE,
+                )
+            )
         await asyncio.sleep(1.0)
         return await check()
     finally:
@@ -136,14 +150,30 @@ async def test_ccl_and_dccl_simple_status_reaches_mm2(tmp_path):
 
     status, report = await run_pair(directory, ports, check)
     fields = dict(item.split("=", 1) for item in status.split(","))
-    assert {k: fields[k] for k in ("Node", "MessageType", "nav_x", "nav_y", "Speed", "Heading", "Depth")} == {
-        "Node": "1", "MessageType": "LAMSS_STATUS", "nav_x": "100", "nav_y": "300", "Speed": "0",
-        "Heading": "150", "Depth": "0"}  # fmt: skip
+    assert {
+        k: fields[k] for k in ("Node", "MessageType", "nav_x", "nav_y", "Speed", "Heading", "Depth")
+    } == {
+        "Node": "1",
+        "MessageType": "LAMSS_STATUS",
+        "nav_x": "100",
+        "nav_y": "300",
+        "Speed": "0",
+        "Heading": "150",
+        "Depth": "0",
+    }
     assert float(fields["Timestamp"]) > 0  # Goby 1.1's header default: the time of creation
     node = dict(item.split("=", 1) for item in report.split(","))
     lat, lon = UTMGeodesy(42.35, -70.95).to_geo(100, 300)
-    assert (node["NAME"], node["TYPE"], node["X"], node["Y"], node["HDG"]) == ("mm1", "topside", "100", "300", "150")
-    assert float(node["LAT"]) == pytest.approx(lat, abs=1e-9) and float(node["LON"]) == pytest.approx(lon, abs=1e-9)
+    assert (node["NAME"], node["TYPE"], node["X"], node["Y"], node["HDG"]) == (
+        "mm1",
+        "topside",
+        "100",
+        "300",
+        "150",
+    )
+    assert float(node["LAT"]) == pytest.approx(lat, abs=1e-9) and float(
+        node["LON"]
+    ) == pytest.approx(lon, abs=1e-9)
     assert not any("is not available" in err for err in run_pair.stderr)
 
 
@@ -161,10 +191,12 @@ REDIRECT_QUEUE = """queue_cfg
         value_base: 10
     }
 """
-REDIRECT = ("MessageType=CCL_REDIRECT,DestinationPlatformId=2,Latitude=42.36,Longitude=-70.94,"
-            "SpeedDepthFlags=88,TransitSpeed=1.5,TransitDepth=10,TransitCommand=1,SurveySpeed=1.0,"
-            "SurveyDepth=20,SurveyCommand=2,NumberOfRows=4,RowLength=200,RowSpacing0=20,"
-            "RowSpacing1=30,RowHeading=90,StartLatitude=42.35,StartLongitude=-70.95")  # fmt: skip
+REDIRECT = (
+    "MessageType=CCL_REDIRECT,DestinationPlatformId=2,Latitude=42.36,Longitude=-70.94,"
+    "SpeedDepthFlags=88,TransitSpeed=1.5,TransitDepth=10,TransitCommand=1,SurveySpeed=1.0,"
+    "SurveyDepth=20,SurveyCommand=2,NumberOfRows=4,RowLength=200,RowSpacing0=20,"
+    "RowSpacing1=30,RowHeading=90,StartLatitude=42.35,StartLongitude=-70.95"
+)
 
 
 def key_values(text: str) -> dict[str, str]:
@@ -186,37 +218,70 @@ async def test_ccl_and_dccl_remus_state_reaches_mm1_and_a_redirect_reaches_mm2(t
         path.write_text(text[:start] + REDIRECT_QUEUE + text[end:])
 
     async def check():
-        report = key_values(await wait_for(ports["mm1"], "NODE_REPORT", lambda v: "NAME=mm2" in str(v)))
-        contacts = {var: await wait_for(ports["mm1"], f"MM2_NAV_{var}", lambda v: isinstance(v, float))
-                    for var in ("X", "Y", "SPEED", "HEADING", "DEPTH", "LAT", "LONG")}  # fmt: skip
-        status = key_values(await wait_for(ports["mm1"], "STATUS_REPORT_IN", lambda v: "CCL_STATUS" in str(v)))
+        report = key_values(
+            await wait_for(ports["mm1"], "NODE_REPORT", lambda v: "NAME=mm2" in str(v))
+        )
+        contacts = {
+            var: await wait_for(ports["mm1"], f"MM2_NAV_{var}", lambda v: isinstance(v, float))
+            for var in ("X", "Y", "SPEED", "HEADING", "DEPTH", "LAT", "LONG")
+        }
+        status = key_values(
+            await wait_for(ports["mm1"], "STATUS_REPORT_IN", lambda v: "CCL_STATUS" in str(v))
+        )
         async with MOOSClient("operator", port=ports["mm1"], clock=moos_clock(WARP)) as operator:
             operator.publish("OUTGOING_COMMAND", REDIRECT)
             await operator.flush()
-        redirect = key_values(await wait_for(ports["mm2"], "CCL_REDIRECT_IN", lambda v: isinstance(v, str)))
+        redirect = key_values(
+            await wait_for(ports["mm2"], "CCL_REDIRECT_IN", lambda v: isinstance(v, str))
+        )
         return report, contacts, status, redirect
 
     report, contacts, status, redirect = await run_pair(directory, ports, check)
-    assert (report["NAME"], report["TYPE"], report["MODE"], report["MOOSDB_TIME"]) == ("mm2", "auv", "NOMOOS", "-1")
+    assert (report["NAME"], report["TYPE"], report["MODE"], report["MOOSDB_TIME"]) == (
+        "mm2",
+        "auv",
+        "NOMOOS",
+        "-1",
+    )
     # what mm2 sent, within the frame's resolution (lat/lon ~2 m, heading 360/255, 2.5 cm/s)
     sent = {"X": 123.0, "Y": 321.0, "SPEED": 1.2, "HEADING": 45.0, "DEPTH": 111.0}
     within = {"X": 2.5, "Y": 2.5, "SPEED": 0.02, "HEADING": 360 / 255 / 2, "DEPTH": 0.1}
     for var, value in sent.items():
         assert contacts[var] == pytest.approx(value, abs=within[var]), var
-    for key, var in (("X", "X"), ("Y", "Y"), ("SPD", "SPEED"), ("HDG", "HEADING"), ("DEPTH", "DEPTH"),
-                     ("LAT", "LAT"), ("LON", "LONG")):  # fmt: skip
+    for key, var in (
+        ("X", "X"),
+        ("Y", "Y"),
+        ("SPD", "SPEED"),
+        ("HDG", "HEADING"),
+        ("DEPTH", "DEPTH"),
+        ("LAT", "LAT"),
+        ("LON", "LONG"),
+    ):
         assert float(report[key]) == contacts[var], key  # the same numbers, 17 digits
     lat, lon = UTMGeodesy(42.35, -70.95).to_geo(123, 321)
-    assert contacts["LAT"] == pytest.approx(lat, abs=2.2e-5) and contacts["LONG"] == pytest.approx(lon, abs=2.2e-5)
+    assert contacts["LAT"] == pytest.approx(lat, abs=2.2e-5) and contacts["LONG"] == pytest.approx(
+        lon, abs=2.2e-5
+    )
     assert float(report["YAW"]) == pytest.approx(float(report["HDG"]) - 360)
-    assert (status["Node"], float(status["Speed"]), float(status["Depth"])) == ("2", contacts["SPEED"], 111.0)
+    assert (status["Node"], float(status["Speed"]), float(status["Depth"])) == (
+        "2",
+        contacts["SPEED"],
+        111.0,
+    )
     assert redirect["DestinationPlatformId"] == "2" and redirect["SpeedDepthFlags"] == "88"
     expected = key_values(REDIRECT)
     for key in ("Latitude", "Longitude", "StartLatitude", "StartLongitude"):
         assert float(redirect[key]) == pytest.approx(float(expected[key]), abs=1.1e-5), key
     for key in ("TransitSpeed", "TransitDepth", "SurveySpeed", "SurveyDepth"):
         assert float(redirect[key]) == float(expected[key]), key  # on a step: exact
-    for key in ("TransitCommand", "SurveyCommand", "NumberOfRows", "RowLength", "RowSpacing0", "RowSpacing1"):
+    for key in (
+        "TransitCommand",
+        "SurveyCommand",
+        "NumberOfRows",
+        "RowLength",
+        "RowSpacing0",
+        "RowSpacing1",
+    ):
         assert redirect[key] == expected[key], key
     assert float(redirect["RowHeading"]) == pytest.approx(90, abs=360 / 255 / 2)
 
@@ -226,5 +291,9 @@ def test_antler_block_of_the_seed_with_xconfig_and_geometry_lines():
 
     config = MissionFile.read(EXAMPLES / "MOOS" / "ccl_and_dccl" / "mm1.moos").antler()
     assert [(r.program, r.options.get("XConfig")) for r in config.runs] == [
-        ("MOOSDB", None), ("pREMUSCodec", "1"), ("pAcommsHandler", "2"), ("iModemSim", "3")]
+        ("MOOSDB", None),
+        ("pREMUSCodec", "1"),
+        ("pAcommsHandler", "2"),
+        ("iModemSim", "3"),
+    ]
     assert config.ms_between_launches == 10

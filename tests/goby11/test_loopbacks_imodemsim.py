@@ -88,8 +88,9 @@ async def test_single_end(tmp_path):
 
 async def test_loopbacks_command(tmp_path):
     prefix = str(tmp_path / "ttyLOOP")
-    proc = await asyncio.create_subprocess_exec(PYGOBY, "loopbacks", "--prefix", prefix, "--pairs", "A,B",
-                                                stdout=asyncio.subprocess.PIPE)  # fmt: skip
+    proc = await asyncio.create_subprocess_exec(
+        PYGOBY, "loopbacks", "--prefix", prefix, "--pairs", "A,B", stdout=asyncio.subprocess.PIPE
+    )
     try:
         lines = [await asyncio.wait_for(proc.stdout.readline(), 20) for _ in range(2)]
         assert lines[0].decode().strip() == f"loopback {prefix}A1 <-> {prefix}A2"
@@ -98,8 +99,9 @@ async def test_loopbacks_command(tmp_path):
         assert await read_until(fa, b"\r\n") == b"ping\r\n"
         os.close(fa)
         os.close(fb)
-        second = await asyncio.create_subprocess_exec(PYGOBY, "loopbacks", "--prefix", prefix, "--pairs", "A",
-                                                      stderr=asyncio.subprocess.PIPE)  # fmt: skip
+        second = await asyncio.create_subprocess_exec(
+            PYGOBY, "loopbacks", "--prefix", prefix, "--pairs", "A", stderr=asyncio.subprocess.PIPE
+        )
         _, err = await asyncio.wait_for(second.communicate(), 20)
         assert second.returncode == 1 and b"belong to a running process" in err
     finally:
@@ -179,19 +181,25 @@ async def test_imodemsim_uses_a_pair_made_by_loopbacks(tmp_path):
         pair.close()
 
 
-@pytest.mark.parametrize(("extra", "reason"), [
-    ("IPPort = 70000\n", "IPPort: 70000 is not a UDP port"),
-    ("BroadcastAddr = far.away\n", "BroadcastAddr: 'far.away' is not an IPv4 address"),
-    ("InputLocType = gps\n", "InputLocType: 'gps' is not one of"),
-    ("Speed = fast\n", "Speed: must be a number, not 'fast'"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("extra", "reason"),
+    [
+        ("IPPort = 70000\n", "IPPort: 70000 is not a UDP port"),
+        ("BroadcastAddr = far.away\n", "BroadcastAddr: 'far.away' is not an IPv4 address"),
+        ("InputLocType = gps\n", "InputLocType: 'gps' is not one of"),
+        ("Speed = fast\n", "Speed: must be a number, not 'fast'"),
+    ],
+)
 def test_imodemsim_configuration_errors(tmp_path, extra, reason):
     """Each names the mission line of the setting (the house rule: file:line: field: reason)."""
     path = imodemsim_mission(tmp_path, "A", 40000, extra)
     text = path.read_text()
     key = extra.split("=")[0].strip()
-    lines = [line for line in text.splitlines() if not line.strip().startswith(key + " ")
-             or line.strip() + "\n" == extra]  # fmt: skip
+    lines = [
+        line
+        for line in text.splitlines()
+        if not line.strip().startswith(key + " ") or line.strip() + "\n" == extra
+    ]
     path.write_text("\n".join(lines) + "\n")
     line = next(n for n, text in enumerate(lines, start=1) if text.strip() + "\n" == extra)
     with pytest.raises(ConfigError, match=rf"^{path}:{line}: {reason}"):
@@ -200,7 +208,9 @@ def test_imodemsim_configuration_errors(tmp_path, extra, reason):
 
 def test_imodemsim_port_that_cannot_be_made(tmp_path):
     path = imodemsim_mission(tmp_path, "A", 40000)
-    path.write_text(path.read_text().replace(f"Port = {tmp_path}/ttyLOOPA1", f"Port = {tmp_path}/modem"))
+    path.write_text(
+        path.read_text().replace(f"Port = {tmp_path}/ttyLOOPA1", f"Port = {tmp_path}/modem")
+    )
     with pytest.raises(ConfigError, match="only loopback names ending in 1 or 2"):
         iModemSim.from_mission(path)
 
@@ -216,7 +226,11 @@ async def test_example_config_is_a_block_imodemsim_reads(tmp_path):
     path.write_text(f"ServerPort = 1\nCommunity = ex\n{block}")
     app = iModemSim.from_mission(path)
     try:
-        assert (app.port_path, app.channel.port, app.position) == (f"{tmp_path}/ttyLOOPA1", udp, [0.0, 0.0, 0.0])
+        assert (app.port_path, app.channel.port, app.position) == (
+            f"{tmp_path}/ttyLOOPA1",
+            udp,
+            [0.0, 0.0, 0.0],
+        )
         assert (app.cfg.common.app_tick, app.cfg.common.comm_tick) == (4, 4)
     finally:
         app.pair.close()

@@ -78,9 +78,15 @@ async def test_goby11_configuration_runs_with_the_11_variables(tmp_path):
         mm1, mm2 = apps
         assert any("VERBOSITY_WARN -> WARN" in note for note in mm1.config_notes)
         assert any("transitional_cfg" in note for note in mm1.config_notes)
-        status = await recorders[1].wait_for("STATUS_REPORT_IN", lambda v: "Node=1" in v, timeout=30)
+        status = await recorders[1].wait_for(
+            "STATUS_REPORT_IN", lambda v: "Node=1" in v, timeout=30
+        )
         fields = dict(item.split("=", 1) for item in status.split(","))
-        assert (fields["Heading"], fields["Speed"], fields["Depth"]) == ("330", "1.5", "20")  # angle_0_360
+        assert (fields["Heading"], fields["Speed"], fields["Depth"]) == (
+            "330",
+            "1.5",
+            "20",
+        )  # angle_0_360
         assert abs(float(fields["Timestamp"]) - WallClock().now()) < 60  # 1.1 header default
         incoming = await recorders[1].wait_for("ACOMMS_INCOMING_DATA")
         data = acomms_pb.V1ModemDataTransmission()
@@ -93,18 +99,30 @@ async def test_goby11_configuration_runs_with_the_11_variables(tmp_path):
             ranging = acomms_pb.V1ModemRangingReply()
             text_format.Parse(reply, ranging)
             assert list(ranging.one_way_travel_time) == [0.25] and ranging.type == 1
-            poker.publish("ACOMMS_POLLER_UPDATE", "dest: 1 update_type: ADD slot { src: 1 dest: 2 "
-                                                  "type: SLOT_PING slot_seconds: 2 }")  # fmt: skip
-            poker.publish("ACOMMS_MAC_CYCLE_UPDATE", "dest: 1 update_type: ADD slot { src: 2 dest: 1 "
-                                                     "type: SLOT_DATA slot_seconds: 3 }")  # fmt: skip
+            poker.publish(
+                "ACOMMS_POLLER_UPDATE",
+                "dest: 1 update_type: ADD slot { src: 1 dest: 2 type: SLOT_PING slot_seconds: 2 }",
+            )
+            poker.publish(
+                "ACOMMS_MAC_CYCLE_UPDATE",
+                "dest: 1 update_type: ADD slot { src: 2 dest: 1 type: SLOT_DATA slot_seconds: 3 }",
+            )
             await poker.flush()
-            await recorders[0].wait_for("ACOMMS_NMEA_OUT", lambda v: v.startswith("$CCMPC"), timeout=20)
+            await recorders[0].wait_for(
+                "ACOMMS_NMEA_OUT", lambda v: v.startswith("$CCMPC"), timeout=20
+            )
             async with asyncio.timeout(10):
                 while len(mm1.acomms.mac.slots) < 3:
                     await asyncio.sleep(0.05)
         slots = mm1.acomms.mac.slots
-        assert [(s.src, s.dest, s.slot_seconds) for s in slots] == [(1, 2, 5.0), (1, 2, 2.0), (2, 1, 3.0)]
-        assert slots[1].Extensions[acomms_pb.MM_TRANSMISSION].type == acomms_pb.MICROMODEM_TWO_WAY_PING
+        assert [(s.src, s.dest, s.slot_seconds) for s in slots] == [
+            (1, 2, 5.0),
+            (1, 2, 2.0),
+            (2, 1, 3.0),
+        ]
+        assert (
+            slots[1].Extensions[acomms_pb.MM_TRANSMISSION].type == acomms_pb.MICROMODEM_TWO_WAY_PING
+        )
 
 
 def test_xml_error_stops_pacommshandler_with_file_and_line(tmp_path):
@@ -112,18 +130,26 @@ def test_xml_error_stops_pacommshandler_with_file_and_line(tmp_path):
     bad.write_text(SIMPLE_STATUS.read_text().replace("<max>20</max>", "<max>fast</max>"))
     path = tmp_path / "mm1.moos"
     path.write_text(mission(1, 1, 1).replace(str(SIMPLE_STATUS), str(bad)))
-    result = subprocess.run([str(Path(sys.executable).with_name("pAcommsHandler")), str(path)],
-                            capture_output=True, text=True, timeout=60)  # fmt: skip
+    result = subprocess.run(
+        [str(Path(sys.executable).with_name("pAcommsHandler")), str(path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert result.returncode == 1
-    assert f"fatal configuration error: {bad}:40: <max> must be a number, not 'fast'" in result.stderr
+    assert (
+        f"fatal configuration error: {bad}:40: <max> must be a number, not 'fast'" in result.stderr
+    )
 
 
 def test_transitional_messages_expand_into_the_configuration(tmp_path):
     from pygoby.acomms.transitional import TransitionalMessages
     from pygoby.protobuf import ProtoLoader, builtin_class
 
-    cfg = builtin_class("goby/apps/moos/protobuf/pAcommsHandler_config.proto",
-                        "goby.apps.moos.protobuf.pAcommsHandlerConfig")(modem_id=3)  # fmt: skip
+    cfg = builtin_class(
+        "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
+        "goby.apps.moos.protobuf.pAcommsHandlerConfig",
+    )(modem_id=3)
     cfg.transitional_cfg.message_file.add(path=str(SIMPLE_STATUS), manipulator=[5])
     cfg.transitional_cfg.generated_proto_dir = str(tmp_path / "proto")
     loader = ProtoLoader()

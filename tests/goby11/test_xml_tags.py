@@ -27,8 +27,9 @@ def build(text: str, **translator_args):
     message_set = parse_message_set(text, "test.xml")
     codec = Codec()
     classes = message_set.load_into(codec)
-    translator = Translator(message_set.translator_entries(), codec.loader.message_class,
-                            **translator_args)  # fmt: skip
+    translator = Translator(
+        message_set.translator_entries(), codec.loader.message_class, **translator_args
+    )
     return message_set, codec, classes, translator
 
 
@@ -78,12 +79,26 @@ def test_every_layout_type_round_trips_through_dccl_and_the_translator():
     message_set, codec, (Every,), translator = build(EVERY_TYPE)
     descriptor = Every.DESCRIPTOR
     assert [(f.name, f.number) for f in descriptor.fields] == [
-        ("When", 1), ("From", 2), ("To", 3), ("kind", 4), ("i", 5), ("f", 6), ("b", 7),
-        ("s", 8), ("e", 9), ("h", 10), ("arr", 11)]  # fmt: skip
+        ("When", 1),
+        ("From", 2),
+        ("To", 3),
+        ("kind", 4),
+        ("i", 5),
+        ("f", 6),
+        ("b", 7),
+        ("s", 8),
+        ("e", 9),
+        ("h", 10),
+        ("arr", 11),
+    ]
     assert descriptor.fields_by_name["arr"].is_repeated
     assert [v.name for v in descriptor.enum_types_by_name["EEnum"].values] == ["E_one", "E_two"]
-    created = translator.create("Every", values(
-        EVERY_OUT="kind=every,To=3,From=1,i=-42,f=3.14159,b=true,s=hello,e=two,h=beef,arr={1,2,3}"))
+    created = translator.create(
+        "Every",
+        values(
+            EVERY_OUT="kind=every,To=3,From=1,i=-42,f=3.14159,b=true,s=hello,e=two,h=beef,arr={1,2,3}"
+        ),
+    )
     assert (created.To, created.From, created.i, created.b, created.s) == (3, 1, -42, True, "hello")
     assert created.e == descriptor.fields_by_name["e"].enum_type.values_by_name["E_two"].number
     assert created.h == b"\xbe\xef" and list(created.arr) == [1, 2, 3]
@@ -92,7 +107,10 @@ def test_every_layout_type_round_trips_through_dccl_and_the_translator():
     assert decoded.f == pytest.approx(3.14) and decoded.kind == "every" and decoded.s == "hello"
     (post,) = translator.publish(decoded)
     assert post.var == "EVERY_IN"
-    assert post.value.startswith("When=") and ",From=1,To=3,kind=every,i=-42,f=3.14,b=true," in post.value
+    assert (
+        post.value.startswith("When=")
+        and ",From=1,To=3,kind=every,i=-42,f=3.14,b=true," in post.value
+    )
     assert post.value.endswith("s=hello,e=two,h=beef,arr={1,2,3}")
 
 
@@ -103,20 +121,25 @@ def test_mandatory_content_gates_the_trigger():
 
 
 def test_bounds_and_precision_are_written_as_goby2_did():
-    message_set = parse_message_set(xml("""
+    message_set = parse_message_set(
+        xml("""
   <message><name>B</name><id>9</id><size>32</size>
     <layout>
       <float><name>x</name><max>3.14159</max><min>-1.005</min><precision>2</precision></float>
       <int><name>n</name><max>-5</max><min>10</min></int>
-    </layout></message>"""))
+    </layout></message>""")
+    )
     text = message_set.proto_text()
     assert "(dccl.field).max = 3.14, (dccl.field).min = -1.0" in text  # rounded to precision
-    assert "optional int32 n = 5 [(dccl.field).max = 10.0, (dccl.field).min = -5.0]" in text  # swapped
+    assert (
+        "optional int32 n = 5 [(dccl.field).max = 10.0, (dccl.field).min = -5.0]" in text
+    )  # swapped
     assert any("swapped" in w for w in message_set.warnings)
 
 
 def test_header_id_time_trigger_and_queuing():
-    message_set, codec, (Status,), translator = build(xml("""
+    message_set, codec, (Status,), translator = build(
+        xml("""
   <message>
     <name>Status</name>
     <trigger>time</trigger><trigger_time>15</trigger_time>
@@ -126,26 +149,48 @@ def test_header_id_time_trigger_and_queuing():
       <precision>1</precision></float></layout>
     <queuing><ack>true</ack><blackout_time>4</blackout_time><max_queue>3</max_queue>
       <newest_first>false</newest_first><value_base>2.5</value_base><ttl>60</ttl></queuing>
-  </message>"""))
+  </message>""")
+    )
     assert codec.compiled(Status).id == 300
     entry = translator.entries["Status"]
     assert (entry.trigger.type, entry.trigger.period) == (entry.trigger.TRIGGER_TIME, 15)
     (queue,) = message_set.queue_entries()
-    assert (queue.ack, queue.blackout_time, queue.max_queue, queue.newest_first, queue.value_base,
-            queue.ttl) == (True, 4, 3, False, 2.5, 60)  # fmt: skip
-    assert [(r.type, r.field) for r in queue.role] == [(1, "_src_id"), (2, "_dest_id"), (3, "_time")]
+    assert (
+        queue.ack,
+        queue.blackout_time,
+        queue.max_queue,
+        queue.newest_first,
+        queue.value_base,
+        queue.ttl,
+    ) == (True, 4, 3, False, 2.5, 60)
+    assert [(r.type, r.field) for r in queue.role] == [
+        (1, "_src_id"),
+        (2, "_dest_id"),
+        (3, "_time"),
+    ]
 
 
 def test_queuing_defaults_are_goby_1_1s():
-    message_set = parse_message_set(xml("<message><name>Q</name><id>1</id><size>8</size>"
-                                        "<layout><bool><name>b</name></bool></layout></message>"))
+    message_set = parse_message_set(
+        xml(
+            "<message><name>Q</name><id>1</id><size>8</size>"
+            "<layout><bool><name>b</name></bool></layout></message>"
+        )
+    )
     (queue,) = message_set.queue_entries()
-    assert (queue.ack, queue.blackout_time, queue.max_queue, queue.newest_first, queue.value_base,
-            queue.ttl) == (False, 0, 0, True, 1.0, 1800)  # fmt: skip
+    assert (
+        queue.ack,
+        queue.blackout_time,
+        queue.max_queue,
+        queue.newest_first,
+        queue.value_base,
+        queue.ttl,
+    ) == (False, 0, 0, True, 1.0, 1800)
 
 
 def test_deprecated_tags_are_accepted_with_warnings():
-    message_set = parse_message_set(xml("""
+    message_set = parse_message_set(
+        xml("""
   <message><name>D</name><id>2</id><size>32</size><repeat/>
     <trigger>publish</trigger><trigger_moos_var>D_OUT</trigger_moos_var>
     <incoming_hex_moos_var>IN_D_HEX</incoming_hex_moos_var>
@@ -156,22 +201,36 @@ def test_deprecated_tags_are_accepted_with_warnings():
     <on_receipt><publish><publish_var type="double">D_IN</publish_var>
       <message_var>a</message_var></publish></on_receipt>
     <queuing><priority_base>1</priority_base><priority_time_const>100</priority_time_const></queuing>
-  </message>"""), "test.xml")
+  </message>"""),
+        "test.xml",
+    )
     joined = "\n".join(message_set.warnings)
-    for word in ("<repeat/>", "incoming_hex_moos_var", "outgoing_hex_moos_var", "key=",
-                 "<max_delta>", "priority_base", "priority_time_const"):  # fmt: skip
+    for word in (
+        "<repeat/>",
+        "incoming_hex_moos_var",
+        "outgoing_hex_moos_var",
+        "key=",
+        "<max_delta>",
+        "priority_base",
+        "priority_time_const",
+    ):
         assert word in joined, word
     assert all(re.match(r"test\.xml:\d+: ", w) for w in message_set.warnings)
     (msg,) = message_set.messages
     assert (msg.trigger_var, msg.header["dest_id"].name, msg.header["dest_id"].source_var) == (
-        "D_OUT", "Dest", "D_DEST")  # fmt: skip
+        "D_OUT",
+        "Dest",
+        "D_DEST",
+    )
 
 
 def test_sources_default_to_the_trigger_and_shared_variables_use_key_value_pairs():
     message_set = load_message_set(EXAMPLES / "xml" / "example1.xml")
     goto, status = message_set.translator_entries()
     techniques = {c.moos_var: (c.technique, c.format) for c in goto.create}
-    assert techniques["OUTGOING_COMMAND"][0] == goto.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS
+    assert (
+        techniques["OUTGOING_COMMAND"][0] == goto.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS
+    )
     assert techniques["SPECIAL_INSTRUCTIONS"] == (goto.TECHNIQUE_FORMAT, "%8%")
     assert {c.moos_var for c in status.create} == {"NAV_X", "NAV_Y", "VEHICLE_HEALTH"}
 
@@ -183,19 +242,25 @@ def test_seed_example1_scenario_goto_command():
     codec = Codec()
     message_set.load_into(codec)
     translator = Translator(message_set.translator_entries(), codec.loader.message_class)
-    command = ("Destination=3,CommandType=GoTo,goto_x=351,goto_y=294,lights_on=true,"
-               "special_instructions=make_toast,goto_speed=2.3")  # fmt: skip
-    created = translator.create("GoToCommand", values(OUTGOING_COMMAND=command,
-                                                      SPECIAL_INSTRUCTIONS="make_toast"))
+    command = (
+        "Destination=3,CommandType=GoTo,goto_x=351,goto_y=294,lights_on=true,"
+        "special_instructions=make_toast,goto_speed=2.3"
+    )
+    created = translator.create(
+        "GoToCommand", values(OUTGOING_COMMAND=command, SPECIAL_INSTRUCTIONS="make_toast")
+    )
     received = codec.decode(codec.encode(created))
     posts = {p.var: p.value for p in translator.publish(received)}
-    assert posts["INCOMING_COMMAND"] == ("Destination=3,type=goto,goto_x=351,goto_y=294,"
-                                         "lights_on=true,new_instructions=make_toast,goto_speed=2.3")
+    assert posts["INCOMING_COMMAND"] == (
+        "Destination=3,type=goto,goto_x=351,goto_y=294,"
+        "lights_on=true,new_instructions=make_toast,goto_speed=2.3"
+    )
     assert posts["SPECIAL_INSTRUCTIONS"] == "special_instructions=make_toast,lights_on=true"
 
 
 def test_publish_format_placeholders_renumbered_and_arrays_indexed():
-    message_set, codec, (P,), translator = build(xml("""
+    message_set, codec, (P,), translator = build(
+        xml("""
   <message><name>P</name><id>3</id><size>32</size>
     <layout>
       <int><name>a</name><max>9</max><min>0</min></int>
@@ -207,7 +272,8 @@ def test_publish_format_placeholders_renumbered_and_arrays_indexed():
       <publish><publish_var>ONE</publish_var><message_var>a</message_var></publish>
       <publish><publish_var>DEFAULT</publish_var><message_var>a</message_var>
         <message_var>v</message_var></publish>
-    </on_receipt></message>"""))
+    </on_receipt></message>""")
+    )
     first, one, default = translator.entries["P"].publish
     assert (first.moos_var, first.format) == ("OUT_%4%", "a=%4%;v0=%5.0%;v1=%5.1%")
     assert one.format == "%4%"
@@ -217,12 +283,14 @@ def test_publish_format_placeholders_renumbered_and_arrays_indexed():
 
 
 def test_a_variable_published_twice_is_named_by_its_algorithms():
-    message_set = parse_message_set(xml("""
+    message_set = parse_message_set(
+        xml("""
   <message><name>T</name><id>4</id><size>32</size>
     <layout><string><name>who</name><max_length>8</max_length></string></layout>
     <on_receipt><publish><publish_var>TWICE</publish_var>
       <message_var>who</message_var><message_var algorithm="to_upper">who</message_var>
-    </publish></on_receipt></message>"""))
+    </publish></on_receipt></message>""")
+    )
     (entry,) = message_set.translator_entries()
     assert entry.publish[0].format == "who=%4%,to_upper(who)=%100%"
 
@@ -265,12 +333,17 @@ ALGORITHM_SET = xml("""
 
 def test_every_algorithm_of_the_manual_runs(tmp_path):
     lookup = ModemIdLookup.from_text("1, topside, ship\n2, mm2, auv\n")
-    _, codec, (Alg,), translator = build(ALGORITHM_SET, lat_origin=42.35, lon_origin=-70.95,
-                                         modem_ids=lookup)  # fmt: skip
-    created = translator.create("Alg", values(
-        ALG_OUT="up=abc,low=DEF,hdg=-90,hdg2=270,x=100,y=300,temp=10,sal=35,depth=100,power=100,"
-                "lat=42.36,lon=-70.94",
-        VEHICLE_NAME="MM2"))  # fmt: skip
+    _, codec, (Alg,), translator = build(
+        ALGORITHM_SET, lat_origin=42.35, lon_origin=-70.95, modem_ids=lookup
+    )
+    created = translator.create(
+        "Alg",
+        values(
+            ALG_OUT="up=abc,low=DEF,hdg=-90,hdg2=270,x=100,y=300,temp=10,sal=35,depth=100,power=100,"
+            "lat=42.36,lon=-70.94",
+            VEHICLE_NAME="MM2",
+        ),
+    )
     assert (created.Node, created.up, created.low) == (2, "ABC", "def")
     assert (created.hdg, created.hdg2) == (270.0, -90.0)
     received = codec.decode(codec.encode(created))
@@ -281,9 +354,11 @@ def test_every_algorithm_of_the_manual_runs(tmp_path):
     assert (lat, lon) == pytest.approx(UTMGeodesy(42.35, -70.95).to_geo(100, 300), abs=1e-9)
     assert float(parts[4]) == pytest.approx(1491.5, abs=2.0)  # Mackenzie at 10 C, 35 PSU, 100 m
     assert (float(parts[5]), float(parts[6])) == (400.0, -200.0)
-    assert float(parts[7]) == pytest.approx(20.0) and float(parts[8]) == pytest.approx(10 ** 10)
+    assert float(parts[7]) == pytest.approx(20.0) and float(parts[8]) == pytest.approx(10**10)
     x, y = UTMGeodesy(42.35, -70.95).to_local(42.36, -70.94)
-    assert float(parts[9]) == pytest.approx(y, abs=0.5) and float(parts[10]) == pytest.approx(x, abs=0.5)
+    assert float(parts[9]) == pytest.approx(y, abs=0.5) and float(parts[10]) == pytest.approx(
+        x, abs=0.5
+    )
     assert parts[11:] == ["ABC", "def", "270"]
 
 
@@ -300,11 +375,19 @@ def test_seed_simple_status_converts_and_fits():
     (entry,) = message_set.translator_entries()
     report = entry.publish[1]
     assert (report.moos_var, report.format) == (
-        "NODE_REPORT", "NAME=%100%,TYPE=%101%,UTC_TIME=%1$.0lf,X=%5%,Y=%6%,LAT=%102$lf,"
-        "LON=%103$lf,SPD=%7%,HDG=%8%,DEPTH=%9%")  # fmt: skip
-    assert [(a.name, a.primary_field, list(a.reference_field), a.output_virtual_field)
-            for a in report.algorithm] == [("modem_id2name", 2, [], 100), ("modem_id2type", 2, [], 101),
-                                           ("utm_y2lat", 6, [5], 102), ("utm_x2lon", 5, [6], 103)]  # fmt: skip
+        "NODE_REPORT",
+        "NAME=%100%,TYPE=%101%,UTC_TIME=%1$.0lf,X=%5%,Y=%6%,LAT=%102$lf,"
+        "LON=%103$lf,SPD=%7%,HDG=%8%,DEPTH=%9%",
+    )
+    assert [
+        (a.name, a.primary_field, list(a.reference_field), a.output_virtual_field)
+        for a in report.algorithm
+    ] == [
+        ("modem_id2name", 2, [], 100),
+        ("modem_id2type", 2, [], 101),
+        ("utm_y2lat", 6, [5], 102),
+        ("utm_x2lon", 5, [6], 103),
+    ]
 
 
 def test_written_proto_compiles_to_the_same_messages(tmp_path):

@@ -110,7 +110,10 @@ async def test_antler_launches_db_and_apps_and_stops_them(tmp_path):
     pad = len("uNoSuchProgram")
     assert f"{'MOOSDB':<{pad}} | MOOSDB alpha listening on 127.0.0.1:{port}" in lines
     assert any(line.startswith(f"{'pEchoTwo':<{pad}} | pEchoTwo [") for line in lines)
-    assert "antler: uNoSuchProgram: uNoSuchProgram is not available (no such program on PATH); the other processes run without it" in lines
+    assert (
+        "antler: uNoSuchProgram: uNoSuchProgram is not available (no such program on PATH); the other processes run without it"
+        in lines
+    )
     for name in ("pEchoOne", "pEchoTwo", "MOOSDB"):
         assert f"antler: {name} exited with status 0" in lines, "\n".join(lines)
     assert sum("listening" in line for line in lines) == 1, lines
@@ -131,8 +134,10 @@ async def test_antler_exits_non_zero_when_an_app_dies(tmp_path):
         out, _ = await asyncio.wait_for(antler.communicate(), 15)
     lines = seen + out.decode().splitlines()
     assert antler.returncode == 1, lines
-    assert any("pEchoTwo: fatal configuration error: " in line and "no_such_field" in line
-               for line in lines)  # fmt: skip
+    assert any(
+        "pEchoTwo: fatal configuration error: " in line and "no_such_field" in line
+        for line in lines
+    )
     assert "antler: pEchoOne exited with status 0" in lines  # stopped by antler
     assert lines[-1] == "antler: failed: pEchoTwo"
 

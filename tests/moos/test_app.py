@@ -78,8 +78,9 @@ def test_configuration_globals_and_defaults():
 
 def test_command_line_overrides():
     mission = MissionFile.from_text(_mission(9123, BLOCK))
-    cfg = pTestApp.read_config(mission, "pTestApp", [("gain", "4"), ("common", "app_tick: 5"),
-                                                      ("out_var", 'say "hi"')])  # fmt: skip
+    cfg = pTestApp.read_config(
+        mission, "pTestApp", [("gain", "4"), ("common", "app_tick: 5"), ("out_var", 'say "hi"')]
+    )
     assert cfg.gain == 4 and cfg.common.app_tick == 5 and cfg.out_var == 'say "hi"'
     assert cfg.common.verbosity == 1 and not cfg.common.log  # merged into the block's common
     with pytest.raises(ConfigError, match="unknown option --nope"):
@@ -87,7 +88,7 @@ def test_command_line_overrides():
 
 
 def test_parse_error_names_line_and_field(tmp_path):
-    text = _mission(9000, "  common { log: false }\n  gain: fast\n  out_var: \"X\"")
+    text = _mission(9000, '  common { log: false }\n  gain: fast\n  out_var: "X"')
     path = tmp_path / "m.moos"
     path.write_text(text)
     with pytest.raises(ConfigError) as err:
@@ -111,10 +112,12 @@ def test_enum_global_must_be_a_value_name():
 
 def test_main_stops_on_config_error_before_connecting(tmp_path, capsys):
     path = tmp_path / "m.moos"
-    path.write_text(_mission(1, "  common { app_tick: many }\n  out_var: \"X\""))
+    path.write_text(_mission(1, '  common { app_tick: many }\n  out_var: "X"'))
     assert pTestApp.main([str(path)], prog="pTestApp") == 1
     err = capsys.readouterr().err
-    assert "fatal configuration error" in err and "m.moos:13: app_tick: Couldn't parse integer" in err
+    assert (
+        "fatal configuration error" in err and "m.moos:13: app_tick: Couldn't parse integer" in err
+    )
 
 
 def test_example_config():
@@ -133,7 +136,9 @@ def test_example_config():
     # the example parses back as a configuration (once the enum without a value gets one)
     body = "\n".join(lines[2:-1]).replace("type:   #", "type: INI_DOUBLE  #")
     body = body.replace("extra_gain]:   #", "extra_gain]: 2  #")
-    pTestApp.read_config(MissionFile.from_text(f"ProcessConfig = pTestApp\n{{\n{body}\n}}"), "pTestApp")
+    pTestApp.read_config(
+        MissionFile.from_text(f"ProcessConfig = pTestApp\n{{\n{body}\n}}"), "pTestApp"
+    )
 
 
 async def _wait_for(cond, timeout=3.0):
@@ -145,7 +150,10 @@ async def _wait_for(cond, timeout=3.0):
 
 
 async def test_app_runs_against_embedded_db():
-    async with MOOSDB(port=0, community="alpha") as db, MOOSClient("tester", port=db.port) as tester:
+    async with (
+        MOOSDB(port=0, community="alpha") as db,
+        MOOSClient("tester", port=db.port) as tester,
+    ):
         tester.publish("NAV_X", 100.0)  # written before the app starts: stale for it
         await tester.flush()
         mission = MissionFile.from_text(_mission(db.port, BLOCK))
@@ -153,7 +161,15 @@ async def test_app_runs_against_embedded_db():
         await asyncio.sleep(0.02)
         app = pTestApp(cfg, name="pTestApp", mission=mission)
         async with app:
-            for var in ("ECHO", "LAT_ORIGIN", "VEHICLE", "GREETING", "CONST", "NEVER", "PTESTAPP_STATUS"):
+            for var in (
+                "ECHO",
+                "LAT_ORIGIN",
+                "VEHICLE",
+                "GREETING",
+                "CONST",
+                "NEVER",
+                "PTESTAPP_STATUS",
+            ):
                 tester.subscribe(var)
             got: dict[str, list] = {}
 
@@ -218,15 +234,23 @@ async def test_a_clean_stop_is_not_reported_as_a_lost_connection(caplog):
 
 async def test_command_line_and_example_config_as_a_program(tmp_path):
     script = HERE / "example_app.py"
-    shown = subprocess.run([sys.executable, str(script), "--example_config"], capture_output=True,
-                           text=True, timeout=30)  # fmt: skip
+    shown = subprocess.run(
+        [sys.executable, str(script), "--example_config"],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
     assert shown.returncode == 0 and shown.stdout.startswith("ProcessConfig = pTestApp\n{\n")
     async with MOOSDB(port=0) as db, MOOSClient("tester", port=db.port) as tester:
         block = BLOCK.replace("pTestApp", "pAlias")
         path = tmp_path / "m.moos"
-        path.write_text(_mission(db.port, block).replace("ProcessConfig = pTestApp", "ProcessConfig = pAlias"))
+        path.write_text(
+            _mission(db.port, block).replace("ProcessConfig = pTestApp", "ProcessConfig = pAlias")
+        )
         tester.subscribe("ECHO")
-        proc = await asyncio.create_subprocess_exec(sys.executable, str(script), str(path), "pAlias")
+        proc = await asyncio.create_subprocess_exec(
+            sys.executable, str(script), str(path), "pAlias"
+        )
         try:
             await _wait_for(lambda: "pAlias" in db.client_names, timeout=10)
             await asyncio.sleep(0.3)
@@ -238,14 +262,20 @@ async def test_command_line_and_example_config_as_a_program(tmp_path):
             assert await asyncio.wait_for(proc.wait(), 10) == 0
 
 
-async def _app_process(tmp_path: Path, db_port: int, script: str = "example_app.py") -> asyncio.subprocess.Process:
+async def _app_process(
+    tmp_path: Path, db_port: int, script: str = "example_app.py"
+) -> asyncio.subprocess.Process:
     """`script` run as a program on a mission whose DB is at `db_port` (pipes for its output)."""
     path = tmp_path / "m.moos"
     path.write_text(_mission(db_port, BLOCK))
     return await asyncio.create_subprocess_exec(
-        sys.executable, str(HERE / script), str(path), "pTestApp",
-        stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE,
-    )  # fmt: skip
+        sys.executable,
+        str(HERE / script),
+        str(path),
+        "pTestApp",
+        stdout=asyncio.subprocess.PIPE,
+        stderr=asyncio.subprocess.PIPE,
+    )
 
 
 async def test_a_second_instance_with_a_taken_name_exits_with_a_clear_error(tmp_path):
@@ -267,7 +297,10 @@ async def test_a_second_instance_with_a_taken_name_exits_with_a_clear_error(tmp_
 async def test_an_app_refused_on_reconnect_keeps_trying(tmp_path):
     # The app's link to the DB breaks without the DB noticing (it keeps the stale session for
     # its client timeout and refuses the name meanwhile): the app must come back by itself.
-    async with MOOSDB(port=0, client_timeout=1.5) as db, MOOSClient("tester", port=db.port) as tester:
+    async with (
+        MOOSDB(port=0, client_timeout=1.5) as db,
+        MOOSClient("tester", port=db.port) as tester,
+    ):
         relay = CuttableRelay(db.port)
         await relay.start()
         proc = await _app_process(tmp_path, relay.port)

@@ -44,8 +44,9 @@ def read(port: int = 9000, common: str = "") -> tuple:
 
 def test_parse_overrides():
     assert appcli.parse_overrides(["--gain", "2", "--common=app_tick: 5"]) == [
-        ("gain", "2"), ("common", "app_tick: 5"),
-    ]  # fmt: skip
+        ("gain", "2"),
+        ("common", "app_tick: 5"),
+    ]
     with pytest.raises(ValueError, match="unexpected argument 'x'"):
         appcli.parse_overrides(["x"])
     with pytest.raises(ValueError, match="option --gain needs a value"):
@@ -75,8 +76,9 @@ def test_initializer_posts(caplog):
 
 
 def test_prefixed_var_names():
-    cfg = builtin_class("goby/moos/protobuf/iFrontSeat_config.proto",
-                        "goby.apps.moos.protobuf.iFrontSeatConfig")()  # fmt: skip
+    cfg = builtin_class(
+        "goby/moos/protobuf/iFrontSeat_config.proto", "goby.apps.moos.protobuf.iFrontSeatConfig"
+    )()
     cfg.moos_var.prefix = "X_"
     names = prefixed_var_names(cfg.moos_var, skip=("status",))
     assert names["command_request"] == "X_COMMAND_REQUEST" and "prefix" not in names

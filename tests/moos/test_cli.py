@@ -72,8 +72,9 @@ def test_watch_streams_wildcard_notifications(moosdb):
     port = str(moosdb)
     watch = subprocess.Popen(
         [PYGOBY, "moos", "watch", "--port", port, "--secs", "6", "--json", "NAV_*"],
-        stdout=subprocess.PIPE, text=True,
-    )  # fmt: skip
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     _wait_for_client(moosdb, "pygoby_watch_")  # connected (and so registered)
     assert _pygoby("moos", "poke", "--port", port, "NAV_X=1", "OTHER=2", "NAV_Y=3").returncode == 0
     lines = []
@@ -94,7 +95,9 @@ def test_poke_without_db_fails_cleanly():
 def test_a_taken_name_fails_cleanly(moosdb):
     async def poke_as_a_taken_name() -> subprocess.CompletedProcess[str]:
         async with MOOSClient("taken", port=moosdb):
-            return await asyncio.to_thread(_pygoby, "moos", "poke", "--port", str(moosdb), "--name", "taken", "X=1")
+            return await asyncio.to_thread(
+                _pygoby, "moos", "poke", "--port", str(moosdb), "--name", "taken", "X=1"
+            )
 
     done = asyncio.run(poke_as_a_taken_name())
     assert done.returncode == 1 and "Traceback" not in done.stderr
@@ -108,8 +111,12 @@ def test_bad_assignment_is_usage_error():
 
 def test_moosdb_port_option_overrides_mission(tmp_path):
     env = dict(os.environ)
-    proc = subprocess.Popen([PYGOBY, "moosdb", "--port", "0", "--community", "c2"],
-                            stdout=subprocess.PIPE, text=True, env=env)  # fmt: skip
+    proc = subprocess.Popen(
+        [PYGOBY, "moosdb", "--port", "0", "--community", "c2"],
+        stdout=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert "MOOSDB c2 listening on 127.0.0.1:" in proc.stdout.readline()
     finally:

@@ -123,7 +123,10 @@ async def test_name_collision_is_refused():
 async def test_refused_on_reconnect_keeps_trying_until_the_stale_session_is_gone(caplog):
     # The link to the DB breaks without the DB noticing: it keeps the client's session until its
     # client timeout and refuses the name meanwhile. The client must not give up.
-    async with MOOSDB(port=0, client_timeout=1.5) as db, MOOSClient("tester", port=db.port) as tester:
+    async with (
+        MOOSDB(port=0, client_timeout=1.5) as db,
+        MOOSClient("tester", port=db.port) as tester,
+    ):
         relay = CuttableRelay(db.port)
         await relay.start()
         app = MOOSClient("app", port=relay.port, reconnect_interval=0.1)
@@ -137,7 +140,9 @@ async def test_refused_on_reconnect_keeps_trying_until_the_stale_session_is_gone
                     await asyncio.sleep(0.01)
             app.publish("STATUS", "after the cut")
             tester.subscribe("STATUS")
-            await app.wait_connected(10)  # refused at first, accepted once the DB dropped the old one
+            await app.wait_connected(
+                10
+            )  # refused at first, accepted once the DB dropped the old one
             assert (await _expect(tester, "STATUS", 3)).string == "after the cut"
             assert "already exists" in caplog.text and "trying again in" in caplog.text
             assert app.failure is None and app.connections == 2
@@ -324,9 +329,12 @@ async def test_client_against_recorded_cpp_db(vectors_dir):
     server = await _scripted_db(listener)
     port = server.sockets[0].getsockname()[1]
     expected = [
-        m for u in listener if u["unit"] == "packet" for m in p.decode_packet(bytes.fromhex(u["hex"]))
+        m
+        for u in listener
+        if u["unit"] == "packet"
+        for m in p.decode_packet(bytes.fromhex(u["hex"]))
         if m.msg_type not in (p.WELCOME, p.TIMING)
-    ]  # fmt: skip
+    ]
     got: list[p.MOOSMessage] = []
     client = MOOSClient("nav_listener", port=port, on_message=got.append, reconnect_interval=5)
     try:
@@ -348,7 +356,9 @@ async def test_client_raises_on_recorded_poison(vectors_dir):
     server = await _scripted_db([u for u in units if u["seq"] == 110])
     client = MOOSClient("dup", port=server.sockets[0].getsockname()[1])
     try:
-        with pytest.raises(MoosRefusedError, match='A client of this name \\("dup"\\) already exists'):
+        with pytest.raises(
+            MoosRefusedError, match='A client of this name \\("dup"\\) already exists'
+        ):
             await client.connect()
     finally:
         await client.close()
@@ -395,10 +405,14 @@ async def test_packets_cut_anywhere_by_tcp_are_all_delivered():
         reader, writer = await raw_connect(db.port, "cutter")
         writer.get_extra_info("socket").setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         stream = b"".join(
-            p.encode_packet([p.notify("CUT", float(i * 3 + j), time=1.0, src="cutter", msg_id=i)
-                             for j in range(rng.randint(1, 3))])
+            p.encode_packet(
+                [
+                    p.notify("CUT", float(i * 3 + j), time=1.0, src="cutter", msg_id=i)
+                    for j in range(rng.randint(1, 3))
+                ]
+            )
             for i in range(150)
-        )  # fmt: skip
+        )
         pos = 0
         while pos < len(stream):
             step = rng.choice((1, 2, 5, 9, 13, 100, 700, 3000))
@@ -416,6 +430,8 @@ async def test_packets_cut_anywhere_by_tcp_are_all_delivered():
         got = [(await _expect(sink, "CUT")).dval for _ in expected]
         assert got == expected
         writer.close()
+
+
 async def test_close_while_the_connection_is_being_lost_returns():
     """close() at any point of the DB going away (here: 0..15 loop turns after it closed the
     connections) ends the client instead of leaving it reconnecting (antler's SIGINT reaches

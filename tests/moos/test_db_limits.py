@@ -93,7 +93,9 @@ async def test_unread_output_stays_within_the_memory_budget(caplog):
         reader, writer = await raw_connect(db.port, "sleeper")
         sock = writer.get_extra_info("socket")
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-        writer.write(p.encode_packet([p.MOOSMessage(p.REGISTER, p.DOUBLE, "BULK", dval=0, src="sleeper")]))
+        writer.write(
+            p.encode_packet([p.MOOSMessage(p.REGISTER, p.DOUBLE, "BULK", dval=0, src="sleeper")])
+        )
         await writer.drain()
         async with MOOSClient("flooder", port=db.port) as flooder:
             await asyncio.sleep(0.1)
@@ -129,8 +131,11 @@ async def test_connection_limit(caplog):
 
 
 async def test_console_script_limits():
-    db = subprocess.Popen([PYGOBY, "moosdb", "--port", "0", "--max-clients", "1",
-                           "--packet-timeout", "0.5"], stdout=subprocess.PIPE, text=True)  # fmt: skip
+    db = subprocess.Popen(
+        [PYGOBY, "moosdb", "--port", "0", "--max-clients", "1", "--packet-timeout", "0.5"],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     try:
         port = int(db.stdout.readline().rsplit(":", 1)[1])
         reader, writer = await raw_connect(port, "only")

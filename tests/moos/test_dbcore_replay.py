@@ -45,7 +45,9 @@ def take_packets(core: DBCore) -> dict[str, list[bytes]]:
 def run(core: DBCore, name: str, *msgs: p.MOOSMessage) -> dict[str, list[p.MOOSMessage]]:
     """Process one packet of `msgs` from `name`; the messages made due, per client."""
     core.process_packet(name, p.encode_packet(msgs))
-    return {n: [m for pk in pks for m in p.decode_packet(pk)] for n, pks in take_packets(core).items()}
+    return {
+        n: [m for pk in pks for m in p.decode_packet(pk)] for n, pks in take_packets(core).items()
+    }
 
 
 def _units(vectors_dir):
@@ -108,8 +110,13 @@ def _replay(units, community, warp=1.0, skip_sessions=()):
 
 def _same(mine: p.MOOSMessage, ref: p.MOOSMessage, where: str) -> None:
     assert (mine.msg_type, mine.data_type, mine.key, mine.id, mine.src, mine.community) == (
-        ref.msg_type, ref.data_type, ref.key, ref.id, ref.src, ref.community,
-    ), where  # fmt: skip
+        ref.msg_type,
+        ref.data_type,
+        ref.key,
+        ref.id,
+        ref.src,
+        ref.community,
+    ), where
     assert mine.src_aux == ref.src_aux or ref.msg_type == p.WELCOME, where
     if ref.msg_type in (p.WELCOME, p.TIMING, p.NULL):
         assert abs(mine.dval - ref.dval) < (5.0 if ref.msg_type == p.WELCOME else 1e9), where
@@ -202,7 +209,13 @@ def test_wildcard_app_pattern_evaluated_at_creation(core):
     _join(core, "listener")
     _join(core, "uPoke")
     _join(core, "other")
-    star = p.MOOSMessage(p.WILDCARD_REGISTER, p.STRING, "listener", sval=p.wildcard_sval("u*", "*_DEPTH", 0), src="listener")  # fmt: skip
+    star = p.MOOSMessage(
+        p.WILDCARD_REGISTER,
+        p.STRING,
+        "listener",
+        sval=p.wildcard_sval("u*", "*_DEPTH", 0),
+        src="listener",
+    )
     _pkt(core, "listener", star)
     _pkt(core, "other", p.notify("A_DEPTH", 1.0, time=1, src="other"))
     out = _pkt(core, "uPoke", p.notify("B_DEPTH", 2.0, time=1, src="uPoke"))
@@ -229,7 +242,9 @@ def test_name_collision_and_disconnect_event(core):
     k = core.connect(p.handshake_message("dup", 0.0))
     assert k.msg_type == p.POISON and "dup" in k.string
     core.disconnect("dup")
-    out = {n: [m for pk in pks for m in p.decode_packet(pk)] for n, pks in take_packets(core).items()}
+    out = {
+        n: [m for pk in pks for m in p.decode_packet(pk)] for n, pks in take_packets(core).items()
+    }
     assert out["watcher"][0].string == "disconnected=dup"
     assert _join(core, "dup").msg_type == p.WELCOME
 
@@ -250,15 +265,22 @@ _names = st.sampled_from(["a", "b", "", "ghost"])
 _keys = st.sampled_from(["X", "Y", "DB_TIME", "", "ALL", "VAR_SUMMARY", "PROC_SUMMARY", "DB_CLEAR"])
 _messages = st.builds(
     p.MOOSMessage,
-    msg_type=st.sampled_from("NRU*/QT.iWKCZ"), data_type=st.sampled_from("DSB~?"), key=_keys,
-    time=st.floats(allow_nan=True), dval=st.floats(allow_nan=True), dval2=st.floats(),
+    msg_type=st.sampled_from("NRU*/QT.iWKCZ"),
+    data_type=st.sampled_from("DSB~?"),
+    key=_keys,
+    time=st.floats(allow_nan=True),
+    dval=st.floats(allow_nan=True),
+    dval2=st.floats(),
     sval=st.one_of(st.binary(max_size=20), st.just(p.wildcard_sval("*", "*", 0.1))),
-    src=_names, id=st.integers(-3, 3),
-)  # fmt: skip
+    src=_names,
+    id=st.integers(-3, 3),
+)
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.lists(st.tuples(st.sampled_from(["a", "b"]), st.lists(_messages, max_size=4)), max_size=12))
+@given(
+    st.lists(st.tuples(st.sampled_from(["a", "b"]), st.lists(_messages, max_size=4)), max_size=12)
+)
 def test_fuzz_core_never_crashes(packets):
     clock = VirtualClock(1000.0)
     core = DBCore("fz", clock)
@@ -277,22 +299,36 @@ def test_fuzz_core_never_crashes(packets):
 
 _notifications = st.builds(
     p.MOOSMessage,
-    msg_type=st.just(p.NOTIFY), data_type=st.sampled_from("DSB"), key=st.sampled_from("XYZ"),
-    time=st.floats(), dval=st.floats(), dval2=st.floats(), sval=st.binary(max_size=6),
-    src=st.sampled_from(["a", "b", "", "élan"]), src_aux=st.sampled_from(["", "aux"]),
-    community=st.sampled_from(["", "other"]), id=st.integers(-3, 100),
-)  # fmt: skip
+    msg_type=st.just(p.NOTIFY),
+    data_type=st.sampled_from("DSB"),
+    key=st.sampled_from("XYZ"),
+    time=st.floats(),
+    dval=st.floats(),
+    dval2=st.floats(),
+    sval=st.binary(max_size=6),
+    src=st.sampled_from(["a", "b", "", "élan"]),
+    src_aux=st.sampled_from(["", "aux"]),
+    community=st.sampled_from(["", "other"]),
+    id=st.integers(-3, 100),
+)
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.lists(st.tuples(st.sampled_from(["a", "b"]), st.lists(_notifications, min_size=1, max_size=5)), max_size=10))
+@given(
+    st.lists(
+        st.tuples(st.sampled_from(["a", "b"]), st.lists(_notifications, min_size=1, max_size=5)),
+        max_size=10,
+    )
+)
 def test_fuzz_forwarded_bytes_are_the_publishers_with_the_community(packets):
     """Whatever mix of sources, communities and types: a subscriber gets each accepted
     notification as its publisher encoded it, the DB's community filled in when empty."""
     core = DBCore("fz", VirtualClock(1000.0))
     for name in ("a", "b", "w"):
         core.connect(p.handshake_message(name, 0.0))
-    star = p.MOOSMessage(p.WILDCARD_REGISTER, p.STRING, "w", sval=p.wildcard_sval("*", "*", 0), src="w")
+    star = p.MOOSMessage(
+        p.WILDCARD_REGISTER, p.STRING, "w", sval=p.wildcard_sval("*", "*", 0), src="w"
+    )
     run(core, "w", star)  # (and the DB_EVENT snapshots, discarded)
     locked: dict[str, str] = {}
     for name, msgs in packets:
@@ -301,5 +337,7 @@ def test_fuzz_forwarded_bytes_are_the_publishers_with_the_community(packets):
         expected = []
         for m in msgs:
             if locked.setdefault(m.key, m.data_type) == m.data_type:
-                expected.append(p.encode_message(dataclasses.replace(m, community=m.community or "fz")))
+                expected.append(
+                    p.encode_message(dataclasses.replace(m, community=m.community or "fz"))
+                )
         assert got == expected

@@ -68,10 +68,19 @@ def test_globals():
 def test_process_config_keeps_order_and_spaces():
     m = MissionFile.from_text(MISSION)
     cfg = m.process_config("PHELMIVP")
-    assert [(s.name, s.value) for s in cfg] == [("AppTick", "4"), ("behaviors", "alpha bravo.bhv"),
-                   ("domain", "course:0:359:360"), ("domain", "speed:0:4:41")]  # fmt: skip
+    assert [(s.name, s.value) for s in cfg] == [
+        ("AppTick", "4"),
+        ("behaviors", "alpha bravo.bhv"),
+        ("domain", "course:0:359:360"),
+        ("domain", "speed:0:4:41"),
+    ]
     lines = MISSION.splitlines()
-    assert [lines[s.line - 1].strip().split()[0] for s in cfg] == ["AppTick", "behaviors", "domain", "domain"]
+    assert [lines[s.line - 1].strip().split()[0] for s in cfg] == [
+        "AppTick",
+        "behaviors",
+        "domain",
+        "domain",
+    ]
     assert m.block_value("pHelmIvP", "apptick") == "4"
     assert m.process_config("nothere") is None
 
@@ -93,8 +102,10 @@ def test_antler_block():
     cfg = MissionFile.from_text(MISSION).antler()
     assert cfg.ms_between_launches == 200
     assert [(r.program, r.moos_name) for r in cfg.runs] == [
-        ("MOOSDB", "MOOSDB"), ("pHelmIvP", "pHelmIvP"), ("uSim", "sim_one"),
-    ]  # fmt: skip
+        ("MOOSDB", "MOOSDB"),
+        ("pHelmIvP", "pHelmIvP"),
+        ("uSim", "sim_one"),
+    ]
     assert cfg.runs[2].extra_args == ["--moos_suicide_disable", "--verbose=true"]
     assert cfg.runs[0].options == {"NewConsole": "false"}
 

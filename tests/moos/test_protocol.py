@@ -20,10 +20,18 @@ def _load(vectors_dir, name):
 
 def _msg_from_record(rec) -> p.MOOSMessage:
     return p.MOOSMessage(
-        msg_type=rec["msg_type"], data_type=rec["data_type"], key=rec["key"], time=rec["time"],
-        dval=rec["dval"], dval2=rec["dval2"], sval=bytes.fromhex(rec["sval_hex"]), src=rec["src"],
-        src_aux=rec["src_aux"], community=rec["community"], id=rec["id"],
-    )  # fmt: skip
+        msg_type=rec["msg_type"],
+        data_type=rec["data_type"],
+        key=rec["key"],
+        time=rec["time"],
+        dval=rec["dval"],
+        dval2=rec["dval2"],
+        sval=bytes.fromhex(rec["sval_hex"]),
+        src=rec["src"],
+        src_aux=rec["src_aux"],
+        community=rec["community"],
+        id=rec["id"],
+    )
 
 
 def _check_fields(msg: p.MOOSMessage, rec) -> None:
@@ -71,7 +79,9 @@ def test_every_session_packet_round_trips(vectors_dir):
 
 def test_protocol_string_matches_recording(vectors_dir):
     units = _load(vectors_dir, "sessions.jsonl")
-    good = next(u for u in units if u["unit"] == "protocol_string" and "bad_protocol" not in u["tags"])
+    good = next(
+        u for u in units if u["unit"] == "protocol_string" and "bad_protocol" not in u["tags"]
+    )
     assert bytes.fromhex(good["hex"]) == p.PROTOCOL_STRING
     assert p.check_protocol_string(p.PROTOCOL_STRING)
     assert p.check_protocol_string(p.PROTOCOL_STRING.lower())
@@ -86,16 +96,16 @@ def test_builders_match_recorded_bytes(vectors_dir):
     built = p.handshake_message("uPokeDB", hs.time)
     assert p.encode_packet([built]) == bytes.fromhex(by_seq[1]["hex"])
     w = p.decode_packet(bytes.fromhex(by_seq[2]["hex"]))[0]
-    assert p.encode_packet([p.welcome_message("alpha", "localhost", w.time, w.dval)]) == bytes.fromhex(
-        by_seq[2]["hex"]
-    )
+    assert p.encode_packet(
+        [p.welcome_message("alpha", "localhost", w.time, w.dval)]
+    ) == bytes.fromhex(by_seq[2]["hex"])
     assert p.welcome_hostname(w) == "localhost"
     t = p.decode_packet(bytes.fromhex(by_seq[96]["hex"]))[0]
     assert p.encode_packet([p.timing_message(t.time)]) == bytes.fromhex(by_seq[96]["hex"])
     k = p.decode_packet(bytes.fromhex(by_seq[110]["hex"]))[0]
-    assert p.encode_packet([p.poison_message(p.name_in_use_reason("dup"), k.time)]) == bytes.fromhex(
-        by_seq[110]["hex"]
-    )
+    assert p.encode_packet(
+        [p.poison_message(p.name_in_use_reason("dup"), k.time)]
+    ) == bytes.fromhex(by_seq[110]["hex"])
     pub = p.decode_packet(bytes.fromhex(by_seq[10]["hex"]))
     built = [
         p.notify("FOO", 3.5, time=pub[0].time, src="uPokeDB", msg_id=9),
@@ -123,11 +133,18 @@ def test_wildcard_sval_round_trip(vectors_dir):
 @pytest.mark.parametrize(
     ("pattern", "name", "expected"),
     [
-        ("*", "", True), ("NAV_*", "NAV_X", True), ("NAV_?", "NAV_XY", False),
-        ("*_DEPTH", "NAV_DEPTH", True), ("[ab]", "a", False), ("[ab]", "[ab]", True),
-        ("nav*", "NAV_X", False), ("", "", True), ("", "X", False), ("a.c", "abc", False),
+        ("*", "", True),
+        ("NAV_*", "NAV_X", True),
+        ("NAV_?", "NAV_XY", False),
+        ("*_DEPTH", "NAV_DEPTH", True),
+        ("[ab]", "a", False),
+        ("[ab]", "[ab]", True),
+        ("nav*", "NAV_X", False),
+        ("", "", True),
+        ("", "X", False),
+        ("a.c", "abc", False),
     ],
-)  # fmt: skip
+)
 def test_wildcard_match(pattern, name, expected):
     assert p.wildcard_match(pattern, name) is expected
 
@@ -221,8 +238,10 @@ def test_fuzz_framer_never_crashes(chunks):
 @given(st.lists(st.integers(1, 40), max_size=30), st.integers(1, 6))
 def test_framer_cuts_a_stream_cut_anywhere(cuts, n_packets):
     """However TCP cuts the stream, the framer gives back the packets, each exactly once."""
-    packets = [p.encode_packet([p.notify(f"K{i}", float(j), time=1.0) for j in range(i % 3 + 1)])
-               for i in range(n_packets)]  # fmt: skip
+    packets = [
+        p.encode_packet([p.notify(f"K{i}", float(j), time=1.0) for j in range(i % 3 + 1)])
+        for i in range(n_packets)
+    ]
     stream = b"".join(packets)
     framer = p.PacketFramer()
     out, pos = [], 0
@@ -242,11 +261,18 @@ _text = st.text(max_size=20)
 @given(
     st.builds(
         p.MOOSMessage,
-        msg_type=st.sampled_from("NRU*/QT.iWK"), data_type=st.sampled_from("DSB~"),
-        key=_text, time=st.floats(allow_nan=False), dval=st.floats(allow_nan=False),
-        dval2=st.floats(allow_nan=False), sval=st.binary(max_size=40), src=_text, src_aux=_text,
-        community=_text, id=st.integers(-(2**31), 2**31 - 1),
-    )  # fmt: skip
+        msg_type=st.sampled_from("NRU*/QT.iWK"),
+        data_type=st.sampled_from("DSB~"),
+        key=_text,
+        time=st.floats(allow_nan=False),
+        dval=st.floats(allow_nan=False),
+        dval2=st.floats(allow_nan=False),
+        sval=st.binary(max_size=40),
+        src=_text,
+        src_aux=_text,
+        community=_text,
+        id=st.integers(-(2**31), 2**31 - 1),
+    )
 )
 def test_fuzz_round_trip(msg):
     assert p.decode_packet(p.encode_packet([msg])) == [msg]

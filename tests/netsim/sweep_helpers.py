@@ -57,9 +57,12 @@ def start_sweep(sweep_file: Path, *args: str, cwd: Path) -> subprocess.Popen:
     """`pygoby netsim sweep` as its own process (group), as a user starts it."""
     return subprocess.Popen(
         [sys.executable, "-m", "pygoby.cli", "netsim", "sweep", str(sweep_file), *args],
-        cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
         start_new_session=True,
-    )  # fmt: skip
+    )
 
 
 def wait_for(condition, timeout: float, what: str, interval: float = 0.02) -> None:
@@ -111,8 +114,9 @@ def kill_when_stored(process: subprocess.Popen, output: Path, count: int) -> dic
     return run_files(output)
 
 
-def resume(sweep_file: Path, *args: str, cwd: Path, output: Path, before: dict[str, int],
-           total: int) -> None:  # fmt: skip
+def resume(
+    sweep_file: Path, *args: str, cwd: Path, output: Path, before: dict[str, int], total: int
+) -> None:
     """Start the sweep again: it runs exactly the runs missing and leaves the stored ones be."""
     process = start_sweep(sweep_file, *args, cwd=cwd)
     out, err = process.communicate(timeout=180)

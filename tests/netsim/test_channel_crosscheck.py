@@ -34,20 +34,33 @@ def bellhop_attenuation(volume, f_hz: float) -> float:
     """dB/km of BELLHOP's volume attenuation: the direct arrival's amplitude decay
     exp(-2 pi f Im(tau)) over 1, 2 and 4 km in deep isovelocity water (the same at each)."""
     case = {
-        "pelagic": 2, "model": "bellhop", "title": "attenuation", "frequency": f_hz,
-        "interpolation": "c_linear", "attenuation": {"volume": volume},
+        "pelagic": 2,
+        "model": "bellhop",
+        "title": "attenuation",
+        "frequency": f_hz,
+        "interpolation": "c_linear",
+        "attenuation": {"volume": volume},
         "media": [{"to": 5000.0, "ssp": [[0, 1500], [5000, 1500]], "mesh": 0}],
-        "surface": "vacuum", "bottom": {"type": "halfspace", "cp": 1600, "rho": 1.6, "ap": 0.1},
-        "source": {"depth": [2500.0]}, "receivers": {"depth": [2500.0], "range": [1000.0, 2000.0, 4000.0]},
-        "bellhop": {"run": "arrivals", "beam": "geometric_hat_cartesian",
-                    "angles": {"from": -30, "to": 30, "count": 601}, "box": {"depth": 5001.0, "range": 5000.0}},
-    }  # fmt: skip
+        "surface": "vacuum",
+        "bottom": {"type": "halfspace", "cp": 1600, "rho": 1.6, "ap": 0.1},
+        "source": {"depth": [2500.0]},
+        "receivers": {"depth": [2500.0], "range": [1000.0, 2000.0, 4000.0]},
+        "bellhop": {
+            "run": "arrivals",
+            "beam": "geometric_hat_cartesian",
+            "angles": {"from": -30, "to": 30, "count": 601},
+            "box": {"depth": 5001.0, "range": 5000.0},
+        },
+    }
     arrivals = pelagic.bellhop.Case.from_dict(case).run().arrivals
     per_km = set()
     for i, range_m in enumerate(arrivals.ranges_m):
         first, last = int(arrivals.arrival_offset[i]), int(arrivals.arrival_offset[i + 1])
-        direct = [j for j in range(first, last)
-                  if arrivals.top_bounces[j] == 0 and arrivals.bottom_bounces[j] == 0]  # fmt: skip
+        direct = [
+            j
+            for j in range(first, last)
+            if arrivals.top_bounces[j] == 0 and arrivals.bottom_bounces[j] == 0
+        ]
         assert direct, f"no direct arrival at {range_m} m"
         im_tau = abs(float(arrivals.attenuation_time_s[direct[0]]))
         per_km.add(round(NEPER_DB * 2 * math.pi * f_hz * im_tau / (range_m / 1000), 9))
@@ -69,8 +82,9 @@ def test_thorp_against_bellhop(f_khz):
 
 
 @pytest.mark.parametrize("f_khz", FREQUENCIES_KHZ)
-@pytest.mark.parametrize("T, S, D, pH", [(10, 35, 100, 8.0), (4, 34.5, 1000, 7.8),
-                                          (27, 35, 10, 8.1), (22, 30, 0, 8.2)])  # fmt: skip
+@pytest.mark.parametrize(
+    "T, S, D, pH", [(10, 35, 100, 8.0), (4, 34.5, 1000, 7.8), (27, 35, 10, 8.1), (22, 30, 0, 8.2)]
+)
 def test_francois_garrison_against_bellhop(f_khz, T, S, D, pH):
     """BELLHOP's Francois-Garrison volume attenuation: 1e-6 relative."""
     volume = {"type": "francois_garrison", "temperature": T, "salinity": S, "ph": pH, "depth": D}
@@ -114,9 +128,17 @@ def test_unesco_against_seawater():
 def free_field_model(**overrides) -> BellhopLoss:
     """Deep isovelocity water with a bottom matched to it (no reflection): only the direct
     path and its surface image remain."""
-    settings = dict(water_depth=5000.0, bottom_speed=1500.0, bottom_density=1.0,
-                    bottom_attenuation=0.0, max_range=4000.0, range_step=100.0,
-                    depth_step=250.0, source_depth_step=50.0, beams=1000)  # fmt: skip
+    settings = dict(
+        water_depth=5000.0,
+        bottom_speed=1500.0,
+        bottom_density=1.0,
+        bottom_attenuation=0.0,
+        max_range=4000.0,
+        range_step=100.0,
+        depth_step=250.0,
+        source_depth_step=50.0,
+        beams=1000,
+    )
     settings.update(overrides)
     return BellhopLoss(BellhopSettings(**settings), sound_speed=1500.0, spreading=2.0)
 
@@ -157,8 +179,9 @@ def test_bellhop_loss_outside_the_grid():
 def test_bad_bellhop_settings_are_configuration_errors():
     from pygoby.netsim.errors import ScenarioError
 
-    bad = SCENARIO.format(model="BELLHOP", bellhop="water_depth: 100 ssp { a: 0 b: 1500 } "
-                          "ssp { a: 50 b: 1500 }")  # fmt: skip
+    bad = SCENARIO.format(
+        model="BELLHOP", bellhop="water_depth: 100 ssp { a: 0 b: 1500 } ssp { a: 50 b: 1500 }"
+    )
     with pytest.raises(ScenarioError, match="channel.propagation: bellhop: the ssp must run"):
         parse_scenario(bad)
     with pytest.raises(ValueError, match="ssp must run from 0 m to the deepest bottom"):
@@ -173,8 +196,10 @@ mac {{ slot_seconds: 10 rate: 1 }}
 node {{ modem_id: 1 track {{ waypoint {{ x: 0 depth: 1000 }} }} }}
 node {{ modem_id: 2 track {{ waypoint {{ x: 1500 depth: 1000 }} }} }}
 """
-FREE_FIELD = ("water_depth: 5000 bottom_speed: 1500 bottom_density: 1 bottom_attenuation: 0 "
-              "max_range: 4000 range_step: 100 depth_step: 250 beams: 1000")  # fmt: skip
+FREE_FIELD = (
+    "water_depth: 5000 bottom_speed: 1500 bottom_density: 1 bottom_attenuation: 0 "
+    "max_range: 4000 range_step: 100 depth_step: 250 beams: 1000"
+)
 
 
 def test_a_scenario_with_the_bellhop_model():
@@ -189,8 +214,9 @@ def test_a_scenario_with_the_bellhop_model():
     assert model.traced == 1
     for e in rx:
         r = e["range_m"]
-        expected = 185 - (-10 * math.log10(1 / r**2 + 1 / math.hypot(r, 2000) ** 2)
-                          + thorp(25) * r / 1000)  # fmt: skip
+        expected = 185 - (
+            -10 * math.log10(1 / r**2 + 1 / math.hypot(r, 2000) ** 2) + thorp(25) * r / 1000
+        )
         assert e["rl"] == pytest.approx(expected, abs=0.06)
     empirical = parse_scenario(SCENARIO.format(model="EMPIRICAL", bellhop=""))
     assert channel_config(empirical).propagation is None

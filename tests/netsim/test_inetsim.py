@@ -48,12 +48,29 @@ ProcessConfig = iNetSimManager
 def reception_with_stats(mode: int) -> object:
     rx = acomms_pb.ModemTransmission(src=2, dest=1, type=acomms_pb.ModemTransmission.DATA)
     stat = rx.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat.add(
-        mode=mode, time=1_700_000_000_000_000, clock_mode=1, mfd_power=10, mfd_ratio=100,
-        rate=1, source=2, dest=1, psk_error_code=0, packet_type=3, number_frames=3,
-        number_bad_frames=0, snr_rss=40, snr_in=12, snr_out=20, snr_symbols=20,
-        mse_equalizer=-12, data_quality_factor=200, doppler=0.4, stddev_noise=40,
-        carrier_freq=25000, bandwidth=5000,
-    )  # fmt: skip
+        mode=mode,
+        time=1_700_000_000_000_000,
+        clock_mode=1,
+        mfd_power=10,
+        mfd_ratio=100,
+        rate=1,
+        source=2,
+        dest=1,
+        psk_error_code=0,
+        packet_type=3,
+        number_frames=3,
+        number_bad_frames=0,
+        snr_rss=40,
+        snr_in=12,
+        snr_out=20,
+        snr_symbols=20,
+        mse_equalizer=-12,
+        data_quality_factor=200,
+        doppler=0.4,
+        stddev_noise=40,
+        carrier_freq=25000,
+        bandwidth=5000,
+    )
     assert stat.IsInitialized()
     return rx
 
@@ -88,21 +105,31 @@ async def test_nav_and_receive_stats_reach_the_manager(tmp_path, manager):
         async with app:
             tester.subscribe("NETSIM_STATUS")
             await app.netsim.wait_connected(5)
-            for var, value in (("NAV_X", 1200.0), ("NAV_Y", -300.0), ("NAV_DEPTH", 15.0),
-                               ("NAV_SPEED", 1.5), ("NAV_HEADING", -90.0)):  # fmt: skip
+            for var, value in (
+                ("NAV_X", 1200.0),
+                ("NAV_Y", -300.0),
+                ("NAV_DEPTH", 15.0),
+                ("NAV_SPEED", 1.5),
+                ("NAV_HEADING", -90.0),
+            ):
                 tester.publish(var, value)
             await wait_for(lambda: navs and navs[-1].nav.heading == 270.0)
             nav = navs[-1].nav
             lat, lon = UTMGeodesy(42.35, -70.95).to_geo(1200.0, -300.0)
             assert nav.modem_tcp_port == 62001
-            assert (nav.lat, nav.lon) == (pytest.approx(lat, abs=1e-9), pytest.approx(lon, abs=1e-9))
+            assert (nav.lat, nav.lon) == (
+                pytest.approx(lat, abs=1e-9),
+                pytest.approx(lon, abs=1e-9),
+            )
             assert (nav.depth, nav.speed) == (15.0, 1.5)
             status = await tester.receive(5)
             assert (status.key, status.value) == ("NETSIM_STATUS", "UPDATE_ACCEPTED")
 
             tester.publish("ACOMMS_MODEM_RECEIVE", serialize_for_moos(reception_with_stats(0)))
             tester.publish("ACOMMS_MODEM_RECEIVE", serialize_for_moos(reception_with_stats(1)))
-            tester.publish("ACOMMS_MODEM_RECEIVE", "@PB[goby.acomms.protobuf.ModemTransmission] src: ")
+            tester.publish(
+                "ACOMMS_MODEM_RECEIVE", "@PB[goby.acomms.protobuf.ModemTransmission] src: "
+            )
             await wait_for(lambda: len(stats) >= 2)
             assert [s.packet_success for s in stats] == [True, False]
             assert {(s.modem_tcp_port, s.tx_modem_tcp_port) for s in stats} == {(62001, 62001)}

@@ -106,7 +106,9 @@ def test_example_config_channel_block():
     ],
 )
 def test_sound_speed_formula_is_selectable(formula, expected):
-    water = f"temperature: 10 salinity: 35 latitude: 30 longitude: -70 sound_speed_formula: {formula}"
+    water = (
+        f"temperature: 10 salinity: 35 latitude: 30 longitude: -70 sound_speed_formula: {formula}"
+    )
     text = BOUNDS + f"environment_channel {{ environment_id: 0 channel {{ water {{ {water} }} }} }}"
     config, _ = environment_channel_configs(parse_config(text))[0]
     assert config.sound_speed(100) == pytest.approx(expected, abs=1e-4)

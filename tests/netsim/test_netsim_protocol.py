@@ -194,7 +194,9 @@ def test_fuzz_garbage_then_a_good_line_always_decodes(garbage, cuts):
     last = events[-1]
     assert isinstance(last, ReceivedMessage) and last.message.id == 4242
     for event in events[:-1]:
-        assert isinstance(event, (ReceivedMessage, LineTooLongError, MissingSeparatorError, UnknownNameError))
+        assert isinstance(
+            event, (ReceivedMessage, LineTooLongError, MissingSeparatorError, UnknownNameError)
+        )
 
 
 @settings(max_examples=200, deadline=None)

@@ -83,8 +83,13 @@ def test_data_arrives_at_end_of_reception_with_physics_stats_and_ack():
     net.send(1, 2, [b"hello", b"world"], ack=1)
     air = DEFAULT_TIMING.data(1, 2)  # two rate-1 frames
     # it leaves once the host's sentences have crossed the 19200-baud serial line
-    sent = ["$CCCYC,0,1,2,1,1,2", "$CADRQ,221320,1,2,1,64,1", "$CCTXD,1,2,1,68656c6c6f",
-            "$CADRQ,221320,1,2,1,64,2", "$CCTXD,1,2,1,776f726c64"]  # fmt: skip
+    sent = [
+        "$CCCYC,0,1,2,1,1,2",
+        "$CADRQ,221320,1,2,1,64,1",
+        "$CCTXD,1,2,1,68656c6c6f",
+        "$CADRQ,221320,1,2,1,64,2",
+        "$CCTXD,1,2,1,776f726c64",
+    ]
     start = T0 + sum((len(body) + 5) * 10 / 19200 for body in sent)
     assert ids(net.run_until(start + 1.001)[2], "CARXP")  # the start arrives after 1 s
     assert net.run_until(start + 1.0 + air - 0.001)[2] == []
@@ -178,8 +183,9 @@ def test_losses_grow_with_range():
 def exchange_log(tmp_path, seed: int) -> list[dict]:
     path = tmp_path / f"events-{seed}.jsonl"
     with EventLogWriter(path) as log:
-        net = Net({62000: 0.0, 62001: 4450.0, 62002: 2000.0}, seed=seed, events=log,
-                  noise_level=110.0)  # fmt: skip
+        net = Net(
+            {62000: 0.0, 62001: 4450.0, 62002: 2000.0}, seed=seed, events=log, noise_level=110.0
+        )
         for k in range(15):
             net.send(1 + k % 3, 1 + (k + 1) % 3, [b"p", b"q", b"r"], ack=1)
             net.run_until(T0 + 12 * (k + 1))
@@ -198,9 +204,12 @@ def test_modem_without_port_is_refused():
     physics = PhysicsChannel(Channel(), VirtualClock(T0))
     with pytest.raises(ValueError, match="no modem port"):
         MicroModemModel(1, VirtualClock(T0), physics, name="alpha")
-    model = MicroModemModel(1, VirtualClock(T0), PhysicsChannel(Channel(), VirtualClock(T0),
-                                                                ports={"alpha": 62005}),
-                            name="alpha")  # fmt: skip
+    model = MicroModemModel(
+        1,
+        VirtualClock(T0),
+        PhysicsChannel(Channel(), VirtualClock(T0), ports={"alpha": 62005}),
+        name="alpha",
+    )
     assert model.channel.port_of(model) == 62005
 
 
@@ -211,9 +220,13 @@ def test_rx_event_figures_are_rounded():
     def fresh(range_m, owtt, rl, noise, sinr):
         snr = rl - noise
         return (
-            round(range_m, 3), round(owtt, 6), round(rl, 2), round(snr, 2), round(sinr, 2),
+            round(range_m, 3),
+            round(owtt, 6),
+            round(rl, 2),
+            round(snr, 2),
+            round(sinr, 2),
             sinr < snr - 0.01,
-        )  # fmt: skip
+        )
 
     cases = [
         (1234.56789, 0.8230452, 120.4449, 62.3, 58.1449),
@@ -228,8 +241,9 @@ def test_rx_event_figures_are_rounded():
 
     def poll(now):
         return [
-            dataclasses.replace(r, range_m=rng, owtt=owtt, received_level=rl, noise_level=noise,
-                                sinr=sinr)  # fmt: skip
+            dataclasses.replace(
+                r, range_m=rng, owtt=owtt, received_level=rl, noise_level=noise, sinr=sinr
+            )
             for r in physics_poll(now)
             for rng, owtt, rl, noise, sinr in [next(scripted)]
         ]
@@ -259,8 +273,9 @@ def test_a_cycle_init_run_late_still_precedes_its_data():
     net.clock.set(T0 + 0.004)
     net.physics.do_work()  # polled past the cycle-init's start
     cycle = AcousticPacket(PacketKind.CYCLE, 1, 0, 0, num_frames=1, tx_time=T0, duration=1.0)
-    data = AcousticPacket(PacketKind.DATA, 1, 0, 0, frames=[b"status"], tx_time=T0 + 1.0,
-                          duration=3.2)  # fmt: skip
+    data = AcousticPacket(
+        PacketKind.DATA, 1, 0, 0, frames=[b"status"], tx_time=T0 + 1.0, duration=3.2
+    )
     net.physics.transmit(sender, cycle)
     net.clock.set(T0 + 1.0)
     net.physics.transmit(sender, data)
@@ -268,5 +283,6 @@ def test_a_cycle_init_run_late_still_precedes_its_data():
     tx = [e for e in events if e["event"] == "tx"]
     assert tx[1]["t"] >= tx[0]["t"] + 1.0
     assert [(e["kind"], e["outcome"]) for e in events if e["event"] == "rx"] == [
-        ("cycle", "good"), ("data", "good"),
-    ]  # fmt: skip
+        ("cycle", "good"),
+        ("data", "good"),
+    ]

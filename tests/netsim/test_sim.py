@@ -14,7 +14,9 @@ ORIGIN = "origin { lat: 42 lon: -70 }"
 
 
 def fixed(modem_id: int, x: float, y: float = 0.0, depth: float = 10.0) -> str:
-    return f"node {{ modem_id: {modem_id} track {{ waypoint {{ x: {x} y: {y} depth: {depth} }} }} }}"
+    return (
+        f"node {{ modem_id: {modem_id} track {{ waypoint {{ x: {x} y: {y} depth: {depth} }} }} }}"
+    )
 
 
 def run(text: str, tmp_path=None) -> tuple[Simulation, list[dict]]:
@@ -143,11 +145,13 @@ def test_same_seed_same_run_other_seed_other_run(tmp_path):
         (f'speed: "fast" {fixed(1, 0)}', "speed"),
         ("node { modem_id: 1 }", "needs a track"),
         ("node { modem_id: 1 track { waypoint { x: 1 } } }", "origin"),
-        ("node { modem_id: 1 track { waypoint { lat: 1 lon: 2 t: 5 } waypoint { lat: 1 lon: 2 t: 5 } } }",
-         "increase"),
-        ("nodes { }", "line 1: .*no field named \"nodes\""),
+        (
+            "node { modem_id: 1 track { waypoint { lat: 1 lon: 2 t: 5 } waypoint { lat: 1 lon: 2 t: 5 } } }",
+            "increase",
+        ),
+        ("nodes { }", 'line 1: .*no field named "nodes"'),
     ],
-)  # fmt: skip
+)
 def test_bad_scenarios_are_refused_with_the_reason(text, reason):
     with pytest.raises(ScenarioError, match=reason):
         parse_scenario(text)

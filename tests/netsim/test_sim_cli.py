@@ -71,7 +71,7 @@ def test_run_refuses_bad_scenario(tmp_path, capsys):
 def test_report_skips_garbage_lines_and_refuses_empty_logs(tmp_path, capsys):
     log = tmp_path / "log.jsonl"
     good = {"event": "tx", "t": 10.0, "port": 62000, "kind": "data", "duration": 3.25}
-    log.write_text("not json\n[1, 2]\n" + json.dumps(good) + "\n{\"event\": 5}\n")
+    log.write_text("not json\n[1, 2]\n" + json.dumps(good) + '\n{"event": 5}\n')
     assert read_events(log) == [good]
     assert main(["netsim", "report", str(log), "-o", str(tmp_path / "out")]) == 0
     empty = tmp_path / "empty.jsonl"
@@ -106,8 +106,15 @@ async def test_real_time_run_over_tcp():
         # an external vehicle simulator reports node 3's position to the manager over TCP
         reader, writer = await asyncio.open_connection("127.0.0.1", run.manager_port)
         request = request_class()(id=7)
-        request.nav.add(modem_tcp_port=62002, time=run.clock.now(), lat=42.0, lon=-69.99,
-                        depth=5, speed=0, heading=0)  # fmt: skip
+        request.nav.add(
+            modem_tcp_port=62002,
+            time=run.clock.now(),
+            lat=42.0,
+            lon=-69.99,
+            depth=5,
+            speed=0,
+            heading=0,
+        )
         writer.write(encode_line(request))
         (answer,) = LineDecoder(response_names()).feed(await reader.readline())
         assert answer.message.request_id == 7 and answer.message.status == 1
@@ -140,8 +147,13 @@ def test_fuzz_scenario_parser_only_raises_scenario_error(text):
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.lists(st.one_of(st.text(max_size=60), st.dictionaries(st.text(max_size=5),
-                                                                 st.integers(), max_size=3))))
+@given(
+    st.lists(
+        st.one_of(
+            st.text(max_size=60), st.dictionaries(st.text(max_size=5), st.integers(), max_size=3)
+        )
+    )
+)
 def test_fuzz_event_log_reader_skips_what_is_not_an_event(tmp_path_factory, lines):
     path = tmp_path_factory.mktemp("log") / "events.jsonl"
     text = "\n".join(json.dumps(x) if isinstance(x, dict) else x.replace("\n", " ") for x in lines)
@@ -172,8 +184,12 @@ def test_real_time_cli_run_ends_cleanly_and_counts_external_deliveries(tmp_path)
     scenario.write_text(EXTERNAL)
     log = tmp_path / "events.jsonl"
     pygoby = Path(sys.executable).with_name("pygoby")
-    done = subprocess.run([pygoby, "netsim", "run", scenario, "--event-log", log],
-                          capture_output=True, text=True, timeout=60)  # fmt: skip
+    done = subprocess.run(
+        [pygoby, "netsim", "run", scenario, "--event-log", log],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr and "Exception" not in done.stderr, done.stderr
     lines = done.stdout.splitlines()
@@ -183,12 +199,17 @@ def test_real_time_cli_run_ends_cleanly_and_counts_external_deliveries(tmp_path)
     ), lines
     progress = [line for line in done.stderr.splitlines() if line.startswith("simulated ")]
     assert progress and all(
-        re.fullmatch(r"simulated [\d,]+/48 s \(\d+%\): packets \d+, messages \d+, [\d.,]+x real time(, ETA \d+ s)?", p)
+        re.fullmatch(
+            r"simulated [\d,]+/48 s \(\d+%\): packets \d+, messages \d+, [\d.,]+x real time(, ETA \d+ s)?",
+            p,
+        )
         for p in progress
     ), progress
     nodes = [e for e in read_events(log) if e["event"] == "node"]
     assert [(e["port"], e["modem_id"], e["external"]) for e in nodes] == [
-        (62000, 1, False), (62001, 2, False), (62002, 3, True)
+        (62000, 1, False),
+        (62001, 2, False),
+        (62002, 3, True),
     ]
 
 

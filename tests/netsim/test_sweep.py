@@ -49,8 +49,11 @@ def test_grid_plan_has_every_combination_and_replicate():
     assert [c.name for c in plan.columns] == ["spacing_m", "mac.rate"]
     assert [c.kind for c in plan.columns] == [float, int]
     points = {r.params for r in plan.runs}
-    assert points == {(("spacing_m", s), ("mac.rate", rate))
-                      for s in (1000.0, 2000.0, 3000.0, 4000.0) for rate in (1, 5)}  # fmt: skip
+    assert points == {
+        (("spacing_m", s), ("mac.rate", rate))
+        for s in (1000.0, 2000.0, 3000.0, 4000.0)
+        for rate in (1, 5)
+    }
     assert sorted({r.seed for r in plan.runs}) == [1, 2]
     assert len({r.run_id for r in plan.runs}) == len(plan.runs)
     # the run ids depend only on what runs: the same file gives the same ids
@@ -124,9 +127,11 @@ axis { field: "seed" value: "7" value: "8" }
 )
 def test_axis_mistakes_name_file_line_and_field(tmp_path, axis, message):
     path = tmp_path / "bad.pb.cfg"
-    text = ("scenario { duration: 60 origin { lat: 42 lon: -70 }\n"
-            "  node { modem_id: 1 track { waypoint { x: 0 } } } }\n"
-            f"axis {{ {axis} }}\n")  # fmt: skip
+    text = (
+        "scenario { duration: 60 origin { lat: 42 lon: -70 }\n"
+        "  node { modem_id: 1 track { waypoint { x: 0 } } } }\n"
+        f"axis {{ {axis} }}\n"
+    )
     path.write_text(text)
     with pytest.raises(ConfigError) as caught:
         sweep, base = parse_sweep(text, path)
@@ -144,8 +149,10 @@ def test_sweep_file_mistakes(tmp_path):
     with pytest.raises(ConfigError, match='speed must be "max"'):
         parse_sweep('scenario { speed: "1" } axis { field: "seed" value: "1" }')
     with pytest.raises(ConfigError, match="replicates must be 1"):
-        plan_of('scenario { node { modem_id: 1 track { waypoint { x: 0 } } } origin { lat: 1 '
-                'lon: 1 } } axis { field: "seed" value: "1" } replicates: 2')
+        plan_of(
+            "scenario { node { modem_id: 1 track { waypoint { x: 0 } } } origin { lat: 1 "
+            'lon: 1 } } axis { field: "seed" value: "1" } replicates: 2'
+        )
     assert main(["netsim", "sweep", str(tmp_path / "missing.pb.cfg")]) == 1
 
 
@@ -165,8 +172,9 @@ def test_run_rows_count_every_link_and_agree_with_the_simulation():
     assert sum(r["good"] for r in rows) == sum(e["outcome"] == "good" for e in data_rx)
     assert sum(r["messages"] for r in rows) == summary.status_received
     for r in rows:
-        assert r["received"] == sum(r[o] for o in ("good", "bad_frames", "not_detected",
-                                                   "receiver_busy", "half_duplex"))  # fmt: skip
+        assert r["received"] == sum(
+            r[o] for o in ("good", "bad_frames", "not_detected", "receiver_busy", "half_duplex")
+        )
         assert r["rate"] == 5 and r["spacing_m"] == 2000.0 and r["nodes"] == 3
         assert r["range_m"] == pytest.approx(2000.0 * abs(r["src"] - r["dest"]), rel=1e-3)
         assert r["latency_mean_s"] > r["owtt_mean_s"] > 0
@@ -231,8 +239,11 @@ def test_a_killed_worker_process_has_its_runs_retried(tmp_path):
     process = start_sweep(sweep, "--jobs", "2", cwd=tmp_path)
     try:
         # the pool's workers are forked by the forkserver: grandchildren of the sweep
-        wait_for(lambda: len([p for p, d in descendants(process.pid).items() if d == 2]) == 2,
-                 60, "two worker processes")  # fmt: skip
+        wait_for(
+            lambda: len([p for p, d in descendants(process.pid).items() if d == 2]) == 2,
+            60,
+            "two worker processes",
+        )
         wait_for(lambda: len(stored_runs(output)) >= 1, 60, "a stored run")
         victim = min(p for p, d in descendants(process.pid).items() if d == 2)
         signal_sent = len(stored_runs(output))
@@ -257,9 +268,13 @@ def test_a_killed_worker_process_has_its_runs_retried(tmp_path):
 @pytest.mark.parametrize(
     "successes, trials, low, high",
     # Newcombe (1998), Stat. Med. 17:857, table I, method 3 (Wilson score, no continuity correction)
-    [(81, 263, 0.2553, 0.3662), (15, 148, 0.0624, 0.1605), (0, 20, 0.0, 0.1611),
-     (1, 29, 0.0061, 0.1718)],
-)  # fmt: skip
+    [
+        (81, 263, 0.2553, 0.3662),
+        (15, 148, 0.0624, 0.1605),
+        (0, 20, 0.0, 0.1611),
+        (1, 29, 0.0061, 0.1718),
+    ],
+)
 def test_wilson_interval_matches_published_values(successes, trials, low, high):
     a, b = wilson_interval(successes, trials)
     assert a == pytest.approx(low, abs=5e-5) and b == pytest.approx(high, abs=5e-5)
@@ -282,11 +297,16 @@ def test_sweep_report_draws_the_figures_and_the_page(tmp_path, capsys):
     points = success_by_range(rows)
     assert {p.rate for p in points} == {1, 5}
     close = next(p for p in points if p.rate == 1 and p.range_m == 1000)
-    assert close.sent == sum(r["sent"] for r in rows if r["rate"] == 1 and round(r["range_m"]) == 1000)
+    assert close.sent == sum(
+        r["sent"] for r in rows if r["rate"] == 1 and round(r["range_m"]) == 1000
+    )
     assert close.success > 0.9  # 1 km at spreading 2: SNR far above rate 1's table
     capsys.readouterr()
     assert main(["netsim", "sweep-report", str(tmp_path / "nothing")]) == 1
-    assert f"{tmp_path / 'nothing'} does not exist: give the output folder of `pygoby netsim sweep`" in capsys.readouterr().err
+    assert (
+        f"{tmp_path / 'nothing'} does not exist: give the output folder of `pygoby netsim sweep`"
+        in capsys.readouterr().err
+    )
     assert main(["netsim", "sweep-report", str(tmp_path)]) == 1
     assert f"no results.parquet in {tmp_path}: " in capsys.readouterr().err
 
@@ -320,5 +340,7 @@ axis { field: "channel.water.sound_speed_formula" value: "MACKENZIE_1981" value:
     bellhop = parse_scenario(plan.runs[3].scenario_text)
     config = channel_config(bellhop)
     assert config.propagation is not None and config.propagation.settings.water_depth == 50
-    assert config.sound_speed(10.0) != channel_config(parse_scenario(plan.runs[2].scenario_text)).sound_speed(10.0)
+    assert config.sound_speed(10.0) != channel_config(
+        parse_scenario(plan.runs[2].scenario_text)
+    ).sound_speed(10.0)
     assert channel_config(parse_scenario(plan.runs[0].scenario_text)).propagation is None

@@ -31,9 +31,11 @@ distributed = pytest.importorskip("distributed")  # (installed by `make test`: p
 
 def _dask(*args: str, cwd) -> subprocess.Popen:
     return subprocess.Popen(
-        [sys.executable, "-m", *args], cwd=cwd,
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )  # fmt: skip
+        [sys.executable, "-m", *args],
+        cwd=cwd,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -41,8 +43,17 @@ def cluster(tmp_path_factory):
     """(scheduler address, {worker address: worker process}, a Client of our own)."""
     directory = tmp_path_factory.mktemp("dask")
     scheduler_file = directory / "scheduler.json"
-    scheduler = _dask("distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
-                      "--no-dashboard", "--scheduler-file", str(scheduler_file), cwd=directory)  # fmt: skip
+    scheduler = _dask(
+        "distributed.cli.dask_scheduler",
+        "--host",
+        "127.0.0.1",
+        "--port",
+        "0",
+        "--no-dashboard",
+        "--scheduler-file",
+        str(scheduler_file),
+        cwd=directory,
+    )
     processes = [scheduler]
     try:
         wait_for(scheduler_file.exists, 60, "the Dask scheduler", interval=0.1)
@@ -53,11 +64,21 @@ def cluster(tmp_path_factory):
             except (json.JSONDecodeError, KeyError):
                 time.sleep(0.05)
         for _ in range(2):
-            processes.append(_dask(
-                "distributed.cli.dask_worker", address, "--nthreads", "1", "--no-nanny",
-                "--no-dashboard", "--host", "127.0.0.1", "--local-directory", str(directory),
-                cwd=directory,
-            ))  # fmt: skip
+            processes.append(
+                _dask(
+                    "distributed.cli.dask_worker",
+                    address,
+                    "--nthreads",
+                    "1",
+                    "--no-nanny",
+                    "--no-dashboard",
+                    "--host",
+                    "127.0.0.1",
+                    "--local-directory",
+                    str(directory),
+                    cwd=directory,
+                )
+            )
         client = distributed.Client(address, timeout=60, set_as_default=False)
         client.wait_for_workers(2, timeout=60)
         pids = client.run(os.getpid)
@@ -88,8 +109,10 @@ def reference(tmp_path_factory):
 def test_cluster_sweep_gives_the_local_table(cluster, reference, tmp_path, capsys):
     address, _, _ = cluster
     sweep = write_sweep(tmp_path, duration=1800, replicates=1)
-    assert main(["netsim", "sweep", str(sweep), "-o", str(tmp_path / "out"),
-                 "--cluster", address]) == 0  # fmt: skip
+    assert (
+        main(["netsim", "sweep", str(sweep), "-o", str(tmp_path / "out"), "--cluster", address])
+        == 0
+    )
     assert f"8 runs on Dask cluster {address}" in capsys.readouterr().out
     assert deterministic(read_table(tmp_path / "out")).equals(reference)
 
@@ -114,8 +137,13 @@ def test_a_killed_cluster_worker_has_its_run_retried_elsewhere(cluster, referenc
 
         def a_worker_is_running_a_run() -> bool:
             busy.clear()
-            busy.update({w: keys for w, keys in client.processing().items()
-                         if any(str(k).startswith("netsim-run-") for k in keys)})  # fmt: skip
+            busy.update(
+                {
+                    w: keys
+                    for w, keys in client.processing().items()
+                    if any(str(k).startswith("netsim-run-") for k in keys)
+                }
+            )
             return bool(busy) and len(stored_runs(output)) >= 1
 
         wait_for(a_worker_is_running_a_run, 120, "a run in progress", interval=0.05)
@@ -137,5 +165,7 @@ def test_no_scheduler_at_the_address_is_a_clear_error(tmp_path):
     from pygoby.netsim.sweep import DaskExecutor, SweepExecutorError, plan_sweep
 
     plan = plan_sweep(write_sweep(tmp_path, replicates=1))
-    with pytest.raises(SweepExecutorError, match="cannot connect to the scheduler tcp://127.0.0.1:9"):
+    with pytest.raises(
+        SweepExecutorError, match="cannot connect to the scheduler tcp://127.0.0.1:9"
+    ):
         DaskExecutor("tcp://127.0.0.1:9", connect_timeout=1).run(plan.runs, None, None)

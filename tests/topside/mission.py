@@ -17,6 +17,8 @@ def topside_mission(net: TwoCommunities, tmp_path: Path, blocks: str) -> Path:
     lookup.write_text(LOOKUP)
     text = mission_text(1, net.dbs[0].port, net.sims[0].port, net.extra, net.slots)
     path = tmp_path / "topside.moos"
-    path.write_text(f"LatOrigin = 42.358\nLongOrigin = -71.087\nmodem_id_lookup_path = {lookup}\n"
-                    f"{text}\n{blocks}\n")  # fmt: skip
+    path.write_text(
+        f"LatOrigin = 42.358\nLongOrigin = -71.087\nmodem_id_lookup_path = {lookup}\n"
+        f"{text}\n{blocks}\n"
+    )
     return path

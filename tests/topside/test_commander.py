@@ -60,8 +60,14 @@ def commands(tmp_path) -> CommandSet:
 
 
 def make(commands, posts, **kwargs) -> Commander:
-    return Commander(commands, community="topside", now=lambda: 1700000000.25,
-                     publish=posts.append, autosave_path=None, **kwargs)  # fmt: skip
+    return Commander(
+        commands,
+        community="topside",
+        now=lambda: 1700000000.25,
+        publish=posts.append,
+        autosave_path=None,
+        **kwargs,
+    )
 
 
 def test_fields_sources_and_limits(commands):
@@ -73,8 +79,13 @@ def test_fields_sources_and_limits(commands):
     assert dest.describe() == "(int) min: 0, max: 31"
     heading = command.field("heading")
     heading.check("359")
-    for bad, reason in [("361", "above the maximum 360"), ("-1", "below the minimum 0"),
-                        ("1.5", "at most 0 decimals"), ("x", "not a number"), ("nan", "finite")]:
+    for bad, reason in [
+        ("361", "above the maximum 360"),
+        ("-1", "below the minimum 0"),
+        ("1.5", "at most 0 decimals"),
+        ("x", "not a number"),
+        ("nan", "finite"),
+    ]:
         with pytest.raises(FieldValueError, match=reason):
             heading.check(bad)
     heading.check("3", partial=True)
@@ -94,7 +105,8 @@ def test_key_value_send_posts_and_preview_publishes_nothing(commands):
     preview = commander.preview(draft)
     assert posts == []
     assert [(p.var, p.value) for p in preview.posts] == [
-        ("COMMAND_OUT", "src=1,dest=2,command_id=7,heading=90,speed=1.5")]
+        ("COMMAND_OUT", "src=1,dest=2,command_id=7,heading=90,speed=1.5")
+    ]
     assert preview.warnings == ["depth: not set"]
     record = commander.send(draft)
     assert posts == preview.posts and record.status == "awaiting ack"
@@ -110,7 +122,10 @@ def test_trigger_without_create_and_mandatory_content(commands):
     commander.send(draft)
     # every source variable in sorted order, the trigger (with its mandatory content) last
     assert [(p.var, p.value) for p in posts] == [
-        ("REPORT_X", 100.0), ("REPORT_Y", -50.0), ("SEND_STATUS", "go")]
+        ("REPORT_X", 100.0),
+        ("REPORT_Y", -50.0),
+        ("SEND_STATUS", "go"),
+    ]
 
 
 def test_multiplex_style_posts_one_prefixed_text(commands, tmp_path):
@@ -121,7 +136,8 @@ def test_multiplex_style_posts_one_prefixed_text(commands, tmp_path):
     commander.set_value(draft, "heading", "45")
     commander.send(draft)
     assert [(p.var, p.value) for p in posts] == [
-        ("LIAISON_COMMANDER_OUT", "@PB[pygoby.examples.Command] dest: 2 heading: 45 ")]
+        ("LIAISON_COMMANDER_OUT", "@PB[pygoby.examples.Command] dest: 2 heading: 45 ")
+    ]
     no_multiplex = CommandSet(commands.translator, {})
     with pytest.raises(CommanderError, match="multiplex_create_moos_var"):
         Commander(no_multiplex, style=MULTIPLEX)
@@ -130,7 +146,9 @@ def test_multiplex_style_posts_one_prefixed_text(commands, tmp_path):
 def test_specials_time_xy_community_modem_id(commands):
     assert specials.lat_lon_pairs(["depth", "lat", "lon", "lon2", "y_lat2"]) == [(1, 2), (4, 3)]
     to_geo = commands.geodesy.to_geo
-    out = specials.substitute(["_time", "_y:300", "7", "_x:100", "y(lat)2:0", "x(lon)2:0"], 12.5, to_geo)
+    out = specials.substitute(
+        ["_time", "_y:300", "7", "_x:100", "y(lat)2:0", "x(lon)2:0"], 12.5, to_geo
+    )
     lat, lon = to_geo(100, 300)
     assert out[:4] == ["12.5", repr(lat), "7", repr(lon)]
     assert [float(v) for v in out[4:]] == pytest.approx([42.358, -71.087])
@@ -160,7 +178,9 @@ def test_ack_and_expire_match_what_was_sent(commands):
     first = commander.send(draft)
     commander.set_value(draft, "command_id", "8")
     second = commander.send(draft)
-    original = commands.resolve("pygoby.examples.Command")(time=5, src=1, dest=2, command_id=8, speed=1.5)
+    original = commands.resolve("pygoby.examples.Command")(
+        time=5, src=1, dest=2, command_id=8, speed=1.5
+    )
     [notice] = commander.handle_mail("ACOMMS_EXPIRE", serialize_for_moos(original), 20.0)
     assert (notice.kind, notice.record, notice.dest) == ("expired", second, "2")
     assert "Message expired from queue: Command" in notice.banner()
@@ -182,17 +202,24 @@ def test_save_file_round_trip_with_commas(commands, tmp_path):
     assert other.open("Command").values == {"dest": "3", "heading": "_y:12"}
     text = savefile.dump([("Msg", [("V", "name", "a,b=c"), ("V", "n2", "2"), ("W", "z", "")])], 0)
     assert text.splitlines()[1:] == ["message::Msg", "V:=name=a,b=c,n2=2 W:=z="]
-    assert savefile.parse(text, {"Msg": ["name", "n2", "z"]}) == [("Msg", {"name": "a,b=c", "n2": "2", "z": ""})]
+    assert savefile.parse(text, {"Msg": ["name", "n2", "z"]}) == [
+        ("Msg", {"name": "a,b=c", "n2": "2", "z": ""})
+    ]
     with pytest.raises(SaveFileError):
         savefile.parse("not a save file")
-    (tmp_path / "bad.txt").write_text(f"{savefile.HEADER_PREFIX}x %%%\nmessage::Nope\nV:=a=1\n"
-                                      "message::Command\nCOMMAND_OUT:=heading=999\n")  # fmt: skip
+    (tmp_path / "bad.txt").write_text(
+        f"{savefile.HEADER_PREFIX}x %%%\nmessage::Nope\nV:=a=1\n"
+        "message::Command\nCOMMAND_OUT:=heading=999\n"
+    )
     warnings = other.load(tmp_path / "bad.txt")
     assert warnings[0] == "Nope: not a message of this mission"
     assert "above the maximum 360" in warnings[1]
     # a Latin-1 save file (issue 16 item 10's class: bytes that are not UTF-8) loads
-    (tmp_path / "latin1.txt").write_bytes(f"{savefile.HEADER_PREFIX}x caf\xe9\nmessage::Command\n"
-                                          "COMMAND_OUT:=dest=3\n".encode("latin-1"))  # fmt: skip
+    (tmp_path / "latin1.txt").write_bytes(
+        f"{savefile.HEADER_PREFIX}x caf\xe9\nmessage::Command\nCOMMAND_OUT:=dest=3\n".encode(
+            "latin-1"
+        )
+    )
     assert other.load(tmp_path / "latin1.txt") == [] and other.open("Command").values["dest"] == "3"
 
 
@@ -209,12 +236,14 @@ def test_save_file_parser_never_fails_unexpectedly(text):
 def test_field_checks_only_raise_field_value_errors(text, partial):
     from pygoby.topside.commander.fields import FieldSpec
 
-    for spec in (FieldSpec("f", 1, "float", "double", minimum=0, maximum=360, precision=1, source="V"),
-                 FieldSpec("i", 2, "int", "uint32", minimum=0, maximum=31, source="V"),
-                 FieldSpec("e", 3, "enum", "E", enum_values=("A", "B"), source="V"),
-                 FieldSpec("s", 4, "string", "string", max_length=5, source="V"),
-                 FieldSpec("b", 5, "bytes", "bytes", max_length=2, source="V"),
-                 FieldSpec("t", 6, "bool", "bool", source="V"),
-                 FieldSpec("r", 7, "int", "int32", repeated=True, max_repeat=3, source="V")):  # fmt: skip
+    for spec in (
+        FieldSpec("f", 1, "float", "double", minimum=0, maximum=360, precision=1, source="V"),
+        FieldSpec("i", 2, "int", "uint32", minimum=0, maximum=31, source="V"),
+        FieldSpec("e", 3, "enum", "E", enum_values=("A", "B"), source="V"),
+        FieldSpec("s", 4, "string", "string", max_length=5, source="V"),
+        FieldSpec("b", 5, "bytes", "bytes", max_length=2, source="V"),
+        FieldSpec("t", 6, "bool", "bool", source="V"),
+        FieldSpec("r", 7, "int", "int32", repeated=True, max_repeat=3, source="V"),
+    ):
         with contextlib.suppress(FieldValueError):
             spec.check(text, partial=partial)

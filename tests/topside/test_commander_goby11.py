@@ -36,8 +36,13 @@ def message_set(node: str) -> AcommsMessageSet:
 def translator(messages: AcommsMessageSet) -> Translator:
     """pAcommsHandler's translator for `messages` (with Goby 1.1's name=value rule)."""
     cfg = messages.cfg
-    out = Translator(cfg.translator_entry, messages.types, lat_origin=42.35, lon_origin=-70.95,
-                     modem_ids=ModemIdLookup.from_file(messages.find(cfg.modem_id_lookup_path)))  # fmt: skip
+    out = Translator(
+        cfg.translator_entry,
+        messages.types,
+        lat_origin=42.35,
+        lon_origin=-70.95,
+        modem_ids=ModemIdLookup.from_file(messages.find(cfg.modem_id_lookup_path)),
+    )
     messages.read_named_values(out)
     return out
 
@@ -48,11 +53,24 @@ def commands() -> CommandSet:
 
 
 def make(commands: CommandSet, posts: list, **kwargs) -> Commander:
-    return Commander(commands, community="mm1", now=lambda: NOW, publish=posts.append,
-                     autosave_path=None, **kwargs)  # fmt: skip
+    return Commander(
+        commands,
+        community="mm1",
+        now=lambda: NOW,
+        publish=posts.append,
+        autosave_path=None,
+        **kwargs,
+    )
 
 
-STATUS = {"Node": "1", "nav_x": "250", "nav_y": "-40", "Speed": "1.5", "Heading": "90.25", "Depth": "12.5"}
+STATUS = {
+    "Node": "1",
+    "nav_x": "250",
+    "nav_y": "-40",
+    "Speed": "1.5",
+    "Heading": "90.25",
+    "Depth": "12.5",
+}
 
 
 def test_simple_status_is_listed_with_goby11_fields(commands):
@@ -60,10 +78,14 @@ def test_simple_status_is_listed_with_goby11_fields(commands):
     assert status.goby11 and status.trigger_var == "" and not status.ack
     # Goby 1.1's fields: named header pieces (src_id "Node"; not the time), then the layout
     assert [(f.name, f.kind, f.source, f.editable) for f in status.fields] == [
-        ("Node", "int", "VEHICLE_NAME", True), ("MessageType", "static", "", False),
-        ("nav_x", "float", "NAV_X", True), ("nav_y", "float", "NAV_Y", True),
-        ("Speed", "float", "NAV_SPEED", True), ("Heading", "float", "NAV_HEADING", True),
-        ("Depth", "float", "NAV_DEPTH", True)]  # fmt: skip
+        ("Node", "int", "VEHICLE_NAME", True),
+        ("MessageType", "static", "", False),
+        ("nav_x", "float", "NAV_X", True),
+        ("nav_y", "float", "NAV_Y", True),
+        ("Speed", "float", "NAV_SPEED", True),
+        ("Heading", "float", "NAV_HEADING", True),
+        ("Depth", "float", "NAV_DEPTH", True),
+    ]
     assert status.field("Speed").describe() == "(float) min: -2, max: 20, precision: 1"
     assert status.field("Node").describe() == "(int) min: 0, max: 31"
 
@@ -77,8 +99,13 @@ def test_send_posts_name_value_per_source_variable_and_preview_publishes_nothing
     preview = commander.preview(draft)
     assert posts == []  # Quirk Q18 fixed
     assert [(p.var, p.value) for p in preview.posts] == [
-        ("NAV_DEPTH", "Depth=12.5"), ("NAV_HEADING", "Heading=90.25"), ("NAV_SPEED", "Speed=1.5"),
-        ("NAV_X", "nav_x=250"), ("NAV_Y", "nav_y=-40"), ("VEHICLE_NAME", "Node=1")]  # fmt: skip
+        ("NAV_DEPTH", "Depth=12.5"),
+        ("NAV_HEADING", "Heading=90.25"),
+        ("NAV_SPEED", "Speed=1.5"),
+        ("NAV_X", "nav_x=250"),
+        ("NAV_Y", "nav_y=-40"),
+        ("VEHICLE_NAME", "Node=1"),
+    ]
     assert preview.warnings == []
     commander.send(draft)
     assert posts == preview.posts
@@ -95,8 +122,13 @@ def test_a_number_where_the_variable_holds_doubles(commands):
         commander.set_value(draft, name, value)
     commander.send(draft)
     assert [(p.var, p.value) for p in posts] == [
-        ("NAV_DEPTH", "Depth=12.5"), ("NAV_HEADING", "Heading=90.25"), ("NAV_SPEED", "Speed=1.5"),
-        ("NAV_X", 250.0), ("NAV_Y", -40.0), ("VEHICLE_NAME", "Node=1")]  # fmt: skip
+        ("NAV_DEPTH", "Depth=12.5"),
+        ("NAV_HEADING", "Heading=90.25"),
+        ("NAV_SPEED", "Speed=1.5"),
+        ("NAV_X", 250.0),
+        ("NAV_Y", -40.0),
+        ("VEHICLE_NAME", "Node=1"),
+    ]
     created = TRANSLATOR.create("SIMPLE_STATUS", {p.var: p.value for p in posts})
     assert (created.nav_x, created.nav_y, created.Speed, created.Node) == (250, -40, 1.5, 1)
     commands.import_xml(str(EXAMPLE1))
@@ -104,7 +136,10 @@ def test_a_number_where_the_variable_holds_doubles(commands):
     commander.set_value(go_to, "goto_x", "5")
     values["OUTGOING_COMMAND"] = 1.0  # several fields share it: only text can carry them
     outgoing = commander.preview(go_to)
-    assert "OUTGOING_COMMAND holds numbers: the MOOSDB would refuse text, not sent" in outgoing.warnings
+    assert (
+        "OUTGOING_COMMAND holds numbers: the MOOSDB would refuse text, not sent"
+        in outgoing.warnings
+    )
 
 
 def test_out_of_range_xml_field_is_refused_with_its_bound(commands):
@@ -140,29 +175,59 @@ def test_the_posts_make_simple_status_on_mm1_and_mm2_decodes_it(commands):
     received = codec.decode(data)
     published = {p.var: p.value for p in translator(mm2).publish(received)}
     fields = dict(item.split("=", 1) for item in published["STATUS_REPORT_IN"].split(","))
-    assert fields == {"Timestamp": "1700000000", "Node": "1", "MessageType": "LAMSS_STATUS", "nav_x": "250",
-                      "nav_y": "-40", "Speed": "1.5", "Heading": "90.25", "Depth": "12.5"}  # fmt: skip
+    assert fields == {
+        "Timestamp": "1700000000",
+        "Node": "1",
+        "MessageType": "LAMSS_STATUS",
+        "nav_x": "250",
+        "nav_y": "-40",
+        "Speed": "1.5",
+        "Heading": "90.25",
+        "Depth": "12.5",
+    }
     node = dict(item.split("=", 1) for item in published["NODE_REPORT"].split(","))
     assert [node[k] for k in ("NAME", "TYPE", "X", "Y", "SPD", "HDG", "DEPTH")] == [
-        "mm1", "topside", "250", "-40", "1.5", "90.25", "12.5"]
+        "mm1",
+        "topside",
+        "250",
+        "-40",
+        "1.5",
+        "90.25",
+        "12.5",
+    ]
 
 
 @settings(max_examples=60, deadline=None)
-@given(x=st.integers(-100000, 100000), speed=st.integers(-20, 200), heading=st.integers(0, 35999),
-       depth=st.integers(0, 64000), node=st.integers(0, 31))  # fmt: skip
+@given(
+    x=st.integers(-100000, 100000),
+    speed=st.integers(-20, 200),
+    heading=st.integers(0, 35999),
+    depth=st.integers(0, 64000),
+    node=st.integers(0, 31),
+)
 def test_any_value_in_range_arrives_as_typed(x, speed, heading, depth, node):
     commands = CommandSet.from_messages(MESSAGES)
     posts = []
     commander = make(commands, posts)
     draft = commander.open("SIMPLE_STATUS")
-    typed = {"Node": str(node), "nav_x": str(x), "Speed": f"{speed / 10:g}",
-             "Heading": f"{heading / 100:g}", "Depth": f"{depth / 10:g}"}  # fmt: skip
+    typed = {
+        "Node": str(node),
+        "nav_x": str(x),
+        "Speed": f"{speed / 10:g}",
+        "Heading": f"{heading / 100:g}",
+        "Depth": f"{depth / 10:g}",
+    }
     for name, value in typed.items():
         commander.set_value(draft, name, value)
     commander.send(draft)
     created = TRANSLATOR.create("SIMPLE_STATUS", {p.var: p.value for p in posts})
-    assert (created.Node, created.nav_x, created.Speed, created.Heading, created.Depth) == pytest.approx(
-        (node, x, speed / 10, heading / 100, depth / 10))  # fmt: skip
+    assert (
+        created.Node,
+        created.nav_x,
+        created.Speed,
+        created.Heading,
+        created.Depth,
+    ) == pytest.approx((node, x, speed / 10, heading / 100, depth / 10))
 
 
 MESSAGES = message_set("mm1")
@@ -175,13 +240,29 @@ def test_name_value_rule_reads_any_string_without_surprises(text, number):
     translator's own error, never something else."""
     for value in (text, f"nav_x={text}", f"Speed={number}", number):
         with contextlib.suppress(TranslatorError):
-            TRANSLATOR.create("SIMPLE_STATUS", {"NAV_X": value, "NAV_SPEED": value, "VEHICLE_NAME": value})
+            TRANSLATOR.create(
+                "SIMPLE_STATUS", {"NAV_X": value, "NAV_SPEED": value, "VEHICLE_NAME": value}
+            )
 
 
 def test_name_value_rule_and_whole_values():
-    created = TRANSLATOR.create("SIMPLE_STATUS", {"NAV_X": "nav_x=3", "NAV_Y": 4.0, "NAV_SPEED": "1.5",
-                                                  "VEHICLE_NAME": "Node=MM2", "NAV_DEPTH": "x=1,Depth=7"})  # fmt: skip
-    assert (created.nav_x, created.nav_y, created.Speed, created.Node, created.Depth) == (3, 4, 1.5, 2, 7)
+    created = TRANSLATOR.create(
+        "SIMPLE_STATUS",
+        {
+            "NAV_X": "nav_x=3",
+            "NAV_Y": 4.0,
+            "NAV_SPEED": "1.5",
+            "VEHICLE_NAME": "Node=MM2",
+            "NAV_DEPTH": "x=1,Depth=7",
+        },
+    )
+    assert (created.nav_x, created.nav_y, created.Speed, created.Node, created.Depth) == (
+        3,
+        4,
+        1.5,
+        2,
+        7,
+    )
 
 
 def test_field_from_another_variable_than_the_trigger_is_editable_and_posted(tmp_path):
@@ -192,30 +273,44 @@ def test_field_from_another_variable_than_the_trigger_is_editable_and_posted(tmp
     assert names == ["GoToCommand", "VehicleStatus"] and len(commands) == 3
     go_to = commands.find("GoToCommand")
     assert [(f.name, f.source, f.editable) for f in go_to.fields] == [
-        ("Destination", "OUTGOING_COMMAND", True), ("type", "OUTGOING_COMMAND", False),
-        ("goto_x", "OUTGOING_COMMAND", True), ("goto_y", "OUTGOING_COMMAND", True),
-        ("lights_on", "OUTGOING_COMMAND", True), ("new_instructions", "SPECIAL_INSTRUCTIONS", True),
-        ("goto_speed", "OUTGOING_COMMAND", True)]  # fmt: skip
-    assert commands.find("VehicleStatus").field("health").enum_values == ("good", "low_battery", "abort")
+        ("Destination", "OUTGOING_COMMAND", True),
+        ("type", "OUTGOING_COMMAND", False),
+        ("goto_x", "OUTGOING_COMMAND", True),
+        ("goto_y", "OUTGOING_COMMAND", True),
+        ("lights_on", "OUTGOING_COMMAND", True),
+        ("new_instructions", "SPECIAL_INSTRUCTIONS", True),
+        ("goto_speed", "OUTGOING_COMMAND", True),
+    ]
+    assert commands.find("VehicleStatus").field("health").enum_values == (
+        "good",
+        "low_battery",
+        "abort",
+    )
     posts = []
     commander = make(commands, posts)
     draft = commander.open("GoToCommand")
-    for name, value in dict(Destination="2", goto_x="100", lights_on="true", new_instructions="dive",
-                            goto_speed="1.25").items():  # fmt: skip
+    for name, value in dict(
+        Destination="2", goto_x="100", lights_on="true", new_instructions="dive", goto_speed="1.25"
+    ).items():
         commander.set_value(draft, name, value)
     outgoing = commander.preview(draft)
     # the trigger variable last; the static field goes with its variable, as in Goby 1.1
     assert [(p.var, p.value) for p in outgoing.posts] == [
         ("SPECIAL_INSTRUCTIONS", "new_instructions=dive"),
-        ("OUTGOING_COMMAND", "Destination=2,type=goto,goto_x=100,lights_on=true,goto_speed=1.25")]
+        ("OUTGOING_COMMAND", "Destination=2,type=goto,goto_x=100,lights_on=true,goto_speed=1.25"),
+    ]
     # the manual's example asks for content the message never holds: the operator is told
-    assert outgoing.warnings == ["OUTGOING_COMMAND lacks its mandatory content 'CommandType=GoTo': "
-                                 "pAcommsHandler will not make the message"]  # fmt: skip
+    assert outgoing.warnings == [
+        "OUTGOING_COMMAND lacks its mandatory content 'CommandType=GoTo': "
+        "pAcommsHandler will not make the message"
+    ]
     status = commander.open("VehicleStatus")
     commander.set_value(status, "health", "low_battery")
     with pytest.raises(FieldValueError, match="one of good, low_battery, abort"):
         commander.set_value(status, "health", "HEALTH_abort")
-    assert [(p.var, p.value) for p in commander.preview(status).posts] == [("VEHICLE_HEALTH", "health=low_battery")]
+    assert [(p.var, p.value) for p in commander.preview(status).posts] == [
+        ("VEHICLE_HEALTH", "health=low_battery")
+    ]
     assert commander.preview(status).message.health == 1
 
 
@@ -238,8 +333,11 @@ def test_save_and_load_round_trip(commands, tmp_path):
         commander.set_value(draft, name, value)
     commander.save(tmp_path / "saved.txt")
     lines = (tmp_path / "saved.txt").read_text().splitlines()
-    assert lines[1:] == ["message::SIMPLE_STATUS", "NAV_DEPTH:=Depth=12.5 NAV_HEADING:=Heading=90.25 "
-                         "NAV_SPEED:=Speed=1.5 NAV_X:=nav_x=250 NAV_Y:=nav_y=-40 VEHICLE_NAME:=Node=1"]  # fmt: skip
+    assert lines[1:] == [
+        "message::SIMPLE_STATUS",
+        "NAV_DEPTH:=Depth=12.5 NAV_HEADING:=Heading=90.25 "
+        "NAV_SPEED:=Speed=1.5 NAV_X:=nav_x=250 NAV_Y:=nav_y=-40 VEHICLE_NAME:=Node=1",
+    ]
     other = make(commands, [])
     assert other.load(tmp_path / "saved.txt") == []
     assert other.open("SIMPLE_STATUS").values == STATUS
@@ -291,14 +389,26 @@ def test_an_xml_file_found_nowhere_is_located_like_load_proto_file(tmp_path, mon
     line = text.splitlines().index('    message_file { path: "../../xml/simple_stats.xml" }') + 1
     monkeypatch.chdir(tmp_path)
     searched = f"searched: {tmp_path}, {mission.parent}"
-    expected = f'{mission}:{line}: message_file.path: "../../xml/simple_stats.xml" not found; {searched}'
+    expected = (
+        f'{mission}:{line}: message_file.path: "../../xml/simple_stats.xml" not found; {searched}'
+    )
     for app in (pAcommsHandler, iCommander):
         with pytest.raises(ConfigError) as caught:
             app.from_mission(mission, app.default_name)
         assert str(caught.value) == expected
-    mission.write_text(text.replace("simple_stats.xml", "simple_status.xml")
-                       + ICOMMANDER_11.replace("example1.xml", "exampel1.xml"))  # fmt: skip
-    line = mission.read_text().splitlines().index('    message_file { path: "../../xml/exampel1.xml" }') + 1
+    mission.write_text(
+        text.replace("simple_stats.xml", "simple_status.xml")
+        + ICOMMANDER_11.replace("example1.xml", "exampel1.xml")
+    )
+    line = (
+        mission.read_text()
+        .splitlines()
+        .index('    message_file { path: "../../xml/exampel1.xml" }')
+        + 1
+    )
     with pytest.raises(ConfigError) as caught:
         iCommander.from_mission(mission, "iCommander")
-    assert str(caught.value) == f'{mission}:{line}: message_file.path: "../../xml/exampel1.xml" not found; {searched}'
+    assert (
+        str(caught.value)
+        == f'{mission}:{line}: message_file.path: "../../xml/exampel1.xml" not found; {searched}'
+    )

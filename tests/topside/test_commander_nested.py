@@ -64,25 +64,37 @@ def commands(tmp_path) -> CommandSet:
     path = tmp_path / "m.moos"
     path.write_text(MISSION.format(proto=tmp_path / "goto.proto"))
     mission = MissionFile.read(path)
-    return CommandSet.from_messages(AcommsMessageSet.load(read_acomms_config(mission), mission.find_file))
+    return CommandSet.from_messages(
+        AcommsMessageSet.load(read_acomms_config(mission), mission.find_file)
+    )
 
 
 def make(commands, posts, **kwargs) -> Commander:
-    return Commander(commands, now=lambda: 100.0, publish=posts.append, autosave_path=None, **kwargs)
+    return Commander(
+        commands, now=lambda: 100.0, publish=posts.append, autosave_path=None, **kwargs
+    )
 
 
 def test_sub_message_fields_are_composable(commands):
     goto = commands.find("Goto")
     assert [(f.name, f.kind, f.editable, f.required) for f in goto.fields] == [
-        ("dest", "int", True, True), ("target.x", "float", True, True), ("target.y", "float", True, False),
-        ("via.x", "float", True, False), ("via.y", "float", True, False),  # via is optional
-        ("track.x", "float", True, False), ("track.y", "float", True, False),
-        ("tree.v", "int", True, False), ("tree.child", "message", False, False)]  # fmt: skip
+        ("dest", "int", True, True),
+        ("target.x", "float", True, True),
+        ("target.y", "float", True, False),
+        ("via.x", "float", True, False),
+        ("via.y", "float", True, False),  # via is optional
+        ("track.x", "float", True, False),
+        ("track.y", "float", True, False),
+        ("tree.v", "int", True, False),
+        ("tree.child", "message", False, False),
+    ]
     assert goto.field("target.x").describe() == "(float) min: -1000, max: 1000, precision: 1"
     assert goto.field("track.x").describe() == (
-        "(float) min: -1000, max: 1000, precision: 1, up to 3 values separated by commas")
+        "(float) min: -1000, max: 1000, precision: 1, up to 3 values separated by commas"
+    )
     assert goto.field("tree.child").describe() == (
-        "(pygoby.test.Tree) recursive or deeper sub-messages cannot be composed here")
+        "(pygoby.test.Tree) recursive or deeper sub-messages cannot be composed here"
+    )
     with pytest.raises(FieldValueError, match="track.x: at most 3 values"):
         goto.field("track.x").check("1,2,3,4")
     with pytest.raises(FieldValueError, match="target.x: 1001 is above the maximum 1000"):
@@ -98,7 +110,9 @@ def test_send_both_styles_and_pacommshandler_reads_it_back(commands):
     preview = commander.preview(draft)
     assert posts == [] and preview.warnings == []
     # goby's key=value technique flattens one level (sub-message field `target_x`)
-    assert [(p.var, p.value) for p in preview.posts] == [("GOTO_OUT", "dest=2,target_x=1.5,target_y=-2")]
+    assert [(p.var, p.value) for p in preview.posts] == [
+        ("GOTO_OUT", "dest=2,target_x=1.5,target_y=-2")
+    ]
     assert not preview.message.HasField("via")  # untouched sub-messages stay unset
     record = commander.send(draft)
     created = commands.translator.create("pygoby.test.Goto", {p.var: p.value for p in posts})
@@ -109,7 +123,10 @@ def test_send_both_styles_and_pacommshandler_reads_it_back(commands):
     draft = multiplex.open("Goto")
     multiplex.set_value(draft, "via.y", "7")
     multiplex.set_value(draft, "tree.v", "3")
-    assert multiplex.preview(draft).posts[0].value == "@PB[pygoby.test.Goto] via { y: 7 } tree { v: 3 } "
+    assert (
+        multiplex.preview(draft).posts[0].value
+        == "@PB[pygoby.test.Goto] via { y: 7 } tree { v: 3 } "
+    )
 
 
 def test_repeated_sub_message_one_value_per_element(commands):
@@ -119,11 +136,19 @@ def test_repeated_sub_message_one_value_per_element(commands):
     for name, value in {"dest": "1", "target.x": "0", "track.x": "1,2,3", "track.y": "4,5"}.items():
         commander.set_value(draft, name, value)
     preview = commander.preview(draft)
-    assert [(w.x, w.y if w.HasField("y") else None) for w in preview.message.track] == [(1, 4), (2, 5), (3, None)]
+    assert [(w.x, w.y if w.HasField("y") else None) for w in preview.message.track] == [
+        (1, 4),
+        (2, 5),
+        (3, None),
+    ]
     assert [(p.var, p.value) for p in preview.posts] == [
-        ("GOTO_OUT", "dest=1,target_x=0,target_y=0,track_x={1,2,3},track_y={4,5,0}")]
+        ("GOTO_OUT", "dest=1,target_x=0,target_y=0,track_x={1,2,3},track_y={4,5,0}")
+    ]
     record = commander.send(draft)
-    assert commands.translator.create("pygoby.test.Goto", {p.var: p.value for p in posts}).track[:2] == record.message.track[:2]
+    assert (
+        commands.translator.create("pygoby.test.Goto", {p.var: p.value for p in posts}).track[:2]
+        == record.message.track[:2]
+    )
     commander.set_value(draft, "track.x", "1")  # element 2 keeps a y, without its required x
     assert commander.preview(draft).warnings == ["track[1].x: not set"]
 
@@ -136,9 +161,15 @@ def test_acks_match_nested_values(commands):
     record = commander.send(draft)
     original = commands.resolve("pygoby.test.Goto")(dest=2)
     original.target.x, original.via.x = 1.5, 11
-    assert commander.handle_mail("ACOMMS_ACK_ORIGINAL", serialize_for_moos(original), 1.0)[0].record is None
+    assert (
+        commander.handle_mail("ACOMMS_ACK_ORIGINAL", serialize_for_moos(original), 1.0)[0].record
+        is None
+    )
     original.via.x = 10
-    assert commander.handle_mail("ACOMMS_ACK_ORIGINAL", serialize_for_moos(original), 2.0)[0].record is record
+    assert (
+        commander.handle_mail("ACOMMS_ACK_ORIGINAL", serialize_for_moos(original), 2.0)[0].record
+        is record
+    )
 
 
 def test_save_and_load_nested_names(commands, tmp_path):
@@ -147,8 +178,10 @@ def test_save_and_load_nested_names(commands, tmp_path):
     commander.set_value(draft, "target.x", "_y:5")
     commander.set_value(draft, "via.y", "3")
     commander.save(tmp_path / "s.txt")
-    assert "GOTO_OUT:=dest=,target.x=_y:5,target.y=,via.x=,via.y=3,track.x=,track.y=,tree.v=" in (
-        tmp_path / "s.txt").read_text()
+    assert (
+        "GOTO_OUT:=dest=,target.x=_y:5,target.y=,via.x=,via.y=3,track.x=,track.y=,tree.v="
+        in (tmp_path / "s.txt").read_text()
+    )
     other = make(commands, [])
     assert other.load(tmp_path / "s.txt") == []
     assert other.open("Goto").values == {"target.x": "_y:5", "via.y": "3"}

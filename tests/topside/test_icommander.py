@@ -68,9 +68,14 @@ async def test_send_refusal_preview_and_ack(tmp_path):
             assert edit.query_one("#field-heading").value == "40"
             assert "above the maximum 360" in str(edit.query_one("#info").render())
             await pilot.press("backspace", "backspace")
-            await fill(pilot, {"heading": "90", "dest": "2", "command_id": "7", "speed": "1.5", "depth": "20"})
+            await fill(
+                pilot,
+                {"heading": "90", "dest": "2", "command_id": "7", "speed": "1.5", "depth": "20"},
+            )
             assert edit.query_one("#field-speed").value == "1.5"
-            assert edit.query_one("#field-time").disabled  # automatic: pAcommsHandler fills it from DB_TIME
+            assert edit.query_one(
+                "#field-time"
+            ).disabled  # automatic: pAcommsHandler fills it from DB_TIME
 
             # Preview: the exact post is shown, nothing is published.
             edit.query_one("#field-depth").focus()
@@ -99,7 +104,10 @@ async def test_send_refusal_preview_and_ack(tmp_path):
             assert "for destination: 2" in banner
             assert app.commander.records[0].status == "acknowledged"
             autosaved = (tmp_path / "autosave.txt").read_text().splitlines()
-            assert autosaved[1:] == ["message::Command", "COMMAND_OUT:=dest=2,command_id=7,heading=90,speed=1.5,depth=20"]
+            assert autosaved[1:] == [
+                "message::Command",
+                "COMMAND_OUT:=dest=2,command_id=7,heading=90,speed=1.5,depth=20",
+            ]
 
 
 SAVE_MISSION = """\
@@ -159,9 +167,13 @@ async def test_save_and_load_round_trip_and_time_special(tmp_path):
             await pilot.press("enter", "enter")
             await pilot.pause()
             lines = saved.read_text().splitlines()
-            assert lines[0].startswith("%%% iCommander message save file: ") and lines[0].endswith(" %%%")
-            assert lines[1:] == ["message::Command",
-                                 "COMMAND_OUT:=time=_time,src=,dest=2,command_id=,heading=180,speed=2.5,depth="]
+            assert lines[0].startswith("%%% iCommander message save file: ") and lines[0].endswith(
+                " %%%"
+            )
+            assert lines[1:] == [
+                "message::Command",
+                "COMMAND_OUT:=time=_time,src=,dest=2,command_id=,heading=180,speed=2.5,depth=",
+            ]
             assert "COMMAND_OUT" not in recorder.seen  # saving publishes nothing
 
         # A new iCommander loads the file at start-up (`load:`) with the same values.

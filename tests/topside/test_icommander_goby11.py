@@ -58,8 +58,14 @@ async def test_compose_simple_status_and_mm2_decodes_it(tmp_path):
             assert edit.query_one("#field-Speed").value == "2"
             assert "above the maximum 20" in str(edit.query_one("#info").render())
             await press(pilot, "backspace")
-            for name, text in {"Speed": "1.5", "Node": "1", "nav_x": "250", "nav_y": "-40",
-                               "Heading": "90.25", "Depth": "12.5"}.items():  # fmt: skip
+            for name, text in {
+                "Speed": "1.5",
+                "Node": "1",
+                "nav_x": "250",
+                "nav_y": "-40",
+                "Heading": "90.25",
+                "Depth": "12.5",
+            }.items():
                 edit.query_one(f"#field-{name}").focus()
                 await pilot.pause()
                 await type_text(pilot, text)
@@ -73,32 +79,57 @@ async def test_compose_simple_status_and_mm2_decodes_it(tmp_path):
             await press(pilot, "down", "down", "enter")  # Return, Send, [Preview]
             assert app.tui.screen.id == "preview"
             report = str(app.tui.screen.query_one("#report-text").render()).splitlines()
-            assert report[1:] == ["NAV_DEPTH: 12.5", "NAV_HEADING: 90.25", "NAV_SPEED: 1.5", "NAV_X: 250.0",
-                                  "NAV_Y: -40.0", "VEHICLE_NAME: Node=1"]  # fmt: skip
+            assert report[1:] == [
+                "NAV_DEPTH: 12.5",
+                "NAV_HEADING: 90.25",
+                "NAV_SPEED: 1.5",
+                "NAV_X: 250.0",
+                "NAV_Y: -40.0",
+                "VEHICLE_NAME: Node=1",
+            ]
             await asyncio.sleep(0.5)
             for var, value in (("NAV_X", 100.0), ("NAV_SPEED", 0.0), ("VEHICLE_NAME", "mm1")):
-                assert await wait_for(ports["mm1"], var, lambda v: True) == value  # the initializers'
+                assert (
+                    await wait_for(ports["mm1"], var, lambda v: True) == value
+                )  # the initializers'
 
             # Send (from the preview); mm1's pAcommsHandler makes SIMPLE_STATUS of the posts
             # (Goby 1.1's name=value rule) and mm2 decodes it.
             await press(pilot, "down", "enter")
             assert app.tui.screen.id == "sent"
             await wait_for(ports["mm1"], "VEHICLE_NAME", lambda v: v == "Node=1", timeout=20)
-            status = await wait_for(ports["mm2"], "STATUS_REPORT_IN", lambda v: "nav_x=250" in str(v))
+            status = await wait_for(
+                ports["mm2"], "STATUS_REPORT_IN", lambda v: "nav_x=250" in str(v)
+            )
             fields = report_fields(status)
-            assert {k: fields[k] for k in ("Node", "MessageType", "nav_x", "nav_y", "Speed", "Heading", "Depth")} == {
-                "Node": "1", "MessageType": "LAMSS_STATUS", "nav_x": "250", "nav_y": "-40", "Speed": "1.5",
-                "Heading": "90.25", "Depth": "12.5"}  # fmt: skip
-            assert (tmp_path / "autosave.txt").read_text().splitlines()[1] == "message::SIMPLE_STATUS"
+            assert {
+                k: fields[k]
+                for k in ("Node", "MessageType", "nav_x", "nav_y", "Speed", "Heading", "Depth")
+            } == {
+                "Node": "1",
+                "MessageType": "LAMSS_STATUS",
+                "nav_x": "250",
+                "nav_y": "-40",
+                "Speed": "1.5",
+                "Heading": "90.25",
+                "Depth": "12.5",
+            }
+            assert (tmp_path / "autosave.txt").read_text().splitlines()[
+                1
+            ] == "message::SIMPLE_STATUS"
 
             # Import Message File: example1.xml's two messages join the list.
             await press(pilot, "down", "enter")  # Main menu
             assert app.tui.screen.id == "main-menu"
-            await press(pilot, "down", "down", "down", "down", "enter")  # Return, Select, Load, Save, [Import]
+            await press(
+                pilot, "down", "down", "down", "down", "enter"
+            )  # Return, Select, Load, Save, [Import]
             assert app.tui.screen.id == "import-file"
             await type_text(pilot, str(EXAMPLES / "xml" / "example1.xml"))
             await press(pilot, "enter")
-            assert "GoToCommand, VehicleStatus" in str(app.tui.screen.query_one("#report-text").render())
+            assert "GoToCommand, VehicleStatus" in str(
+                app.tui.screen.query_one("#report-text").render()
+            )
             await press(pilot, "enter")
             assert "3 messages loaded." in str(app.tui.screen.query_one(".title").render())
 

@@ -19,8 +19,16 @@ from tests.apps.acomms_mission import TwoCommunities
 from .mission import topside_mission
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync"]  # fmt: skip
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 # `make screenshots` sets this to docs/images (the README's pictures); otherwise the shots go to
 # the test's tmp dir, so a test run leaves the work tree as it found it
 SCREENSHOTS_ENV = "PYGOBY_SCREENSHOTS"
@@ -45,9 +53,12 @@ async def browser(tmp_path):
         pytest.fail("chromium is not installed (make test installs it: apt-get install chromium)")
     async with playwright_api.async_playwright() as pw:
         browser = await pw.chromium.launch_persistent_context(
-            str(tmp_path / "chromium-profile"), executable_path=CHROMIUM, args=FLAGS,
-            headless=True, viewport={"width": 1200, "height": 760},
-        )  # fmt: skip
+            str(tmp_path / "chromium-profile"),
+            executable_path=CHROMIUM,
+            args=FLAGS,
+            headless=True,
+            viewport={"width": 1200, "height": 760},
+        )
         yield browser
         await browser.close()
 
@@ -97,11 +108,18 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
             cell = page.locator('#scope-table tr[data-key="NAV_X"] td.value')
             await cell.wait_for()
             await page.wait_for_function(
-                "document.querySelector('#scope-table tr[data-key=\"NAV_X\"] td.value').textContent === '10'")
+                "document.querySelector('#scope-table tr[data-key=\"NAV_X\"] td.value').textContent === '10'"
+            )
             r1.client.publish("NAV_X", 25.0)
             await page.wait_for_function(
-                "document.querySelector('#scope-table tr[data-key=\"NAV_X\"] td.value').textContent === '25'")
-            for var, value in {"NAV_Y": -40.0, "NAV_HEADING": 45.0, "NAV_SPEED": 1.0, "NAV_DEPTH": 0.0}.items():
+                "document.querySelector('#scope-table tr[data-key=\"NAV_X\"] td.value').textContent === '25'"
+            )
+            for var, value in {
+                "NAV_Y": -40.0,
+                "NAV_HEADING": 45.0,
+                "NAV_SPEED": 1.0,
+                "NAV_DEPTH": 0.0,
+            }.items():
                 r1.client.publish(var, value)
             await page.locator('#scope-table tr[data-key="NAV_X"]').click()
             await page.wait_for_timeout(500)
@@ -115,26 +133,48 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
             await heading.fill("400")
             error = page.locator('tr[data-field="heading"] .error')
             await error.filter(has_text="above the maximum 360").wait_for()
-            for name, value in {"dest": "2", "command_id": "7", "heading": "90", "speed": "1.5", "depth": "20"}.items():
+            for name, value in {
+                "dest": "2",
+                "command_id": "7",
+                "heading": "90",
+                "speed": "1.5",
+                "depth": "20",
+            }.items():
                 box = page.locator(f'input[data-field="{name}"]')
                 await box.fill(value)
                 await box.dispatch_event("change")
-            await page.wait_for_function("!document.querySelector('input[data-field=\"heading\"]').classList.contains('invalid')")
+            await page.wait_for_function(
+                "!document.querySelector('input[data-field=\"heading\"]').classList.contains('invalid')"
+            )
             await page.click("#cmd-preview")
-            await page.locator("#cmd-preview-text").filter(has_text="COMMAND_OUT: dest=2,command_id=7,heading=90").wait_for()
+            await (
+                page.locator("#cmd-preview-text")
+                .filter(has_text="COMMAND_OUT: dest=2,command_id=7,heading=90")
+                .wait_for()
+            )
             assert "COMMAND_OUT" not in r1.seen  # preview publishes nothing
             await page.click("#cmd-send")
             assert await r2.wait_for("DESIRED_HEADING", timeout=30) == 90.0
             assert "command_id=7" in await r2.wait_for("COMMAND_IN")
             status = page.locator('#cmd-records tr[data-id="1"] td.status')
             await status.filter(has_text="acknowledged").wait_for(timeout=30_000)
-            await page.locator("#cmd-notices .notice").filter(has_text="Message acknowledged from queue: Command").wait_for()
+            await (
+                page.locator("#cmd-notices .notice")
+                .filter(has_text="Message acknowledged from queue: Command")
+                .wait_for()
+            )
             assert r1.values("COMMAND_OUT") == ["dest=2,command_id=7,heading=90,speed=1.5,depth=20"]
             assert "message::Command" in (tmp_path / "autosave.txt").read_text()
             await shot(page, "commander", tmp_path)
 
             # Map: vehicle 2 reports its position acoustically (STATUS_REPORT_IN at vehicle 1).
-            for var, value in {"NAV_X": 300.0, "NAV_Y": 200.0, "NAV_SPEED": 1.5, "NAV_HEADING": 60.0, "NAV_DEPTH": 5.0}.items():
+            for var, value in {
+                "NAV_X": 300.0,
+                "NAV_Y": 200.0,
+                "NAV_SPEED": 1.5,
+                "NAV_HEADING": 60.0,
+                "NAV_DEPTH": 5.0,
+            }.items():
                 r2.client.publish(var, value)
             await r2.client.flush()
             r2.client.publish("SEND_STATUS", "now")
@@ -142,7 +182,9 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
             await page.goto(f"{base}/map")
             await page.locator('#map-svg g.node[data-name="vehicle1"]').wait_for()
             await page.locator('#map-svg g.node[data-name="vehicle2"]').wait_for()
-            await page.locator('#map-svg line.link[data-from="vehicle2"][data-to="vehicle1"]').wait_for()
+            await page.locator(
+                '#map-svg line.link[data-from="vehicle2"][data-to="vehicle1"]'
+            ).wait_for()
             await shot(page, "map", tmp_path)
 
             # Acomms: queues, the MAC cycle, transmissions and receptions with statistics.

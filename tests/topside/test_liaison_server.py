@@ -47,13 +47,18 @@ async def test_pacommshandler_serves_liaison_with_a_token_off_loopback(tmp_path,
         auth = {"Authorization": f"Bearer {web.token}"}
         status, script = await asyncio.to_thread(fetch, f"{base}/static/liaison.js", None, auth)
         assert status == 200 and "EventSource" in script  # shipped in the package, no CDN
-        types = json.loads((await asyncio.to_thread(fetch, f"{base}/api/commander/types", None, auth))[1])
+        types = json.loads(
+            (await asyncio.to_thread(fetch, f"{base}/api/commander/types", None, auth))[1]
+        )
         assert {t["short"] for t in types["types"]} == {"Command", "SimpleStatus"}
         body = {"action": "open", "type": "Command"}
         assert (await asyncio.to_thread(fetch, f"{base}/api/commander", body, auth))[0] == 403
         status, reply = await asyncio.to_thread(
-            fetch, f"{base}/api/commander", {**body, "action": "set", "field": "heading", "text": "999"},
-            {**auth, "X-Liaison": "1", "Content-Type": "application/json"})  # fmt: skip
+            fetch,
+            f"{base}/api/commander",
+            {**body, "action": "set", "field": "heading", "text": "999"},
+            {**auth, "X-Liaison": "1", "Content-Type": "application/json"},
+        )
         assert status == 422 and "above the maximum 360" in json.loads(reply)["error"]
 
 
@@ -67,22 +72,36 @@ async def test_embedded_liaison_offers_the_goby11_xml_messages(tmp_path):
     async with TwoCommunities(tmp_path, extra=extra) as net:
         base = f"http://127.0.0.1:{net.apps[0].liaison.web.port}"
         types = json.loads((await asyncio.to_thread(fetch, f"{base}/api/commander/types"))[1])
-        assert {t["short"] for t in types["types"]} == {"Command", "SimpleStatus", "GoToCommand", "VehicleStatus"}
+        assert {t["short"] for t in types["types"]} == {
+            "Command",
+            "SimpleStatus",
+            "GoToCommand",
+            "VehicleStatus",
+        }
         headers = {"X-Liaison": "1", "Content-Type": "application/json"}
 
         async def command(**body) -> tuple[int, dict]:
             status, reply = await asyncio.to_thread(fetch, f"{base}/api/commander", body, headers)
             return status, json.loads(reply)
 
-        status, reply = await command(action="set", type="GoToCommand", field="goto_x", text="20000")
+        status, reply = await command(
+            action="set", type="GoToCommand", field="goto_x", text="20000"
+        )
         assert status == 422 and "goto_x: 20000 is above the maximum 10000" in reply["error"]
         for field, text in (("Destination", "2"), ("goto_x", "150"), ("new_instructions", "dive")):
-            assert (await command(action="set", type="GoToCommand", field=field, text=text))[0] == 200
+            assert (await command(action="set", type="GoToCommand", field=field, text=text))[
+                0
+            ] == 200
         status, reply = await command(action="preview", type="GoToCommand")
-        assert reply["preview"]["posts"] == ["SPECIAL_INSTRUCTIONS: new_instructions=dive",
-                                             "OUTGOING_COMMAND: Destination=2,type=goto,goto_x=150"]  # fmt: skip
+        assert reply["preview"]["posts"] == [
+            "SPECIAL_INSTRUCTIONS: new_instructions=dive",
+            "OUTGOING_COMMAND: Destination=2,type=goto,goto_x=150",
+        ]
         fields = {f["name"]: f for f in reply["fields"]}
-        assert fields["new_instructions"]["editable"] and fields["new_instructions"]["source"] == "SPECIAL_INSTRUCTIONS"
+        assert (
+            fields["new_instructions"]["editable"]
+            and fields["new_instructions"]["source"] == "SPECIAL_INSTRUCTIONS"
+        )
 
 
 def test_a_taken_http_port_is_a_configuration_error(tmp_path):
@@ -95,11 +114,23 @@ def test_a_taken_http_port_is_a_configuration_error(tmp_path):
         port = taken.getsockname()[1]
         mission = tmp_path / "topside.moos"
         text = mission.read_text()
-        assert text.count('liaison { node_report_var') == 1
-        mission.write_text(text.replace('liaison { node_report_var', f'liaison {{ http_port: {port} node_report_var'))
+        assert text.count("liaison { node_report_var") == 1
+        mission.write_text(
+            text.replace(
+                "liaison { node_report_var", f"liaison {{ http_port: {port} node_report_var"
+            )
+        )
         pygoby = str(Path(sys.executable).with_name("pygoby"))
-        done = subprocess.run([pygoby, "liaison", "topside.moos"], cwd=tmp_path, capture_output=True,
-                              text=True, timeout=60)  # fmt: skip
+        done = subprocess.run(
+            [pygoby, "liaison", "topside.moos"],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
     assert done.returncode == 1, done.stderr
     assert "Traceback" not in done.stderr
-    assert f"liaison: fatal configuration error: liaison: cannot serve the pages on 127.0.0.1:{port}" in done.stderr
+    assert (
+        f"liaison: fatal configuration error: liaison: cannot serve the pages on 127.0.0.1:{port}"
+        in done.stderr
+    )

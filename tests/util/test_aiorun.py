@@ -32,10 +32,16 @@ STUCK = "time.sleep(3600)  # a cleanup that blocks the event loop"
 CHOKED = 'sys.stderr.write("x" * 10_000_000); sys.stderr.flush()  # into a pipe nobody reads'
 
 
-def signalled(cleanup: str, signum: int, read_stderr: bool = True) -> tuple[subprocess.Popen, str, float]:
+def signalled(
+    cleanup: str, signum: int, read_stderr: bool = True
+) -> tuple[subprocess.Popen, str, float]:
     """The program with `cleanup`, sent `signum` once ready: (process, stderr, seconds to end)."""
-    proc = subprocess.Popen([sys.executable, "-c", PROGRAM.replace("CLEANUP", cleanup)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-c", PROGRAM.replace("CLEANUP", cleanup)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         assert proc.stdout.readline() == "ready\n"
         started = time.monotonic()
@@ -110,4 +116,3 @@ async def test_cancel_and_wait_raises_what_the_task_failed_with():
     with pytest.raises(OSError, match="disk gone"):
         await cancel_and_wait(task)
     await cancel_and_wait(None)
-

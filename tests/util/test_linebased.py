@@ -151,7 +151,9 @@ def test_splitter_scans_each_byte_once():
 
 @settings(max_examples=300, deadline=None)
 @given(
-    stream=st.lists(st.sampled_from([b"a", b"bc", b"\r", b"\n", b"\r\n", b"xyz" * 5])).map(b"".join),
+    stream=st.lists(st.sampled_from([b"a", b"bc", b"\r", b"\n", b"\r\n", b"xyz" * 5])).map(
+        b"".join
+    ),
     cuts=st.lists(st.integers(min_value=0, max_value=200)),
     delimiter=st.sampled_from(["\r", "\r\n"]),
 )

@@ -37,4 +37,6 @@ def test_a_broken_file_is_not_left_half_loaded(tmp_path):
 
 
 def test_an_importable_name():
-    assert import_module_or_file("pygoby.util.modules").import_module_or_file is import_module_or_file
+    assert (
+        import_module_or_file("pygoby.util.modules").import_module_or_file is import_module_or_file
+    )

@@ -12,13 +12,26 @@ from pygoby.util.nmea import (
 )
 
 SPEC_EXAMPLES = [
-    "$CCCFG,SRC,1*31", "$CCCYC,0,1,2,0,1,1*5A", "$CCTMS,2019-12-02T03:02:37Z,0*7A",
-    "$CCCFG,CST,1*37", "$CCCFG,REV,1*32", "$CCCFG,RXP,1*29", "$CCCFG,ALL,0*33",
-    "$CCMSC,1,1,0*41", "$CCCFQ,SRC*3A", "$CCTMQ,0*54", "$CCCFQ,TOP*33", "$CCCFQ,ALL*39",
-    "$CADRQ,120000,1,2,1,32,1*44", "$CCTXD,1,2,1,0102030405*7B",
-    "$CARXD,1,2,1,1,0102030405*62", "$CCTXD,1,2,1,*7A", "$CACYC,0,1,2,0,1,1*58",
-    "$CAACK,2,1,1,1*48", "$CCMPC,1,2*5D",
-]  # fmt: skip
+    "$CCCFG,SRC,1*31",
+    "$CCCYC,0,1,2,0,1,1*5A",
+    "$CCTMS,2019-12-02T03:02:37Z,0*7A",
+    "$CCCFG,CST,1*37",
+    "$CCCFG,REV,1*32",
+    "$CCCFG,RXP,1*29",
+    "$CCCFG,ALL,0*33",
+    "$CCMSC,1,1,0*41",
+    "$CCCFQ,SRC*3A",
+    "$CCTMQ,0*54",
+    "$CCCFQ,TOP*33",
+    "$CCCFQ,ALL*39",
+    "$CADRQ,120000,1,2,1,32,1*44",
+    "$CCTXD,1,2,1,0102030405*7B",
+    "$CARXD,1,2,1,1,0102030405*62",
+    "$CCTXD,1,2,1,*7A",
+    "$CACYC,0,1,2,0,1,1*58",
+    "$CAACK,2,1,1,1*48",
+    "$CCMPC,1,2*5D",
+]
 
 
 @pytest.mark.parametrize("line", SPEC_EXAMPLES)
@@ -151,9 +164,15 @@ def test_as_ints_and_message():
 
 @pytest.mark.parametrize(
     "field, low, high, ok",
-    [("5", 0, 8, True), ("9", 0, 8, False), ("-1", 0, None, False), ("40000000", None, 8, False),
-     ("9" * 30, 0, 2**31, False), ("0", 0, 0, True)],
-)  # fmt: skip
+    [
+        ("5", 0, 8, True),
+        ("9", 0, 8, False),
+        ("-1", 0, None, False),
+        ("40000000", None, 8, False),
+        ("9" * 30, 0, 2**31, False),
+        ("0", 0, 0, True),
+    ],
+)
 def test_as_int_range_checks(field, low, high, ok):
     sentence = NMEASentence.parse(f"$CACYC,{field}")
     if ok:

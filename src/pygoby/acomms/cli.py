@@ -23,15 +23,30 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--port", type=int, required=True, help="TCP port to serve NMEA on (0: any)")
     p.add_argument("--id", type=int, required=True, help="acoustic address (NVRAM SRC)")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
-    p.add_argument("--pty", nargs="?", const="", metavar="PATH",
-                   help="also serve on a pseudo-terminal, linked at PATH if given (e.g. "
-                   "/tmp/ttyLOOPA1, for a mission's serial_port)")  # fmt: skip
-    p.add_argument("--firmware", help="version in $CAREV: 2.x a Micro-Modem 2 (the default), "
-                   "0.x a Micro-Modem 1")  # fmt: skip
-    p.add_argument("--channel-group", default="239.255.42.99:45454",
-                   help="multicast group:port shared by emulators (default %(default)s)")  # fmt: skip
-    p.add_argument("--range", type=float, default=0.0, metavar="METERS",
-                   help="distance between the emulated modems (travel time at --sound-speed)")
+    p.add_argument(
+        "--pty",
+        nargs="?",
+        const="",
+        metavar="PATH",
+        help="also serve on a pseudo-terminal, linked at PATH if given (e.g. "
+        "/tmp/ttyLOOPA1, for a mission's serial_port)",
+    )
+    p.add_argument(
+        "--firmware",
+        help="version in $CAREV: 2.x a Micro-Modem 2 (the default), 0.x a Micro-Modem 1",
+    )
+    p.add_argument(
+        "--channel-group",
+        default="239.255.42.99:45454",
+        help="multicast group:port shared by emulators (default %(default)s)",
+    )
+    p.add_argument(
+        "--range",
+        type=float,
+        default=0.0,
+        metavar="METERS",
+        help="distance between the emulated modems (travel time at --sound-speed)",
+    )
     p.add_argument("--sound-speed", type=float, default=1500.0, help="m/s (default %(default)s)")
     p.set_defaults(func=run)
 
@@ -41,19 +56,37 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Store server for DRIVER_STORE_SERVER clients (RUDICS packets over TCP).",
     )
     s.add_argument("--port", type=int, default=11244, help="TCP port (default %(default)s)")
-    s.add_argument("--host", default="127.0.0.1",
-                   help="address to bind (default %(default)s; 0.0.0.0: every interface)")  # fmt: skip
+    s.add_argument(
+        "--host",
+        default="127.0.0.1",
+        help="address to bind (default %(default)s; 0.0.0.0: every interface)",
+    )
     s.add_argument("--db", default="goby_store_server.db", help="SQLite file (default %(default)s)")
-    s.add_argument("--max-lookback", type=float, default=3600.0,
-                   help="seconds of history a new client receives (default %(default)s)")  # fmt: skip
-    s.add_argument("--retention", type=float, default=3600.0,
-                   help="seconds a delivered transmission is kept (default %(default)s)")  # fmt: skip
-    s.add_argument("--lock-timeout", type=float, default=5.0,
-                   help="seconds to wait for a database locked by another process before "
-                        "answering the client with an error (default %(default)s)")  # fmt: skip
-    s.add_argument("--secrets", metavar="FILE",
-                   help="'MODEM_ID SECRET' per line: each modem id's requests must be signed "
-                        "with its secret, ids not listed are refused (default: no check)")  # fmt: skip
+    s.add_argument(
+        "--max-lookback",
+        type=float,
+        default=3600.0,
+        help="seconds of history a new client receives (default %(default)s)",
+    )
+    s.add_argument(
+        "--retention",
+        type=float,
+        default=3600.0,
+        help="seconds a delivered transmission is kept (default %(default)s)",
+    )
+    s.add_argument(
+        "--lock-timeout",
+        type=float,
+        default=5.0,
+        help="seconds to wait for a database locked by another process before "
+        "answering the client with an error (default %(default)s)",
+    )
+    s.add_argument(
+        "--secrets",
+        metavar="FILE",
+        help="'MODEM_ID SECRET' per line: each modem id's requests must be signed "
+        "with its secret, ids not listed are refused (default: no check)",
+    )
     s.set_defaults(func=run_store_server)
 
     lb = subparsers.add_parser(
@@ -63,7 +96,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "PREFIX<X>2 for each pair name X (what Goby 1.1 missions made with socat). Runs until "
         "Ctrl-C, then removes the links. Links left by a process that died are replaced.",
     )
-    lb.add_argument("--prefix", default="/tmp/ttyLOOP", help="link name prefix (default %(default)s)")
+    lb.add_argument(
+        "--prefix", default="/tmp/ttyLOOP", help="link name prefix (default %(default)s)"
+    )
     lb.add_argument("--pairs", default="A,B,C,D", help="pair names (default %(default)s)")
     lb.set_defaults(func=run_loopbacks)
 
@@ -178,8 +213,10 @@ async def _serve_abc(args: argparse.Namespace) -> None:
     from pygoby.acomms.abc_simulator import ABCSimulator, serve_abc
 
     server = await serve_abc(ABCSimulator(), args.host, args.port)
-    print(f"abc_modem_simulator listening on {args.host}:{server.sockets[0].getsockname()[1]}",
-          flush=True)  # fmt: skip
+    print(
+        f"abc_modem_simulator listening on {args.host}:{server.sockets[0].getsockname()[1]}",
+        flush=True,
+    )
     try:
         await asyncio.Future()
     finally:

@@ -75,7 +75,9 @@ class ModemDriverBase(ABC):
         log.warning("%s: update_cfg is not implemented by this driver", type(self).__name__)
 
     def report(self):
-        report = acomms_pb.ModemReport(modem_id=self.cfg.modem_id, time=acomms_pb.now_us(self.clock.now()))
+        report = acomms_pb.ModemReport(
+            modem_id=self.cfg.modem_id, time=acomms_pb.now_us(self.clock.now())
+        )
         report.link_state = (
             acomms_pb.ModemReport.LINK_AVAILABLE
             if self.link is not None and self.link.is_open
@@ -177,7 +179,6 @@ class ModemDriverBase(ABC):
         if description:
             msg.description = description
         signal.emit(msg)
-
 
     def _traffic_log(self, incoming: bool) -> logging.Logger:
         if self._traffic_logs_for is not self.cfg:  # a new configuration: maybe a new name

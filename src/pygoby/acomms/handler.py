@@ -50,7 +50,9 @@ from pygoby.util.signal import Signal
 log = logging.getLogger(__name__)
 
 Status = acomms_pb.ModemDriverStatus
-DriverType = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type.values_by_name
+DriverType = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name[
+    "driver_type"
+].enum_type.values_by_name
 DRIVER_NONE = DriverType["DRIVER_NONE"].number
 UFIELD = DriverType["DRIVER_UFIELD_SIM_DRIVER"].number
 
@@ -176,8 +178,11 @@ class AcommsHandler:
         if cfg.dccl_cfg.id_codec in ("dccl.default.id", "dccl.ccl.id"):
             self.codec.set_id_codec(cfg.dccl_cfg.id_codec)
         elif cfg.dccl_cfg.id_codec:
-            log.warning("dccl_cfg.id_codec %r: custom id codecs are not supported; using the "
-                        "default id codec", cfg.dccl_cfg.id_codec)  # fmt: skip
+            log.warning(
+                "dccl_cfg.id_codec %r: custom id codecs are not supported; using the "
+                "default id codec",
+                cfg.dccl_cfg.id_codec,
+            )
 
         self.queue_cfg = acomms_pb.QueueManagerConfig()
         self.queue_cfg.CopyFrom(cfg.queue_cfg)
@@ -232,7 +237,9 @@ class AcommsHandler:
         except QueueError as exc:
             raise HandlerError(f"queue_cfg persistent_queue_file: {exc}") from None
         restored = self.queue.attach_store(store)
-        log.info("persistent queue %s: %d queued message(s) restored", os.path.abspath(path), restored)
+        log.info(
+            "persistent queue %s: %d queued message(s) restored", os.path.abspath(path), restored
+        )
 
     def start(self) -> None:
         """Drivers start at the next `do_work`; the MAC starts its cycle now."""
@@ -344,8 +351,11 @@ class AcommsHandler:
         try:
             self.primary.driver.handle_initiate_transmission(transmission)
         except Exception:  # e.g. a slot with a rate the modem lacks: this slot only
-            log.exception("%s cannot start the transmission %s", _name(self.primary),
-                          text_format.MessageToString(transmission, as_one_line=True))  # fmt: skip
+            log.exception(
+                "%s cannot start the transmission %s",
+                _name(self.primary),
+                text_format.MessageToString(transmission, as_one_line=True),
+            )
 
     def _forward_informational(self, slot: DriverSlot) -> None:
         driver = slot.driver

@@ -118,9 +118,14 @@ class MACManager:
         if self.glog.isEnabledFor(DEBUG1):
             order = ", ".join(f"{s.src}->{s.dest} {s.slot_seconds:g} s" for s in self.slots)
             self.glog.log(
-                DEBUG1, "cycle of %d slots, %g s: [%s]; next slot (%d) at %s", len(self.slots),
-                self.cycle_duration, order, self.current, _clock_text(self.next_slot_time),
-            )  # fmt: skip
+                DEBUG1,
+                "cycle of %d slots, %g s: [%s]; next slot (%d) at %s",
+                len(self.slots),
+                self.cycle_duration,
+                order,
+                self.current,
+                _clock_text(self.next_slot_time),
+            )
 
     def _renumber(self) -> None:
         for i, slot in enumerate(self.slots):
@@ -146,11 +151,17 @@ class MACManager:
         initiates = self._initiates(slot)
         if self.glog.isEnabledFor(DEBUG2):
             self.glog.log(
-                DEBUG2, "slot %d (%d->%d, rate %d, %g s) starts at %s (%.3f s late)%s",
-                slot.slot_index, slot.src, slot.dest, slot.rate, slot.slot_seconds,
-                _clock_text(self.next_slot_time), now - self.next_slot_time,
+                DEBUG2,
+                "slot %d (%d->%d, rate %d, %g s) starts at %s (%.3f s late)%s",
+                slot.slot_index,
+                slot.src,
+                slot.dest,
+                slot.rate,
+                slot.slot_seconds,
+                _clock_text(self.next_slot_time),
+                now - self.next_slot_time,
                 ": ours, initiating" if initiates else "",
-            )  # fmt: skip
+            )
         if initiates:
             self.signal_initiate_transmission.emit(slot)
         self.signal_slot_start.emit(slot)
@@ -223,7 +234,11 @@ class MACManager:
 
     def _auto_slot(self, src: int):
         return acomms_pb.ModemTransmission(
-            src=src, dest=-1, rate=self.cfg.rate, type=acomms_pb.DATA, slot_seconds=self.cfg.slot_seconds
+            src=src,
+            dest=-1,
+            rate=self.cfg.rate,
+            type=acomms_pb.DATA,
+            slot_seconds=self.cfg.slot_seconds,
         )
 
     def _auto_schedule(self) -> None:

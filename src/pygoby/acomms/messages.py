@@ -90,9 +90,11 @@ V1ModemDataTransmission = _cls("goby.transitional.protobuf.ModemDataTransmission
 V1ModemRangingRequest = _cls("goby.transitional.protobuf.ModemRangingRequest")
 V1ModemRangingReply = _cls("goby.transitional.protobuf.ModemRangingReply")
 V1MACUpdate = _cls("goby.transitional.protobuf.MACUpdate")
-QUEUE_CCL = _loader.pool.FindEnumTypeByName("goby.transitional.protobuf.QueueType").values_by_name[
-    "QUEUE_CCL"
-].number
+QUEUE_CCL = (
+    _loader.pool.FindEnumTypeByName("goby.transitional.protobuf.QueueType")
+    .values_by_name["QUEUE_CCL"]
+    .number
+)
 
 MM_CONFIG = extension("goby.acomms.micromodem.protobuf.config")
 MM_TRANSMISSION = extension("goby.acomms.micromodem.protobuf.transmission")

@@ -44,15 +44,21 @@ class TransitionalMessages:
         return out
 
     def add_file(
-        self, cfg: Message, message_file: Message, loader: ProtoLoader, find: Callable[[str], str] = str
+        self,
+        cfg: Message,
+        message_file: Message,
+        loader: ProtoLoader,
+        find: Callable[[str], str] = str,
     ) -> MessageSet:
         """One `message_file { path manipulator }`: its types into `loader`, its queue and
         translator entries appended to `cfg` (also how a tool imports one more file)."""
         message_set = load_message_set(find(message_file.path), message_file.manipulator)
         for name in message_set.names:
             if name in self._defined_in:
-                raise ConfigError(f"message {name} is defined in {self._defined_in[name]} too",
-                                  file=message_set.path)  # fmt: skip
+                raise ConfigError(
+                    f"message {name} is defined in {self._defined_in[name]} too",
+                    file=message_set.path,
+                )
         message_set.register(loader)
         for name in message_set.names:
             self._defined_in[name] = message_set.path

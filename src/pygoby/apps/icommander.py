@@ -36,21 +36,27 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
     def __init__(self, cfg: Message, *, acomms: AcommsMessageSet | None = None, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         if not (self.common.HasField("lat_origin") and self.common.HasField("lon_origin")):
-            raise ConfigError("LatOrigin and LongOrigin are required (local x/y -> lat/lon)",
-                              field="common.lat_origin")  # fmt: skip
+            raise ConfigError(
+                "LatOrigin and LongOrigin are required (local x/y -> lat/lon)",
+                field="common.lat_origin",
+            )
         options = cfg.commander
         self.common.verbosity = QUIET  # the terminal belongs to the screens; the log file keeps all
         if acomms is None:
-            acomms = AcommsMessageSet.of_app(self, options.pacommshandler_name,
-                                             cfg.transitional_cfg.message_file)  # fmt: skip
+            acomms = AcommsMessageSet.of_app(
+                self, options.pacommshandler_name, cfg.transitional_cfg.message_file
+            )
         try:
             self.commander = Commander(
                 CommandSet.from_messages(acomms, cfg.modem_id_lookup_path),
-                community=self.common.community, now=self.clock.now, publish=self._post,
+                community=self.common.community,
+                now=self.clock.now,
+                publish=self._post,
                 style=MULTIPLEX if options.send_style == SEND_MULTIPLEX else KEY_VALUE,
                 force_xy_only=cfg.force_xy_only or options.force_xy_only,
-                autosave_path=options.autosave_path or None, values=MoosValues(self.dynamic_vars),
-            )  # fmt: skip
+                autosave_path=options.autosave_path or None,
+                values=MoosValues(self.dynamic_vars),
+            )
         except CommanderError as err:
             raise ConfigError(str(err), field="commander") from None
         self.tui = ICommanderTUI(self.commander, list(cfg.show_variable), on_exit=self.request_stop)

@@ -81,8 +81,9 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         config_class = cls.load_config_class()
         block = mission.goby_block(name) if mission is not None else None
         fs_config.import_configured_driver(config_class, block.text if block else None, overrides)
-        return read_configuration(config_class, mission, name, overrides,
-                                  complete=fs_config.migrate_goby2_abc_config)  # fmt: skip
+        return read_configuration(
+            config_class, mission, name, overrides, complete=fs_config.migrate_goby2_abc_config
+        )
 
     # -- construction ----------------------------------------------------------------------
 
@@ -95,8 +96,10 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         self.interface.log = self.log.getChild(type(self.interface).__name__)
         self.log.info("frontseat driver %s (%s)", driver, type(self.interface).__name__)
         common = self.common
-        origin = (common.lat_origin if common.HasField("lat_origin") else math.nan,
-                  common.lon_origin if common.HasField("lon_origin") else math.nan)  # fmt: skip
+        origin = (
+            common.lat_origin if common.HasField("lat_origin") else math.nan,
+            common.lon_origin if common.HasField("lon_origin") else math.nan,
+        )
         self.backseat = Backseat(self.interface, cfg.legacy_cfg, origin, self.log)
         self._connect_signals()
         self._subscribe_all()
@@ -106,9 +109,11 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
     def _connect_signals(self) -> None:
         interface = self.interface
         interface.signal_data_from_frontseat.connect(self._on_data_from_frontseat)
-        for signal, var in ((interface.signal_command_response, "command_response"),
-                            (interface.signal_raw_from_frontseat, "raw_in"),
-                            (interface.signal_raw_to_frontseat, "raw_out")):  # fmt: skip
+        for signal, var in (
+            (interface.signal_command_response, "command_response"),
+            (interface.signal_raw_from_frontseat, "raw_in"),
+            (interface.signal_raw_to_frontseat, "raw_out"),
+        ):
             signal.connect(lambda message, var=self.var[var]: self.publish_pb(var, message))
         if self.cfg.legacy_cfg.publish_fs_bs_ready:
             interface.signal_state_change.connect(lambda status: self._post(ready_posts(status)))
@@ -155,21 +160,26 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
     # -- MOOS -> frontseat -----------------------------------------------------------------
 
     def _on_command_request(self, msg: MOOSMessage) -> None:
-        if self.backseat.may_command(msg.key) and (
-            command := self.parse_pb(msg, frontseat_pb.CommandRequest)
-        ) is not None:
+        if (
+            self.backseat.may_command(msg.key)
+            and (command := self.parse_pb(msg, frontseat_pb.CommandRequest)) is not None
+        ):
             self.interface.send_command_to_frontseat(command)
 
     def _on_data_to_frontseat(self, msg: MOOSMessage) -> None:
-        if self.backseat.may_send(msg.key) and (
-            data := self.parse_pb(msg, frontseat_pb.InterfaceData)
-        ) is not None:
+        if (
+            self.backseat.may_send(msg.key)
+            and (data := self.parse_pb(msg, frontseat_pb.InterfaceData)) is not None
+        ):
             self.interface.send_data_to_frontseat(data)
 
     def _on_raw_out(self, msg: MOOSMessage) -> None:
         if msg.src == self.name:
             return  # our own post of what the driver sent
-        if self.backseat.may_send(msg.key) and (raw := self.parse_pb(msg, frontseat_pb.Raw)) is not None:
+        if (
+            self.backseat.may_send(msg.key)
+            and (raw := self.parse_pb(msg, frontseat_pb.Raw)) is not None
+        ):
             self.interface.send_raw_to_frontseat(raw)
 
     def _on_helm_state(self, msg: MOOSMessage) -> None:
@@ -184,16 +194,18 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
             self.backseat.set_origin(lon=msg.dval)
 
     def _on_desired(self, msg: MOOSMessage) -> None:
-        if self._is_number(msg) and (
-            request := self.backseat.desired(msg.key, msg.dval, msg.time)
-        ) is not None:
+        if (
+            self._is_number(msg)
+            and (request := self.backseat.desired(msg.key, msg.dval, msg.time)) is not None
+        ):
             # through the MOOSDB, so the state check of IFS_COMMAND_REQUEST applies to it too
             self.publish_pb(self.var["command_request"], request)
 
     def _on_ctd(self, msg: MOOSMessage) -> None:
-        if self._is_number(msg) and (
-            data := self.backseat.ctd(msg.key, msg.dval, msg.time)
-        ) is not None:
+        if (
+            self._is_number(msg)
+            and (data := self.backseat.ctd(msg.key, msg.dval, msg.time)) is not None
+        ):
             self.publish_pb(self.var["data_to_frontseat"], data)
 
     def _is_number(self, msg: MOOSMessage) -> bool:

@@ -44,8 +44,19 @@ LOCATION_TYPES = {
     "moos_local": ("NAV_X", "NAV_Y", "NAV_DEPTH"),
     "moos_global": ("NAV_LAT", "NAV_LONG", "NAV_DEPTH"),
 }
-KNOWN_NAMES = ("Port", "Speed", "IPPort", "BroadcastAddr", "InputLocType", "ConstantPosX", "ConstantPosY",
-               "ConstantDepth", "ConstantLat", "ConstantLon", "ModemID")  # fmt: skip
+KNOWN_NAMES = (
+    "Port",
+    "Speed",
+    "IPPort",
+    "BroadcastAddr",
+    "InputLocType",
+    "ConstantPosX",
+    "ConstantPosY",
+    "ConstantDepth",
+    "ConstantLat",
+    "ConstantLon",
+    "ModemID",
+)
 KNOWN = {name.lower() for name in KNOWN_NAMES}
 
 
@@ -84,8 +95,11 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
         except ValueError:
             self._error("broadcastaddr", f"{address!r} is not an IPv4 address")
         # (the channel's deliveries on the app's clock, which MOOSTimeWarp speeds up)
-        self.channel = (MulticastChannel(MULTICAST_GROUP, udp_port, self.clock) if loopback
-                        else BroadcastChannel(address, udp_port, self.clock))  # fmt: skip
+        self.channel = (
+            MulticastChannel(MULTICAST_GROUP, udp_port, self.clock)
+            if loopback
+            else BroadcastChannel(address, udp_port, self.clock)
+        )
         location = self._text("inputloctype", "constant_local").lower()
         if location not in LOCATION_TYPES:
             self._error("inputloctype", f"{location!r} is not one of {', '.join(LOCATION_TYPES)}")
@@ -98,8 +112,13 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
                 self.subscribe(var, lambda msg, i=index: self._on_position(i, msg))
         modem_id = int(self._number("modemid", 1))
         self.pair = self._make_pair()
-        self.model = MicroModemModel(modem_id, self.clock, self.channel, name=f"{self.name}:{self.port_path}",
-                                     timing=dataclasses.replace(DEFAULT_TIMING, baud=speed))
+        self.model = MicroModemModel(
+            modem_id,
+            self.clock,
+            self.channel,
+            name=f"{self.name}:{self.port_path}",
+            timing=dataclasses.replace(DEFAULT_TIMING, baud=speed),
+        )
         self.server = MMSimServer(self.model, self.channel, port=None, serial_path=self.port_path)
 
     def _error(self, key: str, reason: str) -> NoReturn:
@@ -129,14 +148,19 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
             return None
         partner = partner_of(self.port_path)
         if partner is None:
-            self._error("port", f"{self.port_path} does not exist, and only loopback names ending "
-                        "in 1 or 2 (/tmp/ttyLOOPA1 <-> /tmp/ttyLOOPA2) can be made here; run "
-                        "`pygoby loopbacks` or give a real serial device")  # fmt: skip
+            self._error(
+                "port",
+                f"{self.port_path} does not exist, and only loopback names ending "
+                "in 1 or 2 (/tmp/ttyLOOPA1 <-> /tmp/ttyLOOPA2) can be made here; run "
+                "`pygoby loopbacks` or give a real serial device",
+            )
         try:
             pair = PtyPair(self.port_path, partner).open()
         except (PtyError, OSError) as err:
             self._error("port", f"cannot make the loopback {self.port_path} <-> {partner}: {err}")
-        self.log.info("made the loopback %s <-> %s (the host opens %s)", self.port_path, partner, partner)
+        self.log.info(
+            "made the loopback %s <-> %s (the host opens %s)", self.port_path, partner, partner
+        )
         return pair
 
     def _on_position(self, index: int, msg: MOOSMessage) -> None:
@@ -149,8 +173,13 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
         self.channel.open()
         await self.server.start()
         await super().start(connect_timeout)
-        self.log.info("Micro-Modem emulator on %s, channel %s:%d, position %s", self.port_path,
-                      self.channel.group, self.channel.port, self.position)  # fmt: skip
+        self.log.info(
+            "Micro-Modem emulator on %s, channel %s:%d, position %s",
+            self.port_path,
+            self.channel.group,
+            self.channel.port,
+            self.position,
+        )
 
     async def stop(self) -> None:
         """The serial line and its links go first: they must not outlive a quick kill."""
@@ -161,7 +190,6 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
                 self.pair.close()
         finally:
             await super().stop()
-
 
 
 def main(argv=None) -> int:

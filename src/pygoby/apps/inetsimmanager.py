@@ -41,9 +41,14 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
         self.netsim = NetSimClient(cfg.manager_host, cfg.manager_port, on_response=self._answer)
         self.last_status: str | None = None
         names = {
-            cfg.lat_var: "lat", cfg.lon_var: "lon", cfg.x_var: "x", cfg.y_var: "y",
-            cfg.depth_var: "depth", cfg.speed_var: "speed", cfg.heading_var: "heading",
-        }  # fmt: skip
+            cfg.lat_var: "lat",
+            cfg.lon_var: "lon",
+            cfg.x_var: "x",
+            cfg.y_var: "y",
+            cfg.depth_var: "depth",
+            cfg.speed_var: "speed",
+            cfg.heading_var: "heading",
+        }
         for var, name in names.items():
             self.subscribe(var, lambda msg, name=name: self._nav(name, msg))
         self.subscribe_pb(cfg.modem_receive_var, acomms_pb.ModemTransmission, self._modem_receive)

@@ -77,19 +77,27 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.publish("VEHICLE_ID", float(cfg.modem_id))
         self.messages.apply_libraries(self.acomms.codec)
         self.binding = TranslatorBinding(
-            self, cfg.translator_entry, self.message_types, on_created=self._created,
+            self,
+            cfg.translator_entry,
+            self.message_types,
+            on_created=self._created,
             multiplex_vars=cfg.multiplex_create_moos_var,
             modem_id_lookup_path=cfg.modem_id_lookup_path,
-        )  # fmt: skip
+        )
         self.translator = self.binding.translator
         self.messages.read_named_values(self.translator)
         self._connect_signals()
-        self.goby11 = Goby11Variables(self, self.acomms, cfg.queue_cfg, enabled=bool(
-            cfg.queue_cfg.queue or cfg.transitional_cfg.message_file))  # fmt: skip
+        self.goby11 = Goby11Variables(
+            self,
+            self.acomms,
+            cfg.queue_cfg,
+            enabled=bool(cfg.queue_cfg.queue or cfg.transitional_cfg.message_file),
+        )
         self._configure_queue()
         self._subscribe_all()
-        self.frontseat_forward = self.messages.require(cfg.dccl_frontseat_forward_name,
-                                                       "dccl_frontseat_forward_name")  # fmt: skip
+        self.frontseat_forward = self.messages.require(
+            cfg.dccl_frontseat_forward_name, "dccl_frontseat_forward_name"
+        )
         self.liaison = None
         if cfg.HasField("liaison"):
             from pygoby.topside.liaison import Liaison  # imported only when asked for (web stack)
@@ -102,8 +110,11 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         if skipped:  # goby3 skips them silently: an operator never learns why nothing is sent
-            raise self.config_error(not_loaded(skipped[0], self.messages.loaded()),
-                                    "queue_cfg.message_entry.protobuf_name", skipped[0])  # fmt: skip
+            raise self.config_error(
+                not_loaded(skipped[0], self.messages.loaded()),
+                "queue_cfg.message_entry.protobuf_name",
+                skipped[0],
+            )
 
     # ------------------------------------------------------------------ wiring
     def _connect_signals(self) -> None:
@@ -129,15 +140,19 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def _subscribe_all(self) -> None:
         acomms = self.acomms
-        from_others = {"driver_receive": acomms.inject_receive,
-                       "mac_initiate_transmission": acomms.initiate_transmission}  # fmt: skip
+        from_others = {
+            "driver_receive": acomms.inject_receive,
+            "mac_initiate_transmission": acomms.initiate_transmission,
+        }
         for key, handler in from_others.items():
             self.subscribe_pb(self.var[key], acomms_pb.ModemTransmission, handler, ignore_own=True)
         self.subscribe(self.var["mac_cycle_update"], self._on_mac_update)
         self.subscribe_pb(self.var["queue_flush"], acomms_pb.QueueFlush, self.queue.flush_queue)
         self.subscribe(self.var["config_file_request"], self._on_config_request)
         self.subscribe(self.var["driver_reset"], self._on_driver_reset)
-        self.subscribe_pb(self.var["driver_cfg_update"], acomms_pb.DriverConfig, acomms.update_driver_cfg)
+        self.subscribe_pb(
+            self.var["driver_cfg_update"], acomms_pb.DriverConfig, acomms.update_driver_cfg
+        )
         self.binding.subscribe_all()
         self.goby11.subscribe_all()
 
@@ -170,8 +185,10 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         mac = self.acomms.mac
         if mac.running and mac.slots:
             now = mac.slots[(mac.current - 1) % len(mac.slots)]
-            lines.append(f"MAC slot {now.slot_index} ({now.src}->{now.dest}, rate {now.rate}, "
-                         f"{now.slot_seconds:g} s); next in {mac.next_slot_time - self.clock.now():.1f} s")  # fmt: skip
+            lines.append(
+                f"MAC slot {now.slot_index} ({now.src}->{now.dest}, rate {now.rate}, "
+                f"{now.slot_seconds:g} s); next in {mac.next_slot_time - self.clock.now():.1f} s"
+            )
         else:
             lines.append("MAC: not running")
         lines += [f"queue {q.name} ({q.dccl_id}): {len(q)}" for q in self.queue.queues.values()]
@@ -190,11 +207,15 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
 
     # ------------------------------------------------------------------ MOOS -> acomms
     def _created(self, message: Message) -> None:
-        self.acomms.push(self.messages.transitional.complete(message, self.clock.now(), self.cfg.modem_id))
+        self.acomms.push(
+            self.messages.transitional.complete(message, self.clock.now(), self.cfg.modem_id)
+        )
 
     def _on_mac_update(self, msg: MOOSMessage) -> None:
         """Today's MACUpdate, or Goby 1.1's (ADD/REMOVE/REPLACE with SLOT_* slots)."""
-        if not self.goby11.apply_mac_update(msg) and (update := self.parse_pb(msg, acomms_pb.MACUpdate)):
+        if not self.goby11.apply_mac_update(msg) and (
+            update := self.parse_pb(msg, acomms_pb.MACUpdate)
+        ):
             self.acomms.apply_mac_update(update)
 
     def _on_data_on_demand(self, request, message: Message) -> None:

@@ -27,7 +27,9 @@ RANGE_RESPONSE = "ACOMMS_RANGE_RESPONSE"
 POLLER_UPDATE = "ACOMMS_POLLER_UPDATE"
 # Goby 1.1 posted its acomms messages as plain single-line TextFormat
 GOBY11_TECHNIQUE = Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT
-V1_RANGING = acomms_pb.V1ModemRangingRequest.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name
+V1_RANGING = acomms_pb.V1ModemRangingRequest.DESCRIPTOR.fields_by_name[
+    "type"
+].enum_type.values_by_name
 RANGING_TYPES = {  # Goby 1.1 RangingType -> Micro-Modem transmission type
     V1_RANGING["MODEM_TWO_WAY_PING"].number: acomms_pb.MICROMODEM_TWO_WAY_PING,
     V1_RANGING["REMUS_LBL_RANGING"].number: acomms_pb.MICROMODEM_REMUS_LBL_RANGING,
@@ -51,7 +53,9 @@ def _slot(v1_slot) -> Message:
 
 
 def _same_slot(a: Message, b: Message) -> bool:
-    return all(getattr(a, f) == getattr(b, f) for f in ("src", "dest", "rate", "type", "slot_seconds"))
+    return all(
+        getattr(a, f) == getattr(b, f) for f in ("src", "dest", "rate", "type", "slot_seconds")
+    )
 
 
 def mac_update_from_goby11(value: str | bytes, current: list[Message], src: int) -> Message | None:
@@ -88,8 +92,12 @@ class Goby11Variables:
         self.in_vars = {q.key.id: q.in_pubsub_var for q in queue_cfg.queue if q.in_pubsub_var}
         self.out_vars = {q.out_pubsub_var: q.key.id for q in queue_cfg.queue if q.out_pubsub_var}
         # these run inside the queue's and the driver's work: a failure is logged, not raised
-        acomms.queue.signal_receive_ccl.connect(self._on_ccl_received, contain_errors=True, logger=app.log)
-        acomms.signal_modem_receive.connect(self._on_modem_receive, contain_errors=True, logger=app.log)
+        acomms.queue.signal_receive_ccl.connect(
+            self._on_ccl_received, contain_errors=True, logger=app.log
+        )
+        acomms.signal_modem_receive.connect(
+            self._on_modem_receive, contain_errors=True, logger=app.log
+        )
 
     def subscribe_all(self) -> None:
         for var in self.out_vars:
@@ -130,8 +138,9 @@ class Goby11Variables:
         if request is None:
             return
         kind = RANGING_TYPES.get(request.type, acomms_pb.MICROMODEM_TWO_WAY_PING)
-        ping = acomms_pb.ModemTransmission(src=self.acomms.modem_id, dest=request.base.dest,
-                                   type=acomms_pb.DRIVER_SPECIFIC)  # fmt: skip
+        ping = acomms_pb.ModemTransmission(
+            src=self.acomms.modem_id, dest=request.base.dest, type=acomms_pb.DRIVER_SPECIFIC
+        )
         extension = ping.Extensions[acomms_pb.MM_TRANSMISSION]
         extension.type = kind
         if kind == acomms_pb.MICROMODEM_REMUS_LBL_RANGING:
@@ -159,13 +168,22 @@ class Goby11Variables:
     def _on_modem_receive(self, transmission: Message) -> None:
         if transmission.type == acomms_pb.DATA and self.enabled:
             for index, frame in enumerate(transmission.frame):
-                data = acomms_pb.V1ModemDataTransmission(data=bytes(frame), frame=transmission.frame_start + index,
-                                                 ack_requested=transmission.ack_requested)  # fmt: skip
+                data = acomms_pb.V1ModemDataTransmission(
+                    data=bytes(frame),
+                    frame=transmission.frame_start + index,
+                    ack_requested=transmission.ack_requested,
+                )
                 base = data.base
-                base.src, base.dest, base.rate = transmission.src, transmission.dest, max(transmission.rate, 0)
+                base.src, base.dest, base.rate = (
+                    transmission.src,
+                    transmission.dest,
+                    max(transmission.rate, 0),
+                )
                 base.time = goby11_time(transmission.time / 1e6)
                 self._publish(INCOMING_DATA, data)
-        elif transmission.type == acomms_pb.DRIVER_SPECIFIC and transmission.HasExtension(acomms_pb.MM_TRANSMISSION):
+        elif transmission.type == acomms_pb.DRIVER_SPECIFIC and transmission.HasExtension(
+            acomms_pb.MM_TRANSMISSION
+        ):
             extension = transmission.Extensions[acomms_pb.MM_TRANSMISSION]
             if extension.type in V1_RANGING_OF and extension.HasField("ranging_reply"):
                 reply = acomms_pb.V1ModemRangingReply(type=V1_RANGING_OF[extension.type])

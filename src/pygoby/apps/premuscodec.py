@@ -37,26 +37,43 @@ TEXT = Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT  # Goby 1.1's ModemDataTransmiss
 
 
 class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = ("pygoby/apps/premuscodec_config.proto", "pygoby.apps.protobuf.pREMUSCodecConfig")
+    config_proto = (
+        "pygoby/apps/premuscodec_config.proto",
+        "pygoby.apps.protobuf.pREMUSCodecConfig",
+    )
     default_name = "pREMUSCodec"
 
     def __init__(self, cfg: Message, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         if not (self.common.HasField("lat_origin") and self.common.HasField("lon_origin")):
-            raise ConfigError("LatOrigin and LongOrigin are required (REMUS frames carry latitude "
-                              "and longitude, MOOS vehicles local x/y)", field="common.lat_origin")  # fmt: skip
+            raise ConfigError(
+                "LatOrigin and LongOrigin are required (REMUS frames carry latitude "
+                "and longitude, MOOS vehicles local x/y)",
+                field="common.lat_origin",
+            )
         path = cfg.modem_id_lookup_path
         lookup = ModemIdLookup.from_file(self.find_file(path)) if path else ModemIdLookup()
-        self.reports = RemusReports(UTMGeodesy(self.common.lat_origin, self.common.lon_origin), lookup)
+        self.reports = RemusReports(
+            UTMGeodesy(self.common.lat_origin, self.common.lon_origin), lookup
+        )
         self._last_status = -math.inf
-        incoming = {cfg.mdat_state_var: "state", cfg.mdat_ranger_var: "ranger",
-                    cfg.mdat_redirect_var: "redirect", cfg.mdat_alert_var: "alert",
-                    cfg.mdat_alert2_var: "alert2"}  # fmt: skip
+        incoming = {
+            cfg.mdat_state_var: "state",
+            cfg.mdat_ranger_var: "ranger",
+            cfg.mdat_redirect_var: "redirect",
+            cfg.mdat_alert_var: "alert",
+            cfg.mdat_alert2_var: "alert2",
+        }
         for var, kind in incoming.items():
             self.subscribe(var, partial(self._on_frame, kind))
         # Goby 1.1 registers for the outgoing variables too (they only update dynamic_vars)
-        for var in (cfg.mdat_state_out, cfg.mdat_ranger_out, cfg.mdat_redirect_out, cfg.mdat_alert_out,
-                    cfg.mdat_alert2_out):  # fmt: skip
+        for var in (
+            cfg.mdat_state_out,
+            cfg.mdat_ranger_out,
+            cfg.mdat_redirect_out,
+            cfg.mdat_alert_out,
+            cfg.mdat_alert2_out,
+        ):
             if var not in incoming:
                 self.subscribe(var)
         # state, not events: the newest values count even when posted before we started
@@ -66,8 +83,10 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def on_start(self) -> None:
         if not self.cfg.modem_id_lookup_path:
-            self.log.warning("no modem_id_lookup_path: vehicles are named by their modem id "
-                             "(set it in ProcessConfig or as a MOOS global)")  # fmt: skip
+            self.log.warning(
+                "no modem_id_lookup_path: vehicles are named by their modem id "
+                "(set it in ProcessConfig or as a MOOS global)"
+            )
 
     @property
     def modem_id(self) -> int:
@@ -85,7 +104,9 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
         if msg.src == self.name:
             return  # our own outgoing frame on a variable that is also an incoming one
         if msg.is_double:
-            self.log.warning("%s: a double (%g), not a ModemDataTransmission; skipped", msg.key, msg.dval)
+            self.log.warning(
+                "%s: a double (%g), not a ModemDataTransmission; skipped", msg.key, msg.dval
+            )
             return
         transmission = acomms_pb.V1ModemDataTransmission()
         try:
@@ -95,11 +116,17 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
             return
         data = transmission.data
         try:
-            posts = self.reports.incoming(kind, data, transmission.base.src, transmission.base.dest,
-                                          self.clock.now())  # fmt: skip
+            posts = self.reports.incoming(
+                kind, data, transmission.base.src, transmission.base.dest, self.clock.now()
+            )
         except DcclError as err:
-            self.log.warning("%s: bad CCL frame from modem %d (%s): %s; skipped", msg.key,
-                             transmission.base.src, err, data.hex())  # fmt: skip
+            self.log.warning(
+                "%s: bad CCL frame from modem %d (%s): %s; skipped",
+                msg.key,
+                transmission.base.src,
+                err,
+                data.hex(),
+            )
             return
         self.log.info("%s: %s frame from modem %d", msg.key, kind, transmission.base.src)
         for var, value in posts:
@@ -134,7 +161,9 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
         except DcclError as err:
             self.log.warning("cannot encode our State from NAV_*: %s", err)
             return
-        self._send(self.cfg.mdat_state_out, frame, dest=0, time=now)  # stamped with the frame's time
+        self._send(
+            self.cfg.mdat_state_out, frame, dest=0, time=now
+        )  # stamped with the frame's time
 
     def _on_command(self, msg: MOOSMessage) -> None:
         if msg.is_double:

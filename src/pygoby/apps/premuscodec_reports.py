@@ -80,72 +80,139 @@ class RemusReports:
     def _contacts(self, src: int, lat: float, lon: float, x: float, y: float, now: float) -> Posts:
         """The contact variables collision avoidance reads: <NAME>_NAV_*."""
         name = self.lookup.name(src).upper()
-        return [(f"{name}_NAV_UTC", now), (f"{name}_NAV_X", x), (f"{name}_NAV_Y", y),
-                (f"{name}_NAV_LAT", lat), (f"{name}_NAV_LONG", lon)]  # fmt: skip
+        return [
+            (f"{name}_NAV_UTC", now),
+            (f"{name}_NAV_X", x),
+            (f"{name}_NAV_Y", y),
+            (f"{name}_NAV_LAT", lat),
+            (f"{name}_NAV_LONG", lon),
+        ]
 
     def _position_report(self, frame: State | Ranger, src: int, now: float) -> Posts:
         lat, lon = frame.latitude, frame.longitude
         x, y = self.geodesy.to_local(lat, lon)
         speed = frame.est_velocity if isinstance(frame, State) else frame.speed
-        status = [("MessageType", "CCL_STATUS"), ("Node", src), ("Timestamp", num(now)),
-                  ("Latitude", num(lat)), ("Longitude", num(lon)), ("Speed", num(speed)),
-                  ("Heading", num(frame.heading)), ("Depth", num(frame.depth))]  # fmt: skip
+        status = [
+            ("MessageType", "CCL_STATUS"),
+            ("Node", src),
+            ("Timestamp", num(now)),
+            ("Latitude", num(lat)),
+            ("Longitude", num(lon)),
+            ("Speed", num(speed)),
+            ("Heading", num(frame.heading)),
+            ("Depth", num(frame.depth)),
+        ]
         if isinstance(frame, State):
             gpo = frame.gfi_pitch_oil
-            status += [("GoalLatitude", num(frame.lat_goal)), ("GoalLongitude", num(frame.lon_goal)),
-                       ("Batterypercent", frame.battery_percent), ("GFI", num(gpo.gfi)),
-                       ("Pitch", num(gpo.pitch)), ("Oil", num(gpo.oil))]  # fmt: skip
+            status += [
+                ("GoalLatitude", num(frame.lat_goal)),
+                ("GoalLongitude", num(frame.lon_goal)),
+                ("Batterypercent", frame.battery_percent),
+                ("GFI", num(gpo.gfi)),
+                ("Pitch", num(gpo.pitch)),
+                ("Oil", num(gpo.oil)),
+            ]
         name = self.lookup.name(src)
-        node_report = key_values([
-            ("NAME", name), ("TYPE", self.lookup.type(src)), ("MOOSDB_TIME", -1), ("UTC_TIME", num(now)),
-            ("X", num(x)), ("Y", num(y)), ("LAT", num(lat)), ("LON", num(lon)), ("SPD", num(speed)),
-            ("HDG", num(frame.heading)), ("YAW", num(frame.heading - 360)), ("DEPTH", num(frame.depth)),
-        ]) + NODE_REPORT_TAIL  # fmt: skip
+        node_report = (
+            key_values(
+                [
+                    ("NAME", name),
+                    ("TYPE", self.lookup.type(src)),
+                    ("MOOSDB_TIME", -1),
+                    ("UTC_TIME", num(now)),
+                    ("X", num(x)),
+                    ("Y", num(y)),
+                    ("LAT", num(lat)),
+                    ("LON", num(lon)),
+                    ("SPD", num(speed)),
+                    ("HDG", num(frame.heading)),
+                    ("YAW", num(frame.heading - 360)),
+                    ("DEPTH", num(frame.depth)),
+                ]
+            )
+            + NODE_REPORT_TAIL
+        )
         upper = name.upper()
         return [
             ("STATUS_REPORT_IN", key_values(status)),
             *self._contacts(src, lat, lon, x, y, now),
-            (f"{upper}_NAV_SPEED", speed), (f"{upper}_NAV_DEPTH", frame.depth),
-            (f"{upper}_NAV_HEADING", frame.heading), ("NODE_REPORT", node_report),
-        ]  # fmt: skip
+            (f"{upper}_NAV_SPEED", speed),
+            (f"{upper}_NAV_DEPTH", frame.depth),
+            (f"{upper}_NAV_HEADING", frame.heading),
+            ("NODE_REPORT", node_report),
+        ]
 
     def _position(self, frame: Position, src: int, now: float) -> Posts:
         x, y = self.geodesy.to_local(frame.latitude, frame.longitude)
-        text = key_values([("MessageType", "CCL_POSITION"), ("Node", src), ("Type", frame.type_name),
-                           ("Timestamp", num(now)), ("Latitude", num(frame.latitude)),
-                           ("Longitude", num(frame.longitude)), ("Label", frame.label)])  # fmt: skip
-        return [("CCL_POSITION_IN", text), *self._contacts(src, frame.latitude, frame.longitude, x, y, now)]
+        text = key_values(
+            [
+                ("MessageType", "CCL_POSITION"),
+                ("Node", src),
+                ("Type", frame.type_name),
+                ("Timestamp", num(now)),
+                ("Latitude", num(frame.latitude)),
+                ("Longitude", num(frame.longitude)),
+                ("Label", frame.label),
+            ]
+        )
+        return [
+            ("CCL_POSITION_IN", text),
+            *self._contacts(src, frame.latitude, frame.longitude, x, y, now),
+        ]
 
     @staticmethod
     def _alert_head(kind: str, frame: Alert | Alert2, src: int) -> list[tuple[str, object]]:
-        return [("MessageType", kind), ("Node", src), ("Timestamp", num(float(frame.oasis_time))),
-                ("Latitude", num(frame.latitude)), ("Longitude", num(frame.longitude))]  # fmt: skip
+        return [
+            ("MessageType", kind),
+            ("Node", src),
+            ("Timestamp", num(float(frame.oasis_time))),
+            ("Latitude", num(frame.latitude)),
+            ("Longitude", num(frame.longitude)),
+        ]
 
     def _alert(self, frame: Alert, src: int) -> str:
         pairs = self._alert_head("CCL_ALERT", frame, src) + [("Heading", num(frame.heading))]
         for n, c in enumerate(frame.contacts, start=1):
-            pairs += [(f"Contact{n}Id", c.id), (f"Contact{n}Age", c.age), (f"Contact{n}Bearing", c.bearing),
-                      (f"Contact{n}Signature1", c.signature1), (f"Contact{n}Signature2", c.signature2)]  # fmt: skip
+            pairs += [
+                (f"Contact{n}Id", c.id),
+                (f"Contact{n}Age", c.age),
+                (f"Contact{n}Bearing", c.bearing),
+                (f"Contact{n}Signature1", c.signature1),
+                (f"Contact{n}Signature2", c.signature2),
+            ]
         return key_values(pairs)
 
     def _alert2(self, frame: Alert2, src: int) -> str:
         pairs = self._alert_head("CCL_ALERT2", frame, src)
         for n, c in enumerate(frame.contacts, start=1):
-            pairs += [(f"Contact{n}Id", c.id), (f"Contact{n}Age", c.age), (f"Contact{n}Bearing", c.bearing),
-                      (f"Contact{n}HeadingType", "Absolute" if c.absolute_heading else "Vehicle"),
-                      (f"Contact{n}Heading", num(c.heading)), (f"Contact{n}Signature1", c.signature1),
-                      (f"Contact{n}Signature2", c.signature2)]  # fmt: skip
+            pairs += [
+                (f"Contact{n}Id", c.id),
+                (f"Contact{n}Age", c.age),
+                (f"Contact{n}Bearing", c.bearing),
+                (f"Contact{n}HeadingType", "Absolute" if c.absolute_heading else "Vehicle"),
+                (f"Contact{n}Heading", num(c.heading)),
+                (f"Contact{n}Signature1", c.signature1),
+                (f"Contact{n}Signature2", c.signature2),
+            ]
         return key_values(pairs)
 
     # ------------------------------------------------------------------ MOOS -> frames
-    def state_frame(self, x: float, y: float, depth: float, speed: float, heading: float, now: float) -> bytes:
+    def state_frame(
+        self, x: float, y: float, depth: float, speed: float, heading: float, now: float
+    ) -> bytes:
         """Our own State from NAV_* (local x/y converted with the datum) at `now`; the speed is
         limited to what the frame holds."""
         lat, lon = self.geodesy.to_geo(x, y)
         if math.isfinite(speed):
             speed = min(max(speed, VELOCITY_RANGE[0]), VELOCITY_RANGE[1])
-        return State(latitude=lat, longitude=lon, time=TimeDate.at(now), heading=heading, depth=depth,
-                     est_velocity=speed).encode()  # fmt: skip
+        return State(
+            latitude=lat,
+            longitude=lon,
+            time=TimeDate.at(now),
+            heading=heading,
+            depth=depth,
+            est_velocity=speed,
+        ).encode()
 
     @staticmethod
     def redirect_command(text: str) -> tuple[int, bytes] | None:
@@ -176,33 +243,55 @@ class RemusReports:
         try:
             speed_depth_flags = int(flags, 16)
         except ValueError:
-            raise CCLEncodeError(f"CCL_REDIRECT SpeedDepthFlags={flags!r} is not hexadecimal") from None
+            raise CCLEncodeError(
+                f"CCL_REDIRECT SpeedDepthFlags={flags!r} is not hexadecimal"
+            ) from None
         dest = whole("DestinationPlatformId", required=True)
         if dest < 0:
             raise CCLEncodeError(f"CCL_REDIRECT DestinationPlatformId={dest} is not a modem id")
         redirect = Redirect(
-            latitude=number("Latitude", True), longitude=number("Longitude", True),
-            speed_depth_flags=speed_depth_flags, transit_depth=number("TransitDepth"),
-            transit_speed=number("TransitSpeed"), transit_command=whole("TransitCommand"),
-            survey_depth=number("SurveyDepth"), survey_speed=number("SurveySpeed"),
-            survey_command=whole("SurveyCommand"), num_rows=whole("NumberOfRows"),
-            row_length=whole("RowLength"), spacing_0=whole("RowSpacing0"), spacing_1=whole("RowSpacing1"),
-            row_heading=number("RowHeading"), start_latitude=number("StartLatitude"),
+            latitude=number("Latitude", True),
+            longitude=number("Longitude", True),
+            speed_depth_flags=speed_depth_flags,
+            transit_depth=number("TransitDepth"),
+            transit_speed=number("TransitSpeed"),
+            transit_command=whole("TransitCommand"),
+            survey_depth=number("SurveyDepth"),
+            survey_speed=number("SurveySpeed"),
+            survey_command=whole("SurveyCommand"),
+            num_rows=whole("NumberOfRows"),
+            row_length=whole("RowLength"),
+            spacing_0=whole("RowSpacing0"),
+            spacing_1=whole("RowSpacing1"),
+            row_heading=number("RowHeading"),
+            start_latitude=number("StartLatitude"),
             start_longitude=number("StartLongitude"),
-        )  # fmt: skip
+        )
         return dest, redirect.encode()
 
 
 def redirect_text(frame: Redirect, dest: int, now: float) -> str:
     """CCL_REDIRECT_IN: the keys an OUTGOING_COMMAND takes, so it can be sent on again."""
-    return key_values([
-        ("MessageType", "CCL_REDIRECT"), ("DestinationPlatformId", dest), ("Timestamp", num(now)),
-        ("Latitude", num(frame.latitude)), ("Longitude", num(frame.longitude)),
-        ("SpeedDepthFlags", f"{frame.speed_depth_flags:02X}"), ("TransitSpeed", num(frame.transit_speed)),
-        ("TransitDepth", num(frame.transit_depth)), ("TransitCommand", frame.transit_command),
-        ("SurveySpeed", num(frame.survey_speed)), ("SurveyDepth", num(frame.survey_depth)),
-        ("SurveyCommand", frame.survey_command), ("NumberOfRows", frame.num_rows),
-        ("RowLength", frame.row_length), ("RowSpacing0", frame.spacing_0), ("RowSpacing1", frame.spacing_1),
-        ("RowHeading", num(frame.row_heading)), ("StartLatitude", num(frame.start_latitude)),
-        ("StartLongitude", num(frame.start_longitude)),
-    ])  # fmt: skip
+    return key_values(
+        [
+            ("MessageType", "CCL_REDIRECT"),
+            ("DestinationPlatformId", dest),
+            ("Timestamp", num(now)),
+            ("Latitude", num(frame.latitude)),
+            ("Longitude", num(frame.longitude)),
+            ("SpeedDepthFlags", f"{frame.speed_depth_flags:02X}"),
+            ("TransitSpeed", num(frame.transit_speed)),
+            ("TransitDepth", num(frame.transit_depth)),
+            ("TransitCommand", frame.transit_command),
+            ("SurveySpeed", num(frame.survey_speed)),
+            ("SurveyDepth", num(frame.survey_depth)),
+            ("SurveyCommand", frame.survey_command),
+            ("NumberOfRows", frame.num_rows),
+            ("RowLength", frame.row_length),
+            ("RowSpacing0", frame.spacing_0),
+            ("RowSpacing1", frame.spacing_1),
+            ("RowHeading", num(frame.row_heading)),
+            ("StartLatitude", num(frame.start_latitude)),
+            ("StartLongitude", num(frame.start_longitude)),
+        ]
+    )

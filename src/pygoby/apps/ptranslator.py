@@ -29,8 +29,10 @@ class pTranslator(GobyMOOSApp):  # noqa: N801 - the program's name
         )
         types = MessageTypes(
             [*(p for library in libraries for p in library.proto_files), *cfg.load_proto_file],
-            others, search_dirs=self.search_dirs(), config_error=self.config_error,
-        )  # fmt: skip
+            others,
+            search_dirs=self.search_dirs(),
+            config_error=self.config_error,
+        )
         for entry in cfg.translator_entry:
             types.require(entry.protobuf_name, "translator_entry.protobuf_name")
         self.binding = TranslatorBinding(

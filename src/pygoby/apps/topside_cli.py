@@ -13,8 +13,10 @@ def _run_liaison(args: argparse.Namespace) -> int:
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     liaison = subparsers.add_parser(
-        "liaison", help="the community in a web browser: Scope, Commander, Acomms, Map",
-        add_help=False, prefix_chars="\x00",  # every argument, options included, goes to the app
-    )  # fmt: skip
+        "liaison",
+        help="the community in a web browser: Scope, Commander, Acomms, Map",
+        add_help=False,
+        prefix_chars="\x00",  # every argument, options included, goes to the app
+    )
     liaison.add_argument("rest", nargs=argparse.REMAINDER, help="mission.moos [AppName] [options]")
     liaison.set_defaults(func=_run_liaison)

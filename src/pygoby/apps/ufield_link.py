@@ -33,7 +33,11 @@ class MOOSMailLink:
     def fetch(self) -> list[tuple[str, str]]:
         if self.client is None:
             return []
-        return [(m.key, m.string) for m in self.client.fetch() if m.msg_type == NOTIFY and not m.is_double]
+        return [
+            (m.key, m.string)
+            for m in self.client.fetch()
+            if m.msg_type == NOTIFY and not m.is_double
+        ]
 
     def close(self) -> None:
         if self.client is not None:

@@ -64,10 +64,15 @@ class uSimVehicle(GobyMOOSApp):  # noqa: N801 - the program's name
     def __init__(self, cfg: Message, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.vehicle = VehicleModel(
-            x=cfg.start_x, y=cfg.start_y, depth=cfg.start_depth, heading=cfg.start_heading % 360,
-            speed=cfg.start_speed, turn_rate=cfg.turn_rate, acceleration=cfg.acceleration,
+            x=cfg.start_x,
+            y=cfg.start_y,
+            depth=cfg.start_depth,
+            heading=cfg.start_heading % 360,
+            speed=cfg.start_speed,
+            turn_rate=cfg.turn_rate,
+            acceleration=cfg.acceleration,
             dive_rate=cfg.dive_rate,
-        )  # fmt: skip
+        )
         self._last_step: float | None = None
         self._last_nav = -math.inf
         self._script_start = 0.0
@@ -92,8 +97,13 @@ class uSimVehicle(GobyMOOSApp):  # noqa: N801 - the program's name
         if now - self._last_nav >= self.cfg.nav_period:
             self._last_nav = now
             v = self.vehicle
-            for var, value in (("NAV_X", v.x), ("NAV_Y", v.y), ("NAV_DEPTH", v.depth),
-                               ("NAV_HEADING", v.heading), ("NAV_SPEED", v.speed)):  # fmt: skip
+            for var, value in (
+                ("NAV_X", v.x),
+                ("NAV_Y", v.y),
+                ("NAV_DEPTH", v.depth),
+                ("NAV_HEADING", v.heading),
+                ("NAV_SPEED", v.speed),
+            ):
                 self.publish(var, round(value, 3))
         self._run_script(now)
 

@@ -23,28 +23,49 @@ def _rows(node: MessageNode, part: str, prefix: str, depth: int) -> list[FieldRo
     rows: list[FieldRow] = []
     for oneof in node.oneofs:
         rows.append(
-            FieldRow(f"{prefix}{oneof.name} (oneof case)", part, "oneof", oneof.bits, oneof.bits,
-                     f"{len(oneof.members)} members")
+            FieldRow(
+                f"{prefix}{oneof.name} (oneof case)",
+                part,
+                "oneof",
+                oneof.bits,
+                oneof.bits,
+                f"{len(oneof.members)} members",
+            )
         )
     for item in node.items:
         path = prefix + item.field.name
         if isinstance(item, ScalarItem):
             codec = item.codec
             rows.append(
-                FieldRow(path, part, codec.info.codec_name, item.min_size(), item.max_size(),
-                         f"{item.mode.value} {codec.describe()}".strip())
+                FieldRow(
+                    path,
+                    part,
+                    codec.info.codec_name,
+                    item.min_size(),
+                    item.max_size(),
+                    f"{item.mode.value} {codec.describe()}".strip(),
+                )
             )
         elif isinstance(item, MessageItem):
             kind = "presence bit" if item.presence_bit else item.mode.value
             rows.append(
-                FieldRow(path, part, f"message v{item.child.codec_version}", item.min_size(),
-                         item.max_size(), kind)
+                FieldRow(
+                    path,
+                    part,
+                    f"message v{item.child.codec_version}",
+                    item.min_size(),
+                    item.max_size(),
+                    kind,
+                )
             )
             rows += _rows(item.child, part, path + ".", depth + 1)
         elif isinstance(item, RepeatedItem):
             element = item.codec.info.codec_name if item.codec else "message"
-            layout = (f"{item.max_repeat} slots" if item.slots
-                      else f"{item.prefix_bits}-bit count, {item.min_repeat}..{item.max_repeat}")
+            layout = (
+                f"{item.max_repeat} slots"
+                if item.slots
+                else f"{item.prefix_bits}-bit count, {item.min_repeat}..{item.max_repeat}"
+            )
             rows.append(
                 FieldRow(f"{path}[]", part, element, item.min_size(), item.max_size(), layout)
             )
@@ -53,8 +74,14 @@ def _rows(node: MessageNode, part: str, prefix: str, depth: int) -> list[FieldRo
         elif isinstance(item, ListItem):
             codec = item.codec
             rows.append(
-                FieldRow(f"{path}[]", part, codec.info.codec_name, item.min_size(),
-                         item.max_size(), f"whole list, {codec.describe()}")
+                FieldRow(
+                    f"{path}[]",
+                    part,
+                    codec.info.codec_name,
+                    item.min_size(),
+                    item.max_size(),
+                    f"whole list, {codec.describe()}",
+                )
             )
     return rows
 
@@ -62,8 +89,16 @@ def _rows(node: MessageNode, part: str, prefix: str, depth: int) -> list[FieldRo
 def field_rows(compiled: CompiledType) -> list[FieldRow]:
     rows = []
     if compiled.id_bits:
-        rows.append(FieldRow("(id)", "head", "dccl.default.id", compiled.id_bits,
-                             compiled.id_bits, f"id {compiled.id}"))
+        rows.append(
+            FieldRow(
+                "(id)",
+                "head",
+                "dccl.default.id",
+                compiled.id_bits,
+                compiled.id_bits,
+                f"id {compiled.id}",
+            )
+        )
     rows += _rows(compiled.head, "head", "", 0)
     rows += _rows(compiled.body, "body", "", 0)
     return rows
@@ -96,5 +131,7 @@ def describe(compiled: CompiledType) -> str:
 
 def generated_source(compiled: CompiledType) -> str:
     """The generated Python of the type's encode/decode functions (head and body parts)."""
-    return "\n".join(compiled.source[name] for name in
-                     ("encode_head", "encode_body", "decode_head", "decode_body"))
+    return "\n".join(
+        compiled.source[name]
+        for name in ("encode_head", "encode_body", "decode_head", "decode_body")
+    )

@@ -86,7 +86,9 @@ class Model:
             return DcclLoadError(f"invalid arithmetic model {user.name!r}: {why}")
 
         if not user.IsInitialized():
-            raise DcclLoadError(f"invalid arithmetic model: missing {user.FindInitializationErrors()}")
+            raise DcclLoadError(
+                f"invalid arithmetic model: missing {user.FindInitializationErrors()}"
+            )
         self.user = user
         self.name = user.name
         self.bounds = list(user.value_bound)
@@ -206,8 +208,14 @@ def _from_wire(category: str, info: FieldInfo):
     if category == "uint32":
         return lambda x: cvtt64(x) & _U32
     if category == "uint64":
-        return lambda x: (cvtt64(x - 9223372036854775808.0) ^ (1 << 63) if x >= 9223372036854775808.0
-                          else cvtt64(x)) & _U64
+        return lambda x: (
+            (
+                cvtt64(x - 9223372036854775808.0) ^ (1 << 63)
+                if x >= 9223372036854775808.0
+                else cvtt64(x)
+            )
+            & _U64
+        )
     if category == "enum":
         known = {v.number for v in info.descriptor.enum_type.values}
         # an unknown number makes the element "not set" (dropped)
@@ -251,7 +259,8 @@ class ArithmeticCodec(RepeatedFieldCodec):
         eof = model.eof_frequency
         with_eof = (
             math.ceil(n * math.log2(total) - (n - 1) * math.log2(lowest) - math.log2(eof))
-            if eof else 0
+            if eof
+            else 0
         )
         return max(with_eof, least_probable) + 1
 

@@ -27,34 +27,69 @@ def register(subparsers) -> None:
     parser.add_argument("action", choices=["encode", "decode", "analyze"])
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--proto", help=".proto file defining the message")
-    source.add_argument("--xml", metavar="FILE",
-                        help="Goby 1.1 XML message set (converted to DCCL in memory)")
-    parser.add_argument("-I", "--include", action="append", default=[], metavar="DIR",
-                        help="include directory for imports (repeatable)")
-    parser.add_argument("--message", metavar="FULL.NAME",
-                        help="fully qualified message name (with --xml: the XML <name>; "
-                             "analyze without it shows every DCCL message of the file)")
-    parser.add_argument("--write-proto", metavar="DIR",
-                        help="with --xml: also write the converted .proto file into DIR")
+    source.add_argument(
+        "--xml", metavar="FILE", help="Goby 1.1 XML message set (converted to DCCL in memory)"
+    )
+    parser.add_argument(
+        "-I",
+        "--include",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="include directory for imports (repeatable)",
+    )
+    parser.add_argument(
+        "--message",
+        metavar="FULL.NAME",
+        help="fully qualified message name (with --xml: the XML <name>; "
+        "analyze without it shows every DCCL message of the file)",
+    )
+    parser.add_argument(
+        "--write-proto",
+        metavar="DIR",
+        help="with --xml: also write the converted .proto file into DIR",
+    )
     secret = parser.add_mutually_exclusive_group()
-    secret.add_argument("--passphrase-file", metavar="FILE",
-                        help="encrypt/decrypt the body with the passphrase in FILE (one trailing "
-                        f"newline ignored); without a passphrase option, ${PASSPHRASE_ENV} is used")
-    secret.add_argument("--passphrase",
-                        help="the passphrase itself (visible to every user in the process list: "
-                        "prefer --passphrase-file or the environment variable)")
-    parser.add_argument("--strict", action="store_true",
-                        help="refuse out-of-range values instead of degrading them")
-    parser.add_argument("--source", action="store_true",
-                        help="analyze: print the Python generated for the message, not the table")
-    parser.add_argument("--trace", action="store_true",
-                        help="encode/decode: print each field's value and bits to stderr")
-    parser.add_argument("--arithmetic-model", action="append", default=[], metavar="FILE",
-                        help="a dccl.arith.protobuf.ArithmeticModel in TextFormat for"
-                             " dccl.arithmetic fields (repeatable)")
-    parser.add_argument("--library", action="append", default=[], metavar="LIB",
-                        help="a C++ DCCL codec library name (e.g. libdccl_ccl_compat.so): use"
-                             " pygoby's built-in equivalent (repeatable)")
+    secret.add_argument(
+        "--passphrase-file",
+        metavar="FILE",
+        help="encrypt/decrypt the body with the passphrase in FILE (one trailing "
+        f"newline ignored); without a passphrase option, ${PASSPHRASE_ENV} is used",
+    )
+    secret.add_argument(
+        "--passphrase",
+        help="the passphrase itself (visible to every user in the process list: "
+        "prefer --passphrase-file or the environment variable)",
+    )
+    parser.add_argument(
+        "--strict", action="store_true", help="refuse out-of-range values instead of degrading them"
+    )
+    parser.add_argument(
+        "--source",
+        action="store_true",
+        help="analyze: print the Python generated for the message, not the table",
+    )
+    parser.add_argument(
+        "--trace",
+        action="store_true",
+        help="encode/decode: print each field's value and bits to stderr",
+    )
+    parser.add_argument(
+        "--arithmetic-model",
+        action="append",
+        default=[],
+        metavar="FILE",
+        help="a dccl.arith.protobuf.ArithmeticModel in TextFormat for"
+        " dccl.arithmetic fields (repeatable)",
+    )
+    parser.add_argument(
+        "--library",
+        action="append",
+        default=[],
+        metavar="LIB",
+        help="a C++ DCCL codec library name (e.g. libdccl_ccl_compat.so): use"
+        " pygoby's built-in equivalent (repeatable)",
+    )
     parser.set_defaults(func=run)
 
 
@@ -68,8 +103,10 @@ def _load_xml(codec: Codec, args: argparse.Namespace) -> list:
     if args.message is None:
         return classes
     if args.message not in message_set.names:
-        raise ConfigError(f"no message named {args.message!r}"
-                          f"{did_you_mean(args.message, message_set.names)}", file=args.xml)  # fmt: skip
+        raise ConfigError(
+            f"no message named {args.message!r}{did_you_mean(args.message, message_set.names)}",
+            file=args.xml,
+        )
     return [classes[message_set.names.index(args.message)]]
 
 

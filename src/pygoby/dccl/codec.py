@@ -71,7 +71,9 @@ class Codec:
         self._conditions: DynamicConditions | None = None
         self.set_passphrase(passphrase, do_not_encrypt_ids)
 
-    def set_passphrase(self, passphrase: str | bytes | None, do_not_encrypt_ids: Iterable[int] = ()) -> None:
+    def set_passphrase(
+        self, passphrase: str | bytes | None, do_not_encrypt_ids: Iterable[int] = ()
+    ) -> None:
         self._cipher = BodyCipher(passphrase) if passphrase else None
         self._clear_ids = frozenset(do_not_encrypt_ids)
 
@@ -128,7 +130,8 @@ class Codec:
         if is_ccl_id(root.id) and self._id_codec.name != "dccl.ccl.id":
             log.info(
                 "%s is a legacy CCL type: this Codec now uses the CCL identifier codec"
-                " (other DCCL messages start with the byte 0x20)", root.name
+                " (other DCCL messages start with the byte 0x20)",
+                root.name,
             )
             self.set_id_codec("dccl.ccl.id")
         compiled = self._compile(cls, descriptor)
@@ -204,7 +207,9 @@ class Codec:
             )
         lua = self._lua() if planner.conditioned else None
         generated = {
-            "encode_head": compile_encoder(head, root.name, Part.HEAD, id_raw, id_bits, self.trace, lua),
+            "encode_head": compile_encoder(
+                head, root.name, Part.HEAD, id_raw, id_bits, self.trace, lua
+            ),
             "encode_body": compile_encoder(body, root.name, Part.BODY, 0, 0, self.trace, lua),
             "decode_head": compile_decoder(head, root.name, Part.HEAD, self.trace, lua),
             "decode_body": compile_decoder(body, root.name, Part.BODY, self.trace, lua),

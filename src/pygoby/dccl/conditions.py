@@ -143,8 +143,14 @@ class DynamicConditions:
                 ) from None
 
     # ------------------------------------------------------------------ evaluation
-    def _run(self, conditions: FieldConditions, role: str, this: Message, root: Message,
-             index: int | None) -> Any:
+    def _run(
+        self,
+        conditions: FieldConditions,
+        role: str,
+        this: Message,
+        root: Message,
+        index: int | None,
+    ) -> Any:
         if index is not None:
             self.index = index
         g = self._globals
@@ -163,8 +169,9 @@ class DynamicConditions:
         result = self._run(conditions, "required_if", this, root, None)
         return result is not None and result is not False
 
-    def omit(self, conditions: FieldConditions, this: Message, root: Message,
-             index: int | None = None) -> bool:
+    def omit(
+        self, conditions: FieldConditions, this: Message, root: Message, index: int | None = None
+    ) -> bool:
         result = self._run(conditions, "omit_if", this, root, index)
         truth = result is not None and result is not False
         return not truth if conditions.omit_negates else truth
@@ -274,8 +281,13 @@ def with_bounds(codec: Any, lo: float, hi: float) -> Any:
 class ConditionedField:
     """A field's codec chosen at run time by its conditions (the generated code calls this)."""
 
-    def __init__(self, lua: DynamicConditions, conditions: FieldConditions, codec: Any,
-                 required_codec: Any = None) -> None:
+    def __init__(
+        self,
+        lua: DynamicConditions,
+        conditions: FieldConditions,
+        codec: Any,
+        required_codec: Any = None,
+    ) -> None:
         self.lua = lua
         self.conditions = conditions
         self.codec = codec
@@ -302,7 +314,9 @@ class ConditionedField:
             return 0, 0
         return encode_value(self.codec_for(this, root), root, value, strict)
 
-    def decode(self, this: Message, root: Message, bits: int, pos: int, end: int) -> tuple[Any, int]:
+    def decode(
+        self, this: Message, root: Message, bits: int, pos: int, end: int
+    ) -> tuple[Any, int]:
         if self.omit(this, root):
             return None, pos
         return decode_value(self.codec_for(this, root), root, bits, pos, end)

@@ -88,18 +88,27 @@ def _option_entries(depth: int, options: Message, dccl_options: Message | None) 
 
 
 _TYPE_NAMES = {
-    FieldDescriptor.TYPE_DOUBLE: "double", FieldDescriptor.TYPE_FLOAT: "float",
-    FieldDescriptor.TYPE_INT64: "int64", FieldDescriptor.TYPE_UINT64: "uint64",
-    FieldDescriptor.TYPE_INT32: "int32", FieldDescriptor.TYPE_FIXED64: "fixed64",
-    FieldDescriptor.TYPE_FIXED32: "fixed32", FieldDescriptor.TYPE_BOOL: "bool",
-    FieldDescriptor.TYPE_STRING: "string", FieldDescriptor.TYPE_GROUP: "group",
-    FieldDescriptor.TYPE_BYTES: "bytes", FieldDescriptor.TYPE_UINT32: "uint32",
-    FieldDescriptor.TYPE_SFIXED32: "sfixed32", FieldDescriptor.TYPE_SFIXED64: "sfixed64",
-    FieldDescriptor.TYPE_SINT32: "sint32", FieldDescriptor.TYPE_SINT64: "sint64",
+    FieldDescriptor.TYPE_DOUBLE: "double",
+    FieldDescriptor.TYPE_FLOAT: "float",
+    FieldDescriptor.TYPE_INT64: "int64",
+    FieldDescriptor.TYPE_UINT64: "uint64",
+    FieldDescriptor.TYPE_INT32: "int32",
+    FieldDescriptor.TYPE_FIXED64: "fixed64",
+    FieldDescriptor.TYPE_FIXED32: "fixed32",
+    FieldDescriptor.TYPE_BOOL: "bool",
+    FieldDescriptor.TYPE_STRING: "string",
+    FieldDescriptor.TYPE_GROUP: "group",
+    FieldDescriptor.TYPE_BYTES: "bytes",
+    FieldDescriptor.TYPE_UINT32: "uint32",
+    FieldDescriptor.TYPE_SFIXED32: "sfixed32",
+    FieldDescriptor.TYPE_SFIXED64: "sfixed64",
+    FieldDescriptor.TYPE_SINT32: "sint32",
+    FieldDescriptor.TYPE_SINT64: "sint64",
 }
-_PROTO_TYPES = {
-    number: "TYPE_" + name.upper() for number, name in _TYPE_NAMES.items()
-} | {FieldDescriptor.TYPE_MESSAGE: "TYPE_MESSAGE", FieldDescriptor.TYPE_ENUM: "TYPE_ENUM"}
+_PROTO_TYPES = {number: "TYPE_" + name.upper() for number, name in _TYPE_NAMES.items()} | {
+    FieldDescriptor.TYPE_MESSAGE: "TYPE_MESSAGE",
+    FieldDescriptor.TYPE_ENUM: "TYPE_ENUM",
+}
 
 
 def _field_proto(f: FieldDescriptor) -> descriptor_pb2.FieldDescriptorProto:
@@ -168,7 +177,9 @@ def enum_debug_string(enum: EnumDescriptor) -> str:
         if not f.is_extension:
             lines.append(f"  option {f.name} = {scalar_text(f, value)};\n")
     for value in enum.values:
-        value_proto = next(v for v in proto.value if v.number == value.number and v.name == value.name)
+        value_proto = next(
+            v for v in proto.value if v.number == value.number and v.name == value.name
+        )
         options = _option_entries(1, value_proto.options, None)
         suffix = f" [{', '.join(options)}]" if options else ""
         lines.append(f"  {value.name} = {value.number}{suffix};\n")

@@ -55,8 +55,7 @@ BUILTIN_LIBRARIES = {
             "the dccl.arithmetic codec (pygoby.dccl.arithmetic)",
             proto_files=("dccl/arithmetic/protobuf/arithmetic_extensions.proto",),
         ),
-        BuiltinLibrary(
-            "dccl_native_protobuf", "the dccl.native_protobuf codec (built in)"),
+        BuiltinLibrary("dccl_native_protobuf", "the dccl.native_protobuf codec (built in)"),
         BuiltinLibrary("dccl", "DCCL itself (built in)"),
     )
 }

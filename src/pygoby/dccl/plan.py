@@ -244,7 +244,9 @@ class Planner:
         stack: tuple[str, ...],
     ) -> MessageNode:
         if descriptor.full_name in stack:
-            raise DcclLoadError(f"{descriptor.full_name}: recursive message types cannot be encoded")
+            raise DcclLoadError(
+                f"{descriptor.full_name}: recursive message types cannot be encoded"
+            )
         stack = (*stack, descriptor.full_name)
         node = MessageNode(descriptor, version)
         oneofs = {}
@@ -264,7 +266,8 @@ class Planner:
             node.oneofs = list(oneofs.values())
         if version >= 3:
             node.resets = frozenset(
-                f.name for f in descriptor.fields
+                f.name
+                for f in descriptor.fields
                 if (c := FieldConditions.of(f, field_options(f))) is not None
                 and (c.omit_if is not None or c.required_if is not None)
             )
@@ -295,7 +298,13 @@ class Planner:
         resolved, entry = self.registry.resolve(name, self.root.version, category)
         v2_message = isinstance(entry, DefaultMessageCodec) and entry.version == 2
         if not self._included(f, fopts, part, forced, version, v2_message):
-            if part is Part.BODY and forced is None and version >= 3 and fopts.in_head and stack[1:]:
+            if (
+                part is Part.BODY
+                and forced is None
+                and version >= 3
+                and fopts.in_head
+                and stack[1:]
+            ):
                 log.warning(
                     "%s is in_head inside a sub-message that is not in the header: it is never"
                     " sent (as in DCCL); mark the message field in_head to send it",
@@ -305,7 +314,9 @@ class Planner:
         repeated = f.is_repeated
         # conditions that apply: omit_if on a singular field only in the v3/v4 message codecs
         # (C++'s v2 codec does not look), required_if only for codec versions 3 and 4
-        singular = None if conditions is None else conditions.for_singular(version, self.root.version)
+        singular = (
+            None if conditions is None else conditions.for_singular(version, self.root.version)
+        )
         if isinstance(entry, DefaultMessageCodec):
             child_forced = forced
             if fopts.HasField("in_head"):
@@ -315,9 +326,16 @@ class Planner:
                 return self._repeated(f, fopts, child=child, conditions=conditions)
             mode = self._mode(f, oneof)
             presence = entry.version >= 3 and mode is Mode.OPTIONAL
-            return MessageItem(f, child, mode, presence, oneof,
-                               singular if mode is Mode.OPTIONAL or singular is None
-                               else singular.without_required())
+            return MessageItem(
+                f,
+                child,
+                mode,
+                presence,
+                oneof,
+                singular
+                if mode is Mode.OPTIONAL or singular is None
+                else singular.without_required(),
+            )
         if repeated:
             info = self._info(f, fopts, category, resolved, required=self.root.version >= 3)
             codec = entry(info)

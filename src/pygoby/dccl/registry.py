@@ -125,9 +125,7 @@ def _build_default_registry() -> CodecRegistry:
 DEFAULT_REGISTRY = _build_default_registry()
 
 
-def register_codec(
-    name: str, categories: Iterable[str], factory: CodecFactory
-) -> None:
+def register_codec(name: str, categories: Iterable[str], factory: CodecFactory) -> None:
     """Register a user codec in the defaults, which each Codec created afterwards copies into its
     own registry (a Codec that exists already is not changed: use `codec.registry.register` for
     one Codec). A field selects it with `(dccl.field).codec = "name"`."""

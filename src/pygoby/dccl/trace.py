@@ -50,7 +50,12 @@ class FieldTracer:
         # most significant bit first, as C++ DCCL prints a Bitset
         pattern = f": {bits >> start & (1 << nbits) - 1:0{nbits}b}" if nbits else ""
         log.debug(
-            "%s: %s = %s (%d bit%s%s)", self.where, path, show(value, self.fields.get(path)), nbits,
-            "" if nbits == 1 else "s", pattern,
+            "%s: %s = %s (%d bit%s%s)",
+            self.where,
+            path,
+            show(value, self.fields.get(path)),
+            nbits,
+            "" if nbits == 1 else "s",
+            pattern,
             extra={"dccl_field": path, "dccl_value": value, "dccl_bits": nbits},
         )

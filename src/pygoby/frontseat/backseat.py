@@ -57,23 +57,35 @@ class Backseat:
         state = self.interface.state
         if state == frontseat_pb.INTERFACE_COMMAND:
             return True
-        self.log.debug("%s not sent: the interface is in %s, not INTERFACE_COMMAND",
-                       var, frontseat_pb.InterfaceState.Name(state))  # fmt: skip
+        self.log.debug(
+            "%s not sent: the interface is in %s, not INTERFACE_COMMAND",
+            var,
+            frontseat_pb.InterfaceState.Name(state),
+        )
         return False
 
     def may_send(self, var: str) -> bool:
         if self.interface.state in CONTROL_STATES:
             return True
-        self.log.debug("%s not sent: the interface is in %s", var,
-                       frontseat_pb.InterfaceState.Name(self.interface.state))  # fmt: skip
+        self.log.debug(
+            "%s not sent: the interface is in %s",
+            var,
+            frontseat_pb.InterfaceState.Name(self.interface.state),
+        )
         return False
 
     def helm_state(self, value: str, source: str) -> None:
         current = self.interface.helm_state
         state = helm_state_from_ivphelm(value, source, current)
         if state != current:
-            self.log.info("helm state %s -> %s (%s=%r from %s)", frontseat_pb.HelmState.Name(current),
-                          frontseat_pb.HelmState.Name(state), HELM_STATE_VAR, value, source)  # fmt: skip
+            self.log.info(
+                "helm state %s -> %s (%s=%r from %s)",
+                frontseat_pb.HelmState.Name(current),
+                frontseat_pb.HelmState.Name(state),
+                HELM_STATE_VAR,
+                value,
+                source,
+            )
         self.interface.set_helm_state(state)  # every post counts for helm_state_timeout
 
     def set_origin(self, *, lat: float | None = None, lon: float | None = None) -> None:

@@ -121,9 +121,12 @@ def migrate_goby2_abc_config(cfg: Message) -> None:
     if old.start.HasField("duration"):
         sim_cfg.start.duration = old.start.duration
     cfg.ClearExtension(abc)
-    _log.warning("the Goby 2 [%s] block is read as frontseat_cfg { [%s] { %s } }", ABC_CONFIG,
-                 frontseat_pb.BASIC_SIMULATOR_CONFIG.full_name,
-                 text_format.MessageToString(sim_cfg, as_one_line=True))  # fmt: skip
+    _log.warning(
+        "the Goby 2 [%s] block is read as frontseat_cfg { [%s] { %s } }",
+        ABC_CONFIG,
+        frontseat_pb.BASIC_SIMULATOR_CONFIG.full_name,
+        text_format.MessageToString(sim_cfg, as_one_line=True),
+    )
 
 
 def refuse_unsupported_legacy(legacy_cfg: Message) -> None:

@@ -132,6 +132,9 @@ class CtdSamples:
 def ready_posts(status: Any) -> list[Post]:
     """FRONTSEAT_READY (frontseat accepting commands) and BACKSEAT_READY (helm driving), 1 or 0."""
     return [
-        ("FRONTSEAT_READY", float(status.frontseat_state == frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS)),
+        (
+            "FRONTSEAT_READY",
+            float(status.frontseat_state == frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS),
+        ),
         ("BACKSEAT_READY", float(status.helm_state == frontseat_pb.HELM_DRIVE)),
     ]

@@ -192,8 +192,10 @@ class Antler:
                 continue  # the DB is handled above
             argv = child_argv(run, self.mission_path, self.config.executable_path)
             if argv is None:
-                self.warn(f"{run.moos_name}: {run.program} is not available (no such program on "
-                         "PATH); the other processes run without it")
+                self.warn(
+                    f"{run.moos_name}: {run.program} is not available (no such program on "
+                    "PATH); the other processes run without it"
+                )
                 continue
             new_console = run.options.get("NewConsole", "false").lower() == "true"
             self.children.append(self._spawn(run.moos_name, argv, new_console))

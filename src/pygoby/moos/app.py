@@ -174,7 +174,9 @@ class GobyMOOSApp:
             config_class = builtin_class(*cls.config_proto)
         common = config_class.DESCRIPTOR.fields_by_name.get("common")
         if common is None or common.message_type.full_name != COMMON_PROTO[1]:
-            raise TypeError(f"{config_class.DESCRIPTOR.full_name} needs a `common` field of type {COMMON_PROTO[1]}")
+            raise TypeError(
+                f"{config_class.DESCRIPTOR.full_name} needs a `common` field of type {COMMON_PROTO[1]}"
+            )
         return config_class
 
     @classmethod
@@ -185,9 +187,12 @@ class GobyMOOSApp:
 
     @classmethod
     def from_mission(
-        cls, path: str | os.PathLike[str], name: str | None = None,
-        overrides: Sequence[tuple[str, str]] = (), **kwargs: object,
-    ) -> GobyMOOSApp:  # fmt: skip
+        cls,
+        path: str | os.PathLike[str],
+        name: str | None = None,
+        overrides: Sequence[tuple[str, str]] = (),
+        **kwargs: object,
+    ) -> GobyMOOSApp:
         app_name = name or cls.default_name or cls.__name__
         mission = MissionFile.read(path)
         with collecting_notes() as notes:
@@ -229,9 +234,13 @@ class GobyMOOSApp:
         if host is None:
             host = self.common.server_host if self.common.HasField("server_host") else "127.0.0.1"
         if port is None:
-            port = self.common.server_port if self.common.HasField("server_port") else p.DEFAULT_PORT
+            port = (
+                self.common.server_port if self.common.HasField("server_port") else p.DEFAULT_PORT
+            )
         self._mail: list[MOOSMessage] = []  # received, for the next tick (the list is kept)
-        self.client = MOOSClient(self.name, host, port, clock=self.clock, on_message=self._mail.append)
+        self.client = MOOSClient(
+            self.name, host, port, clock=self.clock, on_message=self._mail.append
+        )
         self.client.signal_connect.connect(self._connected)
         self.client.signal_disconnect.connect(self._disconnected)
         self.client.signal_refused.connect(self._refused)
@@ -368,8 +377,10 @@ class GobyMOOSApp:
             self.log, self.name, self.common, terminal=self.terminal_handler
         )
         if self.config_notes:
-            self.log.info("Goby 1.1/2 configuration forms mapped onto today's:\n  %s",
-                          "\n  ".join(self.config_notes))  # fmt: skip
+            self.log.info(
+                "Goby 1.1/2 configuration forms mapped onto today's:\n  %s",
+                "\n  ".join(self.config_notes),
+            )
         self._stopping = False
         self.start_time = self.clock.now()
         self.on_start()
@@ -431,8 +442,10 @@ class GobyMOOSApp:
     def status_lines(self) -> list[str]:
         """The app's state in a few lines (show_gui's status panel). Override to add yours."""
         state = "connected" if self.connected else "not connected"
-        return [f"MOOSDB {self.client.host}:{self.client.port}: {state}",
-                f"up {self.clock.now() - self.start_time:.0f} s, {self.iterations} iterations"]  # fmt: skip
+        return [
+            f"MOOSDB {self.client.host}:{self.client.port}: {state}",
+            f"up {self.clock.now() - self.start_time:.0f} s, {self.iterations} iterations",
+        ]
 
     async def __aenter__(self) -> GobyMOOSApp:
         await self.start(connect_timeout=5.0)
@@ -461,8 +474,10 @@ class GobyMOOSApp:
             self.log.exception("on_disconnect failed")
 
     def _refused(self, err: Exception) -> None:
-        self.fail(f"{err}: is another {self.name} running? (give this one another name: "
-                  f"`APP mission.moos OtherName`)")  # fmt: skip
+        self.fail(
+            f"{err}: is another {self.name} running? (give this one another name: "
+            f"`APP mission.moos OtherName`)"
+        )
 
     def _post_initializers(self) -> None:
         for var, value in initializer_posts(self.common, self.mission, self.log):
@@ -474,8 +489,11 @@ class GobyMOOSApp:
         mail = self._mail[:]
         self._mail.clear()
         if len(mail) > MAIL_LIMIT:
-            self.log.warning("%d messages arrived since the last tick; handling the newest %d",
-                             len(mail), MAIL_LIMIT)  # fmt: skip
+            self.log.warning(
+                "%d messages arrived since the last tick; handling the newest %d",
+                len(mail),
+                MAIL_LIMIT,
+            )
             del mail[:-MAIL_LIMIT]
         mail.sort(key=_by_time)  # CMOOSApp's SortMailByTime
         dynamic_vars = self.dynamic_vars
@@ -490,8 +508,11 @@ class GobyMOOSApp:
             handlers = handlers_of(key)
             if handlers:
                 if msg.time < stale_before:
-                    self.log.warning("ignoring stale message %s (time %.3f before the app started)",
-                                     key, msg.time)  # fmt: skip
+                    self.log.warning(
+                        "ignoring stale message %s (time %.3f before the app started)",
+                        key,
+                        msg.time,
+                    )
                 else:
                     for handler in handlers:
                         try:
@@ -512,9 +533,10 @@ class GobyMOOSApp:
             if len(self._pattern_routes) >= PATTERN_ROUTES_LIMIT:
                 self._pattern_routes.clear()
             route = self._pattern_routes[(key, src)] = [
-                handler for var_glob, app_glob, handler in self._pattern_handlers
+                handler
+                for var_glob, app_glob, handler in self._pattern_handlers
                 if var_glob.match(key) and app_glob.match(src)
-            ]  # fmt: skip
+            ]
         return route
 
     # -- ticks ---------------------------------------------------------------------------------

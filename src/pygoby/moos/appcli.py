@@ -52,17 +52,30 @@ def program_name(app_class: type[GobyMOOSApp], argv0: str) -> str:
 def argument_parser(program: str, command: str | None = None) -> argparse.ArgumentParser:
     """The app's command line; `command` is how it is typed when that is not `program` (e.g.
     `pygoby liaison`), for the usage and --version lines."""
-    parser = argparse.ArgumentParser(prog=command or program,
-                                     description=f"{program}: a Goby MOOS application")  # fmt: skip
+    parser = argparse.ArgumentParser(
+        prog=command or program, description=f"{program}: a Goby MOOS application"
+    )
     parser.add_argument("mission", nargs="?", help=".moos mission file")
     parser.add_argument("alias", nargs="?", help="name to use with the MOOSDB and ProcessConfig")
     parser.add_argument("-c", "--moos_file", help="same as the mission positional")
     parser.add_argument("-a", "--moos_name", help="same as the alias positional")
-    parser.add_argument("-e", "--example_config", action="store_true", help="print an example ProcessConfig block and exit")
-    parser.add_argument("-V", "--version", action="version", version=f"%(prog)s {package_version()}")
-    parser.add_argument("-v", "--verbose", action="count", default=0,
-                        help="terminal verbosity: -v VERBOSE, -vv DEBUG1, -vvv DEBUG2, -vvvv DEBUG3 "
-                        "(overrides common.verbosity)")  # fmt: skip
+    parser.add_argument(
+        "-e",
+        "--example_config",
+        action="store_true",
+        help="print an example ProcessConfig block and exit",
+    )
+    parser.add_argument(
+        "-V", "--version", action="version", version=f"%(prog)s {package_version()}"
+    )
+    parser.add_argument(
+        "-v",
+        "--verbose",
+        action="count",
+        default=0,
+        help="terminal verbosity: -v VERBOSE, -vv DEBUG1, -vvv DEBUG2, -vvvv DEBUG3 "
+        "(overrides common.verbosity)",
+    )
     return parser
 
 

@@ -53,7 +53,9 @@ def goby_field_options(field: FieldDescriptor) -> Message:
     out = _options_class()()
     if not field.has_options:
         return out
-    out.MergeFromString(length_delimited(field.GetOptions().SerializeToString(), GOBY_FIELD_EXTENSION))
+    out.MergeFromString(
+        length_delimited(field.GetOptions().SerializeToString(), GOBY_FIELD_EXTENSION)
+    )
     return out
 
 
@@ -109,8 +111,12 @@ def apply_moos_globals(config: Message, mission: MissionFile) -> None:
         if value is None:
             continue
         if config.HasField(field.name):
-            log.info("MOOS global %s=%s ignored: %s is set in the ProcessConfig block",
-                     name, value, field.full_name)  # fmt: skip
+            log.info(
+                "MOOS global %s=%s ignored: %s is set in the ProcessConfig block",
+                name,
+                value,
+                field.full_name,
+            )
             continue
         try:
             _set_from_global(config, field, name, value)
@@ -313,7 +319,9 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
         if field.has_default_value:
             value = _format_scalar(field, field.default_value)
         elif opts.HasField("example"):
-            value = _quote(opts.example) if field.type == FieldDescriptor.TYPE_STRING else opts.example
+            value = (
+                _quote(opts.example) if field.type == FieldDescriptor.TYPE_STRING else opts.example
+            )
         elif field.type == FieldDescriptor.TYPE_STRING:
             value = '""'
         elif field.is_required:  # goby3 prints nothing, which does not parse when copied
@@ -371,8 +379,9 @@ def _initializer_value(
         return ini.sval.strip() if ini.trim else ini.sval
     raw = mission.get_value(ini.global_cfg_var, outside_blocks=True) if mission else None
     if raw is None:
-        log.warning("initializer: global %s not found; %s not posted",
-                    ini.global_cfg_var, ini.moos_var)  # fmt: skip
+        log.warning(
+            "initializer: global %s not found; %s not posted", ini.global_cfg_var, ini.moos_var
+        )
         return None
     if not is_double:
         return raw.strip() if ini.trim else raw

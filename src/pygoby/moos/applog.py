@@ -60,7 +60,11 @@ def open_log_file(name: str, common: Any, log: logging.Logger) -> Path:
     """Create the log file (in common.log_path, else ./) and point the _latest symlink at it;
     ConfigError when neither folder is writable."""
     base = f"{name.replace('/', '_')}_{common.community}"
-    stamp = "" if common.log_omit_file_timestamp else "_" + time.strftime("%Y%m%dT%H%M%S", time.gmtime())
+    stamp = (
+        ""
+        if common.log_omit_file_timestamp
+        else "_" + time.strftime("%Y%m%dT%H%M%S", time.gmtime())
+    )
     for directory in (Path(common.log_path), Path(".")):
         path = directory / f"{base}{stamp}.txt"
         try:

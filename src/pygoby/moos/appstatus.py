@@ -39,6 +39,8 @@ class StatusReport:
         usage = resource.getrusage(resource.RUSAGE_SELF)
         publishing = "".join(f"{v}," for v in sorted(published))
         subscribing = "".join(f"{v}," for v in sorted(subscribed))
-        return (f"AppErrorFlag=false,Uptime={uptime:g},cpuload={self.cpu_load():.4g},"
-                f"memory_kb={usage.ru_maxrss},memory_max_kb={usage.ru_maxrss:.4g},"
-                f'MOOSName={name},Publishing="{publishing}",Subscribing="{subscribing}"')  # fmt: skip
+        return (
+            f"AppErrorFlag=false,Uptime={uptime:g},cpuload={self.cpu_load():.4g},"
+            f"memory_kb={usage.ru_maxrss},memory_max_kb={usage.ru_maxrss:.4g},"
+            f'MOOSName={name},Publishing="{publishing}",Subscribing="{subscribing}"'
+        )

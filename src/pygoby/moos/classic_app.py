@@ -47,7 +47,9 @@ class ClassicMOOSApp(GobyMOOSApp):
         cls, mission: MissionFile | None, name: str, overrides: Sequence[tuple[str, str]] = ()
     ) -> Message:
         if overrides:
-            raise ConfigError("takes no --option overrides: set them in its ProcessConfig block", field=name)
+            raise ConfigError(
+                "takes no --option overrides: set them in its ProcessConfig block", field=name
+            )
         cfg = cls.load_config_class()()
         cfg.common.log = False
         if mission is None:
@@ -59,8 +61,12 @@ class ClassicMOOSApp(GobyMOOSApp):
                 continue
             number = parse_number(setting.value)
             if number is None or number <= 0:
-                raise ConfigError(f"must be a positive number, not {setting.value!r}",
-                                  file=mission.path, line=setting.line, field=setting.name)  # fmt: skip
+                raise ConfigError(
+                    f"must be a positive number, not {setting.value!r}",
+                    file=mission.path,
+                    line=setting.line,
+                    field=setting.name,
+                )
             setattr(cfg.common, field, max(1, math.ceil(number)))
         return cfg
 

@@ -33,19 +33,42 @@ _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     db = subparsers.add_parser("moosdb", help="run an embedded MOOSDB")
-    db.add_argument("mission", nargs="?", help=".moos file (ServerPort, Community, MOOSTimeWarp, ClientTimeout)")
-    db.add_argument("--port", "--moos_port", type=int, help="TCP port (default: ServerPort, else 9000; 0 = any)")
-    db.add_argument("--community", "--moos_community", help="community name (default: Community, else #1)")
+    db.add_argument(
+        "mission", nargs="?", help=".moos file (ServerPort, Community, MOOSTimeWarp, ClientTimeout)"
+    )
+    db.add_argument(
+        "--port", "--moos_port", type=int, help="TCP port (default: ServerPort, else 9000; 0 = any)"
+    )
+    db.add_argument(
+        "--community", "--moos_community", help="community name (default: Community, else #1)"
+    )
     db.add_argument("--time-warp", "--moos_time_warp", type=float, help="MOOS time warp")
     db.add_argument("--timeout", "--moos_timeout", type=float, help="client silence timeout, s")
     db.add_argument("--host", default="127.0.0.1", help="address to bind (0.0.0.0: all interfaces)")
-    db.add_argument("--max-packet", type=int, default=p.DEFAULT_MAX_PACKET_SIZE, help="largest packet accepted, bytes")
-    db.add_argument("--packet-timeout", type=float, default=DEFAULT_PACKET_TIMEOUT,
-                    help="seconds a packet may take from its first byte to its last")  # fmt: skip
-    db.add_argument("--max-clients", type=int, default=DEFAULT_MAX_CLIENTS,
-                    help="most connections at once (handshaking ones included)")  # fmt: skip
-    db.add_argument("--memory-budget", type=float, default=DEFAULT_MEMORY_BUDGET / 2**20,
-                    help="MB of partial packets and unsent output for all clients together")  # fmt: skip
+    db.add_argument(
+        "--max-packet",
+        type=int,
+        default=p.DEFAULT_MAX_PACKET_SIZE,
+        help="largest packet accepted, bytes",
+    )
+    db.add_argument(
+        "--packet-timeout",
+        type=float,
+        default=DEFAULT_PACKET_TIMEOUT,
+        help="seconds a packet may take from its first byte to its last",
+    )
+    db.add_argument(
+        "--max-clients",
+        type=int,
+        default=DEFAULT_MAX_CLIENTS,
+        help="most connections at once (handshaking ones included)",
+    )
+    db.add_argument(
+        "--memory-budget",
+        type=float,
+        default=DEFAULT_MEMORY_BUDGET / 2**20,
+        help="MB of partial packets and unsent output for all clients together",
+    )
     db.add_argument("-v", "--verbose", action="store_true")
     db.set_defaults(func=_run_moosdb)
 
@@ -57,29 +80,49 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     common.add_argument("--name", help="MOOS name of this client (default: pygoby_<action>_<pid>)")
     common.add_argument("--connect-timeout", type=float, default=5.0)
 
-    poke = sub.add_parser("poke", parents=[common], help="publish values: VAR=3.5 (double), VAR=text or VAR:=3.5 (string)")
+    poke = sub.add_parser(
+        "poke",
+        parents=[common],
+        help="publish values: VAR=3.5 (double), VAR=text or VAR:=3.5 (string)",
+    )
     poke.add_argument("assignments", nargs="+", metavar="VAR=value")
     poke.set_defaults(func=_run_poke)
 
-    get = sub.add_parser("get", parents=[common], help="print current values (exit 1 if one was never written)")
+    get = sub.add_parser(
+        "get", parents=[common], help="print current values (exit 1 if one was never written)"
+    )
     get.add_argument("variables", nargs="+", metavar="VAR")
     get.add_argument("--json", action="store_true", help="one JSON object keyed by variable")
     get.set_defaults(func=_run_get)
 
-    watch = sub.add_parser("watch", parents=[common], help="print notifications of matching variables")
-    watch.add_argument("patterns", nargs="+", metavar="PATTERN", help="variable name or MOOS wildcard (* ?)")
+    watch = sub.add_parser(
+        "watch", parents=[common], help="print notifications of matching variables"
+    )
+    watch.add_argument(
+        "patterns", nargs="+", metavar="PATTERN", help="variable name or MOOS wildcard (* ?)"
+    )
     watch.add_argument("--secs", type=float, help="stop after this many seconds")
     watch.add_argument("--json", action="store_true", help="one JSON object per line")
     watch.set_defaults(func=_run_watch)
 
     antler = subparsers.add_parser("antler", help="launch a mission's ANTLER block (and a MOOSDB)")
     antler.add_argument("mission")
-    antler.add_argument("--no-db", action="store_true",
-                        help="do not start the embedded MOOSDB: use the one listening on ServerPort")  # fmt: skip
-    antler.add_argument("--logs", metavar="DIR",
-                        help="write each program's output to DIR/<name>.log instead of the terminal")  # fmt: skip
-    antler.add_argument("--color", choices=("auto", "always", "never"), default="auto",
-                        help="coloured name prefixes for NewConsole = true programs (auto: on a terminal)")  # fmt: skip
+    antler.add_argument(
+        "--no-db",
+        action="store_true",
+        help="do not start the embedded MOOSDB: use the one listening on ServerPort",
+    )
+    antler.add_argument(
+        "--logs",
+        metavar="DIR",
+        help="write each program's output to DIR/<name>.log instead of the terminal",
+    )
+    antler.add_argument(
+        "--color",
+        choices=("auto", "always", "never"),
+        default="auto",
+        help="coloured name prefixes for NewConsole = true programs (auto: on a terminal)",
+    )
     antler.set_defaults(func=_run_antler)
 
 
@@ -94,14 +137,19 @@ def _run(coro: Coroutine[Any, Any, int]) -> int:
 
 
 def _run_moosdb(args: argparse.Namespace) -> int:
-    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
-                        format="%(asctime)s %(name)s %(levelname)s: %(message)s")  # fmt: skip
+    logging.basicConfig(
+        level=logging.INFO if args.verbose else logging.WARNING,
+        format="%(asctime)s %(name)s %(levelname)s: %(message)s",
+    )
     mission = None
     if args.mission:
         try:
             mission = MissionFile.read(args.mission)
         except OSError as err:
-            print(f"moosdb: cannot read {args.mission} ({err.strerror}); using defaults", file=sys.stderr)
+            print(
+                f"moosdb: cannot read {args.mission} ({err.strerror}); using defaults",
+                file=sys.stderr,
+            )
     port = args.port
     if port is None:
         try:
@@ -110,12 +158,24 @@ def _run_moosdb(args: argparse.Namespace) -> int:
             print(f"moosdb: {err}", file=sys.stderr)
             return 1
         port = p.DEFAULT_PORT if port is None else port
-    community = args.community or (mission and mission.get_value("Community")) or p.DEFAULT_COMMUNITY
+    community = (
+        args.community or (mission and mission.get_value("Community")) or p.DEFAULT_COMMUNITY
+    )
     warp = args.time_warp or (mission and mission.get_float("MOOSTimeWarp")) or 1.0
-    timeout = args.timeout or (mission and mission.get_float("ClientTimeout")) or DEFAULT_CLIENT_TIMEOUT
-    db = MOOSDB(args.host, port, community, clock=moos_clock(warp), client_timeout=timeout,
-                max_packet_size=args.max_packet, packet_timeout=args.packet_timeout,
-                max_clients=args.max_clients, memory_budget=int(args.memory_budget * 2**20))  # fmt: skip
+    timeout = (
+        args.timeout or (mission and mission.get_float("ClientTimeout")) or DEFAULT_CLIENT_TIMEOUT
+    )
+    db = MOOSDB(
+        args.host,
+        port,
+        community,
+        clock=moos_clock(warp),
+        client_timeout=timeout,
+        max_packet_size=args.max_packet,
+        packet_timeout=args.packet_timeout,
+        max_clients=args.max_clients,
+        memory_budget=int(args.memory_budget * 2**20),
+    )
     return _run(_serve(db))
 
 
@@ -184,10 +244,19 @@ async def _poke(args: argparse.Namespace, pairs: list[tuple[str, float | str]]) 
 
 
 def _describe(msg: p.MOOSMessage) -> dict[str, Any]:
-    kind = {p.DOUBLE: "double", p.STRING: "string", p.BINARY: "binary"}.get(msg.data_type, msg.data_type)
+    kind = {p.DOUBLE: "double", p.STRING: "string", p.BINARY: "binary"}.get(
+        msg.data_type, msg.data_type
+    )
     value: Any = msg.sval.hex() if msg.is_binary else msg.value
-    return {"name": msg.key, "type": kind, "value": value, "src": msg.src,
-            "src_aux": msg.src_aux, "community": msg.community, "time": msg.time}  # fmt: skip
+    return {
+        "name": msg.key,
+        "type": kind,
+        "value": value,
+        "src": msg.src,
+        "src_aux": msg.src_aux,
+        "community": msg.community,
+        "time": msg.time,
+    }
 
 
 def _format(msg: p.MOOSMessage) -> str:
@@ -217,7 +286,9 @@ async def _get(args: argparse.Namespace) -> int:
     await client.close()
     missing = [n for n in args.variables if n not in values]
     if args.json:
-        print(json.dumps({n: _describe(values[n]) if n in values else None for n in args.variables}))
+        print(
+            json.dumps({n: _describe(values[n]) if n in values else None for n in args.variables})
+        )
     else:
         for name in args.variables:
             if name in values:

@@ -122,8 +122,9 @@ class MOOSClient:
         waiter = asyncio.ensure_future(self._connected.wait())
         stopper = asyncio.ensure_future(self._stopped.wait())
         try:
-            done, _ = await asyncio.wait({waiter, stopper}, timeout=timeout,
-                                         return_when=asyncio.FIRST_COMPLETED)  # fmt: skip
+            done, _ = await asyncio.wait(
+                {waiter, stopper}, timeout=timeout, return_when=asyncio.FIRST_COMPLETED
+            )
         finally:
             waiter.cancel()
             stopper.cancel()
@@ -165,8 +166,14 @@ class MOOSClient:
         """Queue a notification (float/int: double, str: string, bytes: binary)."""
         if not key:
             raise ValueError("cannot publish to an empty variable name")
-        msg = p.notify(key, value, time=self.time() if time is None else time, src=self.name,
-                       src_aux=src_aux, msg_id=self._take_id())  # fmt: skip
+        msg = p.notify(
+            key,
+            value,
+            time=self.time() if time is None else time,
+            src=self.name,
+            src_aux=src_aux,
+            msg_id=self._take_id(),
+        )
         self._queue(msg)
 
     def subscribe(self, key: str, interval: float = 0.0) -> None:
@@ -179,8 +186,11 @@ class MOOSClient:
 
     def unsubscribe(self, key: str) -> None:
         if self._subscriptions.pop(key, None) is not None and self.connected:
-            self._queue(MOOSMessage(p.UNREGISTER, p.DOUBLE, key, self.time(), 0.0,
-                                    src=self.name, id=self._take_id()))  # fmt: skip
+            self._queue(
+                MOOSMessage(
+                    p.UNREGISTER, p.DOUBLE, key, self.time(), 0.0, src=self.name, id=self._take_id()
+                )
+            )
 
     def subscribe_wildcard(
         self, var_pattern: str, app_pattern: str = "*", interval: float = 0.0
@@ -208,8 +218,11 @@ class MOOSClient:
             raise ConnectionError(f"{self.name}: not connected")
         future: asyncio.Future[list[MOOSMessage]] = asyncio.get_running_loop().create_future()
         self._requests.append(future)
-        self._queue(MOOSMessage(p.SERVER_REQUEST, p.STRING, name, self.time(), src=self.name,
-                                id=p.SERVER_REQUEST_ID))  # fmt: skip
+        self._queue(
+            MOOSMessage(
+                p.SERVER_REQUEST, p.STRING, name, self.time(), src=self.name, id=p.SERVER_REQUEST_ID
+            )
+        )
         try:
             async with asyncio.timeout(timeout):
                 return await future
@@ -258,12 +271,22 @@ class MOOSClient:
         return msg_id
 
     def _register_msg(self, key: str, interval: float) -> MOOSMessage:
-        return MOOSMessage(p.REGISTER, p.DOUBLE, key, self.time(), interval, src=self.name,
-                           id=self._take_id())  # fmt: skip
+        return MOOSMessage(
+            p.REGISTER, p.DOUBLE, key, self.time(), interval, src=self.name, id=self._take_id()
+        )
 
     def _wildcard_msg(self, kind: str, var: str, app: str, interval: float) -> MOOSMessage:
-        return MOOSMessage(kind, p.STRING, self.name, self.time(), -1.0, -1.0,
-                           p.wildcard_sval(app, var, interval), self.name, id=self._take_id())  # fmt: skip
+        return MOOSMessage(
+            kind,
+            p.STRING,
+            self.name,
+            self.time(),
+            -1.0,
+            -1.0,
+            p.wildcard_sval(app, var, interval),
+            self.name,
+            id=self._take_id(),
+        )
 
     def _queue(self, msg: MOOSMessage) -> None:
         self._outbox.append(msg)
@@ -271,8 +294,12 @@ class MOOSClient:
             dropped = len(self._outbox) - self.outbox_limit // 2
             for _ in range(dropped):
                 self._outbox.popleft()
-            log.warning("%s: outbox over %d messages, dropped the %d oldest",
-                        self.name, self.outbox_limit, dropped)  # fmt: skip
+            log.warning(
+                "%s: outbox over %d messages, dropped the %d oldest",
+                self.name,
+                self.outbox_limit,
+                dropped,
+            )
         self._wake.set()
 
     def _to_inbox(self, msg: MOOSMessage) -> None:
@@ -288,7 +315,9 @@ class MOOSClient:
                 try:
                     reader, writer = await asyncio.open_connection(self.host, self.port)
                 except OSError as err:
-                    log.debug("%s: cannot connect to %s:%d: %s", self.name, self.host, self.port, err)
+                    log.debug(
+                        "%s: cannot connect to %s:%d: %s", self.name, self.host, self.port, err
+                    )
                     await asyncio.sleep(self.reconnect_interval)
                     continue
                 delay = self.reconnect_interval
@@ -305,11 +334,21 @@ class MOOSClient:
                     # connection is gone): it drops it after its client timeout.
                     refusals += 1
                     delay = min(self.reconnect_interval * 2**refusals, MAX_REFUSED_BACKOFF)
-                    log.warning("%s: %s (the MOOSDB still holds the previous session?); "
-                                "trying again in %.1f s", self.name, err, delay)  # fmt: skip
+                    log.warning(
+                        "%s: %s (the MOOSDB still holds the previous session?); "
+                        "trying again in %.1f s",
+                        self.name,
+                        err,
+                        delay,
+                    )
                 except (OSError, EOFError, TimeoutError, MoosProtocolError) as err:
-                    log.warning("%s: connection to %s:%d lost: %s", self.name, self.host,
-                                self.port, err or type(err).__name__)  # fmt: skip
+                    log.warning(
+                        "%s: connection to %s:%d lost: %s",
+                        self.name,
+                        self.host,
+                        self.port,
+                        err or type(err).__name__,
+                    )
                 finally:
                     writer.close()
                     self._on_lost()
@@ -338,7 +377,9 @@ class MOOSClient:
         if sock is not None:
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self.skew.skew = 0.0
-        writer.write(p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(self.name, self.time())]))
+        writer.write(
+            p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(self.name, self.time())])
+        )
         await writer.drain()
         framer = p.PacketFramer(self.max_packet_size)
         async with asyncio.timeout(HANDSHAKE_TIMEOUT):
@@ -356,7 +397,9 @@ class MOOSClient:
         self._resend_registrations()
         self.connections += 1
         self._connected.set()
-        log.info("%s: connected to MOOSDB %s at %s:%d", self.name, self.community, self.host, self.port)
+        log.info(
+            "%s: connected to MOOSDB %s at %s:%d", self.name, self.community, self.host, self.port
+        )
         self.signal_connect.emit()
         write_task = asyncio.create_task(self._write_loop(writer))
         try:

@@ -64,8 +64,11 @@ class _Connection(asyncio.Protocol):
         server = self.server
         if len(server._connections) >= server.max_clients:
             self._closed = True
-            log.warning("refusing a connection from %s: %d connections already (max_clients)",
-                        self.peer, len(server._connections))  # fmt: skip
+            log.warning(
+                "refusing a connection from %s: %d connections already (max_clients)",
+                self.peer,
+                len(server._connections),
+            )
             transport.abort()
             return
         sock = transport.get_extra_info("socket")
@@ -317,7 +320,7 @@ class MOOSDB:
             biggest._drop(
                 f"holding {biggest.pending + biggest.unsent} bytes while all clients' buffers "
                 f"exceed the memory budget of {self.memory_budget} bytes"
-            )  # fmt: skip
+            )
 
     async def _sweep(self) -> None:
         loop = self._loop

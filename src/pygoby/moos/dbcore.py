@@ -58,8 +58,20 @@ class Subscription:
 class Variable:
     """One MOOS variable; its value is the last notification as forwarded (`raw`)."""
 
-    __slots__ = ("name", "key", "type_code", "accepts", "raw", "community", "write_time",
-                 "write_rate", "last_source", "subscribers", "every_update", "timed")  # fmt: skip
+    __slots__ = (
+        "name",
+        "key",
+        "type_code",
+        "accepts",
+        "raw",
+        "community",
+        "write_time",
+        "write_rate",
+        "last_source",
+        "subscribers",
+        "every_update",
+        "timed",
+    )
 
     def __init__(self, name: str) -> None:
         self.name = name
@@ -99,10 +111,21 @@ class Variable:
         """The current value as the N message a new subscriber gets (id -1, dval2 -1)."""
         m = self.message()
         is_double = self.type_code == _DOUBLE
-        return p.encode_message(p.MOOSMessage(
-            p.NOTIFY, m.data_type, self.name, m.time, m.dval if is_double else -1.0, -1.0,
-            b"" if is_double else m.sval, m.src, m.src_aux, m.community, -1,
-        ))  # fmt: skip
+        return p.encode_message(
+            p.MOOSMessage(
+                p.NOTIFY,
+                m.data_type,
+                self.name,
+                m.time,
+                m.dval if is_double else -1.0,
+                -1.0,
+                b"" if is_double else m.sval,
+                m.src,
+                m.src_aux,
+                m.community,
+                -1,
+            )
+        )
 
     def subscribe(self, client: ClientRecord, interval: float) -> Subscription:
         sub = self.subscribers[client.name] = Subscription(client, interval)
@@ -130,8 +153,16 @@ class ClientRecord:
     """A connected client: its held mail (queued, not yet due), its outgoing buffer (due, not
     yet written), wildcard filters, timing statistics and the variables it published."""
 
-    __slots__ = ("name", "asynchronous", "held", "out", "breaks", "filters", "latencies_ms",
-                 "published")  # fmt: skip
+    __slots__ = (
+        "name",
+        "asynchronous",
+        "held",
+        "out",
+        "breaks",
+        "filters",
+        "latencies_ms",
+        "published",
+    )
 
     def __init__(self, name: str, asynchronous: bool) -> None:
         self.name = name
@@ -208,9 +239,11 @@ class DBCore:
     """MOOSDB logic. Times: `clock.now()` is the DB's MOOSTime (warped epoch seconds)."""
 
     def __init__(
-        self, community: str = p.DEFAULT_COMMUNITY, clock: Clock | None = None,
+        self,
+        community: str = p.DEFAULT_COMMUNITY,
+        clock: Clock | None = None,
         hostname: str = "localhost",
-    ) -> None:  # fmt: skip
+    ) -> None:
         self.community = community or p.DEFAULT_COMMUNITY
         community_bytes = p.encode_text(self.community)
         self.community_field = _INT.pack(len(community_bytes)) + community_bytes
@@ -265,7 +298,9 @@ class DBCore:
 
     # -- packets -------------------------------------------------------------------------------
 
-    def process_packet(self, name: str, data: bytes, start: int = 0, end: int | None = None) -> None:
+    def process_packet(
+        self, name: str, data: bytes, start: int = 0, end: int | None = None
+    ) -> None:
         """Process the packet in data[start:end] from client `name` (MoosProtocolError if it is
         malformed: the messages before the fault have taken effect)."""
         client = self.clients[name]
@@ -275,8 +310,10 @@ class DBCore:
             raise MoosProtocolError(f"packet of {end - start} bytes is shorter than its header")
         total, count, _ = _HEADER.unpack_from(data, start)
         if total != end - start or count < 0:
-            raise MoosProtocolError(f"packet header ({total} bytes, {count} messages) does not "
-                                  f"fit the {end - start} bytes given")  # fmt: skip
+            raise MoosProtocolError(
+                f"packet header ({total} bytes, {count} messages) does not "
+                f"fit the {end - start} bytes given"
+            )
         now = self.clock.now()
         pos = start + p.PACKET_HEADER_SIZE
         head = None
@@ -309,16 +346,26 @@ class DBCore:
                 ready[other.name] = other
 
     def _process_messages(
-        self, client: ClientRecord | None, data: bytes, pos: int, end: int, count: int,
-        now: float, answers: list[bytes],
-    ) -> bool:  # fmt: skip
+        self,
+        client: ClientRecord | None,
+        data: bytes,
+        pos: int,
+        end: int,
+        count: int,
+        now: float,
+        answers: list[bytes],
+    ) -> bool:
         """Apply `count` messages from data[pos:end]; True if one was a notification."""
         by_key = self._by_key
         read_int = _INT.unpack_from
         pack_int = _INT.pack
         source = self._source
-        head, read_start, forwarded, growth = (source.head, source.layout.unpack_from,
-                                               source.forwarded, source.growth)  # fmt: skip
+        head, read_start, forwarded, growth = (
+            source.head,
+            source.layout.unpack_from,
+            source.forwarded,
+            source.growth,
+        )
         key_at_offset = 10 + len(head)
         had_notify = False
         for _ in range(count):
@@ -336,14 +383,20 @@ class DBCore:
                     pos = stop
                     continue
                 source = self._source = _Source(self, data, pos + 10, stop)
-                head, read_start, forwarded, growth = (source.head, source.layout.unpack_from,
-                                                       source.forwarded, source.growth)  # fmt: skip
+                head, read_start, forwarded, growth = (
+                    source.head,
+                    source.layout.unpack_from,
+                    source.forwarded,
+                    source.growth,
+                )
                 key_at_offset = 10 + len(head)
                 msg_len, id_types, head_seen, key_len = read_start(data, pos)
             stop = pos + msg_len
             if msg_len < p.MESSAGE_FIXED_SIZE or stop > end:
-                raise MoosProtocolError(f"message length {msg_len} is below "
-                                      f"{p.MESSAGE_FIXED_SIZE} or runs past the packet end")  # fmt: skip
+                raise MoosProtocolError(
+                    f"message length {msg_len} is below "
+                    f"{p.MESSAGE_FIXED_SIZE} or runs past the packet end"
+                )
             if id_types[4] != _NOTIFY:
                 self._on_other(client, p.decode_message(data, pos, stop)[0], now, answers)
                 pos = stop
@@ -353,7 +406,9 @@ class DBCore:
             key_at = pos + key_at_offset
             key_end = key_at + 4 + key_len
             if key_len < 0 or key_end + 28 > stop:
-                raise MoosProtocolError(f"key length {key_len} is negative or runs past the message end")
+                raise MoosProtocolError(
+                    f"key length {key_len} is negative or runs past the message end"
+                )
             (sval_len,) = read_int(data, key_end + 24)
             if sval_len < 0 or key_end + 28 + sval_len != stop:
                 raise MoosProtocolError(f"sval length {sval_len} does not end the message")
@@ -363,7 +418,9 @@ class DBCore:
                 raw = b"".join((pack_int(msg_len + growth), id_types, forwarded, data[key_at:stop]))
             var = by_key.get(data[key_at + 4 : key_end])
             if var is None or var.accepts != data_type:
-                var = self._first_or_mistyped_write(var, data[key_at + 4 : key_end], data_type, source.src, now)
+                var = self._first_or_mistyped_write(
+                    var, data[key_at + 4 : key_end], data_type, source.src, now
+                )
                 if var is None:
                     pos = stop
                     continue
@@ -384,7 +441,9 @@ class DBCore:
                     sub.client.held.append(raw)
             pos = stop
         if pos != end:
-            raise MoosProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
+            raise MoosProtocolError(
+                f"{end - pos} trailing bytes after the last message of the packet"
+            )
         return had_notify
 
     def _first_or_mistyped_write(
@@ -398,8 +457,13 @@ class DBCore:
             var.write_time = now  # no write rate from a first write
             self._apply_filters_on_creation(var, src)
             return var
-        log.info('Attempting to update var "%s" which is type %s with data type %s by client %s',
-                 var.name, var.data_type, chr(data_type), src)  # fmt: skip
+        log.info(
+            'Attempting to update var "%s" which is type %s with data type %s by client %s',
+            var.name,
+            var.data_type,
+            chr(data_type),
+            src,
+        )
         return None
 
     def _relearn_source(self) -> None:
@@ -481,11 +545,21 @@ class DBCore:
                 m = var.message()
                 is_double = var.type_code == _DOUBLE
                 rel = var.write_time - self.start_time if var.written else -1.0
-                out.append(p.MOOSMessage(
-                    p.NOTIFY, var.data_type, var.name, rel, m.dval if is_double else -1.0,
-                    var.write_rate, b"" if is_double else m.sval, m.src, m.src_aux, m.community,
-                    msg.id,
-                ))  # fmt: skip
+                out.append(
+                    p.MOOSMessage(
+                        p.NOTIFY,
+                        var.data_type,
+                        var.name,
+                        rel,
+                        m.dval if is_double else -1.0,
+                        var.write_rate,
+                        b"" if is_double else m.sval,
+                        m.src,
+                        m.src_aux,
+                        m.community,
+                        msg.id,
+                    )
+                )
             return out
         if "VAR_SUMMARY" in key:
             names = ",".join(sorted(self.variables))
@@ -536,7 +610,9 @@ class DBCore:
         parts = []
         for c in self.clients.values():
             lat = c.latencies_ms
-            parts.append(f"{c.name}={lat[-1]:.3f}:{max(lat):.3f}:{min(lat):.3f}:{sum(lat) / len(lat):.3f},")
+            parts.append(
+                f"{c.name}={lat[-1]:.3f}:{max(lat):.3f}:{min(lat):.3f}:{sum(lat) / len(lat):.3f},"
+            )
         return "".join(parts)
 
     def _rw_summary(self) -> str:
@@ -558,7 +634,9 @@ class DBCore:
             else:
                 text = m.string
                 value = text[:22] + "..." if len(text) > 25 else text
-            lines.append(f"{var.name} {when} {writer} {var.write_rate:.1f} Hz {var.data_type} {value}")
+            lines.append(
+                f"{var.name} {when} {writer} {var.write_rate:.1f} Hz {var.data_type} {value}"
+            )
         return "\n".join(lines)
 
 

@@ -137,7 +137,11 @@ class _Parser:
             result.value.append(self.take())
         else:
             result.value.append(self.take())
-            while self.peek() is not None and self.peek()[0] in "\"'" and result.value[-1].text[0] in "\"'":
+            while (
+                self.peek() is not None
+                and self.peek()[0] in "\"'"
+                and result.value[-1].text[0] in "\"'"
+            ):
                 result.value.append(self.take())  # adjacent strings concatenate
         if self.peek() in (",", ";"):
             result.separator = self.take()
@@ -163,8 +167,13 @@ def render(fields: list[Field]) -> str:
 # ---------------------------------------------------------------------------------------------
 # Rules, by the message type a field appears in
 
-VERBOSITY = {"VERBOSITY_QUIET": "QUIET", "VERBOSITY_WARN": "WARN", "VERBOSITY_VERBOSE": "VERBOSE",
-             "VERBOSITY_DEBUG": "DEBUG1", "VERBOSITY_GUI": "VERBOSE"}  # fmt: skip
+VERBOSITY = {
+    "VERBOSITY_QUIET": "QUIET",
+    "VERBOSITY_WARN": "WARN",
+    "VERBOSITY_VERBOSE": "VERBOSE",
+    "VERBOSITY_DEBUG": "DEBUG1",
+    "VERBOSITY_GUI": "VERBOSE",
+}
 # Goby 1.1/2 driver extension scopes -> the goby3 extension holding their fields.
 DRIVER_EXTENSIONS = {
     "MicroModemConfig": "goby.acomms.micromodem.protobuf.config",
@@ -173,9 +182,12 @@ DRIVER_EXTENSIONS = {
     "UDPDriverConfig": "goby.acomms.udp.protobuf.config",
     "ABCDriverConfig": "goby.acomms.abc.protobuf.config",
 }
-SLOT_TYPES = {"SLOT_DATA": None, "SLOT_PING": "MICROMODEM_TWO_WAY_PING",
-              "SLOT_REMUS_LBL": "MICROMODEM_REMUS_LBL_RANGING",
-              "SLOT_NARROWBAND_LBL": "MICROMODEM_NARROWBAND_LBL_RANGING"}  # fmt: skip
+SLOT_TYPES = {
+    "SLOT_DATA": None,
+    "SLOT_PING": "MICROMODEM_TWO_WAY_PING",
+    "SLOT_REMUS_LBL": "MICROMODEM_REMUS_LBL_RANGING",
+    "SLOT_NARROWBAND_LBL": "MICROMODEM_NARROWBAND_LBL_RANGING",
+}
 MM_TRANSMISSION = "goby.acomms.micromodem.protobuf.transmission"
 UNSUPPORTED = {"tcp_share_enable", "tcp_share_port", "tcp_share_to_ip"}
 
@@ -200,7 +212,9 @@ def _verbosity(f: Field, notes: list[str]) -> list[Field] | None:
     if not gui:
         return [f]
     line = f.name.line
-    show_gui = Field(_synthetic("show_gui", line), _synthetic(":", line), [_synthetic("true", line)])
+    show_gui = Field(
+        _synthetic("show_gui", line), _synthetic(":", line), [_synthetic("true", line)]
+    )
     return [f, show_gui]
 
 
@@ -214,8 +228,13 @@ def _driver_extension(f: Field, notes: list[str]) -> list[Field] | None:
     line = f.name.line
     notes.append(f"line {line}: [{scope}.{name}] -> [{target}] {{ {name} }}")
     inner = Field(_synthetic(name, line), f.colon, f.value, f.children, f.brackets)
-    return [Field(_synthetic(f"[{target}]", line), children=[inner],
-                  brackets=(_synthetic("{", line), _synthetic("}", line)))]  # fmt: skip
+    return [
+        Field(
+            _synthetic(f"[{target}]", line),
+            children=[inner],
+            brackets=(_synthetic("{", line), _synthetic("}", line)),
+        )
+    ]
 
 
 def _slot(f: Field, notes: list[str]) -> list[Field] | None:
@@ -234,8 +253,14 @@ def _slot(f: Field, notes: list[str]) -> list[Field] | None:
     notes.append(f"line {line}: slot type: {old} -> DRIVER_SPECIFIC, Micro-Modem {driver_type}")
     f.value = [_synthetic("DRIVER_SPECIFIC", line)]
     inner = Field(_synthetic("type", line), _synthetic(":", line), [_synthetic(driver_type, line)])
-    return [f, Field(_synthetic(f"[{MM_TRANSMISSION}]", line), children=[inner],
-                     brackets=(_synthetic("{", line), _synthetic("}", line)))]  # fmt: skip
+    return [
+        f,
+        Field(
+            _synthetic(f"[{MM_TRANSMISSION}]", line),
+            children=[inner],
+            brackets=(_synthetic("{", line), _synthetic("}", line)),
+        ),
+    ]
 
 
 def _dccl_cfg(f: Field, notes: list[str]) -> list[Field] | None:
@@ -248,16 +273,20 @@ def _dccl_cfg(f: Field, notes: list[str]) -> list[Field] | None:
 def _app(f: Field, notes: list[str]) -> list[Field] | None:
     if f.key not in UNSUPPORTED:
         return None
-    notes.append(f"line {f.name.line}: {f.key} dropped: TCP sharing (experimental in Goby 1.1) "
-                 "is not implemented in pygoby")  # fmt: skip
+    notes.append(
+        f"line {f.name.line}: {f.key} dropped: TCP sharing (experimental in Goby 1.1) "
+        "is not implemented in pygoby"
+    )
     return []
 
 
 def _message_file(f: Field, notes: list[str]) -> list[Field] | None:
     if f.key != "manipulator" or [t.text for t in f.value] != ["TCP_SHARE_IN"]:
         return None
-    notes.append(f"line {f.name.line}: manipulator TCP_SHARE_IN dropped (TCP sharing is not "
-                 "implemented in pygoby)")  # fmt: skip
+    notes.append(
+        f"line {f.name.line}: manipulator TCP_SHARE_IN dropped (TCP sharing is not "
+        "implemented in pygoby)"
+    )
     return []
 
 
@@ -337,4 +366,6 @@ def finish(config: Message, notes: list[str]) -> None:
                 moved += 1
         block.ClearField("message_file")
     if moved:
-        notes.append(f"{moved} XML message file(s) of dccl_cfg/queue_cfg -> transitional_cfg.message_file")
+        notes.append(
+            f"{moved} XML message file(s) of dccl_cfg/queue_cfg -> transitional_cfg.message_file"
+        )

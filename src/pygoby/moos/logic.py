@@ -83,10 +83,14 @@ class LogicCondition:
             for word in ("or", "and"):
                 tail = body[i : i + len(word) + 2].lower()
                 if i > 0 and tail == f" {word} ":
-                    return _Node(word, self._parse(body[:i]), self._parse(body[i + len(word) + 2 :]))
+                    return _Node(
+                        word, self._parse(body[:i]), self._parse(body[i + len(word) + 2 :])
+                    )
             for relation in _RELATIONS:
                 if body.startswith(relation, i):
-                    return self._relation(body[:i].strip(), relation, body[i + len(relation) :].strip())
+                    return self._relation(
+                        body[:i].strip(), relation, body[i + len(relation) :].strip()
+                    )
         raise self._error(f"{body!r} is not a relation (VAR = value) or a combination of them")
 
     def _relation(self, left: str, relation: str, right: str):
@@ -143,5 +147,10 @@ def _compare(relation: str, left: Value, right: Value) -> bool:
         if relation == "==":
             return a == b
     return {
-        "=": a == b, "!=": a != b, "<": a < b, "<=": a <= b, ">": a > b, ">=": a >= b,
+        "=": a == b,
+        "!=": a != b,
+        "<": a < b,
+        "<=": a <= b,
+        ">": a > b,
+        ">=": a >= b,
     }[relation]  # type: ignore[operator]

@@ -172,7 +172,11 @@ class MissionFile:
                 continue
             if keep_quotes:
                 cut = line.find("//")
-                out.append(("" if line.strip().startswith("//") else line[:cut] if cut >= 0 else line).strip())
+                out.append(
+                    (
+                        "" if line.strip().startswith("//") else line[:cut] if cut >= 0 else line
+                    ).strip()
+                )
             else:
                 out.append(strip_comment(line))
         return out
@@ -339,8 +343,12 @@ class MissionFile:
             for item in filter(None, opts.split(",")):
                 k, _, v = item.partition("=")
                 options[k] = v
-            extra_key = next((v for k, v in options.items() if k.lower() == "extraprocessparams"), None)
-            extra = [a for a in lookup.get(extra_key.lower(), "").split(",") if a] if extra_key else []
+            extra_key = next(
+                (v for k, v in options.items() if k.lower() == "extraprocessparams"), None
+            )
+            extra = (
+                [a for a in lookup.get(extra_key.lower(), "").split(",") if a] if extra_key else []
+            )
             runs.append(AntlerRun(program, alias or Path(program).name, options, extra))
         pause = lookup.get("msbetweenlaunches")
         return AntlerConfig(

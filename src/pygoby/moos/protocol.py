@@ -123,9 +123,18 @@ class MOOSMessage:
 
     def copy(self) -> MOOSMessage:
         return MOOSMessage(
-            self.msg_type, self.data_type, self.key, self.time, self.dval, self.dval2,
-            self.sval, self.src, self.src_aux, self.community, self.id,
-        )  # fmt: skip
+            self.msg_type,
+            self.data_type,
+            self.key,
+            self.time,
+            self.dval,
+            self.dval2,
+            self.sval,
+            self.src,
+            self.src_aux,
+            self.community,
+            self.id,
+        )
 
     def encoded_size(self) -> int:
         return (
@@ -152,14 +161,27 @@ def notify(
     if isinstance(value, bool):
         raise TypeError("MOOS has no boolean type; publish a number or a string")
     if isinstance(value, int | float):
-        return MOOSMessage(NOTIFY, DOUBLE, key, time, float(value), -1.0, b"", src, src_aux,
-                           community, msg_id)  # fmt: skip
+        return MOOSMessage(
+            NOTIFY, DOUBLE, key, time, float(value), -1.0, b"", src, src_aux, community, msg_id
+        )
     if isinstance(value, str):
-        return MOOSMessage(NOTIFY, STRING, key, time, -1.0, -1.0, encode_text(value), src,
-                           src_aux, community, msg_id)  # fmt: skip
+        return MOOSMessage(
+            NOTIFY,
+            STRING,
+            key,
+            time,
+            -1.0,
+            -1.0,
+            encode_text(value),
+            src,
+            src_aux,
+            community,
+            msg_id,
+        )
     if isinstance(value, bytes | bytearray | memoryview):
-        return MOOSMessage(NOTIFY, BINARY, key, time, -1.0, -1.0, bytes(value), src, src_aux,
-                           community, msg_id)  # fmt: skip
+        return MOOSMessage(
+            NOTIFY, BINARY, key, time, -1.0, -1.0, bytes(value), src, src_aux, community, msg_id
+        )
     raise TypeError(f"cannot publish a {type(value).__name__} to MOOS (use float, str or bytes)")
 
 
@@ -177,10 +199,24 @@ def encode_message(msg: MOOSMessage) -> bytes:
     # one pack call with the lengths in the format: the hot path of the DB and the client
     return struct.pack(
         f"<iicci{a}si{b}si{c}si{k}sdddi{v}s",
-        MESSAGE_FIXED_SIZE + a + b + c + k + v, msg.id, msg.msg_type.encode("latin-1"),
-        msg.data_type.encode("latin-1"), a, src, b, aux, c, com, k, key,
-        msg.time, msg.dval, msg.dval2, v, sval,
-    )  # fmt: skip
+        MESSAGE_FIXED_SIZE + a + b + c + k + v,
+        msg.id,
+        msg.msg_type.encode("latin-1"),
+        msg.data_type.encode("latin-1"),
+        a,
+        src,
+        b,
+        aux,
+        c,
+        com,
+        k,
+        key,
+        msg.time,
+        msg.dval,
+        msg.dval2,
+        v,
+        sval,
+    )
 
 
 def encode_packet(msgs: Iterable[MOOSMessage]) -> bytes:
@@ -212,7 +248,9 @@ def read_str(data: bytes | memoryview, pos: int, end: int, what: str) -> tuple[b
     return bytes(data[pos : pos + n]), pos + n
 
 
-def decode_message(data: bytes | memoryview, offset: int = 0, end: int | None = None) -> tuple[MOOSMessage, int]:
+def decode_message(
+    data: bytes | memoryview, offset: int = 0, end: int | None = None
+) -> tuple[MOOSMessage, int]:
     """Decode the message starting at `offset`; returns it and the offset after it."""
     if not isinstance(data, bytes):
         data = bytes(data)
@@ -220,7 +258,9 @@ def decode_message(data: bytes | memoryview, offset: int = 0, end: int | None = 
     return msgs[0], stop
 
 
-def _decode_messages(data: bytes, pos: int, limit: int, count: int) -> tuple[list[MOOSMessage], int]:
+def _decode_messages(
+    data: bytes, pos: int, limit: int, count: int
+) -> tuple[list[MOOSMessage], int]:
     """`count` messages from data[pos:limit]; and the offset after the last."""
     msgs = []
     append = msgs.append
@@ -230,8 +270,10 @@ def _decode_messages(data: bytes, pos: int, limit: int, count: int) -> tuple[lis
     chars = _CHARS
     for _ in range(count):
         if limit - pos < MESSAGE_FIXED_SIZE:
-            raise MoosProtocolError(f"message truncated: {limit - pos} bytes left, a message has "
-                                f"at least {MESSAGE_FIXED_SIZE}")  # fmt: skip
+            raise MoosProtocolError(
+                f"message truncated: {limit - pos} bytes left, a message has "
+                f"at least {MESSAGE_FIXED_SIZE}"
+            )
         msg_len, msg_id, msg_type, data_type, n = read_start(data, pos)
         stop = pos + msg_len
         if msg_len < MESSAGE_FIXED_SIZE or stop > limit:
@@ -264,9 +306,24 @@ def _decode_messages(data: bytes, pos: int, limit: int, count: int) -> tuple[lis
         time_, dval, dval2, sval_len = read_doubles(data, pos + n)
         pos += n + 28
         if sval_len < 0 or pos + sval_len != stop:
-            raise MoosProtocolError(f"sval length {sval_len} does not end the message at its msg_len")
-        append(MOOSMessage(chars[msg_type], chars[data_type], key, time_, dval, dval2,
-                           data[pos:stop], src, aux, community, msg_id))  # fmt: skip
+            raise MoosProtocolError(
+                f"sval length {sval_len} does not end the message at its msg_len"
+            )
+        append(
+            MOOSMessage(
+                chars[msg_type],
+                chars[data_type],
+                key,
+                time_,
+                dval,
+                dval2,
+                data[pos:stop],
+                src,
+                aux,
+                community,
+                msg_id,
+            )
+        )
         pos = stop
     return msgs, pos
 
@@ -279,13 +336,17 @@ def parse_packet_header(data: bytes | memoryview, offset: int = 0) -> tuple[int,
     """(total_len, n_msgs) from the 9 bytes at `offset`, validated."""
     total, n_msgs, _compressed = _HEADER.unpack_from(data, offset)
     if total < PACKET_HEADER_SIZE:
-        raise MoosProtocolError(f"packet length {total} is below the {PACKET_HEADER_SIZE}-byte header")
+        raise MoosProtocolError(
+            f"packet length {total} is below the {PACKET_HEADER_SIZE}-byte header"
+        )
     if n_msgs < 0:
         raise MoosProtocolError(f"packet claims {n_msgs} messages")
     return total, n_msgs
 
 
-def decode_packet(data: bytes | memoryview, start: int = 0, end: int | None = None) -> list[MOOSMessage]:
+def decode_packet(
+    data: bytes | memoryview, start: int = 0, end: int | None = None
+) -> list[MOOSMessage]:
     """Decode one complete packet: data[start:end] (by default all of `data`) must be exactly
     its `total_len` bytes."""
     if not isinstance(data, bytes):
@@ -295,7 +356,9 @@ def decode_packet(data: bytes | memoryview, start: int = 0, end: int | None = No
         raise MoosProtocolError(f"packet of {end - start} bytes is shorter than its header")
     total, n_msgs = parse_packet_header(data, start)
     if total != end - start:
-        raise MoosProtocolError(f"packet length field says {total} bytes but {end - start} were given")
+        raise MoosProtocolError(
+            f"packet length field says {total} bytes but {end - start} were given"
+        )
     msgs, pos = _decode_messages(data, start + PACKET_HEADER_SIZE, end, n_msgs)
     if pos != end:
         raise MoosProtocolError(f"{end - pos} trailing bytes after the last message of the packet")
@@ -368,9 +431,16 @@ def handshake_message(name: str, time: float, asynchronous: bool = True) -> MOOS
 
 def welcome_message(community: str, hostname: str, db_time: float, skew: float) -> MOOSMessage:
     return MOOSMessage(
-        WELCOME, DOUBLE, "", db_time, skew, -1.0, encode_text(ASYNC_HANDSHAKE_KEY),
-        src_aux=f"hostname={hostname}", community=community,
-    )  # fmt: skip
+        WELCOME,
+        DOUBLE,
+        "",
+        db_time,
+        skew,
+        -1.0,
+        encode_text(ASYNC_HANDSHAKE_KEY),
+        src_aux=f"hostname={hostname}",
+        community=community,
+    )
 
 
 def poison_message(reason: str, db_time: float) -> MOOSMessage:

@@ -135,8 +135,9 @@ class TimerScript:
             try:
                 self._configure(setting.name.strip().lower(), setting.value.strip())
             except ConfigError as err:
-                raise ConfigError(err.reason, file=file, line=setting.line,
-                                  field=setting.name.strip()) from None  # fmt: skip
+                raise ConfigError(
+                    err.reason, file=file, line=setting.line, field=setting.name.strip()
+                ) from None
         self.quit = False
         self.values: dict[str, Value] = {}
         self.conditions_ok = not self.conditions
@@ -186,8 +187,15 @@ class TimerScript:
             setattr(self, name, _range(value))
             if name == "time_warp" and self.time_warp[0] <= 0:
                 raise ConfigError("must be positive")
-        elif name in ("status_var", "pause_var", "pause_variable", "reset_var", "reset_variable",
-                      "forward_var", "forward_variable"):  # fmt: skip
+        elif name in (
+            "status_var",
+            "pause_var",
+            "pause_variable",
+            "reset_var",
+            "reset_variable",
+            "forward_var",
+            "forward_variable",
+        ):
             if not value or any(c.isspace() for c in value):
                 raise ConfigError(f"must be a variable name, not {value!r}")
             setattr(self, "var_" + name.split("_")[0], value)
@@ -280,9 +288,11 @@ class TimerScript:
 
     def status(self) -> str:
         limit = "any" if self.reset_max is None else str(self.reset_max)
-        return (f"name={self.script_name}, elapsed_time={self._elapsed:.2f}, posted={self._posted}, "
-                f"pending={sum(not e.posted for e in self.events)}, paused={str(self.paused).lower()}, "
-                f"conditions_ok={str(self.conditions_ok).lower()}, resets={self.reset_count}/{limit}")  # fmt: skip
+        return (
+            f"name={self.script_name}, elapsed_time={self._elapsed:.2f}, posted={self._posted}, "
+            f"pending={sum(not e.posted for e in self.events)}, paused={str(self.paused).lower()}, "
+            f"conditions_ok={str(self.conditions_ok).lower()}, resets={self.reset_count}/{limit}"
+        )
 
     def _schedule(self, now: float) -> None:
         for event in self.events:
@@ -317,9 +327,14 @@ class TimerScript:
         if not isinstance(value, str):
             return Post(event.var, value)
         uptime = now - (self.db_start or now)
-        macros = {"DBTIME": f"{uptime:.2f}", "UTCTIME": f"{now:.2f}", "UTC": f"{now:.2f}",
-                  "COUNT": str(self._posted), "TCOUNT": str(self.posted_total),
-                  "IDX": f"{index:03d}"}  # fmt: skip
+        macros = {
+            "DBTIME": f"{uptime:.2f}",
+            "UTCTIME": f"{now:.2f}",
+            "UTC": f"{now:.2f}",
+            "COUNT": str(self._posted),
+            "TCOUNT": str(self.posted_total),
+            "IDX": f"{index:03d}",
+        }
         whole = re.fullmatch(r"\$[(\[](DBTIME|UTCTIME|UTC|COUNT|TCOUNT)[)\]]", value)
         if whole:  # the macro is the whole value: posted as a double
             return Post(event.var, float(macros[whole.group(1)]))

@@ -68,7 +68,9 @@ class MessageTypes:
         self.loader = loader if loader is not None else ProtoLoader()
         self._fallback = fallback
         self._search_dirs = list(search_dirs) or [os.getcwd()]
-        self._error = config_error or (lambda reason, field, value: ConfigError(reason, field=field))
+        self._error = config_error or (
+            lambda reason, field, value: ConfigError(reason, field=field)
+        )
         self.loaded: list[str] = []
         for name in shared_libraries:
             self._load_library(name)
@@ -130,8 +132,10 @@ class MessageTypes:
 def not_loaded(name: str, loaded: Sequence[str]) -> str:
     """The reason of a configuration error for a message type no file defines (typically a
     misspelling), with the types that are there to compare."""
-    return (f'"{name}" is not a loaded message type; the types load_proto_file and '
-            f'load_shared_library loaded are: {", ".join(loaded) or "none"}')  # fmt: skip
+    return (
+        f'"{name}" is not a loaded message type; the types load_proto_file and '
+        f"load_shared_library loaded are: {', '.join(loaded) or 'none'}"
+    )
 
 
 def not_found(path: str, searched: Sequence[str]) -> str:

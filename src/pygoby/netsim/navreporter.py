@@ -69,10 +69,14 @@ class NavReporter:
         if position is None or "depth" not in self.values:
             return None
         return self._nav_class(
-            modem_tcp_port=self.modem_tcp_port, time=self.time, lat=position[0], lon=position[1],
-            depth=self.values["depth"], speed=self.values.get("speed", 0.0),
+            modem_tcp_port=self.modem_tcp_port,
+            time=self.time,
+            lat=position[0],
+            lon=position[1],
+            depth=self.values["depth"],
+            speed=self.values.get("speed", 0.0),
             heading=self.values.get("heading", 0.0) % 360.0,
-        )  # fmt: skip
+        )
 
     def port_of(self, modem_id: int) -> int:
         return self.modem_ports.get(modem_id, self.port_of_id_offset + modem_id)

@@ -168,7 +168,7 @@ class PhysicsChannel:
                     "duration": packet.duration,
                     "bytes": sum(len(f) for f in packet.frames),
                     "receivers": len(planned),
-                }  # fmt: skip
+                }
             )
 
     def do_work(self) -> None:
@@ -262,7 +262,7 @@ class PhysicsChannel:
                 "snr": snr,
                 "sinr": sinr,
                 "collision": collision,
-            }  # fmt: skip
+            }
         )
 
 
@@ -275,6 +275,10 @@ def _link_figures(
     """The rounded figures of an `rx` event."""
     snr = rl - noise
     return (
-        round(range_m, 3), round(owtt, 6), round(rl, 2), round(snr, 2), round(sinr, 2),
+        round(range_m, 3),
+        round(owtt, 6),
+        round(rl, 2),
+        round(snr, 2),
+        round(sinr, 2),
         sinr < snr - 0.01,
-    )  # fmt: skip
+    )

@@ -77,9 +77,12 @@ class RealTimeRun:
                 self.sim.attach_stack(node, driver)
                 driver.startup(
                     driver_config(
-                        node.modem_id, connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT,
-                        tcp_server=self.host, tcp_port=server.port, reconnect_interval=1,
-                    )  # fmt: skip
+                        node.modem_id,
+                        connection_type=acomms_pb.DriverConfig.CONNECTION_TCP_AS_CLIENT,
+                        tcp_server=self.host,
+                        tcp_port=server.port,
+                        reconnect_interval=1,
+                    )
                 )
         self.sim.post_positions()
         deadline = time.monotonic() + STARTUP_TIMEOUT

@@ -24,10 +24,21 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-KIND_COLOURS = {"data": "tab:blue", "cycle": "tab:purple", "ack": "tab:olive",
-                "ping": "tab:orange", "ping_reply": "tab:brown", "mini": "tab:gray"}  # fmt: skip
-OUTCOME_COLOURS = {"good": "tab:green", "bad_frames": "tab:red", "receiver_busy": "tab:pink",
-                   "half_duplex": "black", "not_detected": "lightgray"}  # fmt: skip
+KIND_COLOURS = {
+    "data": "tab:blue",
+    "cycle": "tab:purple",
+    "ack": "tab:olive",
+    "ping": "tab:orange",
+    "ping_reply": "tab:brown",
+    "mini": "tab:gray",
+}
+OUTCOME_COLOURS = {
+    "good": "tab:green",
+    "bad_frames": "tab:red",
+    "receiver_busy": "tab:pink",
+    "half_duplex": "black",
+    "not_detected": "lightgray",
+}
 SNR_BIN_DB = 2.0
 
 
@@ -95,8 +106,10 @@ def plot_success_vs_snr(events: list[dict], path: Path) -> Path:
     fig, (ax, count_ax) = plt.subplots(
         2, 1, figsize=(8, 6), sharex=True, gridspec_kw={"height_ratios": [3, 1]}
     )
-    for key, label, colour in (("snr", "SNR (no interference)", "tab:blue"),
-                               ("sinr", "SINR (with interference)", "tab:red")):  # fmt: skip
+    for key, label, colour in (
+        ("snr", "SNR (no interference)", "tab:blue"),
+        ("sinr", "SINR (with interference)", "tab:red"),
+    ):
         values = [e[key] for e in rx]
         binned = bin_success(values, [e["outcome"] == "good" for e in rx], width=SNR_BIN_DB)
         _success_axes(ax, count_ax, binned, label, colour, SNR_BIN_DB)
@@ -148,8 +161,12 @@ def plot_timeline(events: list[dict], path: Path, window: tuple[float, float] | 
             bars.setdefault(e["kind"], []).append((e["t"] - t0, e["duration"], row[e["port"]]))
     for kind, spans in sorted(bars.items()):
         for i, (x, width, r) in enumerate(spans):
-            ax.broken_barh([(x, width)], (r - 0.35, 0.4), color=KIND_COLOURS.get(kind, "k"),
-                           label=f"tx {kind}" if i == 0 else None)  # fmt: skip
+            ax.broken_barh(
+                [(x, width)],
+                (r - 0.35, 0.4),
+                color=KIND_COLOURS.get(kind, "k"),
+                label=f"tx {kind}" if i == 0 else None,
+            )
     heard: dict[str, tuple[list[float], list[float]]] = {}
     for e in events:
         if e.get("event") == "rx" and start <= e["arrival"] - t0 <= end:
@@ -157,8 +174,14 @@ def plot_timeline(events: list[dict], path: Path, window: tuple[float, float] | 
             xs.append(e["arrival"] - t0)
             ys.append(row[e["port"]] + 0.25)
     for outcome, (xs, ys) in sorted(heard.items()):
-        ax.scatter(xs, ys, marker="|", s=120, color=OUTCOME_COLOURS.get(outcome, "k"),
-                   label=f"rx {outcome}")  # fmt: skip
+        ax.scatter(
+            xs,
+            ys,
+            marker="|",
+            s=120,
+            color=OUTCOME_COLOURS.get(outcome, "k"),
+            label=f"rx {outcome}",
+        )
     ax.set_yticks(range(len(ports)), [labels[p] for p in ports])
     ax.set_ylim(-0.6, len(ports) - 0.2)
     ax.set_xlim(start, end)

@@ -33,9 +33,11 @@ from pygoby.protobuf.textconfig import check_config_values, merge_config_text, r
 SCENARIO_PROTO = "pygoby/netsim/scenario.proto"
 FIRST_MODEM_PORT = 62000
 VIRTUAL_START = 1_700_000_000.0  # default start of a "max"-speed run (repeatable)
-MAC_FIXED_DECENTRALIZED = acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name[
-    "MAC_FIXED_DECENTRALIZED"
-].number
+MAC_FIXED_DECENTRALIZED = (
+    acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"]
+    .enum_type.values_by_name["MAC_FIXED_DECENTRALIZED"]
+    .number
+)
 
 
 @cache
@@ -127,9 +129,12 @@ def channel_config(scenario: Message) -> ChannelConfig:
     if c.HasField("protocol_model"):
         p = c.protocol_model
         protocol = ProtocolModel(
-            p.communication_range, p.detection_range, p.interference_range,
-            p.p_detection, p.p_decoding,
-        )  # fmt: skip
+            p.communication_range,
+            p.detection_range,
+            p.interference_range,
+            p.p_detection,
+            p.p_decoding,
+        )
     sound_speed = sound_speed_of(c)
     try:
         propagation = propagation_of(c, sound_speed)
@@ -184,9 +189,14 @@ def manager_config(scenario: Message, endpoint_ip: str = "127.0.0.1") -> Message
     for port in node_ports(scenario):
         cfg.sim_env_pair.add(modem_tcp_port=port, endpoint_ip_address=endpoint_ip, environment_id=0)
     cfg.env_bounds.add(
-        environment_id=0, lat_min=-90, lat_max=90, lon_min=-180, lon_max=180,
-        depth_min=0, depth_max=12000,
-    )  # fmt: skip
+        environment_id=0,
+        lat_min=-90,
+        lat_max=90,
+        lon_min=-180,
+        lon_max=180,
+        depth_min=0,
+        depth_max=12000,
+    )
     rt = scenario.real_time
     cfg.manager_tcp_port = 0 if rt.ephemeral_ports else rt.manager_tcp_port
     cfg.listen_address = rt.listen_address
@@ -203,10 +213,13 @@ def mac_config(scenario: Message, modem_id: int) -> Message:
     if not cfg.slot:
         for node in scenario.node:
             cfg.slot.add(
-                src=node.modem_id, dest=scenario.traffic.status_dest, rate=cfg.rate,
-                type=acomms_pb.ModemTransmission.DATA, slot_seconds=cfg.slot_seconds,
+                src=node.modem_id,
+                dest=scenario.traffic.status_dest,
+                rate=cfg.rate,
+                type=acomms_pb.ModemTransmission.DATA,
+                slot_seconds=cfg.slot_seconds,
                 ack_requested=scenario.traffic.ack,
-            )  # fmt: skip
+            )
     return cfg
 
 
@@ -268,6 +281,10 @@ class TrackFollower:
         fraction = (elapsed - a.t) / (b.t - a.t)
         lon, lat, _ = WGS84.fwd(a.lon, a.lat, azimuth, distance * fraction)
         return Position(
-            lat, lon, a.depth + (b.depth - a.depth) * fraction, now,
-            speed=distance / (b.t - a.t), heading=azimuth % 360.0,
-        )  # fmt: skip
+            lat,
+            lon,
+            a.depth + (b.depth - a.depth) * fraction,
+            now,
+            speed=distance / (b.t - a.t),
+            heading=azimuth % 360.0,
+        )

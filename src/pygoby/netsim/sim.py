@@ -151,9 +151,11 @@ class Simulation:
         self.manager.on_nav(self.channel.on_environment_nav_update)
         # (in a discrete-event run a driver wakes once for $CARXP and the packet)
         self.physics = PhysicsChannel(
-            self.channel, self.clock, on_event=on_event,
+            self.channel,
+            self.clock,
+            on_event=on_event,
             detections_with_receptions=isinstance(self.clock, VirtualClock),
-        )  # fmt: skip
+        )
         # every event (see the module's documentation): the channel's, and the run's own on the
         # same signal (an event is only made when someone listens)
         self.signal_event = self.physics.signal_event
@@ -165,9 +167,13 @@ class Simulation:
         for node, port in zip(scenario.node, node_ports(scenario), strict=True):
             track = TrackFollower(node.track, scenario) if node.HasField("track") else None
             model = MicroModemModel(
-                node.modem_id, self.clock, self.physics, name=str(port), timing=timing,
+                node.modem_id,
+                self.clock,
+                self.physics,
+                name=str(port),
+                timing=timing,
                 timeline=self.timeline,
-            )  # fmt: skip
+            )
             self.nodes.append(SimNode(node.modem_id, port, model, track))
         self._request_id = 0
         self._wall_start = 0.0
@@ -193,8 +199,13 @@ class Simulation:
         """Start the run's traffic: a `node` event per node (its port and modem id, for the
         report), then every in-process stack's MAC and first status message."""
         for node in self.nodes:
-            self._event("node", t=self.clock.now(), port=node.port, modem_id=node.modem_id,
-                        external=node.driver is None)  # fmt: skip
+            self._event(
+                "node",
+                t=self.clock.now(),
+                port=node.port,
+                modem_id=node.modem_id,
+                external=node.driver is None,
+            )
         for node in self.nodes:
             if node.mac is not None:
                 node.mac.startup(mac_config(self.scenario, node.modem_id))
@@ -213,10 +224,15 @@ class Simulation:
             return
         position = reported.at(now)
         status = self.status_class(
-            src=node.modem_id, dest=self.scenario.traffic.status_dest, time=now,
-            lat=position.lat, lon=position.lon, depth=max(position.depth, 0.0),
-            speed=min(reported.speed, 10.0), heading=reported.heading % 360.0,
-        )  # fmt: skip
+            src=node.modem_id,
+            dest=self.scenario.traffic.status_dest,
+            time=now,
+            lat=position.lat,
+            lon=position.lon,
+            depth=max(position.depth, 0.0),
+            speed=min(reported.speed, 10.0),
+            heading=reported.heading % 360.0,
+        )
         node.queue.push_message(status)
         self.status_sent += 1
 
@@ -235,9 +251,13 @@ class Simulation:
         owtt = msg.Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply.one_way_travel_time
         if owtt:
             self._event(
-                "range", t=self.clock.now(), port=node.port, src=msg.src, dest=msg.dest,
+                "range",
+                t=self.clock.now(),
+                port=node.port,
+                src=msg.src,
+                dest=msg.dest,
                 owtt=list(owtt),
-            )  # fmt: skip
+            )
 
     def _event(self, kind: str, **fields) -> None:
         self.events[kind] += 1
@@ -259,9 +279,14 @@ class Simulation:
         self._request_id = (self._request_id + 1) % 2**31
         for port, p in self.track_positions():
             request.nav.add(
-                modem_tcp_port=port, time=p.time, lat=p.lat, lon=p.lon, depth=p.depth,
-                speed=p.speed, heading=p.heading,
-            )  # fmt: skip
+                modem_tcp_port=port,
+                time=p.time,
+                lat=p.lat,
+                lon=p.lon,
+                depth=p.depth,
+                speed=p.speed,
+                heading=p.heading,
+            )
         if request.nav:
             outcome = self.manager.handle_request(request, LOCAL_IP)
             if outcome.response.status != outcome.response.UPDATE_ACCEPTED:
@@ -282,7 +307,8 @@ class Simulation:
         return RunSummary(
             simulated_seconds=self.clock.now() - self.start,
             wall_seconds=time.perf_counter() - self._wall_start,
-            events=self.events + Counter(
+            events=self.events
+            + Counter(
                 tx=self.physics.transmissions.total(),
                 tx_data=self.physics.transmissions["data"],
                 rx=self.physics.outcomes.total(),

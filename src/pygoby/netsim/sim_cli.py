@@ -43,9 +43,9 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
     report.add_argument("log", help="event log (JSON lines) written by `netsim run`")
     report.add_argument("-o", "--output", default="netsim_report", help="output directory")
     report.add_argument(
-        "--window", help="timeline window START:END in seconds after the first event "
-        "(default: the whole run)",
-    )  # fmt: skip
+        "--window",
+        help="timeline window START:END in seconds after the first event (default: the whole run)",
+    )
     report.set_defaults(func=report_command)
     from pygoby.netsim.sweep.cli import add_subcommands as add_sweep_subcommands
 

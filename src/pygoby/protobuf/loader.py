@@ -109,7 +109,9 @@ class ProtoLoader:
             self._add(file_proto)
         return self.pool.FindFileByName(name)
 
-    def _compile(self, name: str, search: Sequence[str]) -> list[descriptor_pb2.FileDescriptorProto]:
+    def _compile(
+        self, name: str, search: Sequence[str]
+    ) -> list[descriptor_pb2.FileDescriptorProto]:
         from grpc_tools import protoc  # imported lazily: it is slow to import
 
         with tempfile.TemporaryDirectory(prefix="pygoby-protoc-") as tmp:

@@ -41,7 +41,9 @@ PACOMMSHANDLER_CONFIG = (
 )
 XML_PATH_FIELD = "message_file.path"  # dccl_cfg/queue_cfg/transitional_cfg all name it so
 
-ErrorMaker = Callable[[str, str, str], ConfigError]  # (reason, field, value): GobyMOOSApp.config_error
+ErrorMaker = Callable[
+    [str, str, str], ConfigError
+]  # (reason, field, value): GobyMOOSApp.config_error
 
 
 def _unlocated(reason: str, field: str, value: str) -> ConfigError:
@@ -72,9 +74,12 @@ class AcommsMessageSet:
 
     @classmethod
     def load(
-        cls, cfg: Message, find: Callable[[str], str] = str, search_dirs: Sequence[str] = (),
+        cls,
+        cfg: Message,
+        find: Callable[[str], str] = str,
+        search_dirs: Sequence[str] = (),
         config_error: ErrorMaker | None = None,
-    ) -> AcommsMessageSet:  # fmt: skip
+    ) -> AcommsMessageSet:
         """Load `cfg`'s message files; `find` resolves relative file names (the mission's
         find_file), `search_dirs` are the folders it looks in (for "not found" errors; default
         the working directory). The XML files' entries are appended to `cfg`, so load a
@@ -91,17 +96,21 @@ class AcommsMessageSet:
             cfg, loader, _xml_finder(find, search_dirs, error)
         )
         types = MessageTypes(
-            [*(p for library in dccl_libraries for p in library.proto_files),
-             *(find(path) for path in cfg.load_proto_file)],
+            [
+                *(p for library in dccl_libraries for p in library.proto_files),
+                *(find(path) for path in cfg.load_proto_file),
+            ],
             [find(module) for module in modules],
             fallback=acomms_pb.goby_message_class,
             loader=loader,
             search_dirs=search_dirs,
             config_error=config_error,
-        )  # fmt: skip
+        )
         out = cls(cfg, loader, types, transitional, dccl_libraries, find, search_dirs)
-        out.require([entry.protobuf_name for entry in cfg.translator_entry],
-                    "translator_entry.protobuf_name")  # fmt: skip
+        out.require(
+            [entry.protobuf_name for entry in cfg.translator_entry],
+            "translator_entry.protobuf_name",
+        )
         return out
 
     def loaded(self) -> list[str]:
@@ -124,8 +133,12 @@ class AcommsMessageSet:
             cfg = builtin_class(*PACOMMSHANDLER_CONFIG)()
         else:
             cfg = read_acomms_config(mission, block)
-        out = cls.load(cfg, app.find_file, app.search_dirs(),
-                       config_error=functools.partial(app.config_error, block=block))  # fmt: skip
+        out = cls.load(
+            cfg,
+            app.find_file,
+            app.search_dirs(),
+            config_error=functools.partial(app.config_error, block=block),
+        )
         for message_file in message_files:
             if Path(app.find_file(message_file.path)).resolve() not in out.files():
                 out.import_xml(message_file.path, message_file.manipulator, app.config_error)
@@ -163,7 +176,9 @@ class AcommsMessageSet:
         set and to `cfg`; returns their names. ConfigError (file:line) for a file that cannot
         be used or that defines a message already loaded; one not found is located by
         `config_error` when the path comes from a configuration."""
-        message_file = self.cfg.transitional_cfg.message_file.add(path=path, manipulator=manipulators)
+        message_file = self.cfg.transitional_cfg.message_file.add(
+            path=path, manipulator=manipulators
+        )
         find = _xml_finder(self.find, self.search_dirs, config_error or _unlocated)
         try:
             message_set = self.transitional.add_file(self.cfg, message_file, self.loader, find)

@@ -34,8 +34,14 @@ logging.addLevelName(DEBUG3, "DEBUG3")
 
 # goby.util.protobuf.GLogConfig.Verbosity -> logging level
 VERBOSITY_LEVELS = {1: QUIET, 2: logging.WARNING, 4: VERBOSE, 5: DEBUG1, 6: DEBUG2, 7: DEBUG3}
-VERBOSITY_NAMES = {QUIET: "QUIET", logging.WARNING: "WARN", VERBOSE: "VERBOSE", DEBUG1: "DEBUG1",
-                   DEBUG2: "DEBUG2", DEBUG3: "DEBUG3"}  # fmt: skip
+VERBOSITY_NAMES = {
+    QUIET: "QUIET",
+    logging.WARNING: "WARN",
+    VERBOSE: "VERBOSE",
+    DEBUG1: "DEBUG1",
+    DEBUG2: "DEBUG2",
+    DEBUG3: "DEBUG3",
+}
 
 LIBRARY_ROOT = "pygoby"
 APP_LOGGERS = "pygoby.app."  # an application's own lines carry no group (as goby3's)
@@ -89,7 +95,9 @@ class GobyFormatter(logging.Formatter):
     def format(self, record: logging.LogRecord) -> str:
         group = group_name(record.name)
         if group:
-            code = self._colours.setdefault(group, _GROUP_COLOURS[len(self._colours) % len(_GROUP_COLOURS)])
+            code = self._colours.setdefault(
+                group, _GROUP_COLOURS[len(self._colours) % len(_GROUP_COLOURS)]
+            )
             group = self._paint(code, "{" + group + "}")
         text = record.getMessage()
         if record.exc_info:

@@ -18,7 +18,9 @@ def did_you_mean(name: str, candidates: Sequence[str], limit: int = 3) -> str:
     by_last_part: dict[str, list[str]] = {}
     for candidate in candidates:
         by_last_part.setdefault(candidate.rsplit(".", 1)[-1], []).append(candidate)
-    lasts = difflib.get_close_matches(name.rsplit(".", 1)[-1], list(by_last_part), n=limit, cutoff=CUTOFF)
+    lasts = difflib.get_close_matches(
+        name.rsplit(".", 1)[-1], list(by_last_part), n=limit, cutoff=CUTOFF
+    )
     close = [candidate for last in lasts for candidate in by_last_part[last]][:limit]
     if close:
         return f"; did you mean {' or '.join(close)}?"

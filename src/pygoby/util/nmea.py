@@ -107,7 +107,9 @@ class NMEASentence:
         try:
             value = int(self.fields[index])
         except (IndexError, ValueError):
-            raise NMEAFormatError(f"field {index} of {self.message()!r} is not an integer") from None
+            raise NMEAFormatError(
+                f"field {index} of {self.message()!r} is not an integer"
+            ) from None
         if (low is not None and value < low) or (high is not None and value > high):
             raise NMEAFormatError(
                 f"field {index} of {self.message()!r} is out of range [{low}, {high}]"

@@ -43,11 +43,14 @@ class RunProgress:
             from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
             self._bar = Progress(
-                TextColumn("{task.description}"), BarColumn(),
+                TextColumn("{task.description}"),
+                BarColumn(),
                 TextColumn("{task.completed:,.0f}/{task.total:,.0f} " + self.unit),
-                TextColumn("{task.fields[extra]}"), TimeRemainingColumn(),
-                console=Console(file=self.stream), transient=True,
-            )  # fmt: skip
+                TextColumn("{task.fields[extra]}"),
+                TimeRemainingColumn(),
+                console=Console(file=self.stream),
+                transient=True,
+            )
             self._bar.start()
             self._task = self._bar.add_task(self.label, total=self.total or None, extra="")
         return self
@@ -62,7 +65,9 @@ class RunProgress:
         since, first = self._first if self._first is not None else (self._started, 0.0)
         elapsed = time.monotonic() - since
         speed = (done - first) / elapsed if elapsed > 0 else 0.0
-        parts.append(f"{speed:,.0f}x real time" if self.unit == "s" else f"{speed:,.2f} {self.unit}/s")
+        parts.append(
+            f"{speed:,.0f}x real time" if self.unit == "s" else f"{speed:,.2f} {self.unit}/s"
+        )
         if speed > 0 and 0 < done < self.total:
             parts.append(f"ETA {(self.total - done) / speed:,.0f} s")
         return ", ".join(parts)
@@ -77,12 +82,20 @@ class RunProgress:
             return
         self._last_draw = now
         if self._bar is not None:
-            self._bar.update(self._task, completed=done, total=self.total or None,
-                             extra=self.describe(done, **counts))  # fmt: skip
+            self._bar.update(
+                self._task,
+                completed=done,
+                total=self.total or None,
+                extra=self.describe(done, **counts),
+            )
             return
         tenth = int(10 * done / self.total) if self.total > 0 else 10
         if tenth == self._printed_tenth or now - self._started < PLAIN_AFTER:
             return
         self._printed_tenth = tenth
-        print(f"{self.label} {done:,.0f}/{self.total:,.0f} {self.unit} ({tenth * 10}%): "
-              f"{self.describe(done, **counts)}", file=self.stream, flush=True)  # fmt: skip
+        print(
+            f"{self.label} {done:,.0f}/{self.total:,.0f} {self.unit} ({tenth * 10}%): "
+            f"{self.describe(done, **counts)}",
+            file=self.stream,
+            flush=True,
+        )

@@ -60,8 +60,9 @@ class _Claim:
         except OSError as err:
             os.close(fd)
             if err.errno in (errno.EWOULDBLOCK, errno.EACCES):
-                raise PtyError(err.errno, f"{', '.join(map(str, self.paths))} belong to a running "
-                               "process") from None  # fmt: skip
+                raise PtyError(
+                    err.errno, f"{', '.join(map(str, self.paths))} belong to a running process"
+                ) from None
             raise
         os.ftruncate(fd, 0)
         os.write(fd, f"{os.getpid()}\n".encode())

@@ -9,7 +9,9 @@ import sqlite3
 DEFAULT_LOCK_TIMEOUT = 5.0  # s
 
 
-def open_durable(path: str | os.PathLike[str], lock_timeout: float = DEFAULT_LOCK_TIMEOUT) -> sqlite3.Connection:
+def open_durable(
+    path: str | os.PathLike[str], lock_timeout: float = DEFAULT_LOCK_TIMEOUT
+) -> sqlite3.Connection:
     """A connection whose committed transactions survive a crash of the process (kill -9) and
     of the machine: a rollback journal (journal_mode=DELETE) synchronised to the disk at every
     commit (synchronous=FULL). Write in `with connection:` blocks (one transaction each).

@@ -71,6 +71,8 @@ CORPUS_PROTOS = [
     ("tests", "cclmix.proto"),
     ("builtin", "dccl/ccl/protobuf/ccl.proto"),
 ]
+
+
 def hexs(text: str | bytes) -> str:
     return (text.encode() if isinstance(text, str) else text).hex()
 
@@ -91,8 +93,12 @@ class Oracle:
 
     def _start(self) -> None:
         self.proc = subprocess.Popen(
-            [self.harness], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL, text=True, bufsize=1,
+            [self.harness],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+            bufsize=1,
         )
         for line in self.setup:
             self._raw(line, 20)
@@ -139,8 +145,9 @@ class Oracle:
         self.setup = []
         self.ask("reset")
 
-    def open_codec(self, where: str, proto: str, passphrase: str | None = None,
-                   models: list[Path] = ()) -> list[str]:
+    def open_codec(
+        self, where: str, proto: str, passphrase: str | None = None, models: list[Path] = ()
+    ) -> list[str]:
         """A fresh codec with this proto's libraries, models and messages loaded; the names of
         the loaded messages."""
         self.reset()
@@ -174,7 +181,11 @@ class Oracle:
     def decode(self, name: str, data: bytes) -> dict:
         answer = self.ask(f"decode {name} {data.hex()}")
         if answer[0] == "text":
-            text = bytes.fromhex(answer[1]).decode(errors="backslashreplace") if len(answer) > 1 else ""
+            text = (
+                bytes.fromhex(answer[1]).decode(errors="backslashreplace")
+                if len(answer) > 1
+                else ""
+            )
             serialized = answer[2] if len(answer) > 2 else ""
             return {"result": "ok", "decoded": text.strip(), "decoded_bin": serialized}
         if answer[0] == "error":
@@ -224,8 +235,13 @@ UNICODE = "éü°Ωж中€"
 class Values:
     """Random field values near what the field's options allow (bounds, midpoints, out of range)."""
 
-    def __init__(self, rng: random.Random, wild: float = 0.15, models: dict | None = None,
-                 avoid_top: bool = False) -> None:
+    def __init__(
+        self,
+        rng: random.Random,
+        wild: float = 0.15,
+        models: dict | None = None,
+        avoid_top: bool = False,
+    ) -> None:
         self.rng = rng
         self.wild = wild  # probability of a value outside the field's limits
         self.models = models or {}
@@ -241,7 +257,9 @@ class Values:
         if codec in ("dccl.native_protobuf",) or (codec == "" and not opts.HasField("min")):
             return self.native(f)
         if codec in ("dccl.time", "_time"):
-            seconds = NOW + rng.randint(-3 * 86400, 3 * 86400) + rng.choice([0, 0.25, 0.5, 0.123456])
+            seconds = (
+                NOW + rng.randint(-3 * 86400, 3 * 86400) + rng.choice([0, 0.25, 0.5, 0.123456])
+            )
             return int(seconds * 1_000_000) if integer else seconds
         lo, hi = opts.min, opts.max
         res = opts.resolution if opts.HasField("resolution") else math.pow(10.0, -opts.precision)
@@ -265,10 +283,30 @@ class Values:
         rng = self.rng
         if f.cpp_type in INT_LIMITS:
             lo, hi = INT_LIMITS[f.cpp_type]
-            return rng.choice([0, 1, -1 if lo < 0 else 2, lo, hi, rng.randint(lo, hi),
-                               rng.randint(-300, 300) if lo < 0 else rng.randint(0, 300)])
-        return rng.choice([0.0, -0.0, 1.5, -2.25, 1e300, -1e-300, rng.uniform(-1e6, 1e6),
-                           float("inf"), rng.uniform(-1, 1)])
+            return rng.choice(
+                [
+                    0,
+                    1,
+                    -1 if lo < 0 else 2,
+                    lo,
+                    hi,
+                    rng.randint(lo, hi),
+                    rng.randint(-300, 300) if lo < 0 else rng.randint(0, 300),
+                ]
+            )
+        return rng.choice(
+            [
+                0.0,
+                -0.0,
+                1.5,
+                -2.25,
+                1e300,
+                -1e-300,
+                rng.uniform(-1e6, 1e6),
+                float("inf"),
+                rng.uniform(-1, 1),
+            ]
+        )
 
     def arithmetic(self, f: FieldDescriptor, integer: bool):
         model = self.models[field_options_ext(f, "arithmetic").model]
@@ -290,7 +328,11 @@ class Values:
         if f.cpp_type == FieldDescriptor.CPPTYPE_BOOL:
             return rng.random() < 0.6
         if integer:
-            lo = 0 if f.cpp_type in (FieldDescriptor.CPPTYPE_UINT32, FieldDescriptor.CPPTYPE_UINT64) else -(2**31)
+            lo = (
+                0
+                if f.cpp_type in (FieldDescriptor.CPPTYPE_UINT32, FieldDescriptor.CPPTYPE_UINT64)
+                else -(2**31)
+            )
             v = max(lo, int(math.floor(v + 0.5)))
         if self.avoid_top and (bounds[-2] + bounds[-1]) / 2 <= v <= bounds[-1]:
             return bounds[-2]
@@ -369,7 +411,11 @@ class Values:
 def field_options_ext(f: FieldDescriptor, name: str):
     """An extension of (dccl.field) read from the field's options (arithmetic, ccl)."""
     proto, cls, number = {
-        "arithmetic": ("dccl/arithmetic/protobuf/arithmetic_extensions.proto", "ArithmeticOptions", 1001),
+        "arithmetic": (
+            "dccl/arithmetic/protobuf/arithmetic_extensions.proto",
+            "ArithmeticOptions",
+            1001,
+        ),
         "ccl": ("dccl/ccl/protobuf/ccl_extensions.proto", "LegacyCCLFieldOptions", 1000),
     }[name]
     return field_extension(field_options(f), proto, cls, number)
@@ -382,7 +428,9 @@ def to_text(msg: Message) -> str:
 def load_models() -> dict:
     from pygoby.protobuf import builtin_class
 
-    cls = builtin_class("dccl/arithmetic/protobuf/arithmetic.proto", "dccl.arith.protobuf.ArithmeticModel")
+    cls = builtin_class(
+        "dccl/arithmetic/protobuf/arithmetic.proto", "dccl.arith.protobuf.ArithmeticModel"
+    )
     models = {}
     for path in sorted(MODELS.glob("*.txt")):
         model = text_format.Parse(path.read_text(), cls())
@@ -425,7 +473,7 @@ def id_bytes(data: bytes, ccl_frame: bool) -> bytes:
     if ccl_frame:
         return data[:1]
     start = 1 if data[:1] == b"\x20" else 0
-    width = 2 if data[start:start + 1] and data[start] & 1 else 1
+    width = 2 if data[start : start + 1] and data[start] & 1 else 1
     return data[: start + width]
 
 
@@ -433,7 +481,7 @@ def random_bytes(rng: random.Random, max_bytes: int, id_prefix: bytes) -> bytes:
     n = rng.randint(0, max_bytes + 4)
     data = bytes(rng.randrange(256) for _ in range(n))
     if rng.random() < 0.75:
-        data = id_prefix + data[len(id_prefix):]
+        data = id_prefix + data[len(id_prefix) :]
     return data
 
 
@@ -460,7 +508,9 @@ def corpus(oracle: Oracle, rng: random.Random, per_type: int) -> list[dict]:
                 id_prefix = b""
                 if not opts.omit_id:
                     enc, _, _ = oracle.encode(name, to_text(values.message(desc)))
-                    id_prefix = id_bytes(bytes.fromhex(enc), proto.endswith("ccl.proto")) if enc else b""
+                    id_prefix = (
+                        id_bytes(bytes.fromhex(enc), proto.endswith("ccl.proto")) if enc else b""
+                    )
                 inputs: list[tuple[str, bytes]] = []
                 count = per_type if passphrase is None else per_type // 4
                 for _ in range(count):
@@ -479,15 +529,33 @@ def corpus(oracle: Oracle, rng: random.Random, per_type: int) -> list[dict]:
                         continue
                     seen.add(data)
                     answer = oracle.decode(name, data)
-                    records.append({"where": where, "proto": proto, "message": name,
-                                    "passphrase": passphrase, "now": NOW, "origin": origin,
-                                    "hex": data.hex(), **answer})
+                    records.append(
+                        {
+                            "where": where,
+                            "proto": proto,
+                            "message": name,
+                            "passphrase": passphrase,
+                            "now": NOW,
+                            "origin": origin,
+                            "hex": data.hex(),
+                            **answer,
+                        }
+                    )
     return records
 
 
-def encode_vectors(oracle: Oracle, rng: random.Random, suite: str, where: str, proto: str,
-                   count: int, passphrases=(None, "vector key"), strict_share: float = 0.3,
-                   nows=(NOW,), wild: float = 0.15) -> list[dict]:
+def encode_vectors(
+    oracle: Oracle,
+    rng: random.Random,
+    suite: str,
+    where: str,
+    proto: str,
+    count: int,
+    passphrases=(None, "vector key"),
+    strict_share: float = 0.3,
+    nows=(NOW,),
+    wild: float = 0.15,
+) -> list[dict]:
     models = load_models()
     values = Values(rng, wild=wild, models=models)
     records = []
@@ -503,9 +571,19 @@ def encode_vectors(oracle: Oracle, rng: random.Random, suite: str, where: str, p
                 oracle.ask(f"strict {int(strict)}")
                 text = to_text(values.message(desc))
                 enc, error, status = oracle.encode(name, text)
-                record = {"suite": suite, "where": where, "proto": proto, "message": name,
-                          "text": text, "strict": strict, "passphrase": passphrase, "now": now,
-                          "status": status, "hex": enc, "error": error}
+                record = {
+                    "suite": suite,
+                    "where": where,
+                    "proto": proto,
+                    "message": name,
+                    "text": text,
+                    "strict": strict,
+                    "passphrase": passphrase,
+                    "now": now,
+                    "status": status,
+                    "hex": enc,
+                    "error": error,
+                }
                 if status == "ok":
                     record.update(oracle.decode(name, bytes.fromhex(enc)))
                 records.append(record)
@@ -529,8 +607,7 @@ def definition_hashes(oracle: Oracle) -> list[dict]:
         for name in message_names(where, proto):
             answer = oracle.ask(f"load {name}")
             if answer[0] == "ok":
-                records.append({"where": where, "proto": proto, "message": name,
-                                "hash": answer[1]})
+                records.append({"where": where, "proto": proto, "message": name, "hash": answer[1]})
     return records
 
 
@@ -547,21 +624,44 @@ def adaptive_sessions(oracle: Oracle, rng: random.Random, sessions: int) -> list
         for _ in range(rng.randint(3, 12)):
             name = rng.choice(["arith.Adaptive", "arith.Adaptive", "arith.Ints"])
             if encoded and rng.random() < 0.45:
-                name, data = encoded.pop(0) if rng.random() < 0.8 else (name, bytes.fromhex(
-                    "".join(f"{rng.randrange(256):02x}" for _ in range(rng.randint(1, 6)))))
-                steps.append({"op": "decode", "message": name, "hex": data.hex(),
-                              **oracle.decode(name, data)})
+                name, data = (
+                    encoded.pop(0)
+                    if rng.random() < 0.8
+                    else (
+                        name,
+                        bytes.fromhex(
+                            "".join(f"{rng.randrange(256):02x}" for _ in range(rng.randint(1, 6)))
+                        ),
+                    )
+                )
+                steps.append(
+                    {
+                        "op": "decode",
+                        "message": name,
+                        "hex": data.hex(),
+                        **oracle.decode(name, data),
+                    }
+                )
                 continue
             text = to_text(values.message(descriptor(name)))
             enc, error, status = oracle.encode(name, text)
             if status in ("hang", "crash"):
                 break  # the harness restarted with fresh models: the session ends here
-            steps.append({"op": "encode", "message": name, "text": text, "status": status,
-                          "hex": enc, "error": error})
+            steps.append(
+                {
+                    "op": "encode",
+                    "message": name,
+                    "text": text,
+                    "status": status,
+                    "hex": enc,
+                    "error": error,
+                }
+            )
             if status == "ok":
                 encoded.append((name, bytes.fromhex(enc)))
-        records.append({"suite": "adaptive", "where": "tests", "proto": "arith.proto",
-                        "steps": steps})
+        records.append(
+            {"suite": "adaptive", "where": "tests", "proto": "arith.proto", "steps": steps}
+        )
     return records
 
 
@@ -590,11 +690,19 @@ def cross(oracle: Oracle) -> list[dict]:
         if record["status"] == "ok" and ours.hex() == record["hex"]:
             continue
         oracle.open_codec("tests", "arith.proto", record["passphrase"], models_for("arith.proto"))
-        records.append({"where": "tests", "proto": "arith.proto", "message": record["message"],
-                        "passphrase": record["passphrase"],
-                        "text": record["text"], "cpp_status": record["status"],
-                        "cpp_hex": record["hex"], "pygoby_hex": ours.hex(),
-                        **oracle.decode(record["message"], ours)})
+        records.append(
+            {
+                "where": "tests",
+                "proto": "arith.proto",
+                "message": record["message"],
+                "passphrase": record["passphrase"],
+                "text": record["text"],
+                "cpp_status": record["status"],
+                "cpp_hex": record["hex"],
+                "pygoby_hex": ours.hex(),
+                **oracle.decode(record["message"], ours),
+            }
+        )
     return records
 
 
@@ -604,12 +712,16 @@ def ccl_times() -> list[int]:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("harness")
     parser.add_argument("--lib-dir", type=Path, required=True)
-    parser.add_argument("--suite", action="append",
-                        choices=["corpus", "arith", "adaptive", "native", "ccl", "dyn", "hash",
-                                 "hashes", "cross"])
+    parser.add_argument(
+        "--suite",
+        action="append",
+        choices=["corpus", "arith", "adaptive", "native", "ccl", "dyn", "hash", "hashes", "cross"],
+    )
     parser.add_argument("--seed", type=int, default=14)
     args = parser.parse_args()
     suites = args.suite or ["corpus", "arith", "adaptive", "native", "ccl", "dyn", "hash", "hashes"]
@@ -619,20 +731,39 @@ def main() -> int:
         if suite == "corpus":
             write("decode_corpus.jsonl", corpus(oracle, rng, per_type=12))
         elif suite == "arith":
-            write("arith_vectors.jsonl", encode_vectors(oracle, rng, suite, "tests", "arith.proto", 60))
+            write(
+                "arith_vectors.jsonl",
+                encode_vectors(oracle, rng, suite, "tests", "arith.proto", 60),
+            )
         elif suite == "adaptive":
             write("arith_adaptive.jsonl", adaptive_sessions(oracle, rng, 60))
         elif suite == "native":
-            write("native_vectors.jsonl", encode_vectors(oracle, rng, suite, "tests", "native.proto", 80))
+            write(
+                "native_vectors.jsonl",
+                encode_vectors(oracle, rng, suite, "tests", "native.proto", 80),
+            )
         elif suite == "ccl":
-            records = encode_vectors(oracle, rng, suite, "builtin", "dccl/ccl/protobuf/ccl.proto",
-                                     80, nows=ccl_times(), wild=0.25)
+            records = encode_vectors(
+                oracle,
+                rng,
+                suite,
+                "builtin",
+                "dccl/ccl/protobuf/ccl.proto",
+                80,
+                nows=ccl_times(),
+                wild=0.25,
+            )
             records += encode_vectors(oracle, rng, suite, "tests", "cclmix.proto", 40)
             write("ccl_vectors.jsonl", records)
         elif suite == "dyn":
-            write("dyn_vectors.jsonl", encode_vectors(oracle, rng, suite, "tests", "dyncond.proto", 80))
+            write(
+                "dyn_vectors.jsonl",
+                encode_vectors(oracle, rng, suite, "tests", "dyncond.proto", 80),
+            )
         elif suite == "hash":
-            write("hash_vectors.jsonl", encode_vectors(oracle, rng, suite, "tests", "hash.proto", 25))
+            write(
+                "hash_vectors.jsonl", encode_vectors(oracle, rng, suite, "tests", "hash.proto", 25)
+            )
         elif suite == "hashes":
             write("definition_hashes.jsonl", definition_hashes(oracle))
         elif suite == "cross":

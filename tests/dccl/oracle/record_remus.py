@@ -29,7 +29,22 @@ from tests.dccl.remus_cpp import CCL_PROTO, DATA, MESSAGE, to_json, to_message  
 
 MPS = remus.THRUST_MPS_TRANSIT | remus.THRUST_MPS_SURVEY
 # depths at the edges of the piecewise steps, speeds beyond the clamp
-DEPTHS = [0.0, 0.04, 0.05, 99.95, 100.0, 100.1, 199.9, 200.0, 999.75, 1000.0, 5999.5, 6000.0, 7000.0, -3.0]
+DEPTHS = [
+    0.0,
+    0.04,
+    0.05,
+    99.95,
+    100.0,
+    100.1,
+    199.9,
+    200.0,
+    999.75,
+    1000.0,
+    5999.5,
+    6000.0,
+    7000.0,
+    -3.0,
+]
 
 
 def f(rng: random.Random, low: float, high: float) -> float:
@@ -39,44 +54,79 @@ def f(rng: random.Random, low: float, high: float) -> float:
 
 def random_state(rng: random.Random) -> remus.State:
     return remus.State(
-        latitude=rng.uniform(-90, 90), longitude=rng.uniform(-180, 180),
-        fix_age=rng.randint(0, 1020), time=remus.TimeDate.at(rng.randint(946_684_800, 2_050_000_000)),
-        heading=f(rng, 0, 360), depth=rng.choice([f(rng, 0, 6000), f(rng, 0, 150), rng.choice(DEPTHS)]),
-        mission_mode=rng.randrange(8), faults=rng.getrandbits(32), faults_2=rng.randrange(256),
-        mission_leg=rng.randrange(256), est_velocity=f(rng, -5.12, 5.08),
-        objective_index=rng.randrange(256), watts=f(rng, -10, 1100),
-        lat_goal=rng.uniform(-90, 90), lon_goal=rng.uniform(-180, 180),
+        latitude=rng.uniform(-90, 90),
+        longitude=rng.uniform(-180, 180),
+        fix_age=rng.randint(0, 1020),
+        time=remus.TimeDate.at(rng.randint(946_684_800, 2_050_000_000)),
+        heading=f(rng, 0, 360),
+        depth=rng.choice([f(rng, 0, 6000), f(rng, 0, 150), rng.choice(DEPTHS)]),
+        mission_mode=rng.randrange(8),
+        faults=rng.getrandbits(32),
+        faults_2=rng.randrange(256),
+        mission_leg=rng.randrange(256),
+        est_velocity=f(rng, -5.12, 5.08),
+        objective_index=rng.randrange(256),
+        watts=f(rng, -10, 1100),
+        lat_goal=rng.uniform(-90, 90),
+        lon_goal=rng.uniform(-180, 180),
         battery_percent=rng.randrange(256),
         gfi_pitch_oil=remus.GFIPitchOil(f(rng, -5, 105), f(rng, -95, 95), f(rng, -5, 105)),
-    )  # fmt: skip
+    )
 
 
 def random_redirect(rng: random.Random) -> remus.Redirect:
     return remus.Redirect(
-        latitude=rng.uniform(-90, 90), longitude=rng.uniform(-180, 180),
-        message_number=rng.randrange(256), speed_depth_flags=rng.randrange(256) | MPS,
+        latitude=rng.uniform(-90, 90),
+        longitude=rng.uniform(-180, 180),
+        message_number=rng.randrange(256),
+        speed_depth_flags=rng.randrange(256) | MPS,
         transit_depth=rng.choice([f(rng, 0, 6000), rng.choice(DEPTHS)]),
-        transit_speed=f(rng, -4.5, 4.5), transit_command=rng.randrange(256),
-        survey_depth=f(rng, 0, 300), survey_speed=f(rng, -4.5, 4.5),
-        survey_command=rng.randrange(256), num_rows=rng.randrange(256),
-        row_length=rng.randrange(65536), spacing_0=rng.randrange(256), spacing_1=rng.randrange(256),
-        row_heading=f(rng, 0, 360), start_latitude=rng.uniform(-90, 90),
+        transit_speed=f(rng, -4.5, 4.5),
+        transit_command=rng.randrange(256),
+        survey_depth=f(rng, 0, 300),
+        survey_speed=f(rng, -4.5, 4.5),
+        survey_command=rng.randrange(256),
+        num_rows=rng.randrange(256),
+        row_length=rng.randrange(65536),
+        spacing_0=rng.randrange(256),
+        spacing_1=rng.randrange(256),
+        row_heading=f(rng, 0, 360),
+        start_latitude=rng.uniform(-90, 90),
         start_longitude=rng.uniform(-180, 180),
-    )  # fmt: skip
+    )
 
 
 def edge_frames() -> list[remus.State | remus.Redirect]:
-    example = remus.State(latitude=42.35, longitude=-70.95, time=remus.TimeDate.at(NOW), heading=45.0,
-                          depth=111.0, est_velocity=f32(1.2))  # fmt: skip
+    example = remus.State(
+        latitude=42.35,
+        longitude=-70.95,
+        time=remus.TimeDate.at(NOW),
+        heading=45.0,
+        depth=111.0,
+        est_velocity=f32(1.2),
+    )
     out: list[remus.State | remus.Redirect] = [example]
-    for lat, lon in [(0.0, 0.0), (-0.00001, -0.00001), (-42.35, -70.95), (90.0, 180.0), (-90.0, -180.0),
-                     (-LATLON, LATLON)]:  # fmt: skip
+    for lat, lon in [
+        (0.0, 0.0),
+        (-0.00001, -0.00001),
+        (-42.35, -70.95),
+        (90.0, 180.0),
+        (-90.0, -180.0),
+        (-LATLON, LATLON),
+    ]:
         out.append(remus.State(latitude=lat, longitude=lon, lat_goal=-lat, lon_goal=-lon))
-        out.append(remus.Redirect(latitude=lat, longitude=lon, start_latitude=-lat, start_longitude=-lon))
+        out.append(
+            remus.Redirect(latitude=lat, longitude=lon, start_latitude=-lat, start_longitude=-lon)
+        )
     out += [remus.State(depth=d) for d in DEPTHS]
-    out += [remus.Redirect(transit_depth=d, survey_depth=d, transit_speed=s, survey_speed=-s)
-            for d, s in zip(DEPTHS, [0.0, 0.0166, 0.0167, 1.5, 4.2, 4.3, 5.0, 100.0, -4.3, 0.5, 2.0, 3.0, 1.0, -1.0],
-                            strict=True)]  # fmt: skip
+    out += [
+        remus.Redirect(transit_depth=d, survey_depth=d, transit_speed=s, survey_speed=-s)
+        for d, s in zip(
+            DEPTHS,
+            [0.0, 0.0166, 0.0167, 1.5, 4.2, 4.3, 5.0, 100.0, -4.3, 0.5, 2.0, 3.0, 1.0, -1.0],
+            strict=True,
+        )
+    ]
     return out
 
 
@@ -84,7 +134,9 @@ LATLON = remus.LATLON_STEP  # the smallest non-zero coordinate
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("harness")
     parser.add_argument("--lib-dir", type=Path, required=True)
     parser.add_argument("--count", type=int, default=60, help="random frames of each type")
@@ -106,8 +158,16 @@ def main() -> int:
         if status != "ok":
             raise RuntimeError(f"C++ could not encode {text}: {error}")
         decoded = oracle.decode(MESSAGE[kind], bytes.fromhex(hex_bytes))
-        records.append({"type": kind, "now": now, "values": to_json(frame), "cpp_text": text,
-                        "cpp_hex": hex_bytes, "cpp_decoded_bin": decoded["decoded_bin"]})  # fmt: skip
+        records.append(
+            {
+                "type": kind,
+                "now": now,
+                "values": to_json(frame),
+                "cpp_text": text,
+                "cpp_hex": hex_bytes,
+                "cpp_decoded_bin": decoded["decoded_bin"],
+            }
+        )
     with DATA.open("w") as out:
         for record in records:
             out.write(json.dumps(record) + "\n")

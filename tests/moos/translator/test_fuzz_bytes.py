@@ -22,9 +22,15 @@ SETTINGS = settings(
 )
 TEST_MSG = "pygoby.test.translator.TestMsg"
 BNR = "pygoby.test.translator.BasicNodeReport"
-PREFIXES = [b"", b"string_default_optional=", b"string_default_repeat={", b"Name=",
-            b"@PB[pygoby.test.translator.TestMsg] string_default_optional: \"",
-            b"string_default_optional: \"", b"msg_default_optional { val: 1 } "]  # fmt: skip
+PREFIXES = [
+    b"",
+    b"string_default_optional=",
+    b"string_default_repeat={",
+    b"Name=",
+    b'@PB[pygoby.test.translator.TestMsg] string_default_optional: "',
+    b'string_default_optional: "',
+    b"msg_default_optional { val: 1 } ",
+]
 moos_bytes = st.builds(lambda p, b: p + b, st.sampled_from(PREFIXES), st.binary(max_size=60))
 # a MOOS string value as the client library hands it over, or the raw bytes themselves
 moos_value = moos_bytes.flatmap(lambda raw: st.sampled_from([decode_text(raw), raw]))

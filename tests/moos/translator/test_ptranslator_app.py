@@ -172,8 +172,7 @@ def test_configuration_errors(tmp_path, lookup_file):
         )
     missing = '  translator_entry { protobuf_name: "no.Such" }'
     mission = MissionFile.from_text(mission_text(9000, lookup_file, missing))
-    with pytest.raises(ConfigError, match='"no.Such" is not a loaded message type'
-):
+    with pytest.raises(ConfigError, match='"no.Such" is not a loaded message type'):
         pTranslator(
             pTranslator.read_config(mission, "pTranslator"), name="pTranslator", mission=mission
         )

@@ -68,7 +68,9 @@ def driver_type_name(cfg) -> str:
 
 def implemented_types() -> list[str]:
     """The DriverType names that can be used: built-ins and installed ones."""
-    types = set(BUILTIN_DRIVERS) | {n for n in INSTALLED.names() if n in _DRIVER_TYPE.values_by_name}
+    types = set(BUILTIN_DRIVERS) | {
+        n for n in INSTALLED.names() if n in _DRIVER_TYPE.values_by_name
+    }
     return [v.name for v in _DRIVER_TYPE.values if v.name in types]
 
 

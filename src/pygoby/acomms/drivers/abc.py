@@ -56,10 +56,16 @@ class ABCDriver(ModemDriverBase):
             return
         rate = msg.rate if 0 <= msg.rate < len(BITRATE) else len(BITRATE) - 1
         self._last_sent_frames = [msg.frame_start]  # only frame 0 is sent
-        self._write(format_abc(
-            "SEND", TO=msg.dest, FROM=msg.src, HEX=bytes(msg.frame[0]).hex(), BITRATE=BITRATE[rate],
-            ACK="TRUE",
-        ))  # fmt: skip
+        self._write(
+            format_abc(
+                "SEND",
+                TO=msg.dest,
+                FROM=msg.src,
+                HEX=bytes(msg.frame[0]).hex(),
+                BITRATE=BITRATE[rate],
+                ACK="TRUE",
+            )
+        )
 
     def do_work(self) -> None:
         if not self._running or self.link is None:
@@ -82,12 +88,14 @@ class ABCDriver(ModemDriverBase):
         key, fields = parse_abc(line)
         now = acomms_pb.now_us(self.clock.now())
         if key == "RECV":
-            msg = acomms_pb.ModemTransmission(type=acomms_pb.DATA, src=int(fields["FROM"]), dest=int(fields["TO"]),
-                                      time=now)  # fmt: skip
+            msg = acomms_pb.ModemTransmission(
+                type=acomms_pb.DATA, src=int(fields["FROM"]), dest=int(fields["TO"]), time=now
+            )
             msg.frame.append(bytes.fromhex(fields["HEX"]))
         elif key == "ACKN":
-            msg = acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=int(fields["FROM"]), dest=int(fields["TO"]),
-                                      time=now)  # fmt: skip
+            msg = acomms_pb.ModemTransmission(
+                type=acomms_pb.ACK, src=int(fields["FROM"]), dest=int(fields["TO"]), time=now
+            )
             msg.acked_frame.extend(self._last_sent_frames)  # Quirk A9 (sane)
         else:
             msg = acomms_pb.ModemTransmission(type=acomms_pb.DATA, time=now)

@@ -84,7 +84,9 @@ class StoreServerDriver(ModemDriverBase):
         if msg.src < 0:
             msg.src = self.modem_id
         if msg.src != self.modem_id:
-            poll = acomms_pb.ModemTransmission(src=self.modem_id, dest=msg.src, type=acomms_pb.DRIVER_SPECIFIC)
+            poll = acomms_pb.ModemTransmission(
+                src=self.modem_id, dest=msg.src, type=acomms_pb.DRIVER_SPECIFIC
+            )
             ext = poll.Extensions[acomms_pb.STORE_SERVER_TRANSMISSION]
             ext.type, ext.poll_src, ext.poll_dest = POLL, msg.src, msg.dest
             self._outbox.append(poll)
@@ -177,7 +179,9 @@ class StoreServerDriver(ModemDriverBase):
             ext = t.Extensions[acomms_pb.STORE_SERVER_TRANSMISSION]
             if t.type == acomms_pb.DRIVER_SPECIFIC and ext.type == POLL:
                 if ext.poll_src == self.modem_id:
-                    request = acomms_pb.ModemTransmission(src=ext.poll_src, dest=ext.poll_dest, type=acomms_pb.DATA)
+                    request = acomms_pb.ModemTransmission(
+                        src=ext.poll_src, dest=ext.poll_dest, type=acomms_pb.DATA
+                    )
                     self.handle_initiate_transmission(request)
                 continue
             if t.type == acomms_pb.DATA and t.dest == self.modem_id and t.ack_requested:

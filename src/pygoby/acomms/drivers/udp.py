@@ -64,9 +64,7 @@ class UDPDriver(DatagramDriverBase):
 
     def _send(self, msg) -> None:
         if self._sock is None:
-            raise ModemDriverError(
-                "UDP driver is not started", Status.CONNECTION_TO_MODEM_FAILED
-            )
+            raise ModemDriverError("UDP driver is not started", Status.CONNECTION_TO_MODEM_FAILED)
         data = msg.SerializeToString()
         targets = list(self._remotes.get(acomms_pb.BROADCAST_ID, []))
         if msg.HasField("dest") and msg.dest != acomms_pb.BROADCAST_ID:
@@ -76,8 +74,9 @@ class UDPDriver(DatagramDriverBase):
             log.warning(
                 "UDP driver: no remote for destination %d (remotes configured for modem ids "
                 "%s); a broadcast (0) reaches only the remotes whose modem_id is 0",
-                msg.dest, sorted(self._remotes) or "none",
-            )  # fmt: skip
+                msg.dest,
+                sorted(self._remotes) or "none",
+            )
         for address in targets:
             try:
                 self._sock.sendto(data, address)
@@ -89,7 +88,10 @@ class UDPDriver(DatagramDriverBase):
         self.emit_raw(True, data)
         if msg.type != acomms_pb.ACK and msg.ack_requested and msg.dest in self._ack_ids:
             ack = acomms_pb.ModemTransmission(
-                type=acomms_pb.ACK, time=acomms_pb.now_us(self.clock.now()), src=msg.dest, dest=msg.src
+                type=acomms_pb.ACK,
+                time=acomms_pb.now_us(self.clock.now()),
+                src=msg.dest,
+                dest=msg.src,
             )
             ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
             self._send(ack)

@@ -108,7 +108,9 @@ class UFldDriver(ModemDriverBase):
             if msg.frame and msg.frame[0]:
                 self._send(msg)
         elif msg.type == acomms_pb.DATA:  # third party: ask that node to send
-            poll = acomms_pb.ModemTransmission(type=acomms_pb.DRIVER_SPECIFIC, src=self.modem_id, dest=msg.src)
+            poll = acomms_pb.ModemTransmission(
+                type=acomms_pb.DRIVER_SPECIFIC, src=self.modem_id, dest=msg.src
+            )
             ext = poll.Extensions[acomms_pb.UFLD_TRANSMISSION]
             ext.type, ext.poll_src, ext.poll_dest = POLL, msg.src, msg.dest
             self._send(poll)
@@ -146,7 +148,9 @@ class UFldDriver(ModemDriverBase):
             return
         ext = msg.Extensions[acomms_pb.UFLD_TRANSMISSION]
         if msg.type == acomms_pb.DRIVER_SPECIFIC and ext.type == POLL:
-            request = acomms_pb.ModemTransmission(type=acomms_pb.DATA, src=ext.poll_src, dest=ext.poll_dest)
+            request = acomms_pb.ModemTransmission(
+                type=acomms_pb.DATA, src=ext.poll_src, dest=ext.poll_dest
+            )
             self.handle_initiate_transmission(request)
             return
         if msg.type == acomms_pb.DATA and msg.ack_requested and msg.dest != acomms_pb.BROADCAST_ID:
@@ -165,8 +169,12 @@ class UFldDriver(ModemDriverBase):
         except (KeyError, ValueError) as exc:
             log.warning("ignoring bad range report %r: %s", text, exc)
             return
-        msg = acomms_pb.ModemTransmission(type=acomms_pb.DRIVER_SPECIFIC, src=self.modem_id,
-                                  dest=self.lookup.modem_id(self._ping_target), time=when * 1_000_000)  # fmt: skip
+        msg = acomms_pb.ModemTransmission(
+            type=acomms_pb.DRIVER_SPECIFIC,
+            src=self.modem_id,
+            dest=self.lookup.modem_id(self._ping_target),
+            time=when * 1_000_000,
+        )
         ext = msg.Extensions[acomms_pb.MM_TRANSMISSION]
         ext.type = acomms_pb.MICROMODEM_TWO_WAY_PING
         ext.ranging_reply.one_way_travel_time.append(owtt)

@@ -66,19 +66,76 @@ CST_VERSION_MM2 = 6  # $CACST / $CAXST with a version field and dated times (Mic
 # their defaults where the guide's descriptions give them (CRL, CST, CTO, DBG, DGM, ...) or the
 # pygoby emulator's choice otherwise (placeholders, not values read from a modem).
 LEGACY_NVRAM = {
-    "AGC": 0, "AGN": 250, "ASD": 0, "BBD": 0, "BND": 3, "BR1": 3, "BR2": 3, "BRN": 0, "BSP": 1,
-    "BW0": 4000, "CPR": 1, "CRL": 50, "CST": 1, "CTO": 10, "DBG": 0, "DGM": 0, "DOP": 0,
-    "DQF": 0, "DTH": 108, "DTO": 2, "DTP": 90, "ECD": 50, "EFB": 10, "EFF": 20, "FC0": 25000,
-    "FMD": 0, "FML": 200, "GPS": 0, "HFC": 0, "IRE": 0, "MCM": 0, "MFC": 0, "MFD": 1, "MOD": 0,
-    "MPR": 0, "MSE": 0, "MVM": 0, "NDT": 150, "NPT": 50, "NRL": 25, "NRV": 150, "PAD": 2,
-    "PCM": 0, "POW": -100, "PRL": 50, "PTH": 180, "PTO": 6, "REV": 1, "RXA": 0, "RXD": 1,
-    "RXP": 1, "SCG": 0, "SGP": 0, "SHF": 0, "SNR": 0, "SNV": 0, "SRC": 1, "TAT": 50, "TOA": 0,
-    "TXD": 400, "TXF": 1, "TXP": 1, "XST": 1,
-}  # fmt: skip
+    "AGC": 0,
+    "AGN": 250,
+    "ASD": 0,
+    "BBD": 0,
+    "BND": 3,
+    "BR1": 3,
+    "BR2": 3,
+    "BRN": 0,
+    "BSP": 1,
+    "BW0": 4000,
+    "CPR": 1,
+    "CRL": 50,
+    "CST": 1,
+    "CTO": 10,
+    "DBG": 0,
+    "DGM": 0,
+    "DOP": 0,
+    "DQF": 0,
+    "DTH": 108,
+    "DTO": 2,
+    "DTP": 90,
+    "ECD": 50,
+    "EFB": 10,
+    "EFF": 20,
+    "FC0": 25000,
+    "FMD": 0,
+    "FML": 200,
+    "GPS": 0,
+    "HFC": 0,
+    "IRE": 0,
+    "MCM": 0,
+    "MFC": 0,
+    "MFD": 1,
+    "MOD": 0,
+    "MPR": 0,
+    "MSE": 0,
+    "MVM": 0,
+    "NDT": 150,
+    "NPT": 50,
+    "NRL": 25,
+    "NRV": 150,
+    "PAD": 2,
+    "PCM": 0,
+    "POW": -100,
+    "PRL": 50,
+    "PTH": 180,
+    "PTO": 6,
+    "REV": 1,
+    "RXA": 0,
+    "RXD": 1,
+    "RXP": 1,
+    "SCG": 0,
+    "SGP": 0,
+    "SHF": 0,
+    "SNR": 0,
+    "SNV": 0,
+    "SRC": 1,
+    "TAT": 50,
+    "TOA": 0,
+    "TXD": 400,
+    "TXF": 1,
+    "TXP": 1,
+    "XST": 1,
+}
 # Micro-Modem 2 dotted keys known from goby3 and pyacomms (info.* are read-only)
 MM2_NVRAM: dict[str, int | str] = {
-    "psk.packet.mod_hdr_version": 1, "recv.base64data": 0, "uart1.bitrate": 19200,
-}  # fmt: skip
+    "psk.packet.mod_hdr_version": 1,
+    "recv.base64data": 0,
+    "uart1.bitrate": 19200,
+}
 READ_ONLY = ("info.firmware_version",)
 
 
@@ -261,9 +318,13 @@ class MicroModemModel:
 
     def _cmd_clk(self, s: NMEASentence) -> None:
         year, month, day, hour, minute, second = (
-            s.as_int(1, *YEARS), s.as_int(2, 1, 12), s.as_int(3, 1, 31), s.as_int(4, 0, 23),
-            s.as_int(5, 0, 59), s.as_int(6, 0, 59),
-        )  # fmt: skip
+            s.as_int(1, *YEARS),
+            s.as_int(2, 1, 12),
+            s.as_int(3, 1, 31),
+            s.as_int(4, 0, 23),
+            s.as_int(5, 0, 59),
+            s.as_int(6, 0, 59),
+        )
         given = dt.datetime(year, month, day, hour, minute, second, tzinfo=dt.UTC).timestamp()
         self._set_clock_at_next_second(given, self._reply_clk)
 
@@ -299,9 +360,13 @@ class MicroModemModel:
     def _cmd_tmq(self, s: NMEASentence) -> None:
         asked = self.modem_time()
         self.timeline.at(
-            self.clock.now() + self.timing.tmq_reply, self._say, "$CATMQ", self._iso(asked),
-            self._clock_source, "RTC",
-        )  # fmt: skip
+            self.clock.now() + self.timing.tmq_reply,
+            self._say,
+            "$CATMQ",
+            self._iso(asked),
+            self._clock_source,
+            "RTC",
+        )
 
     def _cmd_alq(self, s: NMEASentence) -> None:
         self._say("$CAALQ", APPLICATION_NAME, NMEA_API_LEVEL)
@@ -318,7 +383,9 @@ class MicroModemModel:
         if adr1 == self.modem_id:
             self._start_transmit(_Transmit(adr1, adr2, rate, bool(ack), nframes))
         else:  # a third-party cycle-init: an acoustic poll asking adr1 to send
-            cycle = AcousticPacket(PacketKind.CYCLE, adr1, adr2, rate, bool(ack), num_frames=nframes)
+            cycle = AcousticPacket(
+                PacketKind.CYCLE, adr1, adr2, rate, bool(ack), num_frames=nframes
+            )
             self._send(cycle, self.timing.mini_packet, at=self._line_done)
 
     def _start_transmit(self, tx: _Transmit) -> None:
@@ -381,7 +448,11 @@ class MicroModemModel:
         self._pings[dest] = ping.tx_time
 
     def _cmd_muc(self, s: NMEASentence) -> None:
-        src, dest, data = s.as_int(1, 0, MAX_ADDRESS), s.as_int(2, 0, MAX_ADDRESS), bytes.fromhex(s[3])
+        src, dest, data = (
+            s.as_int(1, 0, MAX_ADDRESS),
+            s.as_int(2, 0, MAX_ADDRESS),
+            bytes.fromhex(s[3]),
+        )
         if len(data) != 2 or data[0] & 0xE0:
             self._error("MUC", 7, "Mini-packet data must be 13 bits")
             return
@@ -492,13 +563,20 @@ class MicroModemModel:
         if self._on("XST") and packet.kind in _XST_KINDS:
             frames = len(packet.frames)
             values = {
-                "clock_mode": self._clock_mode_field(), "mode": 0, "probe_length": 0,
-                "bandwidth": 5000, "carrier_freq": 25000, "rate": packet.rate,
-                "source": packet.src, "dest": packet.dest, "ack_requested": packet.ack_requested,
+                "clock_mode": self._clock_mode_field(),
+                "mode": 0,
+                "probe_length": 0,
+                "bandwidth": 5000,
+                "carrier_freq": 25000,
+                "rate": packet.rate,
+                "source": packet.src,
+                "dest": packet.dest,
+                "ack_requested": packet.ack_requested,
                 "number_frames_expected": frames if packet.kind is PacketKind.DATA else 0,
-                "number_frames_sent": frames, "packet_type": _packet_type(packet),
+                "number_frames_sent": frames,
+                "packet_type": _packet_type(packet),
                 "number_bytes": nbytes,
-            }  # fmt: skip
+            }
             when = packet.tx_time + self._clock_offset
             self._emit(format_xst(when, values, self.statistics_version))
         if then is not None:
@@ -618,15 +696,24 @@ class MicroModemModel:
         else:
             base = _cst_values(stats)
         values = (
-            *base[:_RATE], p.rate, p.src, p.dest, 3 if bad else 0, _packet_type(p), frames, bad,
+            *base[:_RATE],
+            p.rate,
+            p.src,
+            p.dest,
+            3 if bad else 0,
+            _packet_type(p),
+            frames,
+            bad,
             *base[_BAD_FRAMES + 1 :],
-        )  # fmt: skip
+        )
         self._emit(
             CycleStatistics(
-                self.statistics_version, 1 if bad else 0,
-                acomms_pb.now_us(r.arrival_time + self._clock_offset), self._clock_mode_field(),
+                self.statistics_version,
+                1 if bad else 0,
+                acomms_pb.now_us(r.arrival_time + self._clock_offset),
+                self._clock_mode_field(),
                 values,
-            )  # fmt: skip
+            )
         )
 
 
@@ -687,10 +774,33 @@ def _c_int(text: str) -> int:
 
 # $CACST values from mfd_peak to bandwidth of a reception the channel says nothing about
 _CST_DEFAULTS = (
-    1000, 20, 150, 150, 250, 0, 0, 0, 0,  # mfd_peak .. shf_p2bshift
-    0, 0, 0, 0, 1, 0, 0,  # rate .. number_bad_frames (set per packet)
-    100, 15, 15, 20, -15, 200, 0.0, 50, 25000, 5000,  # snr_rss .. bandwidth
-)  # fmt: skip
+    1000,
+    20,
+    150,
+    150,
+    250,
+    0,
+    0,
+    0,
+    0,  # mfd_peak .. shf_p2bshift
+    0,
+    0,
+    0,
+    0,
+    1,
+    0,
+    0,  # rate .. number_bad_frames (set per packet)
+    100,
+    15,
+    15,
+    20,
+    -15,
+    200,
+    0.0,
+    50,
+    25000,
+    5000,  # snr_rss .. bandwidth
+)
 _RATE, _BAD_FRAMES = CST_FIELD_INDEX["rate"], CST_FIELD_INDEX["number_bad_frames"]
 _RXP = NMEASentence.build("$CARXP", [0])  # (sentences are immutable: one serves every packet)
 _XST_KINDS = (PacketKind.DATA, PacketKind.CYCLE, PacketKind.FDP)
@@ -698,9 +808,27 @@ _XST_KINDS = (PacketKind.DATA, PacketKind.CYCLE, PacketKind.FDP)
 _COMMANDS = {
     name: getattr(MicroModemModel, "_cmd_" + name.lower())
     for name in (
-        "CFG", "CFQ", "MSC", "CLK", "CLQ", "TMS", "TMQ", "ALQ", "CYC", "TXD", "MPC", "MUC", "TDP",
-        "MEC", "PDT", "PNT", "PGT", "SWP", "MSQ", "RSP",
+        "CFG",
+        "CFQ",
+        "MSC",
+        "CLK",
+        "CLQ",
+        "TMS",
+        "TMQ",
+        "ALQ",
+        "CYC",
+        "TXD",
+        "MPC",
+        "MUC",
+        "TDP",
+        "MEC",
+        "PDT",
+        "PNT",
+        "PGT",
+        "SWP",
+        "MSQ",
+        "RSP",
     )
-}  # fmt: skip
+}
 _MM2_COMMANDS = frozenset({"TMS", "TMQ", "ALQ", "TDP"})
 _HEARD = {kind: getattr(MicroModemModel, "_heard_" + kind.value) for kind in PacketKind}

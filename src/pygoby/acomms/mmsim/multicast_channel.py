@@ -39,12 +39,20 @@ MAX_FRAMES, MAX_FRAME_BYTES = 8, 256  # (the largest packet: rate 5)
 def packet_to_json(packet: AcousticPacket, sender: str) -> bytes:
     return json.dumps(
         {
-            "sender": sender, "kind": packet.kind.value, "src": packet.src, "dest": packet.dest,
-            "rate": packet.rate, "ack": packet.ack_requested,
+            "sender": sender,
+            "kind": packet.kind.value,
+            "src": packet.src,
+            "dest": packet.dest,
+            "rate": packet.rate,
+            "ack": packet.ack_requested,
             "frames": [base64.b64encode(f).decode() for f in packet.frames],
-            "acked": packet.acked_frames, "num_frames": packet.num_frames, "tx": packet.tx_time,
-            "duration": packet.duration, "hw": packet.hw_control, "reply": packet.reply,
-        }  # fmt: skip
+            "acked": packet.acked_frames,
+            "num_frames": packet.num_frames,
+            "tx": packet.tx_time,
+            "duration": packet.duration,
+            "hw": packet.hw_control,
+            "reply": packet.reply,
+        }
     ).encode()
 
 
@@ -56,11 +64,19 @@ def packet_from_json(data: bytes) -> tuple[str, AcousticPacket]:
         raise ValueError("more data than a packet carries")
     hw = d["hw"]
     packet = AcousticPacket(
-        PacketKind(d["kind"]), _int(d["src"]), _int(d["dest"]), _int(d["rate"]), bool(d["ack"]),
-        frames, [_int(a) for a in d["acked"][:MAX_FRAMES]], _int(d["num_frames"]),
-        float(d["tx"]), float(d["duration"]), None if hw is None else tuple(map(_int, hw[:3])),
+        PacketKind(d["kind"]),
+        _int(d["src"]),
+        _int(d["dest"]),
+        _int(d["rate"]),
+        bool(d["ack"]),
+        frames,
+        [_int(a) for a in d["acked"][:MAX_FRAMES]],
+        _int(d["num_frames"]),
+        float(d["tx"]),
+        float(d["duration"]),
+        None if hw is None else tuple(map(_int, hw[:3])),
         bool(d["reply"]),
-    )  # fmt: skip
+    )
     if not 0 <= packet.duration < 3600:
         raise ValueError(f"bad duration {packet.duration}")
     return str(d["sender"]), packet

@@ -79,7 +79,9 @@ class MMSimServer:
         if self.port is not None:
             self._server = await asyncio.start_server(self._client, self.host, self.port)
             self.port = self._server.sockets[0].getsockname()[1]
-            log.info("Micro-Modem emulator id %d on %s:%d", self.model.modem_id, self.host, self.port)
+            log.info(
+                "Micro-Modem emulator id %d on %s:%d", self.model.modem_id, self.host, self.port
+            )
         if self.serial_path is not None:
             self._pty_master = open_serial(self.serial_path)
         elif self.pty_path is not None:

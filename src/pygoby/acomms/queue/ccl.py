@@ -27,10 +27,14 @@ class CCLQueue(MessageQueue):
 def queue_entry(cfg) -> object:
     """The QueuedMessageEntry holding a Goby 1.1 QueueConfig's options (for the contest)."""
     return acomms_pb.QueuedMessageEntry(
-        protobuf_name=f"CCL:{cfg.name}", ack=cfg.ack, blackout_time=cfg.blackout_time,
-        max_queue=cfg.max_queue, newest_first=cfg.newest_first, value_base=cfg.value_base,
+        protobuf_name=f"CCL:{cfg.name}",
+        ack=cfg.ack,
+        blackout_time=cfg.blackout_time,
+        max_queue=cfg.max_queue,
+        newest_first=cfg.newest_first,
+        value_base=cfg.value_base,
         ttl=cfg.ttl,
-    )  # fmt: skip
+    )
 
 
 def dccl_first_byte(dccl_id: int) -> int:
@@ -48,7 +52,9 @@ def goby11_time(seconds: float) -> str:
 
 def received(transmission, data: bytes, ccl_id: int, frame: int):
     """The Goby 1.1 ModemDataTransmission of a received CCL frame."""
-    out = acomms_pb.V1ModemDataTransmission(data=data, frame=frame, ack_requested=transmission.ack_requested)
+    out = acomms_pb.V1ModemDataTransmission(
+        data=data, frame=frame, ack_requested=transmission.ack_requested
+    )
     out.base.src, out.base.dest = transmission.src, transmission.dest
     out.base.rate = max(transmission.rate, 0)
     out.base.time = goby11_time(transmission.time / 1e6)

@@ -40,15 +40,29 @@ class QueueLog:
         if self.push.isEnabledFor(VERBOSE):
             limit = queue.entry.max_queue
             self.push.log(
-                VERBOSE, "pushed %s (%d->%d, %d B, %s): queue size %d%s, priority %.3g",
-                queue.name, item.src, item.dest, len(item.encoded), _ack_text(item.ack_requested),
-                len(queue), f"/{limit}" if limit else "", queue.priority(now),
-            )  # fmt: skip
+                VERBOSE,
+                "pushed %s (%d->%d, %d B, %s): queue size %d%s, priority %.3g",
+                queue.name,
+                item.src,
+                item.dest,
+                len(item.encoded),
+                _ack_text(item.ack_requested),
+                len(queue),
+                f"/{limit}" if limit else "",
+                queue.priority(now),
+            )
 
     def dropped(self, queue: MessageQueue, victim: QueuedItem) -> None:
         which = "oldest" if queue.entry.newest_first else "newest"
-        self.push.log(VERBOSE, "%s queue full (max_queue %d): dropped the %s message (%d->%d)",
-                      queue.name, queue.entry.max_queue, which, victim.src, victim.dest)  # fmt: skip
+        self.push.log(
+            VERBOSE,
+            "%s queue full (max_queue %d): dropped the %s message (%d->%d)",
+            queue.name,
+            queue.entry.max_queue,
+            which,
+            victim.src,
+            victim.dest,
+        )
 
     def not_queued(self, name: str, why: str) -> None:
         if self.push.isEnabledFor(DEBUG1):
@@ -61,45 +75,86 @@ class QueueLog:
     def popped(self, queue: MessageQueue, item: QueuedItem, frame: int, priority: float) -> None:
         if self.pop.isEnabledFor(VERBOSE):
             then = "kept until acknowledged" if item.ack_requested else "removed"
-            self.pop.log(VERBOSE, "popped %s (%d->%d, %d B) for frame %d at priority %.3g; %s; "
-                         "queue size %d", queue.name, item.src, item.dest, len(item.encoded), frame,
-                         priority, then, len(queue))  # fmt: skip
+            self.pop.log(
+                VERBOSE,
+                "popped %s (%d->%d, %d B) for frame %d at priority %.3g; %s; queue size %d",
+                queue.name,
+                item.src,
+                item.dest,
+                len(item.encoded),
+                frame,
+                priority,
+                then,
+                len(queue),
+            )
 
     def expired(self, queue: MessageQueue, item: QueuedItem) -> None:
-        self.pop.log(VERBOSE, "expired %s (%d->%d) after its ttl of %g s; queue size %d",
-                     queue.name, item.src, item.dest, queue.entry.ttl, len(queue))  # fmt: skip
+        self.pop.log(
+            VERBOSE,
+            "expired %s (%d->%d) after its ttl of %g s; queue size %d",
+            queue.name,
+            item.src,
+            item.dest,
+            queue.entry.ttl,
+            len(queue),
+        )
 
     # -- transmissions ----------------------------------------------------------------------
 
     def transmission(self, request, names: list[str]) -> None:
         if not names:
             if self.out.isEnabledFor(DEBUG1):
-                self.out.log(DEBUG1, "slot %d (%d->%d, rate %d): nothing to send",
-                             request.slot_index, request.src, request.dest, request.rate)  # fmt: skip
+                self.out.log(
+                    DEBUG1,
+                    "slot %d (%d->%d, rate %d): nothing to send",
+                    request.slot_index,
+                    request.src,
+                    request.dest,
+                    request.rate,
+                )
             return
         if not self.out.isEnabledFor(VERBOSE):
             return
         size = sum(len(frame) for frame in request.frame)
         self.out.log(
-            VERBOSE, "transmit slot %d: %d->%d, rate %d, %d frame(s), %d B: %s (%s)",
-            request.slot_index, request.src, request.dest, request.rate, len(request.frame), size,
-            ", ".join(names), _ack_text(request.ack_requested),
-        )  # fmt: skip
+            VERBOSE,
+            "transmit slot %d: %d->%d, rate %d, %d frame(s), %d B: %s (%s)",
+            request.slot_index,
+            request.src,
+            request.dest,
+            request.rate,
+            len(request.frame),
+            size,
+            ", ".join(names),
+            _ack_text(request.ack_requested),
+        )
 
     def reception(self, transmission, names: list[str]) -> None:
         if self.into.isEnabledFor(VERBOSE):
             size = sum(len(frame) for frame in transmission.frame)
             self.into.log(
-                VERBOSE, "received %d->%d, rate %d, %d frame(s), %d B: %s (%s)", transmission.src,
-                transmission.dest, transmission.rate, len(transmission.frame), size, _names(names),
+                VERBOSE,
+                "received %d->%d, rate %d, %d frame(s), %d B: %s (%s)",
+                transmission.src,
+                transmission.dest,
+                transmission.rate,
+                len(transmission.frame),
+                size,
+                _names(names),
                 _ack_text(transmission.ack_requested),
-            )  # fmt: skip
+            )
 
     def acknowledged(self, ack, names: list[str]) -> None:
         if self.into.isEnabledFor(VERBOSE):
             what = "acknowledges " + ", ".join(names) if names else "no message waits for them"
-            self.into.log(VERBOSE, "received ACK %d->%d for frame(s) %s: %s", ack.src, ack.dest,
-                          list(ack.acked_frame), what)  # fmt: skip
+            self.into.log(
+                VERBOSE,
+                "received ACK %d->%d for frame(s) %s: %s",
+                ack.src,
+                ack.dest,
+                list(ack.acked_frame),
+                what,
+            )
 
     def ack_for_another(self, ack, modem_id: int) -> None:
         self.into.warning("ignoring an ACK for modem %d (we are %d)", ack.dest, modem_id)
@@ -117,7 +172,12 @@ class QueueLog:
     def contest(self, request, frame_used: int, entries: list[tuple[str, str]], winner) -> None:
         """`entries`: (queue name, "priority P" or why it could not take part)."""
         lines = "; ".join(f"{name}: {state}" for name, state in entries) or "no queues"
-        self.priority.log(DEBUG2, "contest for %d->%d (%d B used): %s -> winner %s",
-                          request.src, request.dest, frame_used, lines,
-                          winner.name if winner is not None else "none")  # fmt: skip
-
+        self.priority.log(
+            DEBUG2,
+            "contest for %d->%d (%d B used): %s -> winner %s",
+            request.src,
+            request.dest,
+            frame_used,
+            lines,
+            winner.name if winner is not None else "none",
+        )

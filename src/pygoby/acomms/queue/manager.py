@@ -97,7 +97,9 @@ class QueueManager:
             existing.entry, existing.roles = copy, roles
             existing.manipulators = frozenset(copy.manipulator)
             return existing
-        queue = MessageQueue(copy, compiled.id, self.clock.now(), roles, message_class=message_class)
+        queue = MessageQueue(
+            copy, compiled.id, self.clock.now(), roles, message_class=message_class
+        )
         queue.journal = self.store
         self.queues = dict(sorted({**self.queues, compiled.id: queue}.items()))
         self._by_name[entry.protobuf_name] = queue
@@ -127,7 +129,9 @@ class QueueManager:
         if existing is not None:
             existing.entry = entry
             return existing
-        queue = CCLQueue(entry, ccl_id, self.clock.now(), message_class=acomms_pb.V1ModemDataTransmission)
+        queue = CCLQueue(
+            entry, ccl_id, self.clock.now(), message_class=acomms_pb.V1ModemDataTransmission
+        )
         queue.journal = self.store
         self.ccl_queues[ccl_id] = queue
         return queue
@@ -149,12 +153,17 @@ class QueueManager:
         dest = transmission.base.dest
         if dest == self.modem_id:  # to ourselves: looped back, as Goby 1.1 did
             now = acomms_pb.now_us(self.clock.now())
-            loop = acomms_pb.ModemTransmission(src=self.modem_id, dest=dest, time=now, type=acomms_pb.DATA)
+            loop = acomms_pb.ModemTransmission(
+                src=self.modem_id, dest=dest, time=now, type=acomms_pb.DATA
+            )
             self.signal_receive_ccl.emit(ccl.received(loop, data, ccl_id, 0))
             return
         ack = queue.entry.ack and dest != acomms_pb.BROADCAST_ID
-        queue.push(QueuedItem(transmission, data, self.modem_id, dest,
-                              acomms_pb.now_us(self.clock.now()), ack))  # fmt: skip
+        queue.push(
+            QueuedItem(
+                transmission, data, self.modem_id, dest, acomms_pb.now_us(self.clock.now()), ack
+            )
+        )
 
     def _all_queues(self) -> list[MessageQueue]:
         return [*self.queues.values(), *self.ccl_queues.values()]
@@ -175,20 +184,31 @@ class QueueManager:
             if queue is None or queue.message_class is None:
                 self.log.push.warning(
                     "persistent queue %s: a stored %s is kept, but not sent (no such queue is "
-                    "configured)", store.path, stored.queue,
-                )  # fmt: skip
+                    "configured)",
+                    store.path,
+                    stored.queue,
+                )
                 continue
             try:
                 message = queue.message_class.FromString(stored.message)
             except DecodeError as exc:
                 self.log.push.warning(
                     "persistent queue %s: a stored %s does not parse (%s); dropped",
-                    store.path, stored.queue, exc,
-                )  # fmt: skip
+                    store.path,
+                    stored.queue,
+                    exc,
+                )
                 store.forget(stored.key)
                 continue
-            item = QueuedItem(message, stored.encoded, stored.src, stored.dest, stored.time,
-                              stored.ack_requested, key=stored.key)  # fmt: skip
+            item = QueuedItem(
+                message,
+                stored.encoded,
+                stored.src,
+                stored.dest,
+                stored.time,
+                stored.ack_requested,
+                key=stored.key,
+            )
             queue.push(item)
             self._size_changed(queue)
             restored += 1
@@ -198,7 +218,9 @@ class QueueManager:
     def _size_changed(self, queue: MessageQueue) -> None:
         if isinstance(queue, CCLQueue):
             return  # QueueSize names DCCL ids only
-        self.signal_queue_size_change.emit(acomms_pb.QueueSize(dccl_id=queue.dccl_id, size=len(queue)))
+        self.signal_queue_size_change.emit(
+            acomms_pb.QueueSize(dccl_id=queue.dccl_id, size=len(queue))
+        )
 
     # ------------------------------------------------------------------ push
     def push_message(self, msg, encoded: bytes | None = None) -> None:
@@ -224,7 +246,9 @@ class QueueManager:
             self.signal_receive.emit(msg)
             if queue.entry.ack:
                 now = acomms_pb.now_us(self.clock.now())
-                ack_msg = acomms_pb.ModemTransmission(src=item.dest, dest=item.dest, type=acomms_pb.ACK, time=now)
+                ack_msg = acomms_pb.ModemTransmission(
+                    src=item.dest, dest=item.dest, type=acomms_pb.ACK, time=now
+                )
                 self.signal_ack.emit(ack_msg, msg)
             return
         item.ack_requested = queue.entry.ack and item.dest != acomms_pb.BROADCAST_ID
@@ -337,7 +361,9 @@ class QueueManager:
         return best
 
     @staticmethod
-    def _excluded(queue: MessageQueue, request, used: int, limit: int | None, now: float) -> str | None:
+    def _excluded(
+        queue: MessageQueue, request, used: int, limit: int | None, now: float
+    ) -> str | None:
         """Why `queue` cannot take part in the contest for this frame; None when it can."""
         if len(queue) <= queue.waiting_count:
             return "empty" if not len(queue) else "all waiting for acks"
@@ -479,7 +505,11 @@ class QueueManager:
         if dest not in (acomms_pb.BROADCAST_ID, self.modem_id) and not queue.has("PROMISCUOUS"):
             self.log.not_delivered(queue.name, f"for {dest}, not for us: dropped")
             return
-        if dest == acomms_pb.BROADCAST_ID and src == self.modem_id and queue.roles.get(Role.SOURCE_ID):
+        if (
+            dest == acomms_pb.BROADCAST_ID
+            and src == self.modem_id
+            and queue.roles.get(Role.SOURCE_ID)
+        ):
             return  # our own broadcast heard back
         if queue.has("NO_DEQUEUE"):
             return
@@ -504,9 +534,13 @@ class QueueManager:
         if item.msg.DESCRIPTOR.full_name == acomms_pb.NetworkAck.DESCRIPTOR.full_name:
             return
         ack = acomms_pb.NetworkAck(
-            message_src=item.src, message_dest=self.message_dest(item.msg), message_time=item.time,
-            message_dccl_id=queue.dccl_id, ack_src=ack_src, ack_type=kind,
-        )  # fmt: skip
+            message_src=item.src,
+            message_dest=self.message_dest(item.msg),
+            message_time=item.time,
+            message_dccl_id=queue.dccl_id,
+            ack_src=ack_src,
+            ack_type=kind,
+        )
         if item.src == self.modem_id:
             self.signal_receive.emit(ack)
         elif len(self.signal_in_route):

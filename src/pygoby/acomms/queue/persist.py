@@ -63,7 +63,9 @@ class QueueStore:
     process. A failure to write later (a full disk) is logged as an error and the queue goes
     on in memory: the message is still sent, it is only not durable."""
 
-    def __init__(self, path: str | os.PathLike[str], lock_timeout: float = DEFAULT_LOCK_TIMEOUT) -> None:
+    def __init__(
+        self, path: str | os.PathLike[str], lock_timeout: float = DEFAULT_LOCK_TIMEOUT
+    ) -> None:
         self.path = os.fspath(path)
         db = None
         try:
@@ -74,8 +76,10 @@ class QueueStore:
                 db.execute("BEGIN EXCLUSIVE")
                 version = db.execute("PRAGMA user_version").fetchone()[0]
                 if version not in (0, SCHEMA_VERSION):
-                    raise QueueError(f"persistent queue {self.path}: schema version {version}, "
-                                     f"this pygoby reads {SCHEMA_VERSION}")  # fmt: skip
+                    raise QueueError(
+                        f"persistent queue {self.path}: schema version {version}, "
+                        f"this pygoby reads {SCHEMA_VERSION}"
+                    )
                 db.execute(_SCHEMA)
                 db.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
         except (sqlite3.Error, QueueError) as exc:
@@ -106,9 +110,16 @@ class QueueStore:
         cursor = self._write(
             "INSERT INTO queued (queue, message, encoded, src, dest, time, ack_requested)"
             " VALUES (?, ?, ?, ?, ?, ?, ?)",
-            (queue.name, item.msg.SerializeToString(), item.encoded, item.src, item.dest,
-             item.time, int(item.ack_requested)),
-        )  # fmt: skip
+            (
+                queue.name,
+                item.msg.SerializeToString(),
+                item.encoded,
+                item.src,
+                item.dest,
+                item.time,
+                int(item.ack_requested),
+            ),
+        )
         if cursor is not None:
             item.key = cursor.lastrowid
 
@@ -124,6 +135,10 @@ class QueueStore:
             with self.db:
                 return self.db.execute(sql, args)
         except sqlite3.Error as exc:
-            log.error("persistent queue %s: cannot record a change (%s); the queue goes on in "
-                      "memory only for it", self.path, exc)  # fmt: skip
+            log.error(
+                "persistent queue %s: cannot record a change (%s); the queue goes on in "
+                "memory only for it",
+                self.path,
+                exc,
+            )
             return None

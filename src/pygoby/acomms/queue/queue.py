@@ -18,7 +18,9 @@ from typing import Protocol
 
 from pygoby.acomms import messages as acomms_pb
 
-Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name["manipulator"].enum_type.values_by_name
+Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name[
+    "manipulator"
+].enum_type.values_by_name
 
 
 @dataclass(eq=False, slots=True)

@@ -13,11 +13,18 @@ from pygoby.acomms.errors import RoleError
 
 Role = acomms_pb.QueuedMessageEntry.Role
 _INTEGER_TYPES = {
-    FieldDescriptor.TYPE_INT32, FieldDescriptor.TYPE_INT64, FieldDescriptor.TYPE_UINT32,
-    FieldDescriptor.TYPE_UINT64, FieldDescriptor.TYPE_SINT32, FieldDescriptor.TYPE_SINT64,
-    FieldDescriptor.TYPE_FIXED32, FieldDescriptor.TYPE_FIXED64, FieldDescriptor.TYPE_SFIXED32,
-    FieldDescriptor.TYPE_SFIXED64, FieldDescriptor.TYPE_ENUM,
-}  # fmt: skip
+    FieldDescriptor.TYPE_INT32,
+    FieldDescriptor.TYPE_INT64,
+    FieldDescriptor.TYPE_UINT32,
+    FieldDescriptor.TYPE_UINT64,
+    FieldDescriptor.TYPE_SINT32,
+    FieldDescriptor.TYPE_SINT64,
+    FieldDescriptor.TYPE_FIXED32,
+    FieldDescriptor.TYPE_FIXED64,
+    FieldDescriptor.TYPE_SFIXED32,
+    FieldDescriptor.TYPE_SFIXED64,
+    FieldDescriptor.TYPE_ENUM,
+}
 
 
 @dataclass(frozen=True)
@@ -63,8 +70,10 @@ def compile_roles(entry, descriptor: Descriptor) -> dict[int, RoleGetter]:
         if role.type in (Role.SOURCE_ID, Role.DESTINATION_ID) and field.type not in _INTEGER_TYPES:
             raise RoleError(f"{entry.protobuf_name}: {role.field!r} must be an integer")
         if role.type == Role.TIMESTAMP and field.type not in (
-            FieldDescriptor.TYPE_UINT64, FieldDescriptor.TYPE_DOUBLE, FieldDescriptor.TYPE_STRING,
-        ):  # fmt: skip
+            FieldDescriptor.TYPE_UINT64,
+            FieldDescriptor.TYPE_DOUBLE,
+            FieldDescriptor.TYPE_STRING,
+        ):
             raise RoleError(f"{entry.protobuf_name}: {role.field!r} cannot carry a time")
         getters[role.type] = RoleGetter(path, kind=field.type)
     return getters

@@ -31,7 +31,9 @@ def sign_request(payload: bytes, secret: bytes, now: float) -> bytes:
 
 def verify_request(payload: bytes, secret: bytes) -> float:
     """The request's auth_time if it is signed with `secret`; StoreServerAuthError otherwise."""
-    auth = acomms_pb.StoreServerRequestAuth.FromString(payload)  # the other fields are unknown to it
+    auth = acomms_pb.StoreServerRequestAuth.FromString(
+        payload
+    )  # the other fields are unknown to it
     if not (auth.HasField("auth_hmac") and auth.HasField("auth_time")):
         raise StoreServerAuthError("the request is not signed")
     tail = acomms_pb.StoreServerRequestAuth(auth_hmac=auth.auth_hmac).SerializeToString()

@@ -98,7 +98,9 @@ class StoreServer:
             raise StoreServerAuthError("no secret is configured for it")
         auth_time = verify_request(payload, secret)
         if not abs(auth_time - now) <= self.auth_window:
-            raise StoreServerAuthError(f"request time is {auth_time - now:+.0f} s from the server's clock")
+            raise StoreServerAuthError(
+                f"request time is {auth_time - now:+.0f} s from the server's clock"
+            )
         return auth_time
 
     def _prune(self, now: float) -> None:

@@ -45,7 +45,6 @@ _DELIVERED = """(
 )"""
 
 
-
 class TransmissionStore:
     def __init__(
         self,
@@ -117,8 +116,11 @@ class TransmissionStore:
                         if inbox:
                             newest = row_id - 1  # the next response starts here
                             break
-                        log.warning("skipping stored transmission %d: %d bytes cannot fit in "
-                                    "a response", row_id, len(data))  # fmt: skip
+                        log.warning(
+                            "skipping stored transmission %d: %d bytes cannot fit in a response",
+                            row_id,
+                            len(data),
+                        )
                         continue
                     budget -= size
                 inbox.append(data)
@@ -130,7 +132,6 @@ class TransmissionStore:
         for data in inbox:
             response.inbox.add().ParseFromString(data)
         return response
-
 
     def _accept_auth_time(self, modem_id: int, auth_time: float) -> None:
         row = self.db.execute("SELECT last_time FROM auth WHERE modem_id = ?", (modem_id,))

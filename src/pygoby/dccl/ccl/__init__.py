@@ -18,4 +18,12 @@ CCL_MESSAGES = tuple(
     for name in ("Empty", "Redirect", "Bathy", "CTD", "State", "Command", "Error")
 )
 
-__all__ = ["CCL_MESSAGES", "CCL_PROTO", "CCLEncodeError", "CCLFrameError", "codecs", "fields", "remus"]
+__all__ = [
+    "CCL_MESSAGES",
+    "CCL_PROTO",
+    "CCLEncodeError",
+    "CCLFrameError",
+    "codecs",
+    "fields",
+    "remus",
+]

@@ -78,9 +78,15 @@ class SpeedCodec(FixedWidthCodec):
             if field is None or field.cpp_type != FieldDescriptor.CPPTYPE_ENUM:
                 raise DcclLoadError(f"{info.name}: thrust_mode_tag {tag} is not an enum field")
             number = getattr(root, field.name)
-            return fields.SPEED_MODE_MSEC if number == fields.SPEED_MODE_MSEC else fields.SPEED_MODE_RPM
+            return (
+                fields.SPEED_MODE_MSEC
+                if number == fields.SPEED_MODE_MSEC
+                else fields.SPEED_MODE_RPM
+            )
 
-        self.to_raw = lambda root, v, strict: fields.encode_speed(0.0 if v is None else v, mode(root))
+        self.to_raw = lambda root, v, strict: fields.encode_speed(
+            0.0 if v is None else v, mode(root)
+        )
         self.from_raw = lambda root, raw: fields.decode_speed(raw, mode(root))
         self.null_raw = 0
 
@@ -145,23 +151,37 @@ class GFIPitchOilCodec(FixedWidthCodec):
 
 CCL_FIELD_CODECS: dict[str, tuple[tuple[str, ...], Callable[[FieldInfo], FixedWidthCodec]]] = {
     "_ccl_latloncompressed": (
-        ("double",), _function_codec(24, fields.encode_latlon, fields.decode_latlon)),
+        ("double",),
+        _function_codec(24, fields.encode_latlon, fields.decode_latlon),
+    ),
     "_ccl_fix_age": (("uint32",), FixAgeCodec),
     "_ccl_time_date": (("uint64",), TimeDateCodec),
     "_ccl_heading": (
-        ("float",), _function_codec(8, fields.encode_heading, lambda raw: f32(fields.decode_heading(raw)))),
+        ("float",),
+        _function_codec(8, fields.encode_heading, lambda raw: f32(fields.decode_heading(raw))),
+    ),
     "_ccl_depth": (("float",), DepthCodec),
     "_ccl_velocity": (
-        ("float",), _function_codec(8, fields.encode_velocity, fields.decode_velocity)),
+        ("float",),
+        _function_codec(8, fields.encode_velocity, fields.decode_velocity),
+    ),
     "_ccl_watts": (("float",), _function_codec(8, fields.encode_watts, fields.decode_watts)),
     "_ccl_gfi_pitch_oil": (("message",), GFIPitchOilCodec),
     "_ccl_speed": (("float",), SpeedCodec),
     "_ccl_hires_altitude": (
-        ("float",), _function_codec(16, fields.encode_hires_altitude, fields.decode_hires_altitude)),
+        ("float",),
+        _function_codec(16, fields.encode_hires_altitude, fields.decode_hires_altitude),
+    ),
     "_ccl_temperature": (
-        ("float",), _function_codec(8, fields.encode_temperature, fields.decode_temperature)),
+        ("float",),
+        _function_codec(8, fields.encode_temperature, fields.decode_temperature),
+    ),
     "_ccl_salinity": (
-        ("float",), _function_codec(8, fields.encode_salinity, fields.decode_salinity)),
+        ("float",),
+        _function_codec(8, fields.encode_salinity, fields.decode_salinity),
+    ),
     "_ccl_sound_speed": (
-        ("float",), _function_codec(8, fields.encode_sound_speed, fields.decode_sound_speed)),
+        ("float",),
+        _function_codec(8, fields.encode_sound_speed, fields.decode_sound_speed),
+    ),
 }

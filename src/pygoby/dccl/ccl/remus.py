@@ -114,8 +114,15 @@ class _Field:
             out[i] |= word >> 8 * k & 0xFF
 
     def shifted(self, offset: int, prefix: str) -> _Field:
-        return _Field(prefix + self.name, tuple(i + offset for i in self.at), self.encode, self.decode,
-                      self.check, self.shift, self.bits)  # fmt: skip
+        return _Field(
+            prefix + self.name,
+            tuple(i + offset for i in self.at),
+            self.encode,
+            self.decode,
+            self.check,
+            self.shift,
+            self.bits,
+        )
 
 
 def _finite(name: str, value: float) -> float:
@@ -141,7 +148,9 @@ def _whole(name: str, value: int, low: int, high: int) -> int:
 def _uint(name: str, at: tuple[int, ...], bits: int | None = None, shift: int = 0) -> _Field:
     limit = (1 << (bits if bits is not None else 8 * len(at))) - 1
 
-    return _Field(name, at, lambda value: _whole(name, value, 0, limit), int, shift=shift, bits=bits)
+    return _Field(
+        name, at, lambda value: _whole(name, value, 0, limit), int, shift=shift, bits=bits
+    )
 
 
 def _latlon(name: str, at: tuple[int, ...], limit: float) -> _Field:
@@ -152,7 +161,11 @@ def _latlon(name: str, at: tuple[int, ...], limit: float) -> _Field:
 
     def check(raw: int) -> str | None:
         degrees = fields.decode_latlon(raw)  # (+-90 itself encodes as one step beyond)
-        return f"{degrees:.6f} is beyond +-{limit:g} degrees" if abs(degrees) > limit + LATLON_STEP else None
+        return (
+            f"{degrees:.6f} is beyond +-{limit:g} degrees"
+            if abs(degrees) > limit + LATLON_STEP
+            else None
+        )
 
     return _Field(name, at, encode, fields.decode_latlon, check)
 
@@ -169,8 +182,14 @@ def _depth_check(raw: int) -> str | None:
 
 
 def _depth(name: str, at: tuple[int, ...], bits: int | None = None) -> _Field:
-    return _Field(name, at, lambda m: fields.encode_depth(_finite(name, m)), fields.decode_depth,
-                  _depth_check, bits=bits)  # fmt: skip
+    return _Field(
+        name,
+        at,
+        lambda m: fields.encode_depth(_finite(name, m)),
+        fields.decode_depth,
+        _depth_check,
+        bits=bits,
+    )
 
 
 def _speed_mps(name: str, at: tuple[int, ...]) -> _Field:
@@ -192,20 +211,34 @@ def _velocity(name: str, at: tuple[int, ...]) -> _Field:
 
 
 def _time_date_problem(month: int, day: int, hour: int, minute: int, second: int) -> str | None:
-    if 1 <= month <= 12 and 1 <= day <= 31 and 0 <= hour <= 23 and 0 <= minute <= 59 and 0 <= second <= 59:
+    if (
+        1 <= month <= 12
+        and 1 <= day <= 31
+        and 0 <= hour <= 23
+        and 0 <= minute <= 59
+        and 0 <= second <= 59
+    ):
         return None
     return f"month {month} day {day} {hour:02d}:{minute:02d}:{second:02d} is not a date and time"
 
 
 def _time_date(name: str, at: tuple[int, ...]) -> _Field:
     def encode(value: TimeDate) -> int:
-        parts = [_whole(f"{name}.{part}", v, 0, 59) for part, v in zip(TimeDate._fields, TimeDate(*value), strict=True)]
+        parts = [
+            _whole(f"{name}.{part}", v, 0, 59)
+            for part, v in zip(TimeDate._fields, TimeDate(*value), strict=True)
+        ]
         if problem := _time_date_problem(*parts):
             raise CCLEncodeError(f"{name}: {problem}")
         return fields.pack_time_date(*parts)
 
-    return _Field(name, at, encode, lambda raw: TimeDate(*fields.time_date_parts(raw)),
-                  lambda raw: _time_date_problem(*fields.time_date_parts(raw)))  # fmt: skip
+    return _Field(
+        name,
+        at,
+        encode,
+        lambda raw: TimeDate(*fields.time_date_parts(raw)),
+        lambda raw: _time_date_problem(*fields.time_date_parts(raw)),
+    )
 
 
 def _bcd_check(digits: int) -> Callable[[int], str | None]:
@@ -225,7 +258,9 @@ def _bcd(name: str, at: tuple[int, ...], scale: float) -> _Field:
         try:
             return fields.encode_bcd(steps, digits)
         except ValueError:
-            raise CCLEncodeError(f"{name} = {value} does not fit {digits} digits of {scale:g}") from None
+            raise CCLEncodeError(
+                f"{name} = {value} does not fit {digits} digits of {scale:g}"
+            ) from None
 
     def decode(raw: int) -> float:
         return fields.decode_bcd(raw, digits) * scale
@@ -293,7 +328,9 @@ class CCLFrame:
     def decode(cls, data: bytes) -> Self:
         data = bytes(data[:FRAME_BYTES])
         if len(data) < cls.min_bytes():
-            raise CCLFrameError(f"{cls.NAME}: {len(data)}-byte frame, needs at least {cls.min_bytes()}")
+            raise CCLFrameError(
+                f"{cls.NAME}: {len(data)}-byte frame, needs at least {cls.min_bytes()}"
+            )
         if cls.ID is not None and data[0] != cls.ID:
             raise CCLFrameError(f"{cls.NAME}: the frame's id is {data[0]}, not {cls.ID}")
         data = data.ljust(FRAME_BYTES, b"\0")
@@ -357,7 +394,12 @@ State.LAYOUT = (
     _latlon("lat_goal", (23, 24, 25), 90.0),
     _latlon("lon_goal", (26, 27, 28), 180.0),
     _uint("battery_percent", (29,)),
-    _Field("gfi_pitch_oil", (30, 31), _gfi_pitch_oil_encode, lambda raw: GFIPitchOil(*fields.decode_gfi_pitch_oil(raw))),
+    _Field(
+        "gfi_pitch_oil",
+        (30, 31),
+        _gfi_pitch_oil_encode,
+        lambda raw: GFIPitchOil(*fields.decode_gfi_pitch_oil(raw)),
+    ),
 )
 
 
@@ -431,14 +473,22 @@ Ranger.LAYOUT = (
     _bcd("depth", (23, 28), 1.0),
 )
 
-POSITION_TYPES = {0: "Disabled", 1: "Ship's pole", 2: "Gateway Buoy", 3: "Transponder",
-                  4: "Vehicle position", 5: "Last"}  # fmt: skip
+POSITION_TYPES = {
+    0: "Disabled",
+    1: "Ship's pole",
+    2: "Gateway Buoy",
+    3: "Transponder",
+    4: "Vehicle position",
+    5: "Last",
+}
 POSITION_INVALID = 0x80  # or'd into the type: the position is (temporarily) invalid
 LABEL_BYTES = 13
 
 
 def _position_type_check(raw: int) -> str | None:
-    return None if raw & POSITION_INVALID or raw in POSITION_TYPES else f"unknown position type {raw}"
+    return (
+        None if raw & POSITION_INVALID or raw in POSITION_TYPES else f"unknown position type {raw}"
+    )
 
 
 def _label_encode(label: str) -> int:
@@ -504,15 +554,21 @@ class Alert2Contact:
 
 
 _ALERT_CONTACT = (
-    _uint("id", (0, 1)), _uint("age", (2,)), _uint("bearing", (3,)), _uint("signature1", (4,)),
+    _uint("id", (0, 1)),
+    _uint("age", (2,)),
+    _uint("bearing", (3,)),
+    _uint("signature1", (4,)),
     _uint("signature2", (5,)),
-)  # fmt: skip
+)
 _ALERT2_CONTACT = (
-    _uint("id", (0, 1)), _uint("age", (2,), bits=7),
+    _uint("id", (0, 1)),
+    _uint("age", (2,), bits=7),
     _Field("absolute_heading", (2,), int, bool, shift=7, bits=1),
-    _uint("bearing", (3,)), _heading("heading", (4,)), _uint("signature1", (5,)),
+    _uint("bearing", (3,)),
+    _heading("heading", (4,)),
+    _uint("signature1", (5,)),
     _uint("signature2", (6,)),
-)  # fmt: skip
+)
 CONTACTS = 3
 
 
@@ -536,13 +592,15 @@ class _AlertBase(CCLFrame):
         contacts = []
         for index in range(CONTACTS):
             prefix = f"c{index}_"
-            mine = {k[len(prefix):]: values.pop(k) for k in list(values) if k.startswith(prefix)}
+            mine = {k[len(prefix) :]: values.pop(k) for k in list(values) if k.startswith(prefix)}
             contacts.append(cls.CONTACT(**mine))
         return cls(contacts=contacts, **values)
 
 
 def _alert_layout(contact: tuple[_Field, ...], starts: tuple[int, ...]) -> tuple[_Field, ...]:
-    return tuple(f.shifted(start, f"c{index}_") for index, start in enumerate(starts) for f in contact)
+    return tuple(
+        f.shifted(start, f"c{index}_") for index, start in enumerate(starts) for f in contact
+    )
 
 
 def _contacts(cls: type) -> Any:
@@ -608,14 +666,37 @@ def decode_frame(data: bytes) -> CCLFrame:
         raise CCLFrameError("empty frame")
     cls = BY_ID.get(data[0])
     if cls is None:
-        raise CCLFrameError(f"unknown CCL id {data[0]} (known: {', '.join(map(str, sorted(BY_ID)))})")
+        raise CCLFrameError(
+            f"unknown CCL id {data[0]} (known: {', '.join(map(str, sorted(BY_ID)))})"
+        )
     return cls.decode(data)
 
 
 __all__ = [
-    "BY_ID", "CCLEncodeError", "CCLFrame", "CCLFrameError", "FRAME_BYTES", "GFIPitchOil",
-    "LATLON_STEP", "MDAT_OASIS", "MDAT_POSITION", "MDAT_RANGER", "MDAT_REDIRECT", "MDAT_STATE",
-    "POSITION_INVALID", "POSITION_TYPES", "THRUST_MPS_SURVEY", "THRUST_MPS_TRANSIT", "Alert",
-    "Alert2", "Alert2Contact", "AlertContact", "Position", "Ranger", "Redirect", "State",
-    "TimeDate", "decode_frame",
-]  # fmt: skip
+    "BY_ID",
+    "CCLEncodeError",
+    "CCLFrame",
+    "CCLFrameError",
+    "FRAME_BYTES",
+    "GFIPitchOil",
+    "LATLON_STEP",
+    "MDAT_OASIS",
+    "MDAT_POSITION",
+    "MDAT_RANGER",
+    "MDAT_REDIRECT",
+    "MDAT_STATE",
+    "POSITION_INVALID",
+    "POSITION_TYPES",
+    "THRUST_MPS_SURVEY",
+    "THRUST_MPS_TRANSIT",
+    "Alert",
+    "Alert2",
+    "Alert2Contact",
+    "AlertContact",
+    "Position",
+    "Ranger",
+    "Redirect",
+    "State",
+    "TimeDate",
+    "decode_frame",
+]

@@ -10,7 +10,9 @@ from pygoby.dccl.codecs.numeric import f32, wrap_to
 from pygoby.dccl.errors import DcclLoadError
 
 _INT = re.compile(r"\s*([+-]?\d+)")
-_REAL = re.compile(r"\s*([+-]?(?:\d+\.?\d*(?:[eE][+-]?\d+)?|\.\d+(?:[eE][+-]?\d+)?|inf(?:inity)?|nan))", re.I)
+_REAL = re.compile(
+    r"\s*([+-]?(?:\d+\.?\d*(?:[eE][+-]?\d+)?|\.\d+(?:[eE][+-]?\d+)?|inf(?:inity)?|nan))", re.I
+)
 
 
 def parse_static(text: str, category: str) -> Any:

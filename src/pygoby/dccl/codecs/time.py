@@ -21,7 +21,9 @@ class TimeCodec(FixedWidthCodec):
         else:
             res = opts.resolution
         self.window = window
-        self.inner = NumericCodec(info, bounds=(0.0, float(window)), resolution=res, category="double")
+        self.inner = NumericCodec(
+            info, bounds=(0.0, float(window)), resolution=res, category="double"
+        )
         self.bits = self.inner.bits
         inner_to_raw, inner_from_raw = self.inner.to_raw, self.inner.from_raw
         now = info.now

@@ -86,7 +86,9 @@ class MessageSet:
             try:
                 codec.load(cls)
             except DcclError as err:
-                raise ConfigError(f"message {msg.name}: {err}", file=self.path, line=msg.line) from None
+                raise ConfigError(
+                    f"message {msg.name}: {err}", file=self.path, line=msg.line
+                ) from None
         return classes
 
 

@@ -28,12 +28,23 @@ _CARRIER_PROTO = "pygoby/dccl/option_carrier.proto"
 
 _FD = descriptor_pb2.FieldDescriptorProto
 PROTO_TYPES = {
-    "int": _FD.TYPE_INT32, "float": _FD.TYPE_DOUBLE, "bool": _FD.TYPE_BOOL,
-    "string": _FD.TYPE_STRING, "static": _FD.TYPE_STRING, "hex": _FD.TYPE_BYTES,
-    "time": _FD.TYPE_DOUBLE, "src_id": _FD.TYPE_INT32, "dest_id": _FD.TYPE_INT32,
-}  # fmt: skip
-PROTO_TYPE_NAMES = {_FD.TYPE_INT32: "int32", _FD.TYPE_DOUBLE: "double", _FD.TYPE_BOOL: "bool",
-                    _FD.TYPE_STRING: "string", _FD.TYPE_BYTES: "bytes"}  # fmt: skip
+    "int": _FD.TYPE_INT32,
+    "float": _FD.TYPE_DOUBLE,
+    "bool": _FD.TYPE_BOOL,
+    "string": _FD.TYPE_STRING,
+    "static": _FD.TYPE_STRING,
+    "hex": _FD.TYPE_BYTES,
+    "time": _FD.TYPE_DOUBLE,
+    "src_id": _FD.TYPE_INT32,
+    "dest_id": _FD.TYPE_INT32,
+}
+PROTO_TYPE_NAMES = {
+    _FD.TYPE_INT32: "int32",
+    _FD.TYPE_DOUBLE: "double",
+    _FD.TYPE_BOOL: "bool",
+    _FD.TYPE_STRING: "string",
+    _FD.TYPE_BYTES: "bytes",
+}
 
 
 def enum_type_name(var: Var) -> str:
@@ -85,16 +96,21 @@ def _option_bytes(carrier_name: str, attribute: str, values: dict[str, object]) 
     return carrier.SerializeToString()
 
 
-def file_descriptor(messages: Iterable[XmlMessage], file_name: str) -> descriptor_pb2.FileDescriptorProto:
+def file_descriptor(
+    messages: Iterable[XmlMessage], file_name: str
+) -> descriptor_pb2.FileDescriptorProto:
     """The in-memory .proto file of a message set."""
     fdp = descriptor_pb2.FileDescriptorProto(name=file_name, syntax="proto2")
     fdp.dependency.append(DCCL_OPTIONS_PROTO)
     for msg in messages:
         dp = fdp.message_type.add(name=msg.name)
-        dp.options.MergeFromString(_option_bytes(
-            "pygoby.dccl.MessageOptionsCarrier", "msg",
-            {"id": msg.id, "max_bytes": msg.size, "codec_version": CODEC_VERSION},
-        ))  # fmt: skip
+        dp.options.MergeFromString(
+            _option_bytes(
+                "pygoby.dccl.MessageOptionsCarrier",
+                "msg",
+                {"id": msg.id, "max_bytes": msg.size, "codec_version": CODEC_VERSION},
+            )
+        )
         for var in msg.all_vars():
             field = dp.field.add(name=var.name, number=var.number)
             field.label = _FD.LABEL_REPEATED if var.array_length != 1 else _FD.LABEL_OPTIONAL
@@ -141,10 +157,17 @@ def proto_text(messages: Iterable[XmlMessage], source: str = "") -> str:
             if var.kind == "enum":
                 lines.append(f"    enum {enum_type_name(var)}")
                 lines.append("    {")
-                lines += [f"        {enum_value_name(var, v)} = {i};" for i, v in enumerate(var.enum_values)]
+                lines += [
+                    f"        {enum_value_name(var, v)} = {i};"
+                    for i, v in enumerate(var.enum_values)
+                ]
                 lines.append("    }")
             label = "repeated" if var.array_length != 1 else "optional"
-            kind = enum_type_name(var) if var.kind == "enum" else PROTO_TYPE_NAMES[PROTO_TYPES[var.kind]]
+            kind = (
+                enum_type_name(var)
+                if var.kind == "enum"
+                else PROTO_TYPE_NAMES[PROTO_TYPES[var.kind]]
+            )
             options = [_option_text(k, v) for k, v in field_options(var).items()]
             if var.kind == "static":
                 options.insert(0, f'default = "{var.static_value}"')
@@ -160,21 +183,28 @@ def proto_text(messages: Iterable[XmlMessage], source: str = "") -> str:
 
 
 def queue_entry(msg: XmlMessage, manipulators: Iterable[int] = ()) -> Message:
-    entry = builtin_class("goby/acomms/protobuf/queue.proto", "goby.acomms.protobuf.QueuedMessageEntry")()
+    entry = builtin_class(
+        "goby/acomms/protobuf/queue.proto", "goby.acomms.protobuf.QueuedMessageEntry"
+    )()
     q = msg.queuing
     entry.protobuf_name = msg.name
     entry.ack, entry.blackout_time, entry.max_queue = q.ack, q.blackout_time, q.max_queue
     entry.newest_first, entry.value_base, entry.ttl = q.newest_first, q.value_base, q.ttl
     entry.manipulator.extend(manipulators)
     Role = type(entry).Role
-    for role_type, tag in ((Role.SOURCE_ID, "src_id"), (Role.DESTINATION_ID, "dest_id"),
-                           (Role.TIMESTAMP, "time")):  # fmt: skip
+    for role_type, tag in (
+        (Role.SOURCE_ID, "src_id"),
+        (Role.DESTINATION_ID, "dest_id"),
+        (Role.TIMESTAMP, "time"),
+    ):
         entry.role.add(type=role_type, field=msg.header[tag].name)
     return entry
 
 
 def translator_entry(msg: XmlMessage) -> Message:
-    entry = builtin_class("goby/moos/protobuf/translator.proto", "goby.moos.protobuf.TranslatorEntry")()
+    entry = builtin_class(
+        "goby/moos/protobuf/translator.proto", "goby.moos.protobuf.TranslatorEntry"
+    )()
     T = type(entry)
     entry.protobuf_name = msg.name
     entry.use_short_enum = True
@@ -205,8 +235,9 @@ def _add_create(entry: Message, creates: dict[str, Message], var: Var) -> None:
         create.technique = T.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS
         create.ClearField("format")
     else:
-        create = entry.create.add(technique=T.TECHNIQUE_FORMAT, moos_var=var.source_var,
-                                  format=f"%{var.number}%")  # fmt: skip
+        create = entry.create.add(
+            technique=T.TECHNIQUE_FORMAT, moos_var=var.source_var, format=f"%{var.number}%"
+        )
         creates[var.source_var] = create
     for algorithm in var.algorithms:
         create.algorithm.add(name=algorithm, primary_field=var.number)
@@ -255,9 +286,11 @@ def _add_publish(entry: Message, msg: XmlMessage, publish: Publish, next_virtual
                 for algorithm in value.algorithms:
                     name, *references = algorithm.split(":")
                     serializer.algorithm.add(
-                        name=name, primary_field=var.number, output_virtual_field=next_virtual,
+                        name=name,
+                        primary_field=var.number,
+                        output_virtual_field=next_virtual,
                         reference_field=[_reference_number(msg, r) for r in references],
-                    )  # fmt: skip
+                    )
                 field = next_virtual
                 next_virtual += 1
             replacement[v1_index] = f"{field}.{k}" if var.array_length > 1 else str(field)

@@ -73,9 +73,7 @@ def start_params(cfg: Any) -> Start:
     sim = cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
     missing = sim.FindInitializationErrors()
     if missing:
-        raise AbcConfigError(
-            f"lacks required {', '.join(missing)}", field="basic_simulator_config"
-        )
+        raise AbcConfigError(f"lacks required {', '.join(missing)}", field="basic_simulator_config")
     start = sim.start
     try:
         return Start(
@@ -226,7 +224,9 @@ class AbcFrontSeat(InterfaceBase):
         if request is None or not request.response_requested:
             return
         self.signal_command_response(
-            frontseat_pb.CommandResponse(request_successful=result == "OK", request_id=request.request_id)
+            frontseat_pb.CommandResponse(
+                request_successful=result == "OK", request_id=request.request_id
+            )
         )
 
 

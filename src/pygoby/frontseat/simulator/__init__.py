@@ -5,7 +5,9 @@ from pygoby.frontseat.simulator.protocol import Command, Nav, Start, format_line
 from pygoby.util.modules import lazy_exports
 
 # (the server module runs as `python -m pygoby.frontseat.simulator.server`: not imported here)
-__getattr__, __dir__ = lazy_exports(globals(), {"SimulatorServer": "pygoby.frontseat.simulator.server"})
+__getattr__, __dir__ = lazy_exports(
+    globals(), {"SimulatorServer": "pygoby.frontseat.simulator.server"}
+)
 
 __all__ = [
     "BasicFrontSeatSimulator",

@@ -151,8 +151,11 @@ class Start:
             raise SimulatorProtocolError(f"START FREQ must be positive, not {self.freq}")
         if self.warp <= 0:
             raise SimulatorProtocolError(f"START WARP must be positive, not {self.warp}")
-        for name, rate in (("ACCEL", self.accel), ("HDG_RATE", self.hdg_rate),
-                           ("Z_RATE", self.z_rate)):  # fmt: skip
+        for name, rate in (
+            ("ACCEL", self.accel),
+            ("HDG_RATE", self.hdg_rate),
+            ("Z_RATE", self.z_rate),
+        ):
             if not (math.isfinite(rate) and rate >= 0):
                 raise SimulatorProtocolError(f"START {name} must be zero or positive, not {rate}")
 
@@ -167,16 +170,19 @@ class Start:
 
     def to_line(self) -> str:
         """All eight fields, as the driver sends them."""
-        return format_line(KEY_START, {
-            "LAT": format_round_trip(self.lat),
-            "LON": format_round_trip(self.lon),
-            "DURATION": str(self.duration),
-            "FREQ": str(self.freq),
-            "ACCEL": format_round_trip(self.accel),
-            "HDG_RATE": format_round_trip(self.hdg_rate),
-            "Z_RATE": format_round_trip(self.z_rate),
-            "WARP": str(self.warp),
-        })  # fmt: skip
+        return format_line(
+            KEY_START,
+            {
+                "LAT": format_round_trip(self.lat),
+                "LON": format_round_trip(self.lon),
+                "DURATION": str(self.duration),
+                "FREQ": str(self.freq),
+                "ACCEL": format_round_trip(self.accel),
+                "HDG_RATE": format_round_trip(self.hdg_rate),
+                "Z_RATE": format_round_trip(self.z_rate),
+                "WARP": str(self.warp),
+            },
+        )
 
 
 @dataclass(frozen=True)
@@ -215,8 +221,11 @@ class Command:
         return cls(msg.number("HEADING"), msg.number("SPEED"), msg.number("DEPTH"))
 
     def to_line(self) -> str:
-        return format_line(KEY_CMD, {
-            "HEADING": format_g(self.heading),
-            "SPEED": format_g(self.speed),
-            "DEPTH": format_g(self.depth),
-        })  # fmt: skip
+        return format_line(
+            KEY_CMD,
+            {
+                "HEADING": format_g(self.heading),
+                "SPEED": format_g(self.speed),
+                "DEPTH": format_g(self.depth),
+            },
+        )

@@ -257,8 +257,10 @@ def check_serialize_format(
     plain = _SUBMESSAGE_DIRECTIVE.sub("%%", _INDEXED_DIRECTIVE.sub("%%", fmt))
     for item in boostformat.parse_format(plain):
         number = getattr(item, "argument", None)
-        if number is not None and number not in descriptor.fields_by_number and (
-            number not in virtual_fields
+        if (
+            number is not None
+            and number not in descriptor.fields_by_number
+            and (number not in virtual_fields)
         ):
             raise TranslatorConfigError(
                 f"format {fmt!r}: %{number}% names no field of {descriptor.full_name} "

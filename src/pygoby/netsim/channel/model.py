@@ -263,8 +263,11 @@ class Channel:
                 log.warning(
                     "node %d is absent from the channel: its last position (t=%.3f) is more than "
                     "position_staleness = %g s old at t=%.3f",
-                    port, position.time, self.config.position_staleness, t,
-                )  # fmt: skip
+                    port,
+                    position.time,
+                    self.config.position_staleness,
+                    t,
+                )
             return None
         return position
 
@@ -342,7 +345,8 @@ class Channel:
                 interval=Interval(arrival, arrival + duration),
                 owtt=delay,
                 range_m=range_m,
-                received_level=config.source_level - self._loss(tx_band, source, receiver, range_m, alpha),
+                received_level=config.source_level
+                - self._loss(tx_band, source, receiver, range_m, alpha),
                 closing_speed=closing_speed(source, receiver_now),
             )
             order = pending.arrival_order
@@ -352,8 +356,9 @@ class Channel:
             planned.append((port, arrival))
         return planned
 
-    def _loss(self, band: Band, source: Position, receiver: Position, range_m: float,
-              alpha: float) -> float:  # fmt: skip
+    def _loss(
+        self, band: Band, source: Position, receiver: Position, range_m: float, alpha: float
+    ) -> float:
         propagation = self.config.propagation
         if propagation is None:
             return transmission_loss(range_m, alpha, self.config.spreading)

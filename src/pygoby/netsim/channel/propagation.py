@@ -60,12 +60,17 @@ class BellhopSettings:
             ssp=tuple((p.a, p.b) for p in msg.ssp),
             water_depth=msg.water_depth,
             bathymetry=tuple((p.a, p.b) for p in msg.bathymetry),
-            bottom_speed=msg.bottom_speed, bottom_density=msg.bottom_density,
-            bottom_attenuation=msg.bottom_attenuation, max_range=msg.max_range,
-            range_step=msg.range_step, depth_step=msg.depth_step,
-            source_depth_step=msg.source_depth_step, beams=msg.beams,
-            run=msg.Run.Name(msg.run).lower(), cached_fields=msg.cached_fields,
-        )  # fmt: skip
+            bottom_speed=msg.bottom_speed,
+            bottom_density=msg.bottom_density,
+            bottom_attenuation=msg.bottom_attenuation,
+            max_range=msg.max_range,
+            range_step=msg.range_step,
+            depth_step=msg.depth_step,
+            source_depth_step=msg.source_depth_step,
+            beams=msg.beams,
+            run=msg.Run.Name(msg.run).lower(),
+            cached_fields=msg.cached_fields,
+        )
 
     @property
     def deepest(self) -> float:
@@ -121,20 +126,24 @@ class BellhopLoss:
     def __post_init__(self) -> None:
         s = self.settings
         if s.range_step <= 0 or s.depth_step <= 0 or s.source_depth_step <= 0 or s.beams < 1:
-            raise ValueError("bellhop: range_step, depth_step, source_depth_step and beams must "
-                             "be positive")  # fmt: skip
+            raise ValueError(
+                "bellhop: range_step, depth_step, source_depth_step and beams must be positive"
+            )
         if s.max_range < 2 * s.range_step or s.deepest <= 2 * EDGE_M:
-            raise ValueError("bellhop: max_range must span two range steps and the water must "
-                             "be deeper than 2 m")  # fmt: skip
+            raise ValueError(
+                "bellhop: max_range must span two range steps and the water must be deeper than 2 m"
+            )
         if s.ssp and (s.ssp[0][0] > 0 or s.ssp[-1][0] < s.deepest):
-            raise ValueError(f"bellhop: the ssp must run from 0 m to the deepest bottom "
-                             f"({s.deepest:g} m)")  # fmt: skip
+            raise ValueError(
+                f"bellhop: the ssp must run from 0 m to the deepest bottom ({s.deepest:g} m)"
+            )
         self.ssp = list(s.ssp) if s.ssp else self._sampled_profile()
         try:
             import pelagic  # noqa: F401  (checked now: a missing package is a configuration error)
         except ImportError:
-            raise ValueError("the BELLHOP model needs the pelagic package: "
-                             "pip install 'pygoby[bellhop]'") from None  # fmt: skip
+            raise ValueError(
+                "the BELLHOP model needs the pelagic package: pip install 'pygoby[bellhop]'"
+            ) from None
 
     def _sampled_profile(self) -> list[tuple[float, float]]:
         deepest, c = self.settings.deepest, self.sound_speed
@@ -145,11 +154,16 @@ class BellhopLoss:
 
     def source_depth_bin(self, depth: float) -> float:
         step = self.settings.source_depth_step
-        top = self.settings.bathymetry[0][1] if self.settings.bathymetry else self.settings.water_depth
+        top = (
+            self.settings.bathymetry[0][1]
+            if self.settings.bathymetry
+            else self.settings.water_depth
+        )
         return min(max(round(depth / step) * step, EDGE_M), top - EDGE_M)
 
-    def loss(self, carrier_hz: float, source_depth: float, receiver_depth: float,
-             slant_range: float) -> float:  # fmt: skip
+    def loss(
+        self, carrier_hz: float, source_depth: float, receiver_depth: float, slant_range: float
+    ) -> float:
         """Loss in dB (without absorption) between nodes at these depths and slant range."""
         grid = self.grid(carrier_hz, self.source_depth_bin(source_depth))
         dz = receiver_depth - source_depth
@@ -160,7 +174,9 @@ class BellhopLoss:
             return grid.at(receiver_depth, first) - 20 * math.log10(near / max(slant_range, 1.0))
         if horizontal > last:
             edge = math.hypot(last, dz)
-            return grid.at(receiver_depth, last) + self.spreading * 10 * math.log10(slant_range / edge)
+            return grid.at(receiver_depth, last) + self.spreading * 10 * math.log10(
+                slant_range / edge
+            )
         return grid.at(receiver_depth, horizontal)
 
     def grid(self, carrier_hz: float, source_depth: float) -> LossGrid:
@@ -179,27 +195,41 @@ class BellhopLoss:
             self._fields.popitem(last=False)
         return grid
 
-    def case(self, carrier_hz: float, source_depth: float, ranges: Sequence[float],
-             depths: Sequence[float]) -> dict:  # fmt: skip
+    def case(
+        self,
+        carrier_hz: float,
+        source_depth: float,
+        ranges: Sequence[float],
+        depths: Sequence[float],
+    ) -> dict:
         """The pelagic (BELLHOP JSON v2) case for one source depth."""
         s = self.settings
-        bottom: dict = {"type": "halfspace", "cp": s.bottom_speed, "rho": s.bottom_density,
-                        "ap": s.bottom_attenuation}  # fmt: skip
+        bottom: dict = {
+            "type": "halfspace",
+            "cp": s.bottom_speed,
+            "rho": s.bottom_density,
+            "ap": s.bottom_attenuation,
+        }
         if s.bathymetry:
             bottom["shape"] = {"points": [list(p) for p in s.bathymetry]}
         return {
-            "pelagic": 2, "model": "bellhop", "title": "pygoby netsim", "frequency": carrier_hz,
+            "pelagic": 2,
+            "model": "bellhop",
+            "title": "pygoby netsim",
+            "frequency": carrier_hz,
             "interpolation": "c_linear",
             "media": [{"to": s.deepest, "ssp": [list(p) for p in self.ssp], "mesh": 0}],
-            "surface": "vacuum", "bottom": bottom,
+            "surface": "vacuum",
+            "bottom": bottom,
             "source": {"depth": [source_depth]},
             "receivers": {"depth": list(depths), "range": list(ranges)},
             "bellhop": {
-                "run": s.run, "beam": "geometric_hat_cartesian",
+                "run": s.run,
+                "beam": "geometric_hat_cartesian",
                 "angles": {"from": -89.0, "to": 89.0, "count": s.beams},
                 "box": {"depth": s.deepest * 1.01, "range": s.max_range * 1.01 + s.range_step},
             },
-        }  # fmt: skip
+        }
 
     def trace(self, carrier_hz: float, source_depth: float) -> LossGrid:
         import time
@@ -226,8 +256,14 @@ class BellhopLoss:
         with np.errstate(divide="ignore"):
             loss = np.minimum(result.field.transmission_loss()[0], MAX_LOSS_DB)
         seconds, cpu = time.perf_counter() - started, time.process_time() - cpu_started
-        log.debug("BELLHOP field for %g Hz, source at %g m: %d x %d in %.2f s",
-                  carrier_hz, source_depth, len(depths), len(ranges), seconds)  # fmt: skip
+        log.debug(
+            "BELLHOP field for %g Hz, source at %g m: %d x %d in %.2f s",
+            carrier_hz,
+            source_depth,
+            len(depths),
+            len(ranges),
+            seconds,
+        )
         return LossGrid(ranges, depths, loss.astype(float).tolist(), seconds, cpu)
 
 

@@ -56,9 +56,11 @@ def sound_speed_of(settings: Message) -> float | SoundSpeedProfile:
 
 def absorption_of(settings: Message) -> Callable[[float], float]:
     """The absorption formula (f kHz -> dB/km) of settings with `absorption` and `water`."""
-    name = settings.DESCRIPTOR.fields_by_name["absorption"].enum_type.values_by_number[
-        settings.absorption
-    ].name
+    name = (
+        settings.DESCRIPTOR.fields_by_name["absorption"]
+        .enum_type.values_by_number[settings.absorption]
+        .name
+    )
     if name == "FRANCOIS_GARRISON":
         w = settings.water  # defaults apply when unset
         return functools.partial(

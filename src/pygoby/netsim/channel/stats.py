@@ -79,10 +79,13 @@ def link_statistics(
         return None
     fields = dict(
         _level_statistics(
-            reception.sinr, reception.received_level, reception.noise_level, carrier_hz,
+            reception.sinr,
+            reception.received_level,
+            reception.noise_level,
+            carrier_hz,
             bandwidth_hz,
         )
-    )  # fmt: skip
+    )
     fields["doppler"] = min(max(round(reception.closing_speed, 1), -3.0), 3.0)
     return fields
 

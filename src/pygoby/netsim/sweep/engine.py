@@ -56,8 +56,13 @@ def run_sweep(
     def failed(run: RunSpec, reason: str) -> None:
         store.write_failure(run, reason)
         outcome.failed[run.run_id] = reason
-        log.error("run %s (point %d, seed %d) failed: %s", run.run_id, run.point, run.seed,
-                  reason.splitlines()[-1])  # fmt: skip
+        log.error(
+            "run %s (point %d, seed %d) failed: %s",
+            run.run_id,
+            run.point,
+            run.seed,
+            reason.splitlines()[-1],
+        )
         if progress is not None:
             progress(outcome.stored + len(outcome.failed), outcome.total)
 

@@ -143,7 +143,9 @@ class DaskExecutor:
         try:
             client = Client(self.address, timeout=self.connect_timeout, set_as_default=False)
         except (OSError, TimeoutError) as exc:
-            raise SweepExecutorError(f"cannot connect to the scheduler {self.address}: {exc}") from None
+            raise SweepExecutorError(
+                f"cannot connect to the scheduler {self.address}: {exc}"
+            ) from None
         with client:
             futures = {
                 client.submit(execute_run, run, key=f"netsim-run-{run.run_id}", pure=False): run

@@ -99,8 +99,11 @@ def parse_sweep(text: str, path: Path | None = None) -> tuple[Message, Message]:
     else:
         base = sweep.scenario
     if base.speed.strip().lower() != "max":
-        raise ScenarioError('a sweep runs scenarios on the virtual clock: speed must be "max"',
-                          file=path, field="scenario.speed")  # fmt: skip
+        raise ScenarioError(
+            'a sweep runs scenarios on the virtual clock: speed must be "max"',
+            file=path,
+            field="scenario.speed",
+        )
     if not sweep.axis:
         raise ScenarioError("a sweep needs at least one axis", file=path)
     if sweep.replicates < 1 or (sweep.sampling == sweep.RANDOM and sweep.random_samples < 1):
@@ -138,7 +141,9 @@ def field_descriptor(message_class_descriptor, path: str) -> FieldDescriptor:
         last = i == len(segments) - 1
         if field.type == FieldDescriptor.TYPE_MESSAGE:
             if last:
-                raise ValueError(f"{name} is a message; the path must end at a number, enum, bool or string")
+                raise ValueError(
+                    f"{name} is a message; the path must end at a number, enum, bool or string"
+                )
             descriptor = field.message_type
         elif not last:
             raise ValueError(f"{name} is not a message")
@@ -166,12 +171,16 @@ def set_field(message: Message, path: str, value: Value) -> None:
 
 
 _KINDS = {
-    FieldDescriptor.CPPTYPE_INT32: int, FieldDescriptor.CPPTYPE_INT64: int,
-    FieldDescriptor.CPPTYPE_UINT32: int, FieldDescriptor.CPPTYPE_UINT64: int,
-    FieldDescriptor.CPPTYPE_DOUBLE: float, FieldDescriptor.CPPTYPE_FLOAT: float,
-    FieldDescriptor.CPPTYPE_BOOL: bool, FieldDescriptor.CPPTYPE_STRING: str,
+    FieldDescriptor.CPPTYPE_INT32: int,
+    FieldDescriptor.CPPTYPE_INT64: int,
+    FieldDescriptor.CPPTYPE_UINT32: int,
+    FieldDescriptor.CPPTYPE_UINT64: int,
+    FieldDescriptor.CPPTYPE_DOUBLE: float,
+    FieldDescriptor.CPPTYPE_FLOAT: float,
+    FieldDescriptor.CPPTYPE_BOOL: bool,
+    FieldDescriptor.CPPTYPE_STRING: str,
     FieldDescriptor.CPPTYPE_ENUM: str,  # results carry the enum's name
-}  # fmt: skip
+}
 
 
 def parse_value(field: FieldDescriptor, text: str) -> Value:
@@ -239,7 +248,7 @@ def _axes(sweep: Message, base: Message, path: Path | None, text: str) -> list[_
             if axis.field.startswith(LAYOUT_PREFIX):
                 if not sweep.HasField("layout"):
                     raise ValueError("a layout axis needs a layout { } block")
-                descriptor = field_descriptor(layout_descriptor, axis.field[len(LAYOUT_PREFIX):])
+                descriptor = field_descriptor(layout_descriptor, axis.field[len(LAYOUT_PREFIX) :])
             else:
                 descriptor = field_descriptor(base.DESCRIPTOR, axis.field)
             if bool(axis.value) == axis.HasField("span"):
@@ -257,7 +266,9 @@ def _axes(sweep: Message, base: Message, path: Path | None, text: str) -> list[_
         name = axis.name or axis.field
         seed_column = name == "seed" and axis.field == "seed"  # (the seed column itself)
         if name in names or (name in RESERVED_COLUMNS and not seed_column):
-            raise ScenarioError(f"column {name!r} is used twice: give the axis another name", **where)
+            raise ScenarioError(
+                f"column {name!r} is used twice: give the axis another name", **where
+            )
         names.add(name)
         column = AxisColumn(name, axis.field, _KINDS[descriptor.cpp_type])
         axes.append(_Axis(column, descriptor, values, axis.span if axis.HasField("span") else None))
@@ -289,19 +300,46 @@ def _random_value(axis: _Axis, rng: random.Random) -> Value:
 
 
 # Columns every results row has (see pygoby.netsim.sweep.run); axes may not reuse them.
-RESERVED_COLUMNS = frozenset({
-    "run_id", "point", "replicate", "seed", "nodes", "duration_s", "src", "dest", "rate",
-    "range_m", "sent", "frames_sent", "received", "good", "bad_frames", "not_detected",
-    "receiver_busy", "half_duplex", "frames_good", "messages", "latency_mean_s",
-    "latency_max_s", "acked", "snr_mean_db", "sinr_mean_db", "owtt_mean_s", "wall_s",
-})  # fmt: skip
+RESERVED_COLUMNS = frozenset(
+    {
+        "run_id",
+        "point",
+        "replicate",
+        "seed",
+        "nodes",
+        "duration_s",
+        "src",
+        "dest",
+        "rate",
+        "range_m",
+        "sent",
+        "frames_sent",
+        "received",
+        "good",
+        "bad_frames",
+        "not_detected",
+        "receiver_busy",
+        "half_duplex",
+        "frames_good",
+        "messages",
+        "latency_mean_s",
+        "latency_max_s",
+        "acked",
+        "snr_mean_db",
+        "sinr_mean_db",
+        "owtt_mean_s",
+        "wall_s",
+    }
+)
 
 
 def expand(sweep: Message, base: Message, path: Path | None = None, text: str = "") -> SweepPlan:
     """Every run of the sweep, in a fixed order (points in grid/sample order, then replicates)."""
     axes = _axes(sweep, base, path, text)
     if sweep.replicates > 1 and any(a.column.field == "seed" for a in axes):
-        raise ScenarioError("an axis sets seed: replicates must be 1", file=path, field="replicates")
+        raise ScenarioError(
+            "an axis sets seed: replicates must be 1", file=path, field="replicates"
+        )
     if sweep.sampling == sweep.RANDOM:
         rng = random.Random(sweep.sampling_seed)
         points = [tuple(_random_value(a, rng) for a in axes) for _ in range(sweep.random_samples)]
@@ -315,18 +353,27 @@ def expand(sweep: Message, base: Message, path: Path | None = None, text: str = 
             params = ", ".join(f"{a.column.name}={v}" for a, v in zip(axes, values, strict=True))
             field = getattr(exc, "field", None)
             reason = getattr(exc, "reason", str(exc))
-            raise ScenarioError(f"{reason} (point {index}: {params})", file=path,
-                                line=_axis_line(text, field) if field else None,
-                                field=field) from None  # fmt: skip
+            raise ScenarioError(
+                f"{reason} (point {index}: {params})",
+                file=path,
+                line=_axis_line(text, field) if field else None,
+                field=field,
+            ) from None
         params = tuple((a.column.name, v) for a, v in zip(axes, values, strict=True))
         for replicate in range(sweep.replicates):
             if not any(a.column.field == "seed" for a in axes):
                 scenario.seed = sweep.first_seed + replicate
             scenario_text = text_format.MessageToString(scenario)
-            runs.append(RunSpec(
-                run_id=run_id(params, scenario_text), point=index, replicate=replicate,
-                seed=scenario.seed, params=params, scenario_text=scenario_text,
-            ))  # fmt: skip
+            runs.append(
+                RunSpec(
+                    run_id=run_id(params, scenario_text),
+                    point=index,
+                    replicate=replicate,
+                    seed=scenario.seed,
+                    params=params,
+                    scenario_text=scenario_text,
+                )
+            )
     return SweepPlan(runs, [a.column for a in axes], sweep.output)
 
 
@@ -347,7 +394,7 @@ def point_scenario(sweep: Message, base: Message, axes: list[_Axis], values) -> 
         layout.CopyFrom(sweep.layout)
         for axis, value in zip(axes, values, strict=True):
             if axis.column.field.startswith(LAYOUT_PREFIX):
-                _set_axis(layout, axis, axis.column.field[len(LAYOUT_PREFIX):], value)
+                _set_axis(layout, axis, axis.column.field[len(LAYOUT_PREFIX) :], value)
         apply_layout(scenario, layout)
     for axis, value in zip(axes, values, strict=True):
         if not axis.column.field.startswith(LAYOUT_PREFIX):

@@ -94,8 +94,9 @@ def success_by_range(rows: list[dict]) -> list[SuccessPoint]:
         total = totals[(r["rate"], key(r["range_m"]))]
         total[0] += r["good"]
         total[1] += r["sent"]
-    return [SuccessPoint(rate, rng, good, sent)
-            for (rate, rng), (good, sent) in sorted(totals.items())]  # fmt: skip
+    return [
+        SuccessPoint(rate, rng, good, sent) for (rate, rng), (good, sent) in sorted(totals.items())
+    ]
 
 
 @dataclass(frozen=True)
@@ -116,10 +117,15 @@ def per_run(rows: list[dict]) -> list[RunFigures]:
         messages = sum(r["messages"] for r in links)
         latency = sum(r["latency_mean_s"] * r["messages"] for r in links if r["messages"])
         rates = [r["rate"] for r in links if r["rate"] >= 0]
-        figures.append(RunFigures(
-            run_id, max(set(rates), key=rates.count) if rates else -1, links[0]["nodes"],
-            messages / links[0]["duration_s"] * 3600, latency / messages if messages else math.nan,
-        ))  # fmt: skip
+        figures.append(
+            RunFigures(
+                run_id,
+                max(set(rates), key=rates.count) if rates else -1,
+                links[0]["nodes"],
+                messages / links[0]["duration_s"] * 3600,
+                latency / messages if messages else math.nan,
+            )
+        )
     return figures
 
 
@@ -167,8 +173,14 @@ def _plot_vs_nodes(runs: list[RunFigures], attribute: str, ylabel: str, title: s
                 by_nodes[r.nodes].append(getattr(r, attribute))
         nodes = sorted(by_nodes)
         stats = [mean_and_halfwidth(by_nodes[n]) for n in nodes]
-        ax.errorbar(nodes, [s[0] for s in stats], yerr=[s[1] for s in stats], fmt="o-",
-                    capsize=3, label=_rate_label(rate))  # fmt: skip
+        ax.errorbar(
+            nodes,
+            [s[0] for s in stats],
+            yerr=[s[1] for s in stats],
+            fmt="o-",
+            capsize=3,
+            label=_rate_label(rate),
+        )
     ax.set_xlabel("nodes")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
@@ -180,10 +192,21 @@ def _plot_vs_nodes(runs: list[RunFigures], attribute: str, ylabel: str, title: s
 def plot_snr_vs_range(rows: list[dict], path: Path) -> Path:
     links = [r for r in rows if r["received"] > 0]
     fig, ax = plt.subplots(figsize=(8, 5))
-    ax.scatter([r["range_m"] / 1000 for r in links], [r["snr_mean_db"] for r in links], s=10,
-               alpha=0.6, label="SNR (ambient noise)")  # fmt: skip
-    ax.scatter([r["range_m"] / 1000 for r in links], [r["sinr_mean_db"] for r in links], s=10,
-               alpha=0.6, marker="x", label="SINR (with interference)")  # fmt: skip
+    ax.scatter(
+        [r["range_m"] / 1000 for r in links],
+        [r["snr_mean_db"] for r in links],
+        s=10,
+        alpha=0.6,
+        label="SNR (ambient noise)",
+    )
+    ax.scatter(
+        [r["range_m"] / 1000 for r in links],
+        [r["sinr_mean_db"] for r in links],
+        s=10,
+        alpha=0.6,
+        marker="x",
+        label="SINR (with interference)",
+    )
     ax.set_xlabel("range (km)")
     ax.set_ylabel("dB (mean over the link's data receptions)")
     ax.set_title(f"SNR vs range ({len(links)} links)")
@@ -201,12 +224,20 @@ def write_sweep_report(table: pa.Table, out_dir: str | Path) -> list[Path]:
     runs = per_run(rows)
     figures = [
         plot_success_vs_range(points, out / "success_vs_range.png"),
-        _plot_vs_nodes(runs, "throughput_per_hour", "NodeStatus messages delivered per hour",
-                       "Throughput vs node count (mean over runs, ±1.96 SE)",
-                       out / "throughput_vs_nodes.png"),  # fmt: skip
-        _plot_vs_nodes(runs, "latency_s", "mean message latency (s)",
-                       "Latency vs node count (mean over runs, ±1.96 SE)",
-                       out / "latency_vs_nodes.png"),  # fmt: skip
+        _plot_vs_nodes(
+            runs,
+            "throughput_per_hour",
+            "NodeStatus messages delivered per hour",
+            "Throughput vs node count (mean over runs, ±1.96 SE)",
+            out / "throughput_vs_nodes.png",
+        ),
+        _plot_vs_nodes(
+            runs,
+            "latency_s",
+            "mean message latency (s)",
+            "Latency vs node count (mean over runs, ±1.96 SE)",
+            out / "latency_vs_nodes.png",
+        ),
         plot_snr_vs_range(rows, out / "snr_vs_range.png"),
     ]
     page = out / "index.html"
@@ -230,7 +261,8 @@ def _html(table: pa.Table, rows, runs, points, figures) -> str:
     )
     images = "".join(
         f'<figure><img src="{esc(f.name)}" alt="{esc(f.stem)}"><figcaption>{esc(f.stem)}'
-        "</figcaption></figure>" for f in figures
+        "</figcaption></figure>"
+        for f in figures
     )
     seeds = len(set(table.column("seed").to_pylist()))
     return f"""<!DOCTYPE html>

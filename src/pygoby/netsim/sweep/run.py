@@ -93,7 +93,9 @@ class LinkTally:
             latency = event["t"] - event["msg_t"]
             link.messages += 1
             link.latency_sum += latency
-            link.latency_max = latency if math.isnan(link.latency_max) else max(link.latency_max, latency)
+            link.latency_max = (
+                latency if math.isnan(link.latency_max) else max(link.latency_max, latency)
+            )
 
 
 @dataclass(frozen=True)
@@ -117,9 +119,15 @@ def execute_run(spec: RunSpec) -> RunResult:
     tally.port_of_id = dict(zip(ids, ports, strict=True))
     Simulation(scenario, on_event=tally).run_virtual()
     wall = time.perf_counter() - started
-    base = {"run_id": spec.run_id, "point": spec.point, "replicate": spec.replicate,
-            "seed": spec.seed, **dict(spec.params), "nodes": len(ids),
-            "duration_s": scenario.duration}  # fmt: skip
+    base = {
+        "run_id": spec.run_id,
+        "point": spec.point,
+        "replicate": spec.replicate,
+        "seed": spec.seed,
+        **dict(spec.params),
+        "nodes": len(ids),
+        "duration_s": scenario.duration,
+    }
     rows = []
     for src, tx_port in zip(ids, ports, strict=True):
         rates = tally.rates.get(tx_port)
@@ -129,15 +137,26 @@ def execute_run(spec: RunSpec) -> RunResult:
                 continue
             link = tally.links.get((tx_port, rx_port), _Link())
             n = link.received
-            rows.append({
-                **base, "src": src, "dest": dest, "rate": rate,
-                "range_m": _mean(link.range_sum, n),
-                "sent": tally.sent[tx_port], "frames_sent": tally.frames_sent[tx_port],
-                "received": n, **{o: link.outcomes[o] for o in OUTCOMES},
-                "frames_good": link.frames_good, "messages": link.messages,
-                "latency_mean_s": _mean(link.latency_sum, link.messages),
-                "latency_max_s": link.latency_max, "acked": link.acked,
-                "snr_mean_db": _mean(link.snr_sum, n), "sinr_mean_db": _mean(link.sinr_sum, n),
-                "owtt_mean_s": _mean(link.owtt_sum, n), "wall_s": wall,
-            })  # fmt: skip
+            rows.append(
+                {
+                    **base,
+                    "src": src,
+                    "dest": dest,
+                    "rate": rate,
+                    "range_m": _mean(link.range_sum, n),
+                    "sent": tally.sent[tx_port],
+                    "frames_sent": tally.frames_sent[tx_port],
+                    "received": n,
+                    **{o: link.outcomes[o] for o in OUTCOMES},
+                    "frames_good": link.frames_good,
+                    "messages": link.messages,
+                    "latency_mean_s": _mean(link.latency_sum, link.messages),
+                    "latency_max_s": link.latency_max,
+                    "acked": link.acked,
+                    "snr_mean_db": _mean(link.snr_sum, n),
+                    "sinr_mean_db": _mean(link.sinr_sum, n),
+                    "owtt_mean_s": _mean(link.owtt_sum, n),
+                    "wall_s": wall,
+                }
+            )
     return RunResult(spec.run_id, rows, wall)

@@ -31,18 +31,37 @@ RESULTS_FILE = "results.parquet"  # the sweep's table, in its output folder
 
 _ARROW = {int: pa.int64(), float: pa.float64(), bool: pa.bool_(), str: pa.string()}
 
-HEAD_COLUMNS = [("run_id", pa.string()), ("point", pa.int64()), ("replicate", pa.int64()),
-                ("seed", pa.int64())]  # fmt: skip
+HEAD_COLUMNS = [
+    ("run_id", pa.string()),
+    ("point", pa.int64()),
+    ("replicate", pa.int64()),
+    ("seed", pa.int64()),
+]
 TAIL_COLUMNS = [
-    ("nodes", pa.int64()), ("duration_s", pa.float64()), ("src", pa.int64()),
-    ("dest", pa.int64()), ("rate", pa.int64()), ("range_m", pa.float64()),
-    ("sent", pa.int64()), ("frames_sent", pa.int64()), ("received", pa.int64()),
-    ("good", pa.int64()), ("bad_frames", pa.int64()), ("not_detected", pa.int64()),
-    ("receiver_busy", pa.int64()), ("half_duplex", pa.int64()), ("frames_good", pa.int64()),
-    ("messages", pa.int64()), ("latency_mean_s", pa.float64()), ("latency_max_s", pa.float64()),
-    ("acked", pa.int64()), ("snr_mean_db", pa.float64()), ("sinr_mean_db", pa.float64()),
-    ("owtt_mean_s", pa.float64()), ("wall_s", pa.float64()),
-]  # fmt: skip
+    ("nodes", pa.int64()),
+    ("duration_s", pa.float64()),
+    ("src", pa.int64()),
+    ("dest", pa.int64()),
+    ("rate", pa.int64()),
+    ("range_m", pa.float64()),
+    ("sent", pa.int64()),
+    ("frames_sent", pa.int64()),
+    ("received", pa.int64()),
+    ("good", pa.int64()),
+    ("bad_frames", pa.int64()),
+    ("not_detected", pa.int64()),
+    ("receiver_busy", pa.int64()),
+    ("half_duplex", pa.int64()),
+    ("frames_good", pa.int64()),
+    ("messages", pa.int64()),
+    ("latency_mean_s", pa.float64()),
+    ("latency_max_s", pa.float64()),
+    ("acked", pa.int64()),
+    ("snr_mean_db", pa.float64()),
+    ("sinr_mean_db", pa.float64()),
+    ("owtt_mean_s", pa.float64()),
+    ("wall_s", pa.float64()),
+]
 
 
 def results_schema(columns: Iterable[AxisColumn]) -> pa.Schema:

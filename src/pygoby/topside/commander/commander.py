@@ -84,8 +84,12 @@ class Outgoing:
     message: Message
 
     def lines(self) -> list[str]:
-        return [f"{post.var}: {post.value!r}" if not isinstance(post.value, str)
-                else f"{post.var}: {post.value}" for post in self.posts]  # fmt: skip
+        return [
+            f"{post.var}: {post.value!r}"
+            if not isinstance(post.value, str)
+            else f"{post.var}: {post.value}"
+            for post in self.posts
+        ]
 
 
 PENDING = ("awaiting ack", "sent")
@@ -121,8 +125,10 @@ class Notice:
 
     def banner(self) -> str:
         stamp = time.strftime("%Y-%b-%d %H:%M:%S", time.gmtime(self.time))
-        return (f"Message {self.kind} from queue: {self.type_name.rsplit('.', 1)[-1]}\n"
-                f" for destination: {self.dest}\n at time: {stamp}\n {self.text}")  # fmt: skip
+        return (
+            f"Message {self.kind} from queue: {self.type_name.rsplit('.', 1)[-1]}\n"
+            f" for destination: {self.dest}\n at time: {stamp}\n {self.text}"
+        )
 
 
 class Commander:
@@ -164,7 +170,12 @@ class Commander:
     @property
     def source_variables(self) -> set[str]:
         """The variables a send of a Goby 1.1 message may post to (whose types matter)."""
-        return {var for kind in self.commands.types.values() if kind.goby11 for var in kind.operator_vars}
+        return {
+            var
+            for kind in self.commands.types.values()
+            if kind.goby11
+            for var in kind.operator_vars
+        }
 
     def import_xml(self, path: str) -> list[str]:
         """Add the messages of a Goby 1.1 XML file; ConfigError for a file that cannot be used."""
@@ -227,7 +238,11 @@ class Commander:
             if field_name in names:
                 for axis, name in zip("yx", names, strict=True):
                     current = draft.values.get(name, "")
-                    metres = current.split(":", 1)[1] if specials.is_placeholder(current) and ":" in current else ""
+                    metres = (
+                        current.split(":", 1)[1]
+                        if specials.is_placeholder(current) and ":" in current
+                        else ""
+                    )
                     self.set_value(draft, name, specials.xy_placeholder(axis, metres))
                 return
         raise FieldValueError(f"{field_name}: not one of a latitude/longitude pair of fields")
@@ -256,9 +271,13 @@ class Commander:
         for post in outgoing.posts:
             self._publish(post)
         record = SentRecord(
-            next(self._ids), draft.type, self.now(), outgoing.message, outgoing.posts,
+            next(self._ids),
+            draft.type,
+            self.now(),
+            outgoing.message,
+            outgoing.posts,
             "awaiting ack" if draft.type.ack else "sent",
-        )  # fmt: skip
+        )
         self.records.append(record)
         if self.autosave_path is not None:
             self.save(self.autosave_path)
@@ -299,26 +318,43 @@ class Commander:
         except TranslatorError as err:
             raise CommanderError(f"{kind.name} cannot be serialized: {err}") from None
         trigger = posts[-1] if posts and posts[-1].var == kind.trigger_var else None
-        if (self.style == KEY_VALUE and trigger is not None and kind.mandatory_content
-                and kind.mandatory_content not in str(trigger.value)):  # fmt: skip
-            warnings.append(f"{kind.trigger_var} lacks its mandatory content "
-                            f"{kind.mandatory_content!r}: pAcommsHandler will not make the message")  # fmt: skip
+        if (
+            self.style == KEY_VALUE
+            and trigger is not None
+            and kind.mandatory_content
+            and kind.mandatory_content not in str(trigger.value)
+        ):
+            warnings.append(
+                f"{kind.trigger_var} lacks its mandatory content "
+                f"{kind.mandatory_content!r}: pAcommsHandler will not make the message"
+            )
         return Outgoing(posts, warnings, msg)
 
-    def _posts(self, kind: CommandType, msg: Message, values: dict[str, str], warnings: list[str]) -> list[Post]:
+    def _posts(
+        self, kind: CommandType, msg: Message, values: dict[str, str], warnings: list[str]
+    ) -> list[Post]:
         if self.style == MULTIPLEX:
-            return [make_post(self.commands.multiplex_var, serialize_for_moos(msg), _PREFIXED_TEXT, kind.name)]
+            return [
+                make_post(
+                    self.commands.multiplex_var, serialize_for_moos(msg), _PREFIXED_TEXT, kind.name
+                )
+            ]
         if kind.goby11:
             posts = self._goby11_posts(kind, values, warnings)
         else:
-            posts = [p for p in self.commands.translator.inverse_publish(msg)
-                     if p.var in kind.operator_vars or p.var == kind.trigger_var]  # fmt: skip
+            posts = [
+                p
+                for p in self.commands.translator.inverse_publish(msg)
+                if p.var in kind.operator_vars or p.var == kind.trigger_var
+            ]
         trigger = [p for p in posts if p.var == kind.trigger_var]
         if kind.trigger_var and (not trigger or trigger[0].value == ""):
             trigger = [Post(kind.trigger_var, kind.mandatory_content, "")]
         return [p for p in posts if p.var != kind.trigger_var] + trigger
 
-    def _goby11_posts(self, kind: CommandType, values: dict[str, str], warnings: list[str]) -> list[Post]:
+    def _goby11_posts(
+        self, kind: CommandType, values: dict[str, str], warnings: list[str]
+    ) -> list[Post]:
         """Goby 1.1 iCommander: `name=value,...` (message order) on each source variable,
         sorted; repeated values in braces (`name={1,2}`), as Goby 1.1's key=value reading takes
         them; a number where the variable holds doubles (see the module's docstring)."""
@@ -336,8 +372,10 @@ class Commander:
                 else:
                     warnings.append(f"{var} holds numbers: the MOOSDB would refuse text, not sent")
                 continue
-            pairs = [f"{spec.name}={'{' + text.strip('{}') + '}' if spec.repeated else text}"
-                     for spec, text in items]  # fmt: skip
+            pairs = [
+                f"{spec.name}={'{' + text.strip('{}') + '}' if spec.repeated else text}"
+                for spec, text in items
+            ]
             posts.append(Post(var, ",".join(pairs), ""))
         return posts
 
@@ -365,8 +403,9 @@ class Commander:
         dest = ""
         if command is not None and command.dest_field:
             dest = str(getattr(original, command.dest_field))
-        notice = Notice(kind, name, dest, stamp,
-                        text_format.MessageToString(original, as_one_line=True), record)  # fmt: skip
+        notice = Notice(
+            kind, name, dest, stamp, text_format.MessageToString(original, as_one_line=True), record
+        )
         self.notices.append(notice)
         return [notice]
 
@@ -381,8 +420,11 @@ class Commander:
     def save(self, path: str | Path) -> None:
         messages = []
         for draft in self.drafts.values():
-            values = [(spec.source, spec.name, draft.values.get(spec.name, ""))
-                      for spec in draft.type.fields if spec.editable]  # fmt: skip
+            values = [
+                (spec.source, spec.name, draft.values.get(spec.name, ""))
+                for spec in draft.type.fields
+                if spec.editable
+            ]
             messages.append((draft.type.short_name, values))
         Path(path).write_text(savefile.dump(messages))
 
@@ -407,8 +449,6 @@ class Commander:
                 except (FieldValueError, KeyError) as err:
                     warnings.append(f"{message_name}: {err}".replace("KeyError", ""))
         return warnings
-
-
 
 
 _NUMERIC = ("int", "float", "bool")
@@ -465,7 +505,9 @@ def _set_field(msg: Message, spec: FieldSpec, text: str) -> None:
             elements = getattr(msg, step)
             for index, item in enumerate(items):
                 element = elements[index] if index < len(elements) else elements.add()
-                setattr(element, name, _convert(spec, element.DESCRIPTOR.fields_by_name[name], item))
+                setattr(
+                    element, name, _convert(spec, element.DESCRIPTOR.fields_by_name[name], item)
+                )
             return
         msg = getattr(msg, step)
     field = msg.DESCRIPTOR.fields_by_name[name]
@@ -496,4 +538,3 @@ def _same(record: SentRecord, original: Message) -> bool:
         if not _close(getattr(*mine), getattr(*theirs), spec.precision):
             return False
     return True
-

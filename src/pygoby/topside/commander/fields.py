@@ -19,9 +19,17 @@ from pygoby.topside.errors import FieldValueError
 
 _FD = FieldDescriptor
 _INT_TYPES = {
-    _FD.TYPE_INT32, _FD.TYPE_INT64, _FD.TYPE_UINT32, _FD.TYPE_UINT64, _FD.TYPE_SINT32,
-    _FD.TYPE_SINT64, _FD.TYPE_FIXED32, _FD.TYPE_FIXED64, _FD.TYPE_SFIXED32, _FD.TYPE_SFIXED64,
-}  # fmt: skip
+    _FD.TYPE_INT32,
+    _FD.TYPE_INT64,
+    _FD.TYPE_UINT32,
+    _FD.TYPE_UINT64,
+    _FD.TYPE_SINT32,
+    _FD.TYPE_SINT64,
+    _FD.TYPE_FIXED32,
+    _FD.TYPE_FIXED64,
+    _FD.TYPE_SFIXED32,
+    _FD.TYPE_SFIXED64,
+}
 _UNSIGNED = {_FD.TYPE_UINT32, _FD.TYPE_UINT64, _FD.TYPE_FIXED32, _FD.TYPE_FIXED64}
 _FLOAT_TYPES = {_FD.TYPE_DOUBLE, _FD.TYPE_FLOAT}
 
@@ -73,10 +81,16 @@ class FieldSpec:
 
     @classmethod
     def from_descriptor(
-        cls, field: FieldDescriptor, source: str = "", automatic_from: str = "", *,
-        path: str = "", required: bool | None = None, short_enum: bool = False,
+        cls,
+        field: FieldDescriptor,
+        source: str = "",
+        automatic_from: str = "",
+        *,
+        path: str = "",
+        required: bool | None = None,
+        short_enum: bool = False,
         elements_of: FieldDescriptor | None = None,
-    ) -> FieldSpec:  # fmt: skip
+    ) -> FieldSpec:
         """`path`: the name inside the command (`pose.x` for a sub-message's field);
         `required`: whether the message needs it (a required field of an optional sub-message
         does not); `short_enum`: enum values without their `FIELD_` prefix (use_short_enum);
@@ -87,19 +101,24 @@ class FieldSpec:
         kind = _kind(field, options.codec)
         numeric = kind in ("int", "float")
         type_name = (
-            field.message_type.full_name if field.type == _FD.TYPE_MESSAGE
-            else field.enum_type.full_name if field.type == _FD.TYPE_ENUM
+            field.message_type.full_name
+            if field.type == _FD.TYPE_MESSAGE
+            else field.enum_type.full_name
+            if field.type == _FD.TYPE_ENUM
             else _TYPE_NAMES.get(field.type, "?")
-        )  # fmt: skip
+        )
         default = ""
         if field.has_default_value and kind not in ("message", "static"):
             value = field.default_value
             default = (
-                enum_name(field, value, short_enum) if kind == "enum"
-                else str(value).lower() if kind == "bool"
-                else _number_text(value) if numeric
+                enum_name(field, value, short_enum)
+                if kind == "enum"
+                else str(value).lower()
+                if kind == "bool"
+                else _number_text(value)
+                if numeric
                 else str(value)
-            )  # fmt: skip
+            )
         return cls(
             name=path or field.name,
             number=field.number,
@@ -112,8 +131,11 @@ class FieldSpec:
             precision=(options.precision if kind == "float" else None),
             max_length=options.max_length if options.HasField("max_length") else None,
             max_repeat=repeat.max_repeat if repeat.HasField("max_repeat") else None,
-            enum_values=tuple(enum_name(field, v.number, short_enum) for v in field.enum_type.values)
-            if kind == "enum" else (),
+            enum_values=tuple(
+                enum_name(field, v.number, short_enum) for v in field.enum_type.values
+            )
+            if kind == "enum"
+            else (),
             static_value=options.static_value if kind == "static" else None,
             default=default,
             description=options.description,
@@ -185,7 +207,9 @@ class FieldSpec:
         elif self.kind == "bool":
             lowered = text.lower()
             options = ("true", "false", "1", "0")
-            if not (lowered in options or (partial and any(o.startswith(lowered) for o in options))):
+            if not (
+                lowered in options or (partial and any(o.startswith(lowered) for o in options))
+            ):
                 raise FieldValueError(f"{name}: true or false")
         elif self.kind == "enum":
             upper = text.upper()
@@ -236,6 +260,7 @@ def _split_repeated(text: str) -> list[str]:
 
 
 _TYPE_NAMES = {
-    getattr(_FD, name): name.removeprefix("TYPE_").lower() for name in dir(_FD)
+    getattr(_FD, name): name.removeprefix("TYPE_").lower()
+    for name in dir(_FD)
     if name.startswith("TYPE_")
-}  # fmt: skip
+}

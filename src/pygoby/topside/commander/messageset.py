@@ -91,9 +91,12 @@ def _effective_sources(entry: Message, cls: type[Message]) -> dict[int, str]:
 
 
 def _leaves(
-    descriptor: Descriptor, prefix: str, required: bool, chain: tuple[str, ...],
+    descriptor: Descriptor,
+    prefix: str,
+    required: bool,
+    chain: tuple[str, ...],
     elements_of: FieldDescriptor | None = None,
-) -> Iterator[tuple[str, FieldDescriptor, bool, FieldDescriptor | None]]:  # fmt: skip
+) -> Iterator[tuple[str, FieldDescriptor, bool, FieldDescriptor | None]]:
     """(path, field, required all the way down, the repeated sub-message whose elements hold
     it) of every field: singular sub-messages unfolded (`pose.x`), and repeated ones of plain
     fields (`track.x`: one value per element); deeper, recursive and other repeated
@@ -106,15 +109,15 @@ def _leaves(
             yield path, field, needed, elements_of
         elif not field.is_repeated:
             yield from _leaves(sub, path + ".", needed, (*chain, sub.full_name), elements_of)
-        elif elements_of is None and all(f.message_type is None and not f.is_repeated for f in sub.fields):
+        elif elements_of is None and all(
+            f.message_type is None and not f.is_repeated for f in sub.fields
+        ):
             yield from _leaves(sub, path + ".", False, (*chain, sub.full_name), field)
         else:
             yield path, field, needed, elements_of
 
 
-def command_type(
-    entry: Message, cls: type[Message], queue_entry: Message | None
-) -> CommandType:
+def command_type(entry: Message, cls: type[Message], queue_entry: Message | None) -> CommandType:
     """A translator entry with a publish trigger (goby3 style)."""
     trigger = entry.trigger.moos_var
     sources = _effective_sources(entry, cls)
@@ -123,13 +126,22 @@ def command_type(
     short = entry.use_short_enum
     fields = []
     top = cls.DESCRIPTOR.fields_by_name
-    for path, field, required, elements_of in _leaves(cls.DESCRIPTOR, "", True, (cls.DESCRIPTOR.full_name,)):
+    for path, field, required, elements_of in _leaves(
+        cls.DESCRIPTOR, "", True, (cls.DESCRIPTOR.full_name,)
+    ):
         var = sources.get(top[path.split(".", 1)[0]].number, "")
         mine = var in operator_vars
-        fields.append(FieldSpec.from_descriptor(
-            field, var if mine else "", "" if mine else var, path=path, required=required,
-            short_enum=short, elements_of=elements_of,
-        ))  # fmt: skip
+        fields.append(
+            FieldSpec.from_descriptor(
+                field,
+                var if mine else "",
+                "" if mine else var,
+                path=path,
+                required=required,
+                short_enum=short,
+                elements_of=elements_of,
+            )
+        )
     return CommandType(
         name=entry.protobuf_name,
         cls=cls,
@@ -149,8 +161,10 @@ def goby11_command_type(
     source and destination header pieces, then the layout."""
     shown = [msg.header[tag] for tag in ("src_id", "dest_id") if msg.header[tag].named]
     by_number = cls.DESCRIPTOR.fields_by_number
-    fields = tuple(FieldSpec.from_descriptor(by_number[var.number], var.source_var, short_enum=True)
-                   for var in [*shown, *msg.layout])  # fmt: skip
+    fields = tuple(
+        FieldSpec.from_descriptor(by_number[var.number], var.source_var, short_enum=True)
+        for var in [*shown, *msg.layout]
+    )
     return CommandType(
         name=msg.name,
         cls=cls,
@@ -235,7 +249,9 @@ class CommandSet:
         return cls.from_messages(AcommsMessageSet.load(cfg, find), modem_id_lookup_path)
 
     @classmethod
-    def from_messages(cls, messages: AcommsMessageSet, modem_id_lookup_path: str = "") -> CommandSet:
+    def from_messages(
+        cls, messages: AcommsMessageSet, modem_id_lookup_path: str = ""
+    ) -> CommandSet:
         """From a loaded message set (e.g. the one a running pAcommsHandler uses);
         `modem_id_lookup_path` replaces the configuration's."""
         cfg, find = messages.cfg, messages.find

@@ -21,7 +21,9 @@ HEADER_PREFIX = "%%% iCommander message save file: "
 _ITEM = re.compile(r"(?:^|\s)(\S+?):=")
 
 
-def dump(messages: Iterable[tuple[str, Sequence[tuple[str, str, str]]]], when: float | None = None) -> str:
+def dump(
+    messages: Iterable[tuple[str, Sequence[tuple[str, str, str]]]], when: float | None = None
+) -> str:
     """`messages`: (message name, [(source variable, field name, value text), ...]) in field
     order. Empty values are kept (`name=`), as Goby 1 did, so a field cleared on purpose stays
     cleared."""
@@ -36,13 +38,17 @@ def dump(messages: Iterable[tuple[str, Sequence[tuple[str, str, str]]]], when: f
     return "\n".join(lines) + "\n"
 
 
-def parse(text: str, fields_of: dict[str, Sequence[str]] | None = None) -> list[tuple[str, dict[str, str]]]:
+def parse(
+    text: str, fields_of: dict[str, Sequence[str]] | None = None
+) -> list[tuple[str, dict[str, str]]]:
     """[(message name, {field: value})] from a save file. `fields_of` (message name -> its
     field names) lets a value hold commas: it then runs up to the next `,<field>=`."""
     lines = text.splitlines()
     if not lines or not lines[0].startswith(HEADER_PREFIX):
-        raise SaveFileError("not an iCommander message save file (first line must start with "
-                            f"{HEADER_PREFIX.strip()!r})")  # fmt: skip
+        raise SaveFileError(
+            "not an iCommander message save file (first line must start with "
+            f"{HEADER_PREFIX.strip()!r})"
+        )
     out: list[tuple[str, dict[str, str]]] = []
     for line in lines[1:]:
         if line.startswith("message::"):

@@ -117,14 +117,20 @@ class EditScreen(Screen):
     def compose(self) -> ComposeResult:
         kind = self.draft.type
         yield Static(id="info", classes="info")
-        yield Static(f"Message (Type: {kind.short_name})  {len(kind.fields)} entries total   "
-                     "{Enter} for options   {Up/Down} for more message variables", classes="title")  # fmt: skip
+        yield Static(
+            f"Message (Type: {kind.short_name})  {len(kind.fields)} entries total   "
+            "{Enter} for options   {Up/Down} for more message variables",
+            classes="title",
+        )
         with VerticalScroll():
             for number, spec in enumerate(kind.fields, start=1):
                 label = "static" if spec.kind == "static" else spec.kind
                 yield Label(f"{number}. {spec.name} ({label})", classes="field-name")
-                box = Input(value=self.draft.value(spec.name), id=box_id(spec.name),
-                            disabled=not spec.editable)  # fmt: skip
+                box = Input(
+                    value=self.draft.value(spec.name),
+                    id=box_id(spec.name),
+                    disabled=not spec.editable,
+                )
                 self._values[spec.name] = box.value
                 yield box
         yield Footer()
@@ -148,12 +154,18 @@ class EditScreen(Screen):
         return (box.id or "").removeprefix("field-").replace("--", ".")
 
     def on_descendant_focus(self, event) -> None:
-        if isinstance(event.widget, Input) and event.widget.id and event.widget.id.startswith("field-"):
+        if (
+            isinstance(event.widget, Input)
+            and event.widget.id
+            and event.widget.id.startswith("field-")
+        ):
             name = self._field(event.widget)
             kind = self.draft.type
             index = [f.name for f in kind.fields].index(name) + 1
-            self.show_info(f"Editing message variable {index} of {len(kind.fields)}: {name}\n"
-                           f"{kind.field(name).describe()}")  # fmt: skip
+            self.show_info(
+                f"Editing message variable {index} of {len(kind.fields)}: {name}\n"
+                f"{kind.field(name).describe()}"
+            )
 
     def on_input_changed(self, event: Input.Changed) -> None:
         if self._quiet or not (event.input.id or "").startswith("field-"):
@@ -161,10 +173,12 @@ class EditScreen(Screen):
         name, box = self._field(event.input), event.input
         before, text = self._values.get(name, ""), event.value
         spec = self.draft.type.field(name)
-        typed = text[len(before):] if text.startswith(before) else ""
+        typed = text[len(before) :] if text.startswith(before) else ""
         if spec.kind in ("int", "float") and typed in ("t", "x", "y", "m") and len(typed) == 1:
             self._revert(box, before)
-            self.app.run_action_for(self, {"t": "time", "x": "xy", "y": "xy", "m": "modem_id"}[typed], name)  # type: ignore[attr-defined]
+            self.app.run_action_for(
+                self, {"t": "time", "x": "xy", "y": "xy", "m": "modem_id"}[typed], name
+            )  # type: ignore[attr-defined]
             return
         try:
             self.commander.check(self.draft, name, text, partial=True)
@@ -210,8 +224,12 @@ class ICommanderTUI(App):
     """
     TITLE = TITLE
 
-    def __init__(self, commander: Commander, show_variables: list[str] | None = None,
-                 on_exit: Callable[[], None] | None = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        commander: Commander,
+        show_variables: list[str] | None = None,
+        on_exit: Callable[[], None] | None = None,
+    ) -> None:
         super().__init__()
         self.commander = commander
         self.show_variables = {name: "" for name in show_variables or []}
@@ -250,8 +268,13 @@ class ICommanderTUI(App):
         while len(self.screen_stack) > 1:
             self.pop_screen()
         choices = [("return", "Return to active message")] if self.commander.active else []
-        choices += [("select", "Select Message"), ("load", "Load"), ("save", "Save"),
-                    ("import", "Import Message File"), ("exit", "Exit")]  # fmt: skip
+        choices += [
+            ("select", "Select Message"),
+            ("load", "Load"),
+            ("save", "Save"),
+            ("import", "Import Message File"),
+            ("exit", "Exit"),
+        ]
         title = f"{TITLE}\n{len(self.commander.commands)} messages loaded.\nMain Menu:"
         self.push_screen(Menu(title, choices, "main-menu"), self._main_choice)
 
@@ -309,8 +332,9 @@ class ICommanderTUI(App):
         self.push_screen(EditScreen(self.commander, self.commander.open(name)))
 
     def open_actions(self, field: str) -> None:
-        self.push_screen(Menu("Choose an action", ACTIONS, "actions"),
-                         lambda choice: self._action(choice, field))  # fmt: skip
+        self.push_screen(
+            Menu("Choose an action", ACTIONS, "actions"), lambda choice: self._action(choice, field)
+        )
 
     def run_action_for(self, screen: EditScreen, action: str, field: str) -> None:
         self._action(action, field)
@@ -323,16 +347,28 @@ class ICommanderTUI(App):
         try:
             if action == "send":
                 record = commander.send(draft)
-                self._report(f"Message(s) sent (#{record.record_id})" + (
-                    f", autosaved to {commander.autosave_path}" if commander.autosave_path else ""),
-                    commander.preview(draft), [("return", "Return to message"), ("menu", "Main menu")])  # fmt: skip
+                self._report(
+                    f"Message(s) sent (#{record.record_id})"
+                    + (
+                        f", autosaved to {commander.autosave_path}"
+                        if commander.autosave_path
+                        else ""
+                    ),
+                    commander.preview(draft),
+                    [("return", "Return to message"), ("menu", "Main menu")],
+                )
             elif action == "preview":
-                self._report("Previewing message (nothing published):", commander.preview(draft),
-                             [("return", "Return to message"), ("send", "Send")])  # fmt: skip
+                self._report(
+                    "Previewing message (nothing published):",
+                    commander.preview(draft),
+                    [("return", "Return to message"), ("send", "Send")],
+                )
             elif action == "switch":
                 opened = [(d.name, d.type.short_name) for d in commander.drafts.values()]
-                self.push_screen(Menu("Choose an active message to switch to:", opened, "switch"),
-                                 lambda name: name and self.edit(name))  # fmt: skip
+                self.push_screen(
+                    Menu("Choose an active message to switch to:", opened, "switch"),
+                    lambda name: name and self.edit(name),
+                )
             elif action == "time":
                 commander.insert_time(draft, field)
             elif action == "xy":
@@ -341,8 +377,10 @@ class ICommanderTUI(App):
                 commander.insert_community(draft, field)
             elif action == "modem_id":
                 ids = [(str(i), f"{i}: {name} ({kind})") for i, name, kind in commander.modem_ids()]
-                self.push_screen(Menu("Choose vehicle to insert id for:", ids, "modem-ids"),
-                                 lambda picked: self._modem_id(field, picked))  # fmt: skip
+                self.push_screen(
+                    Menu("Choose vehicle to insert id for:", ids, "modem-ids"),
+                    lambda picked: self._modem_id(field, picked),
+                )
             elif action == "clear":
                 commander.clear(draft)
             elif action == "menu":

@@ -34,15 +34,25 @@ class Liaison(GobyMOOSApp):
             acomms = AcommsMessageSet.of_app(self, web.commander.pacommshandler_name)
         try:
             self.state = LiaisonState(
-                web, acomms.cfg, CommandSet.from_messages(acomms, cfg.modem_id_lookup_path),
-                community=self.common.community, now=self.clock.now, publish=self._post,
-                start_time=self.start_time, values=MoosValues(self.dynamic_vars),
-            )  # fmt: skip
+                web,
+                acomms.cfg,
+                CommandSet.from_messages(acomms, cfg.modem_id_lookup_path),
+                community=self.common.community,
+                now=self.clock.now,
+                publish=self._post,
+                start_time=self.start_time,
+                values=MoosValues(self.dynamic_vars),
+            )
         except CommanderError as err:
             raise ConfigError(str(err), field="liaison.commander") from None
         self.subscribe_pattern("*", "*", self.state.handle)
-        self.web = WebServer(self.state, web.http_address, web.http_port, web.token,
-                             1.0 / web.update_freq if web.update_freq > 0 else 1.0)  # fmt: skip
+        self.web = WebServer(
+            self.state,
+            web.http_address,
+            web.http_port,
+            web.token,
+            1.0 / web.update_freq if web.update_freq > 0 else 1.0,
+        )
 
     @classmethod
     def embedded(cls, host: GobyMOOSApp, acomms: AcommsMessageSet) -> Liaison:
@@ -52,8 +62,15 @@ class Liaison(GobyMOOSApp):
         cfg.common.CopyFrom(host.common)
         cfg.common.log = False
         cfg.liaison.CopyFrom(acomms.cfg.liaison)
-        return cls(cfg, acomms=acomms, name=f"{host.name}_liaison", mission=host.mission,
-                   clock=host.clock, host=host.client.host, port=host.client.port)  # fmt: skip
+        return cls(
+            cfg,
+            acomms=acomms,
+            name=f"{host.name}_liaison",
+            mission=host.mission,
+            clock=host.clock,
+            host=host.client.host,
+            port=host.client.port,
+        )
 
     def _post(self, post: Post) -> None:
         self.publish(post.var, post.value, src_aux=post.source_aux)

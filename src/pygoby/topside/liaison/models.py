@@ -67,9 +67,16 @@ class ScopeModel:
         row = self.rows.get(msg.key)
         if row is None:
             row = self.rows[msg.key] = ScopeRow(
-                msg.key, value, kind, msg.src, msg.src_aux, msg.community, msg.time,
-                deque(maxlen=256), deque(maxlen=self.max_history),
-            )  # fmt: skip
+                msg.key,
+                value,
+                kind,
+                msg.src,
+                msg.src_aux,
+                msg.community,
+                msg.time,
+                deque(maxlen=256),
+                deque(maxlen=self.max_history),
+            )
         row.value, row.kind, row.time = value, kind, msg.time
         row.source, row.source_aux, row.community = msg.src, msg.src_aux, msg.community
         row.arrivals.append(msg.time)
@@ -87,12 +94,19 @@ class ScopeModel:
                 continue
             row = self.rows[key]
             recent = sum(1 for t in row.arrivals if now - t <= RATE_WINDOW)
-            out.append({
-                "key": key, "value": _display(row.value), "type": row.kind,
-                "source": row.source, "aux": row.source_aux, "community": row.community,
-                "age": round(max(now - row.time, 0.0), 1), "rate": round(recent / RATE_WINDOW, 2),
-                "numeric": bool(row.history),
-            })  # fmt: skip
+            out.append(
+                {
+                    "key": key,
+                    "value": _display(row.value),
+                    "type": row.kind,
+                    "source": row.source,
+                    "aux": row.source_aux,
+                    "community": row.community,
+                    "age": round(max(now - row.time, 0.0), 1),
+                    "rate": round(recent / RATE_WINDOW, 2),
+                    "numeric": bool(row.history),
+                }
+            )
         return out
 
     def history(self, key: str) -> list[tuple[float, float]]:
@@ -135,10 +149,15 @@ class AcommsModel:
     `cfg` is pAcommsHandler's configuration (queues, MAC slots, variable names); `resolve`
     finds the mission's message classes (to name the DCCL messages inside frames)."""
 
-    def __init__(self, cfg: Message, resolve: Callable[[str], type[Message]], now: float, history: int = 20) -> None:
+    def __init__(
+        self, cfg: Message, resolve: Callable[[str], type[Message]], now: float, history: int = 20
+    ) -> None:
         names = cfg.moos_var
-        self.var = {f.name: names.prefix + getattr(names, f.name)
-                    for f in names.DESCRIPTOR.fields if f.name != "prefix"}  # fmt: skip
+        self.var = {
+            f.name: names.prefix + getattr(names, f.name)
+            for f in names.DESCRIPTOR.fields
+            if f.name != "prefix"
+        }
         self.modem_id = cfg.modem_id
         self._resolve = resolve
         self.codec = Codec()
@@ -150,11 +169,19 @@ class AcommsModel:
                 dccl_id = self.codec.compiled(cls).id
             except Exception:  # noqa: BLE001 - a type pAcommsHandler skips too; shown without id
                 pass
-            self.queues[entry.protobuf_name] = QueueState(entry.protobuf_name, dccl_id, entry, last_sent=now)
+            self.queues[entry.protobuf_name] = QueueState(
+                entry.protobuf_name, dccl_id, entry, last_sent=now
+            )
         self.slots = [
-            {"src": s.src, "dest": s.dest, "rate": s.rate, "type": acomms_pb.ModemTransmission.TransmissionType.Name(s.type),
-             "seconds": s.slot_seconds} for s in cfg.mac_cfg.slot
-        ]  # fmt: skip
+            {
+                "src": s.src,
+                "dest": s.dest,
+                "rate": s.rate,
+                "type": acomms_pb.ModemTransmission.TransmissionType.Name(s.type),
+                "seconds": s.slot_seconds,
+            }
+            for s in cfg.mac_cfg.slot
+        ]
         self.slot_index: int | None = None
         self.slot_start: float | None = None
         self.tx: deque[dict] = deque(maxlen=history)
@@ -223,11 +250,13 @@ class AcommsModel:
         names = self._messages_in(transmission)
         row = {
             "time": transmission.time / 1e6 if transmission.HasField("time") else when,
-            "src": transmission.src, "dest": transmission.dest,
+            "src": transmission.src,
+            "dest": transmission.dest,
             "type": acomms_pb.ModemTransmission.TransmissionType.Name(transmission.type),
-            "rate": transmission.rate, "frames": len(transmission.frame),
+            "rate": transmission.rate,
+            "frames": len(transmission.frame),
             "messages": [n.rsplit(".", 1)[-1] for n in names],
-        }  # fmt: skip
+        }
         mm = _mm_extension(transmission)
         if sent:
             if mm is not None and mm.transmit_stat:
@@ -238,13 +267,23 @@ class AcommsModel:
                     queue.last_sent, queue.sent = row["time"], queue.sent + 1
         elif mm is not None and mm.receive_stat:
             stat = mm.receive_stat[-1]
-            row.update(snr_in=stat.snr_in, snr_out=stat.snr_out, doppler=stat.doppler,
-                       mse=stat.mse_equalizer, bad_frames=stat.number_bad_frames,
-                       psk_error=_enum_name(stat, "psk_error_code"))  # fmt: skip
+            row.update(
+                snr_in=stat.snr_in,
+                snr_out=stat.snr_out,
+                doppler=stat.doppler,
+                mse=stat.mse_equalizer,
+                bad_frames=stat.number_bad_frames,
+                psk_error=_enum_name(stat, "psk_error_code"),
+            )
         (self.tx if sent else self.rx).appendleft(row)
         verb = "sent" if sent else "heard"
-        self.timeline.appendleft({"time": row["time"], "kind": "tx" if sent else "rx",
-                                  "text": f"{verb} {row['type']} {row['src']}->{row['dest']} {', '.join(row['messages'])}"})  # fmt: skip
+        self.timeline.appendleft(
+            {
+                "time": row["time"],
+                "kind": "tx" if sent else "rx",
+                "text": f"{verb} {row['type']} {row['src']}->{row['dest']} {', '.join(row['messages'])}",
+            }
+        )
 
     def _original(self, kind: str, value: MoosValue, when: float) -> None:
         original = dynamic_parse(value, self._resolve, _TEXT)
@@ -259,24 +298,40 @@ class AcommsModel:
         self._original("expired", value, when)
 
     def snapshot(self, now: float) -> dict:
-        waiting = [q for q in self.queues.values()
-                   if q.size > 0 and q.last_sent + q.entry.blackout_time <= now]  # fmt: skip
+        waiting = [
+            q
+            for q in self.queues.values()
+            if q.size > 0 and q.last_sent + q.entry.blackout_time <= now
+        ]
         following = max(waiting, key=lambda q: q.priority(now), default=None)
         cycle = sum(s["seconds"] for s in self.slots)
         return {
             "modem_id": self.modem_id,
-            "queues": [{
-                "name": q.name, "dccl_id": q.dccl_id, "size": q.size, "ack": q.entry.ack,
-                "ttl": q.entry.ttl, "value_base": q.entry.value_base,
-                "max_queue": q.entry.max_queue, "priority": round(q.priority(now), 3),
-                "sent": q.sent, "next": q is following,
-            } for q in self.queues.values()],
+            "queues": [
+                {
+                    "name": q.name,
+                    "dccl_id": q.dccl_id,
+                    "size": q.size,
+                    "ack": q.entry.ack,
+                    "ttl": q.entry.ttl,
+                    "value_base": q.entry.value_base,
+                    "max_queue": q.entry.max_queue,
+                    "priority": round(q.priority(now), 3),
+                    "sent": q.sent,
+                    "next": q is following,
+                }
+                for q in self.queues.values()
+            ],
             "mac": {
-                "slots": self.slots, "cycle_seconds": cycle, "current": self.slot_index,
+                "slots": self.slots,
+                "cycle_seconds": cycle,
+                "current": self.slot_index,
                 "into_slot": None if self.slot_start is None else round(now - self.slot_start, 1),
             },
-            "tx": list(self.tx), "rx": list(self.rx), "timeline": list(self.timeline),
-        }  # fmt: skip
+            "tx": list(self.tx),
+            "rx": list(self.rx),
+            "timeline": list(self.timeline),
+        }
 
 
 # ---------------------------------------------------------------------------------- Map
@@ -307,10 +362,16 @@ class MapModel:
     REPORT_VARS = ("NODE_REPORT", "NODE_REPORT_LOCAL")
 
     def __init__(
-        self, community: str, geodesy: UTMGeodesy, modem_ids: ModemIdLookup,
-        report_vars: list[str], receive_var: str, transmit_var: str,
-        link_seconds: float = 120, max_track: int = 500,
-    ) -> None:  # fmt: skip
+        self,
+        community: str,
+        geodesy: UTMGeodesy,
+        modem_ids: ModemIdLookup,
+        report_vars: list[str],
+        receive_var: str,
+        transmit_var: str,
+        link_seconds: float = 120,
+        max_track: int = 500,
+    ) -> None:
         self.community = community
         self.geodesy = geodesy
         self.modem_ids = modem_ids
@@ -325,8 +386,19 @@ class MapModel:
 
     @property
     def variables(self) -> list[str]:
-        return sorted({*self.report_vars, "NAV_X", "NAV_Y", "NAV_HEADING", "NAV_LAT", "NAV_LONG",
-                       "MODEM_ID", self.receive_var, self.transmit_var})  # fmt: skip
+        return sorted(
+            {
+                *self.report_vars,
+                "NAV_X",
+                "NAV_Y",
+                "NAV_HEADING",
+                "NAV_LAT",
+                "NAV_LONG",
+                "MODEM_ID",
+                self.receive_var,
+                self.transmit_var,
+            }
+        )
 
     def _name(self, modem_id: int) -> str:
         if modem_id == self.own_id:
@@ -409,9 +481,20 @@ class MapModel:
     def snapshot(self, now: float) -> dict:
         return {
             "community": self.community,
-            "nodes": [{"name": n.name, "x": n.x, "y": n.y, "heading": n.heading,
-                       "age": round(now - n.time, 1), "track": list(n.track)}
-                      for n in self.nodes.values()],
-            "links": [{"from": a, "to": b, "age": round(now - t, 1)}
-                      for (a, b), t in self.links.items() if now - t <= self.link_seconds],
-        }  # fmt: skip
+            "nodes": [
+                {
+                    "name": n.name,
+                    "x": n.x,
+                    "y": n.y,
+                    "heading": n.heading,
+                    "age": round(now - n.time, 1),
+                    "track": list(n.track),
+                }
+                for n in self.nodes.values()
+            ],
+            "links": [
+                {"from": a, "to": b, "age": round(now - t, 1)}
+                for (a, b), t in self.links.items()
+                if now - t <= self.link_seconds
+            ],
+        }

@@ -24,17 +24,33 @@ SEND_MULTIPLEX = 2  # pygoby.apps.protobuf.SendStyle
 
 
 def field_view(draft: Draft) -> list[dict]:
-    return [{
-        "name": spec.name, "kind": spec.kind, "type": spec.proto_type, "editable": spec.editable,
-        "required": spec.required, "describe": spec.describe(), "value": draft.value(spec.name),
-        "enum": list(spec.enum_values), "source": spec.source, "automatic": spec.automatic_from,
-    } for spec in draft.type.fields]  # fmt: skip
+    return [
+        {
+            "name": spec.name,
+            "kind": spec.kind,
+            "type": spec.proto_type,
+            "editable": spec.editable,
+            "required": spec.required,
+            "describe": spec.describe(),
+            "value": draft.value(spec.name),
+            "enum": list(spec.enum_values),
+            "source": spec.source,
+            "automatic": spec.automatic_from,
+        }
+        for spec in draft.type.fields
+    ]
 
 
 def record_view(record: SentRecord) -> dict:
-    return {"id": record.record_id, "type": record.type.short_name, "time": record.time,
-            "status": record.status, "status_time": record.status_time, "text": record.text,
-            "posts": [f"{p.var}: {p.value}" for p in record.posts]}  # fmt: skip
+    return {
+        "id": record.record_id,
+        "type": record.type.short_name,
+        "time": record.time,
+        "status": record.status,
+        "status_time": record.status_time,
+        "text": record.text,
+        "posts": [f"{p.var}: {p.value}" for p in record.posts],
+    }
 
 
 def outgoing_view(outgoing: Outgoing) -> dict:
@@ -75,10 +91,15 @@ class LiaisonState:
         self.acomms = AcommsModel(acomms_cfg, commands.resolve, start_time)
         names = acomms_cfg.moos_var
         self.map = MapModel(
-            community, commands.geodesy, commands.modem_ids, list(cfg.node_report_var),
-            names.prefix + names.driver_receive, names.prefix + names.driver_transmit,
-            cfg.link_seconds, cfg.max_track_points,
-        )  # fmt: skip
+            community,
+            commands.geodesy,
+            commands.modem_ids,
+            list(cfg.node_report_var),
+            names.prefix + names.driver_receive,
+            names.prefix + names.driver_transmit,
+            cfg.link_seconds,
+            cfg.max_track_points,
+        )
         self.load_warnings: list[str] = []
         for path in commander_cfg.load:
             self.load_warnings += self.commander.load(path)
@@ -106,5 +127,7 @@ class LiaisonState:
         raise KeyError(name)
 
     def commander_types(self) -> list[dict]:
-        return [{"name": t.name, "short": t.short_name, "ack": t.ack, "trigger": t.trigger_var}
-                for t in self.commander.commands.types.values()]  # fmt: skip
+        return [
+            {"name": t.name, "short": t.short_name, "ack": t.ack, "trigger": t.trigger_var}
+            for t in self.commander.commands.types.values()
+        ]

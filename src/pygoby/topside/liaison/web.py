@@ -62,9 +62,12 @@ def _json_default(value: object) -> object:
 
 
 def make_app(
-    state: LiaisonState, *, token: str | None, update_period: float,
+    state: LiaisonState,
+    *,
+    token: str | None,
+    update_period: float,
     stopping: asyncio.Event | None = None,
-) -> Starlette:  # fmt: skip
+) -> Starlette:
     """The ASGI application. `token`: None when no token is needed; `stopping` ends the live
     streams (so that the server can stop while pages are open)."""
     stopping = stopping or asyncio.Event()
@@ -72,8 +75,11 @@ def make_app(
     def authorised(request: Request) -> bool:
         if token is None:
             return True
-        offered = (request.query_params.get("token") or request.cookies.get(COOKIE)
-                   or request.headers.get("authorization", "").removeprefix("Bearer "))  # fmt: skip
+        offered = (
+            request.query_params.get("token")
+            or request.cookies.get(COOKIE)
+            or request.headers.get("authorization", "").removeprefix("Bearer ")
+        )
         return bool(offered) and hmac.compare_digest(offered, token)
 
     def guard(handler: Callable) -> Callable:
@@ -109,17 +115,23 @@ def make_app(
                     async with asyncio.timeout(update_period):
                         await stopping.wait()
 
-        return StreamingResponse(stream(), media_type="text/event-stream",
-                                 headers={"Cache-Control": "no-store"})  # fmt: skip
+        return StreamingResponse(
+            stream(), media_type="text/event-stream", headers={"Cache-Control": "no-store"}
+        )
 
     async def history(request: Request) -> Response:
         key = request.query_params.get("key", "")
         return JSONResponse({"key": key, "points": state.scope.history(key)})
 
     async def types(request: Request) -> Response:
-        return JSONResponse({"types": state.commander_types(), "community": state.commander.community,
-                             "modem_ids": state.commander.modem_ids(),
-                             "style": state.commander.style})  # fmt: skip
+        return JSONResponse(
+            {
+                "types": state.commander_types(),
+                "community": state.commander.community,
+                "modem_ids": state.commander.modem_ids(),
+                "style": state.commander.style,
+            }
+        )
 
     async def command(request: Request) -> Response:
         """POST {action, type, field?, text?, ...}: one commander operation."""
@@ -132,7 +144,9 @@ def make_app(
             if action == "open":
                 pass
             elif action == "check":
-                commander.check(draft, body["field"], body.get("text", ""), partial=bool(body.get("partial")))
+                commander.check(
+                    draft, body["field"], body.get("text", ""), partial=bool(body.get("partial"))
+                )
             elif action == "set":
                 commander.set_value(draft, body["field"], body.get("text", ""))
             elif action == "special":
@@ -196,24 +210,42 @@ def listen(address: str, port: int) -> socket.socket:
     try:
         return socket.create_server((address, port), family=family)
     except OSError as err:
-        raise ConfigError(f"cannot serve the pages on {address}:{port}: {err.strerror or err} "
-                          "(set http_address / http_port)", field="liaison") from None  # fmt: skip
+        raise ConfigError(
+            f"cannot serve the pages on {address}:{port}: {err.strerror or err} "
+            "(set http_address / http_port)",
+            field="liaison",
+        ) from None
 
 
 class WebServer:
     """uvicorn in the running asyncio loop, on a socket bound at construction; `url` once
     started."""
 
-    def __init__(self, state: LiaisonState, address: str, port: int, token: str = "",
-                 update_period: float = 0.2) -> None:  # fmt: skip
+    def __init__(
+        self,
+        state: LiaisonState,
+        address: str,
+        port: int,
+        token: str = "",
+        update_period: float = 0.2,
+    ) -> None:
         self.address = address
         self.token: str | None = None
         if not is_loopback(address):
             self.token = token or secrets.token_urlsafe(16)
         self._stopping = asyncio.Event()
-        app = make_app(state, token=self.token, update_period=update_period, stopping=self._stopping)
-        config = uvicorn.Config(app, host=address, port=port, log_level="warning", lifespan="off",
-                                access_log=False, timeout_graceful_shutdown=1)  # fmt: skip
+        app = make_app(
+            state, token=self.token, update_period=update_period, stopping=self._stopping
+        )
+        config = uvicorn.Config(
+            app,
+            host=address,
+            port=port,
+            log_level="warning",
+            lifespan="off",
+            access_log=False,
+            timeout_graceful_shutdown=1,
+        )
         self._server = _EmbeddedServer(config)
         self._task: asyncio.Task | None = None
         self._socket = listen(address, port)
@@ -226,7 +258,9 @@ class WebServer:
         return f"http://{host}:{self.port}{suffix}"
 
     async def start(self) -> None:
-        self._task = asyncio.create_task(self._server.serve(sockets=[self._socket]), name="liaison-http")
+        self._task = asyncio.create_task(
+            self._server.serve(sockets=[self._socket]), name="liaison-http"
+        )
         while not self._server.started:
             if self._task.done():
                 self._task.result()  # the server failed to start: raise its error

@@ -87,6 +87,9 @@ class ApplicationAcks:
                 continue
             for j in range(MAX_FRAME_NUMBER):
                 if part.acked_frames >> j & 1:
-                    acks.append(acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=msg.src, dest=part.ack_dest,
-                                                    acked_frame=[j]))  # fmt: skip
+                    acks.append(
+                        acomms_pb.ModemTransmission(
+                            type=acomms_pb.ACK, src=msg.src, dest=part.ack_dest, acked_frame=[j]
+                        )
+                    )
         return acks

@@ -265,9 +265,7 @@ class MMDriver(ModemDriverBase):
         log.warning("no valid answer to %s (%s)", front, reason)
         if self._fails >= MAX_FAILS_BEFORE_DEAD:
             self.shutdown()
-            raise ModemDriverError(
-                f"modem did not respond to {front}", Status.MODEM_NOT_RESPONDING
-            )
+            raise ModemDriverError(f"modem did not respond to {front}", Status.MODEM_NOT_RESPONDING)
         if self._tries >= RETRIES:
             log.warning("giving up on %s, continuing onwards anyway", front)
             self._pop_front()
@@ -425,8 +423,9 @@ class MMDriver(ModemDriverBase):
 
     def _on_clk(self, s: NMEASentence) -> None:
         if self._outstanding("CLK"):
-            t = dt.datetime(*(s.as_int(i, *bounds) for i, bounds in enumerate(CLOCK_FIELDS, 1)),
-                            tzinfo=dt.UTC)  # fmt: skip
+            t = dt.datetime(
+                *(s.as_int(i, *bounds) for i, bounds in enumerate(CLOCK_FIELDS, 1)), tzinfo=dt.UTC
+            )
             self._check_clock(t.timestamp(), whole_seconds=True)
 
     def _on_tms(self, s: NMEASentence) -> None:
@@ -484,18 +483,26 @@ class MMDriver(ModemDriverBase):
 
     def _on_cyc(self, s: NMEASentence) -> None:
         src, dest, rate, ack, nframes = (
-            s.as_int(2, 0, MAX_ADDRESS), s.as_int(3, 0, MAX_ADDRESS), s.as_int(4, 0, MAX_RATE),
-            s.as_int(5, 0, 1), s.as_int(6, 0, MAX_FRAMES),
-        )  # fmt: skip
+            s.as_int(2, 0, MAX_ADDRESS),
+            s.as_int(3, 0, MAX_ADDRESS),
+            s.as_int(4, 0, MAX_RATE),
+            s.as_int(5, 0, 1),
+            s.as_int(6, 0, MAX_FRAMES),
+        )
         if self._outstanding("CYC") and tuple(self._out[0].fields[2:5]) == tuple(s.fields[2:5]):
             return  # the modem's echo of our own $CCCYC
         if src == self.modem_id:
             check_rate(rate)
             request = acomms_pb.ModemTransmission(
-                src=src, dest=dest, rate=rate, type=acomms_pb.DATA, time=acomms_pb.now_us(self.clock.now()),
-                max_num_frames=nframes, max_frame_bytes=RATE_FRAME_BYTES[rate],
+                src=src,
+                dest=dest,
+                rate=rate,
+                type=acomms_pb.DATA,
+                time=acomms_pb.now_us(self.clock.now()),
+                max_num_frames=nframes,
+                max_frame_bytes=RATE_FRAME_BYTES[rate],
                 ack_requested=bool(ack),
-            )  # fmt: skip
+            )
             self._request_data(request)
             self._expected_xst = 2 if rate == 0 else 1
             self._transmit = acomms_pb.ModemTransmission()
@@ -509,9 +516,12 @@ class MMDriver(ModemDriverBase):
 
     def _on_drq(self, s: NMEASentence) -> None:
         src, dest, ack, nbytes, frame_no = (
-            s.as_int(2, 0, MAX_ADDRESS), s.as_int(3, 0, MAX_ADDRESS), s.as_int(4, 0, 1),
-            s.as_int(5, 0, MAX_FRAME_BYTES), s.as_int(6, 1, MAX_FRAMES),
-        )  # fmt: skip
+            s.as_int(2, 0, MAX_ADDRESS),
+            s.as_int(3, 0, MAX_ADDRESS),
+            s.as_int(4, 0, 1),
+            s.as_int(5, 0, MAX_FRAME_BYTES),
+            s.as_int(6, 1, MAX_FRAMES),
+        )
         index = frame_no - 1
         if 0 <= index < len(self._cached.frame) and self._cached.frame[index]:
             data = bytes(self._cached.frame[index])
@@ -567,9 +577,11 @@ class MMDriver(ModemDriverBase):
 
     def _on_rxd(self, s: NMEASentence) -> None:
         src, dest, ack, frame_no = (
-            s.as_int(1, 0, MAX_ADDRESS), s.as_int(2, 0, MAX_ADDRESS), s.as_int(3, 0, 1),
+            s.as_int(1, 0, MAX_ADDRESS),
+            s.as_int(2, 0, MAX_ADDRESS),
+            s.as_int(3, 0, 1),
             s.as_int(4, 1, MAX_FRAMES),
-        )  # fmt: skip
+        )
         data = _hex(s[5], MAX_FRAME_BYTES) if len(s) > 5 else b""
         rx = self._receiving()
         if frame_no == 1:
@@ -599,12 +611,21 @@ class MMDriver(ModemDriverBase):
             today = _utc_date(self.clock.now())
         new_clock = self.revision >= MM2_BITFIELD_CLOCK_REVISION
         if self._ack_msg is not None and self._receive is None and not self._expected_cst:
-            add_cst(self._ack_msg.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat, s, today, new_clock)
+            add_cst(
+                self._ack_msg.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat,
+                s,
+                today,
+                new_clock,
+            )
             self._flush_ack()
             return
         # (what _receiving() gives, kept only once the statistics are in: add_cst appends
         # nothing when the sentence is bad)
-        rx = self._receive if self._receive is not None else acomms_pb.ModemTransmission(type=acomms_pb.DATA)
+        rx = (
+            self._receive
+            if self._receive is not None
+            else acomms_pb.ModemTransmission(type=acomms_pb.DATA)
+        )
         ext = rx.Extensions[acomms_pb.MM_TRANSMISSION]
         stat = add_cst(ext.receive_stat, s, today, new_clock)
         self._receive = rx
@@ -650,7 +671,10 @@ class MMDriver(ModemDriverBase):
 
     def _ping_result(self, src: int, dest: int, kind: int = acomms_pb.MICROMODEM_TWO_WAY_PING):
         msg = acomms_pb.ModemTransmission(
-            type=acomms_pb.DRIVER_SPECIFIC, src=src, dest=dest, time=acomms_pb.now_us(self.clock.now())
+            type=acomms_pb.DRIVER_SPECIFIC,
+            src=src,
+            dest=dest,
+            time=acomms_pb.now_us(self.clock.now()),
         )
         msg.Extensions[acomms_pb.MM_TRANSMISSION].type = kind
         return msg
@@ -702,7 +726,9 @@ class MMDriver(ModemDriverBase):
             good &= crc_ok
             if len(payload) > 4 * MAX_FDP_BYTES:  # (hex or base64 of more than the packet holds)
                 raise ValueError(f"a flexible data packet has at most {MAX_FDP_BYTES} bytes")
-            frame += base64.b64decode(payload) if self.mm_cfg.use_base64_fdp else bytes.fromhex(payload)
+            frame += (
+                base64.b64decode(payload) if self.mm_cfg.use_base64_fdp else bytes.fromhex(payload)
+            )
             if len(frame) > MAX_FDP_BYTES:
                 raise ValueError(f"a flexible data packet has at most {MAX_FDP_BYTES} bytes")
         if good:
@@ -747,15 +773,31 @@ class MMDriver(ModemDriverBase):
         p, timeout = self._lbl_params(msg, "narrowband_lbl")
         freqs = [*list(p.receive_freq)[:4], 0, 0, 0, 0][:4]
         self._last_lbl_type = acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING
-        self._push("$CCPNT", p.transmit_freq, p.transmit_ping_ms, p.receive_ping_ms, timeout,
-                   *freqs, int(p.transmit_flag))  # fmt: skip
+        self._push(
+            "$CCPNT",
+            p.transmit_freq,
+            p.transmit_ping_ms,
+            p.receive_ping_ms,
+            timeout,
+            *freqs,
+            int(p.transmit_flag),
+        )
 
     def _initiate_generic_lbl(self, msg) -> None:
         p, timeout = self._lbl_params(msg, "generic_lbl")
         codes = [*list(p.receive_seq_code)[:4], 0, 0, 0, 0][:4]
         self._last_lbl_type = acomms_pb.MICROMODEM_GENERIC_LBL_RANGING
-        self._push("$CCPGT", p.transmit_freq, p.n_bits, p.transmit_seq_code, timeout,
-                   p.receive_freq, *codes, p.bandwidth, 0)  # fmt: skip
+        self._push(
+            "$CCPGT",
+            p.transmit_freq,
+            p.n_bits,
+            p.transmit_seq_code,
+            timeout,
+            p.receive_freq,
+            *codes,
+            p.bandwidth,
+            0,
+        )
 
     def _initiate_hardware_control(self, msg) -> None:
         hw = msg.Extensions[acomms_pb.MM_TRANSMISSION].hw_ctl
@@ -766,16 +808,23 @@ class MMDriver(ModemDriverBase):
         p = acomms_pb.MMConfig().fm_sweep
         p.CopyFrom(self.mm_cfg.fm_sweep)
         p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].fm_sweep)
-        self._push("$CCSWP", int(p.start_freq * 10), int(p.stop_freq * 10),
-                   int(abs(p.start_freq - p.stop_freq)), int(p.duration_ms * 10),
-                   p.number_repetitions, int(p.repetition_period_ms * 10))  # fmt: skip
+        self._push(
+            "$CCSWP",
+            int(p.start_freq * 10),
+            int(p.stop_freq * 10),
+            int(abs(p.start_freq - p.stop_freq)),
+            int(p.duration_ms * 10),
+            p.number_repetitions,
+            int(p.repetition_period_ms * 10),
+        )
 
     def _initiate_m_sequence(self, msg) -> None:
         p = acomms_pb.MMConfig().m_sequence
         p.CopyFrom(self.mm_cfg.m_sequence)
         p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].m_sequence)
-        self._push("$CCMSQ", p.seqlen_bits, p.number_repetitions, p.carrier_cycles_per_chip,
-                   p.carrier_freq)  # fmt: skip
+        self._push(
+            "$CCMSQ", p.seqlen_bits, p.number_repetitions, p.carrier_cycles_per_chip, p.carrier_freq
+        )
 
     def _on_mer(self, s: NMEASentence) -> None:
         src, dest = _addresses(s)

@@ -16,11 +16,33 @@ log = logging.getLogger(__name__)
 
 # ReceiveStatistics fields in $CACST order after the TOA and clock mode (v0 fields 4..29)
 _CST_FIELDS = (
-    "mfd_peak", "mfd_power", "mfd_ratio", "spl", "shf_agn", "shf_ainpshift", "shf_ainshift",
-    "shf_mfdshift", "shf_p2bshift", "rate", "source", "dest", "psk_error_code", "packet_type",
-    "number_frames", "number_bad_frames", "snr_rss", "snr_in", "snr_out", "snr_symbols",
-    "mse_equalizer", "data_quality_factor", "doppler", "stddev_noise", "carrier_freq", "bandwidth",
-)  # fmt: skip
+    "mfd_peak",
+    "mfd_power",
+    "mfd_ratio",
+    "spl",
+    "shf_agn",
+    "shf_ainpshift",
+    "shf_ainshift",
+    "shf_mfdshift",
+    "shf_p2bshift",
+    "rate",
+    "source",
+    "dest",
+    "psk_error_code",
+    "packet_type",
+    "number_frames",
+    "number_bad_frames",
+    "snr_rss",
+    "snr_in",
+    "snr_out",
+    "snr_symbols",
+    "mse_equalizer",
+    "data_quality_factor",
+    "doppler",
+    "stddev_noise",
+    "carrier_freq",
+    "bandwidth",
+)
 _DECIMAL = "doppler"  # the one field printed with a decimal
 # enum fields whose out-of-range values become -1 (the enums' INVALID value)
 _CST_ENUM_RANGES = {"psk_error_code": (0, 6), "packet_type": (1, 5)}
@@ -85,9 +107,15 @@ class CycleStatistics:
     def sentence(self) -> NMEASentence:
         head = (str(self.version),) if self.version >= 6 else ()
         return NMEASentence(
-            ("$CACST", *head, str(self.mode), toa_text(self.toa_us, self.version >= 6),
-             str(self.clock_mode), *(_CST_TAIL % self.values).split(","))
-        )  # fmt: skip
+            (
+                "$CACST",
+                *head,
+                str(self.mode),
+                toa_text(self.toa_us, self.version >= 6),
+                str(self.clock_mode),
+                *(_CST_TAIL % self.values).split(","),
+            )
+        )
 
     @property
     def fields(self) -> tuple[str, ...]:
@@ -112,9 +140,12 @@ def cycle_statistics(stat: Mapping | object, version: int = 0) -> CycleStatistic
     6 on the sentence carries its version and the date of the time of arrival (Micro-Modem 2)."""
     get = stat.__getitem__ if isinstance(stat, Mapping) else stat.__getattribute__
     return CycleStatistics(
-        version, int(get("mode")), int(get("time")), int(get("clock_mode")),
+        version,
+        int(get("mode")),
+        int(get("time")),
+        int(get("clock_mode")),
         tuple(round(get(name), 1) if name == _DECIMAL else int(get(name)) for name in _CST_FIELDS),
-    )  # fmt: skip
+    )
 
 
 def format_cst(stat: Mapping | object, version: int = 0) -> NMEASentence:
@@ -184,14 +215,22 @@ def add_cst(
 ):
     """Append `parse_cst`'s ReceiveStatistics to the repeated field `stats` and return it
     (nothing is appended when the sentence is bad)."""
-    if isinstance(sentence, CycleStatistics) and math.copysign(1, sentence.values[DOPPLER_INDEX]) > 0:
+    if (
+        isinstance(sentence, CycleStatistics)
+        and math.copysign(1, sentence.values[DOPPLER_INDEX]) > 0
+    ):
         # an emulated link's statistics recur: all but the time of arrival are converted once
         # (not with a Doppler of -0.0, which would share the memo's key with 0.0)
         time = sentence.time_on(today)
         stats.append(
-            _without_toa(sentence.version, sentence.mode, sentence.clock_mode, sentence.values,
-                         new_clock_bitfield)
-        )  # fmt: skip
+            _without_toa(
+                sentence.version,
+                sentence.mode,
+                sentence.clock_mode,
+                sentence.values,
+                new_clock_bitfield,
+            )
+        )
         stat = stats[-1]
         stat.time = time
         return stat
@@ -208,10 +247,20 @@ def _without_toa(version: int, mode: int, clock_mode: int, values: tuple, new_bi
 
 # $CAXST v0 field order after date and time
 _XST_FIELDS = (
-    "clock_mode", "mode", "probe_length", "bandwidth", "carrier_freq", "rate", "source", "dest",
-    "ack_requested", "number_frames_expected", "number_frames_sent", "packet_type",
+    "clock_mode",
+    "mode",
+    "probe_length",
+    "bandwidth",
+    "carrier_freq",
+    "rate",
+    "source",
+    "dest",
+    "ack_requested",
+    "number_frames_expected",
+    "number_frames_sent",
+    "packet_type",
     "number_bytes",
-)  # fmt: skip
+)
 # enum fields of $CAXST whose out-of-range values become -1 (the enums' INVALID value)
 _XST_ENUM_RANGES = {"mode": (0, 4), "clock_mode": (0, 3), "packet_type": (1, 5)}
 
