@@ -125,7 +125,7 @@ def test_located_fills_only_what_is_missing():
 
 
 def test_a_text_format_parse_error_names_the_line_of_the_file():
-    from pygoby.netsim.config import config_class
+    from pygoby.netsim.manager.config import config_class
     from pygoby.protobuf.textconfig import merge_config_text
 
     with pytest.raises(ConfigError) as info:
@@ -141,7 +141,7 @@ def test_a_text_format_parse_error_names_the_line_of_the_file():
 def test_configuration_errors_from_files_carry_file_and_line(tmp_path):
     from pygoby.moos.appconfig import read_configuration
     from pygoby.moos.moosfile import MissionFile
-    from pygoby.netsim.scenario import load_scenario
+    from pygoby.netsim.sim.scenario import load_scenario
     from pygoby.protobuf import builtin_class
 
     scenario = tmp_path / "run.pb.cfg"

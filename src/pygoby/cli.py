@@ -15,7 +15,7 @@ SUBCOMMAND_MODULES = [
     "pygoby.dccl.cli",
     "pygoby.acomms.cli",
     "pygoby.moos.cli",
-    "pygoby.netsim.sim_cli",
+    "pygoby.netsim.cli",
     "pygoby.apps.topside_cli",
 ]
 

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pygoby.acomms.drivers.micromodem.statistics import CycleStatistics, parse_cst
-from pygoby.acomms.mmsim import AcousticPacket, LoopbackChannel, MicroModemModel, PacketKind
+from pygoby.acomms.mmsim import AcousticPacket, LoopbackChannel, MicroModemModel, ModemPacketKind
 from pygoby.acomms.mmsim.channel import Reception
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.util.clock import VirtualClock
@@ -367,7 +367,7 @@ def test_a_rate_0_poll_heard_before_the_host_spoke_goes_on_the_water_at_once():
 
 def test_channel_statistics_reach_cacst():
     model = MicroModemModel(2, VirtualClock(T0), firmware="0.94.0.00")
-    packet = AcousticPacket(PacketKind.DATA, 1, 2, rate=1, frames=[b"a", b"b"], duration=1.0)
+    packet = AcousticPacket(ModemPacketKind.DATA, 1, 2, rate=1, frames=[b"a", b"b"], duration=1.0)
     model.receive(
         packet,
         Reception(
@@ -383,7 +383,7 @@ def test_channel_statistics_reach_cacst():
 
 def test_mm2_statistics_carry_their_version_and_date():
     model = MicroModemModel(2, VirtualClock(T0))
-    packet = AcousticPacket(PacketKind.DATA, 1, 2, rate=0, frames=[b"a"], duration=3.2)
+    packet = AcousticPacket(ModemPacketKind.DATA, 1, 2, rate=0, frames=[b"a"], duration=3.2)
     model.receive(packet, Reception(T0 + 0.25))
     (cst,) = [s for s in model.take_output() if isinstance(s, CycleStatistics)]
     fields = NMEASentence.parse(cst.message()).fields

@@ -21,7 +21,7 @@ from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, Post
-from pygoby.topside.acomms_config import AcommsMessageSet
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
 from pygoby.topside.commander import KEY_VALUE, MULTIPLEX, Commander, CommanderError, CommandSet
 from pygoby.topside.icommander import ICommanderTUI
 

@@ -11,7 +11,7 @@ from google.protobuf.message import Message
 
 from pygoby.dccl.libraries import split_libraries
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
+from pygoby.moosacomms.translator_binding import MessageTypes, TranslatorBinding
 
 
 class pTranslator(GobyMOOSApp):  # noqa: N801 - the program's name

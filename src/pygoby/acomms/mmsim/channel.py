@@ -33,7 +33,7 @@ from pygoby.util.timeline import Timeline
 DEFAULT_SOUND_SPEED = 1500.0  # m/s
 
 
-class PacketKind(enum.Enum):
+class ModemPacketKind(enum.Enum):
     DATA = "data"  # data frames at a rate (a PSK packet carries its cycle-init in its header)
     CYCLE = "cycle"  # a cycle-init mini-packet: rate 0's own, or a third-party poll
     ACK = "ack"  # acoustic acknowledgement of frames
@@ -47,7 +47,7 @@ class PacketKind(enum.Enum):
 
 @dataclass
 class AcousticPacket:
-    kind: PacketKind
+    kind: ModemPacketKind
     src: int
     dest: int
     rate: int = 0
@@ -86,7 +86,7 @@ class ChannelEndpoint(Protocol):
     def receive(self, packet: AcousticPacket, reception: Reception) -> None: ...
 
 
-class Channel(Protocol):
+class ModemChannel(Protocol):
     def attach(self, endpoint: ChannelEndpoint) -> None: ...
 
     def detach(self, endpoint: ChannelEndpoint) -> None: ...

@@ -25,7 +25,7 @@ from pygoby.acomms.mmsim.channel import (
     AcousticPacket,
     ChannelEndpoint,
     LoopbackChannel,
-    PacketKind,
+    ModemPacketKind,
 )
 from pygoby.util.clock import Clock
 
@@ -64,7 +64,7 @@ def packet_from_json(data: bytes) -> tuple[str, AcousticPacket]:
         raise ValueError("more data than a packet carries")
     hw = d["hw"]
     packet = AcousticPacket(
-        PacketKind(d["kind"]),
+        ModemPacketKind(d["kind"]),
         _int(d["src"]),
         _int(d["dest"]),
         _int(d["rate"]),

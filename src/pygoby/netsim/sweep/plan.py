@@ -27,7 +27,7 @@ from google.protobuf.message import Message
 
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.errors import ScenarioError
-from pygoby.netsim.scenario import check_scenario, parse_scenario
+from pygoby.netsim.sim.scenario import check_scenario, parse_scenario
 from pygoby.protobuf import builtin_class
 from pygoby.protobuf.textconfig import merge_config_text, read_config_file
 

@@ -29,7 +29,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from pygoby.netsim.report import plt, save_figure
+from pygoby.netsim.report.plots import plt, save_figure
 from pygoby.netsim.sweep.store import RESULTS_FILE
 
 Z95 = 1.959963984540054  # standard normal 97.5 % quantile

@@ -1,5 +1,5 @@
 """The messages an operator can send, with where each field's value comes from, read from the
-message set pAcommsHandler loads (`pygoby.topside.acomms_config.AcommsMessageSet`: its
+message set pAcommsHandler loads (`pygoby.moosacomms.acomms_config.AcommsMessageSet`: its
 `load_proto_file`/`load_shared_library` definitions, `translator_entry` blocks, queues, and the
 Goby 1.1 XML `message_file`s).
 
@@ -31,7 +31,7 @@ from pygoby.dccl.xml import XmlMessage
 from pygoby.moos.translator import ModemIdLookup, Technique, Translator, UTMGeodesy
 from pygoby.moos.translator.format import parsed_fields
 from pygoby.moos.translator.techniques import PROTOBUF_TECHNIQUES
-from pygoby.topside.acomms_config import AcommsMessageSet
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
 from pygoby.topside.commander.fields import FieldSpec
 
 TRIGGER_PUBLISH = 1

@@ -11,8 +11,8 @@ from google.protobuf.message import Message
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.translator import MoosValues, Post
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
 from pygoby.protobuf import builtin_class
-from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.topside.commander import CommanderError, CommandSet
 from pygoby.topside.liaison.state import LiaisonState
 from pygoby.topside.liaison.web import WebServer

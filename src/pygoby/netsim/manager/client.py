@@ -25,7 +25,7 @@ from collections.abc import Callable, Iterable
 from google.protobuf.message import Message
 
 from pygoby.netsim.errors import LineError
-from pygoby.netsim.protocol import (
+from pygoby.netsim.manager.protocol import (
     LEGACY_REQUEST_NAME,
     REQUEST_NAME,
     LineDecoder,

@@ -24,7 +24,6 @@ from pathlib import Path
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.transitional import TransitionalMessages
 from pygoby.dccl import Codec, DcclError
 from pygoby.dccl.libraries import BuiltinLibrary, split_libraries
 from pygoby.errors import ConfigError
@@ -32,7 +31,8 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import Translator
-from pygoby.moos.translator_binding import MessageTypes, not_found
+from pygoby.moosacomms.transitional import TransitionalMessages
+from pygoby.moosacomms.translator_binding import MessageTypes, not_found
 from pygoby.protobuf import ProtoLoader, builtin_class
 
 PACOMMSHANDLER_CONFIG = (

@@ -17,7 +17,7 @@ from collections.abc import Mapping
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.netsim.protocol import message_class
+from pygoby.netsim.manager.protocol import message_class
 from pygoby.util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)

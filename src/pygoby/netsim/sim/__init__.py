@@ -1,0 +1,14 @@
+"""The acoustic network simulation behind `pygoby netsim run`.
+
+* `scenario`: the scenario file and what it means.
+* `simulation`: the whole network in one process on a virtual clock; `realtime`: the same on
+  the wall clock, over TCP.
+* `physics_channel`: the Micro-Modem emulators' channel backed by `netsim.channel`'s physics.
+"""
+
+__all__ = [
+    "physics_channel",
+    "realtime",
+    "scenario",
+    "simulation",
+]
