@@ -37,7 +37,7 @@ bench: $(STAMP)
 # SOAK_SECONDS per scenario
 SOAK_SECONDS ?= 20
 soak: $(STAMP)
-	$(PY) benchmarks/soak/run.py --seconds $(SOAK_SECONDS)
+	$(PY) -m benchmarks.soak.run --seconds $(SOAK_SECONDS)
 
 # Figures of the examples' READMEs, regenerated from their sources (commit the result).
 EXAMPLE_SWEEP := examples/netsim/sweep_range_rate

@@ -17,7 +17,7 @@ from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from kit import (
+from benchmarks.soak.kit import (
     ANSWER_TIMEOUT,
     Figures,
     Garbage,
@@ -32,7 +32,6 @@ from kit import (
     stop_or_fail,
     venv_command,
 )
-
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.rudics import parse_rudics_packet, serialize_rudics_packet
 from pygoby.moos import protocol as p
@@ -594,7 +593,7 @@ async def stale_session(seconds: float, workdir: Path) -> Figures:
 
 async def netsim_manager_hostile(seconds: float, workdir: Path) -> Figures:
     """64 clients x 10 Hz NavUpdates with garbage clients (benchmarks/test_netsim_bench.py)."""
-    from test_netsim_bench import ManagerProcess, _config, _load
+    from benchmarks.test_netsim_bench import ManagerProcess, _config, _load
 
     figures = Figures()
     manager = ManagerProcess(_config(workdir))
@@ -618,7 +617,7 @@ async def netsim_manager_hostile(seconds: float, workdir: Path) -> Figures:
 
 
 def _rss(pid: int) -> float | None:
-    from kit import rss_mb
+    from benchmarks.soak.kit import rss_mb
 
     return rss_mb(pid)
 
