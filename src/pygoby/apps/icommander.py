@@ -23,7 +23,6 @@ from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, Post
 from pygoby.moosacomms.acomms_config import AcommsMessageSet
 from pygoby.topside.commander import KEY_VALUE, MULTIPLEX, Commander, CommanderError, CommandSet
-from pygoby.topside.icommander import ICommanderTUI
 
 SEND_MULTIPLEX = 2  # pygoby.apps.protobuf.SendStyle
 QUIET = 1  # goby.util.protobuf.GLogConfig.Verbosity
@@ -59,6 +58,9 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
             )
         except CommanderError as err:
             raise ConfigError(str(err), field="commander") from None
+        # textual (pip extra `topside`) is imported here, where a missing one is reported cleanly
+        from pygoby.topside.icommander import ICommanderTUI
+
         self.tui = ICommanderTUI(self.commander, list(cfg.show_variable), on_exit=self.request_stop)
         for var in self.commander.watched_variables:
             self.subscribe(var, self._on_ack_or_expire)

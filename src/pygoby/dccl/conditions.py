@@ -38,18 +38,17 @@ from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.errors import DcclError, DcclLoadError
+from pygoby.util.extras import MissingExtraError, needs_extra
 
 _INT64 = (FieldDescriptor.CPPTYPE_INT64, FieldDescriptor.CPPTYPE_UINT64)
 
 
 def _lupa():
     try:
-        from lupa import lua53
-    except ImportError as exc:
-        raise DcclLoadError(
-            "dynamic_conditions are Lua expressions and need the 'lupa' package with Lua 5.3"
-            f" (pip install lupa): {exc}"
-        ) from None
+        with needs_extra("lua", "dynamic_conditions (Lua 5.3 expressions)"):
+            from lupa import lua53
+    except MissingExtraError as exc:
+        raise DcclLoadError(str(exc)) from None
     return lua53
 
 

@@ -26,6 +26,7 @@ from pygoby.moos.appconfig import collecting_notes
 from pygoby.moos.moosfile import MissionFile
 from pygoby.util.aiorun import StopSignals
 from pygoby.util.console import quiet_broken_pipe
+from pygoby.util.extras import MissingExtraError
 
 if TYPE_CHECKING:
     from google.protobuf.message import Message
@@ -166,6 +167,9 @@ def run_app(
         app.config_notes = notes
     except ConfigError as err:
         print(f"{name}: fatal configuration error: {err}", file=sys.stderr)
+        return 1
+    except MissingExtraError as err:  # the app needs a package a pip extra installs
+        print(f"{name}: {err}", file=sys.stderr)
         return 1
     return quiet_broken_pipe(lambda: run_until_signal(app))
 

@@ -22,12 +22,15 @@ import sys
 from collections import deque
 from typing import TYPE_CHECKING, Any, Protocol
 
-from textual.app import App, ComposeResult
-from textual.binding import Binding
-from textual.containers import Horizontal, Vertical
-from textual.css.query import NoMatches
-from textual.widgets import Footer, Header, OptionList, RichLog, Static
-from textual.widgets.option_list import Option
+from pygoby.util.extras import needs_extra
+
+with needs_extra("topside", "common.show_gui's live view"):
+    from textual.app import App, ComposeResult
+    from textual.binding import Binding
+    from textual.containers import Horizontal, Vertical
+    from textual.css.query import NoMatches
+    from textual.widgets import Footer, Header, OptionList, RichLog, Static
+    from textual.widgets.option_list import Option
 
 from pygoby.util.glog import GobyFormatter, group_name, level_for
 

@@ -26,8 +26,11 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-import pyarrow as pa
-import pyarrow.parquet as pq
+from pygoby.util.extras import needs_extra
+
+with needs_extra("sim", "netsim sweep reports"):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
 
 from pygoby.netsim.report.plots import plt, save_figure
 from pygoby.netsim.sweep.store import RESULTS_FILE

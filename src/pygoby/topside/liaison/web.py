@@ -22,18 +22,21 @@ import socket
 from collections.abc import AsyncIterator, Callable
 from pathlib import Path
 
-import uvicorn
-from starlette.applications import Starlette
-from starlette.requests import Request
-from starlette.responses import (
-    FileResponse,
-    JSONResponse,
-    RedirectResponse,
-    Response,
-    StreamingResponse,
-)
-from starlette.routing import Mount, Route
-from starlette.staticfiles import StaticFiles
+from pygoby.util.extras import needs_extra
+
+with needs_extra("topside", "liaison"):
+    import uvicorn
+    from starlette.applications import Starlette
+    from starlette.requests import Request
+    from starlette.responses import (
+        FileResponse,
+        JSONResponse,
+        RedirectResponse,
+        Response,
+        StreamingResponse,
+    )
+    from starlette.routing import Mount, Route
+    from starlette.staticfiles import StaticFiles
 
 from pygoby.errors import ConfigError, PygobyError
 from pygoby.topside.commander import CommanderError, FieldValueError, SaveFileError
