@@ -48,9 +48,12 @@ def test_importing_dccl_acomms_and_moos_loads_no_extra_package():
 
 
 def test_a_missing_package_names_its_extra():
-    with pytest.raises(
-        MissingExtraError, match=r"netsim reports needs .*pip install 'pygoby\[sim\]'"
-    ), needs_extra("sim", "netsim reports"):
+    with (
+        pytest.raises(
+            MissingExtraError, match=r"netsim reports needs .*pip install 'pygoby\[sim\]'"
+        ),
+        needs_extra("sim", "netsim reports"),
+    ):
         import pygoby_no_such_package  # noqa: F401
 
 

@@ -375,7 +375,10 @@ class DBCore:
             source.growth,
         )
         key_at_offset = p.SRC_AT + len(head)
+        # the layout's offsets as locals: the loop below runs for every message the DB gets
         tail_size, sval_length_in_tail = _TAIL_SIZE, p.SVAL_LENGTH_IN_TAIL
+        msg_type_in, data_type_in = _MSG_TYPE_IN_ID_TYPES, _DATA_TYPE_IN_ID_TYPES
+        length_size = _STRING_LENGTH_SIZE
         had_notify = False
         for _ in range(count):
             try:  # one unpack reads a notification from the remembered source up to its key
@@ -406,14 +409,14 @@ class DBCore:
                     f"message length {msg_len} is below "
                     f"{p.MESSAGE_FIXED_SIZE} or runs past the packet end"
                 )
-            if id_types[_MSG_TYPE_IN_ID_TYPES] != _NOTIFY:
+            if id_types[msg_type_in] != _NOTIFY:
                 self._on_other(client, p.decode_message(data, pos, stop)[0], now, answers)
                 pos = stop
                 continue
             had_notify = True
-            data_type = id_types[_DATA_TYPE_IN_ID_TYPES]
+            data_type = id_types[data_type_in]
             key_at = pos + key_at_offset
-            key_end = key_at + _STRING_LENGTH_SIZE + key_len
+            key_end = key_at + length_size + key_len
             if key_len < 0 or key_end + tail_size > stop:
                 raise MoosProtocolError(
                     f"key length {key_len} is negative or runs past the message end"
@@ -425,10 +428,10 @@ class DBCore:
                 raw = data[pos:stop]
             else:
                 raw = b"".join((pack_int(msg_len + growth), id_types, forwarded, data[key_at:stop]))
-            var = by_key.get(data[key_at + _STRING_LENGTH_SIZE : key_end])
+            var = by_key.get(data[key_at + length_size : key_end])
             if var is None or var.accepts != data_type:
                 var = self._first_or_mistyped_write(
-                    var, data[key_at + _STRING_LENGTH_SIZE : key_end], data_type, source.src, now
+                    var, data[key_at + length_size : key_end], data_type, source.src, now
                 )
                 if var is None:
                     pos = stop
