@@ -1,7 +1,7 @@
-"""MACManager: TDMA slot scheduling aligned to UTC (spec acomms.md §6).
+"""MACManager: TDMA slot scheduling aligned to UTC.
 
 Schemes: MAC_NONE, MAC_FIXED_DECENTRALIZED, MAC_POLLED (goby3) and MAC_AUTO_DECENTRALIZED (Goby
-1.1 passive auto-discovery, §6.7). Call `do_work()` regularly (>= 5 Hz) with a Clock; at each slot
+1.1 passive auto-discovery). Call `do_work()` regularly (>= 5 Hz) with a Clock; at each slot
 start the MAC may emit `signal_initiate_transmission(slot)` and always emits
 `signal_slot_start(slot)`. For auto-discovery connect the driver's receptions to
 `handle_modem_receive`.
@@ -182,7 +182,7 @@ class MACManager:
 
     # ------------------------------------------------------------------ MACUpdate
     def apply_update(self, update) -> bool | None:
-        """Apply a MACUpdate addressed to this node (§6.6).
+        """Apply a MACUpdate addressed to this node.
 
         Returns None when `cycle_state` is absent, else True for STARTED / False for STOPPED
         (the caller silences or restores a Micro-Modem with `SRC,0` / `SRC,<id>`).

@@ -1,4 +1,4 @@
-"""pTranslator: MOOS variables -> protobuf messages -> MOOS variables (spec goby-moos-apps.md 3).
+"""pTranslator: MOOS variables -> protobuf messages -> MOOS variables.
 
 Every message created by a translator_entry's trigger is published straight back through the
 same entry's publish rules. The translation itself is `pygoby.moos.translator`; this module

@@ -1,4 +1,4 @@
-"""QueueManager: the priority contest that fills ModemTransmission frames (spec acomms.md §5).
+"""QueueManager: the priority contest that fills ModemTransmission frames.
 
 Connect a driver with `driver.signal_data_request.connect(queue.handle_modem_data_request)` and
 `driver.signal_receive.connect(queue.handle_modem_receive)` (or pygoby.acomms.bind.bind). Call

@@ -121,7 +121,8 @@ def serialize(
     registry: AlgorithmRegistry | None = None,
 ) -> str:
     descriptor = msg.DESCRIPTOR
-    # Every field counts (goby3 skips the first-declared one: Quirk Q9, fixed here).
+    # Every field counts (goby3 skips the first-declared one, so a directive for it renders
+    # empty when its number is the largest; fixed: QUIRKS.md Q-APPS-9).
     max_field = max([1, *(f.number for f in descriptor.fields)])
     virtual = (
         run_publish_algorithms(msg, algorithms, registry or AlgorithmRegistry())

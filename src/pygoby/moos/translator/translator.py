@@ -40,7 +40,8 @@ LAT_ORIGIN_VAR = "LAT_ORIGIN"
 LONG_ORIGIN_VAR = "LONG_ORIGIN"
 
 # Outputs that may be posted as MOOS doubles when they look like numbers. goby3 converts
-# every non-binary output (Quirk Q5); hex and @PB outputs are kept as strings here.
+# every non-binary output, even an all-digit hex string; hex and @PB outputs are kept as
+# strings here (QUIRKS.md Q-APPS-5).
 _NUMBER_CANDIDATES = frozenset(
     {
         Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT,
@@ -176,8 +177,8 @@ class Translator:
                 format_technique.check_serialize_format(descriptor, publish.moos_var, virtual)
 
     def read_named_values(self, protobuf_name: str, keys: Mapping[str, str]) -> None:
-        """Goby 1.1's rule for the message's create variables in `keys` ({variable: name},
-        seed 003 §2.3.8): a string value holding `<name>=value` gives that value, any other
+        """Goby 1.1's rule for the message's create variables in `keys` ({variable: name}):
+        a string value holding `<name>=value` gives that value, any other
         value is read whole (`NAV_X: "nav_x=3.5"` and `NAV_X: 3.5` both give 3.5). For the
         messages of Goby 1.1 XML files, whose iCommander posted `name=value` strings."""
         self._entry(protobuf_name)
