@@ -84,6 +84,8 @@ class MACManager:
     def reference_time(self, now: float) -> float:
         if self.cfg.ref_time_type == acomms_pb.MACConfig.REFERENCE_FIXED:
             return float(self.cfg.fixed_ref_time)
+        # UTC midnight: a cycle that does not divide 86400 s changes phase at midnight until the
+        # next update(), as in goby3 (QUIRKS.md Q-ACOMMS-12)
         return math.floor(now / SECONDS_PER_DAY) * SECONDS_PER_DAY
 
     def update(self) -> None:
@@ -254,7 +256,9 @@ class MACManager:
         self._log_cycle()
 
     def _auto_place_blank(self, cycle_start: float) -> None:
-        """Blank position = N-1-[(k mod 5) == (S mod 5)] (k: cycles since midnight)."""
+        """Blank position = N-1-[(k mod 5) == (S mod 5)] (k: cycles since midnight, S: the sum of
+        the heard ids), from the slot count (Goby 1.x stepped a list iterator past its end:
+        QUIRKS.md Q-ACOMMS-3)."""
         ids = sorted(self.heard)
         n = len(ids) + 1
         k = round((cycle_start - self.reference_time(cycle_start)) / self.cycle_duration)

@@ -314,7 +314,7 @@ def _parse_directive(extract, msg, spec, delimiter, algorithms, short, registry)
         set_element_from_string(msg, field, index, extract, short)
     elif field.is_repeated:
         parts = re.split("[" + re.escape(delimiter) + "]", extract) if delimiter else [extract]
-        for part in parts:
+        for part in parts:  # enums too (goby3 aborts on a repeated enum: QUIRKS.md Q-APPS-10)
             append_from_string(msg, field, part, short)
     elif is_message(field):
         parse_message_bytes(getattr(msg, field.name), hex_decode(extract), field.name)

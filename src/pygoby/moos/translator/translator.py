@@ -63,6 +63,8 @@ class Post:
 
 
 def make_post(var: str, value: str | bytes, technique: Technique, type_name: str) -> Post:
+    # binary or not is decided for each post from its own value (goby3 keeps the binary flag of
+    # an earlier NATIVE_ENCODED publish for the entry's later ones: QUIRKS.md Q-APPS-6)
     technique = Technique(technique)
     aux = f"{type_name}:{technique.name}"
     if isinstance(value, bytes):
@@ -270,7 +272,8 @@ class Translator:
     # --- protobuf -> MOOS --------------------------------------------------------------------
 
     def publish(self, msg: Message) -> list[Post]:
-        """The entry's publish rules applied to `msg`, sorted by variable name (stable)."""
+        """The entry's publish rules applied to `msg`, sorted by variable name (stable), not in
+        declaration order, as goby3 posts them (QUIRKS.md Q-APPS-22)."""
         name = msg.DESCRIPTOR.full_name
         entry = self._entries.get(name)
         if entry is None:
