@@ -87,3 +87,29 @@ def test_code_states_its_rules_instead_of_citing_outside_documents():
         for line in citations(path.read_text(encoding="utf-8"))
     ]
     assert len(found) <= MAX_CITATIONS, "\n".join(found)
+
+
+QUIRK_ID = re.compile(r"\bQ-[A-Z0-9]+-\d+\b")
+
+
+def test_every_quirk_id_in_the_code_is_listed_with_modules_that_exist():
+    """QUIRKS.md has a row for every id a comment (or the README) gives, and each row's modules
+    are files of the repository."""
+    rows = {
+        match.group(1): line
+        for line in (REPO / "QUIRKS.md").read_text().splitlines()
+        if (match := re.match(r"\| (Q-[A-Z0-9]+-\d+) \|", line))
+    }
+    used = {
+        found
+        for path in [*(REPO / "src").rglob("*.py"), *(REPO / "src").rglob("*.proto")]
+        for found in QUIRK_ID.findall(path.read_text(encoding="utf-8"))
+    } | set(QUIRK_ID.findall((REPO / "README.md").read_text()))
+    assert used - rows.keys() == set()
+    for quirk, row in rows.items():
+        where = row.rstrip(" |").rsplit("|", 1)[1]
+        modules = re.findall(r"`([^`]+)`", where)
+        assert modules, f"{quirk}: no module named"
+        for module in modules:
+            path = REPO / module if module.startswith("examples/") else REPO / "src/pygoby" / module
+            assert path.is_file(), f"{quirk}: {module} does not exist"
