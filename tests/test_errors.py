@@ -20,7 +20,7 @@ from pygoby.moos.translator import TranslatorConfigError
 from pygoby.netsim import NetsimError, ScenarioError
 from pygoby.protobuf import ProtoError
 from pygoby.topside import TopsideError
-from pygoby.util import LinkClosedError, NMEAError, PluginError, PtyError
+from pygoby.util import LinkClosedError, MissingExtraError, NMEAError, PluginError, PtyError
 
 # the root(s) every error class of a package derives from
 PACKAGE_ROOTS: dict[str, tuple[type[BaseException], ...]] = {
@@ -31,7 +31,8 @@ PACKAGE_ROOTS: dict[str, tuple[type[BaseException], ...]] = {
     "pygoby.netsim": (NetsimError,),
     "pygoby.protobuf": (ProtoError,),
     "pygoby.topside": (TopsideError,),
-    "pygoby.util": (NMEAError, LinkClosedError, PtyError, PluginError),  # one root per kind
+    # one root per kind
+    "pygoby.util": (NMEAError, LinkClosedError, PtyError, PluginError, MissingExtraError),
     "pygoby.errors": (PygobyError,),
 }
 

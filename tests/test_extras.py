@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from pygoby.util.extras import MissingExtraError, needs_extra
+from pygoby.util.errors import MissingExtraError
+from pygoby.util.extras import needs_extra
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 from pygoby import __version__
 from pygoby.util.console import quiet_broken_pipe
-from pygoby.util.extras import MissingExtraError
+from pygoby.util.errors import MissingExtraError
 
 # Each module has `register(subparsers)`, which adds parsers whose `func(args) -> int` runs them.
 SUBCOMMAND_MODULES = [

@@ -38,7 +38,8 @@ from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.errors import DcclError, DcclLoadError
-from pygoby.util.extras import MissingExtraError, needs_extra
+from pygoby.util.errors import MissingExtraError
+from pygoby.util.extras import needs_extra
 
 _INT64 = (FieldDescriptor.CPPTYPE_INT64, FieldDescriptor.CPPTYPE_UINT64)
 

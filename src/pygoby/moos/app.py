@@ -117,7 +117,7 @@ from pygoby.moos.translator import (
 from pygoby.protobuf import builtin_class
 from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock
-from pygoby.util.extras import MissingExtraError
+from pygoby.util.errors import MissingExtraError
 
 Handler = Callable[[MOOSMessage], None]
 

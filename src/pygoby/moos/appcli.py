@@ -26,7 +26,7 @@ from pygoby.moos.appconfig import collecting_notes
 from pygoby.moos.moosfile import MissionFile
 from pygoby.util.aiorun import StopSignals
 from pygoby.util.console import quiet_broken_pipe
-from pygoby.util.extras import MissingExtraError
+from pygoby.util.errors import MissingExtraError
 
 if TYPE_CHECKING:
     from google.protobuf.message import Message

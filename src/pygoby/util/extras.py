@@ -12,11 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from pygoby.errors import PygobyError
-
-
-class MissingExtraError(PygobyError, ImportError):
-    """A feature's package is not installed; the text names the pip extra that installs it."""
+from pygoby.util.errors import MissingExtraError
 
 
 def missing_extra_text(error: ImportError, extra: str, feature: str) -> str:

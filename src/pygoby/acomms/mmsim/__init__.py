@@ -6,7 +6,7 @@ from pygoby.acomms.mmsim.channel import (
     LoopbackChannel,
     ModemChannel,
     ModemPacketKind,
-    Reception,
+    ModemReception,
 )
 from pygoby.acomms.mmsim.model import MicroModemModel
 
@@ -17,5 +17,5 @@ __all__ = [
     "LoopbackChannel",
     "MicroModemModel",
     "ModemPacketKind",
-    "Reception",
+    "ModemReception",
 ]

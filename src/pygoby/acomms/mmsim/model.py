@@ -41,7 +41,12 @@ from pygoby.acomms.drivers.micromodem.statistics import (
     CycleStatistics,
     format_xst,
 )
-from pygoby.acomms.mmsim.channel import AcousticPacket, ModemChannel, ModemPacketKind, Reception
+from pygoby.acomms.mmsim.channel import (
+    AcousticPacket,
+    ModemChannel,
+    ModemPacketKind,
+    ModemReception,
+)
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, FDP_RATES, ModemTiming
 from pygoby.util.clock import Clock
 from pygoby.util.errors import NMEAError
@@ -601,10 +606,10 @@ class MicroModemModel:
         if packet.kind is not ModemPacketKind.SIGNAL and self._on("RXP"):
             self._emit(_RXP)
 
-    def receive(self, packet: AcousticPacket, reception: Reception) -> None:
+    def receive(self, packet: AcousticPacket, reception: ModemReception) -> None:
         _HEARD[packet.kind](self, packet, reception)
 
-    def _heard_data(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_data(self, p: AcousticPacket, r: ModemReception) -> None:
         if p.rate != 0:  # (a PSK packet's header is its cycle-init)
             self._emit(_heard_cycle_sentence(p, len(p.frames)))
         good: list[int] = []
@@ -628,20 +633,20 @@ class MicroModemModel:
             )
             self._send(ack, self.timing.mini_packet)
 
-    def _heard_cycle(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_cycle(self, p: AcousticPacket, r: ModemReception) -> None:
         self._emit(_heard_cycle_sentence(p, p.num_frames))
         self._cst(p, r, frames=0, bad=0)
         if p.src == self.modem_id and self._tx is None:  # polled: send our data
             self._start_transmit(_Transmit(p.src, p.dest, p.rate, p.ack_requested, p.num_frames))
 
-    def _heard_ack(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_ack(self, p: AcousticPacket, r: ModemReception) -> None:
         if p.dest != self.modem_id:
             return
         for frame_no in p.acked_frames:
             self._say("$CAACK", p.src, p.dest, frame_no, 1)
         self._cst(p, r, frames=0, bad=0)
 
-    def _heard_ping(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_ping(self, p: AcousticPacket, r: ModemReception) -> None:
         if p.dest != self.modem_id:
             return
         self._say("$CAMPA", p.src, p.dest)
@@ -650,7 +655,7 @@ class MicroModemModel:
         reply = AcousticPacket(ModemPacketKind.PING_REPLY, self.modem_id, p.src)
         self.timeline.at(reply_at, self._send, reply, self.timing.ping, None, reply_at)
 
-    def _heard_ping_reply(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_ping_reply(self, p: AcousticPacket, r: ModemReception) -> None:
         sent = self._pings.pop(p.src, None) if p.dest == self.modem_id else None
         if sent is not None:
             round_trip = r.arrival_time - sent - self.timing.ping - self._turnaround()
@@ -659,10 +664,10 @@ class MicroModemModel:
     def _turnaround(self) -> float:
         return max(0, int(self.nvram["TAT"])) / 1000
 
-    def _heard_mini(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_mini(self, p: AcousticPacket, r: ModemReception) -> None:
         self._say("$CAMUA", p.src, p.dest, p.frames[0].hex().upper())
 
-    def _heard_fdp(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_fdp(self, p: AcousticPacket, r: ModemReception) -> None:
         payload = b"".join(p.frames)
         bad = sum(not r.frame_good(i) for i in range(len(p.frames)))
         good = not bad
@@ -677,10 +682,10 @@ class MicroModemModel:
         self._say("$CARDP", p.src, p.dest, p.rate, int(p.ack_requested), 0, triple, "")
         self._cst(p, r, frames=len(p.frames), bad=bad)
 
-    def _heard_signal(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_signal(self, p: AcousticPacket, r: ModemReception) -> None:
         pass  # (sweeps, sequences and navigation pings carry nothing for a modem)
 
-    def _heard_hw_control(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_hw_control(self, p: AcousticPacket, r: ModemReception) -> None:
         if p.dest != self.modem_id or p.hw_control is None:
             return
         line, mode, arg = p.hw_control
@@ -698,7 +703,7 @@ class MicroModemModel:
         )
         self._send(reply, self.timing.mini_packet)
 
-    def _cst(self, p: AcousticPacket, r: Reception, frames: int, bad: int) -> None:
+    def _cst(self, p: AcousticPacket, r: ModemReception, frames: int, bad: int) -> None:
         if not self._on("CST"):
             return
         stats = tuple(r.stats.items())

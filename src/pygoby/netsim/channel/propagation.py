@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 from google.protobuf.message import Message
 
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile
-from pygoby.util.extras import MissingExtraError, needs_extra
+from pygoby.util.errors import MissingExtraError
+from pygoby.util.extras import needs_extra
 
 log = logging.getLogger(__name__)
 

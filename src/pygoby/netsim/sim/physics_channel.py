@@ -38,8 +38,12 @@ from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-from pygoby.acomms.mmsim.channel import AcousticPacket, ChannelEndpoint, ModemPacketKind
-from pygoby.acomms.mmsim.channel import Reception as ModemReception
+from pygoby.acomms.mmsim.channel import (
+    AcousticPacket,
+    ChannelEndpoint,
+    ModemPacketKind,
+    ModemReception,
+)
 from pygoby.netsim.channel import Channel, Outcome, PacketKind, Reception, Transmission
 from pygoby.netsim.channel.stats import link_statistics
 from pygoby.util.clock import Clock

@@ -30,7 +30,8 @@ from concurrent.futures.process import BrokenProcessPool
 from pygoby.netsim.errors import NetsimError
 from pygoby.netsim.sweep.plan import RunSpec
 from pygoby.netsim.sweep.run import RunResult, execute_run
-from pygoby.util.extras import MissingExtraError, needs_extra
+from pygoby.util.errors import MissingExtraError
+from pygoby.util.extras import needs_extra
 
 log = logging.getLogger(__name__)
 
