@@ -178,7 +178,9 @@ class MMDriver(ModemDriverBase):
             self._written_at = None  # (re)connected: rewrite the outstanding sentence now
         self._link_was_open = link_open
         assert self._sentences is not None
-        self._handle_sentences(self._sentences.read_sentences())
+        sentences = self._sentences.read_sentences()
+        if sentences:  # (a direct link's empty list: the common case in a simulation)
+            self._handle_sentences(sentences)
         if not link_open:
             return  # a dead link is the link's business (it reconnects); do not count failures
         now = self.clock.now()
