@@ -209,6 +209,7 @@ class TranslatorBinding:
             start_time=self.app.start_time,
             multiplex_vars=self.multiplex_vars,
             variables=MoosValues(self.app.dynamic_vars),
+            clock=self.app.clock,
         )
 
     def tick(self, now: float) -> None:

@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from pygoby.moos.translator import TranslatorConfigError, TranslatorError
+from pygoby.moos.translator import TranslatorConfigError
 from pygoby.moos.translator import format as fmt
 from pygoby.moos.translator.boostformat import FloatArg, IntArg, boost_format, parse_format
 
@@ -153,9 +153,46 @@ def test_parse_bytes_and_submessage_hex(msgs):
     assert out.msg_default_optional.val == 1
 
 
-def test_parse_mismatch_is_an_error(msgs):
-    with pytest.raises(TranslatorError, match="does not match format"):
-        fmt.parse("hello", msgs.BasicNodeReport(), "NAME=%1%")
+def test_a_literal_missing_from_the_input_skips_nothing_and_parsing_goes_on(msgs):
+    # goby3's scanner: a format character that does not occur leaves the input as it is; one
+    # that occurs drops the input through it ('e' of "hello" -> "llo").
+    out = msgs.BasicNodeReport()
+    mismatch = fmt.parse("hello", out, "NAME=%1%")
+    assert out.Name == "llo"
+    assert mismatch == fmt.FormatMismatch("n", 0, 0)
+    assert str(mismatch) == "no 'n' (format character 0) in the input after character 0"
+
+
+def test_an_empty_input_fills_fields_as_goby3_leaves_them(msgs):
+    # goby3's as<T>("") gives NaN for floating point and the type's maximum for integers;
+    # a repeated index pads with the field's default value.
+    out = msgs.BasicNodeReport()
+    mismatch = fmt.parse("", out, "depth:=%6%;t=%200%;r=%10.2%")
+    assert math.isnan(out.depth)
+    assert math.isnan(out.time)
+    assert out.repeat[:] == [0, 0, 2**31 - 1]
+    assert mismatch == fmt.FormatMismatch("d", 0, 0)
+
+
+def test_the_first_missing_literal_is_reported_after_what_matched(msgs):
+    out = msgs.BasicNodeReport()
+    mismatch = fmt.parse("x=550,y", out, "x=%202%,y=%3%;n=%1%")
+    assert out.x == 550
+    assert math.isnan(out.y)  # "" after the last match
+    assert out.Name == ""
+    assert mismatch == fmt.FormatMismatch("=", 9, 7)
+
+
+def test_a_whole_match_reports_nothing(msgs):
+    assert fmt.parse("x=550,y=3", msgs.BasicNodeReport(), "x=%202%,y=%3%") is None
+
+
+def test_adjacent_directives_read_the_same_input(msgs):
+    # goby3: the second directive's value starts where the first one's did (nothing is
+    # consumed between them).
+    out = msgs.BasicNodeReport()
+    assert fmt.parse("12", out, "%202%%3%") is None
+    assert (out.x, out.y) == (12, 12)
 
 
 def test_parse_unknown_enum_warns(msgs, caplog):
@@ -171,8 +208,7 @@ def test_parse_unknown_enum_warns(msgs, caplog):
     [
         ("%99%", "Bad field: 99"),
         ("%x%", "Bad specifier: x"),
-        ("%1%%3%", "adjacent directives"),
-        ("a%%b%1%", "adjacent directives"),
+        ("a%%b%1%", "empty directive"),
         ("%3:1%", "Invalid ':' syntax"),
         ("%117:1%", "Invalid '.' syntax"),
         ("%1", "unterminated"),

@@ -16,6 +16,7 @@ from pygoby.moos.translator import (
     post_for_moos,
     serialize_protobuf,
 )
+from pygoby.util.clock import VirtualClock
 
 from .test_algorithms import LOOKUP
 
@@ -195,8 +196,42 @@ def test_bad_input_creates_nothing(Entry, loader):
     translator = Translator([e], loader.message_class)
     with pytest.raises(TranslatorError, match=f"{BNR} from B: cannot parse"):
         translator.create(BNR, {"A": "X=1", "B": "x: {"})
-    with pytest.raises(TranslatorError, match=f"{BNR} from A: input 'Y=1' does not match format"):
-        translator.create(BNR, {"A": "Y=1", "B": "x: 1"})
+
+
+def test_a_partly_matching_format_input_still_creates_the_message(Entry, loader):
+    # goby3 fills what the format could parse and creates the message (a vehicle whose DEPTH
+    # was never posted still sends its status); the mismatch is reported to the caller.
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{BNR}"
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "name=%1%" }}
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "DEPTH" format: "depth:=%6%" }}""",
+    )
+    mismatches = []
+    msg = Translator([e], loader.message_class).create(BNR, {"A": "name=unicorn"}, mismatches)
+    assert msg.Name == "unicorn"
+    assert math.isnan(msg.depth)
+    (mismatch,) = mismatches
+    assert str(mismatch) == (
+        f"{BNR} from DEPTH: input '' does not match format 'depth:=%6%': no 'd' (format "
+        "character 0) in the input after character 0"
+    )
+
+
+def test_strict_format_keeps_the_refusal(Entry, loader):
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{BNR}" strict_format: true
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "X=%202%" }}""",
+    )
+    translator = Translator([e], loader.message_class)
+    assert translator.create(BNR, {"A": "x=1"}).x == 1
+    with pytest.raises(
+        TranslatorError,
+        match=f"{BNR} from A: input 'Y=1' does not match format 'X=%202%': no 'x' .*"
+        r"\(strict_format: nothing created\)",
+    ):
+        translator.create(BNR, {"A": "Y=1"})
 
 
 def test_publish_without_entry_is_an_error(Entry, loader, msgs):
@@ -311,11 +346,34 @@ def test_runner_time_trigger_schedule(Entry, loader):
     assert len(runner.tick(112.0)) == 1
 
 
-def test_runner_bad_input_logged_and_skipped(Entry, loader, caplog):
-    runner = TranslatorRunner(trigger_translator(Entry, loader), start_time=0.0)
+def test_runner_warns_about_a_partial_match_once_a_minute_per_rule(Entry, loader, caplog):
+    clock = VirtualClock(1000.0)
+    runner = TranslatorRunner(trigger_translator(Entry, loader), start_time=0.0, clock=clock)
     with caplog.at_level(logging.WARNING):
-        assert runner.on_mail("CMD", "report") == []  # no space after 'report': no match
-    assert "not creating pygoby.test.translator.BasicNodeReport" in caplog.text
+        (created,) = runner.on_mail("CMD", "report")  # no space after 'report'
+        assert created.Name == ""  # "report" was consumed by the literals that matched
+        clock.advance(59)
+        assert len(runner.on_mail("CMD", "report")) == 1
+        clock.advance(1)
+        assert len(runner.on_mail("CMD", "report")) == 1
+    warnings = [r.getMessage() for r in caplog.records]
+    assert len(warnings) == 2
+    assert warnings[0].startswith(
+        f"{BNR} from CMD: input 'report' does not match format 'report %1%': no ' ' (format "
+        "character 6) in the input after character 6; created from the part that matched"
+    )
+
+
+def test_runner_bad_input_logged_and_skipped(Entry, loader, caplog):
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{BNR}" trigger {{ moos_var: "B" }}
+        create {{ technique: TECHNIQUE_PROTOBUF_TEXT_FORMAT moos_var: "B" }}""",
+    )
+    runner = TranslatorRunner(Translator([e], loader.message_class), start_time=0.0)
+    with caplog.at_level(logging.WARNING):
+        assert runner.on_mail("B", "x: {") == []
+    assert f"not creating {BNR}: {BNR} from B: cannot parse" in caplog.text
 
 
 def test_runner_updates_datum_from_origin_mail(Entry, loader):

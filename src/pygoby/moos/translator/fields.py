@@ -118,6 +118,9 @@ def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
     if cpp == FieldDescriptor.CPPTYPE_DOUBLE:
         return as_double(text)
     wanted = field.name.upper() + "_" + text if use_short_enum else text
+    if not wanted.isascii():
+        # Enum value names are identifiers; protobuf's lookup fails on undecodable bytes.
+        raise UnconvertibleError(f"{text!r} is not a value of enum {field.enum_type.full_name}")
     for candidate in (wanted, wanted.upper(), wanted.lower()):
         value = field.enum_type.values_by_name.get(candidate)
         if value is not None:

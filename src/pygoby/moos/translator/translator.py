@@ -30,6 +30,7 @@ from pygoby.moos.translator.techniques import (
     serialize_for_moos,
     serialize_protobuf,
 )
+from pygoby.util.clock import Clock, WallClock
 from pygoby.util.modem_id import ModemIdLookup
 
 log = logging.getLogger("pygoby.moos.translator")
@@ -38,6 +39,8 @@ TRIGGER_PUBLISH = 1
 TRIGGER_TIME = 2
 LAT_ORIGIN_VAR = "LAT_ORIGIN"
 LONG_ORIGIN_VAR = "LONG_ORIGIN"
+# Seconds between two warnings about the same create rule's partly matching input.
+MISMATCH_WARNING_INTERVAL = 60.0
 
 # Outputs that may be posted as MOOS doubles when they look like numbers. goby3 converts
 # every non-binary output (Quirk Q5); hex and @PB outputs are kept as strings here.
@@ -48,6 +51,23 @@ _NUMBER_CANDIDATES = frozenset(
         Technique.TECHNIQUE_FORMAT,
     }
 )
+
+
+@dataclass(frozen=True)
+class CreateMismatch:
+    """A TECHNIQUE_FORMAT create whose input matched only part of its format."""
+
+    protobuf_name: str
+    var: str
+    format: str
+    value: MoosValue
+    where: format_technique.FormatMismatch
+
+    def __str__(self) -> str:
+        return (
+            f"{self.protobuf_name} from {self.var}: input {as_text(self.value)[:80]!r} does not "
+            f"match format {self.format!r}: {self.where}"
+        )
 
 
 @dataclass(frozen=True)
@@ -226,10 +246,18 @@ class Translator:
 
     # --- MOOS -> protobuf --------------------------------------------------------------------
 
-    def create(self, protobuf_name: str, variables: Mapping[str, MoosValue]) -> Message:
+    def create(
+        self,
+        protobuf_name: str,
+        variables: Mapping[str, MoosValue],
+        mismatches: list[CreateMismatch] | None = None,
+    ) -> Message:
         """Build a message from the newest variable values with the entry's create rules.
 
-        Raises TranslatorError if any rule fails: no partially built message comes out."""
+        A TECHNIQUE_FORMAT input that matches only part of its format still fills the fields
+        (as goby3 does) and is reported in `mismatches`; with the entry's `strict_format` it
+        is a TranslatorError instead. Raises TranslatorError if any rule fails: no partially
+        built message comes out."""
         entry = self._entry(protobuf_name)
         msg = self._classes[protobuf_name]()
         named = self._named_values.get(protobuf_name, {})
@@ -241,14 +269,21 @@ class Translator:
                 value = keyvalue.val_from_string(source, key)
                 source = source if value is None else value
             try:
-                self._apply_create(msg, create, technique, source, entry.use_short_enum)
+                mismatch = self._apply_create(msg, create, technique, source, entry.use_short_enum)
             except TranslatorError as exc:
                 raise type(exc)(f"{protobuf_name} from {create.moos_var}: {exc}") from None
+            if mismatch is None:
+                continue
+            found = CreateMismatch(protobuf_name, create.moos_var, create.format, source, mismatch)
+            if entry.strict_format:
+                raise TranslatorError(f"{found} (strict_format: nothing created)")
+            if mismatches is not None:
+                mismatches.append(found)
         return msg
 
     def _apply_create(
         self, msg, create, technique: Technique, source: MoosValue, short: bool
-    ) -> None:
+    ) -> format_technique.FormatMismatch | None:
         if technique in PROTOBUF_TECHNIQUES:
             parse_protobuf(source, msg, technique)
         elif technique == Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
@@ -256,7 +291,7 @@ class Translator:
                 as_text(source), msg, create.algorithm, short, self.registry, create.moos_var
             )
         else:
-            format_technique.parse(
+            return format_technique.parse(
                 as_text(source),
                 msg,
                 create.format,
@@ -265,6 +300,7 @@ class Translator:
                 short,
                 self.registry,
             )
+        return None
 
     # --- protobuf -> MOOS --------------------------------------------------------------------
 
@@ -361,8 +397,12 @@ class TranslatorRunner:
         start_time: float,
         multiplex_vars: Iterable[str] = (),
         variables: Mapping[str, MoosValue] | None = None,
+        clock: Clock | None = None,
     ) -> None:
         self.translator = translator
+        self.clock = clock or WallClock()
+        # (entry, create variable) -> when its partial-match warning was last logged
+        self._mismatch_warned: dict[tuple[str, str], float] = {}
         # The newest value per variable: our own table, or the application's (e.g. a view of
         # GobyMOOSApp.dynamic_vars, which also holds mail from before the start).
         self._owns_variables = variables is None
@@ -424,8 +464,21 @@ class TranslatorRunner:
 
     def create(self, name: str) -> Message | None:
         """`name` made now from the newest values; None, with a warning, when a rule fails."""
+        mismatches: list[CreateMismatch] = []
         try:
-            return self.translator.create(name, self.variables)
+            msg = self.translator.create(name, self.variables, mismatches)
         except TranslatorError as exc:
             log.warning("not creating %s: %s", name, exc)
             return None
+        now = self.clock.now()
+        for mismatch in mismatches:
+            key = (mismatch.protobuf_name, mismatch.var)
+            last = self._mismatch_warned.get(key)
+            if last is None or not 0 <= now - last < MISMATCH_WARNING_INTERVAL:
+                self._mismatch_warned[key] = now
+                log.warning(
+                    "%s; created from the part that matched, as goby3 does (this warning at "
+                    "most once a minute; strict_format: true creates nothing instead)",
+                    mismatch,
+                )
+        return msg
