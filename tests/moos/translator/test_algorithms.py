@@ -87,6 +87,11 @@ def test_value_rule(value, text):
         ("modem_id2name", "7", [], "7"),
         ("modem_id2name", "unicorn", [], "unicorn"),
         ("modem_id2name", "", [], ""),
+        ("modem_id2name", "0003", [], "unicorn"),
+        # beyond an unsigned int (goby3 throws) and beyond Python's int() digit limit: unchanged
+        ("modem_id2name", "4294967296", [], "4294967296"),
+        ("modem_id2name", "9" * 5000, [], "9" * 5000),
+        ("modem_id2type", "9" * 5000, [], "9" * 5000),
         ("modem_id2type", "4", [], "auv"),
         ("modem_id2type", "9", [], "unknown_type"),
         ("modem_id2type", "x", [], "x"),

@@ -241,3 +241,18 @@ def test_boost_format_subset():
     )
     assert boost_format(parse_format("%s,%d"), ["x", IntArg(-3, 32)]) == "x,-3"
     assert boost_format(parse_format("%1$5.1s|"), ["hello"]) == "    h|"
+
+
+def test_an_integer_beyond_pythons_digit_limit_is_one_warning_and_the_maximum(msgs, caplog):
+    # goby3's as<int32> of an out-of-range integer gives INT32_MAX; Python's int() refuses
+    # strings of more than 4300 digits, which must not escape as a traceback.
+    out = msgs.BasicNodeReport()
+    with caplog.at_level(logging.WARNING):
+        assert fmt.parse("9" * 5000 + ";-" + "9" * 5000, out, "%10.0%;%10.1%") is None
+    assert out.repeat[:] == [2**31 - 1, 2**31 - 1]
+    assert [r.getMessage() for r in caplog.records] == [
+        "field repeat: a 5000-digit integer is out of range; set to the int32 maximum as goby3 "
+        "does",
+        "field repeat: a 5001-digit integer is out of range; set to the int32 maximum as goby3 "
+        "does",
+    ]

@@ -11,7 +11,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from pygoby.moos.translator.conversions import lexical_double
+from pygoby.moos.translator.conversions import lexical_double, significant_digits
 from pygoby.moos.translator.errors import TranslatorConfigError
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup
@@ -205,12 +205,22 @@ class AlgorithmRegistry:
         lat = self.geodesy.to_geo(x, numeric(value))[0]
         return render_double(_round_decimals(lat, 12))
 
+    @staticmethod
+    def _modem_id(value: str) -> int | None:
+        """The id a modem_id2* algorithm looks up; None leaves the value unchanged (goby3
+        throws on an empty value or one beyond an unsigned int: Quirk Q11)."""
+        if not (value.isascii() and value.isdigit()) or significant_digits(value) > 10:
+            return None
+        modem_id = int(value)
+        return modem_id if modem_id < 2**32 else None
+
     def _modem_id2name(self, value: str, _refs: Sequence[str]) -> str:
-        # Empty input is left unchanged (goby3 throws: Quirk Q11).
-        return self.modem_ids.name(int(value)) if value.isdigit() and value.isascii() else value
+        modem_id = self._modem_id(value)
+        return value if modem_id is None else self.modem_ids.name(modem_id)
 
     def _modem_id2type(self, value: str, _refs: Sequence[str]) -> str:
-        return self.modem_ids.type(int(value)) if value.isdigit() and value.isascii() else value
+        modem_id = self._modem_id(value)
+        return value if modem_id is None else self.modem_ids.type(modem_id)
 
 
 def run_publish_algorithms(msg, algorithms, registry: AlgorithmRegistry) -> dict[int, str]:
