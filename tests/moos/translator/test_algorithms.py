@@ -119,14 +119,21 @@ def test_utm_origin_zero_and_datum_change():
     assert registry.run("utm_y2lat", "0", ["0"]) == "42.35"
 
 
-def test_unknown_algorithm_is_a_config_error(registry):
-    with pytest.raises(TranslatorConfigError, match="unknown algorithm 'alg_TSD_to_soundspeed'"):
-        registry.get("alg_TSD_to_soundspeed")
+def test_an_unknown_algorithm_passes_the_value_through(registry):
+    # goby3's algorithm performer does nothing for a name it does not know.
+    assert registry.find("alg_TSD_to_soundspeed") is None
+    assert registry.run("alg_TSD_to_soundspeed", "10.5", ["35", "3"]) == "10.5"
+    assert registry.unknown_reason("alg_TSD_to_soundspeed") == (
+        "unknown algorithm 'alg_TSD_to_soundspeed'"
+    )
 
 
 def test_modem_id_algorithms_need_lookup_table():
-    with pytest.raises(TranslatorConfigError, match="needs modem_id_lookup_path"):
-        AlgorithmRegistry().get("modem_id2name")
+    registry = AlgorithmRegistry()
+    assert registry.run("modem_id2name", "3") == "3"
+    assert registry.unknown_reason("modem_id2name") == (
+        "unknown algorithm 'modem_id2name' (needs modem_id_lookup_path)"
+    )
 
 
 def test_missing_references_is_a_config_error(registry):

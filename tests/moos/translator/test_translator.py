@@ -246,16 +246,6 @@ def test_publish_without_entry_is_an_error(Entry, loader, msgs):
         ('protobuf_name: "no.Such"', "is not a loaded message type"),
         (
             f'protobuf_name: "{BNR}" create {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%1%" '
-            'algorithm { name: "frobnicate" primary_field: 1 } }',
-            "unknown algorithm 'frobnicate'",
-        ),
-        (
-            f'protobuf_name: "{BNR}" publish {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%1%" '
-            'algorithm { name: "nope" output_virtual_field: 50 primary_field: 1 } }',
-            "unknown algorithm 'nope'",
-        ),
-        (
-            f'protobuf_name: "{BNR}" create {{ technique: TECHNIQUE_FORMAT moos_var: "A" format: "%1%" '
             'algorithm { name: "add" primary_field: 1 } }',
             "cannot be used in a create rule",
         ),

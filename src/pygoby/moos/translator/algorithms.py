@@ -128,17 +128,20 @@ class AlgorithmRegistry:
     def names(self) -> list[str]:
         return sorted(self._algorithms)
 
-    def get(self, name: str) -> Algorithm:
-        try:
-            return self._algorithms[name]
-        except KeyError:
-            hint = ""
-            if name in ("modem_id2name", "modem_id2type", "name2modem_id"):
-                hint = " (needs modem_id_lookup_path)"
-            raise TranslatorConfigError(f"unknown algorithm {name!r}{hint}") from None
+    def find(self, name: str) -> Algorithm | None:
+        return self._algorithms.get(name)
+
+    def unknown_reason(self, name: str) -> str:
+        """Why `name` is not an algorithm of this registry."""
+        hint = ""
+        if name in ("modem_id2name", "modem_id2type", "name2modem_id"):
+            hint = " (needs modem_id_lookup_path)"
+        return f"unknown algorithm {name!r}{hint}"
 
     def run(self, name: str, value: str, references: Sequence[str] = ()) -> str:
-        return self.get(name).run(value, references)
+        algorithm = self._algorithms.get(name)
+        # goby3 ignores an algorithm it does not know: the value passes through unchanged.
+        return value if algorithm is None else algorithm.run(value, references)
 
     def _add(self, name: str, run: Callable[[str, Sequence[str]], str], refs: bool = False) -> None:
         self._algorithms[name] = Algorithm(name, refs, run)

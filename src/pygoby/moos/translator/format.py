@@ -244,21 +244,30 @@ def parsed_fields(descriptor: Descriptor, fmt: str) -> set[int]:
 
 def check_serialize_format(
     descriptor: Descriptor, fmt: str, virtual_fields: Collection[int] = ()
-) -> None:
-    """Reject publish formats that cannot render (bad sub-message paths, bad directives) or
-    that name a field the message does not have (upstream renders such a directive as empty
-    or "unknown": a typo would be published silently). `virtual_fields`: the publish
-    algorithms' output_virtual_field numbers."""
+) -> list[str]:
+    """Reject publish formats that cannot render (bad sub-message paths, where goby3 throws
+    at every publication; bad directives). Return what renders, as in goby3, but is likely a
+    mistake: a directive naming a field the message does not have (rendered "unknown", or
+    nothing past the highest field number) and an element index on a field that is not
+    repeated (the whole field is rendered). `virtual_fields`: the publish algorithms'
+    output_virtual_field numbers."""
     probe = message_factory.GetMessageClass(descriptor)()
     for match in _SUBMESSAGE_DIRECTIVE.finditer(fmt):
         spec = match.group(0).strip("%")
         _walk_path(probe, spec.split(":")[:-1], spec, create=False)
+    notes = []
     for match in _INDEXED_DIRECTIVE.finditer(_SUBMESSAGE_DIRECTIVE.sub("%%", fmt)):
         number = int(match.group(0).strip("%").split(".")[0])
         field = descriptor.fields_by_number.get(number)
-        if field is None or not field.is_repeated:
-            raise TranslatorConfigError(
-                f"format {fmt!r}: {match.group(0)} names no repeated field of {descriptor.full_name}"
+        if field is None:
+            notes.append(
+                f"{match.group(0)} names no field of {descriptor.full_name}: it prints "
+                "'unknown', as in goby3"
+            )
+        elif not field.is_repeated:
+            notes.append(
+                f"{match.group(0)}: field {number} ({field.name}) is not repeated: the whole "
+                "field prints, as in goby3"
             )
     plain = _SUBMESSAGE_DIRECTIVE.sub("%%", _INDEXED_DIRECTIVE.sub("%%", fmt))
     for item in boostformat.parse_format(plain):
@@ -268,10 +277,11 @@ def check_serialize_format(
             and number not in descriptor.fields_by_number
             and (number not in virtual_fields)
         ):
-            raise TranslatorConfigError(
-                f"format {fmt!r}: %{number}% names no field of {descriptor.full_name} "
-                "(nor an algorithm's output_virtual_field)"
+            notes.append(
+                f"%{number}% names no field of {descriptor.full_name} (nor an algorithm's "
+                "output_virtual_field): it prints 'unknown' or nothing, as in goby3"
             )
+    return notes
 
 
 @dataclass(frozen=True)

@@ -54,6 +54,15 @@ _NUMBER_CANDIDATES = frozenset(
 
 
 @dataclass(frozen=True)
+class EntryNote:
+    """Something in a translator entry that behaves as in goby3 but looks like a mistake.
+    `field`: its path in the entry, e.g. "publish[0].format"."""
+
+    field: str
+    message: str
+
+
+@dataclass(frozen=True)
 class CreateMismatch:
     """A TECHNIQUE_FORMAT create whose input matched only part of its format."""
 
@@ -138,7 +147,10 @@ class Translator:
 
     # --- configuration -------------------------------------------------------------------
 
-    def add_entry(self, entry: Message) -> None:
+    def add_entry(self, entry: Message) -> list[EntryNote]:
+        """Add one entry; returns what in it behaves as in goby3 but looks like a mistake (to
+        log once at start-up); raises TranslatorConfigError where goby3 would crash or
+        corrupt data."""
         name = entry.protobuf_name
         if name in self._entries:
             raise TranslatorConfigError(f"Duplicate translator entry for {name}")
@@ -148,23 +160,38 @@ class Translator:
             raise TranslatorConfigError(
                 f"translator_entry protobuf_name {name!r} is not a loaded message type: {exc}"
             ) from None
-        self._check_entry(entry, cls)
+        notes = self._check_entry(entry, cls)
         self._entries[name] = entry
         self._classes[name] = cls
+        return notes
 
-    def _check_entry(self, entry: Message, cls: type[Message]) -> None:
+    def _check_algorithms(self, name: str, algorithms, where: str) -> list[EntryNote]:
+        return [
+            EntryNote(
+                f"{where}.algorithm[{index}].name",
+                f"{name}: {self.registry.unknown_reason(algorithm.name)}: the value passes through "
+                "unchanged, as in goby3",
+            )
+            for index, algorithm in enumerate(algorithms)
+            if self.registry.find(algorithm.name) is None
+        ]
+
+    def _check_entry(self, entry: Message, cls: type[Message]) -> list[EntryNote]:
         name = entry.protobuf_name
         descriptor = cls.DESCRIPTOR
+        notes: list[EntryNote] = []
         if entry.HasField("trigger"):
             trigger = entry.trigger
             if trigger.type == TRIGGER_PUBLISH and not trigger.moos_var:
                 raise TranslatorConfigError(f"{name}: TRIGGER_PUBLISH needs trigger.moos_var")
             if trigger.type == TRIGGER_TIME and trigger.period == 0:
                 raise TranslatorConfigError(f"{name}: TRIGGER_TIME needs a period > 0")
-        for create in entry.create:
+        for index, create in enumerate(entry.create):
             technique = Technique(create.technique)
+            notes += self._check_algorithms(name, create.algorithm, f"create[{index}]")
             for algorithm in create.algorithm:
-                if self.registry.get(algorithm.name).needs_references:
+                known = self.registry.find(algorithm.name)
+                if known is not None and known.needs_references:
                     raise TranslatorConfigError(
                         f"{name}: algorithm {algorithm.name!r} needs reference fields and cannot "
                         "be used in a create rule"
@@ -175,10 +202,10 @@ class Translator:
                         f"{name}: create from {create.moos_var} needs a format"
                     )
                 format_technique.check_parse_format(descriptor, create.format)
-        for publish in entry.publish:
+        for index, publish in enumerate(entry.publish):
             technique = Technique(publish.technique)
+            notes += self._check_algorithms(name, publish.algorithm, f"publish[{index}]")
             for algorithm in publish.algorithm:
-                self.registry.get(algorithm.name)
                 for number in algorithm.reference_field:
                     field = descriptor.fields_by_number.get(number)
                     if field is None or field.is_repeated:
@@ -192,8 +219,14 @@ class Translator:
                         f"{name}: publish to {publish.moos_var} needs a format"
                     )
                 virtual = {algorithm.output_virtual_field for algorithm in publish.algorithm}
-                format_technique.check_serialize_format(descriptor, publish.format, virtual)
-                format_technique.check_serialize_format(descriptor, publish.moos_var, virtual)
+                for field_name in ("format", "moos_var"):
+                    notes += [
+                        EntryNote(f"publish[{index}].{field_name}", f"{name}: {note}")
+                        for note in format_technique.check_serialize_format(
+                            descriptor, getattr(publish, field_name), virtual
+                        )
+                    ]
+        return notes
 
     def read_named_values(self, protobuf_name: str, keys: Mapping[str, str]) -> None:
         """Goby 1.1's rule for the message's create variables in `keys` ({variable: name},
