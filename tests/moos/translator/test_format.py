@@ -5,6 +5,7 @@ import pytest
 
 from pygoby.moos.translator import TranslatorConfigError
 from pygoby.moos.translator import format as fmt
+from pygoby.moos.translator.algorithms import AlgorithmRegistry
 from pygoby.moos.translator.boostformat import FloatArg, IntArg, boost_format, parse_format
 
 REPEAT = [1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6, -6]
@@ -256,3 +257,58 @@ def test_an_integer_beyond_pythons_digit_limit_is_one_warning_and_the_maximum(ms
         "field repeat: a 5001-digit integer is out of range; set to the int32 maximum as goby3 "
         "does",
     ]
+
+
+@pytest.mark.parametrize(
+    ("directive", "printed"),
+    [
+        # An algorithm's output is a string to Boost.Format: the conversion character and a
+        # precision do not change it (goby3 prints %101$.6lf of utm_x2lon in full) ...
+        ("%101%", "-70.94887000425"),
+        ("%101$.6lf", "-70.94887000425"),
+        ("%101$lf", "-70.94887000425"),
+        ("%101$.3f", "-70.94887000425"),
+        ("%101$e", "-70.94887000425"),
+        ("%101$.2E", "-70.94887000425"),
+        ("%101$g", "-70.94887000425"),
+        ("%101$d", "-70.94887000425"),
+        ("%101$x", "-70.94887000425"),
+        ("%101$s", "-70.94887000425"),
+        ("%|101$|", "-70.94887000425"),
+        ("%|101$.3f|", "-70.94887000425"),
+        ("%101$+f", "-70.94887000425"),
+        ("%100$+f", "42.352720906492"),  # showpos does nothing to a string
+        # ... except `s` with a precision (at most that many characters) and `c` (one)
+        ("%101$.3s", "-70"),
+        ("%|101$.2s|", "-7"),
+        ("%101$.0s", ""),
+        ("%101$c", "-"),
+        ("%100$C", "4"),
+        # width and the padding flags apply
+        ("%101$20f", "     -70.94887000425"),
+        ("%101$-20s|", "-70.94887000425     |"),
+        ("%101$020f", "00000-70.94887000425"),
+        ("%101$-020f|", "-70.94887000425     |"),
+        ("%100$ f", " 42.352720906492"),
+        ("%101$ f", "-70.94887000425"),
+        ("%100$+ f", "42.352720906492"),
+        ("%101$10f", "-70.94887000425"),  # already wider than 10
+        # a number field printed with s/c is cut the same way
+        ("%202$.2s", "10"),
+        ("%202$c", "1"),
+        ("%202$5.2s", "   10"),
+    ],
+)
+def test_printf_directives_on_algorithm_outputs_print_as_goby3(msgs, Entry, directive, printed):
+    algorithm = Entry.PublishSerializer.Algorithm
+    algorithms = [
+        algorithm(
+            name="utm_x2lon", output_virtual_field=101, primary_field=202, reference_field=[3]
+        ),
+        algorithm(
+            name="utm_y2lat", output_virtual_field=100, primary_field=3, reference_field=[202]
+        ),
+    ]
+    report = msgs.BasicNodeReport(x=100, y=300)
+    registry = AlgorithmRegistry(42.35, -70.95)
+    assert fmt.serialize(report, directive, algorithms=algorithms, registry=registry) == printed
