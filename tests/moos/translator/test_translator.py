@@ -141,9 +141,15 @@ def test_posts_sorted_by_variable_then_declaration(Entry, loader, msgs):
 
 
 def test_hex_of_digits_stays_a_string(Entry, loader, msgs):
+    # goby3 posts any output that reads as a number as a MOOS double, hex included: "0802"
+    # would arrive as 802 and no longer decode (the leading zero is gone). Hex stays a string.
     translator = one_in_one_out(Entry, loader, Technique.TECHNIQUE_PROTOBUF_NATIVE_HEX, BNR)
     (post,) = translator.publish(msgs.BasicNodeReport(repeat=[8]))
     assert post == Post("TEST_MSG_1", "5008", f"{BNR}:TECHNIQUE_PROTOBUF_NATIVE_HEX")
+    deploy = "pygoby.test.translator.Deploy"
+    translator = one_in_one_out(Entry, loader, Technique.TECHNIQUE_PROTOBUF_NATIVE_HEX, deploy)
+    (post,) = translator.publish(msgs.Deploy(deploy_mode=2))
+    assert post == Post("TEST_MSG_1", "0802", f"{deploy}:TECHNIQUE_PROTOBUF_NATIVE_HEX")
 
 
 def test_numeric_text_format_output_is_never_a_double(Entry, loader, msgs):
