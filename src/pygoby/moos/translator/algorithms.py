@@ -66,7 +66,8 @@ def _db_to_power(x: float) -> float:
 
 
 def _nmea_angle(x: float, degree_digits: int) -> str:
-    # floor-based split, reproduced as is: negative input gives odd strings (Quirk Q23).
+    # goby3's floor-based split into degrees and minutes, reproduced as is: negative input gives
+    # odd strings (apply abs first; QUIRKS.md Q-APPS-23).
     if not math.isfinite(x):
         return "nan"
     degrees = math.floor(x)
@@ -140,7 +141,8 @@ class AlgorithmRegistry:
 
     def run(self, name: str, value: str, references: Sequence[str] = ()) -> str:
         algorithm = self._algorithms.get(name)
-        # goby3 ignores an algorithm it does not know: the value passes through unchanged.
+        # goby3 ignores an algorithm it does not know: the value passes through unchanged
+        # (QUIRKS.md Q-APPS-26).
         return value if algorithm is None else algorithm.run(value, references)
 
     def _add(self, name: str, run: Callable[[str, Sequence[str]], str], refs: bool = False) -> None:
@@ -211,7 +213,7 @@ class AlgorithmRegistry:
     @staticmethod
     def _modem_id(value: str) -> int | None:
         """The id a modem_id2* algorithm looks up; None leaves the value unchanged (goby3
-        throws on an empty value or one beyond an unsigned int: Quirk Q11)."""
+        throws on an empty value or one beyond an unsigned int: QUIRKS.md Q-APPS-11)."""
         if not (value.isascii() and value.isdigit()) or significant_digits(value) > 10:
             return None
         modem_id = int(value)

@@ -77,7 +77,7 @@ def as_int(text: str, kind: str) -> int:
     if not is_integer_literal(text):
         return high
     if significant_digits(text) > MAX_INT_DIGITS:
-        return high  # out of every integer type's range (and of Python's int() limit)
+        return high  # out of every type's range and of Python's int() limit: Q-APPS-30
     value = int(text)
     if kind.startswith("u"):
         if value < 0:

@@ -122,7 +122,8 @@ def serialize(
     registry: AlgorithmRegistry | None = None,
 ) -> str:
     descriptor = msg.DESCRIPTOR
-    # Every field counts (goby3 skips the first-declared one: Quirk Q9, fixed here).
+    # Every field counts (goby3 skips the first-declared one, so a directive for it renders
+    # empty when its number is the largest; fixed: QUIRKS.md Q-APPS-9).
     max_field = max([1, *(f.number for f in descriptor.fields)])
     virtual = (
         run_publish_algorithms(msg, algorithms, registry or AlgorithmRegistry())
@@ -172,8 +173,9 @@ def serialize(
 def _scan(fmt: str):
     """Yield ('literal', position, char) and ('directive', position, spec, separator) for a
     parse format. The separator is the format character after the directive's closing '%'
-    (itself scanned next, as a literal or the next directive's '%'), or NUL when the
-    directive ends the format: goby3 reads the string's terminator there."""
+    (itself scanned next, as a literal or the next directive's '%': adjacent directives read
+    the same text, QUIRKS.md Q-APPS-28), or NUL when the directive ends the format: goby3
+    reads the string's terminator there."""
     i = 0
     while i < len(fmt):
         if fmt[i] != "%":
@@ -182,11 +184,12 @@ def _scan(fmt: str):
             continue
         close = fmt.find("%", i + 1)
         if close < 0:
-            # goby3 reads past the end of the format looking for the '%'.
+            # goby3 reads past the end of the format looking for the '%' (Q-APPS-29).
             raise TranslatorConfigError(f"format {fmt!r}: unterminated directive")
         spec = fmt[i + 1 : close]
         if not spec:
-            # goby3 throws "Bad specifier" at every creation, uncaught: pTranslator ends.
+            # goby3 throws "Bad specifier" at every creation, uncaught: pTranslator ends
+            # (QUIRKS.md Q-APPS-29).
             raise TranslatorConfigError(
                 f"format {fmt!r}: empty directive '%%' at position {i} (a literal '%' cannot "
                 "be parsed)"
@@ -249,8 +252,8 @@ def check_serialize_format(
     at every publication; bad directives). Return what renders, as in goby3, but is likely a
     mistake: a directive naming a field the message does not have (rendered "unknown", or
     nothing past the highest field number) and an element index on a field that is not
-    repeated (the whole field is rendered). `virtual_fields`: the publish algorithms'
-    output_virtual_field numbers."""
+    repeated (the whole field is rendered): QUIRKS.md Q-APPS-27. `virtual_fields`: the publish
+    algorithms' output_virtual_field numbers."""
     probe = message_factory.GetMessageClass(descriptor)()
     for match in _SUBMESSAGE_DIRECTIVE.finditer(fmt):
         spec = match.group(0).strip("%")
@@ -313,7 +316,8 @@ def parse(
     character skips the input to just past its next occurrence (case-insensitive); a literal
     that does not occur skips nothing and the scan goes on, so every directive is still
     parsed (from whatever input remains; an empty value gives NaN or the integer maximum).
-    Returns the first such literal, None when the whole format matched."""
+    Returns the first such literal, None when the whole format matched (QUIRKS.md
+    Q-APPS-25)."""
     remaining = text
     lower = text.lower()
     consumed = 0
@@ -351,7 +355,7 @@ def _parse_directive(extract, msg, spec, delimiter, algorithms, short, registry)
         set_element_from_string(msg, field, index, extract, short)
     elif field.is_repeated:
         parts = re.split("[" + re.escape(delimiter) + "]", extract) if delimiter else [extract]
-        for part in parts:
+        for part in parts:  # enums too (goby3 aborts on a repeated enum: QUIRKS.md Q-APPS-10)
             append_from_string(msg, field, part, short)
     elif is_message(field):
         parse_message_bytes(getattr(msg, field.name), hex_decode(extract), field.name)
