@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import shutil
 from pathlib import Path
+from typing import TextIO
 
 from pygoby.moos import protocol as p
 from pygoby.moos.alog.files import AlogSink
@@ -48,7 +49,7 @@ class pLogger(ClassicMOOSApp):  # noqa: N801 - the program's name
             self.log.warning("%s", warning)
         self.sink: AlogSink | None = None
         self.directory: Path | None = None
-        self._slog = None
+        self._slog: TextIO | None = None
         self._sync_vars = [r.var for r in self.settings.logs if r.sync]
         self._sync_set = set(self._sync_vars)
         self._fresh: dict[str, float] = {}

@@ -3,5 +3,14 @@
 
 from pygoby.moos.alog.files import AlogFile, AlogSink
 from pygoby.moos.alog.format import AlogEntry, AlogFormatter, AlogReader, banner
+from pygoby.moos.alog.tools import LogToolError
 
-__all__ = ["AlogEntry", "AlogFile", "AlogFormatter", "AlogReader", "AlogSink", "banner"]
+__all__ = [
+    "AlogEntry",
+    "AlogFile",
+    "AlogFormatter",
+    "AlogReader",
+    "AlogSink",
+    "LogToolError",
+    "banner",
+]

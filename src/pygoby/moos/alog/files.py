@@ -175,9 +175,12 @@ class AlogSink:
         path = self.directory / (name + ".gz" if self.compress else name)
         if self._alog is not None:
             self._alog.close()
-        self._alog = gzip.open(path, "wb") if self.compress else open(path, "wb")  # noqa: SIM115
+        stream: IO[bytes] = (
+            gzip.open(path, "wb") if self.compress else open(path, "wb")  # type: ignore[assignment]  # noqa: SIM115
+        )
         header = self._banner_of(str(self.directory / name)).encode()
-        self._alog.write(header)
+        stream.write(header)
+        self._alog = stream
         self._alog_bytes = len(header)
         self.files.append(path)
 

@@ -172,16 +172,20 @@ class AlogReader:
             return None
         match = _LINE.fullmatch(line)
         if match is None:
-            return self._bad(line)
+            self._bad(line)
+            return None
         stamp, name, source, raw = match.groups()
         if not _NUMBER.fullmatch(stamp):
-            return self._bad(line)
+            self._bad(line)
+            return None
         msg_time = float(stamp)
         if not math.isfinite(msg_time):
-            return self._bad(line)
+            self._bad(line)
+            return None
         value = self._value(raw or "")
         if value is None:
-            return self._bad(line)
+            self._bad(line)
+            return None
         src, aux, community = _split_source(source)
         return AlogEntry(msg_time, name, src, value[0], aux, community, value[1])
 
@@ -225,11 +229,10 @@ class AlogReader:
             self.binary_marked = True
 
     def _bad(self, line: str) -> None:
-        if line.strip():
+        if line.strip():  # blank lines are not damage
             self.bad_lines += 1
             if self.first_bad_line is None:
                 self.first_bad_line = self.lines
-        return None
 
 
 def _split_source(source: str) -> tuple[str, str, str]:

@@ -238,7 +238,7 @@ def _write_parquet(source: Iterator[tuple], path: Path, progress: Callable[[int]
             batch = [row for _, row in zip(range(PARQUET_BATCH), source, strict=False)]
             if not batch:
                 break
-            columns = list(zip(*batch, strict=True))
+            columns: list[Sequence[Any]] = list(zip(*batch, strict=True))
             # strings keep undecodable bytes as surrogates; Parquet wants valid UTF-8
             for index in (2, 3, 5):
                 columns[index] = [_utf8(text) for text in columns[index]]

@@ -1,0 +1,138 @@
+"""pLogger in a short mission on the embedded MOOSDB (MOOSTimeWarp 20): what it writes, then the
+log converted and replayed into another MOOSDB, compared with what was posted."""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+from pygoby.apps.plogger import pLogger
+from pygoby.cli import main as pygoby_main
+from pygoby.moos.alog import AlogFile
+from pygoby.moos.alog.tools import replay
+from pygoby.moos.client import MOOSClient
+from pygoby.moos.db import MOOSDB
+from pygoby.moos.timewarp import moos_clock
+
+WARP = 20.0
+
+MISSION = """\
+ServerHost = localhost
+ServerPort = {port}
+Community  = alpha
+MOOSTimeWarp = 20
+
+ProcessConfig = pLogger
+{{
+  AppTick   = 10
+  CommsTick = 10
+  File = Mission
+  PATH = {tmp}/logs/
+  FileTimeStamp = false
+  SyncLog = true @ 0.2
+  AsyncLog = true
+  WildCardLogging = true
+  WildCardOmitPattern = *_STATUS, DB_*
+  Log = NAV_X @ 0
+  LogAuxSrc = true
+  LoggingDirectorySummaryFile = {tmp}/.LastOpenedMOOSLogDirectory
+  Colour = blue
+}}
+"""
+
+# what the "vehicle" posts: (variable, value, aux)
+POSTS = [
+    ("NAV_X", 1.5, ""),
+    ("MSG", "hello  world, with spaces", "bhv_a"),
+    ("RAW", b"\x00\x01\xfe\xff\n", ""),
+    ("NAV_X", -2.25, ""),
+    ("MSG", "x=1,y=2", ""),
+    ("NAV_X", 3.0, ""),
+]
+
+
+async def wait_for(client: MOOSClient, key: str) -> None:
+    while (await client.receive(5)).key != key:
+        pass
+
+
+async def post_mission(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> Path:
+    clock = moos_clock(WARP)
+    async with MOOSDB(port=0, community="alpha", clock=clock) as db:
+        mission = tmp_path / "m.moos"
+        mission.write_text(MISSION.format(port=db.port, tmp=tmp_path))
+        app = pLogger.from_mission(mission)
+        async with MOOSClient("vehicle", port=db.port, clock=clock) as vehicle, app:
+            vehicle.subscribe("LOGGER_DIRECTORY")
+            await wait_for(vehicle, "LOGGER_DIRECTORY")  # pLogger is connected and registered
+            await asyncio.sleep(0.1)
+            for key, value, aux in POSTS:
+                vehicle.publish(key, value, src_aux=aux)
+                await vehicle.flush()
+                await asyncio.sleep(0.5 / WARP)  # half a second of MOOS time apart
+            vehicle.publish("VEHICLE_STATUS", "omitted")
+            await vehicle.flush()
+            await asyncio.sleep(0.3)
+    assert "unknown option 'Colour' ignored" in caplog.text
+    return tmp_path / "logs" / "Mission"
+
+
+async def test_plogger_writes_and_replay_reproduces(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    caplog.set_level(logging.WARNING)
+    directory = await post_mission(tmp_path, caplog)
+    assert sorted(p.name for p in directory.iterdir()) == [
+        "Mission._moos",
+        "Mission.alog",
+        "Mission.blog",
+        "Mission.slog",
+    ]
+    assert (tmp_path / ".LastOpenedMOOSLogDirectory").read_text() == (
+        f"LastOpenedLoggingDirectory={directory}\n"
+    )
+    assert "ProcessConfig = pLogger" in (directory / "Mission._moos").read_text()
+    slog = (directory / "Mission.slog").read_text()
+    assert "%%   (2) NAV_X" in slog and "1.5" in slog
+
+    log = AlogFile(directory / "Mission.alog")
+    entries = [e for e in log if e.source == "vehicle"]
+    assert log.reader.bad_lines == 0
+    assert [(e.name, e.value, e.source_aux) for e in entries] == POSTS
+    times = [e.time for e in entries]
+    assert times == sorted(times) and times[0] > 0
+    names = {e.name for e in AlogFile(directory / "Mission.alog")}
+    assert "VEHICLE_STATUS" not in names and "PLOGGER_STATUS" not in names
+    assert "LOGGER_DIRECTORY" in names
+
+    out = tmp_path / "m.parquet"
+    assert pygoby_main(["log", "convert", str(directory / "Mission.alog"), "-o", str(out)]) == 0
+    table = [r for r in pq.read_table(out).to_pylist() if r["source"].startswith("vehicle")]
+    assert [r["name"] for r in table] == [k for k, _, _ in POSTS]
+    assert table[2]["type"] == "binary" and table[2]["value"] == "0001feff0a"
+    assert table[0]["value_double"] == 1.5 and table[1]["source"] == "vehicle:bhv_a"
+
+    # replay into another DB: same values, order and source names
+    async with (
+        MOOSDB(port=0) as other,
+        MOOSClient("watcher", port=other.port) as watcher,
+    ):
+        for key in ("NAV_X", "MSG", "RAW"):
+            watcher.subscribe(key)
+        await watcher.flush()
+        count = await replay(
+            AlogFile(directory / "Mission.alog"),
+            "127.0.0.1",
+            other.port,
+            warp=20,
+            only=["NAV_X", "MSG", "RAW"],
+        )
+        assert count == len(POSTS)
+        got = [await watcher.receive(5) for _ in POSTS]
+    assert [(m.key, m.value, m.src, m.src_aux) for m in got] == [
+        (k, v, "vehicle", aux) for k, v, aux in POSTS
+    ]
