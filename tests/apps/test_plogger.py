@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import re
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -13,7 +14,6 @@ import pytest
 from pygoby.apps.plogger import pLogger
 from pygoby.cli import main as pygoby_main
 from pygoby.moos.alog import AlogFile
-from pygoby.moos.alog.tools import replay
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.timewarp import moos_clock
@@ -82,7 +82,7 @@ async def post_mission(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> Path
 
 
 async def test_plogger_writes_and_replay_reproduces(
-    tmp_path: Path, caplog: pytest.LogCaptureFixture
+    tmp_path: Path, caplog: pytest.LogCaptureFixture, capsys: pytest.CaptureFixture[str]
 ) -> None:
     caplog.set_level(logging.WARNING)
     directory = await post_mission(tmp_path, caplog)
@@ -111,6 +111,7 @@ async def test_plogger_writes_and_replay_reproduces(
 
     out = tmp_path / "m.parquet"
     assert pygoby_main(["log", "convert", str(directory / "Mission.alog"), "-o", str(out)]) == 0
+    capsys.readouterr()
     table = [r for r in pq.read_table(out).to_pylist() if r["source"].startswith("vehicle")]
     assert [r["name"] for r in table] == [k for k, _, _ in POSTS]
     assert table[2]["type"] == "binary" and table[2]["value"] == "0001feff0a"
@@ -124,15 +125,25 @@ async def test_plogger_writes_and_replay_reproduces(
         for key in ("NAV_X", "MSG", "RAW"):
             watcher.subscribe(key)
         await watcher.flush()
-        count = await replay(
-            AlogFile(directory / "Mission.alog"),
-            "127.0.0.1",
-            other.port,
-            warp=20,
-            only=["NAV_X", "MSG", "RAW"],
-        )
-        assert count == len(POSTS)
+        command = ["log", "replay", str(directory / "Mission.alog"), "--port", str(other.port)]
+        command += ["--warp", "20", "--only", "NAV_X", "MSG", "RAW"]
+        assert await asyncio.to_thread(pygoby_main, command) == 0
+        assert capsys.readouterr().out == f"{len(POSTS)} messages posted\n"
         got = [await watcher.receive(5) for _ in POSTS]
     assert [(m.key, m.value, m.src, m.src_aux) for m in got] == [
         (k, v, "vehicle", aux) for k, v, aux in POSTS
     ]
+
+
+@pytest.mark.parametrize("vehicle", ["topside", "unicorn"])
+def test_two_vehicles_missions_log_with_plogger(vehicle: str) -> None:
+    mission = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / f"{vehicle}.moos"
+    app = pLogger.from_mission(mission)
+    assert app.settings.warnings == []
+    assert (app.settings.file, app.settings.path, app.settings.wildcard_logging) == (
+        vehicle,
+        "./logs",
+        True,
+    )
+    stamp = rf"{vehicle}_\d{{1,2}}_\d{{1,2}}_\d{{4}}_____\d\d_\d\d_\d\d"  # D_M_YYYY_____HH_MM_SS
+    assert re.fullmatch(stamp, app.settings.directory_name())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import csv
 import gzip
 import json
@@ -121,6 +122,20 @@ def test_sink_rotates_and_compresses(tmp_path: Path) -> None:
     values = [e.value for f in sink.files for e in AlogFile(f)]
     assert values == [float(i) for i in range(100)]
     assert {AlogFile(f).log_start for f in sink.files} == {0.0}
+
+
+async def test_sink_flushes_without_being_closed(tmp_path: Path) -> None:
+    # a logger killed with -9 loses at most the lines of its last flush period
+    sink = AlogSink(tmp_path, "F", lambda name: banner(name, 0.0))
+    sink.put_line(AlogFormatter(0.0).line(1.0, "ALIVE", "me", 1.0))
+    try:
+        for _ in range(100):
+            if [e.name for e in AlogFile(tmp_path / "F.alog")] == ["ALIVE"]:
+                break
+            await asyncio.sleep(0.05)
+        assert [e.name for e in AlogFile(tmp_path / "F.alog")] == ["ALIVE"]
+    finally:
+        sink.close()
 
 
 def test_sink_drops_and_counts_when_its_buffer_is_full(tmp_path: Path) -> None:
