@@ -147,3 +147,48 @@ def test_two_vehicles_missions_log_with_plogger(vehicle: str) -> None:
     )
     stamp = rf"{vehicle}_\d{{1,2}}_\d{{1,2}}_\d{{4}}_____\d\d_\d\d_\d\d"  # D_M_YYYY_____HH_MM_SS
     assert re.fullmatch(stamp, app.settings.directory_name())
+
+
+async def test_an_unusable_path_falls_back_to_the_working_directory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    (tmp_path / "a_file").write_text("not a directory")
+    mission = tmp_path / "m.moos"
+    mission.write_text(
+        "ServerPort = 1\nProcessConfig = pLogger\n{\n  File = Day\n  FileTimeStamp = false\n"
+        f"  PATH = {tmp_path}/a_file/logs\n  Log = X @ 0\n"
+        f"  LoggingDirectorySummaryFile = {tmp_path}/summary\n}}\n"
+    )
+    monkeypatch.chdir(tmp_path)
+    app = pLogger.from_mission(mission)
+    await app.start()  # no MOOSDB needed: the files are made at start-up
+    try:
+        assert app.directory == Path("Day")
+    finally:
+        await app.stop()
+    assert "cannot make the log directory" in caplog.text
+    assert sorted(p.name for p in (tmp_path / "Day").iterdir()) == ["Day._moos", "Day.alog"]
+
+
+async def test_replay_skips_a_source_whose_name_is_taken(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    from pygoby.moos.alog import AlogFormatter, banner
+    from pygoby.moos.alog.tools import replay
+
+    path = tmp_path / "r.alog"
+    fmt = AlogFormatter(0.0)
+    path.write_text(
+        banner(str(path), 0.0)
+        + fmt.line(1.0, "A", "taken", 1.0)
+        + fmt.line(1.1, "B", "free", "b")
+        + fmt.line(1.2, "DB_TIME", "MOOSDB_#1", 5.0)
+    )
+    async with MOOSDB(port=0) as db, MOOSClient("taken", port=db.port) as taken:
+        await taken.connect()
+        taken.subscribe("B")
+        await taken.flush()
+        assert await replay(AlogFile(path), "127.0.0.1", db.port, warp=100) == 1
+        got = await taken.receive(5)
+    assert (got.key, got.value, got.src) == ("B", "b", "free")
+    assert "not replaying taken's messages" in caplog.text

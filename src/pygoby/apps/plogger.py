@@ -77,17 +77,21 @@ class pLogger(ClassicMOOSApp):  # noqa: N801 - the program's name
         s = self.settings
         self.formatter.log_start = self.start_time  # start() takes the time afresh
         root = s.directory_name()
-        self.directory = Path(s.path) / root
-        self.directory.mkdir(parents=True, exist_ok=True)
+        self.directory = self._make_directory(root)
+        if self.directory is None:
+            return
         try:
             Path(s.summary_file).write_text(f"LastOpenedLoggingDirectory={self.directory}\n")
         except OSError as err:
             self.log.warning("cannot write %s: %s", s.summary_file, err)
         if self.mission is not None and self.mission.path is not None:
             copy = self.directory / f"{root}._moos"
-            with open(copy, "w") as out, open(self.mission.path) as original:
-                out.write(banner(str(copy), self.start_time))
-                shutil.copyfileobj(original, out)
+            try:
+                with open(copy, "w") as out, open(self.mission.path) as original:
+                    out.write(banner(str(copy), self.start_time))
+                    shutil.copyfileobj(original, out)
+            except OSError as err:
+                self.log.warning("no copy of the mission file: %s", err)
         if s.async_log or s.wildcard_logging:
             self.sink = AlogSink(
                 self.directory,
@@ -107,6 +111,17 @@ class pLogger(ClassicMOOSApp):  # noqa: N801 - the program's name
             self._slog.write(slog_header(str(slog), self.start_time, self._sync_vars))
             self._slog.write(slog_labels(self._sync_vars, 0.0))
         self.log.info("logging to %s", self.directory)
+
+    def _make_directory(self, root: str) -> Path | None:
+        """PATH/root, else ./root as pLogger falls back; None (and the app fails) if neither."""
+        for directory in (Path(self.settings.path) / root, Path(root)):
+            try:
+                directory.mkdir(parents=True, exist_ok=True)
+                return directory
+            except OSError as err:
+                self.log.warning("cannot make the log directory %s: %s", directory, err)
+        self.fail(f"no log directory: neither {self.settings.path}/{root} nor ./{root}")
+        return None
 
     def on_connect(self) -> None:
         self.formatter.own_community = self.client.community

@@ -126,17 +126,21 @@ def replay_command(args: argparse.Namespace) -> int:
 
     log = AlogFile(args.file)
     progress = print_progress() if sys.stderr.isatty() else None
-    count = asyncio.run(
-        replay(
-            log,
-            args.host,
-            args.port,
-            warp=args.warp,
-            start=args.start,
-            only=args.only,
-            progress=progress,
+    try:
+        count = asyncio.run(
+            replay(
+                log,
+                args.host,
+                args.port,
+                warp=args.warp,
+                start=args.start,
+                only=args.only,
+                progress=progress,
+            )
         )
-    )
+    except TimeoutError as err:
+        print(f"log replay: {err}", file=sys.stderr)
+        return 1
     print(f"{count} messages posted")
     _report_bad_lines(log)
     return 0

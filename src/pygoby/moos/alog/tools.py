@@ -8,6 +8,7 @@ from __future__ import annotations
 import asyncio
 import csv
 import json
+import logging
 import math
 import os
 import sys
@@ -19,11 +20,14 @@ from typing import IO, Any
 
 from pygoby.moos.alog.files import AlogFile
 from pygoby.moos.alog.format import AlogEntry, AlogFormatter, banner
-from pygoby.moos.errors import MoosError
+from pygoby.moos.errors import MoosError, MoosRefusedError
+
+logger = logging.getLogger(__name__)
 
 CONVERT_FORMATS = (".parquet", ".csv", ".jsonl")
 CONVERT_COLUMNS = ("time", "utc_time", "name", "source", "type", "value", "value_double")
 PARQUET_BATCH = 65_536  # rows per Parquet row group written
+CONNECT_TIMEOUT = 5.0  # s for each source's client to reach the DB
 DB_SOURCE_PREFIX = "MOOSDB"  # MOOSDB_<community>: the DB's own posts
 
 
@@ -276,10 +280,12 @@ async def replay(
 ) -> int:
     """Post the entries (from log time `start`, only `only` variables when given) into the
     MOOSDB at host:port with their original spacing divided by `warp`, each under its
-    original source name (one client per source, as uPlayBack does); returns how many."""
+    original source name (one client per source, as uPlayBack does); returns how many. A source
+    the DB refuses (its name is taken) is skipped with a warning; no DB at all: TimeoutError."""
     from pygoby.moos.client import MOOSClient
 
     clients: dict[str, MOOSClient] = {}
+    refused: set[str] = set()
     loop = asyncio.get_running_loop()
     origin: tuple[float, float] | None = None  # (loop time, log time) of the first post
     count = 0
@@ -294,10 +300,19 @@ async def replay(
             delay = origin[0] + (entry.time - origin[1]) / warp - loop.time()
             if delay > 0:
                 await asyncio.sleep(delay)
+            if entry.source in refused:
+                continue
             client = clients.get(entry.source)
             if client is None:
                 client = clients[entry.source] = MOOSClient(entry.source, host, port)
-                await client.connect()
+                try:
+                    await client.connect(CONNECT_TIMEOUT)
+                except MoosRefusedError as err:
+                    # a process of that name is connected already (a live pLogger, ...)
+                    logger.warning("not replaying %s's messages: %s", entry.source, err)
+                    refused.add(entry.source)
+                    await clients.pop(entry.source).close()
+                    continue
             client.publish(entry.name, entry.value, src_aux=entry.source_aux)
             count += 1
             if progress is not None and count % 100 == 0:
