@@ -192,3 +192,44 @@ async def test_replay_skips_a_source_whose_name_is_taken(
         got = await taken.receive(5)
     assert (got.key, got.value, got.src) == ("B", "b", "free")
     assert "not replaying taken's messages" in caplog.text
+
+
+async def test_kill_9_loses_at_most_the_last_second(tmp_path: Path) -> None:
+    """pLogger as a user starts it (its own process): its lines reach the disk without it
+    closing the file (its writer flushes at least every half second), so kill -9 loses at
+    most what arrived in the last second."""
+    import os
+    import signal
+    import sys
+
+    async with MOOSDB(port=0) as db, MOOSClient("vehicle", port=db.port) as vehicle:
+        mission = tmp_path / "k.moos"
+        mission.write_text(
+            f"ServerPort = {db.port}\nProcessConfig = pLogger\n{{\n  AppTick = 10\n"
+            f"  CommsTick = 10\n  File = K\n  FileTimeStamp = false\n  PATH = {tmp_path}\n"
+            f"  Log = COUNT @ 0\n  LoggingDirectorySummaryFile = {tmp_path}/summary\n}}\n"
+        )
+        process = await asyncio.create_subprocess_exec(
+            sys.executable,
+            "-m",
+            "pygoby.apps.plogger",
+            str(mission),
+            stdout=asyncio.subprocess.DEVNULL,
+            stderr=asyncio.subprocess.DEVNULL,
+        )
+        try:
+            while "pLogger" not in db.client_names:
+                await asyncio.sleep(0.1)
+            await asyncio.sleep(0.5)  # its registration reaches the DB
+            for i in range(20):
+                vehicle.publish("COUNT", float(i))
+            await vehicle.flush()
+            alog = tmp_path / "K" / "K.alog"
+            for _ in range(100):  # until the writer has flushed them
+                await asyncio.sleep(0.1)
+                if alog.exists() and len(list(AlogFile(alog))) == 20:
+                    break
+        finally:
+            os.kill(process.pid, signal.SIGKILL)
+            await process.wait()
+    assert [e.value for e in AlogFile(alog)] == [float(i) for i in range(20)]
