@@ -233,3 +233,10 @@ async def test_kill_9_loses_at_most_the_last_second(tmp_path: Path) -> None:
             os.kill(process.pid, signal.SIGKILL)
             await process.wait()
     assert [e.value for e in AlogFile(alog)] == [float(i) for i in range(20)]
+
+
+def test_plogger_example_config(capsys: pytest.CaptureFixture[str]) -> None:
+    assert pLogger.main(["--example_config"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("ProcessConfig = pLogger\n{\n  AppTick = 4\n")
+    assert "  Log = NAV_X @ 0 " in out and out.endswith("}\n")

@@ -301,3 +301,15 @@ def test_convert(
 def test_convert_refuses_unknown_formats(alog: Path, tmp_path: Path) -> None:
     with pytest.raises(LogToolError, match=r"unknown output format '\.xlsx'"):
         convert([alog], tmp_path / "x.xlsx")
+
+
+def test_slog_layout() -> None:
+    from pygoby.moos.alog.format import slog_header, slog_labels, slog_row
+
+    # 18-column left-justified cells, each followed by a space; NaN for no fresh double
+    assert slog_row(1.25, [3.5, None]) == f"{'1.25':<18} {'3.5':<18} {'NaN':<18} \n"
+    assert slog_labels(["NAV_X"], 12.0) == (
+        f"{'%% TIME':<18} {'NAV_X':<18} \n{'%% TIME':<18} {'[  12.00]':<18} \n"
+    )
+    header = slog_header("f.slog", 0.0, ["NAV_X", "NAV_Y"]).splitlines()
+    assert header[-4:] == ["%%   (1) TIME ", "%%   (2) NAV_X", "%%   (3) NAV_Y", "%" * 56]
