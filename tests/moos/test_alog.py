@@ -313,3 +313,14 @@ def test_slog_layout() -> None:
     )
     header = slog_header("f.slog", 0.0, ["NAV_X", "NAV_Y"]).splitlines()
     assert header[-4:] == ["%%   (1) TIME ", "%%   (2) NAV_X", "%%   (3) NAV_Y", "%" * 56]
+
+
+def test_cli_errors_are_one_line(
+    alog: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert pygoby_main(["log", "summary", str(tmp_path / "none.alog")]) == 1
+    assert capsys.readouterr().err == f"pygoby log: no such file: {tmp_path / 'none.alog'}\n"
+    assert pygoby_main(["log", "convert", str(alog), "-o", str(tmp_path / "x.xlsx")]) == 1
+    assert "unknown output format '.xlsx'" in capsys.readouterr().err
+    assert pygoby_main(["log", "clip", str(alog), "0", "1", "-o", str(tmp_path / "no/x.alog")]) == 1
+    assert capsys.readouterr().err.startswith("pygoby log: [Errno 2] No such file or directory")

@@ -13,9 +13,35 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import functools
 import sys
+from collections.abc import Callable
+from pathlib import Path
 
 from pygoby.moos.alog.files import AlogFile
+from pygoby.moos.alog.tools import LogToolError
+
+Command = Callable[[argparse.Namespace], int]
+
+
+def reporting_errors(command: Command) -> Command:
+    """Missing inputs, unwritable outputs, no MOOSDB to replay into (TimeoutError is an
+    OSError) and refused requests: one line on stderr, status 1."""
+
+    @functools.wraps(command)
+    def run(args: argparse.Namespace) -> int:
+        inputs = getattr(args, "files", None) or [args.file]
+        missing = [name for name in inputs if not Path(name).is_file()]
+        if missing:
+            print(f"pygoby log: no such file: {', '.join(missing)}", file=sys.stderr)
+            return 1
+        try:
+            return command(args)
+        except (LogToolError, OSError) as err:
+            print(f"pygoby log: {err}", file=sys.stderr)
+            return 1
+
+    return run
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -73,6 +99,7 @@ def _report_bad_lines(log: AlogFile) -> None:
         )
 
 
+@reporting_errors
 def grep_command(args: argparse.Namespace) -> int:
     from pygoby.moos.alog.tools import grep, value_text
 
@@ -86,6 +113,7 @@ def grep_command(args: argparse.Namespace) -> int:
     return 0
 
 
+@reporting_errors
 def summary_command(args: argparse.Namespace) -> int:
     from pygoby.moos.alog.tools import summarize, summary_lines
 
@@ -96,6 +124,7 @@ def summary_command(args: argparse.Namespace) -> int:
     return 0
 
 
+@reporting_errors
 def clip_command(args: argparse.Namespace) -> int:
     from pygoby.moos.alog.tools import clip
 
@@ -107,6 +136,7 @@ def clip_command(args: argparse.Namespace) -> int:
     return 0
 
 
+@reporting_errors
 def convert_command(args: argparse.Namespace) -> int:
     from pygoby.moos.alog.tools import convert
 
@@ -121,26 +151,23 @@ def convert_command(args: argparse.Namespace) -> int:
     return 0
 
 
+@reporting_errors
 def replay_command(args: argparse.Namespace) -> int:
     from pygoby.moos.alog.tools import print_progress, replay
 
     log = AlogFile(args.file)
     progress = print_progress() if sys.stderr.isatty() else None
-    try:
-        count = asyncio.run(
-            replay(
-                log,
-                args.host,
-                args.port,
-                warp=args.warp,
-                start=args.start,
-                only=args.only,
-                progress=progress,
-            )
+    count = asyncio.run(
+        replay(
+            log,
+            args.host,
+            args.port,
+            warp=args.warp,
+            start=args.start,
+            only=args.only,
+            progress=progress,
         )
-    except TimeoutError as err:
-        print(f"log replay: {err}", file=sys.stderr)
-        return 1
+    )
     print(f"{count} messages posted")
     _report_bad_lines(log)
     return 0

@@ -36,8 +36,10 @@ BINARY_TAG = re.compile(
     r"<MOOS_BINARY>File=(?P<file>[^,]*),Offset=(?P<offset>\d+),Bytes=(?P<size>\d+)</MOOS_BINARY>"
 )
 # a value the MOOS-IvP tools take for a number (their isNumber), plus C++'s inf and nan
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:inf|nan)")
-_LINE = re.compile(r"[ \t]*(\S+)[ \t]+(\S+)[ \t]+(\S+)(?:[ \t]+(.*))?")
+_NUMBER_TEXT = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_NUMBER = re.compile(rf"{_NUMBER_TEXT}|[+-]?(?:inf|nan)")
+# TIME VARIABLE SOURCE [VALUE]: one match checks the columns and that the time is a number
+_ENTRY = re.compile(rf"[ \t]*({_NUMBER_TEXT})[ \t]+(\S+)[ \t]+(\S+)(?:[ \t]+(.*))?")
 
 Value = float | str | bytes
 
@@ -170,16 +172,13 @@ class AlogReader:
         if line.startswith("%%"):
             self._header_line(line)
             return None
-        match = _LINE.fullmatch(line)
+        match = _ENTRY.fullmatch(line)
         if match is None:
             self._bad(line)
             return None
         stamp, name, source, raw = match.groups()
-        if not _NUMBER.fullmatch(stamp):
-            self._bad(line)
-            return None
         msg_time = float(stamp)
-        if not math.isfinite(msg_time):
+        if not math.isfinite(msg_time):  # digits beyond a double's range
             self._bad(line)
             return None
         value = self._value(raw or "")
@@ -204,10 +203,10 @@ class AlogReader:
                 return bytes.fromhex(raw[2:].strip()), None
             except ValueError:
                 return None
-        tag = BINARY_TAG.fullmatch(raw.strip())
-        if tag:
-            ref = (tag["file"], int(tag["offset"]), int(tag["size"]))
-            return b"", ref
+        if raw.startswith("<MOOS_BINARY>"):
+            tag = BINARY_TAG.fullmatch(raw.strip())
+            if tag:
+                return b"", (tag["file"], int(tag["offset"]), int(tag["size"]))
         number = raw.rstrip()
         if _NUMBER.fullmatch(number):
             return float(number), None
@@ -237,6 +236,8 @@ class AlogReader:
 
 def _split_source(source: str) -> tuple[str, str, str]:
     """`src[:aux][@community]` -> (src, aux, community)."""
+    if "@" not in source and ":" not in source:
+        return source, "", ""
     community = ""
     if "@" in source:
         source, community = source.rsplit("@", 1)
