@@ -205,6 +205,7 @@ def test_logger_config() -> None:
             Setting("WildCardOmitPattern", "*_STATUS, DB_*", 7),
             Setting("Colour", "blue", 8),
             Setting("MaxAlogSize", "2M", 9),
+            Setting("WildcardExclusionLog", "true", 10),
         ],
         err,
     )
@@ -215,7 +216,10 @@ def test_logger_config() -> None:
     ]
     assert cfg.wildcard_omit == ["MISSION_FILE", "*_STATUS", "DB_*"]
     assert cfg.max_alog_bytes == 2 << 20
-    assert cfg.warnings == ["line 8: unknown option 'Colour' ignored"]
+    assert cfg.warnings == [
+        "line 8: unknown option 'Colour' ignored",
+        "line 10: WildcardExclusionLog: the .xlog of excluded variables is not written; ignored",
+    ]
     assert parse_log_request("X@0").period == 0.0
     with pytest.raises(ConfigError) as caught:
         read_logger_config([Setting("DoublePrecision", "many", 4)], err)

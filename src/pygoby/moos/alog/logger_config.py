@@ -13,6 +13,11 @@ from pygoby.moos.moosfile import Setting, parse_number
 # pLogger registers a `Log = VAR` without `@ period` with this interval (s)
 DEFAULT_LOG_PERIOD = 2.0
 MIN_SYNC_PERIOD = 0.1
+# pLogger options pygoby's pLogger reads but does not act on (a warning says so)
+UNSUPPORTED = {
+    "dynamicsynclogcolumns": "PLOGGER_CMD's dynamic .slog columns are not supported",
+    "wildcardexclusionlog": "the .xlog of excluded variables is not written",
+}
 _SIZE = re.compile(r"(\d+(?:\.\d*)?)\s*([kKmMgG]?)[bB]?")
 _SIZE_UNITS = {"": 1, "k": 1 << 10, "m": 1 << 20, "g": 1 << 30}
 
@@ -150,6 +155,8 @@ def read_logger_config(
             if match is None:
                 raise error(f"must be a size such as 500M, not {s.value!r}", s)
             cfg.max_alog_bytes = int(float(match[1]) * _SIZE_UNITS[match[2].lower()])
+        elif key in UNSUPPORTED:
+            cfg.warnings.append(f"line {s.line}: {s.name}: {UNSUPPORTED[key]}; ignored")
         else:
             cfg.warnings.append(f"line {s.line}: unknown option {s.name!r} ignored")
     if global_log_path:
