@@ -38,6 +38,7 @@ class Var:
     max_length: int | None = None
     num_bytes: int | None = None
     array_length: int = 1
+    max_delta: float | None = None  # <max_delta>: DCCL1 sends array elements 1.. as deltas
     static_value: str | None = None
     enum_values: list[str] = field(default_factory=list)
     number: int = 0  # field number in the converted protobuf message
@@ -94,6 +95,7 @@ class XmlMessage:
     trigger_var: str = ""
     mandatory_content: str = ""
     trigger_time: int | None = None
+    repeat: bool = False  # <repeat/>: DCCL1 packs as many copies as <size> allows
     header: dict[str, Var] = field(default_factory=dict)  # by tag: time, src_id, dest_id
     layout: list[Var] = field(default_factory=list)
     publishes: list[Publish] = field(default_factory=list)
