@@ -73,6 +73,10 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         self.queue = self.acomms.queue
+        if self.messages.transitional.speaks_dccl1(cfg):
+            self.queue.use_dccl1(
+                self.messages.transitional.dccl1_bridge(cfg, self.messages.loader, self.clock.now)
+            )
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
         self.messages.apply_libraries(self.acomms.codec)
