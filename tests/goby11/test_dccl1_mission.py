@@ -1,0 +1,159 @@
+"""A Goby 1.1 vehicle and a pygoby one on one emulated acoustic channel: the 1.1 side sends
+frames recorded from the real Goby 1.1.2 libdccl; pygoby's pAcommsHandler (a Goby 1.1
+configuration) receives them through its emulated Micro-Modem and publishes them as the XML
+says, and its own SIMPLE_STATUS reaches the 1.1 side in Goby 1.1's bytes."""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+from pathlib import Path
+
+from pygoby.acomms.mmsim import LoopbackChannel
+from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind, Reception
+from pygoby.apps.pacommshandler import pAcommsHandler
+from pygoby.dccl.dccl1 import Dccl1Codec, stitch, unstitch
+from pygoby.dccl.xml import load_message_set
+from pygoby.util.clock import WallClock
+from tests.apps.acomms_mission import Recorder, modem_and_db
+from tests.goby11.seed_listings import EXAMPLES
+
+DATA = Path(__file__).parents[1] / "data" / "goby11-dccl1"
+SIMPLE_STATUS = DATA / "xml" / "simple_status.xml"
+GOBY11_ID = 14  # the recorded vectors below were sent by modem 14
+
+
+def recorded(case: str) -> dict:
+    for line in (DATA / "vectors.jsonl").read_text().splitlines():
+        vector = json.loads(line)
+        if vector["message"] == "SIMPLE_STATUS" and vector["case"] == case:
+            assert vector["src"] == GOBY11_ID and vector["dest"] == 2
+            assert vector["passphrase"] is None
+            return vector
+    raise LookupError(case)
+
+
+class Goby11Vehicle:
+    """The Goby 1.1 side on the acoustic channel: sends the frames it is given, keeps the
+    frames it hears."""
+
+    def __init__(self, clock, channel) -> None:
+        self.clock, self.channel = clock, channel
+        self.heard: list[AcousticPacket] = []
+        channel.attach(self)
+
+    @property
+    def modem_id(self) -> int:
+        return GOBY11_ID
+
+    @property
+    def name(self) -> str:
+        return "goby11"
+
+    def detect(self, packet: AcousticPacket, arrival: float) -> None:
+        pass
+
+    def receive(self, packet: AcousticPacket, reception: Reception) -> None:
+        self.heard.append(packet)
+
+    def send(self, frame: bytes, dest: int) -> None:
+        packet = AcousticPacket(
+            PacketKind.DATA, GOBY11_ID, dest, rate=1, frames=[frame], tx_time=self.clock.now()
+        )
+        packet.duration = 1.0
+        self.channel.transmit(self, packet)
+
+
+def mission(db_port: int, modem_port: int) -> str:
+    return f"""ServerHost = localhost
+ServerPort = {db_port}
+Community = mm2
+modem_id_lookup_path = {EXAMPLES}/MOOS/ccl_and_dccl/modemidlookup.txt
+
+ProcessConfig = pAcommsHandler
+{{
+  common
+  {{
+    verbosity: VERBOSITY_WARN
+    log: false
+    app_tick: 20
+    initializer {{ type: INI_STRING moos_var: "VEHICLE_NAME" sval: "mm2" }}
+    initializer {{ type: INI_DOUBLE moos_var: "NAV_X" dval: 120 }}
+    initializer {{ type: INI_DOUBLE moos_var: "NAV_Y" dval: -40 }}
+    initializer {{ type: INI_DOUBLE moos_var: "NAV_HEADING" dval: 90 }}
+    initializer {{ type: INI_DOUBLE moos_var: "NAV_SPEED" dval: 1.2 }}
+    initializer {{ type: INI_DOUBLE moos_var: "NAV_DEPTH" dval: 7 }}
+  }}
+  modem_id: 2
+  driver_type: DRIVER_WHOI_MICROMODEM
+  driver_cfg
+  {{
+    connection_type: CONNECTION_TCP_AS_CLIENT
+    tcp_server: "127.0.0.1"
+    tcp_port: {modem_port}
+    [MicroModemConfig.reset_nvram]: false
+  }}
+  mac_cfg
+  {{
+    type: MAC_FIXED_DECENTRALIZED
+    slot {{ src: 2 dest: {GOBY11_ID} rate: 1 type: SLOT_DATA slot_seconds: 3 }}
+  }}
+  dccl_cfg {{ message_file {{ path: "{SIMPLE_STATUS}" }} }}
+}}
+"""
+
+
+def status_fields(value: str) -> dict[str, str]:
+    return dict(item.split("=", 1) for item in value.split(","))
+
+
+async def test_recorded_goby11_frames_in_and_goby11_bytes_out(tmp_path):
+    clock = WallClock()
+    channel = LoopbackChannel(clock, range_m=150)  # 0.1 s away
+    goby11 = Goby11Vehicle(clock, channel)
+    async with contextlib.AsyncExitStack() as stack:
+        sim, db = await modem_and_db(stack, 2, channel, clock)
+        path = tmp_path / "mm2.moos"
+        path.write_text(mission(db.port, sim.port))
+        app = pAcommsHandler.from_mission(path, "pAcommsHandler")
+        recorder = Recorder("recorder", db.port)
+        await recorder.start(["STATUS_REPORT_IN"])
+        stack.push_async_callback(recorder.close)
+        await stack.enter_async_context(app)
+        await asyncio.sleep(0.5)  # the driver is up
+
+        # a frame of one message, exactly as Goby 1.1.2 wrote it
+        first = recorded("random3")
+        goby11.send(bytes.fromhex(first["hex"]), 2)
+        report = status_fields(
+            await recorder.wait_for("STATUS_REPORT_IN", lambda v: "nav_x=-56144" in v)
+        )
+        expected = first["decoded"]["values"]
+        assert (report["Node"], report["nav_y"], report["Speed"], report["Heading"]) == (
+            str(GOBY11_ID),
+            str(expected["nav_y"]),
+            str(expected["Speed"]),
+            str(expected["Heading"]),
+        )
+        # two recorded messages stitched into one frame as Goby 1.1's queue does
+        second = recorded("hdr_time_half_even")
+        count = len(recorder.values("STATUS_REPORT_IN"))
+        goby11.send(
+            stitch([(bytes.fromhex(first["hex"]), 2), (bytes.fromhex(second["hex"]), 2)]), 2
+        )
+        await recorder.wait_for("STATUS_REPORT_IN", lambda v: "nav_x=64281" in v, start=count)
+        assert any("nav_x=-56144" in v for v in recorder.values("STATUS_REPORT_IN")[count:])
+
+        # pygoby's answer, heard by the 1.1 side, in Goby 1.1's bytes
+        async with asyncio.timeout(30):
+            while not any(p.kind is PacketKind.DATA and p.frames for p in goby11.heard):
+                await asyncio.sleep(0.05)
+    frame = next(p for p in goby11.heard if p.kind is PacketKind.DATA and p.frames).frames[0]
+    assert frame[0] == 0x20
+    codec = Dccl1Codec()  # a Goby 1.1 node with no passphrase configured
+    codec.load(load_message_set(SIMPLE_STATUS))
+    decoded = [codec.decode(part.data) for part in unstitch(frame)]
+    assert {(d.message, d.header.src) for d in decoded} == {("SIMPLE_STATUS", 2)}
+    assert (decoded[0].values["nav_x"], decoded[0].values["Speed"]) == (120, 1.2)
+    assert decoded[0].values["Heading"] == 90
