@@ -10,13 +10,17 @@ import contextlib
 import json
 from pathlib import Path
 
+from google.protobuf import text_format
+
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mmsim import LoopbackChannel
 from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind, Reception
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.dccl.dccl1 import Dccl1Codec, stitch, unstitch
 from pygoby.dccl.xml import load_message_set
+from pygoby.moos.client import MOOSClient
 from pygoby.util.clock import WallClock
-from tests.apps.acomms_mission import Recorder, modem_and_db
+from tests.apps.acomms_mission import Recorder, modem_and_db, two_vehicle_missions
 from tests.goby11.seed_listings import EXAMPLES
 
 DATA = Path(__file__).parents[1] / "data" / "goby11-dccl1"
@@ -157,3 +161,111 @@ async def test_recorded_goby11_frames_in_and_goby11_bytes_out(tmp_path):
     assert {(d.message, d.header.src) for d in decoded} == {("SIMPLE_STATUS", 2)}
     assert (decoded[0].values["nav_x"], decoded[0].values["Speed"]) == (120, 1.2)
     assert decoded[0].values["Heading"] == 90
+
+
+EXAMPLE1 = DATA / "xml" / "example1.xml"
+
+
+def command_mission(modem_id: int, db_port: int, modem_port: int) -> str:
+    """The Goby 1.1 manual's example1.xml (GoToCommand: acked, as 1.1.2's <queuing> default)
+    and SIMPLE_STATUS on two nodes."""
+    return f"""ServerHost = localhost
+ServerPort = {db_port}
+Community = mm{modem_id}
+modem_id_lookup_path = {EXAMPLES}/MOOS/ccl_and_dccl/modemidlookup.txt
+
+ProcessConfig = pAcommsHandler
+{{
+  common {{ verbosity: VERBOSITY_WARN log: false app_tick: 20 }}
+  modem_id: {modem_id}
+  driver_type: DRIVER_WHOI_MICROMODEM
+  driver_cfg
+  {{
+    connection_type: CONNECTION_TCP_AS_CLIENT
+    tcp_server: "127.0.0.1"
+    tcp_port: {modem_port}
+    [MicroModemConfig.reset_nvram]: false
+  }}
+  mac_cfg
+  {{
+    type: MAC_FIXED_DECENTRALIZED
+    slot {{ src: 1 dest: 2 rate: 1 type: SLOT_DATA slot_seconds: 3 }}
+  }}
+  dccl_cfg {{ message_file {{ path: "{EXAMPLE1}" }} message_file {{ path: "{SIMPLE_STATUS}" }} }}
+}}
+"""
+
+
+def goby11_text(value: str, cls):
+    out = cls()
+    text_format.Parse(value, out)
+    return out
+
+
+async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
+    """ACOMMS_OUTGOING_DATA / OUT_GOTOCOMMAND_HEX_32B on the sender, ACOMMS_INCOMING_DATA /
+    IN_GOTOCOMMAND_HEX_32B on the receiver, 1.1's ModemDataAck and QueueSize,
+    ACOMMS_FLUSH_QUEUE in 1.1's comma-equals form, a message handed in on the IN_ variable."""
+    watched = [
+        "ACOMMS_OUTGOING_DATA",
+        "OUT_GOTOCOMMAND_HEX_32B",
+        "ACOMMS_INCOMING_DATA",
+        "IN_GOTOCOMMAND_HEX_32B",
+        "INCOMING_COMMAND",
+        "ACOMMS_ACK",
+        "ACOMMS_QSIZE",
+    ]
+    clock = WallClock()
+    channel = LoopbackChannel(clock, range_m=150)
+    async with two_vehicle_missions(tmp_path, command_mission, watched, channel, clock) as (
+        apps,
+        recorders,
+    ):
+        mm1, _ = apps
+        sender, receiver = recorders
+        async with MOOSClient("operator", port=mm1.client.port) as operator:
+            operator.publish(
+                "OUTGOING_COMMAND", "CommandType=GoTo,Destination=2,goto_x=10,goto_speed=1.5"
+            )
+            await operator.flush()
+        outgoing = goby11_text(
+            await sender.wait_for("OUT_GOTOCOMMAND_HEX_32B"), acomms_pb.V1ModemDataTransmission
+        )
+        assert outgoing.data[0] == 0x20 and outgoing.queue_key.id == 1
+        assert (
+            sender.values("ACOMMS_OUTGOING_DATA")[0] == sender.values("OUT_GOTOCOMMAND_HEX_32B")[0]
+        )
+        await receiver.wait_for("INCOMING_COMMAND", lambda v: "goto_x=10" in v)
+        incoming = goby11_text(
+            await receiver.wait_for("IN_GOTOCOMMAND_HEX_32B"), acomms_pb.V1ModemDataTransmission
+        )
+        assert incoming.data == outgoing.data and incoming.base.src == 1
+        ack = goby11_text(await sender.wait_for("ACOMMS_ACK"), acomms_pb.V1ModemDataAck)
+        assert (ack.base.src, ack.orig_msg.data) == (2, outgoing.data)
+        sizes = [goby11_text(v, acomms_pb.V1QueueSize) for v in sender.values("ACOMMS_QSIZE")]
+        assert (acomms_pb.QUEUE_DCCL, 1, 1) in {(s.key.type, s.key.id, s.size) for s in sizes}
+
+        # SIMPLE_STATUS (id 20) queues every 5 s, sent one per slot at most: flush it 1.1's way
+        async with MOOSClient("operator", port=mm1.client.port) as operator:
+            start = len(sender.values("ACOMMS_QSIZE"))
+            await sender.wait_for(
+                "ACOMMS_QSIZE", lambda v: "id: 20" in v and "size: 0" not in v, timeout=15
+            )
+            operator.publish("ACOMMS_FLUSH_QUEUE", "key_type=QUEUE_DCCL,key_id=20")
+            await operator.flush()
+            await sender.wait_for(
+                "ACOMMS_QSIZE", lambda v: "id: 20" in v and "size: 0" in v, start=start
+            )
+
+        # a received message handed in by another process (as 1.1's tcp_share did)
+        count = len(receiver.values("INCOMING_COMMAND"))
+        async with MOOSClient("share", port=apps[1].client.port) as share:
+            command = mm1.messages.loader.message_class("GoToCommand")
+            handed = acomms_pb.V1ModemDataTransmission(
+                data=mm1.queue.dccl1.encode(command(goto_x=77, Destination=2, _src_id=1))
+            )
+            share.publish(
+                "IN_GOTOCOMMAND_HEX_32B", text_format.MessageToString(handed, as_one_line=True)
+            )
+            await share.flush()
+        await receiver.wait_for("INCOMING_COMMAND", lambda v: "goto_x=77" in v, start=count)

@@ -20,7 +20,7 @@ from pygoby.acomms.queue.persist import QueueStore
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
 from pygoby.dccl import DcclError
-from pygoby.dccl.dccl1 import DCCL1_FIRST_BYTE, is_dccl1_frame, stitch, unstitch
+from pygoby.dccl.dccl1 import DCCL1_FIRST_BYTE, Dccl1Header, is_dccl1_frame, stitch, unstitch
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.signal import Signal
 
@@ -43,6 +43,10 @@ class QueueManager:
         self.signal_ack = Signal()  # (ack ModemTransmission, original message)
         self.signal_expire = Signal()  # (original message)
         self.signal_queue_size_change = Signal()  # (QueueSize)
+        self.signal_ccl_queue_size_change = Signal()  # (CCL id, size)
+        self.signal_queued = Signal()  # (queue name, QueuedItem): a message was queued
+        # (ModemTransmission, message bytes, DCCL id): a Goby 1.1 DCCL message for us arrived
+        self.signal_receive_dccl1 = Signal()
         self.signal_data_on_demand = Signal()  # (request ModemTransmission, message to fill)
         # routing (pygoby.acomms.route): the router may rewrite an outgoing item's link dest;
         # link packets for us are offered as (message, its bytes, its own dest, our id)
@@ -199,6 +203,7 @@ class QueueManager:
                 transmission, data, self.modem_id, dest, acomms_pb.now_us(self.clock.now()), ack
             )
         )
+        self._size_changed(queue)
 
     def _all_queues(self) -> list[MessageQueue]:
         return [*self.queues.values(), *self.ccl_queues.values()]
@@ -251,8 +256,9 @@ class QueueManager:
         return restored
 
     def _size_changed(self, queue: MessageQueue) -> None:
-        if isinstance(queue, CCLQueue):
-            return  # QueueSize names DCCL ids only
+        if isinstance(queue, CCLQueue):  # QueueSize names DCCL ids only
+            self.signal_ccl_queue_size_change.emit(queue.dccl_id, len(queue))
+            return
         self.signal_queue_size_change.emit(
             acomms_pb.QueueSize(dccl_id=queue.dccl_id, size=len(queue))
         )
@@ -302,6 +308,7 @@ class QueueManager:
         if victim is not None:
             self.log.dropped(queue, victim)
         self._size_changed(queue)
+        self.signal_queued.emit(queue.name, item)
 
     def message_dest(self, msg) -> int:
         """A message's own destination (its DESTINATION_ID role; 0 without one)."""
@@ -314,6 +321,14 @@ class QueueManager:
             return default
         value = getter.get(msg)
         return default if value is None else int(value)
+
+    def flush_ccl_queue(self, ccl_id: int) -> None:
+        queue = self.ccl_queues.get(ccl_id)
+        if queue is None:
+            self.log.push.warning("flush: no CCL queue with id %d", ccl_id)
+            return
+        queue.clear()
+        self._size_changed(queue)
 
     def flush_queue(self, flush) -> None:
         queue = self.queues.get(flush.dccl_id)
@@ -489,7 +504,7 @@ class QueueManager:
                     self._receive_ccl(transmission, data, index)
                     names.append(f"CCL {data[0]}")
                 elif self.dccl1 is not None and is_dccl1_frame(data):
-                    names += self._decode_dccl1_frame(data)
+                    names += self._decode_dccl1_frame(transmission, data)
                 else:
                     names += self._decode_frame(data, route)
             self.log.reception(transmission, names)
@@ -537,7 +552,7 @@ class QueueManager:
             self._deliver(msg)
         return names
 
-    def _decode_dccl1_frame(self, data: bytes) -> list[str]:
+    def _decode_dccl1_frame(self, transmission, data: bytes) -> list[str]:
         """The messages of a Goby 1.1 frame, each decoded and delivered on its own."""
         names = []
         try:
@@ -546,14 +561,24 @@ class QueueManager:
             self.log.undecodable(0, exc)
             return names
         for part in parts:
-            try:
-                msg = self.dccl1.decode(part.data, self.clock.now())  # type: ignore[union-attr]
-            except DcclError as exc:  # the other messages of the frame still count
-                self.log.undecodable(0, exc)
-                continue
-            names.append(msg.DESCRIPTOR.full_name)
-            self._deliver(msg)
+            header = Dccl1Header.unpack(part.data)
+            if part.broadcast or header.dest in (acomms_pb.BROADCAST_ID, self.modem_id):
+                self.signal_receive_dccl1.emit(transmission, part.data, header.id)
+            name = self.receive_dccl1_message(part.data)
+            if name is not None:
+                names.append(name)
         return names
+
+    def receive_dccl1_message(self, data: bytes) -> str | None:
+        """Decode and deliver one Goby 1.1 DCCL message; its type name, None if it does not
+        decode (logged: the other messages of its frame still count)."""
+        try:
+            msg = self.dccl1.decode(data, self.clock.now())  # type: ignore[union-attr]
+        except DcclError as exc:
+            self.log.undecodable(0, exc)
+            return None
+        self._deliver(msg)
+        return msg.DESCRIPTOR.full_name
 
     def _codec_for_source(self, data: bytes):
         """encrypt_rule on receipt: the passphrase of the sender, read from the clear header."""

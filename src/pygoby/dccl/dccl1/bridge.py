@@ -41,6 +41,10 @@ class Dccl1Bridge:
     def handles(self, full_name: str) -> bool:
         return full_name in self._xml
 
+    @property
+    def xml_messages(self) -> list[XmlMessage]:
+        return list(self._xml.values())
+
     def dccl_ids(self) -> dict[int, str]:
         return {msg.id or 0: name for name, msg in self._xml.items()}
 

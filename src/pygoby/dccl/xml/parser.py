@@ -465,12 +465,11 @@ class _Reader:
             msg.publishes = [self.publish(p, msg) for p in receipt_groups["publish"]]
         if "queuing" in groups:
             msg.queuing = self.queuing(groups["queuing"][0], context)
-        self.ignored(
-            groups,
-            ("incoming_hex_moos_var", "outgoing_hex_moos_var"),
-            self.text,
-            "is accepted and not used: pygoby (like Goby 2) does not post encoded DCCL hex",
-        )
+        # the variables the encoded message is posted on (Goby 1.1 configurations only)
+        if "incoming_hex_moos_var" in groups:
+            msg.incoming_hex_var = self.text(groups["incoming_hex_moos_var"][0])
+        if "outgoing_hex_moos_var" in groups:
+            msg.outgoing_hex_var = self.text(groups["outgoing_hex_moos_var"][0])
         return msg
 
     def ignored(
