@@ -269,3 +269,30 @@ async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
             )
             await share.flush()
         await receiver.wait_for("INCOMING_COMMAND", lambda v: "goto_x=77" in v, start=count)
+
+
+def test_liaison_names_goby11_frames_and_reads_goby11_queue_sizes():
+    from pygoby.acomms.transitional import TransitionalMessages
+    from pygoby.moos import protocol
+    from pygoby.protobuf import ProtoLoader, builtin_class
+    from pygoby.topside.liaison.models import AcommsModel
+
+    cfg = builtin_class(
+        "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
+        "goby.apps.moos.protobuf.pAcommsHandlerConfig",
+    )(modem_id=2)
+    cfg.transitional_cfg.message_file.add(path=str(SIMPLE_STATUS))
+    loader = ProtoLoader()
+    TransitionalMessages.expand(cfg, loader)
+    model = AcommsModel(cfg, loader.message_class, now=0.0)
+    size = acomms_pb.V1QueueSize(size=3)
+    size.key.type, size.key.id = acomms_pb.QUEUE_DCCL, 20
+    model.handle(
+        protocol.notify(
+            "ACOMMS_QSIZE", text_format.MessageToString(size, as_one_line=True), time=1.0
+        )
+    )
+    assert model.queues["SIMPLE_STATUS"].size == 3
+    frame = bytes.fromhex(recorded("random3")["hex"])
+    transmission = acomms_pb.ModemTransmission(frame=[stitch([(frame, 2), (frame, 2)])])
+    assert model._messages_in(transmission) == ["SIMPLE_STATUS", "SIMPLE_STATUS"]
