@@ -18,7 +18,7 @@ from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError
 from pygoby.dccl.xml import load_message_set, parse_message_set
 from pygoby.errors import ConfigError
 
-DATA = Path(__file__).parents[1] / "data" / "goby11-dccl1"
+DATA = Path(__file__).parents[1] / "data" / "vectors" / "goby11-dccl1"
 VECTORS = [json.loads(line) for line in (DATA / "vectors.jsonl").read_text().splitlines()]
 MESSAGE_SETS = {name: load_message_set(DATA / "xml" / name) for name in {v["xml"] for v in VECTORS}}
 

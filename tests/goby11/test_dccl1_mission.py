@@ -23,7 +23,7 @@ from pygoby.util.clock import WallClock
 from tests.apps.acomms_mission import Recorder, modem_and_db, two_vehicle_missions
 from tests.goby11.seed_listings import EXAMPLES
 
-DATA = Path(__file__).parents[1] / "data" / "goby11-dccl1"
+DATA = Path(__file__).parents[1] / "data" / "vectors" / "goby11-dccl1"
 SIMPLE_STATUS = DATA / "xml" / "simple_status.xml"
 GOBY11_ID = 14  # the recorded vectors below were sent by modem 14
 
