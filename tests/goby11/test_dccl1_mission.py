@@ -296,3 +296,23 @@ def test_liaison_names_goby11_frames_and_reads_goby11_queue_sizes():
     frame = bytes.fromhex(recorded("random3")["hex"])
     transmission = acomms_pb.ModemTransmission(frame=[stitch([(frame, 2), (frame, 2)])])
     assert model._messages_in(transmission) == ["SIMPLE_STATUS", "SIMPLE_STATUS"]
+
+
+def test_goby11_configuration_speaks_dccl1_unless_told_dccl_v2(tmp_path):
+    """The default for a Goby 1.1 configuration, and the one setting that keeps Goby 2's bytes."""
+    path = tmp_path / "mm2.moos"
+    apps = []
+    for setting in ("", "transitional_cfg { wire_format: DCCL_V2 }"):
+        text = mission(9000, 9001).replace("dccl_cfg {", f"{setting}\n  dccl_cfg {{")
+        path.write_text(text)
+        apps.append(pAcommsHandler.from_mission(path, "pAcommsHandler"))
+    goby11, goby2 = apps
+    assert goby11.queue.dccl1 is not None and goby2.queue.dccl1 is None
+    status = goby11.messages.loader.message_class("SIMPLE_STATUS")(nav_x=5, Timestamp=0, Node=2)
+    goby11.queue.push_message(status)
+    goby2.queue.push_message(status)
+    (sent11,) = goby11.queue.queues[20].items()
+    (sent2,) = goby2.queue.queues[20].items()
+    assert sent11.encoded[0] == 0x20 and sent2.encoded[0] == 20 << 1  # DCCL v2's id byte
+    assert goby11.queue.dccl1.decode(sent11.encoded).nav_x == 5
+    assert goby2.acomms.codec.decode(sent2.encoded).nav_x == 5
