@@ -166,9 +166,19 @@ async def test_recorded_goby11_frames_in_and_goby11_bytes_out(tmp_path):
 EXAMPLE1 = DATA / "xml" / "example1.xml"
 
 
-def command_mission(modem_id: int, db_port: int, modem_port: int) -> str:
-    """The Goby 1.1 manual's example1.xml (GoToCommand: acked, as 1.1.2's <queuing> default)
-    and SIMPLE_STATUS on two nodes."""
+EXPIRING = """<?xml version="1.0"?>
+<message_set><message><name>Expiring</name><id>5</id><size>8</size>
+  <trigger>publish</trigger><trigger_var>EXPIRE_ME</trigger_var>
+  <header><dest_id><name>Dest</name></dest_id></header>
+  <layout><bool><name>b</name></bool></layout>
+  <queuing><ttl>1</ttl></queuing>
+</message></message_set>
+"""
+
+
+def command_mission(modem_id: int, db_port: int, modem_port: int, expiring: Path) -> str:
+    """The Goby 1.1 manual's example1.xml (GoToCommand: acked, as 1.1.2's <queuing> default),
+    SIMPLE_STATUS and a message with a ttl of 1 s on two nodes."""
     return f"""ServerHost = localhost
 ServerPort = {db_port}
 Community = mm{modem_id}
@@ -191,7 +201,12 @@ ProcessConfig = pAcommsHandler
     type: MAC_FIXED_DECENTRALIZED
     slot {{ src: 1 dest: 2 rate: 1 type: SLOT_DATA slot_seconds: 3 }}
   }}
-  dccl_cfg {{ message_file {{ path: "{EXAMPLE1}" }} message_file {{ path: "{SIMPLE_STATUS}" }} }}
+  dccl_cfg
+  {{
+    message_file {{ path: "{EXAMPLE1}" }}
+    message_file {{ path: "{SIMPLE_STATUS}" }}
+    message_file {{ path: "{expiring}" }}
+  }}
 }}
 """
 
@@ -214,10 +229,17 @@ async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
         "INCOMING_COMMAND",
         "ACOMMS_ACK",
         "ACOMMS_QSIZE",
+        "ACOMMS_EXPIRE",
     ]
     clock = WallClock()
     channel = LoopbackChannel(clock, range_m=150)
-    async with two_vehicle_missions(tmp_path, command_mission, watched, channel, clock) as (
+    expiring = tmp_path / "expiring.xml"
+    expiring.write_text(EXPIRING)
+
+    def mission_file(modem_id: int, db_port: int, modem_port: int) -> str:
+        return command_mission(modem_id, db_port, modem_port, expiring)
+
+    async with two_vehicle_missions(tmp_path, mission_file, watched, channel, clock) as (
         apps,
         recorders,
     ):
@@ -256,6 +278,14 @@ async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
             await sender.wait_for(
                 "ACOMMS_QSIZE", lambda v: "id: 20" in v and "size: 0" in v, start=start
             )
+
+        # for modem 5, which no slot serves: expires after its ttl of 1 s
+        async with MOOSClient("operator", port=mm1.client.port) as operator:
+            operator.publish("EXPIRE_ME", "Dest=5,b=true")
+            await operator.flush()
+        expired = goby11_text(await sender.wait_for("ACOMMS_EXPIRE"), acomms_pb.V1ModemDataExpire)
+        assert expired.orig_msg.queue_key.id == 5 and expired.orig_msg.data[0] == 0x20
+        assert expired.orig_msg.base.dest == 5
 
         # a received message handed in by another process (as 1.1's tcp_share did)
         count = len(receiver.values("INCOMING_COMMAND"))
