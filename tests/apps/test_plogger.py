@@ -240,3 +240,29 @@ def test_plogger_example_config(capsys: pytest.CaptureFixture[str]) -> None:
     out = capsys.readouterr().out
     assert out.startswith("ProcessConfig = pLogger\n{\n  AppTick = 4\n")
     assert "  Log = NAV_X @ 0 " in out and out.endswith("}\n")
+
+
+async def test_logger_restart_starts_new_files(tmp_path: Path) -> None:
+    async with MOOSDB(port=0) as db:
+        mission = tmp_path / "r.moos"
+        mission.write_text(
+            f"ServerPort = {db.port}\nProcessConfig = pLogger\n{{\n  AppTick = 20\n"
+            f"  CommsTick = 20\n  File = R\n  FileTimeStamp = false\n  PATH = {tmp_path}\n"
+            f"  WildCardLogging = true\n  WildCardOmitPattern = *_STATUS, DB_*\n"
+            f"  LoggingDirectorySummaryFile = {tmp_path}/summary\n}}\n"
+        )
+        async with MOOSClient("vehicle", port=db.port) as vehicle, pLogger.from_mission(mission):
+            vehicle.subscribe("LOGGER_DIRECTORY")
+            await wait_for(vehicle, "LOGGER_DIRECTORY")
+            alog = tmp_path / "R" / "R.alog"
+            for key in ("BEFORE", "LOGGER_RESTART", "AFTER"):
+                vehicle.publish(key, "x")
+                await vehicle.flush()
+                if key == "LOGGER_RESTART":  # posted again once the new files are open
+                    await wait_for(vehicle, "LOGGER_DIRECTORY")
+            for _ in range(100):
+                await asyncio.sleep(0.05)
+                if "AFTER" in {e.name for e in AlogFile(alog)}:
+                    break
+    names = [e.name for e in AlogFile(alog) if e.source == "vehicle"]
+    assert "BEFORE" not in names and names[-1] == "AFTER"

@@ -3,18 +3,18 @@
     pLogger mission.moos [AppName]
 
 Files land in `PATH/<File>_<D_M_YYYY_____HH_MM_SS>/` (or `PATH/<File>/` with FileTimeStamp =
-false). Writing happens on a thread with a bounded buffer, so a slow disk never stalls MOOS
-traffic: lines that do not fit are dropped and counted (warned about, and shown in the status).
+false); posting LOGGER_RESTART starts a new directory. Writing happens on a thread with a
+bounded buffer, so a slow disk never stalls MOOS traffic: lines that do not fit are dropped and
+counted (warned about, and shown in the status).
 """
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 from typing import TextIO
 
 from pygoby.moos import protocol as p
-from pygoby.moos.alog.files import AlogSink
+from pygoby.moos.alog.files import AlogSink, copy_with_banner, make_log_directory
 from pygoby.moos.alog.format import AlogFormatter, banner, slog_header, slog_labels, slog_row
 from pygoby.moos.alog.logger_config import read_logger_config
 from pygoby.moos.classic_app import ClassicMOOSApp
@@ -52,6 +52,7 @@ class pLogger(ClassicMOOSApp):  # noqa: N801 - the program's name
         self._slog: TextIO | None = None
         self._sync_vars = [r.var for r in self.settings.logs if r.sync]
         self._sync_set = set(self._sync_vars)
+        self._log_vars = {r.var for r in self.settings.logs}
         self._fresh: dict[str, float] = {}
         self._last_sync = -1e300
         self._sync_rows = 0
@@ -70,12 +71,23 @@ class pLogger(ClassicMOOSApp):  # noqa: N801 - the program's name
             self.subscribe_pattern("*", "*", self._on_wildcard)
         for request in self.settings.logs:
             self.subscribe(request.var, self._on_mail, blackout=request.period)
+        self.subscribe("LOGGER_RESTART", self._on_restart)
 
     # -- files ---------------------------------------------------------------------------------
 
     def on_start(self) -> None:
-        s = self.settings
         self.formatter.log_start = self.start_time  # start() takes the time afresh
+        self._open_session()
+
+    def _on_restart(self, msg: MOOSMessage) -> None:
+        """LOGGER_RESTART: close the files and start a new directory (same LOGSTART)."""
+        self._close_session()
+        self._open_session()
+        self.on_connect()
+
+    def _open_session(self) -> None:
+        s = self.settings
+        self._reported_drops = 0
         root = s.directory_name()
         self.directory = self._make_directory(root)
         if self.directory is None:
@@ -87,9 +99,7 @@ class pLogger(ClassicMOOSApp):  # noqa: N801 - the program's name
         if self.mission is not None and self.mission.path is not None:
             copy = self.directory / f"{root}._moos"
             try:
-                with open(copy, "w") as out, open(self.mission.path) as original:
-                    out.write(banner(str(copy), self.start_time))
-                    shutil.copyfileobj(original, out)
+                copy_with_banner(self.mission.path, copy, banner(str(copy), self.start_time))
             except OSError as err:
                 self.log.warning("no copy of the mission file: %s", err)
         if s.async_log or s.wildcard_logging:
@@ -114,14 +124,10 @@ class pLogger(ClassicMOOSApp):  # noqa: N801 - the program's name
 
     def _make_directory(self, root: str) -> Path | None:
         """PATH/root, else ./root as pLogger falls back; None (and the app fails) if neither."""
-        for directory in (Path(self.settings.path) / root, Path(root)):
-            try:
-                directory.mkdir(parents=True, exist_ok=True)
-                return directory
-            except OSError as err:
-                self.log.warning("cannot make the log directory %s: %s", directory, err)
-        self.fail(f"no log directory: neither {self.settings.path}/{root} nor ./{root}")
-        return None
+        directory = make_log_directory([Path(self.settings.path) / root, Path(root)], self.log)
+        if directory is None:
+            self.fail(f"no log directory: neither {self.settings.path}/{root} nor ./{root}")
+        return directory
 
     def on_connect(self) -> None:
         self.formatter.own_community = self.client.community
@@ -130,10 +136,15 @@ class pLogger(ClassicMOOSApp):  # noqa: N801 - the program's name
 
     def on_stop(self) -> None:
         self._handle_mail()  # what arrived since the last tick
+        self._close_session()
+
+    def _close_session(self) -> None:
         if self.sink is not None:
             self.sink.close()
+            self.sink = None
         if self._slog is not None:
             self._slog.close()
+            self._slog = None
 
     # -- mail ----------------------------------------------------------------------------------
 
@@ -143,7 +154,7 @@ class pLogger(ClassicMOOSApp):  # noqa: N801 - the program's name
             return
         if self._accept and not any(glob.match(key) for glob in self._accept):
             return
-        if key not in self._handlers:  # a Log = VAR line logs it already
+        if key not in self._log_vars:  # a Log = VAR line logs it already
             self._on_mail(msg)
 
     def _on_mail(self, msg: MOOSMessage) -> None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import gzip
 import logging
 import os
+import shutil
 import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -228,3 +229,21 @@ class AlogSink:
         if self._blog is None:
             self._blog = open(self.directory / self.blog_name, "wb")  # noqa: SIM115
         return self._blog
+
+
+def make_log_directory(candidates: list[Path], logger: logging.Logger) -> Path | None:
+    """The first of `candidates` that exists or can be made (a warning for each that cannot)."""
+    for directory in candidates:
+        try:
+            directory.mkdir(parents=True, exist_ok=True)
+            return directory
+        except OSError as err:
+            logger.warning("cannot make the log directory %s: %s", directory, err)
+    return None
+
+
+def copy_with_banner(original: str | os.PathLike[str], copy: Path, header: str) -> None:
+    """`original` copied to `copy` under a banner (pLogger's ._moos copy of the mission)."""
+    with open(copy, "w") as out, open(original) as source:
+        out.write(header)
+        shutil.copyfileobj(source, out)
