@@ -165,6 +165,20 @@ def test_damaged_file_is_read_to_the_end(tmp_path: Path) -> None:
     assert log.reader.bad_lines == 4 and log.reader.first_bad_line == 7
 
 
+def test_an_over_long_line_is_skipped_in_bounded_memory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import pygoby.moos.alog.files as files
+
+    monkeypatch.setattr(files, "MAX_LINE_BYTES", 64)
+    path = tmp_path / "long.alog"
+    path.write_bytes(b"1.000 A s " + b"x" * 1000 + b"\n2.000 B s ok \n")
+    log = AlogFile(path)
+    assert [(e.name, e.value) for e in log] == [("B", "ok")]
+    assert (log.reader.bad_lines, log.reader.first_bad_line) == (1, 1)
+    assert [e.name for e in log] == ["B"] and log.reader.bad_lines == 1  # a second pass
+
+
 @settings(max_examples=300, deadline=None)
 @given(st.lists(st.binary(max_size=80) | st.text(max_size=80), max_size=20))
 def test_reader_never_raises(lines: list[bytes | str]) -> None:

@@ -3,7 +3,7 @@
 * `AlogFile(path)`: iterate its entries (plain or `.gz`), binary values fetched from the
   `.blog` beside it; damaged lines are skipped and counted (`reader.bad_lines`).
 * `AlogSink`: the writer pLogger uses: the app thread hands it lines and never waits on the
-  disk; a thread writes them, flushes at least once a second, starts a new file past
+  disk; a thread writes them, flushes at least twice a second, starts a new file past
   `max_bytes`, and counts the lines it had to drop when its bounded buffer was full.
 """
 
@@ -23,8 +23,9 @@ from pygoby.moos.alog.format import AlogEntry, AlogReader, binary_tag, decode_li
 log = logging.getLogger(__name__)
 
 FLUSH_PERIOD = 0.5  # s: a kill -9 loses at most about this much
-DEFAULT_MAX_PENDING = 200_000
-HEADER_LINES = 10  # the banner is within a file's first lines  # lines waiting for the disk before new ones are dropped
+DEFAULT_MAX_PENDING = 200_000  # lines waiting for the disk before new ones are dropped
+HEADER_LINES = 10  # the banner is within a file's first lines
+MAX_LINE_BYTES = 16 << 20  # longer lines are damage (a file without newlines must not fill memory)
 
 
 def open_text_or_gz(path: str | os.PathLike[str]) -> IO[bytes]:
@@ -58,9 +59,17 @@ class AlogFile:
         return self.reader.log_start or 0.0
 
     def __iter__(self) -> Iterator[AlogEntry]:
+        self.reader = AlogReader()  # each pass counts afresh
+        self.unresolved_binary = 0
+        self._blogs = {}
         try:
             with open_text_or_gz(self.path) as stream:
-                for raw in stream:
+                while raw := stream.readline(MAX_LINE_BYTES):
+                    if len(raw) == MAX_LINE_BYTES and not raw.endswith(b"\n"):
+                        while (rest := stream.readline(MAX_LINE_BYTES)) and rest[-1:] != b"\n":
+                            pass
+                        self.reader.skip_line()
+                        continue
                     entry = self.reader.feed(decode_line(raw))
                     if entry is None:
                         continue

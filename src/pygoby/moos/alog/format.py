@@ -227,6 +227,11 @@ class AlogReader:
         elif line == BINARY_MARKING:
             self.binary_marked = True
 
+    def skip_line(self) -> None:
+        """Count a line the caller could not hand over (too long) as a damaged one."""
+        self.lines += 1
+        self._bad("?")
+
     def _bad(self, line: str) -> None:
         if line.strip():  # blank lines are not damage
             self.bad_lines += 1
