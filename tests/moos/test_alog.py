@@ -190,6 +190,26 @@ def test_reader_never_raises(lines: list[bytes | str]) -> None:
             assert math.isfinite(entry.time) and entry.name and entry.source
 
 
+@settings(max_examples=100, deadline=None)
+@given(st.binary(max_size=400), st.integers(0, 400), st.integers(10, 400))
+def test_damaged_files_plain_or_gz_never_raise(data: bytes, cut: int, flip: int) -> None:
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        plain = Path(folder) / "f.alog"
+        plain.write_bytes(banner("f", 1.0).encode() + data)
+        packed = Path(folder) / "f.alog.gz"
+        packed.write_bytes(gzip.compress(plain.read_bytes())[:cut])  # cut mid-stream
+        garbled = Path(folder) / "g.alog.gz"
+        compressed = bytearray(gzip.compress(plain.read_bytes()))
+        compressed[flip % len(compressed)] ^= 0x5A
+        garbled.write_bytes(compressed)
+        for path in (plain, packed, garbled):
+            log = AlogFile(path)
+            entries = list(log)
+            assert log.reader.bad_lines + len(entries) <= log.reader.lines
+
+
 @settings(max_examples=200, deadline=None)
 @given(
     st.floats(0, 1e6, allow_nan=False),

@@ -14,6 +14,7 @@ import logging
 import os
 import shutil
 import threading
+import zlib
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
@@ -53,7 +54,7 @@ class AlogFile:
                 with open_text_or_gz(self.path) as stream:
                     for raw, _ in zip(stream, range(HEADER_LINES), strict=False):
                         header.feed(decode_line(raw))
-            except (OSError, EOFError, gzip.BadGzipFile):
+            except (OSError, EOFError, zlib.error):
                 pass
             return header.log_start or 0.0
         return self.reader.log_start or 0.0
@@ -76,7 +77,7 @@ class AlogFile:
                     if entry.binary_ref is not None:
                         self._resolve(entry)
                     yield entry
-        except (OSError, EOFError, gzip.BadGzipFile) as err:
+        except (OSError, EOFError, zlib.error) as err:
             # a truncated .gz (a logger killed mid-write) ends the log where it breaks
             log.warning("%s: stopped reading: %s", self.path, err)
         finally:
