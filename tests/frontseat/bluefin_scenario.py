@@ -84,7 +84,9 @@ class Helm:
             self.requests += 1
 
 
-def driver_on_memory(cfg: object | None = None) -> tuple[BluefinFrontSeat, MemoryLink, VirtualClock]:
+def driver_on_memory(
+    cfg: object | None = None,
+) -> tuple[BluefinFrontSeat, MemoryLink, VirtualClock]:
     clock = VirtualClock(T0)
     link = MemoryLink()
     link.open()

@@ -42,7 +42,11 @@ def started(extra: str = ""):
 
 
 def test_loaded_by_plugin_name_and_by_goby3_library_name():
-    for name in ("bluefin", "libgoby_frontseat_bluefin.so.30", "/usr/lib/libgoby_frontseat_bluefin.so"):
+    for name in (
+        "bluefin",
+        "libgoby_frontseat_bluefin.so.30",
+        "/usr/lib/libgoby_frontseat_bluefin.so",
+    ):
         assert type(load_driver(name, config())).__name__ == "BluefinFrontSeat"
 
 
@@ -64,7 +68,9 @@ def test_configuration_is_checked(extra, error):
 
 
 def test_start_up_asks_for_acks_first_then_each_sentence_one_at_a_time():
-    driver, link, _ = driver_on_memory(config(extra='accepting_commands_hook: BFCTL_TRIGGER extra_bplog: "cma"'))
+    driver, link, _ = driver_on_memory(
+        config(extra='accepting_commands_hook: BFCTL_TRIGGER extra_bplog: "cma"')
+    )
     assert driver.frontseat_state() == frontseat_pb.FRONTSEAT_NOT_CONNECTED
     driver.do_work()
     assert driver.frontseat_state() == frontseat_pb.FRONTSEAT_IDLE
@@ -152,7 +158,13 @@ def test_desired_course_becomes_bprmb(course, extra, expected):
 
 def test_rpm_interpolation_clips_and_truncates():
     table = [(1.0, 500), (2.0, 1000)]
-    assert [rpm_for_speed(s, table) for s in (0.5, 1.0, 1.333, 2.0, 3.0)] == [500, 500, 666, 1000, 1000]
+    assert [rpm_for_speed(s, table) for s in (0.5, 1.0, 1.333, 2.0, 3.0)] == [
+        500,
+        500,
+        666,
+        1000,
+        1000,
+    ]
 
 
 @pytest.mark.parametrize(
@@ -192,7 +204,10 @@ def test_a_nak_answers_the_request_unsuccessfully_and_is_not_resent():
     driver.do_work()
     assert responses == [
         frontseat_pb.CommandResponse(
-            request_successful=False, request_id=3, error_code=1, error_string="payload is not in control"
+            request_successful=False,
+            request_id=3,
+            error_code=1,
+            error_string="payload is not in control",
         )
     ]
     clock.advance(0.5)
@@ -236,7 +251,22 @@ def test_navigation_becomes_a_node_status():
     driver, link, clock = started()
     data = []
     driver.signal_data_from_frontseat.connect(data.append)
-    feed(link, "$BFNVG", "221320.000", "4405.3333", "N", "00950.9167", "E", 1, "12.5", "10.25", "90", "1", "-2", "221319.500")
+    feed(
+        link,
+        "$BFNVG",
+        "221320.000",
+        "4405.3333",
+        "N",
+        "00950.9167",
+        "E",
+        1,
+        "12.5",
+        "10.25",
+        "90",
+        "1",
+        "-2",
+        "221319.500",
+    )
     feed(link, "$BFNVR", "221320.000", "1.2", "0.9", "0", "0.1", "0.2", "0.3")
     driver.do_work()
     (status,) = [d.node_status for d in data]
@@ -244,11 +274,17 @@ def test_navigation_becomes_a_node_status():
     assert (status.global_fix.lat, status.global_fix.lon) == pytest.approx((LAT, LON), abs=1e-6)
     assert (status.global_fix.altitude, status.global_fix.depth) == (12.5, 10.25)
     assert (status.pose.heading, status.pose.roll, status.pose.pitch) == (90, 1, -2)
-    assert (status.pose.pitch_rate, status.pose.roll_rate, status.pose.heading_rate) == (0.1, 0.2, 0.3)
+    assert (status.pose.pitch_rate, status.pose.roll_rate, status.pose.heading_rate) == (
+        0.1,
+        0.2,
+        0.3,
+    )
     assert status.speed.over_ground == pytest.approx(1.5)
     assert status.source.position == frontseat_pb.Source.GPS
     assert status.time == T0 - 0.5  # the time the solution was computed
-    assert abs(status.local_fix.x) < 1 and abs(status.local_fix.y) < 1 and status.local_fix.z == -10.25
+    assert (
+        abs(status.local_fix.x) < 1 and abs(status.local_fix.y) < 1 and status.local_fix.z == -10.25
+    )
     assert driver.frontseat_providing_data()
 
 
@@ -256,7 +292,22 @@ def test_only_nvg_counts_as_data_arriving():
     """goby3 also counts $BFACK, which comes for every heartbeat: missing navigation would then
     go unnoticed (fixed: the configuration says "without $BFNVG")."""
     driver, link, clock = started()
-    feed(link, "$BFNVG", "221320.000", "4405.3333", "N", "00950.9167", "E", 0, "", "1", "0", "0", "0", "221320.000")
+    feed(
+        link,
+        "$BFNVG",
+        "221320.000",
+        "4405.3333",
+        "N",
+        "00950.9167",
+        "E",
+        0,
+        "",
+        "1",
+        "0",
+        "0",
+        "0",
+        "221320.000",
+    )
     driver.do_work()
     assert driver.frontseat_providing_data()
     for _ in range(7):
@@ -295,11 +346,19 @@ def test_sensor_sentences_become_extension_data():
     [
         ("BFMSC_TRIGGER", [("$BFMIS", "x", "Running")], frontseat_pb.FRONTSEAT_IN_CONTROL),
         ("BFMSC_TRIGGER", [("$BFMSC", "go")], frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS),
-        ("BFMIS_RUNNING_TRIGGER", [("$BFMIS", "x", "Running")], frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS),
+        (
+            "BFMIS_RUNNING_TRIGGER",
+            [("$BFMIS", "x", "Running")],
+            frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS,
+        ),
         ("BFCTL_TRIGGER", [("$BFMSC", "go")], frontseat_pb.FRONTSEAT_IDLE),
         ("BFCTL_TRIGGER", [("$BFCTL", "1")], frontseat_pb.FRONTSEAT_ACCEPTING_COMMANDS),
         ("BFCTL_TRIGGER", [("$BFCTL", "1"), ("$BFCTL", "0")], frontseat_pb.FRONTSEAT_IN_CONTROL),
-        ("BFMSC_TRIGGER", [("$BFMSC", "go"), ("$BFMIS", "x", "Stopped")], frontseat_pb.FRONTSEAT_IDLE),
+        (
+            "BFMSC_TRIGGER",
+            [("$BFMSC", "go"), ("$BFMIS", "x", "Stopped")],
+            frontseat_pb.FRONTSEAT_IDLE,
+        ),
     ],
 )
 def test_accepting_commands_hooks(hook, events, expected):
@@ -336,7 +395,12 @@ def test_heartbeat_every_interval_with_payload_status():
     driver, link, clock = started()
     data = frontseat_pb.InterfaceData()
     status = data.Extensions[frontseat_pb.BLUEFIN_DATA].payload_status.add()
-    status.id, status.expire_time, status.msg, status.all_ok = 1, int((T0 + 2.5) * 1e6), "sonar warm", False
+    status.id, status.expire_time, status.msg, status.all_ok = (
+        1,
+        int((T0 + 2.5) * 1e6),
+        "sonar warm",
+        False,
+    )
     driver.send_data_to_frontseat(data)
     beats = []
     for _ in range(4):

@@ -17,12 +17,22 @@ from pathlib import Path
 from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.bluefin.simulator import HuxleyOptions
 
-from .bluefin_scenario import T0, TICK, Helm, driver_on_memory, format_exchange, parse_exchange, run_exchange
+from .bluefin_scenario import (
+    T0,
+    TICK,
+    Helm,
+    driver_on_memory,
+    format_exchange,
+    parse_exchange,
+    run_exchange,
+)
 
 RECORD = Path(__file__).resolve().parents[1] / "data" / "frontseat" / "bluefin_exchange.txt"
 DURATION = 30.0
 OPTIONS = HuxleyOptions(nav_rate=2.0)
-HEADER = "# Bluefin SPI exchange: pygoby's bluefin driver with bluefin_frontseat_simulator (nav 2 Hz)\n"
+HEADER = (
+    "# Bluefin SPI exchange: pygoby's bluefin driver with bluefin_frontseat_simulator (nav 2 Hz)\n"
+)
 
 
 def record() -> str:
@@ -51,7 +61,11 @@ def test_replaying_the_record_against_the_driver():
         assert written == (step.from_driver if step else []), f"at {elapsed} s"
         states.add(driver.state)
     assert frontseat_pb.INTERFACE_COMMAND in states
-    assert any(line.startswith("$BPRMB,") and ",90,10,0,1.5,1,0*" in line for s in recorded.values() for line in s.from_driver)
+    assert any(
+        line.startswith("$BPRMB,") and ",90,10,0,1.5,1,0*" in line
+        for s in recorded.values()
+        for line in s.from_driver
+    )
 
 
 if __name__ == "__main__":

@@ -51,7 +51,9 @@ async def rig(options: HuxleyOptions | None = None, extra: str = "") -> AsyncIte
     server = HuxleyServer(0, simulator=HuxleySimulator(options), clock=clock, poll_interval=0.002)
     port = await server.start()
     serving = asyncio.create_task(server.serve())
-    driver = BluefinFrontSeat(config(port, "reconnect_interval: 1 " + extra), clock, connect_timeout=5)
+    driver = BluefinFrontSeat(
+        config(port, "reconnect_interval: 1 " + extra), clock, connect_timeout=5
+    )
     await driver.start()
     try:
         yield Rig(server, driver, clock)
@@ -96,14 +98,18 @@ async def test_missing_navigation_is_not_providing_data():
         await r.run(lambda: state(r) == frontseat_pb.INTERFACE_COMMAND)
         t = await r.run(lambda: state(r) == frontseat_pb.INTERFACE_FS_ERROR)
         assert r.driver.status().frontseat_error == frontseat_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
-        assert 6.0 + 5.0 <= t <= 6.0 + 5.0 + 1.0  # allow_missing_nav_interval 5 s after the last NVG
+        assert (
+            6.0 + 5.0 <= t <= 6.0 + 5.0 + 1.0
+        )  # allow_missing_nav_interval 5 s after the last NVG
 
 
 async def test_naks_answer_the_helm_unsuccessfully():
     async with rig(HuxleyOptions(nak=frozenset({"RMB"}))) as r:
         await r.run(lambda: len(r.responses) >= 2)
         assert not any(resp.request_successful for resp in r.responses)
-        assert {(resp.error_code, resp.error_string) for resp in r.responses} == {(1, "simulated failure")}
+        assert {(resp.error_code, resp.error_string) for resp in r.responses} == {
+            (1, "simulated failure")
+        }
         assert state(r) == frontseat_pb.INTERFACE_COMMAND  # a NAK is an answer: no error state
 
 
@@ -133,7 +139,18 @@ async def test_clock_skew_shows_in_the_node_status_time():
 
 def test_the_command_line_options():
     args = build_parser().parse_args(
-        ["0", "--nak", "rmb", "--no-ack", "--drop-after", "3", "--clock-skew", "2", "--nav-stop-after", "9"]
+        [
+            "0",
+            "--nak",
+            "rmb",
+            "--no-ack",
+            "--drop-after",
+            "3",
+            "--clock-skew",
+            "2",
+            "--nav-stop-after",
+            "9",
+        ]
     )
     options = options_from(args)
     assert options.nak == frozenset({"RMB"}) and options.no_ack

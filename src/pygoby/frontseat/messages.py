@@ -65,6 +65,7 @@ TrimStatus = _cls("TrimStatus")
 BLUEFIN_CONFIG = _loader.pool.FindExtensionByName(f"{PACKAGE}.bluefin_config")
 BLUEFIN_DATA = _loader.pool.FindExtensionByName(f"{PACKAGE}.bluefin_data")
 BLUEFIN_COMMAND = _loader.pool.FindExtensionByName(f"{PACKAGE}.bluefin_command")
+ModemRaw = _loader.message_class("goby.acomms.protobuf.ModemRaw")  # in BluefinExtraData
 
 # Enum wrappers (`.Name(value)`, `.Value(name)`) and their values as plain ints.
 InterfaceState = _enum("InterfaceState")
