@@ -22,8 +22,14 @@ from .bluefin_scenario import T0, Helm, config
 
 
 class Rig:
-    def __init__(self, server: HuxleyServer, driver: BluefinFrontSeat, clock: VirtualClock) -> None:
-        self.server, self.driver, self.clock = server, driver, clock
+    def __init__(
+        self,
+        server: HuxleyServer,
+        serving: asyncio.Task,
+        driver: BluefinFrontSeat,
+        clock: VirtualClock,
+    ) -> None:
+        self.server, self.serving, self.driver, self.clock = server, serving, driver, clock
         self.helm = Helm(driver)
         self.data: list = []
         self.responses: list = []
@@ -31,14 +37,18 @@ class Rig:
         driver.signal_command_response.connect(self.responses.append)
 
     async def run(self, until: Callable[[], bool], limit: float = 120.0) -> float:
-        """Advance virtual time 0.1 s per step (the helm acting, the driver ticking) until
-        `until()`; returns the virtual seconds since T0. Fails after `limit` virtual s."""
+        """Advance virtual time 0.1 s per step (the helm acting, the driver ticking, the
+        simulator stepping once after the driver, however slow the machine) until `until()`;
+        returns the virtual seconds since T0. Fails after `limit` virtual s."""
         while not until():
             assert self.clock.now() - T0 < limit, "condition not reached in virtual time"
             self.clock.advance(0.1)
             self.helm.act(self.clock.now() - T0)
             self.driver.do_work()
-            await asyncio.sleep(0.003)
+            steps = self.server.steps
+            while self.server.steps < steps + 2:  # it has read what the driver wrote
+                assert not self.serving.done(), self.serving
+                await asyncio.sleep(0.001)
         return self.clock.now() - T0
 
     def last_status(self):
@@ -56,7 +66,7 @@ async def rig(options: HuxleyOptions | None = None, extra: str = "") -> AsyncIte
     )
     await driver.start()
     try:
-        yield Rig(server, driver, clock)
+        yield Rig(server, serving, driver, clock)
     finally:
         await driver.stop()
         serving.cancel()
@@ -156,3 +166,15 @@ def test_the_command_line_options():
     assert options.nak == frozenset({"RMB"}) and options.no_ack
     assert (options.drop_after, options.clock_skew, options.nav_stop_after) == (3, 2, 9)
     assert math.isclose(options.lat, HuxleyOptions().lat)
+
+
+@pytest.mark.parametrize("command", ["bluefin_frontseat_simulator", "basic_frontseat_simulator"])
+def test_the_pygoby_subcommands_are_the_simulators(command, capsys):
+    from pygoby.cli import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main([command, "--help"])
+    assert exit_info.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"usage: pygoby {command} [-h]")
+    assert ("--nak" in out) == (command == "bluefin_frontseat_simulator")

@@ -21,9 +21,10 @@ SIMULATORS = {
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     for name, (module, help_text) in SIMULATORS.items():
-        # add_help=False: -h/--help goes to the simulator's own parser, with its options
-        sub = subparsers.add_parser(name, help=help_text, add_help=False)
-        sub.add_argument("args", nargs=argparse.REMAINDER)
+        # every argument, -h and options included, goes to the simulator's own parser: no help
+        # here and no option prefix ("\0" never starts an argument)
+        sub = subparsers.add_parser(name, help=help_text, add_help=False, prefix_chars="\0")
+        sub.add_argument("args", nargs="*")
         sub.set_defaults(func=lambda args, module=module, name=name: _run(module, name, args.args))
 
 

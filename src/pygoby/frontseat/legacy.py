@@ -159,7 +159,9 @@ def ready_posts(status: Any) -> list[Post]:
     ]
 
 
-# Bluefin extra commands from MOOS (pub_sub_bf_commands): variable -> BluefinCommand.
+# Bluefin extra commands from MOOS (pub_sub_bf_commands): variable -> BluefinCommand. goby3's
+# documentation also names PENDING_SURFACE (a GPS request), which no goby3 code defines or
+# subscribes to: nothing here either (QUIRKS.md Q-BLUEFIN-11).
 _BFCMD = frontseat_pb.BluefinExtraCommands
 BLUEFIN_COMMAND_VARS = {
     "BUOYANCY_CONTROL": _BFCMD.BUOYANCY_ADJUST,

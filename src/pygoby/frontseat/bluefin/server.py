@@ -42,6 +42,7 @@ class HuxleyServer:
         self.poll_interval = poll_interval
         self.exchange: list[str] = []  # "< line" received, "> line" sent, in order
         self._session: int | None = None  # link.connections of the current session
+        self.steps = 0  # step() calls so far (tests on a virtual clock wait for the next one)
 
     @property
     def port(self) -> int:
@@ -67,6 +68,7 @@ class HuxleyServer:
 
     def step(self) -> None:
         """One look: session changes, received lines, the simulator's tick, faults."""
+        self.steps += 1
         now = self.clock.now()
         simulator = self.simulator
         if self.link.is_open and self._session != self.link.connections:
@@ -127,7 +129,11 @@ def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
         help="answer this sentence (e.g. RMB) with a failed $BFACK; repeatable",
     )
     faults.add_argument("--no-ack", action="store_true", help="never send $BFACK")
-    faults.add_argument("--drop-after", type=float, help="close the connection after this many s")
+    faults.add_argument(
+        "--drop-after",
+        type=float,
+        help="close the connection once, this many s after the first connection",
+    )
     faults.add_argument("--clock-skew", type=float, default=0.0, help="s added to timestamps")
     parser.add_argument("-v", "--verbose", action="count", default=0)
     return parser

@@ -24,9 +24,9 @@ How it answers, as a Huxley running a mission with a payload-controlled segment:
   rate-limited heading, depth and speed on a local grid round `lat`, `lon`).
 
 Faults (all off by default): `nav_stop_after` s without any more NVG/NVR; `nak` (sentence ids
-answered with status 1, e.g. {"RMB"}); `no_ack` (never acknowledge); `drop_after` s, after which
-`drop_due` asks the server to close the connection (once per session); `clock_skew` s added to
-every timestamp it writes.
+answered with status 1, e.g. {"RMB"}); `no_ack` (never acknowledge); `drop_after` s into the
+first session, `drop_due` asks the server to close the connection (once: the payload's
+reconnection then stays up); `clock_skew` s added to every timestamp it writes.
 """
 
 from __future__ import annotations
@@ -104,7 +104,6 @@ class HuxleySimulator:
         self.in_control = False
         self.control_done = False
         self.last_nav = None
-        self._dropped = False
         self._reports_due.clear()
         return []
 
@@ -113,7 +112,7 @@ class HuxleySimulator:
         self.in_control = False
 
     def drop_due(self, now: float) -> bool:
-        """True once per session when the `drop_after` fault wants the connection closed."""
+        """True once when the `drop_after` fault wants the connection closed."""
         after = self.options.drop_after
         if after is None or self.session_start is None or self._dropped:
             return False

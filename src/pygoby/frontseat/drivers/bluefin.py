@@ -41,7 +41,7 @@ saying Running gives IN_CONTROL under the other hooks (unless already accepting)
 Commands: a desired course -> `$BPRMB,<t>,<heading>,<depth>,0,<speed>,1,0` (or
 `<rpm>,0` interpolated in `rpm_table` with `use_rpm_table_for_speed`); a speed under 0.01 m/s,
 or both depth and speed under 1 (goby3 compares them truncated to integers: reproduced,
-QUIRKS.md Q-FS-BF-1) -> the stop request `$BPRMB,<t>,0,0,2,0,0,1`. The BluefinExtraCommands
+QUIRKS.md Q-BLUEFIN-1) -> the stop request `$BPRMB,<t>,0,0,2,0,0,1`. The BluefinExtraCommands
 extension -> `$BPTRM`, `$BPBOY`, `$BPSIL,<t>,<mode>`, `$BPRCE,<t>,0` (cancel behaviour and
 mission end), `$BPABT,<t>,backseat abort,<reason>`, `$BPSMC,<t>,1`; a desired course in the same
 request is then ignored. `cancel_request_id` forgets that outstanding request. Data to the
@@ -50,11 +50,14 @@ the modem's incoming sentence -> `$BPTMR,<t>,3,<text with , as : and * as />` (i
 `send_tmr_messages`). Raw text from other processes is written as a sentence (its checksum
 recomputed).
 
-Differences from goby3 (QUIRKS.md Q-FS-BF-*): the heartbeat really comes every
-`heartbeat_interval` s; only `$BFNVG` counts as data arriving (not `$BFACK`); an ACK resets the
-resend count and a mismatched ACK stops the wait; the ACKs of RCE, ABT and SMC answer their
-requests; a sentence that cannot be read (missing or non-numeric field) is logged and skipped;
-the write queue holds at most MAX_QUEUE sentences.
+Differences from goby3 (QUIRKS.md Q-BLUEFIN-2 to Q-BLUEFIN-7, Q-BLUEFIN-10, Q-BLUEFIN-12): the heartbeat
+really comes every `heartbeat_interval` s; only `$BFNVG` counts as data arriving (not `$BFACK`);
+an ACK resets the resend count and a mismatched ACK ends the wait; the ACKs of RCE, ABT and SMC
+answer their requests; a sentence that cannot be read (missing or non-numeric field) is logged
+and skipped; the write queue holds at most MAX_QUEUE sentences; `$BPSTS` shows each payload's
+latest status; lines still buffered from a lost connection are discarded (Q-BLUEFIN-12).
+Reproduced: the stop request above (Q-BLUEFIN-1), `dvl_time` (Q-BLUEFIN-8), one
+sentence freed per tick (Q-BLUEFIN-9).
 """
 
 from __future__ import annotations
@@ -182,6 +185,7 @@ class BluefinFrontSeat(InterfaceBase):
         self.rpm_table = sorted(table.items())
 
         self._frontseat_state: int = frontseat_pb.FRONTSEAT_NOT_CONNECTED
+        self._connection: int | None = None  # link.connections at the last start-up
         self._providing_data = False
         self._last_nav_time: float | None = None
         self._last_heartbeat: float | None = None
@@ -224,6 +228,11 @@ class BluefinFrontSeat(InterfaceBase):
                 self.log.warning("lost Huxley at %s; reconnecting", self.address)
             self._frontseat_state = frontseat_pb.FRONTSEAT_NOT_CONNECTED
         else:
+            connection = getattr(self.link, "connections", None)
+            if connection != self._connection:  # a new connection: what is buffered is stale
+                self._connection = connection
+                self._frontseat_state = frontseat_pb.FRONTSEAT_NOT_CONNECTED
+                self.link.read_lines()
             if self._frontseat_state == frontseat_pb.FRONTSEAT_NOT_CONNECTED:
                 self.log.info("connected to Huxley at %s", self.address)
                 self._frontseat_state = frontseat_pb.FRONTSEAT_IDLE
