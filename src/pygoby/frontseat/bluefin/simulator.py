@@ -154,7 +154,7 @@ class HuxleySimulator:
 
     def _log_request(self, sentence: NMEASentence) -> tuple[int, str]:
         if len(sentence) < 3 or sentence[2] not in ("ON", "OFF"):
-            return ACK_INVALID, "expected $BPLOG,<name>,ON|OFF"
+            return ACK_INVALID, "expected a sentence name and ON or OFF"
         name = sentence[1].upper()
         if sentence[2] == "ON":
             self.logging.add(name)
@@ -185,7 +185,7 @@ class HuxleySimulator:
         )
         if self.options.no_ack or not acking:
             return []
-        sent_at = sentence[1] if sentence.sentence_id != "LOG" else ""
+        sent_at = sentence[1] if sentence.sentence_id != "LOG" and len(sentence) > 1 else ""
         values = (self._t(now), sentence.sentence_id, sent_at, "", status, "", text)
         return [sentences.build("$BFACK", values).message()]
 
