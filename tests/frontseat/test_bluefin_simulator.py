@@ -28,7 +28,9 @@ def test_acks_only_once_asked_and_by_status():
     assert say(sim, "$BPSTS", "221320.000", 1, "Deploy") == []  # ACKs not asked for yet
     assert acks(say(sim, "$BPLOG", "ACK", "ON")) == [("LOG", "2", "")]
     assert acks(say(sim, "$BPXYZ", "221320.000")) == [("XYZ", "0", "unknown sentence")]
-    assert acks(say(sim, "$BPLOG", "NVG")) == [("LOG", "0", "expected a sentence name and ON or OFF")]
+    assert acks(say(sim, "$BPLOG", "NVG")) == [
+        ("LOG", "0", "expected a sentence name and ON or OFF")
+    ]
     rmb = ("221320.000", 90, 10, 0, 1.5, 1, 0)
     assert acks(say(sim, "$BPRMB", *rmb)) == [("RMB", "1", "payload is not in control")]
     for name in ("MIS", "MSC", "CTL"):
