@@ -1,7 +1,7 @@
 """examples/frontseat/bluefin_auv.moos run through iFrontSeat: the Bluefin vehicle simulator,
 the embedded MOOSDB, iFrontSeat and a scripted helm in one process, time-warped. The interface
 reaches INTERFACE_COMMAND, the vehicle follows the helm's DESIRED_*, TRIM_CONTROL comes back as
-TRIM_REPORT and ACOMMS_RAW_INCOMING reaches the vehicle as $BPTMR."""
+TRIM_REPORT, ACOMMS_RAW_INCOMING reaches the vehicle as $BPTMR and CTD_* as $BPCTD."""
 
 from __future__ import annotations
 
@@ -29,7 +29,8 @@ def test_the_example_mission_reads():
     assert cfg.driver_library == "libgoby_frontseat_bluefin.so.30"
     bf = cfg.frontseat_cfg.Extensions[frontseat_pb.BLUEFIN_CONFIG]
     assert (bf.huxley_tcp_port, bf.reconnect_interval) == (29500, 2)
-    assert cfg.legacy_cfg.pub_sub_bf_commands and cfg.legacy_cfg.subscribe_acomms_raw
+    legacy = cfg.legacy_cfg
+    assert legacy.pub_sub_bf_commands and legacy.subscribe_acomms_raw and legacy.subscribe_ctd
 
 
 async def test_the_example_mission_drives_the_bluefin_vehicle():
@@ -48,6 +49,7 @@ async def test_the_example_mission_drives_the_bluefin_vehicle():
             ),
         ]
         app = iFrontSeat.from_mission(MISSION, overrides=overrides, port=db.port)
+        assert app.cfg.legacy_cfg.pub_sub_bf_commands  # the mission's legacy_cfg is kept
         await stack.enter_async_context(app)
 
         latest: dict[str, object] = {}
@@ -84,6 +86,10 @@ async def test_the_example_mission_drives_the_bluefin_vehicle():
         )
         assert latest["FRONTSEAT_READY"] == 1.0
 
+        # a backseat CTD (legacy CTD_*: S/m, dbar, C) goes to the vehicle as $BPCTD (S/m, kPa)
+        helm.publish("CTD_CONDUCTIVITY", 4.2)
+        helm.publish("CTD_PRESSURE", 10.0)
+        helm.publish("CTD_TEMPERATURE", 10.5)
         helm.publish("TRIM_CONTROL", "true")
         raw = frontseat_pb.ModemRaw(raw=b"$CARXD,1,2,0,1,abcd*7F")
         post = post_for_moos("ACOMMS_RAW_INCOMING", raw, app.moos_technique)
@@ -93,4 +99,7 @@ async def test_the_example_mission_drives_the_bluefin_vehicle():
         await until(lambda: any(s.sentence_id == "TMR" for s in server.simulator.received), 20)
         (tmr,) = [s for s in server.simulator.received if s.sentence_id == "TMR"]
         assert tmr.fields[2:] == ("3", "$CARXD:1:2:0:1:abcd/7F")
+        await until(lambda: any(s.sentence_id == "CTD" for s in server.simulator.received), 20)
+        (ctd,) = [s for s in server.simulator.received if s.sentence_id == "CTD"]
+        assert ctd.fields[2:5] == ("4.2", "10.5", "100")
         assert app.interface.state == frontseat_pb.INTERFACE_COMMAND
