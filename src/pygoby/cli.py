@@ -16,6 +16,7 @@ SUBCOMMAND_MODULES = [
     "pygoby.acomms.cli",
     "pygoby.moos.cli",
     "pygoby.moos.alog.cli",
+    "pygoby.frontseat.cli",
     "pygoby.netsim.sim_cli",
     "pygoby.apps.topside_cli",
 ]
