@@ -6,7 +6,8 @@
 * `channel/`: the packet-level acoustic channel physics (geometry, sound speed, absorption,
   levels, frame-error models).
 * `sim/`: `pygoby netsim run` — scenarios, the simulation on a virtual clock or in real time,
-  and the modem emulators' channel backed by `channel/`.
+  the modem emulators' channel backed by `channel/`, and its one-sender-one-receiver form
+  (`range_link`, for iModemSim's multicast channel).
 * `report/`: the event log a simulation writes and `pygoby netsim report`'s plots of it.
 * `sweep/`: parameter sweeps of scenarios.
 * `cli`: the `pygoby netsim` subcommands; `errors`: the NetsimError family.
