@@ -35,10 +35,13 @@ def test_the_extras_are_the_feature_packages():
     )
 
 
-def test_importing_dccl_acomms_and_moos_loads_no_extra_package():
+def test_importing_the_core_loads_no_extra_package():
     check = (
         "import sys\n"
         "import pygoby.dccl, pygoby.acomms, pygoby.moos\n"
+        # and the acomms-on-MOOS layer with the apps over it that need no extra
+        "import pygoby.frontseat, pygoby.moosacomms.acomms_config, pygoby.moosacomms.goby11\n"
+        "import pygoby.apps.pacommshandler, pygoby.apps.ptranslator, pygoby.apps.ifrontseat\n"
         "print(' '.join(sorted({name.split('.')[0] for name in sys.modules})))\n"
     )
     loaded = subprocess.run(
