@@ -31,8 +31,7 @@ def driver_name(cfg) -> str:
     if cfg.WhichOneof("driver") == "driver_name":
         kind = cfg.driver_name
     else:
-        driver_type = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
-        kind = driver_type.values_by_number[cfg.driver_type].name.removeprefix("DRIVER_")
+        kind = acomms_pb.DriverType.Name(cfg.driver_type).removeprefix("DRIVER_")
     return f"{kind}::{cfg.modem_id}"
 
 
@@ -45,12 +44,12 @@ class ModemDriverBase(ABC):
 
     def __init__(self, clock: Clock | None = None, link: LineLink | None = None) -> None:
         self.clock: Clock = clock if clock is not None else WallClock()
-        self.signal_receive = Signal()
-        self.signal_transmit_result = Signal()
-        self.signal_data_request = Signal()
-        self.signal_modify_transmission = Signal()
-        self.signal_raw_incoming = Signal()
-        self.signal_raw_outgoing = Signal()
+        self.signal_receive: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_transmit_result: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_data_request: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_modify_transmission: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_raw_incoming: Signal[acomms_pb.ModemRaw] = Signal()
+        self.signal_raw_outgoing: Signal[acomms_pb.ModemRaw] = Signal()
         self.cfg = acomms_pb.DriverConfig()
         self.link: LineLink | None = link
         self._injected_link = link is not None

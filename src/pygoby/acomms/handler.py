@@ -50,11 +50,8 @@ from pygoby.util.signal import Signal
 log = logging.getLogger(__name__)
 
 Status = acomms_pb.ModemDriverStatus
-DriverType = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name[
-    "driver_type"
-].enum_type.values_by_name
-DRIVER_NONE = DriverType["DRIVER_NONE"].number
-UFIELD = DriverType["DRIVER_UFIELD_SIM_DRIVER"].number
+DRIVER_NONE = acomms_pb.DriverType.DRIVER_NONE
+UFIELD = acomms_pb.DriverType.DRIVER_UFIELD_SIM_DRIVER
 
 ROUTE_COMMAND = RouteCommand.DESCRIPTOR.full_name
 
@@ -138,10 +135,16 @@ class AcommsHandler:
         # Drivers first (as upstream): a bad driver configuration fails before anything runs.
         self.slots: list[DriverSlot] = []
         self.primary: DriverSlot | None = None
-        self.signal_raw_incoming = Signal()  # (ModemRaw) of the primary driver
-        self.signal_raw_outgoing = Signal()
-        self.signal_modem_receive = Signal()  # (ModemTransmission) received by the primary
-        self.signal_modem_transmit = Signal()  # (ModemTransmission) transmit result
+        self.signal_raw_incoming: Signal[acomms_pb.ModemRaw] = (
+            Signal()
+        )  # (ModemRaw) of the primary driver
+        self.signal_raw_outgoing: Signal[acomms_pb.ModemRaw] = Signal()
+        self.signal_modem_receive: Signal[acomms_pb.ModemTransmission] = (
+            Signal()
+        )  # (ModemTransmission) received by the primary
+        self.signal_modem_transmit: Signal[acomms_pb.ModemTransmission] = (
+            Signal()
+        )  # (ModemTransmission) transmit result
         primary_cfg = acomms_pb.DriverConfig()
         primary_cfg.CopyFrom(cfg.driver_cfg)
         top_level = primary_cfg.WhichOneof("driver") is None and cfg.HasField("driver_type")

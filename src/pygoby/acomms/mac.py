@@ -16,6 +16,7 @@ import math
 import time
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.protobuf import enum_type
 from pygoby.util.clock import Clock
 from pygoby.util.glog import DEBUG1, DEBUG2, VERBOSE, group_logger
 from pygoby.util.signal import Signal
@@ -24,12 +25,12 @@ SKEW_TOLERANCE = 2.0  # s late before a slot is skipped and the schedule re-anch
 AUTO_ENTROPY = 5
 SECONDS_PER_DAY = 86400
 
-MACType = acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name
+MACType = enum_type(acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"]).values_by_name
 MAC_NONE = MACType["MAC_NONE"].number
 MAC_FIXED_DECENTRALIZED = MACType["MAC_FIXED_DECENTRALIZED"].number
 MAC_AUTO_DECENTRALIZED = MACType["MAC_AUTO_DECENTRALIZED"].number
 MAC_POLLED = MACType["MAC_POLLED"].number
-_MAC_TYPE_NAMES = acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_number
+_MAC_TYPE_NAMES = enum_type(acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"]).values_by_number
 U = acomms_pb.MACUpdate
 
 
@@ -37,8 +38,8 @@ class MACManager:
     def __init__(self, clock: Clock) -> None:
         self.clock = clock
         self.cfg = acomms_pb.MACConfig()
-        self.signal_initiate_transmission = Signal()
-        self.signal_slot_start = Signal()
+        self.signal_initiate_transmission: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_slot_start: Signal[acomms_pb.ModemTransmission] = Signal()
         self.slots: list = []  # the cycle: ModemTransmissions, in order
         self.running = False
         self.current = 0  # index of the next slot to run

@@ -11,13 +11,12 @@ from __future__ import annotations
 import logging
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.protobuf import default_loader
+from pygoby.protobuf.goby.acomms.protobuf import route_pb2
 
 log = logging.getLogger(__name__)
 
-default_loader().load_file("goby/acomms/protobuf/route.proto")
-RouteManagerConfig = default_loader().message_class("goby.acomms.protobuf.RouteManagerConfig")
-RouteCommand = default_loader().message_class("goby.acomms.protobuf.RouteCommand")
+RouteManagerConfig = route_pb2.RouteManagerConfig
+RouteCommand = route_pb2.RouteCommand
 
 NO_ROUTE = -1
 

@@ -42,15 +42,14 @@ from pygoby.moos.appconfig import prefixed_var_names, read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import LAT_ORIGIN_VAR, LONG_ORIGIN_VAR
+from pygoby.protobuf.goby.moos.protobuf.iFrontSeat_config_pb2 import iFrontSeatConfig
 
 LEGACY_BLACKOUT = 1.0  # s, goby3's registration interval for the DESIRED_* and CTD_* variables
 
 
 class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "goby/moos/protobuf/iFrontSeat_config.proto",
-        "goby.apps.moos.protobuf.iFrontSeatConfig",
-    )
+    config_class = iFrontSeatConfig
+    cfg: iFrontSeatConfig
     default_name = "iFrontSeat"
     # the frontseat link is served through a MOOSDB outage (its lines read, the helm's
     # silence noticed); what the interface posts meanwhile is delivered when the DB is back
@@ -87,7 +86,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
 
     # -- construction ----------------------------------------------------------------------
 
-    def __init__(self, cfg: Message, **kwargs: Any) -> None:
+    def __init__(self, cfg: iFrontSeatConfig, **kwargs: Any) -> None:
         super().__init__(cfg, **kwargs)
         fs_config.refuse_unsupported_legacy(cfg.legacy_cfg)
         self.var = prefixed_var_names(cfg.moos_var)

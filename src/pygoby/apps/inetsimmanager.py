@@ -17,16 +17,15 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.netsim.client import NetSimClient, status_name
 from pygoby.netsim.navreporter import NavReporter
+from pygoby.protobuf.pygoby.netsim.inetsimmanager_config_pb2 import iNetSimManagerConfig
 
 
 class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "pygoby/netsim/inetsimmanager_config.proto",
-        "pygoby.netsim.protobuf.iNetSimManagerConfig",
-    )
+    config_class = iNetSimManagerConfig
+    cfg: iNetSimManagerConfig
     default_name = "iNetSimManager"
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: iNetSimManagerConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         common = cfg.common
         origin = None

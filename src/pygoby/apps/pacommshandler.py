@@ -32,7 +32,8 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import locate, prefixed_var_names
 from pygoby.moos.protocol import MOOSMessage, text_or_binary
 from pygoby.moos.translator_binding import TranslatorBinding, not_loaded
-from pygoby.topside.acomms_config import PACOMMSHANDLER_CONFIG, AcommsMessageSet
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
+from pygoby.topside.acomms_config import AcommsMessageSet
 
 IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
 
@@ -46,13 +47,14 @@ def _make_driver(cfg, clock) -> ModemDriverBase | None:
 
 
 class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = PACOMMSHANDLER_CONFIG
+    config_class = pAcommsHandlerConfig
+    cfg: pAcommsHandlerConfig
     default_name = "pAcommsHandler"
     # the modem, the MAC and the queue keep going through a MOOSDB outage; what they post
     # meanwhile is delivered when the DB is back
     iterate_without_comms = True
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: pAcommsHandlerConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.var = prefixed_var_names(cfg.moos_var, skip=(IFS_DATA_OUT,))
         self.ifs_data_out = getattr(cfg.moos_var, IFS_DATA_OUT)

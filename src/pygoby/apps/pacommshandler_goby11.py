@@ -27,9 +27,7 @@ RANGE_RESPONSE = "ACOMMS_RANGE_RESPONSE"
 POLLER_UPDATE = "ACOMMS_POLLER_UPDATE"
 # Goby 1.1 posted its acomms messages as plain single-line TextFormat
 GOBY11_TECHNIQUE = Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT
-V1_RANGING = acomms_pb.V1ModemRangingRequest.DESCRIPTOR.fields_by_name[
-    "type"
-].enum_type.values_by_name
+V1_RANGING = acomms_pb.V1RangingType.DESCRIPTOR.values_by_name
 RANGING_TYPES = {  # Goby 1.1 RangingType -> Micro-Modem transmission type
     V1_RANGING["MODEM_TWO_WAY_PING"].number: acomms_pb.MICROMODEM_TWO_WAY_PING,
     V1_RANGING["REMUS_LBL_RANGING"].number: acomms_pb.MICROMODEM_REMUS_LBL_RANGING,

@@ -18,8 +18,6 @@ from __future__ import annotations
 import math
 from functools import partial
 
-from google.protobuf.message import Message
-
 from pygoby.acomms import messages as acomms_pb
 from pygoby.apps.premuscodec_reports import RemusReports
 from pygoby.dccl import DcclError
@@ -27,6 +25,7 @@ from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import Technique, TranslatorError, parse_for_moos, serialize_for_moos
+from pygoby.protobuf.pygoby.apps.premuscodec_config_pb2 import pREMUSCodecConfig
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup, atoi
 
@@ -37,13 +36,11 @@ TEXT = Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT  # Goby 1.1's ModemDataTransmiss
 
 
 class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "pygoby/apps/premuscodec_config.proto",
-        "pygoby.apps.protobuf.pREMUSCodecConfig",
-    )
+    config_class = pREMUSCodecConfig
+    cfg: pREMUSCodecConfig
     default_name = "pREMUSCodec"
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: pREMUSCodecConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         if not (self.common.HasField("lat_origin") and self.common.HasField("lon_origin")):
             raise ConfigError(

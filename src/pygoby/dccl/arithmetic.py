@@ -44,10 +44,9 @@ from pygoby.dccl.codecs.base import FieldInfo, RepeatedFieldCodec
 from pygoby.dccl.codecs.numeric import f32
 from pygoby.dccl.errors import DcclDecodeError, DcclError, DcclLoadError
 from pygoby.dccl.options import field_extension
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf import enum_type
+from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_pb2 import ArithmeticModel
 
-MODEL_PROTO = "dccl/arithmetic/protobuf/arithmetic.proto"
-MODEL_NAME = "dccl.arith.protobuf.ArithmeticModel"
 EXTENSIONS_PROTO = "dccl/arithmetic/protobuf/arithmetic_extensions.proto"
 
 EOF_SYMBOL = -2
@@ -63,8 +62,8 @@ _U32 = (1 << 32) - 1
 _NAN = float("nan")
 
 
-def model_class() -> type[Message]:
-    return builtin_class(MODEL_PROTO, MODEL_NAME)
+def model_class() -> type[ArithmeticModel]:
+    return ArithmeticModel
 
 
 def load_model_file(path: str | os.PathLike[str]) -> Message:
@@ -217,7 +216,7 @@ def _from_wire(category: str, info: FieldInfo):
             & _U64
         )
     if category == "enum":
-        known = {v.number for v in info.descriptor.enum_type.values}
+        known = {v.number for v in enum_type(info.descriptor).values}
         # an unknown number makes the element "not set" (dropped)
         return lambda x: n if (n := cvtt32(x)) in known else None
     raise DcclLoadError(f"{info.name}: dccl.arithmetic cannot code {category} fields")

@@ -38,6 +38,7 @@ from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.errors import DcclError, DcclLoadError
+from pygoby.protobuf import enum_type
 
 _INT64 = (FieldDescriptor.CPPTYPE_INT64, FieldDescriptor.CPPTYPE_UINT64)
 
@@ -198,7 +199,7 @@ class DynamicConditions:
         if cpp == FieldDescriptor.CPPTYPE_MESSAGE:
             return self._table(value)
         if cpp == FieldDescriptor.CPPTYPE_ENUM:
-            known = f.enum_type.values_by_number.get(value)
+            known = enum_type(f).values_by_number.get(value)
             return known.name if known is not None else value
         if cpp in _INT64 and value >= 1 << 63:
             return value - (1 << 64)  # a Lua integer is signed 64-bit

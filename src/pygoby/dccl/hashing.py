@@ -26,6 +26,7 @@ from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec
 from pygoby.dccl.codecs.numeric import NumericCodec
 from pygoby.dccl.errors import DcclDecodeError, DcclLoadError
 from pygoby.dccl.options import field_options, message_options
+from pygoby.protobuf import enum_type, message_type
 from pygoby.protobuf.cpp_text import c_escape, message_text, scalar_text
 
 _U64 = (1 << 64) - 1
@@ -113,7 +114,7 @@ _PROTO_TYPES = {number: "TYPE_" + name.upper() for number, name in _TYPE_NAMES.i
 
 def _field_proto(f: FieldDescriptor) -> descriptor_pb2.FieldDescriptorProto:
     proto = descriptor_pb2.DescriptorProto()
-    f.containing_type.CopyToProto(proto)
+    f.containing_type.CopyToProto(proto)  # type: ignore[union-attr]  # (a field of a message)
     return next(p for p in proto.field if p.number == f.number)
 
 
@@ -151,9 +152,9 @@ def _field_debug_string(f: FieldDescriptor, depth: int) -> str:
     """FieldDescriptor::DebugString at `depth` (as inside a oneof)."""
     prefix = " " * (2 * depth)
     if f.type in (FieldDescriptor.TYPE_MESSAGE, FieldDescriptor.TYPE_GROUP):
-        type_name = "." + f.message_type.full_name
+        type_name = "." + message_type(f).full_name
     elif f.type == FieldDescriptor.TYPE_ENUM:
-        type_name = "." + f.enum_type.full_name
+        type_name = "." + enum_type(f).full_name
     else:
         type_name = _TYPE_NAMES[f.type]
     label = "" if f.containing_oneof is not None else _label(f)[6:].lower() + " "

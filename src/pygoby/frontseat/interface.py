@@ -56,8 +56,11 @@ from pygoby.frontseat.messages import (
     INTERFACE_HELM_ERROR,
     INTERFACE_LISTEN,
     INTERFACE_STANDBY,
+    CommandResponse,
+    InterfaceData,
     InterfaceState,
     InterfaceStatus,
+    Raw,
 )
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.geodesy import UTMGeodesy
@@ -92,11 +95,15 @@ class InterfaceBase(abc.ABC):
         self._last_frontseat_error: int = ERROR_FRONTSEAT_NONE
 
         # A raising subscriber is logged and does not stop the others (nor the interface's tick)
-        self.signal_data_from_frontseat = Signal(contain_errors=True, logger=_log)
-        self.signal_command_response = Signal(contain_errors=True, logger=_log)
-        self.signal_raw_from_frontseat = Signal(contain_errors=True, logger=_log)
-        self.signal_raw_to_frontseat = Signal(contain_errors=True, logger=_log)
-        self.signal_state_change = Signal(contain_errors=True, logger=_log)
+        self.signal_data_from_frontseat: Signal[InterfaceData] = Signal(
+            contain_errors=True, logger=_log
+        )
+        self.signal_command_response: Signal[CommandResponse] = Signal(
+            contain_errors=True, logger=_log
+        )
+        self.signal_raw_from_frontseat: Signal[Raw] = Signal(contain_errors=True, logger=_log)
+        self.signal_raw_to_frontseat: Signal[Raw] = Signal(contain_errors=True, logger=_log)
+        self.signal_state_change: Signal[InterfaceStatus] = Signal(contain_errors=True, logger=_log)
 
         self._geodesy: UTMGeodesy | None = None
         origin = self.cfg.origin

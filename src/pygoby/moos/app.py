@@ -114,7 +114,7 @@ from pygoby.moos.translator import (
     parse_for_moos,
     post_for_moos,
 )
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf import builtin_class, message_type
 from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock
 
@@ -173,7 +173,7 @@ class GobyMOOSApp:
                 raise TypeError(f"{cls.__name__} must set config_class or config_proto")
             config_class = builtin_class(*cls.config_proto)
         common = config_class.DESCRIPTOR.fields_by_name.get("common")
-        if common is None or common.message_type.full_name != COMMON_PROTO[1]:
+        if common is None or message_type(common).full_name != COMMON_PROTO[1]:
             raise TypeError(
                 f"{config_class.DESCRIPTOR.full_name} needs a `common` field of type {COMMON_PROTO[1]}"
             )

@@ -24,6 +24,7 @@ import math
 import re
 from collections.abc import Callable, Iterator, Sequence
 from contextvars import ContextVar
+from typing import TypeVar
 
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
@@ -31,9 +32,12 @@ from google.protobuf.message import Message
 from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
 from pygoby.moos.moosfile import GobyBlock, MissionFile, parse_number
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf import enum_type
+from pygoby.protobuf.goby.protobuf.option_extensions_pb2 import GobyFieldOptions
 from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
 from pygoby.protobuf.wire import length_delimited
+
+ConfigT = TypeVar("ConfigT", bound=Message)  # an app's configuration message
 
 log = logging.getLogger(__name__)
 
@@ -44,8 +48,8 @@ EXAMPLE_FALLBACK_INDENT = 46
 
 
 @functools.cache
-def _options_class() -> type[Message]:
-    return builtin_class("goby/protobuf/option_extensions.proto", "goby.GobyFieldOptions")
+def _options_class() -> type[GobyFieldOptions]:
+    return GobyFieldOptions
 
 
 def goby_field_options(field: FieldDescriptor) -> Message:
@@ -137,7 +141,7 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
         elif (number := parse_number(value)) is not None:
             setattr(config, field.name, number > 0)
     elif kind == FieldDescriptor.TYPE_ENUM:
-        enum_value = field.enum_type.values_by_name.get(value)
+        enum_value = enum_type(field).values_by_name.get(value)
         if enum_value is None:
             raise ConfigError(
                 f'invalid enumeration "{value}" (MOOS global {name})', field=field.name
@@ -195,13 +199,13 @@ def collecting_notes() -> Iterator[list[str]]:
 
 
 def read_configuration(
-    config_class: type[Message],
+    config_class: type[ConfigT],
     mission: MissionFile | None,
     app_name: str,
     overrides: Sequence[tuple[str, str]] = (),
-    complete: Callable[[Message], None] | None = None,
+    complete: Callable[[ConfigT], None] | None = None,
     notes: list[str] | None = None,
-) -> Message:
+) -> ConfigT:
     """`complete(config)`, if given, runs after the overrides and before the check for required
     fields (an app's own rewriting of older configuration forms). Goby 1.1 and Goby 2 forms are
     mapped onto today's configuration first (pygoby.moos.goby11_config); what was mapped is
@@ -251,7 +255,7 @@ def _shift(note: str, first_line: int) -> str:
 
 def _format_scalar(field: FieldDescriptor, value: object) -> str:
     if field.type == FieldDescriptor.TYPE_ENUM:
-        return field.enum_type.values_by_number[value].name  # type: ignore[index]
+        return enum_type(field).values_by_number[value].name  # type: ignore[index]
     if field.type == FieldDescriptor.TYPE_BOOL:
         return "true" if value else "false"
     if field.type in (FieldDescriptor.TYPE_STRING, FieldDescriptor.TYPE_BYTES):
@@ -329,7 +333,7 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
         else:
             value = ""
         if field.type == FieldDescriptor.TYPE_ENUM:
-            comment += " (" + ", ".join(v.name for v in field.enum_type.values) + ")"
+            comment += " (" + ", ".join(v.name for v in enum_type(field).values) + ")"
         comment += _label(field)
         if field.has_default_value:
             comment += f" (default={_format_scalar(field, field.default_value)})"
@@ -342,7 +346,7 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
 def _placeholder(field: FieldDescriptor) -> str:
     """A value of the field's type that parses (the first enumerator, 0, false, "")."""
     if field.type == FieldDescriptor.TYPE_ENUM:
-        return field.enum_type.values[0].name
+        return enum_type(field).values[0].name
     if field.type == FieldDescriptor.TYPE_BOOL:
         return "false"
     if field.type == FieldDescriptor.TYPE_BYTES:

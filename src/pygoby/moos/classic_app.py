@@ -27,10 +27,12 @@ from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import apply_moos_globals
 from pygoby.moos.moosfile import MissionFile, Setting, parse_number
+from pygoby.protobuf.pygoby.moos.classic_app_pb2 import ClassicMOOSAppConfig
 
 
 class ClassicMOOSApp(GobyMOOSApp):
-    config_proto = ("pygoby/moos/classic_app.proto", "pygoby.moos.protobuf.ClassicMOOSAppConfig")
+    config_class = ClassicMOOSAppConfig
+    cfg: ClassicMOOSAppConfig
     keep_quotes: ClassVar[bool] = False
     # the block's own `name = value` lines, as `--example_config` prints them
     example_lines: ClassVar[tuple[str, ...]] = ()
@@ -70,7 +72,7 @@ class ClassicMOOSApp(GobyMOOSApp):
             setattr(cfg.common, field, max(1, math.ceil(number)))
         return cfg
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: ClassicMOOSAppConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         block = self.mission.process_config(self.name, self.keep_quotes) if self.mission else None
         if block is None:

@@ -29,8 +29,9 @@ from pygoby.netsim.protocol import (
     LEGACY_REQUEST_NAME,
     REQUEST_NAME,
     LineDecoder,
+    NavUpdate,
+    NetSimManagerResponse,
     encode_line,
-    message_class,
     request_class,
     response_names,
 )
@@ -116,7 +117,9 @@ class NetSimClient:
     ) -> None:
         self.host, self.port = host, port
         self.tracker = RequestTracker(legacy_names)
-        self.signal_response = Signal()  # every response received, in arrival order
+        self.signal_response: Signal[NetSimManagerResponse] = (
+            Signal()
+        )  # every response received, in arrival order
         if on_response is not None:
             self.signal_response.connect(on_response)
         self.backoff_initial, self.backoff_max = backoff_initial, backoff_max
@@ -170,7 +173,7 @@ class NetSimClient:
     @staticmethod
     def nav(**fields) -> Message:
         """Convenience: a NavUpdate from keyword fields."""
-        return message_class("NavUpdate")(**fields)
+        return NavUpdate(**fields)
 
     async def _run(self) -> None:
         delay = self.backoff_initial

@@ -16,11 +16,8 @@ from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.netsim.channel.settings import environment_channel_configs
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
 from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
-
-CONFIG_PROTO = "netsim/messages/manager_config.proto"
-CONFIG_TYPE = "netsim.protobuf.NetSimManagerConfig"
 
 # Message types whose contents stand for upstream blocks with more fields than pygoby declares.
 _OPEN_BLOCKS = frozenset({"netsim.protobuf.UnusedGoby3Block", "netsim.protobuf.SerialPortConfig"})
@@ -62,8 +59,8 @@ environment_channel {
 
 
 @cache
-def config_class() -> type[Message]:
-    return builtin_class(CONFIG_PROTO, CONFIG_TYPE)
+def config_class() -> type[NetSimManagerConfig]:
+    return NetSimManagerConfig
 
 
 class _Parser(text_format._Parser):  # noqa: SLF001 - per-message control of unknown fields

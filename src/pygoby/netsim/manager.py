@@ -31,9 +31,11 @@ from pygoby.netsim.errors import LineError
 from pygoby.netsim.protocol import (
     LEGACY_RESPONSE_NAME,
     RESPONSE_NAME,
+    EnvironmentNavUpdate,
     LineDecoder,
+    NetSimManagerResponse,
+    ReceiveStats,
     encode_line,
-    message_class,
     request_names,
 )
 from pygoby.util.signal import Signal
@@ -44,7 +46,7 @@ NAV_FIELDS = ("modem_tcp_port", "time", "lat", "lon", "depth", "speed", "heading
 
 
 def status_enum():
-    return message_class("NetSimManagerResponse").Status
+    return NetSimManagerResponse.Status
 
 
 def peer_ip_string(address: str) -> str:
@@ -77,16 +79,18 @@ class NetSimManager:
         self._pairs = {pair.modem_tcp_port: pair for pair in config.sim_env_pair}
         self._bounds = {bounds.environment_id: bounds for bounds in config.env_bounds}
         self._latest: dict[int, Message] = {}
-        self.signal_nav = Signal()  # each forwarded EnvironmentNavUpdate
-        self.signal_stats = Signal()  # each ReceiveStats
-        self._response_cls = message_class("NetSimManagerResponse")
+        self.signal_nav: Signal[EnvironmentNavUpdate] = (
+            Signal()
+        )  # each forwarded EnvironmentNavUpdate
+        self.signal_stats: Signal[ReceiveStats] = Signal()  # each ReceiveStats
+        self._response_cls = NetSimManagerResponse
         # the status values, looked up once (each enum attribute access is a Python __getattr__)
         status = status_enum()
         self.accepted = status.UPDATE_ACCEPTED
         self._invalid_port = status.UPDATE_FAILED_INVALID_MODEM_TCP_PORT
         self._invalid_source = status.UPDATE_FAILED_INVALID_SOURCE_ADDRESS
         self._out_of_region = status.UPDATE_FAILED_OUT_OF_DEFINED_REGION
-        self._env_nav_cls = message_class("EnvironmentNavUpdate")
+        self._env_nav_cls = EnvironmentNavUpdate
 
     # -- queries -------------------------------------------------------------------------
 

@@ -17,7 +17,7 @@ from collections.abc import Mapping
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.netsim.protocol import message_class
+from pygoby.netsim.protocol import NavUpdate, ReceiveStats
 from pygoby.util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)
@@ -39,8 +39,8 @@ class NavReporter:
         self.port_of_id_offset = port_of_id_offset
         self.values: dict[str, float] = {}
         self.time = -math.inf  # of the newest value
-        self._nav_class = message_class("NavUpdate")
-        self._stats_class = message_class("ReceiveStats")
+        self._nav_class = NavUpdate
+        self._stats_class = ReceiveStats
 
     def set_origin(self, lat: float, lon: float) -> None:
         self.geodesy = UTMGeodesy(lat, lon)

@@ -92,7 +92,7 @@ class PhysicsChannel:
         self.clock = clock
         self.ports = dict(ports or {})
         self.control_rate = control_rate
-        self.signal_event = Signal()
+        self.signal_event: Signal[dict[str, object]] = Signal()
         if on_event is not None:
             self.signal_event.connect(on_event)
         self._endpoints: dict[int, ChannelEndpoint] = {}

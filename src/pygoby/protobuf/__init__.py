@@ -6,6 +6,16 @@ from pygoby.protobuf.loader import (
     ProtoLoader,
     builtin_class,
     default_loader,
+    enum_type,
+    message_type,
 )
 
-__all__ = ["BUILTIN_PROTO_DIR", "ProtoError", "ProtoLoader", "builtin_class", "default_loader"]
+__all__ = [
+    "BUILTIN_PROTO_DIR",
+    "ProtoError",
+    "ProtoLoader",
+    "builtin_class",
+    "default_loader",
+    "enum_type",
+    "message_type",
+]

@@ -11,6 +11,8 @@ import struct
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
+from pygoby.protobuf import enum_type, message_type
+
 _ESCAPES = {0x0A: "\\n", 0x0D: "\\r", 0x09: "\\t", 0x22: '\\"', 0x27: "\\'", 0x5C: "\\\\"}
 _F32 = struct.Struct("<f")
 
@@ -69,7 +71,7 @@ def scalar_text(field: FieldDescriptor, value) -> str:
     if cpp == FieldDescriptor.CPPTYPE_FLOAT:
         return float_text(value)
     if cpp == FieldDescriptor.CPPTYPE_ENUM:
-        enum_value = field.enum_type.values_by_number.get(value)
+        enum_value = enum_type(field).values_by_number.get(value)
         return enum_value.name if enum_value is not None else str(value)
     return str(value)
 
@@ -78,7 +80,7 @@ def field_label(field: FieldDescriptor) -> str:
     if field.is_extension:
         return "[" + field.full_name + "]"
     if field.type == FieldDescriptor.TYPE_GROUP:
-        return field.message_type.name
+        return message_type(field).name
     return field.name
 
 

@@ -22,7 +22,7 @@ from importlib import resources
 from pathlib import Path
 
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
-from google.protobuf.descriptor import Descriptor, FileDescriptor
+from google.protobuf.descriptor import Descriptor, EnumDescriptor, FieldDescriptor, FileDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import PygobyError
@@ -230,3 +230,17 @@ def builtin_class(proto_file: str, full_name: str) -> type[Message]:
     loader = default_loader()
     loader.load_file(proto_file)
     return loader.message_class(full_name)
+
+
+def enum_type(field: FieldDescriptor) -> EnumDescriptor:
+    """The enum type of an enum field (protobuf types it as optional: None for other fields)."""
+    if field.enum_type is None:
+        raise ProtoError(f"{field.full_name} is not an enum field")
+    return field.enum_type
+
+
+def message_type(field: FieldDescriptor) -> Descriptor:
+    """The message type of a message field (protobuf types it as optional: None for others)."""
+    if field.message_type is None:
+        raise ProtoError(f"{field.full_name} is not a message field")
+    return field.message_type

@@ -33,12 +33,11 @@ from pygoby.moos.appconfig import read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import Translator
 from pygoby.moos.translator_binding import MessageTypes, not_found
-from pygoby.protobuf import ProtoLoader, builtin_class
-
-PACOMMSHANDLER_CONFIG = (
-    "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
-    "goby.apps.moos.protobuf.pAcommsHandlerConfig",
+from pygoby.protobuf import ProtoLoader
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
+    pAcommsHandlerConfig,
 )
+
 XML_PATH_FIELD = "message_file.path"  # dccl_cfg/queue_cfg/transitional_cfg all name it so
 
 ErrorMaker = Callable[
@@ -52,9 +51,9 @@ def _unlocated(reason: str, field: str, value: str) -> ConfigError:
 
 def read_acomms_config(
     mission: MissionFile, block: str = "pAcommsHandler", overrides: Sequence[tuple[str, str]] = ()
-) -> Message:
+) -> pAcommsHandlerConfig:
     """The pAcommsHandlerConfig of `mission`'s ProcessConfig `block` (ConfigError file:line)."""
-    return read_configuration(builtin_class(*PACOMMSHANDLER_CONFIG), mission, block, overrides)
+    return read_configuration(pAcommsHandlerConfig, mission, block, overrides)
 
 
 @dataclass
@@ -130,7 +129,7 @@ class AcommsMessageSet:
         if mission is None:
             raise ConfigError(f"{app.name} needs the mission file with the {block} ProcessConfig")
         if message_files and mission.goby_block(block) is None:
-            cfg = builtin_class(*PACOMMSHANDLER_CONFIG)()
+            cfg = pAcommsHandlerConfig()
         else:
             cfg = read_acomms_config(mission, block)
         out = cls.load(

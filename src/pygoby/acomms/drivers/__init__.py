@@ -56,7 +56,7 @@ BUILTIN_DRIVERS = {
 }
 
 Factory = Callable[[Clock | None], ModemDriverBase]
-_DRIVER_TYPE = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
+_DRIVER_TYPE = acomms_pb.DriverType.DESCRIPTOR
 
 
 INSTALLED = PluginGroup(ENTRY_POINT_GROUP, "modem driver", PLUGIN_FACTORY, DriverNotFoundError)

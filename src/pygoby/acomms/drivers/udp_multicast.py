@@ -14,12 +14,11 @@ import struct
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.datagram import DatagramDriverBase
 from pygoby.acomms.errors import ModemDriverError
-from pygoby.protobuf import default_loader
 
 log = logging.getLogger(__name__)
 
 Status = acomms_pb.ModemDriverStatus
-_CONFIG = default_loader().pool.FindExtensionByName("goby.acomms.udp_multicast.protobuf.config")
+_CONFIG = acomms_pb.UDP_MULTICAST_CONFIG
 
 
 class UDPMulticastDriver(DatagramDriverBase):

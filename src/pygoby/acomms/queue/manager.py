@@ -9,7 +9,7 @@ logs, and in which group, is pygoby.acomms.queue.log.
 
 from __future__ import annotations
 
-from google.protobuf.message import DecodeError
+from google.protobuf.message import DecodeError, Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import QueueError
@@ -35,16 +35,24 @@ class QueueManager:
         self._by_name: dict[str, MessageQueue] = {}
         self.ccl_queues: dict[int, CCLQueue] = {}  # Goby 1.1 raw CCL queues, by CCL id
         self.store: QueueStore | None = None  # the persistent queue (attach_store)
-        self.signal_receive = Signal()  # (message)
-        self.signal_receive_ccl = Signal()  # (Goby 1.1 ModemDataTransmission of a CCL frame)
-        self.signal_ack = Signal()  # (ack ModemTransmission, original message)
-        self.signal_expire = Signal()  # (original message)
-        self.signal_queue_size_change = Signal()  # (QueueSize)
-        self.signal_data_on_demand = Signal()  # (request ModemTransmission, message to fill)
+        self.signal_receive: Signal[Message] = Signal()  # (message)
+        self.signal_receive_ccl: Signal[acomms_pb.V1ModemDataTransmission] = (
+            Signal()
+        )  # (Goby 1.1 ModemDataTransmission of a CCL frame)
+        self.signal_ack: Signal[[acomms_pb.ModemTransmission, Message]] = (
+            Signal()
+        )  # (ack ModemTransmission, original message)
+        self.signal_expire: Signal[Message] = Signal()  # (original message)
+        self.signal_queue_size_change: Signal[acomms_pb.QueueSize] = Signal()  # (QueueSize)
+        self.signal_data_on_demand: Signal[[acomms_pb.ModemTransmission, Message]] = (
+            Signal()
+        )  # (request ModemTransmission, message to fill)
         # routing (pygoby.acomms.route): the router may rewrite an outgoing item's link dest;
         # link packets for us are offered as (message, its bytes, its own dest, our id)
-        self.signal_out_route = Signal()  # (QueuedItem, modem_id)
-        self.signal_in_route = Signal()  # (message, encoded bytes, message dest, modem_id)
+        self.signal_out_route: Signal[[QueuedItem, int]] = Signal()  # (QueuedItem, modem_id)
+        self.signal_in_route: Signal[[Message, bytes, int, int]] = (
+            Signal()
+        )  # (message, encoded bytes, message dest, modem_id)
         self.log = QueueLog(0)
 
     @property

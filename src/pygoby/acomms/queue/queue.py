@@ -16,11 +16,9 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from pygoby.acomms import messages as acomms_pb
+from pygoby.protobuf.goby.acomms.protobuf.manipulator_pb2 import Manipulator
 
-Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name[
-    "manipulator"
-].enum_type.values_by_name
+Manip = Manipulator.DESCRIPTOR.values_by_name
 
 
 @dataclass(eq=False, slots=True)

@@ -18,6 +18,7 @@ from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec
 from pygoby.dccl.codecs.numeric import NumericCodec, f32
 from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_extension
+from pygoby.protobuf import message_type
 
 CCL_EXTENSIONS_PROTO = "dccl/ccl/protobuf/ccl_extensions.proto"
 
@@ -132,7 +133,7 @@ class GFIPitchOilCodec(FixedWidthCodec):
     def __init__(self, info: FieldInfo) -> None:
         super().__init__(info)
         cls = message_factory.GetMessageClass(info.descriptor.message_type)
-        names = {f.name for f in info.descriptor.message_type.fields}
+        names = {f.name for f in message_type(info.descriptor).fields}
         if not {"gfi", "pitch", "oil"} <= names:
             raise DcclLoadError(f"{info.name}: _ccl_gfi_pitch_oil needs gfi, pitch and oil fields")
 

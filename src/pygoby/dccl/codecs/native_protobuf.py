@@ -24,6 +24,7 @@ from google.protobuf.descriptor import FieldDescriptor as FD
 
 from pygoby.dccl.codecs.base import FieldCodec, FieldInfo
 from pygoby.dccl.errors import DcclDecodeError, DcclLoadError
+from pygoby.protobuf import enum_type
 from pygoby.protobuf.wire import encode_varint
 
 _U64 = (1 << 64) - 1
@@ -69,7 +70,7 @@ class NativeProtobufCodec(FieldCodec):
         self.fixed = _FIXED.get(kind)
         self.width = 8 * (1 if kind == FD.TYPE_BOOL else self.fixed.size if self.fixed else 1)
         if kind == FD.TYPE_ENUM:
-            values = info.descriptor.enum_type.values
+            values = enum_type(info.descriptor).values
             self.index = {v.number: i for i, v in reversed(list(enumerate(values)))}
             self.numbers = [v.number for v in values]
         self.to_bytes = self._encoder()

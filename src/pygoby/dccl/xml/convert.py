@@ -21,6 +21,9 @@ from google.protobuf.message import Message
 
 from pygoby.dccl.xml.model import V1_PLACEHOLDER, Publish, Var, XmlMessage
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.goby.acomms.protobuf.manipulator_pb2 import Manipulator
+from pygoby.protobuf.goby.acomms.protobuf.queue_pb2 import QueuedMessageEntry
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 
 DCCL_OPTIONS_PROTO = "dccl/option_extensions.proto"
 CODEC_VERSION = 2
@@ -182,10 +185,10 @@ def proto_text(messages: Iterable[XmlMessage], source: str = "") -> str:
 # Queue and translator entries
 
 
-def queue_entry(msg: XmlMessage, manipulators: Iterable[int] = ()) -> Message:
-    entry = builtin_class(
-        "goby/acomms/protobuf/queue.proto", "goby.acomms.protobuf.QueuedMessageEntry"
-    )()
+def queue_entry(
+    msg: XmlMessage, manipulators: Iterable[Manipulator.ValueType] = ()
+) -> QueuedMessageEntry:
+    entry = QueuedMessageEntry()
     q = msg.queuing
     entry.protobuf_name = msg.name
     entry.ack, entry.blackout_time, entry.max_queue = q.ack, q.blackout_time, q.max_queue
@@ -201,10 +204,8 @@ def queue_entry(msg: XmlMessage, manipulators: Iterable[int] = ()) -> Message:
     return entry
 
 
-def translator_entry(msg: XmlMessage) -> Message:
-    entry = builtin_class(
-        "goby/moos/protobuf/translator.proto", "goby.moos.protobuf.TranslatorEntry"
-    )()
+def translator_entry(msg: XmlMessage) -> TranslatorEntry:
+    entry = TranslatorEntry()
     T = type(entry)
     entry.protobuf_name = msg.name
     entry.use_short_enum = True

@@ -19,6 +19,7 @@ from pygoby.moos.translator.conversions import (
     hex_encode,
 )
 from pygoby.moos.translator.errors import TranslatorError, UnconvertibleError
+from pygoby.protobuf import enum_type
 
 log = logging.getLogger("pygoby.moos.translator")
 
@@ -47,7 +48,7 @@ def strip_name_from_enum(value_name: str, field_name: str) -> str:
 
 
 def enum_name(field: FieldDescriptor, number: int, use_short_enum: bool) -> str:
-    value = field.enum_type.values_by_number.get(number)
+    value = enum_type(field).values_by_number.get(number)
     name = value.name if value is not None else str(number)
     return strip_name_from_enum(name, field.name) if use_short_enum else name
 
@@ -79,7 +80,7 @@ def default_value(field: FieldDescriptor):
     if not field.is_repeated:
         return field.default_value
     if field.cpp_type == FieldDescriptor.CPPTYPE_ENUM:
-        return field.enum_type.values[0].number
+        return enum_type(field).values[0].number
     if field.cpp_type == FieldDescriptor.CPPTYPE_STRING:
         return b"" if is_bytes(field) else ""
     return _TYPE_DEFAULTS[field.cpp_type]
@@ -119,10 +120,10 @@ def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
         return as_double(text)
     wanted = field.name.upper() + "_" + text if use_short_enum else text
     for candidate in (wanted, wanted.upper(), wanted.lower()):
-        value = field.enum_type.values_by_name.get(candidate)
+        value = enum_type(field).values_by_name.get(candidate)
         if value is not None:
             return value.number
-    raise UnconvertibleError(f"{text!r} is not a value of enum {field.enum_type.full_name}")
+    raise UnconvertibleError(f"{text!r} is not a value of enum {enum_type(field).full_name}")
 
 
 def parse_message_bytes(target: Message, data: bytes, where: str) -> None:

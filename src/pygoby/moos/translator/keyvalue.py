@@ -20,6 +20,7 @@ from pygoby.moos.translator.fields import (
     set_from_string,
     stream_value,
 )
+from pygoby.protobuf import message_type
 
 log = logging.getLogger("pygoby.moos.translator")
 
@@ -63,7 +64,7 @@ def _entry(msg: Message, field: FieldDescriptor, use_short_enum: bool) -> str:
     name = field.name
     value = getattr(msg, name)
     if is_message(field):
-        sub_fields = field.message_type.fields
+        sub_fields = message_type(field).fields
         if field.is_repeated:
             return ",".join(
                 f"{name}_{sub.name}={{"
@@ -132,7 +133,7 @@ def parse(
                     value = (registry or AlgorithmRegistry()).run(algorithm.name, value)
             _set_values(msg, field, value.split(","), 0, use_short_enum)
             continue
-        for sub in field.message_type.fields:
+        for sub in message_type(field).fields:
             value = val_from_string(lower, f"{field.name}_{sub.name}")
             if value is None:
                 continue
@@ -181,7 +182,7 @@ def _warn_unknown_keys(lower: str, msg: Message, where: str) -> None:
     for field in msg.DESCRIPTOR.fields:
         known.add(field.name.lower())
         if is_message(field):
-            known.update(f"{field.name}_{sub.name}".lower() for sub in field.message_type.fields)
+            known.update(f"{field.name}_{sub.name}".lower() for sub in message_type(field).fields)
     keys = _top_level_keys(lower)
     type_name = msg.DESCRIPTOR.full_name
     unknown = [k for k in keys if k is not None and k not in known and "(" not in k]

@@ -6,19 +6,16 @@ These are modelling choices, not measured modem behaviour.
 
 from __future__ import annotations
 
-from functools import cache, lru_cache
+from functools import lru_cache
 
 from google.protobuf.message import Message
 
 from pygoby.netsim.channel.model import Outcome, PacketKind, Reception
-from pygoby.protobuf import builtin_class
-
-MM_STATS_PROTO = "goby/acomms/protobuf/mm_receive_statistics.proto"
+from pygoby.protobuf.goby.acomms.protobuf.mm_receive_statistics_pb2 import ReceiveStatistics
 
 
-@cache
-def receive_statistics_class() -> type[Message]:
-    return builtin_class(MM_STATS_PROTO, "goby.acomms.micromodem.protobuf.ReceiveStatistics")
+def receive_statistics_class() -> type[ReceiveStatistics]:
+    return ReceiveStatistics
 
 
 def _clamp(value: float, low: int, high: int) -> int:

@@ -45,6 +45,7 @@ from pygoby.moos.translator import (
     make_post,
     serialize_for_moos,
 )
+from pygoby.protobuf import enum_type
 from pygoby.topside.commander import savefile, specials
 from pygoby.topside.commander.fields import FieldSpec, FieldValueError
 from pygoby.topside.commander.messageset import CommandSet, CommandType
@@ -165,7 +166,9 @@ class Commander:
         self.notices: list[Notice] = []
         self._ids = itertools.count(1)
         self.values: Mapping[str, MoosValue] = values if values is not None else {}
-        self.signal_import = Signal()  # (names) after import_xml: new source variables
+        self.signal_import: Signal[list[str]] = (
+            Signal()
+        )  # (names) after import_xml: new source variables
 
     @property
     def source_variables(self) -> set[str]:
@@ -463,7 +466,7 @@ def _number(text: str) -> float:
 def _convert(spec: FieldSpec, field: FieldDescriptor, text: str) -> object:
     kind = field.type
     if kind == _FD.TYPE_ENUM:
-        for value, shown in zip(field.enum_type.values, spec.enum_values, strict=True):
+        for value, shown in zip(enum_type(field).values, spec.enum_values, strict=True):
             if shown.upper() == text.upper():
                 return value.number
         raise FieldValueError(f"{spec.name}: {text!r} is not one of its values")

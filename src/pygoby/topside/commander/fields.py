@@ -14,6 +14,7 @@ from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.dccl.options import field_options
 from pygoby.moos.translator.fields import enum_name
+from pygoby.protobuf import enum_type, message_type
 from pygoby.topside.commander import specials
 from pygoby.topside.errors import FieldValueError
 
@@ -101,9 +102,9 @@ class FieldSpec:
         kind = _kind(field, options.codec)
         numeric = kind in ("int", "float")
         type_name = (
-            field.message_type.full_name
+            message_type(field).full_name
             if field.type == _FD.TYPE_MESSAGE
-            else field.enum_type.full_name
+            else enum_type(field).full_name
             if field.type == _FD.TYPE_ENUM
             else _TYPE_NAMES.get(field.type, "?")
         )
@@ -132,7 +133,7 @@ class FieldSpec:
             max_length=options.max_length if options.HasField("max_length") else None,
             max_repeat=repeat.max_repeat if repeat.HasField("max_repeat") else None,
             enum_values=tuple(
-                enum_name(field, v.number, short_enum) for v in field.enum_type.values
+                enum_name(field, v.number, short_enum) for v in enum_type(field).values
             )
             if kind == "enum"
             else (),

@@ -6,25 +6,24 @@ client of the same MOOSDB sharing pAcommsHandler's message set.
 
 from __future__ import annotations
 
-from google.protobuf.message import Message
-
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.translator import MoosValues, Post
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf.pygoby.apps.topside_config_pb2 import LiaisonAppConfig
 from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.topside.commander import CommanderError, CommandSet
 from pygoby.topside.liaison.state import LiaisonState
 from pygoby.topside.liaison.web import WebServer
 
-CONFIG = ("pygoby/apps/topside_config.proto", "pygoby.apps.protobuf.LiaisonAppConfig")
-
 
 class Liaison(GobyMOOSApp):
-    config_proto = CONFIG
+    config_class = LiaisonAppConfig
+    cfg: LiaisonAppConfig
     default_name = "liaison"
 
-    def __init__(self, cfg: Message, *, acomms: AcommsMessageSet | None = None, **kwargs) -> None:
+    def __init__(
+        self, cfg: LiaisonAppConfig, *, acomms: AcommsMessageSet | None = None, **kwargs
+    ) -> None:
         """`acomms`: the message set of the pAcommsHandler whose messages, queues and MAC cycle
         the pages show (default: the `liaison.commander.pacommshandler_name` block of the
         mission)."""
@@ -58,7 +57,7 @@ class Liaison(GobyMOOSApp):
     def embedded(cls, host: GobyMOOSApp, acomms: AcommsMessageSet) -> Liaison:
         """The liaison a pAcommsHandler (`host`, its block's `liaison` section) serves, as its
         own client of the host's MOOSDB, with the host's message set."""
-        cfg = builtin_class(*CONFIG)()
+        cfg = LiaisonAppConfig()
         cfg.common.CopyFrom(host.common)
         cfg.common.log = False
         cfg.liaison.CopyFrom(acomms.cfg.liaison)

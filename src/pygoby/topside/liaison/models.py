@@ -21,6 +21,7 @@ from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import ModemIdLookup, UTMGeodesy, dynamic_parse, parse_for_moos
 from pygoby.moos.translator.keyvalue import val_from_string
 from pygoby.moos.translator.techniques import MoosValue, Technique
+from pygoby.protobuf import enum_type
 
 RATE_WINDOW = 10.0  # seconds over which a variable's rate is measured
 _TEXT = Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT
@@ -133,7 +134,7 @@ class QueueState:
 
 
 def _enum_name(msg: Message, field: str) -> str:
-    enum = msg.DESCRIPTOR.fields_by_name[field].enum_type
+    enum = enum_type(msg.DESCRIPTOR.fields_by_name[field])
     return enum.values_by_number[getattr(msg, field)].name
 
 
