@@ -7,10 +7,10 @@ this module names the classes, extensions and enum values the rest of pygoby use
 
 from __future__ import annotations
 
-from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.protobuf import default_loader
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 from pygoby.protobuf.goby.acomms.protobuf import (
     abc_driver_pb2,
     amac_config_pb2,
@@ -42,7 +42,7 @@ def goby_message_class(full_name: str) -> type[Message]:
     return loader.message_class(full_name)
 
 
-def extension(full_name: str) -> FieldDescriptor:
+def extension(full_name: str) -> AnyFieldDescriptor:
     """An extension field by full name, for `msg.Extensions[...]`."""
     return default_loader().pool.FindExtensionByName(full_name)
 

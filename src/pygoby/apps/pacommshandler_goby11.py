@@ -18,7 +18,10 @@ from pygoby.acomms.queue import QueueError
 from pygoby.acomms.queue.ccl import goby11_time
 from pygoby.moos import goby11_config
 from pygoby.moos.protocol import MOOSMessage
+from pygoby.moos.protocol import Value as MoosValue
 from pygoby.moos.translator import Technique, serialize_for_moos
+from pygoby.protobuf.descriptors import MessageT
+from pygoby.protobuf.goby.moos.protobuf.transitional_pb2 import Slot as V1Slot
 
 INCOMING_DATA = "ACOMMS_INCOMING_DATA"
 OUTGOING_DATA = "ACOMMS_OUTGOING_DATA"
@@ -27,39 +30,40 @@ RANGE_RESPONSE = "ACOMMS_RANGE_RESPONSE"
 POLLER_UPDATE = "ACOMMS_POLLER_UPDATE"
 # Goby 1.1 posted its acomms messages as plain single-line TextFormat
 GOBY11_TECHNIQUE = Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT
-V1_RANGING = acomms_pb.V1RangingType.DESCRIPTOR.values_by_name
 RANGING_TYPES = {  # Goby 1.1 RangingType -> Micro-Modem transmission type
-    V1_RANGING["MODEM_TWO_WAY_PING"].number: acomms_pb.MICROMODEM_TWO_WAY_PING,
-    V1_RANGING["REMUS_LBL_RANGING"].number: acomms_pb.MICROMODEM_REMUS_LBL_RANGING,
+    acomms_pb.V1RangingType.MODEM_TWO_WAY_PING: acomms_pb.MICROMODEM_TWO_WAY_PING,
+    acomms_pb.V1RangingType.REMUS_LBL_RANGING: acomms_pb.MICROMODEM_REMUS_LBL_RANGING,
 }
 V1_RANGING_OF = {v: k for k, v in RANGING_TYPES.items()}
 
 
-def parse_goby11(value: str | bytes, out: Message) -> None:
+def parse_goby11(value: MoosValue, out: Message) -> None:
     """A Goby 1.1 (or goby3) TextFormat string, 1.1 spellings (slot types, ...) translated."""
-    text = value.decode("latin-1") if isinstance(value, bytes) else value
+    text = value.decode("latin-1") if isinstance(value, bytes) else str(value)
     text_format.Merge(goby11_config.translate(text, out.DESCRIPTOR).text, out)
 
 
 V1_UPDATE = acomms_pb.V1MACUpdate.UpdateType
 
 
-def _slot(v1_slot) -> Message:
+def _slot(v1_slot: V1Slot) -> acomms_pb.ModemTransmission:
     slot = acomms_pb.ModemTransmission()
     parse_goby11(text_format.MessageToString(v1_slot), slot)
     return slot
 
 
-def _same_slot(a: Message, b: Message) -> bool:
+def _same_slot(a: acomms_pb.ModemTransmission, b: acomms_pb.ModemTransmission) -> bool:
     return all(
         getattr(a, f) == getattr(b, f) for f in ("src", "dest", "rate", "type", "slot_seconds")
     )
 
 
-def mac_update_from_goby11(value: str | bytes, current: list[Message], src: int) -> Message | None:
+def mac_update_from_goby11(
+    value: MoosValue, current: list[acomms_pb.ModemTransmission], src: int
+) -> acomms_pb.MACUpdate | None:
     """A Goby 1.1 MACUpdate (`dest update_type: ADD|REMOVE|REPLACE slot {...}`) as today's
     MACUpdate against the `current` cycle; None if `value` is not the Goby 1.1 form."""
-    text = value.decode("latin-1") if isinstance(value, bytes) else value
+    text = value.decode("latin-1") if isinstance(value, bytes) else str(value)
     old = acomms_pb.V1MACUpdate()
     try:
         text_format.Merge(text, old)
@@ -84,7 +88,7 @@ class Goby11Variables:
 
     `app` publishes/subscribes (a GobyMOOSApp); `acomms` is its AcommsHandler."""
 
-    def __init__(self, app, acomms, queue_cfg: Message, enabled: bool) -> None:
+    def __init__(self, app, acomms, queue_cfg: acomms_pb.QueueManagerConfig, enabled: bool) -> None:
         self.app, self.acomms = app, acomms
         self.enabled = enabled  # the 1.1 data variables (only for Goby 1.1 style configurations)
         self.in_vars = {q.key.id: q.in_pubsub_var for q in queue_cfg.queue if q.in_pubsub_var}
@@ -107,7 +111,7 @@ class Goby11Variables:
         self.app.publish(var, serialize_for_moos(message, GOBY11_TECHNIQUE))
 
     # ---------------------------------------------------------------- MOOS -> acomms
-    def _parse(self, msg: MOOSMessage, out: Message) -> Message | None:
+    def _parse(self, msg: MOOSMessage, out: MessageT) -> MessageT | None:
         try:
             parse_goby11(msg.value, out)
         except text_format.ParseError as err:
@@ -158,12 +162,12 @@ class Goby11Variables:
         return True
 
     # ---------------------------------------------------------------- acomms -> MOOS
-    def _on_ccl_received(self, transmission: Message) -> None:
+    def _on_ccl_received(self, transmission: acomms_pb.V1ModemDataTransmission) -> None:
         var = self.in_vars.get(transmission.queue_key.id)
         if var:
             self._publish(var, transmission)
 
-    def _on_modem_receive(self, transmission: Message) -> None:
+    def _on_modem_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         if transmission.type == acomms_pb.DATA and self.enabled:
             for index, frame in enumerate(transmission.frame):
                 data = acomms_pb.V1ModemDataTransmission(

@@ -25,6 +25,7 @@ from pygoby.dccl.options import message_options
 from pygoby.dccl.plan import Part, Planner, root_options
 from pygoby.dccl.registry import DEFAULT_REGISTRY, CodecRegistry
 from pygoby.protobuf import ProtoError, ProtoLoader
+from pygoby.protobuf.descriptors import AnyDescriptor
 from pygoby.util.clock import Clock
 from pygoby.util.names import did_you_mean
 
@@ -116,7 +117,7 @@ class Codec:
             raise
 
     # ---------------------------------------------------------------- loading
-    def load(self, message_type: type[Message] | Descriptor) -> type[Message]:
+    def load(self, message_type: type[Message] | AnyDescriptor) -> type[Message]:
         """Validate and compile a message type (a generated class or a descriptor)."""
         if isinstance(message_type, Descriptor):
             descriptor = message_type
@@ -178,7 +179,7 @@ class Codec:
             raise DcclLoadError(f"{path}: no message has (dccl.msg) options")
         return [self.load(self.loader.message_class(d.full_name)) for d in dccl]
 
-    def unload(self, message_type: type[Message] | Descriptor) -> None:
+    def unload(self, message_type: type[Message] | AnyDescriptor) -> None:
         descriptor = getattr(message_type, "DESCRIPTOR", message_type)
         compiled = self._by_name.pop(descriptor.full_name, None)
         if compiled is not None and compiled.id is not None:
@@ -187,7 +188,7 @@ class Codec:
     def loaded(self) -> list[type[Message]]:
         return [c.cls for c in self._by_name.values()]
 
-    def _compile(self, cls: type[Message], descriptor: Descriptor) -> CompiledType:
+    def _compile(self, cls: type[Message], descriptor: AnyDescriptor) -> CompiledType:
         root = root_options(descriptor)
         planner = Planner(root, self.registry, self._now, self._lua)
         head = planner.plan_root(descriptor, Part.HEAD)
@@ -231,7 +232,7 @@ class Codec:
             source={name: g.source for name, g in generated.items()},
         )
 
-    def compiled(self, message_type: type[Message] | Descriptor | str) -> CompiledType:
+    def compiled(self, message_type: type[Message] | AnyDescriptor | str) -> CompiledType:
         """The compiled form of a loaded type (loading it first if it is a class/descriptor)."""
         if isinstance(message_type, str):
             try:
@@ -270,20 +271,20 @@ class Codec:
         """Length in bytes of `encode(msg)`."""
         return len(self.encode(msg))
 
-    def analyze(self, message_type: type[Message] | Descriptor | str) -> str:
+    def analyze(self, message_type: type[Message] | AnyDescriptor | str) -> str:
         """A table of the type's fields: codec, part (head/body), bit sizes, and totals."""
         return describe(self.compiled(message_type))
 
-    def definition_hash(self, message_type: type[Message] | Descriptor | str) -> int:
+    def definition_hash(self, message_type: type[Message] | AnyDescriptor | str) -> int:
         """The 64-bit hash of a type's DCCL definition that C++ DCCL's `load()` returns (and
         `dccl.hash` fields send masked); see pygoby.dccl.hashing."""
         compiled = self.compiled(message_type)
         return definition_hash(compiled.cls.DESCRIPTOR, compiled.head, compiled.body)
 
-    def max_size(self, message_type: type[Message] | Descriptor | str) -> int:
+    def max_size(self, message_type: type[Message] | AnyDescriptor | str) -> int:
         return self.compiled(message_type).max_size()
 
-    def min_size(self, message_type: type[Message] | Descriptor | str) -> int:
+    def min_size(self, message_type: type[Message] | AnyDescriptor | str) -> int:
         return self.compiled(message_type).min_size()
 
     # ---------------------------------------------------------------- decoding
@@ -300,7 +301,7 @@ class Codec:
         return self._compiled_for(data, None).cls
 
     def _compiled_for(
-        self, data: bytes, message_type: type[Message] | Descriptor | str | None
+        self, data: bytes, message_type: type[Message] | AnyDescriptor | str | None
     ) -> CompiledType:
         if message_type is not None:
             compiled = self.compiled(message_type)
@@ -318,13 +319,13 @@ class Codec:
         return compiled
 
     def decode(
-        self, data: bytes, message_type: type[Message] | Descriptor | str | None = None
+        self, data: bytes, message_type: type[Message] | AnyDescriptor | str | None = None
     ) -> Message:
         """Decode bytes; the type comes from the ID unless given (it must be for omit_id types)."""
         return self.decode_prefix(data, message_type)[0]
 
     def decode_prefix(
-        self, data: bytes, message_type: type[Message] | Descriptor | str | None = None
+        self, data: bytes, message_type: type[Message] | AnyDescriptor | str | None = None
     ) -> tuple[Message, int]:
         """Decode one message from the start of `data`: (message, bytes it used).
 
@@ -354,7 +355,7 @@ class Codec:
         return msg, head_bytes + (used + 7) // 8
 
 
-def _messages_of(descriptors: Iterable[Descriptor]) -> Iterator[Descriptor]:
+def _messages_of(descriptors: Iterable[AnyDescriptor]) -> Iterator[AnyDescriptor]:
     """`descriptors` and every message type nested in them."""
     for descriptor in descriptors:
         yield descriptor

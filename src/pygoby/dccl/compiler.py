@@ -38,6 +38,7 @@ from pygoby.dccl.plan import (
 )
 from pygoby.dccl.rawtext import extend_raw_strings, set_raw_string
 from pygoby.dccl.trace import FieldTracer
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 
 def _truncated(where: str) -> DcclDecodeError:
@@ -148,7 +149,7 @@ def _set(var: str, field_name: str, value: str) -> str:
     return f"setattr({var}, {field_name!r}, {value})"
 
 
-def _is_string(field: FieldDescriptor) -> bool:
+def _is_string(field: AnyFieldDescriptor) -> bool:
     return field.type == FieldDescriptor.TYPE_STRING
 
 
@@ -189,7 +190,7 @@ class _PartCompiler:
         return start
 
     def _trace_end(
-        self, start: str | None, path: str, value: str, ind: int, field: FieldDescriptor | None
+        self, start: str | None, path: str, value: str, ind: int, field: AnyFieldDescriptor | None
     ) -> None:
         if start is not None:
             if field is not None:

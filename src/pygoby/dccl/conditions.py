@@ -34,11 +34,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from google.protobuf import descriptor_pb2
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.errors import DcclError, DcclLoadError
 from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 _INT64 = (FieldDescriptor.CPPTYPE_INT64, FieldDescriptor.CPPTYPE_UINT64)
 
@@ -62,7 +63,7 @@ def with_return(script: str) -> str:
 class FieldConditions:
     """The dynamic conditions of one field, as the plan uses them."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     required_if: str | None = None  # required_if, or only_if
     omit_if: str | None = None  # omit_if, or "not (only_if)"
     omit_negates: bool = False  # omit_if is an only_if: omit when it is false
@@ -71,7 +72,7 @@ class FieldConditions:
     scripts: dict[str, Any] = field(default_factory=dict)  # compiled, by role
 
     @classmethod
-    def of(cls, f: FieldDescriptor, options: Message) -> FieldConditions | None:
+    def of(cls, f: AnyFieldDescriptor, options: Message) -> FieldConditions | None:
         if not options.HasField("dynamic_conditions"):
             return None
         dc = options.dynamic_conditions
@@ -194,7 +195,7 @@ class DynamicConditions:
                     table[f.containing_oneof.name] = f.name
         return self._set_meta(table, self._defaults(msg.DESCRIPTOR))
 
-    def _value(self, f: FieldDescriptor, value: Any) -> Any:
+    def _value(self, f: AnyFieldDescriptor, value: Any) -> Any:
         cpp = f.cpp_type
         if cpp == FieldDescriptor.CPPTYPE_MESSAGE:
             return self._table(value)
@@ -205,7 +206,7 @@ class DynamicConditions:
             return value - (1 << 64)  # a Lua integer is signed 64-bit
         return value
 
-    def _defaults(self, desc: Descriptor):
+    def _defaults(self, desc: AnyDescriptor):
         meta = self._meta.get(desc.full_name)
         if meta is None:
             meta = self.lua.table()
@@ -219,7 +220,7 @@ class DynamicConditions:
         return meta
 
 
-def _synthetic(f: FieldDescriptor) -> bool:
+def _synthetic(f: AnyFieldDescriptor) -> bool:
     oneof = f.containing_oneof
     return len(oneof.fields) == 1 and oneof.name == "_" + f.name
 
@@ -240,7 +241,7 @@ def _file_proto(serialized: bytes) -> dict[str, descriptor_pb2.FieldDescriptorPr
     return fields
 
 
-def _explicit_default(f: FieldDescriptor) -> str | None:
+def _explicit_default(f: AnyFieldDescriptor) -> str | None:
     """The text of a field's `[default = ...]`, None without one (only singular scalars)."""
     if f.is_repeated or f.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE:
         return None
@@ -250,7 +251,7 @@ def _explicit_default(f: FieldDescriptor) -> str | None:
     return proto.default_value
 
 
-def _default_value(f: FieldDescriptor, text: str) -> Any:
+def _default_value(f: AnyFieldDescriptor, text: str) -> Any:
     cpp = f.cpp_type
     if cpp == FieldDescriptor.CPPTYPE_ENUM:
         return text  # the value's name

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import functools
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.protobuf import builtin_class, default_loader
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 from pygoby.protobuf.wire import length_delimited
 
 _CARRIER_PROTO = "pygoby/dccl/option_carrier.proto"
@@ -31,7 +31,7 @@ def _carriers() -> tuple[type[Message], type[Message]]:
     )
 
 
-def field_options(field: FieldDescriptor) -> Message:
+def field_options(field: AnyFieldDescriptor) -> Message:
     """The field's DCCLFieldOptions (an empty one when the field has none)."""
     carrier = _carriers()[0]()
     if field.has_options:
@@ -39,7 +39,7 @@ def field_options(field: FieldDescriptor) -> Message:
     return carrier.field
 
 
-def message_options(descriptor: Descriptor) -> Message:
+def message_options(descriptor: AnyDescriptor) -> Message:
     """The message type's DCCLMessageOptions (an empty one when it has none)."""
     carrier = _carriers()[1]()
     if descriptor.has_options:

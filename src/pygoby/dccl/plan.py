@@ -12,13 +12,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.dccl.codecs.base import FieldCodec, FieldInfo, RepeatedFieldCodec, field_category
 from pygoby.dccl.conditions import DynamicConditions, FieldConditions
 from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_options, message_options
 from pygoby.dccl.registry import CodecRegistry, DefaultMessageCodec
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 log = logging.getLogger("pygoby.dccl")
 
@@ -48,7 +49,7 @@ class Oneof:
 class ScalarItem:
     """A singular field written by a field codec (any type, incl. messages with a user codec)."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     codec: FieldCodec
     mode: Mode
     oneof: Oneof | None = None
@@ -67,7 +68,7 @@ class ScalarItem:
 class MessageItem:
     """A singular embedded message handled by a built-in message codec."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     child: MessageNode
     mode: Mode
     presence_bit: bool
@@ -85,7 +86,7 @@ class MessageItem:
 class RepeatedItem:
     """A repeated field: count prefix + elements (V >= 3) or max_repeat slots (V = 2)."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     max_repeat: int
     min_repeat: int
     slots: bool  # v2: always max_repeat optional-encoded slots, no prefix
@@ -115,7 +116,7 @@ class RepeatedItem:
 class ListItem:
     """A repeated field coded as a whole by a `RepeatedFieldCodec` (e.g. dccl.arithmetic)."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     codec: RepeatedFieldCodec
 
     def min_size(self) -> int:
@@ -130,7 +131,7 @@ Item = ScalarItem | MessageItem | RepeatedItem | ListItem
 
 @dataclass
 class MessageNode:
-    descriptor: Descriptor
+    descriptor: AnyDescriptor
     codec_version: int  # version of the message codec handling this message
     items: list[Item] = field(default_factory=list)
     oneofs: list[Oneof] = field(default_factory=list)  # case fields written first (v4 BODY)
@@ -172,7 +173,7 @@ class RootOptions:
     max_bytes: int
 
 
-def root_options(descriptor: Descriptor) -> RootOptions:
+def root_options(descriptor: AnyDescriptor) -> RootOptions:
     opts = message_options(descriptor)
     name = descriptor.full_name
     if not opts.HasField("codec_version"):
@@ -208,7 +209,7 @@ class Planner:
         self.lua = lua  # the Codec's Lua state (made on first use) for dynamic conditions
         self.conditioned = False  # some field has dynamic conditions
 
-    def plan_root(self, descriptor: Descriptor, part: Part) -> MessageNode:
+    def plan_root(self, descriptor: AnyDescriptor, part: Part) -> MessageNode:
         opts = message_options(descriptor)
         name = opts.codec if opts.HasField("codec") else self.default_name
         _, entry = self.registry.resolve(name, self.root.version, "message")
@@ -219,7 +220,7 @@ class Planner:
             self._check_fixed(node)
         return node
 
-    def _codec_name(self, f: FieldDescriptor, fopts) -> str:
+    def _codec_name(self, f: AnyFieldDescriptor, fopts) -> str:
         if fopts.HasField("codec"):
             return fopts.codec
         if f.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE:
@@ -237,7 +238,7 @@ class Planner:
 
     def _plan_message(
         self,
-        descriptor: Descriptor,
+        descriptor: AnyDescriptor,
         part: Part,
         forced: Part | None,
         version: int,
@@ -354,7 +355,7 @@ class Planner:
                 item.required_codec = entry(required)
         return item
 
-    def _mode(self, f: FieldDescriptor, oneof: Oneof | None) -> Mode:
+    def _mode(self, f: AnyFieldDescriptor, oneof: Oneof | None) -> Mode:
         if oneof is not None:
             return Mode.ONEOF
         if f.is_required:

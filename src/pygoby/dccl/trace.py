@@ -18,10 +18,12 @@ from google.protobuf import text_format
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
+
 log = logging.getLogger("pygoby.dccl.trace")
 
 
-def show(value: Any, field: FieldDescriptor | None = None) -> str:
+def show(value: Any, field: AnyFieldDescriptor | None = None) -> str:
     """A field value as the trace prints it (enum values by name)."""
     if value is None:
         return "not set"

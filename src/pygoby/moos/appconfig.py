@@ -26,13 +26,14 @@ from collections.abc import Callable, Iterator, Sequence
 from contextvars import ContextVar
 from typing import TypeVar
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
 from pygoby.moos.moosfile import GobyBlock, MissionFile, parse_number
 from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 from pygoby.protobuf.goby.protobuf.option_extensions_pb2 import GobyFieldOptions
 from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
 from pygoby.protobuf.wire import length_delimited
@@ -52,7 +53,7 @@ def _options_class() -> type[GobyFieldOptions]:
     return GobyFieldOptions
 
 
-def goby_field_options(field: FieldDescriptor) -> Message:
+def goby_field_options(field: AnyFieldDescriptor) -> Message:
     """The field's `(goby.field)` options (an empty GobyFieldOptions if it has none)."""
     out = _options_class()()
     if not field.has_options:
@@ -129,7 +130,7 @@ def apply_moos_globals(config: Message, mission: MissionFile) -> None:
             raise err.located(file=path, line=mission.global_line(name)) from None
 
 
-def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: str) -> None:
+def _set_from_global(config: Message, field: AnyFieldDescriptor, name: str, value: str) -> None:
     """A MOOS global's text as the field's value; text that is no value of its type is an
     error (MOOS would read "abc" as 0: a mistyped ServerPort must not mean port 9000)."""
     kind = field.type
@@ -253,7 +254,7 @@ def _shift(note: str, first_line: int) -> str:
 # --example_config
 
 
-def _format_scalar(field: FieldDescriptor, value: object) -> str:
+def _format_scalar(field: AnyFieldDescriptor, value: object) -> str:
     if field.type == FieldDescriptor.TYPE_ENUM:
         return enum_type(field).values_by_number[value].name  # type: ignore[index]
     if field.type == FieldDescriptor.TYPE_BOOL:
@@ -267,7 +268,7 @@ def _format_scalar(field: FieldDescriptor, value: object) -> str:
     return str(value)
 
 
-def _label(field: FieldDescriptor) -> str:
+def _label(field: AnyFieldDescriptor) -> str:
     if field.is_repeated:
         return " (repeated)"
     return " (required)" if field.is_required else " (optional)"
@@ -297,7 +298,7 @@ def _wrap_words(comment: str, width: int) -> list[str]:
     return lines
 
 
-def _extensions(descriptor: Descriptor) -> list[FieldDescriptor]:
+def _extensions(descriptor: AnyDescriptor) -> list[AnyFieldDescriptor]:
     """Extensions of `descriptor` loaded into its pool (e.g. driver configurations)."""
     try:
         found = descriptor.file.pool.FindAllExtensions(descriptor)
@@ -306,7 +307,7 @@ def _extensions(descriptor: Descriptor) -> list[FieldDescriptor]:
     return sorted(found, key=lambda f: f.number)
 
 
-def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
+def _describe_fields(descriptor: AnyDescriptor, depth: int) -> list[str]:
     out: list[str] = []
     indent = "  " * depth
     for field in [*descriptor.fields, *_extensions(descriptor)]:
@@ -343,7 +344,7 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
     return out
 
 
-def _placeholder(field: FieldDescriptor) -> str:
+def _placeholder(field: AnyFieldDescriptor) -> str:
     """A value of the field's type that parses (the first enumerator, 0, false, "")."""
     if field.type == FieldDescriptor.TYPE_ENUM:
         return enum_type(field).values[0].name

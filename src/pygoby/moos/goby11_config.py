@@ -27,8 +27,9 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
+
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 # ---------------------------------------------------------------------------------------------
 # Tokens and the field tree
@@ -300,12 +301,12 @@ RULES: dict[str, Rule] = {
 }
 
 
-def _field_type(descriptor: Descriptor | None, key: str) -> Descriptor | None:
+def _field_type(descriptor: AnyDescriptor | None, key: str) -> AnyDescriptor | None:
     if descriptor is None:
         return None
     if key.startswith("["):
         try:
-            found: FieldDescriptor | None = descriptor.file.pool.FindExtensionByName(key[1:-1])
+            found: AnyFieldDescriptor | None = descriptor.file.pool.FindExtensionByName(key[1:-1])
         except KeyError:
             return None
     else:
@@ -313,7 +314,9 @@ def _field_type(descriptor: Descriptor | None, key: str) -> Descriptor | None:
     return found.message_type if found is not None else None
 
 
-def _rewrite(fields: list[Field], descriptor: Descriptor | None, notes: list[str]) -> list[Field]:
+def _rewrite(
+    fields: list[Field], descriptor: AnyDescriptor | None, notes: list[str]
+) -> list[Field]:
     rule = RULES.get(descriptor.full_name) if descriptor is not None else None
     out: list[Field] = []
     for f in fields:
@@ -331,7 +334,7 @@ class Translation:
     notes: list[str]  # what was changed, one line per change
 
 
-def translate(text: str, descriptor: Descriptor) -> Translation:
+def translate(text: str, descriptor: AnyDescriptor) -> Translation:
     """Rewrite the Goby 1.1/2 forms of a ProcessConfig block for `descriptor` (the app's
     configuration type). Text that does not tokenize is returned unchanged (protobuf's parser
     then reports the problem with its line)."""

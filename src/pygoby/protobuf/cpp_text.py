@@ -12,6 +12,7 @@ from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.protobuf import enum_type, message_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 _ESCAPES = {0x0A: "\\n", 0x0D: "\\r", 0x09: "\\t", 0x22: '\\"', 0x27: "\\'", 0x5C: "\\\\"}
 _F32 = struct.Struct("<f")
@@ -58,7 +59,7 @@ def float_text(value: float) -> str:
     return short if _float32(float(short)) == value else f"{value:.9g}"
 
 
-def scalar_text(field: FieldDescriptor, value) -> str:
+def scalar_text(field: AnyFieldDescriptor, value) -> str:
     """A non-message field value as C++ TextFormat prints it."""
     cpp = field.cpp_type
     if cpp == FieldDescriptor.CPPTYPE_STRING:
@@ -76,7 +77,7 @@ def scalar_text(field: FieldDescriptor, value) -> str:
     return str(value)
 
 
-def field_label(field: FieldDescriptor) -> str:
+def field_label(field: AnyFieldDescriptor) -> str:
     if field.is_extension:
         return "[" + field.full_name + "]"
     if field.type == FieldDescriptor.TYPE_GROUP:

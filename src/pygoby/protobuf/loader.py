@@ -22,10 +22,11 @@ from importlib import resources
 from pathlib import Path
 
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
-from google.protobuf.descriptor import Descriptor, EnumDescriptor, FieldDescriptor, FileDescriptor
+from google.protobuf.descriptor import Descriptor, FileDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import PygobyError
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyEnumDescriptor, AnyFieldDescriptor
 
 BUILTIN_PROTO_DIR = Path(__file__).resolve().parent
 
@@ -232,14 +233,14 @@ def builtin_class(proto_file: str, full_name: str) -> type[Message]:
     return loader.message_class(full_name)
 
 
-def enum_type(field: FieldDescriptor) -> EnumDescriptor:
+def enum_type(field: AnyFieldDescriptor) -> AnyEnumDescriptor:
     """The enum type of an enum field (protobuf types it as optional: None for other fields)."""
     if field.enum_type is None:
         raise ProtoError(f"{field.full_name} is not an enum field")
     return field.enum_type
 
 
-def message_type(field: FieldDescriptor) -> Descriptor:
+def message_type(field: AnyFieldDescriptor) -> AnyDescriptor:
     """The message type of a message field (protobuf types it as optional: None for others)."""
     if field.message_type is None:
         raise ProtoError(f"{field.full_name} is not a message field")

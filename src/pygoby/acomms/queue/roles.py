@@ -6,10 +6,11 @@ import datetime as dt
 import math
 from dataclasses import dataclass
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import RoleError
+from pygoby.protobuf.descriptors import AnyDescriptor
 
 Role = acomms_pb.QueuedMessageEntry.Role
 _INTEGER_TYPES = {
@@ -44,7 +45,7 @@ class RoleGetter:
         return value
 
 
-def compile_roles(entry, descriptor: Descriptor) -> dict[int, RoleGetter]:
+def compile_roles(entry, descriptor: AnyDescriptor) -> dict[int, RoleGetter]:
     """Validate the roles of `entry` against `descriptor` (rules of spec §3.5)."""
     getters: dict[int, RoleGetter] = {}
     for role in entry.role:

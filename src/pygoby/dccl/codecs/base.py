@@ -26,6 +26,7 @@ from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError, DcclLoadError
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 _CATEGORY_BY_CPPTYPE = {
     FieldDescriptor.CPPTYPE_INT32: "int32",
@@ -44,7 +45,7 @@ SCALAR_CATEGORIES = NUMERIC_CATEGORIES | {"bool", "enum", "string", "bytes"}
 ALL_CATEGORIES = SCALAR_CATEGORIES | {"message"}
 
 
-def field_category(field: FieldDescriptor) -> str:
+def field_category(field: AnyFieldDescriptor) -> str:
     """The DCCL type family of a field: int32, int64, uint32, uint64, double, float, bool, enum,
     string, bytes or message (members of a protobuf family are encoded identically)."""
     if field.cpp_type == FieldDescriptor.CPPTYPE_STRING:
@@ -64,7 +65,7 @@ def ceil_log2(n: float) -> int:
 class FieldInfo:
     """What a codec knows about the field it encodes."""
 
-    descriptor: FieldDescriptor
+    descriptor: AnyFieldDescriptor
     options: Message  # dccl.DCCLFieldOptions
     category: str
     required: bool  # required encoding (no "not set" state), spec §6.4

@@ -20,6 +20,7 @@ from pygoby.moos.translator.conversions import (
 )
 from pygoby.moos.translator.errors import TranslatorError, UnconvertibleError
 from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 log = logging.getLogger("pygoby.moos.translator")
 
@@ -31,11 +32,11 @@ INT_KINDS = {
 }
 
 
-def is_message(field: FieldDescriptor) -> bool:
+def is_message(field: AnyFieldDescriptor) -> bool:
     return field.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE
 
 
-def is_bytes(field: FieldDescriptor) -> bool:
+def is_bytes(field: AnyFieldDescriptor) -> bool:
     return field.type == FieldDescriptor.TYPE_BYTES
 
 
@@ -47,7 +48,7 @@ def strip_name_from_enum(value_name: str, field_name: str) -> str:
     return value_name if pos < 0 else value_name[:pos] + value_name[pos + len(needle) :]
 
 
-def enum_name(field: FieldDescriptor, number: int, use_short_enum: bool) -> str:
+def enum_name(field: AnyFieldDescriptor, number: int, use_short_enum: bool) -> str:
     value = enum_type(field).values_by_number.get(number)
     name = value.name if value is not None else str(number)
     return strip_name_from_enum(name, field.name) if use_short_enum else name
@@ -57,7 +58,7 @@ def serialize_message(msg: Message) -> bytes:
     return msg.SerializePartialToString(deterministic=True)
 
 
-def stream_value(field: FieldDescriptor, value, use_short_enum: bool) -> str:
+def stream_value(field: AnyFieldDescriptor, value, use_short_enum: bool) -> str:
     """One element of `field` as Goby's CSV/FORMAT serializers stream it."""
     cpp = field.cpp_type
     if cpp == FieldDescriptor.CPPTYPE_MESSAGE:
@@ -75,7 +76,7 @@ def stream_value(field: FieldDescriptor, value, use_short_enum: bool) -> str:
     return enum_name(field, value, use_short_enum)
 
 
-def default_value(field: FieldDescriptor):
+def default_value(field: AnyFieldDescriptor):
     """The value an unset element reads as: the declared default, else the type default."""
     if not field.is_repeated:
         return field.default_value
@@ -97,7 +98,7 @@ _TYPE_DEFAULTS = {
 }
 
 
-def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
+def value_from_string(field: AnyFieldDescriptor, text: str, use_short_enum: bool):
     """Convert `text` to a scalar value for `field` (not for message fields)."""
     cpp = field.cpp_type
     if cpp in INT_KINDS:
@@ -136,7 +137,9 @@ def parse_message_bytes(target: Message, data: bytes, where: str) -> None:
         ) from None
 
 
-def set_from_string(msg: Message, field: FieldDescriptor, text: str, use_short_enum: bool) -> None:
+def set_from_string(
+    msg: Message, field: AnyFieldDescriptor, text: str, use_short_enum: bool
+) -> None:
     """Set singular `field` of `msg` from `text` (message fields: hex of the binary encoding)."""
     if is_message(field):
         parse_message_bytes(getattr(msg, field.name), hex_decode(text), field.name)
@@ -148,7 +151,7 @@ def set_from_string(msg: Message, field: FieldDescriptor, text: str, use_short_e
 
 
 def append_from_string(
-    msg: Message, field: FieldDescriptor, text: str, use_short_enum: bool
+    msg: Message, field: AnyFieldDescriptor, text: str, use_short_enum: bool
 ) -> None:
     """Append one element parsed from `text` to repeated `field`."""
     container = getattr(msg, field.name)
@@ -162,7 +165,7 @@ def append_from_string(
 
 
 def set_element_from_string(
-    msg: Message, field: FieldDescriptor, index: int, text: str, use_short_enum: bool
+    msg: Message, field: AnyFieldDescriptor, index: int, text: str, use_short_enum: bool
 ) -> None:
     """Set element `index` of repeated `field`, padding with default values as needed."""
     container = getattr(msg, field.name)

@@ -12,7 +12,7 @@ import re
 from collections.abc import Collection, Sequence
 
 from google.protobuf import message_factory
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.moos.translator import boostformat
@@ -29,6 +29,7 @@ from pygoby.moos.translator.fields import (
     set_from_string,
     stream_value,
 )
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 _SUBMESSAGE_DIRECTIVE = re.compile(r"%([0-9.]+:)+[0-9.]+%")
 _INDEXED_DIRECTIVE = re.compile(r"%[0-9]+\.[0-9]+%")
@@ -100,7 +101,7 @@ def _repeated_text(
     return (parts[0] if parts else "") if indexed else delimiter.join(parts)
 
 
-def _scalar_arg(msg: Message, field: FieldDescriptor, short: bool) -> boostformat.Arg:
+def _scalar_arg(msg: Message, field: AnyFieldDescriptor, short: bool) -> boostformat.Arg:
     value = getattr(msg, field.name)
     cpp = field.cpp_type
     if cpp in INT_KINDS:
@@ -189,7 +190,7 @@ def _directives(fmt: str):
         yield "directive", spec, separator
 
 
-def _field_spec(descriptor: Descriptor, spec: str) -> tuple[FieldDescriptor, int | None]:
+def _field_spec(descriptor: AnyDescriptor, spec: str) -> tuple[AnyFieldDescriptor, int | None]:
     parts = spec.split(".")
     number = _int_or_none(parts[0])
     index = _int_or_none(parts[1]) if len(parts) == 2 else None
@@ -203,7 +204,7 @@ def _field_spec(descriptor: Descriptor, spec: str) -> tuple[FieldDescriptor, int
     return field, index
 
 
-def check_parse_format(descriptor: Descriptor, fmt: str) -> None:
+def check_parse_format(descriptor: AnyDescriptor, fmt: str) -> None:
     """Reject create formats that cannot work, before any mail arrives."""
     for kind, spec, _sep in _directives(fmt.lower()):
         if kind != "directive":
@@ -226,7 +227,7 @@ def check_parse_format(descriptor: Descriptor, fmt: str) -> None:
         _field_spec(current, last)
 
 
-def parsed_fields(descriptor: Descriptor, fmt: str) -> set[int]:
+def parsed_fields(descriptor: AnyDescriptor, fmt: str) -> set[int]:
     """The numbers of the top-level fields a create format sets (for tools that show where a
     field's value comes from)."""
     return {
@@ -237,7 +238,7 @@ def parsed_fields(descriptor: Descriptor, fmt: str) -> set[int]:
 
 
 def check_serialize_format(
-    descriptor: Descriptor, fmt: str, virtual_fields: Collection[int] = ()
+    descriptor: AnyDescriptor, fmt: str, virtual_fields: Collection[int] = ()
 ) -> None:
     """Reject publish formats that cannot render (bad sub-message paths, bad directives) or
     that name a field the message does not have (upstream renders such a directive as empty

@@ -10,7 +10,6 @@ from __future__ import annotations
 import logging
 from collections.abc import Sequence
 
-from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.moos.translator.algorithms import AlgorithmRegistry, run_publish_algorithms
@@ -21,11 +20,12 @@ from pygoby.moos.translator.fields import (
     stream_value,
 )
 from pygoby.protobuf import message_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 log = logging.getLogger("pygoby.moos.translator")
 
 
-def is_set(msg: Message, field: FieldDescriptor) -> bool:
+def is_set(msg: Message, field: AnyFieldDescriptor) -> bool:
     """C++ HasField / FieldSize > 0 semantics."""
     if field.is_repeated:
         return len(getattr(msg, field.name)) > 0
@@ -52,7 +52,7 @@ def val_from_string(text: str, key: str) -> str | None:
     return text[value_start : end if end >= 0 else len(text)]
 
 
-def _sub_value(msg: Message, field: FieldDescriptor, use_short_enum: bool) -> str:
+def _sub_value(msg: Message, field: AnyFieldDescriptor, use_short_enum: bool) -> str:
     """A field inside a flattened sub-message: repeated ones joined by commas, no braces."""
     value = getattr(msg, field.name)
     if field.is_repeated:
@@ -60,7 +60,7 @@ def _sub_value(msg: Message, field: FieldDescriptor, use_short_enum: bool) -> st
     return stream_value(field, value, use_short_enum)
 
 
-def _entry(msg: Message, field: FieldDescriptor, use_short_enum: bool) -> str:
+def _entry(msg: Message, field: AnyFieldDescriptor, use_short_enum: bool) -> str:
     name = field.name
     value = getattr(msg, name)
     if is_message(field):
@@ -104,7 +104,7 @@ def serialize(
 
 
 def _set_values(
-    msg: Message, field: FieldDescriptor, values: list[str], index: int, use_short_enum: bool
+    msg: Message, field: AnyFieldDescriptor, values: list[str], index: int, use_short_enum: bool
 ) -> None:
     if field.is_repeated:
         for value in values:

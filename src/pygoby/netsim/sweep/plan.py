@@ -28,6 +28,7 @@ from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.errors import ScenarioError
 from pygoby.netsim.scenario import check_scenario, parse_scenario
 from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 from pygoby.protobuf.pygoby.netsim.scenario_pb2 import Scenario
 from pygoby.protobuf.pygoby.netsim.sweep_pb2 import Axis, Layout, Sweep
 from pygoby.protobuf.textconfig import merge_config_text, read_config_file
@@ -123,7 +124,7 @@ def _segments(path: str) -> list[tuple[str, int | None]]:
     return parts
 
 
-def field_descriptor(message_class_descriptor, path: str) -> FieldDescriptor:
+def field_descriptor(message_class_descriptor, path: str) -> AnyFieldDescriptor:
     """The descriptor of the scalar a path ends at (checked against the message type)."""
     descriptor = message_class_descriptor
     segments = _segments(path)
@@ -182,7 +183,7 @@ _KINDS = {
 }
 
 
-def parse_value(field: FieldDescriptor, text: str) -> Value:
+def parse_value(field: AnyFieldDescriptor, text: str) -> Value:
     """A value written as in TextFormat, as the field's Python type (enums by name)."""
     kind = _KINDS[field.cpp_type]
     text = text.strip()
@@ -213,7 +214,7 @@ def parse_value(field: FieldDescriptor, text: str) -> Value:
     return text
 
 
-def _field_value(field: FieldDescriptor, value: Value):
+def _field_value(field: AnyFieldDescriptor, value: Value):
     """What to assign to the protobuf field (enum names become numbers)."""
     if field.cpp_type == FieldDescriptor.CPPTYPE_ENUM:
         return enum_type(field).values_by_name[value].number
@@ -226,7 +227,7 @@ def _field_value(field: FieldDescriptor, value: Value):
 @dataclass(frozen=True)
 class _Axis:
     column: AxisColumn
-    descriptor: FieldDescriptor
+    descriptor: AnyFieldDescriptor
     values: tuple[Value, ...]  # GRID values (or RANDOM choices)
     span: Axis.Span | None
 

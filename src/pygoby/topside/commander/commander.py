@@ -46,6 +46,7 @@ from pygoby.moos.translator import (
     serialize_for_moos,
 )
 from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 from pygoby.topside.commander import savefile, specials
 from pygoby.topside.commander.fields import FieldSpec, FieldValueError
 from pygoby.topside.commander.messageset import CommandSet, CommandType
@@ -463,7 +464,7 @@ def _number(text: str) -> float:
     return 1.0 if lowered == "true" else 0.0 if lowered == "false" else float(text)
 
 
-def _convert(spec: FieldSpec, field: FieldDescriptor, text: str) -> object:
+def _convert(spec: FieldSpec, field: AnyFieldDescriptor, text: str) -> object:
     kind = field.type
     if kind == _FD.TYPE_ENUM:
         for value, shown in zip(enum_type(field).values, spec.enum_values, strict=True):

@@ -15,6 +15,7 @@ from google.protobuf.descriptor import FieldDescriptor
 from pygoby.dccl.options import field_options
 from pygoby.moos.translator.fields import enum_name
 from pygoby.protobuf import enum_type, message_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 from pygoby.topside.commander import specials
 from pygoby.topside.errors import FieldValueError
 
@@ -35,7 +36,7 @@ _UNSIGNED = {_FD.TYPE_UINT32, _FD.TYPE_UINT64, _FD.TYPE_FIXED32, _FD.TYPE_FIXED6
 _FLOAT_TYPES = {_FD.TYPE_DOUBLE, _FD.TYPE_FLOAT}
 
 
-def _kind(field: FieldDescriptor, codec: str) -> str:
+def _kind(field: AnyFieldDescriptor, codec: str) -> str:
     if codec == "_static" or codec.startswith("dccl.static"):
         return "static"
     if field.type in _INT_TYPES:
@@ -83,14 +84,14 @@ class FieldSpec:
     @classmethod
     def from_descriptor(
         cls,
-        field: FieldDescriptor,
+        field: AnyFieldDescriptor,
         source: str = "",
         automatic_from: str = "",
         *,
         path: str = "",
         required: bool | None = None,
         short_enum: bool = False,
-        elements_of: FieldDescriptor | None = None,
+        elements_of: AnyFieldDescriptor | None = None,
     ) -> FieldSpec:
         """`path`: the name inside the command (`pose.x` for a sub-message's field);
         `required`: whether the message needs it (a required field of an optional sub-message

@@ -24,13 +24,14 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.xml import XmlMessage
 from pygoby.moos.translator import ModemIdLookup, Technique, Translator, UTMGeodesy
 from pygoby.moos.translator.format import parsed_fields
 from pygoby.moos.translator.techniques import PROTOBUF_TECHNIQUES
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.topside.commander.fields import FieldSpec
 
@@ -91,11 +92,11 @@ def _effective_sources(entry: Message, cls: type[Message]) -> dict[int, str]:
 
 
 def _leaves(
-    descriptor: Descriptor,
+    descriptor: AnyDescriptor,
     prefix: str,
     required: bool,
     chain: tuple[str, ...],
-    elements_of: FieldDescriptor | None = None,
+    elements_of: AnyFieldDescriptor | None = None,
 ) -> Iterator[tuple[str, FieldDescriptor, bool, FieldDescriptor | None]]:
     """(path, field, required all the way down, the repeated sub-message whose elements hold
     it) of every field: singular sub-messages unfolded (`pose.x`), and repeated ones of plain

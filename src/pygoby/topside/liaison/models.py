@@ -11,6 +11,7 @@ import re
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 from google.protobuf.message import Message
 
@@ -22,6 +23,10 @@ from pygoby.moos.translator import ModemIdLookup, UTMGeodesy, dynamic_parse, par
 from pygoby.moos.translator.keyvalue import val_from_string
 from pygoby.moos.translator.techniques import MoosValue, Technique
 from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import MessageT
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
+    pAcommsHandlerConfig,
+)
 
 RATE_WINDOW = 10.0  # seconds over which a variable's rate is measured
 _TEXT = Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT
@@ -120,7 +125,7 @@ class ScopeModel:
 class QueueState:
     name: str
     dccl_id: int | None
-    entry: Message
+    entry: acomms_pb.QueuedMessageEntry
     size: int = 0
     last_sent: float = 0.0
     sent: int = 0
@@ -138,7 +143,7 @@ def _enum_name(msg: Message, field: str) -> str:
     return enum.values_by_number[getattr(msg, field)].name
 
 
-def _mm_extension(transmission: Message) -> Message | None:
+def _mm_extension(transmission: acomms_pb.ModemTransmission) -> acomms_pb.MMTransmission | None:
     if transmission.HasExtension(acomms_pb.MM_TRANSMISSION):
         return transmission.Extensions[acomms_pb.MM_TRANSMISSION]
     return None
@@ -151,7 +156,11 @@ class AcommsModel:
     finds the mission's message classes (to name the DCCL messages inside frames)."""
 
     def __init__(
-        self, cfg: Message, resolve: Callable[[str], type[Message]], now: float, history: int = 20
+        self,
+        cfg: pAcommsHandlerConfig,
+        resolve: Callable[[str], type[Message]],
+        now: float,
+        history: int = 20,
     ) -> None:
         names = cfg.moos_var
         self.var = {
@@ -173,7 +182,7 @@ class AcommsModel:
             self.queues[entry.protobuf_name] = QueueState(
                 entry.protobuf_name, dccl_id, entry, last_sent=now
             )
-        self.slots = [
+        self.slots: list[dict[str, Any]] = [
             {
                 "src": s.src,
                 "dest": s.dest,
@@ -188,7 +197,7 @@ class AcommsModel:
         self.tx: deque[dict] = deque(maxlen=history)
         self.rx: deque[dict] = deque(maxlen=history)
         self.timeline: deque[dict] = deque(maxlen=4 * history)
-        self._handlers = {
+        self._handlers: dict[str, Callable[[MoosValue, float], None]] = {
             self.var["queue_size"]: self._on_qsize,
             self.var["mac_slot_start"]: self._on_slot,
             self.var["driver_transmit"]: functools.partial(self._on_modem, True),
@@ -206,7 +215,7 @@ class AcommsModel:
         if handler is not None and isinstance(msg.value, str | bytes):
             handler(msg.value, msg.time)
 
-    def _parse(self, cls: type[Message], value: MoosValue) -> Message | None:
+    def _parse(self, cls: type[MessageT], value: MoosValue) -> MessageT | None:
         out = cls()
         try:
             parse_for_moos(value, out)
@@ -228,7 +237,7 @@ class AcommsModel:
             self.slot_index = slot.slot_index if slot.HasField("slot_index") else None
             self.slot_start = slot.time / 1e6 if slot.HasField("time") else when
 
-    def _messages_in(self, transmission: Message) -> list[str]:
+    def _messages_in(self, transmission: acomms_pb.ModemTransmission) -> list[str]:
         names = []
         for frame in transmission.frame:
             data, offset = bytes(frame), 0
@@ -249,7 +258,7 @@ class AcommsModel:
         if transmission is None:
             return
         names = self._messages_in(transmission)
-        row = {
+        row: dict[str, Any] = {
             "time": transmission.time / 1e6 if transmission.HasField("time") else when,
             "src": transmission.src,
             "dest": transmission.dest,
