@@ -54,7 +54,7 @@ class ModemDriverBase(ABC):
         self.link: LineLink | None = link
         self._injected_link = link is not None
         self._raw_log: IO[str] | None = None
-        self._traffic_logs: tuple[logging.Logger, logging.Logger] = (log, log)
+        self._traffic_logs: tuple[logging.Logger, ...] = (log, log)  # (out, in)
         self._traffic_logs_for: object = None  # the cfg the traffic loggers are named for
 
     # --- the interface -------------------------------------------------------------------

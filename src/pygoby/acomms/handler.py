@@ -105,7 +105,7 @@ class DriverSlot:
     """One configured driver and its run state (`restart_at` is None while it runs)."""
 
     driver: ModemDriverBase
-    cfg: object  # DriverConfig
+    cfg: acomms_pb.DriverConfig
     restart_at: float | None = 0.0
     failures: int = 0
 
@@ -345,7 +345,7 @@ class AcommsHandler:
         """A RouteCommand received over the link replaces the route when routing is configured
         (pAcommsHandler's rule); any other message is left alone."""
         if message.DESCRIPTOR.full_name == ROUTE_COMMAND and self.route_cfg.route.hop:
-            self.replace_route(message.new_route)
+            self.replace_route(message.new_route)  # type: ignore[attr-defined]  # (a RouteCommand)
 
     # ------------------------------------------------------------------ internals
     def _initiate_on_primary(self, transmission) -> None:
@@ -390,7 +390,13 @@ class AcommsHandler:
         except Exception:
             log.exception("driver %s failed to shut down cleanly", _name(slot))
 
-    def _driver_failed(self, slot: DriverSlot, status: int, why, started: bool = True) -> None:
+    def _driver_failed(
+        self,
+        slot: DriverSlot,
+        status: acomms_pb.ModemDriverStatus.Status.ValueType,
+        why,
+        started: bool = True,
+    ) -> None:
         slot.failures += 1
         log.warning("driver %s failed (%s): %s", _name(slot), Status.Status.Name(status), why)
         if started or slot.running:
@@ -427,7 +433,7 @@ class AcommsHandler:
         new.driver.signal_receive.connect(self.mac.handle_modem_receive)
 
 
-def _status_of(exc: BaseException, default: int) -> int:
+def _status_of(exc: BaseException, default: Status.Status.ValueType) -> Status.Status.ValueType:
     return exc.status if isinstance(exc, ModemDriverError) else default
 
 

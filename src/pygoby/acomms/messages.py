@@ -68,6 +68,7 @@ StoreServerResponse = store_server_pb2.StoreServerResponse
 
 MMConfig = mm_driver_pb2.Config
 MMTransmission = mm_driver_pb2.Transmission
+MMTransmissionType = mm_driver_pb2.TransmissionType.ValueType
 ReceiveStatistics = mm_receive_statistics_pb2.ReceiveStatistics
 TransmitStatistics = mm_driver_pb2.TransmitStatistics
 RangingReply = mm_driver_pb2.RangingReply
@@ -94,6 +95,7 @@ MM_CONFIG = mm_driver_pb2.config
 MM_TRANSMISSION = mm_driver_pb2.transmission
 UDP_CONFIG = udp_driver_pb2.config
 UDP_MULTICAST_CONFIG = udp_multicast_driver_pb2.config
+UDPMulticastConfig = udp_multicast_driver_pb2.Config
 ABC_CONFIG = abc_driver_pb2.config
 STORE_SERVER_CONFIG = store_server_driver_pb2.config
 STORE_SERVER_TRANSMISSION = store_server_driver_pb2.transmission

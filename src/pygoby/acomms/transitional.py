@@ -20,6 +20,8 @@ from google.protobuf.message import Message
 from pygoby.dccl.xml import MessageSet, XmlMessage, load_message_set
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
+from pygoby.protobuf.goby.moos.protobuf.transitional_pb2 import MessageFile
 
 log = logging.getLogger(__name__)
 
@@ -34,7 +36,7 @@ class TransitionalMessages:
 
     @classmethod
     def expand(
-        cls, cfg: Message, loader: ProtoLoader, find: Callable[[str], str] = str
+        cls, cfg: pAcommsHandlerConfig, loader: ProtoLoader, find: Callable[[str], str] = str
     ) -> TransitionalMessages:
         """Load `cfg.transitional_cfg.message_file` (paths through `find`), register the types
         in `loader` and append their queue and translator entries to `cfg`."""
@@ -45,8 +47,8 @@ class TransitionalMessages:
 
     def add_file(
         self,
-        cfg: Message,
-        message_file: Message,
+        cfg: pAcommsHandlerConfig,
+        message_file: MessageFile,
         loader: ProtoLoader,
         find: Callable[[str], str] = str,
     ) -> MessageSet:

@@ -44,10 +44,9 @@ from pygoby.dccl.codecs.base import FieldInfo, RepeatedFieldCodec
 from pygoby.dccl.codecs.numeric import f32
 from pygoby.dccl.errors import DcclDecodeError, DcclError, DcclLoadError
 from pygoby.dccl.options import field_extension
-from pygoby.protobuf import enum_type
+from pygoby.protobuf import enum_type, initialization_errors
+from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_extensions_pb2 import ArithmeticOptions
 from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_pb2 import ArithmeticModel
-
-EXTENSIONS_PROTO = "dccl/arithmetic/protobuf/arithmetic_extensions.proto"
 
 EOF_SYMBOL = -2
 OUT_OF_RANGE_SYMBOL = -1
@@ -85,9 +84,7 @@ class Model:
             return DcclLoadError(f"invalid arithmetic model {user.name!r}: {why}")
 
         if not user.IsInitialized():
-            raise DcclLoadError(
-                f"invalid arithmetic model: missing {user.FindInitializationErrors()}"
-            )
+            raise DcclLoadError(f"invalid arithmetic model: missing {initialization_errors(user)}")
         self.user = user
         self.name = user.name
         self.bounds = list(user.value_bound)
@@ -227,7 +224,7 @@ class ArithmeticCodec(RepeatedFieldCodec):
 
     def __init__(self, info: FieldInfo) -> None:
         super().__init__(info)
-        options = field_extension(info.options, EXTENSIONS_PROTO, "ArithmeticOptions", 1001)
+        options = field_extension(info.options, ArithmeticOptions, 1001)
         if not options.HasField("model"):
             raise DcclLoadError(f"{info.name}: missing (dccl.field).arithmetic.model")
         self.model_name = options.model

@@ -24,7 +24,7 @@ from pygoby.dccl.identifier import id_codec as lookup_id_codec
 from pygoby.dccl.options import message_options
 from pygoby.dccl.plan import Part, Planner, root_options
 from pygoby.dccl.registry import DEFAULT_REGISTRY, CodecRegistry
-from pygoby.protobuf import ProtoError, ProtoLoader
+from pygoby.protobuf import ProtoError, ProtoLoader, initialization_errors
 from pygoby.protobuf.descriptors import AnyDescriptor
 from pygoby.util.clock import Clock
 from pygoby.util.names import did_you_mean
@@ -251,7 +251,7 @@ class Codec:
         """Encode a message (its type is loaded on first use)."""
         compiled = self._by_name.get(msg.DESCRIPTOR.full_name) or self.compiled(type(msg))
         if not msg.IsInitialized():
-            missing = ", ".join(msg.FindInitializationErrors())
+            missing = ", ".join(initialization_errors(msg))
             raise DcclEncodeError(f"{compiled.name}: required fields are not set: {missing}")
         strict = self.strict
         try:

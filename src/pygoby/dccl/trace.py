@@ -15,7 +15,6 @@ import logging
 from typing import Any
 
 from google.protobuf import text_format
-from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.protobuf.descriptors import AnyFieldDescriptor
@@ -42,7 +41,7 @@ class FieldTracer:
 
     def __init__(self, type_name: str, action: str, part: str) -> None:
         self.where = f"{action} {type_name} {part}"
-        self.fields: dict[str, FieldDescriptor] = {}  # by the paths the generated code passes
+        self.fields: dict[str, AnyFieldDescriptor] = {}  # by the paths the generated code passes
 
     def __call__(self, path: str, value: Any, start: int, end: int, bits: int) -> None:
         """`bits` holds the field's bits at positions start..end (LSB first, spec §3.2)."""

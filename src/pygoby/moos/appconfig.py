@@ -24,7 +24,7 @@ import math
 import re
 from collections.abc import Callable, Iterator, Sequence
 from contextvars import ContextVar
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
@@ -32,8 +32,9 @@ from google.protobuf.message import Message
 from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
 from pygoby.moos.moosfile import GobyBlock, MissionFile, parse_number
-from pygoby.protobuf import enum_type
+from pygoby.protobuf import enum_type, initialization_errors
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
+from pygoby.protobuf.goby.moos.protobuf.goby_moos_app_pb2 import GobyMOOSAppConfig
 from pygoby.protobuf.goby.protobuf.option_extensions_pb2 import GobyFieldOptions
 from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
 from pygoby.protobuf.wire import length_delimited
@@ -53,7 +54,7 @@ def _options_class() -> type[GobyFieldOptions]:
     return GobyFieldOptions
 
 
-def goby_field_options(field: AnyFieldDescriptor) -> Message:
+def goby_field_options(field: AnyFieldDescriptor) -> GobyFieldOptions:
     """The field's `(goby.field)` options (an empty GobyFieldOptions if it has none)."""
     out = _options_class()()
     if not field.has_options:
@@ -72,7 +73,7 @@ def locate(err: ConfigError, mission: MissionFile | None, app_name: str) -> Conf
     """`err` (about the field at `err.field` of the app's configuration) with the mission file
     and the line of that field in the app's ProcessConfig block filled in."""
     block = mission.goby_block(app_name) if mission is not None else None
-    if block is None or err.field is None:
+    if mission is None or block is None or err.field is None:
         return err
     path = mission.path if mission.path else "mission file"
     return err.located(file=path, line=line_of_field(block.text, err.field, block.first_line))
@@ -214,6 +215,7 @@ def read_configuration(
     config = config_class()
     source = str(mission.path) if mission is not None and mission.path else "mission file"
     translated: list[str] = []
+    block: GobyBlock | None = None
     if mission is not None:
         block = mission.goby_block(app_name)
         if block is None:
@@ -234,10 +236,10 @@ def read_configuration(
     apply_overrides(config, overrides)
     if complete is not None:
         complete(config)
-    missing = config.FindInitializationErrors()
+    missing = initialization_errors(config)
     if missing:
         raise ConfigError(f"missing required configuration fields: {', '.join(missing)}")
-    block_text, first_line = (block.text, block.first_line) if mission is not None else ("", 1)
+    block_text, first_line = (block.text, block.first_line) if block is not None else ("", 1)
     check_config_values(config, block_text, file=source, first_line=first_line)
     return config
 
@@ -301,7 +303,7 @@ def _wrap_words(comment: str, width: int) -> list[str]:
 def _extensions(descriptor: AnyDescriptor) -> list[AnyFieldDescriptor]:
     """Extensions of `descriptor` loaded into its pool (e.g. driver configurations)."""
     try:
-        found = descriptor.file.pool.FindAllExtensions(descriptor)
+        found = descriptor.file.pool.FindAllExtensions(descriptor)  # type: ignore[arg-type]
     except (AttributeError, KeyError):
         return []
     return sorted(found, key=lambda f: f.number)
@@ -361,7 +363,7 @@ def example_config(config_class: type[Message], app_name: str) -> str:
 
 
 def initializer_posts(
-    common: Message, mission: MissionFile | None, log: logging.Logger = log
+    common: GobyMOOSAppConfig, mission: MissionFile | None, log: logging.Logger = log
 ) -> list[tuple[str, float | str]]:
     """The (MOOS variable, value) posts of `common.initializer` (spec 2.5): a constant, or a
     global of the mission file (a double that does not parse is NaN); a missing global is
@@ -375,7 +377,10 @@ def initializer_posts(
 
 
 def _initializer_value(
-    ini: Message, common: Message, mission: MissionFile | None, log: logging.Logger
+    ini: GobyMOOSAppConfig.Initializer,
+    common: GobyMOOSAppConfig,
+    mission: MissionFile | None,
+    log: logging.Logger,
 ) -> float | str | None:
     is_double = ini.type == type(common).Initializer.INI_DOUBLE
     if not ini.HasField("global_cfg_var"):
@@ -396,7 +401,7 @@ def _initializer_value(
         return math.nan
 
 
-def prefixed_var_names(names: Message, skip: Sequence[str] = ()) -> dict[str, str]:
+def prefixed_var_names(names: Any, skip: Sequence[str] = ()) -> dict[str, str]:
     """An app's `moos_var` block as {field name: prefix + variable}, for every field but
     `prefix` and those in `skip`."""
     return {

@@ -16,6 +16,7 @@ from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.netsim.channel.settings import environment_channel_configs
+from pygoby.protobuf import initialization_errors
 from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
 from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
 
@@ -91,7 +92,7 @@ def load_config(path: str | os.PathLike[str]) -> Message:
 def validate_config(config: Message) -> None:
     """The start-up checks of upstream, in its order; the first failure raises ConfigError."""
     if not config.IsInitialized():
-        missing = ", ".join(config.FindInitializationErrors())
+        missing = ", ".join(initialization_errors(config))
         raise ConfigError(f"configuration is missing required fields: {missing}")
     environments: set[int] = set()
     for bounds in config.env_bounds:

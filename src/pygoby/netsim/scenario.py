@@ -24,6 +24,7 @@ from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.channel.settings import absorption_of, propagation_of, sound_speed_of
 from pygoby.netsim.config import config_class as manager_config_class
 from pygoby.netsim.errors import ScenarioError
+from pygoby.protobuf import initialization_errors
 from pygoby.protobuf.goby.acomms.protobuf.amac_config_pb2 import MACConfig
 from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
 from pygoby.protobuf.pygoby.netsim.scenario_pb2 import NodeStatus, Scenario, Track, Waypoint
@@ -59,7 +60,7 @@ def parse_scenario(text: str, file: str | Path | None = None) -> Scenario:
 
 def check_scenario(scenario: Scenario) -> None:
     if not scenario.IsInitialized():
-        missing = ", ".join(scenario.FindInitializationErrors())
+        missing = ", ".join(initialization_errors(scenario))
         raise ScenarioError(f"scenario is missing required fields: {missing}")
     if not scenario.node:
         raise ScenarioError("a scenario needs at least one node")

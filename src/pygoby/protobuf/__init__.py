@@ -7,6 +7,7 @@ from pygoby.protobuf.loader import (
     builtin_class,
     default_loader,
     enum_type,
+    initialization_errors,
     message_type,
 )
 
@@ -17,5 +18,6 @@ __all__ = [
     "builtin_class",
     "default_loader",
     "enum_type",
+    "initialization_errors",
     "message_type",
 ]

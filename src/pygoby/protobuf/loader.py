@@ -245,3 +245,10 @@ def message_type(field: AnyFieldDescriptor) -> AnyDescriptor:
     if field.message_type is None:
         raise ProtoError(f"{field.full_name} is not a message field")
     return field.message_type
+
+
+def initialization_errors(message: Message) -> list[str]:
+    """Paths of the required fields `message` lacks ("node[0].track.speed"), as protobuf's
+    FindInitializationErrors gives them (a method its type stubs leave out)."""
+    errors: list[str] = message.FindInitializationErrors()  # type: ignore[attr-defined]
+    return errors

@@ -21,6 +21,7 @@ from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 PORT_MAX = 65535
 _INTEGER_TYPES = frozenset(
@@ -156,7 +157,7 @@ def line_of_field(text: str, path: str, first_line: int = 1) -> int | None:
     return first_line + code.count("\n", 0, position) if path else None
 
 
-def _integer_values(message: Message, prefix: str) -> Iterator[tuple[str, FieldDescriptor, int]]:
+def _integer_values(message: Message, prefix: str) -> Iterator[tuple[str, AnyFieldDescriptor, int]]:
     for field, value in message.ListFields():
         name = f"[{field.full_name}]" if field.is_extension else field.name
         path = f"{prefix}{name}"

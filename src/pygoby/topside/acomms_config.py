@@ -63,7 +63,7 @@ class AcommsMessageSet:
     class), the XML message sets (`transitional`) and the built-ins standing for C++ DCCL codec
     libraries (their messages are in `types`; a codec also needs `apply_libraries`)."""
 
-    cfg: Message
+    cfg: pAcommsHandlerConfig
     loader: ProtoLoader
     types: MessageTypes
     transitional: TransitionalMessages
@@ -74,7 +74,7 @@ class AcommsMessageSet:
     @classmethod
     def load(
         cls,
-        cfg: Message,
+        cfg: pAcommsHandlerConfig,
         find: Callable[[str], str] = str,
         search_dirs: Sequence[str] = (),
         config_error: ErrorMaker | None = None,

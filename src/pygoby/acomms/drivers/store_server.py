@@ -27,7 +27,7 @@ from pygoby.errors import ConfigError
 log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 11244
-POLL = 1  # store_server.protobuf.Transmission.STORE_SERVER_DRIVER_POLL
+POLL = acomms_pb.StoreServerTransmission.STORE_SERVER_DRIVER_POLL
 # Room in a request for everything but the frames' bytes (ids, times, the transmission's other
 # fields, the request around it), so that one full transmission always fits in one packet.
 TRANSMISSION_OVERHEAD = 256

@@ -56,7 +56,8 @@ class UDPDriver(DatagramDriverBase):
                 raise ModemDriverError(
                     f"cannot resolve {remote.ip}: {exc}", Status.INVALID_CONFIGURATION
                 ) from exc
-            self._remotes.setdefault(remote.modem_id, []).append(info[0][4][:2])
+            host, port = info[0][4][:2]
+            self._remotes.setdefault(remote.modem_id, []).append((str(host), int(port)))
         self._ack_ids = {cfg.modem_id, *self.udp_cfg.additional_application_ack_modem_id}
 
     def _max_frame_bytes(self, msg) -> int:

@@ -24,7 +24,7 @@ _CONFIG = acomms_pb.UDP_MULTICAST_CONFIG
 class UDPMulticastDriver(DatagramDriverBase):
     def __init__(self, clock=None) -> None:
         super().__init__(clock)
-        self.mc_cfg = None
+        self.mc_cfg = acomms_pb.UDPMulticastConfig()
 
     def startup(self, cfg) -> None:
         if not cfg.HasField("modem_id"):

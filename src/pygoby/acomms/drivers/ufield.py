@@ -26,7 +26,7 @@ log = logging.getLogger(__name__)
 
 DEFAULT_FRAME_BYTES = 64
 SOUND_SPEED = 1500.0
-POLL = 1  # goby.moos.ufld.protobuf.Transmission.UFIELD_DRIVER_POLL
+POLL = acomms_pb.UFldTransmission.UFIELD_DRIVER_POLL
 
 
 def parse_moos_pairs(text: str) -> dict[str, str]:

@@ -24,7 +24,7 @@ class CCLQueue(MessageQueue):
         return self.entry.protobuf_name
 
 
-def queue_entry(cfg) -> object:
+def queue_entry(cfg: acomms_pb.V1QueueConfig) -> acomms_pb.QueuedMessageEntry:
     """The QueuedMessageEntry holding a Goby 1.1 QueueConfig's options (for the contest)."""
     return acomms_pb.QueuedMessageEntry(
         protobuf_name=f"CCL:{cfg.name}",

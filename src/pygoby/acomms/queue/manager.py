@@ -19,16 +19,16 @@ from pygoby.acomms.queue.log import QueueLog
 from pygoby.acomms.queue.persist import QueueStore
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
-from pygoby.dccl import DcclError
+from pygoby.dccl import Codec, DcclError
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.signal import Signal
 
 
 class QueueManager:
-    def __init__(self, codec, clock: Clock | None = None) -> None:
+    def __init__(self, codec: Codec, clock: Clock | None = None) -> None:
         """`codec` is a pygoby.dccl.Codec (types are loaded into it as queues are added)."""
         self.codec = codec
-        self._peer_codecs: dict[int, object] = {}  # encrypt_rule: peer id -> Codec
+        self._peer_codecs: dict[int, Codec] = {}  # encrypt_rule: peer id -> Codec
         self.clock: Clock = clock if clock is not None else WallClock()
         self.cfg = acomms_pb.QueueManagerConfig()
         self.queues: dict[int, MessageQueue] = {}  # by DCCL id, kept in ascending order
@@ -188,8 +188,8 @@ class QueueManager:
             queue.journal = store
         restored = 0
         for stored in store.items():
-            queue = queues.get(stored.queue)
-            if queue is None or queue.message_class is None:
+            found = queues.get(stored.queue)
+            if found is None or found.message_class is None:
                 self.log.push.warning(
                     "persistent queue %s: a stored %s is kept, but not sent (no such queue is "
                     "configured)",
@@ -197,8 +197,9 @@ class QueueManager:
                     stored.queue,
                 )
                 continue
+            queue = found
             try:
-                message = queue.message_class.FromString(stored.message)
+                message = found.message_class.FromString(stored.message)
             except DecodeError as exc:
                 self.log.push.warning(
                     "persistent queue %s: a stored %s does not parse (%s); dropped",
@@ -534,7 +535,13 @@ class QueueManager:
                 self.signal_expire.emit(item.msg)
                 self._network_ack(queue, item, acomms_pb.NetworkAck.EXPIRE, self.modem_id)
 
-    def _network_ack(self, queue: MessageQueue, item: QueuedItem, kind: int, ack_src: int) -> None:
+    def _network_ack(
+        self,
+        queue: MessageQueue,
+        item: QueuedItem,
+        kind: acomms_pb.NetworkAck.AckType.ValueType,
+        ack_src: int,
+    ) -> None:
         """NetworkAck for messages from `make_network_ack_for_src_id` sources (never for a
         NetworkAck): delivered here if we sent the original, else offered to the router."""
         if item.src not in self.cfg.make_network_ack_for_src_id:

@@ -10,7 +10,7 @@ from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import RoleError
-from pygoby.protobuf.descriptors import AnyDescriptor
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 Role = acomms_pb.QueuedMessageEntry.Role
 _INTEGER_TYPES = {
@@ -59,7 +59,8 @@ def compile_roles(entry, descriptor: AnyDescriptor) -> dict[int, RoleGetter]:
             getters[role.type] = RoleGetter(None, role.static_value)
             continue
         path = tuple(role.field.split("."))
-        current, field = descriptor, None
+        current: AnyDescriptor | None = descriptor
+        field: AnyFieldDescriptor | None = None
         for name in path:
             if current is None or name not in current.fields_by_name:
                 raise RoleError(f"{entry.protobuf_name}: no field {role.field!r}")

@@ -19,13 +19,12 @@ from pygoby.dccl.codecs.numeric import NumericCodec, f32
 from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_extension
 from pygoby.protobuf import message_type
-
-CCL_EXTENSIONS_PROTO = "dccl/ccl/protobuf/ccl_extensions.proto"
+from pygoby.protobuf.dccl.ccl.protobuf.ccl_extensions_pb2 import LegacyCCLFieldOptions
 
 
 def ccl_options(info: FieldInfo):
     """The field's `(dccl.field).(ccl)` options (LegacyCCLFieldOptions)."""
-    return field_extension(info.options, CCL_EXTENSIONS_PROTO, "LegacyCCLFieldOptions", 1000)
+    return field_extension(info.options, LegacyCCLFieldOptions, 1000)
 
 
 class _FunctionCodec(FixedWidthCodec):

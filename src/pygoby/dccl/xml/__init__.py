@@ -31,6 +31,8 @@ from pygoby.dccl.xml.model import Publish, PublishVar, Queuing, Var, XmlMessage
 from pygoby.dccl.xml.parser import ALGORITHMS, read_message_file, read_message_set
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoError, ProtoLoader
+from pygoby.protobuf.goby.acomms.protobuf.queue_pb2 import QueuedMessageEntry
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 
 
 @dataclass
@@ -64,10 +66,10 @@ class MessageSet:
         out.write_text(self.proto_text())
         return out
 
-    def queue_entries(self) -> list[Message]:
+    def queue_entries(self) -> list[QueuedMessageEntry]:
         return [convert.queue_entry(m, self.manipulators) for m in self.messages]
 
-    def translator_entries(self) -> list[Message]:
+    def translator_entries(self) -> list[TranslatorEntry]:
         return [convert.translator_entry(m) for m in self.messages]
 
     def register(self, loader: ProtoLoader) -> list[type[Message]]:

@@ -49,6 +49,7 @@ from pygoby.frontseat.simulator.protocol import (
     Start,
     parse_line,
 )
+from pygoby.protobuf import initialization_errors
 from pygoby.util.clock import Clock
 from pygoby.util.errors import LinkClosedError
 from pygoby.util.linebased import LineLink, TCPClientLink
@@ -71,7 +72,7 @@ def start_params(cfg: Any) -> Start:
             field="frontseat_cfg",
         )
     sim = cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
-    missing = sim.FindInitializationErrors()
+    missing = initialization_errors(sim)
     if missing:
         raise AbcConfigError(f"lacks required {', '.join(missing)}", field="basic_simulator_config")
     start = sim.start

@@ -30,6 +30,7 @@ from pygoby.moos.translator.techniques import (
     serialize_for_moos,
     serialize_protobuf,
 )
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 from pygoby.util.modem_id import ModemIdLookup
 
 log = logging.getLogger("pygoby.moos.translator")
@@ -101,7 +102,7 @@ class Translator:
 
     def __init__(
         self,
-        entries: Iterable[Message],
+        entries: Iterable[TranslatorEntry],
         resolve: MessageResolver,
         *,
         lat_origin: float = 0.0,
@@ -110,7 +111,7 @@ class Translator:
     ) -> None:
         self.registry = AlgorithmRegistry(lat_origin, lon_origin, modem_ids)
         self._resolve = resolve
-        self._entries: dict[str, Message] = {}
+        self._entries: dict[str, TranslatorEntry] = {}
         self._classes: dict[str, type[Message]] = {}
         self._named_values: dict[str, dict[str, str]] = {}
         for entry in entries:
@@ -118,7 +119,7 @@ class Translator:
 
     # --- configuration -------------------------------------------------------------------
 
-    def add_entry(self, entry: Message) -> None:
+    def add_entry(self, entry: TranslatorEntry) -> None:
         name = entry.protobuf_name
         if name in self._entries:
             raise TranslatorConfigError(f"Duplicate translator entry for {name}")
@@ -132,7 +133,7 @@ class Translator:
         self._entries[name] = entry
         self._classes[name] = cls
 
-    def _check_entry(self, entry: Message, cls: type[Message]) -> None:
+    def _check_entry(self, entry: TranslatorEntry, cls: type[Message]) -> None:
         name = entry.protobuf_name
         descriptor = cls.DESCRIPTOR
         if entry.HasField("trigger"):
@@ -188,7 +189,7 @@ class Translator:
         self.registry.set_datum(lat_origin, lon_origin)
 
     @property
-    def entries(self) -> Mapping[str, Message]:
+    def entries(self) -> Mapping[str, TranslatorEntry]:
         return self._entries
 
     def message_class(self, protobuf_name: str) -> type[Message]:
@@ -320,7 +321,7 @@ class Translator:
             posts.append(Post(trigger.moos_var, "", ""))
         return sorted(posts, key=lambda post: post.var)
 
-    def _entry(self, protobuf_name: str) -> Message:
+    def _entry(self, protobuf_name: str) -> TranslatorEntry:
         try:
             return self._entries[protobuf_name]
         except KeyError:

@@ -45,7 +45,7 @@ from pygoby.moos.translator import (
     make_post,
     serialize_for_moos,
 )
-from pygoby.protobuf import enum_type
+from pygoby.protobuf import enum_type, initialization_errors
 from pygoby.protobuf.descriptors import AnyFieldDescriptor
 from pygoby.topside.commander import savefile, specials
 from pygoby.topside.commander.fields import FieldSpec, FieldValueError
@@ -316,7 +316,7 @@ class Commander:
                 values[spec.name] = text
         # what the rules above cannot see: an element of a repeated sub-message left without a
         # required field
-        warnings += [f"{path}: not set" for path in msg.FindInitializationErrors() if "[" in path]
+        warnings += [f"{path}: not set" for path in initialization_errors(msg) if "[" in path]
         try:
             posts = self._posts(kind, msg, values, warnings)
         except TranslatorError as err:

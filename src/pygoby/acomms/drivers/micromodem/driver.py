@@ -176,7 +176,7 @@ class MMDriver(ModemDriverBase):
             self._written_at = None  # (re)connected: rewrite the outstanding sentence now
         self._link_was_open = link_open
         if self._typed:
-            sentences = self.link.read_sentences()
+            sentences = self.link.read_sentences()  # type: ignore[attr-defined]  # (hasattr)
             if sentences:
                 self._handle_sentences(sentences)
         else:
@@ -239,7 +239,7 @@ class MMDriver(ModemDriverBase):
         sentence = self._out[0]
         if self._typed:
             try:
-                self.link.write_sentence(sentence)
+                self.link.write_sentence(sentence)  # type: ignore[union-attr]  # (_typed)
             except LinkClosedError as exc:
                 raise ModemDriverError(str(exc), Status.CONNECTION_TO_MODEM_FAILED) from exc
             if self.signal_raw_outgoing or self._raw_log is not None:
@@ -423,9 +423,10 @@ class MMDriver(ModemDriverBase):
 
     def _on_clk(self, s: NMEASentence) -> None:
         if self._outstanding("CLK"):
-            t = dt.datetime(
-                *(s.as_int(i, *bounds) for i, bounds in enumerate(CLOCK_FIELDS, 1)), tzinfo=dt.UTC
+            year, month, day, hour, minute, second = (
+                s.as_int(i, *bounds) for i, bounds in enumerate(CLOCK_FIELDS, 1)
             )
+            t = dt.datetime(year, month, day, hour, minute, second, tzinfo=dt.UTC)
             self._check_clock(t.timestamp(), whole_seconds=True)
 
     def _on_tms(self, s: NMEASentence) -> None:
@@ -605,7 +606,7 @@ class MMDriver(ModemDriverBase):
                 self._finish_receive()
 
     def _on_cst(self, s: NMEASentence) -> None:
-        if type(s) is CycleStatistics and s.version >= 6:
+        if isinstance(s, CycleStatistics) and s.version >= 6:
             today = _EPOCH_DATE  # (a dated time of arrival: the reader's date is not used)
         else:
             today = _utc_date(self.clock.now())
@@ -669,7 +670,12 @@ class MMDriver(ModemDriverBase):
     def _on_mpa(self, s: NMEASentence) -> None:
         self.signal_receive.emit(self._ping_result(*_addresses(s)))
 
-    def _ping_result(self, src: int, dest: int, kind: int = acomms_pb.MICROMODEM_TWO_WAY_PING):
+    def _ping_result(
+        self,
+        src: int,
+        dest: int,
+        kind: acomms_pb.MMTransmissionType = acomms_pb.MICROMODEM_TWO_WAY_PING,
+    ) -> acomms_pb.ModemTransmission:
         msg = acomms_pb.ModemTransmission(
             type=acomms_pb.DRIVER_SPECIFIC,
             src=src,
