@@ -79,7 +79,7 @@ class Model:
 
     ENCODER, DECODER = 0, 1
 
-    def __init__(self, user: Message) -> None:
+    def __init__(self, user: ArithmeticModel) -> None:
         def invalid(why: str) -> DcclLoadError:
             return DcclLoadError(f"invalid arithmetic model {user.name!r}: {why}")
 
@@ -163,7 +163,7 @@ class ModelManager:
     def __init__(self) -> None:
         self._models: dict[str, Model] = {}
 
-    def set_model(self, model: Message) -> None:
+    def set_model(self, model: ArithmeticModel) -> None:
         """Add or replace a model (fresh frequency tables for adaptive ones)."""
         self._models[model.name] = Model(model)
 
@@ -409,7 +409,7 @@ class ArithmeticCodec(RepeatedFieldCodec):
         return (values[0] if values else None), pos
 
 
-def set_model(codec: Any, model: Message | str | os.PathLike[str]) -> None:
+def set_model(codec: Any, model: ArithmeticModel | str | os.PathLike[str]) -> None:
     """Give `codec` (a pygoby.dccl.Codec) an arithmetic model: an ArithmeticModel message or
     the path of a TextFormat file holding one (C++: ModelManager::set_model)."""
     if not isinstance(model, Message):

@@ -6,6 +6,7 @@ import logging
 import os
 import time
 from collections.abc import Callable, Iterable, Iterator
+from typing import cast
 
 from google.protobuf import message_factory
 from google.protobuf.descriptor import Descriptor
@@ -119,11 +120,11 @@ class Codec:
     # ---------------------------------------------------------------- loading
     def load(self, message_type: type[Message] | AnyDescriptor) -> type[Message]:
         """Validate and compile a message type (a generated class or a descriptor)."""
+        descriptor = _descriptor_of(message_type)
         if isinstance(message_type, Descriptor):
-            descriptor = message_type
-            cls = message_factory.GetMessageClass(descriptor)
+            cls = message_factory.GetMessageClass(message_type)
         else:
-            cls, descriptor = message_type, message_type.DESCRIPTOR
+            cls = cast(type[Message], message_type)
         known = self._by_name.get(descriptor.full_name)
         if known is not None:
             return known.cls
@@ -180,7 +181,7 @@ class Codec:
         return [self.load(self.loader.message_class(d.full_name)) for d in dccl]
 
     def unload(self, message_type: type[Message] | AnyDescriptor) -> None:
-        descriptor = getattr(message_type, "DESCRIPTOR", message_type)
+        descriptor = _descriptor_of(message_type)
         compiled = self._by_name.pop(descriptor.full_name, None)
         if compiled is not None and compiled.id is not None:
             self._by_id.pop(compiled.id, None)
@@ -239,7 +240,7 @@ class Codec:
                 return self._by_name[message_type]
             except KeyError:
                 raise DcclError(f"message type {message_type!r} is not loaded") from None
-        descriptor = getattr(message_type, "DESCRIPTOR", message_type)
+        descriptor = _descriptor_of(message_type)
         compiled = self._by_name.get(descriptor.full_name)
         if compiled is None:
             self.load(message_type)
@@ -313,10 +314,10 @@ class Codec:
                     )
             return compiled
         dccl_id, _ = self.read_id(data)
-        compiled = self._by_id.get(dccl_id)
-        if compiled is None:
+        found = self._by_id.get(dccl_id)
+        if found is None:
             raise DcclDecodeError(f"no message type with id {dccl_id} is loaded")
-        return compiled
+        return found
 
     def decode(
         self, data: bytes, message_type: type[Message] | AnyDescriptor | str | None = None
@@ -360,3 +361,9 @@ def _messages_of(descriptors: Iterable[AnyDescriptor]) -> Iterator[AnyDescriptor
     for descriptor in descriptors:
         yield descriptor
         yield from _messages_of(descriptor.nested_types)
+
+
+def _descriptor_of(message_type: type[Message] | AnyDescriptor) -> AnyDescriptor:
+    """The descriptor of a generated class, or the descriptor itself."""
+    descriptor: AnyDescriptor = getattr(message_type, "DESCRIPTOR", message_type)
+    return descriptor

@@ -19,6 +19,7 @@ from pygoby.dccl.conditions import DynamicConditions, FieldConditions
 from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_options, message_options
 from pygoby.dccl.registry import CodecRegistry, DefaultMessageCodec
+from pygoby.protobuf import message_type
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 log = logging.getLogger("pygoby.dccl")
@@ -99,10 +100,14 @@ class RepeatedItem:
         return 0 if self.slots else (self.max_repeat - self.min_repeat).bit_length()
 
     def element_min(self) -> int:
-        return self.codec.min_size() if self.codec else self.child.min_size()
+        return self.codec.min_size() if self.codec else self._child().min_size()
 
     def element_max(self) -> int:
-        return self.codec.max_size() if self.codec else self.child.max_size()
+        return self.codec.max_size() if self.codec else self._child().max_size()
+
+    def _child(self) -> MessageNode:
+        assert self.child is not None  # (a repeated message field: no codec, a child)
+        return self.child
 
     def min_size(self) -> int:
         count = self.max_repeat if self.slots else self.min_repeat
@@ -224,7 +229,7 @@ class Planner:
         if fopts.HasField("codec"):
             return fopts.codec
         if f.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE:
-            sub = message_options(f.message_type)
+            sub = message_options(message_type(f))
             if sub.HasField("codec"):
                 return sub.codec
         return self.default_name
@@ -350,7 +355,7 @@ class Planner:
             if mode is not Mode.OPTIONAL:
                 singular = singular.without_required()
             item.conditions = singular
-            if singular.required_if is not None:
+            if singular.required_if is not None:  # type: ignore[union-attr]  # (set just above)
                 required = self._info(f, fopts, category, resolved, required=True)
                 item.required_codec = entry(required)
         return item

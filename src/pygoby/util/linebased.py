@@ -14,7 +14,7 @@ import functools
 import logging
 import os
 from collections import deque
-from typing import Protocol
+from typing import Any, Protocol
 
 from pygoby.util.errors import LinkClosedError
 
@@ -313,7 +313,7 @@ class SerialLink(_StreamLinkBase):
     def __init__(self, port: str, baud: int, delimiter: str = "\r\n") -> None:
         super().__init__(delimiter)
         self.port, self.baud = port, baud
-        self._serial = None
+        self._serial: Any = None  # a serial.Serial once open (pyserial has no type stubs)
         self._transport = _SerialTransport(self)
 
     def describe(self) -> str:
@@ -353,7 +353,7 @@ class SerialLink(_StreamLinkBase):
             with contextlib.suppress(Exception):
                 asyncio.get_running_loop().remove_reader(self._serial.fileno())
             self._serial.close()
-            self._serial = None
+            self._serial: Any = None  # a serial.Serial once open (pyserial has no type stubs)
         self._lost(self._transport)
 
     def close(self) -> None:

@@ -23,9 +23,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from google.protobuf.descriptor import FieldDescriptor
-from google.protobuf.message import Message
 
 from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError, DcclLoadError
+from pygoby.protobuf.dccl.option_extensions_pb2 import DCCLFieldOptions
 from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 _CATEGORY_BY_CPPTYPE = {
@@ -66,7 +66,7 @@ class FieldInfo:
     """What a codec knows about the field it encodes."""
 
     descriptor: AnyFieldDescriptor
-    options: Message  # dccl.DCCLFieldOptions
+    options: DCCLFieldOptions
     category: str
     required: bool  # required encoding (no "not set" state), spec §6.4
     version: int  # the root message's codec_version
@@ -128,11 +128,9 @@ class FixedWidthCodec(FieldCodec):
     # repeated field): every default codec writes zeros; some legacy CCL codecs do not.
     null_raw: int = 0
 
-    def to_raw(self, value: Any, strict: bool) -> int:
-        raise NotImplementedError
-
-    def from_raw(self, raw: int) -> Any:
-        raise NotImplementedError
+    # value <-> raw integer: each codec sets them in __init__ (a closure per field: the hot path)
+    to_raw: Callable[..., int]  # (value, strict); root-aware CCL codecs: (root, value, strict)
+    from_raw: Callable[..., Any]  # (raw); root-aware CCL codecs: (root, raw)
 
     def encode(self, value: Any, strict: bool) -> tuple[int, int]:
         return self.to_raw(value, strict), self.bits

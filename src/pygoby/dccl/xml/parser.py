@@ -152,9 +152,10 @@ def parse_tree(data: bytes, file: Path) -> Element:
 # children with (minimum, maximum) occurrences and its allowed attributes. `None` maximum: any.
 
 _SOURCE = {"src_var": (0, 1), "moos_var": (0, 1)}
-_HEADER_PIECE = {"name": (1, 1), **_SOURCE}
-_VAR_COMMON = {"name": (1, 1), **_SOURCE, "array_length": (0, 1)}
-SCHEMA: dict[str, tuple[dict[str, tuple[int, int | None]], frozenset[str]]] = {
+Occurs = dict[str, tuple[int, int | None]]  # child tag -> (min, max) occurrences
+_HEADER_PIECE: Occurs = {"name": (1, 1), **_SOURCE}
+_VAR_COMMON: Occurs = {"name": (1, 1), **_SOURCE, "array_length": (0, 1)}
+SCHEMA: dict[str, tuple[Occurs, frozenset[str]]] = {
     "message_set": ({"message": (1, None)}, frozenset()),
     "message": (
         {
