@@ -115,6 +115,7 @@ from pygoby.moos.translator import (
     post_for_moos,
 )
 from pygoby.protobuf import builtin_class, message_type
+from pygoby.protobuf.goby.moos.protobuf.goby_moos_app_pb2 import GobyMOOSAppConfig
 from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock
 
@@ -144,7 +145,7 @@ class _Timer:
         return True
 
 
-def _app_technique(common: Message) -> Technique:
+def _app_technique(common: GobyMOOSAppConfig) -> Technique:
     try:
         return moos_technique_from_config(common)
     except TranslatorError as err:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from google.protobuf.message import Message
 
@@ -52,7 +52,7 @@ class ClassicMOOSApp(GobyMOOSApp):
             raise ConfigError(
                 "takes no --option overrides: set them in its ProcessConfig block", field=name
             )
-        cfg = cls.load_config_class()()
+        cfg: Any = cls.load_config_class()()  # (a ClassicMOOSAppConfig or a subclass's)
         cfg.common.log = False
         if mission is None:
             return cfg

@@ -26,8 +26,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
-
-from google.protobuf.message import Message
+from typing import Any
 
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
@@ -139,8 +138,8 @@ class _Parser:
         else:
             result.value.append(self.take())
             while (
-                self.peek() is not None
-                and self.peek()[0] in "\"'"
+                (following := self.peek()) is not None
+                and following[0] in "\"'"
                 and result.value[-1].text[0] in "\"'"
             ):
                 result.value.append(self.take())  # adjacent strings concatenate
@@ -350,7 +349,7 @@ def translate(text: str, descriptor: AnyDescriptor) -> Translation:
     return Translation(render(fields), notes)
 
 
-def finish(config: Message, notes: list[str]) -> None:
+def finish(config: Any, notes: list[str]) -> None:  # (any app's configuration message)
     """The moves that need the parsed message: Goby 1.1 put XML message files in dccl_cfg and
     queue_cfg (and copied each to the other); they all become transitional_cfg.message_file."""
     fields = config.DESCRIPTOR.fields_by_name

@@ -252,3 +252,9 @@ def initialization_errors(message: Message) -> list[str]:
     FindInitializationErrors gives them (a method its type stubs leave out)."""
     errors: list[str] = message.FindInitializationErrors()  # type: ignore[attr-defined]
     return errors
+
+
+def class_of(descriptor: AnyDescriptor) -> type[Message]:
+    """The message class of a descriptor of any pool (protobuf's stubs take only the
+    pure-Python descriptor type)."""
+    return message_factory.GetMessageClass(descriptor)  # type: ignore[arg-type]

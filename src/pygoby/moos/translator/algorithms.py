@@ -175,7 +175,8 @@ class AlgorithmRegistry:
         if self.modem_ids is not None:
             self._add("modem_id2name", self._modem_id2name)
             self._add("modem_id2type", self._modem_id2type)
-            self._add("name2modem_id", lambda v, _r: str(self.modem_ids.modem_id(v)))
+            lookup = self.modem_ids
+            self._add("name2modem_id", lambda v, _r: str(lookup.modem_id(v)))
 
     @staticmethod
     def _reference(name: str, refs: Sequence[str], count: int) -> list[float]:
@@ -207,9 +208,11 @@ class AlgorithmRegistry:
 
     def _modem_id2name(self, value: str, _refs: Sequence[str]) -> str:
         # Empty input is left unchanged (goby3 throws: Quirk Q11).
+        assert self.modem_ids is not None  # (registered only with a lookup)
         return self.modem_ids.name(int(value)) if value.isdigit() and value.isascii() else value
 
     def _modem_id2type(self, value: str, _refs: Sequence[str]) -> str:
+        assert self.modem_ids is not None  # (registered only with a lookup)
         return self.modem_ids.type(int(value)) if value.isdigit() and value.isascii() else value
 
 

@@ -11,7 +11,6 @@ from __future__ import annotations
 import re
 from collections.abc import Collection, Sequence
 
-from google.protobuf import message_factory
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
@@ -29,6 +28,7 @@ from pygoby.moos.translator.fields import (
     set_from_string,
     stream_value,
 )
+from pygoby.protobuf import class_of, message_type
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 _SUBMESSAGE_DIRECTIVE = re.compile(r"%([0-9.]+:)+[0-9.]+%")
@@ -76,11 +76,7 @@ def _walk_path(message: Message, parts: list[str], spec: str, create: bool) -> M
             while len(container) <= index:
                 container.add()
         # Reading past the end (publish side) sees an empty element.
-        message = (
-            container[index]
-            if index < len(container)
-            else message_factory.GetMessageClass(field.message_type)()
-        )
+        message = container[index] if index < len(container) else class_of(message_type(field))()
     return message
 
 
@@ -141,11 +137,11 @@ def serialize(
         working = working.replace(match.group(0), f"%{max_field}%")
 
     current = working
-    indexed: dict[int, tuple[int, int]] = {}
+    indexed: dict[int, tuple[int, int | None]] = {}
     for match in _INDEXED_DIRECTIVE.finditer(current):
-        field_number, index = match.group(0).strip("%").split(".")
+        number_text, index_text = match.group(0).strip("%").split(".")
         max_field += 1
-        indexed[max_field] = (int(field_number), int(index))
+        indexed[max_field] = (int(number_text), int(index_text))
         working = working.replace(match.group(0), f"%{max_field}%")
 
     args: list[boostformat.Arg] = []
@@ -223,7 +219,7 @@ def check_parse_format(descriptor: AnyDescriptor, fmt: str) -> None:
                     f"Invalid '.' syntax given for format: {spec}. Repeated message, but no "
                     "valid index given. E.g., use '3.4' for index 4 of field 3."
                 )
-            current = field.message_type
+            current = message_type(field)
         _field_spec(current, last)
 
 
@@ -244,7 +240,7 @@ def check_serialize_format(
     that name a field the message does not have (upstream renders such a directive as empty
     or "unknown": a typo would be published silently). `virtual_fields`: the publish
     algorithms' output_virtual_field numbers."""
-    probe = message_factory.GetMessageClass(descriptor)()
+    probe = class_of(descriptor)()
     for match in _SUBMESSAGE_DIRECTIVE.finditer(fmt):
         spec = match.group(0).strip("%")
         _walk_path(probe, spec.split(":")[:-1], spec, create=False)
@@ -257,14 +253,14 @@ def check_serialize_format(
             )
     plain = _SUBMESSAGE_DIRECTIVE.sub("%%", _INDEXED_DIRECTIVE.sub("%%", fmt))
     for item in boostformat.parse_format(plain):
-        number = getattr(item, "argument", None)
+        argument: int | None = getattr(item, "argument", None)
         if (
-            number is not None
-            and number not in descriptor.fields_by_number
-            and (number not in virtual_fields)
+            argument is not None
+            and argument not in descriptor.fields_by_number
+            and (argument not in virtual_fields)
         ):
             raise TranslatorConfigError(
-                f"format {fmt!r}: %{number}% names no field of {descriptor.full_name} "
+                f"format {fmt!r}: %{argument}% names no field of {descriptor.full_name} "
                 "(nor an algorithm's output_virtual_field)"
             )
 

@@ -158,13 +158,13 @@ class Translator:
                 format_technique.check_parse_format(descriptor, create.format)
         for publish in entry.publish:
             technique = Technique(publish.technique)
-            for algorithm in publish.algorithm:
-                self.registry.get(algorithm.name)
-                for number in algorithm.reference_field:
+            for publish_algorithm in publish.algorithm:
+                self.registry.get(publish_algorithm.name)
+                for number in publish_algorithm.reference_field:
                     field = descriptor.fields_by_number.get(number)
                     if field is None or field.is_repeated:
                         raise TranslatorConfigError(
-                            f"{name}: algorithm {algorithm.name!r} reference field {number} is "
+                            f"{name}: algorithm {publish_algorithm.name!r} reference field {number} is "
                             "missing or repeated (must be optional or required)"
                         )
             if technique == Technique.TECHNIQUE_FORMAT:
@@ -279,6 +279,7 @@ class Translator:
         for publish in entry.publish:
             technique = Technique(publish.technique)
             var = publish.moos_var
+            value: str | bytes
             short = entry.use_short_enum
             if technique == Technique.TECHNIQUE_FORMAT:
                 args = (publish.repeated_delimiter, publish.algorithm, short, self.registry)
@@ -303,6 +304,7 @@ class Translator:
         short = entry.use_short_enum
         for create in entry.create:
             technique = Technique(create.technique)
+            value: str | bytes
             if technique == Technique.TECHNIQUE_FORMAT:
                 value = format_technique.serialize(
                     msg, create.format, create.repeated_delimiter, (), short
