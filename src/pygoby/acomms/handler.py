@@ -434,7 +434,7 @@ class AcommsHandler:
 
 
 def _status_of(exc: BaseException, default: Status.Status.ValueType) -> Status.Status.ValueType:
-    return exc.status if isinstance(exc, ModemDriverError) else default
+    return exc.status if isinstance(exc, ModemDriverError) else default  # type: ignore[return-value]
 
 
 def _name(slot: DriverSlot) -> str:

@@ -68,7 +68,6 @@ StoreServerResponse = store_server_pb2.StoreServerResponse
 
 MMConfig = mm_driver_pb2.Config
 MMTransmission = mm_driver_pb2.Transmission
-MMTransmissionType = mm_driver_pb2.TransmissionType.ValueType
 ReceiveStatistics = mm_receive_statistics_pb2.ReceiveStatistics
 TransmitStatistics = mm_driver_pb2.TransmitStatistics
 RangingReply = mm_driver_pb2.RangingReply

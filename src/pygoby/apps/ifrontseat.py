@@ -24,11 +24,12 @@ onto them:
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import sys
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 from google.protobuf.message import Message
 
@@ -58,7 +59,9 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
     # -- configuration ---------------------------------------------------------------------
 
     @classmethod
-    def main(cls, argv: Sequence[str] | None = None, prog: str | None = None) -> int:
+    def main(
+        cls, argv: Sequence[str] | None = None, prog: str | None = None, command: str | None = None
+    ) -> int:
         """As goby3, the driver named in the environment is loaded before the options are
         read (its configuration extension then parses and shows in --example_config)."""
         try:
@@ -66,12 +69,12 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         except DriverLoadError as err:
             print(f"iFrontSeat: {err}", file=sys.stderr)
             return 1
-        return super().main(argv, prog)
+        return super().main(argv, prog, command)
 
     @classmethod
-    def load_config_class(cls) -> type[Message]:
+    def load_config_class(cls) -> type[iFrontSeatConfig]:
         fs_config.load_goby2_extensions()
-        return super().load_config_class()
+        return cast(type[iFrontSeatConfig], super().load_config_class())
 
     @classmethod
     def read_config(
@@ -113,7 +116,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
             (interface.signal_raw_from_frontseat, "raw_in"),
             (interface.signal_raw_to_frontseat, "raw_out"),
         ):
-            signal.connect(lambda message, var=self.var[var]: self.publish_pb(var, message))
+            signal.connect(functools.partial(self.publish_pb, self.var[var]))
         if self.cfg.legacy_cfg.publish_fs_bs_ready:
             interface.signal_state_change.connect(lambda status: self._post(ready_posts(status)))
 
@@ -214,7 +217,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
 
     # -- frontseat -> MOOS -----------------------------------------------------------------
 
-    def _on_data_from_frontseat(self, data: Message) -> None:
+    def _on_data_from_frontseat(self, data: frontseat_pb.InterfaceData) -> None:
         self.publish_pb(self.var["data_from_frontseat"], data)
         if data.HasField("node_status"):
             self.publish_pb(self.var["node_status"], data.node_status)

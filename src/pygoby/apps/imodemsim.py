@@ -23,6 +23,7 @@ ProcessConfig (seed 003 §2.3.15):
 from __future__ import annotations
 
 import dataclasses
+import functools
 import ipaddress
 import logging
 from typing import NoReturn
@@ -109,7 +110,7 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
             self.position = [self._number(n.lower(), 0.0) for n in names]
         else:
             for index, var in enumerate(LOCATION_TYPES[location]):
-                self.subscribe(var, lambda msg, i=index: self._on_position(i, msg))
+                self.subscribe(var, functools.partial(self._on_position, index))
         modem_id = int(self._number("modemid", 1))
         self.pair = self._make_pair()
         self.model = MicroModemModel(

@@ -10,6 +10,8 @@ The reporting itself is `pygoby.netsim.navreporter.NavReporter`; the manager con
 
 from __future__ import annotations
 
+import functools
+
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
@@ -17,6 +19,7 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.netsim.client import NetSimClient, status_name
 from pygoby.netsim.navreporter import NavReporter
+from pygoby.netsim.protocol import NetSimManagerResponse
 from pygoby.protobuf.pygoby.netsim.inetsimmanager_config_pb2 import iNetSimManagerConfig
 
 
@@ -49,7 +52,7 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
             cfg.heading_var: "heading",
         }
         for var, name in names.items():
-            self.subscribe(var, lambda msg, name=name: self._nav(name, msg))
+            self.subscribe(var, functools.partial(self._nav, name))
         self.subscribe_pb(cfg.modem_receive_var, acomms_pb.ModemTransmission, self._modem_receive)
         self.register_timer(cfg.nav_period, self.send_nav)
 
@@ -77,7 +80,7 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
         if stats and self.netsim.send_stats(stats) is None:
             self.log.info("not connected to netsim_manager: %d receive stats dropped", len(stats))
 
-    def _answer(self, response: Message) -> None:
+    def _answer(self, response: NetSimManagerResponse) -> None:
         status = status_name(response)
         if status != "UPDATE_ACCEPTED":
             self.log.warning("netsim_manager refused request %d: %s", response.request_id, status)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import base64
 import functools
+from collections.abc import Callable
 
 from google.protobuf.message import Message
 
@@ -34,6 +35,7 @@ from pygoby.moos.protocol import MOOSMessage, text_or_binary
 from pygoby.moos.translator_binding import TranslatorBinding, not_loaded
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
 from pygoby.topside.acomms_config import AcommsMessageSet
+from pygoby.util.signal import Signal
 
 IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
 
@@ -124,7 +126,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         work, so a failing slot is logged and contained (it must not look like a driver
         failure or break a slot)."""
         acomms, queue, mac = self.acomms, self.acomms.queue, self.acomms.mac
-        connections = [
+        connections: list[tuple[Signal[...], Callable[..., object]]] = [
             (acomms.signal_raw_incoming, functools.partial(self._post_raw, True)),
             (acomms.signal_raw_outgoing, functools.partial(self._post_raw, False)),
             (acomms.signal_modem_receive, self._poster("driver_receive")),

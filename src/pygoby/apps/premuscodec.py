@@ -94,7 +94,7 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
         if msg.is_double:
             return int(msg.dval) if math.isfinite(msg.dval) else 0
         value = msg.value
-        return atoi(value.decode("latin-1") if isinstance(value, bytes) else value)
+        return atoi(value.decode("latin-1") if isinstance(value, bytes) else str(value))
 
     # ------------------------------------------------------------------ frames in
     def _on_frame(self, kind: str, msg: MOOSMessage) -> None:
@@ -165,7 +165,7 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
     def _on_command(self, msg: MOOSMessage) -> None:
         if msg.is_double:
             return
-        text = msg.value.decode("latin-1") if isinstance(msg.value, bytes) else msg.value
+        text = msg.value.decode("latin-1") if isinstance(msg.value, bytes) else str(msg.value)
         try:
             command = self.reports.redirect_command(text)
         except DcclError as err:

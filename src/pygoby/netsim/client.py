@@ -42,7 +42,7 @@ log = logging.getLogger(__name__)
 
 MAX_REQUEST_ID = 2**31 - 1
 
-ResponseCallback = Callable[[Message], None]
+ResponseCallback = Callable[[NetSimManagerResponse], None]
 
 
 def status_name(response: Message) -> str:

@@ -353,7 +353,7 @@ class SerialLink(_StreamLinkBase):
             with contextlib.suppress(Exception):
                 asyncio.get_running_loop().remove_reader(self._serial.fileno())
             self._serial.close()
-            self._serial: Any = None  # a serial.Serial once open (pyserial has no type stubs)
+            self._serial = None
         self._lost(self._transport)
 
     def close(self) -> None:

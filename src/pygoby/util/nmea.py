@@ -42,7 +42,7 @@ class NMEASentence:
         # (str and int values are nearly all of them: converted without a call per field;
         # `type(v) is int` is False for bool, which _field_text prints as 1/0)
         fields: list[str] = [
-            v if (kind := type(v)) is str else str(v) if kind is int else _field_text(v)
+            v if (kind := type(v)) is str else str(v) if kind is int else _field_text(v)  # type: ignore[misc]  # (v is a str when its type is)
             for v in values
         ]
         sentence = cls((token, *fields))

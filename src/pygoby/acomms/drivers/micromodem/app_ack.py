@@ -9,6 +9,7 @@ field is always 0, and usable with every data rate.
 from __future__ import annotations
 
 import logging
+from typing import cast
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.dccl import Codec, DcclError
@@ -71,7 +72,8 @@ class ApplicationAcks:
         try:
             if self.codec.id(data) != self.dccl_id:
                 return []
-            ack, used = self.codec.decode_prefix(data)
+            decoded, used = self.codec.decode_prefix(data)
+            ack = cast(acomms_pb.MMApplicationAck, decoded)  # (the id checked above is its)
         except DcclError as exc:
             log.warning("cannot decode an application ack: %s", exc)
             return []

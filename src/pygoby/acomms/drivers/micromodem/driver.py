@@ -32,6 +32,7 @@ from pygoby.acomms.drivers.micromodem.statistics import (
     parse_xst,
 )
 from pygoby.acomms.errors import ModemDriverError
+from pygoby.protobuf.goby.acomms.protobuf.mm_driver_pb2 import TransmissionType
 from pygoby.util.errors import LinkClosedError, NMEAError
 from pygoby.util.nmea import NMEASentence
 
@@ -674,7 +675,7 @@ class MMDriver(ModemDriverBase):
         self,
         src: int,
         dest: int,
-        kind: acomms_pb.MMTransmissionType = acomms_pb.MICROMODEM_TWO_WAY_PING,
+        kind: TransmissionType.ValueType = acomms_pb.MICROMODEM_TWO_WAY_PING,
     ) -> acomms_pb.ModemTransmission:
         msg = acomms_pb.ModemTransmission(
             type=acomms_pb.DRIVER_SPECIFIC,
@@ -840,7 +841,7 @@ class MMDriver(ModemDriverBase):
             src, dest = dest, src
         msg = self._ping_result(src, dest, acomms_pb.MICROMODEM_HARDWARE_CONTROL_REPLY)
         hw = msg.Extensions[acomms_pb.MM_TRANSMISSION].hw_ctl
-        hw.line, hw.mode, hw.arg = line, mode, arg
+        hw.line, hw.mode, hw.arg = line, mode, arg  # type: ignore[assignment]  # (in range)
         self.signal_receive.emit(msg)
 
     def _on_tta(self, s: NMEASentence) -> None:
