@@ -21,8 +21,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from google.protobuf.message import Message
-
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.transitional import TransitionalMessages
 from pygoby.dccl import Codec, DcclError
@@ -37,6 +35,7 @@ from pygoby.protobuf import ProtoLoader
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
     pAcommsHandlerConfig,
 )
+from pygoby.protobuf.goby.moos.protobuf.transitional_pb2 import MessageFile
 
 XML_PATH_FIELD = "message_file.path"  # dccl_cfg/queue_cfg/transitional_cfg all name it so
 
@@ -120,7 +119,7 @@ class AcommsMessageSet:
 
     @classmethod
     def of_app(
-        cls, app: GobyMOOSApp, block: str, message_files: Sequence[Message] = ()
+        cls, app: GobyMOOSApp, block: str, message_files: Sequence[MessageFile] = ()
     ) -> AcommsMessageSet:
         """The message set of the pAcommsHandler block `block` of `app`'s mission, plus the
         app's own XML `message_files` (Goby 1.1's iCommander had them; a file pAcommsHandler

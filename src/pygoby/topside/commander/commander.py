@@ -28,7 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -389,7 +389,7 @@ class Commander:
         variables = self.commands.variables
         return variables.ack_original, variables.expire
 
-    def handle_mail(self, var: str, value: object, when: float | None = None) -> list[Notice]:
+    def handle_mail(self, var: str, value: MoosValue, when: float | None = None) -> list[Notice]:
         """Feed ACOMMS_ACK_ORIGINAL / ACOMMS_EXPIRE mail (not older than the app's start)."""
         ack_var, expire_var = self.watched_variables
         if var not in (ack_var, expire_var):
@@ -435,7 +435,7 @@ class Commander:
     def load(self, path: str | Path) -> list[str]:
         """Open the messages of a save file; returns warnings (unknown messages, values the
         fields refuse). Raises SaveFileError / OSError for an unusable file."""
-        names = {}
+        names: dict[str, Sequence[str]] = {}
         for kind in self.commands.types.values():
             names[kind.short_name] = names[kind.name] = [f.name for f in kind.fields]
         warnings = []
@@ -469,7 +469,7 @@ def _convert(spec: FieldSpec, field: AnyFieldDescriptor, text: str) -> object:
     if kind == _FD.TYPE_ENUM:
         for value, shown in zip(enum_type(field).values, spec.enum_values, strict=True):
             if shown.upper() == text.upper():
-                return value.number
+                return value.number  # type: ignore[attr-defined]  # (an EnumValueDescriptor)
         raise FieldValueError(f"{spec.name}: {text!r} is not one of its values")
     if kind == _FD.TYPE_BOOL:
         return text.lower() in ("true", "1")

@@ -176,9 +176,9 @@ class EditScreen(Screen):
         typed = text[len(before) :] if text.startswith(before) else ""
         if spec.kind in ("int", "float") and typed in ("t", "x", "y", "m") and len(typed) == 1:
             self._revert(box, before)
-            self.app.run_action_for(
+            self.app.run_action_for(  # type: ignore[attr-defined]  # (ICommanderApp's)
                 self, {"t": "time", "x": "xy", "y": "xy", "m": "modem_id"}[typed], name
-            )  # type: ignore[attr-defined]
+            )
             return
         try:
             self.commander.check(self.draft, name, text, partial=True)
@@ -367,7 +367,7 @@ class ICommanderTUI(App):
                 opened = [(d.name, d.type.short_name) for d in commander.drafts.values()]
                 self.push_screen(
                     Menu("Choose an active message to switch to:", opened, "switch"),
-                    lambda name: name and self.edit(name),
+                    lambda name: self.edit(name) if name else None,
                 )
             elif action == "time":
                 commander.insert_time(draft, field)

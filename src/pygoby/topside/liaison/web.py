@@ -37,6 +37,7 @@ from starlette.staticfiles import StaticFiles
 
 from pygoby.errors import ConfigError, PygobyError
 from pygoby.topside.commander import CommanderError, FieldValueError, SaveFileError
+from pygoby.topside.commander.commander import Draft
 from pygoby.topside.liaison.state import LiaisonState, field_view, outgoing_view, record_view
 from pygoby.util.aiorun import cancel_and_wait
 
@@ -145,28 +146,31 @@ def make_app(
                 pass
             elif action == "check":
                 commander.check(
-                    draft, body["field"], body.get("text", ""), partial=bool(body.get("partial"))
+                    needed(draft),
+                    body["field"],
+                    body.get("text", ""),
+                    partial=bool(body.get("partial")),
                 )
             elif action == "set":
-                commander.set_value(draft, body["field"], body.get("text", ""))
+                commander.set_value(needed(draft), body["field"], body.get("text", ""))
             elif action == "special":
                 special = body["special"]
                 if special == "time":
-                    commander.insert_time(draft, body["field"])
+                    commander.insert_time(needed(draft), body["field"])
                 elif special == "xy":
-                    commander.insert_xy(draft, body["field"])
+                    commander.insert_xy(needed(draft), body["field"])
                 elif special == "community":
-                    commander.insert_community(draft, body["field"])
+                    commander.insert_community(needed(draft), body["field"])
                 elif special == "modem_id":
-                    commander.insert_modem_id(draft, body["field"], int(body["modem_id"]))
+                    commander.insert_modem_id(needed(draft), body["field"], int(body["modem_id"]))
                 else:
                     raise CommanderError(f"no special {special!r}")
             elif action == "clear":
-                commander.clear(draft)
+                commander.clear(needed(draft))
             elif action == "preview":
-                result["preview"] = outgoing_view(commander.preview(draft))
+                result["preview"] = outgoing_view(commander.preview(needed(draft)))
             elif action == "send":
-                result["record"] = record_view(commander.send(draft))
+                result["record"] = record_view(commander.send(needed(draft)))
             elif action == "save":
                 commander.save(body["path"])
             elif action == "load":
@@ -199,7 +203,7 @@ class _EmbeddedServer(uvicorn.Server):
     server itself."""
 
     @contextlib.contextmanager
-    def capture_signals(self):  # type: ignore[override]
+    def capture_signals(self):
         yield
 
 
@@ -281,3 +285,10 @@ class WebServer:
                 await cancel_and_wait(task)
         elif not task.cancelled():
             task.exception()  # retrieved; the server logs its own errors
+
+
+def needed(draft: Draft | None) -> Draft:
+    """The draft an action works on (a request without "type" has none: a 400)."""
+    if draft is None:
+        raise KeyError("type")
+    return draft
