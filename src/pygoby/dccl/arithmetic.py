@@ -65,7 +65,7 @@ def model_class() -> type[ArithmeticModel]:
     return ArithmeticModel
 
 
-def load_model_file(path: str | os.PathLike[str]) -> Message:
+def load_model_file(path: str | os.PathLike[str]) -> ArithmeticModel:
     """An ArithmeticModel from a TextFormat file (`--arithmetic-model FILE`)."""
     try:
         with open(path) as f:

@@ -26,6 +26,7 @@ from pygoby.dccl.options import message_options
 from pygoby.dccl.plan import Part, Planner, root_options
 from pygoby.dccl.registry import DEFAULT_REGISTRY, CodecRegistry
 from pygoby.protobuf import ProtoError, ProtoLoader, initialization_errors
+from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_pb2 import ArithmeticModel
 from pygoby.protobuf.descriptors import AnyDescriptor
 from pygoby.util.clock import Clock
 from pygoby.util.names import did_you_mean
@@ -85,7 +86,7 @@ class Codec:
             self._conditions = DynamicConditions()
         return self._conditions
 
-    def set_arithmetic_model(self, model: Message | str | os.PathLike[str]) -> None:
+    def set_arithmetic_model(self, model: ArithmeticModel | str | os.PathLike[str]) -> None:
         """Give this Codec a `dccl.arith.protobuf.ArithmeticModel` (a message, or a TextFormat
         file) for `dccl.arithmetic` fields; set models before loading the types that use them.
         A model of the same name is replaced (adaptive ones start afresh)."""
@@ -365,5 +366,4 @@ def _messages_of(descriptors: Iterable[AnyDescriptor]) -> Iterator[AnyDescriptor
 
 def _descriptor_of(message_type: type[Message] | AnyDescriptor) -> AnyDescriptor:
     """The descriptor of a generated class, or the descriptor itself."""
-    descriptor: AnyDescriptor = getattr(message_type, "DESCRIPTOR", message_type)
-    return descriptor
+    return cast(AnyDescriptor, getattr(message_type, "DESCRIPTOR", message_type))

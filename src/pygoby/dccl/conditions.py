@@ -30,7 +30,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from google.protobuf import descriptor_pb2
@@ -39,6 +39,7 @@ from google.protobuf.message import Message
 
 from pygoby.dccl.errors import DcclError, DcclLoadError
 from pygoby.protobuf import enum_type
+from pygoby.protobuf.dccl.option_extensions_pb2 import DCCLFieldOptions
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 _INT64 = (FieldDescriptor.CPPTYPE_INT64, FieldDescriptor.CPPTYPE_UINT64)
@@ -69,10 +70,10 @@ class FieldConditions:
     omit_negates: bool = False  # omit_if is an only_if: omit when it is false
     min: str | None = None
     max: str | None = None
-    scripts: dict[str, Any] = field(default_factory=dict)  # compiled, by role
+    scripts: dict[str, Any] = dataclasses.field(default_factory=dict)  # compiled, by role
 
     @classmethod
-    def of(cls, f: AnyFieldDescriptor, options: Message) -> FieldConditions | None:
+    def of(cls, f: AnyFieldDescriptor, options: DCCLFieldOptions) -> FieldConditions | None:
         if not options.HasField("dynamic_conditions"):
             return None
         dc = options.dynamic_conditions
@@ -222,7 +223,7 @@ class DynamicConditions:
 
 def _synthetic(f: AnyFieldDescriptor) -> bool:
     oneof = f.containing_oneof
-    return len(oneof.fields) == 1 and oneof.name == "_" + f.name
+    return oneof is not None and len(oneof.fields) == 1 and oneof.name == "_" + f.name
 
 
 @functools.cache
@@ -245,7 +246,7 @@ def _explicit_default(f: AnyFieldDescriptor) -> str | None:
     """The text of a field's `[default = ...]`, None without one (only singular scalars)."""
     if f.is_repeated or f.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE:
         return None
-    proto = _file_proto(f.file.serialized_pb).get(f.full_name)
+    proto = _file_proto(f.file.serialized_pb).get(f.full_name)  # type: ignore[union-attr]
     if proto is None or not proto.HasField("default_value"):
         return None
     return proto.default_value

@@ -100,12 +100,12 @@ class RepeatedItem:
         return 0 if self.slots else (self.max_repeat - self.min_repeat).bit_length()
 
     def element_min(self) -> int:
-        return self.codec.min_size() if self.codec else self._child().min_size()
+        return self.codec.min_size() if self.codec else self.child_node().min_size()
 
     def element_max(self) -> int:
-        return self.codec.max_size() if self.codec else self._child().max_size()
+        return self.codec.max_size() if self.codec else self.child_node().max_size()
 
-    def _child(self) -> MessageNode:
+    def child_node(self) -> MessageNode:
         assert self.child is not None  # (a repeated message field: no codec, a child)
         return self.child
 

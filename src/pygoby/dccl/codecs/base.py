@@ -82,7 +82,7 @@ class FieldInfo:
         return self.descriptor.full_name
 
     def require(self, option: str) -> Any:
-        if not self.options.HasField(option):
+        if not self.options.HasField(option):  # type: ignore[arg-type]  # (a field name)
             raise DcclLoadError(f"{self.name}: missing (dccl.field).{option}")
         return getattr(self.options, option)
 

@@ -18,8 +18,10 @@ negative enum index is "not set".
 from __future__ import annotations
 
 import struct
+from collections.abc import Sequence
 from typing import Any
 
+from google.protobuf.descriptor import EnumValueDescriptor
 from google.protobuf.descriptor import FieldDescriptor as FD
 
 from pygoby.dccl.codecs.base import FieldCodec, FieldInfo
@@ -70,7 +72,7 @@ class NativeProtobufCodec(FieldCodec):
         self.fixed = _FIXED.get(kind)
         self.width = 8 * (1 if kind == FD.TYPE_BOOL else self.fixed.size if self.fixed else 1)
         if kind == FD.TYPE_ENUM:
-            values = enum_type(info.descriptor).values
+            values: Sequence[EnumValueDescriptor] = enum_type(info.descriptor).values  # type: ignore[assignment]
             self.index = {v.number: i for i, v in reversed(list(enumerate(values)))}
             self.numbers = [v.number for v in values]
         self.to_bytes = self._encoder()

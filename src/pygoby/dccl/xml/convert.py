@@ -17,7 +17,6 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from google.protobuf import descriptor_pb2
-from google.protobuf.message import Message
 
 from pygoby.dccl.xml.model import V1_PLACEHOLDER, Publish, Var, XmlMessage
 from pygoby.protobuf import builtin_class
@@ -217,7 +216,7 @@ def translator_entry(msg: XmlMessage) -> TranslatorEntry:
         entry.trigger.moos_var = msg.trigger_var
         if msg.mandatory_content:
             entry.trigger.mandatory_content = msg.mandatory_content
-    creates: dict[str, Message] = {}
+    creates: dict[str, TranslatorEntry.CreateParser] = {}
     for var in msg.all_vars():
         _add_create(entry, creates, var)
     highest = max(v.number for v in msg.all_vars())
@@ -227,8 +226,10 @@ def translator_entry(msg: XmlMessage) -> TranslatorEntry:
     return entry
 
 
-def _add_create(entry: Message, creates: dict[str, Message], var: Var) -> None:
-    T = type(entry)
+def _add_create(
+    entry: TranslatorEntry, creates: dict[str, TranslatorEntry.CreateParser], var: Var
+) -> None:
+    T = TranslatorEntry
     if not var.source_var:
         return
     create = creates.get(var.source_var)
@@ -272,8 +273,10 @@ def default_format(msg: XmlMessage, publish: Publish) -> str:
     return ",".join(parts)
 
 
-def _add_publish(entry: Message, msg: XmlMessage, publish: Publish, next_virtual: int) -> int:
-    T = type(entry)
+def _add_publish(
+    entry: TranslatorEntry, msg: XmlMessage, publish: Publish, next_virtual: int
+) -> int:
+    T = TranslatorEntry
     serializer = entry.publish.add(technique=T.TECHNIQUE_FORMAT)
     replacement: dict[int, str] = {}
     v1_index = 0

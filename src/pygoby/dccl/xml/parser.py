@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
+import os
 import re
 import xml.sax
 from collections.abc import Callable, Iterable
@@ -744,14 +745,16 @@ class _Reader:
         return q
 
 
-def read_message_set(data: bytes, file: str | Path = "<xml>") -> tuple[list[XmlMessage], list[str]]:
+def read_message_set(
+    data: bytes, file: str | os.PathLike[str] = "<xml>"
+) -> tuple[list[XmlMessage], list[str]]:
     """Parse and check the XML text of a message set: (messages, warnings)."""
     path = Path(file)
     reader = _Reader(path)
     return reader.read(parse_tree(data, path)), reader.warnings
 
 
-def read_message_file(path: str | Path) -> tuple[list[XmlMessage], list[str]]:
+def read_message_file(path: str | os.PathLike[str]) -> tuple[list[XmlMessage], list[str]]:
     p = Path(path)
     try:
         with open(p, "rb") as handle:
