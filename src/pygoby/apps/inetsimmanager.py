@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import functools
 
-from google.protobuf.message import Message
-
 from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
@@ -75,7 +73,7 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
         if nav is not None:
             self.netsim.send_navs([nav])
 
-    def _modem_receive(self, transmission: Message) -> None:
+    def _modem_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         stats = self.reporter.receive_stats(transmission)
         if stats and self.netsim.send_stats(stats) is None:
             self.log.info("not connected to netsim_manager: %d receive stats dropped", len(stats))

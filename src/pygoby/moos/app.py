@@ -115,6 +115,7 @@ from pygoby.moos.translator import (
     post_for_moos,
 )
 from pygoby.protobuf import builtin_class, message_type
+from pygoby.protobuf.descriptors import MessageT
 from pygoby.protobuf.goby.moos.protobuf.goby_moos_app_pb2 import GobyMOOSAppConfig
 from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock
@@ -340,7 +341,7 @@ class GobyMOOSApp:
         post = post_for_moos(var, message, self.moos_technique)
         self.publish(post.var, post.value, src_aux=post.source_aux)
 
-    def parse_pb(self, msg: MOOSMessage, cls: type[Message]) -> Message | None:
+    def parse_pb(self, msg: MOOSMessage, cls: type[MessageT]) -> MessageT | None:
         """`msg`'s value as a `cls` message; None, with a warning, when it does not parse."""
         out = cls()
         try:
@@ -353,8 +354,8 @@ class GobyMOOSApp:
     def subscribe_pb(
         self,
         var: str,
-        cls: type[Message],
-        handler: Callable[[Message], None],
+        cls: type[MessageT],
+        handler: Callable[[MessageT], None],
         *,
         ignore_own: bool = False,
     ) -> None:

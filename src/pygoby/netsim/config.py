@@ -12,7 +12,6 @@ import os
 from functools import cache
 
 from google.protobuf import text_format
-from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.netsim.channel.settings import environment_channel_configs
@@ -69,10 +68,10 @@ class _Parser(text_format._Parser):  # noqa: SLF001 - per-message control of unk
 
     def _MergeField(self, tokenizer, message):  # noqa: N802 - overrides protobuf's method
         self.allow_unknown_field = message.DESCRIPTOR.full_name in _OPEN_BLOCKS
-        super()._MergeField(tokenizer, message)
+        super()._MergeField(tokenizer, message)  # type: ignore[misc]  # (protobuf's private parser)
 
 
-def parse_config(text: str, file: str | os.PathLike[str] | None = None) -> Message:
+def parse_config(text: str, file: str | os.PathLike[str] | None = None) -> NetSimManagerConfig:
     """Parse and validate a TextFormat configuration; raises ConfigError (with `file`:line)."""
     config = config_class()()
     merge_config_text(text, config, file=file, parser=_Parser())
@@ -84,12 +83,12 @@ def parse_config(text: str, file: str | os.PathLike[str] | None = None) -> Messa
     return config
 
 
-def load_config(path: str | os.PathLike[str]) -> Message:
+def load_config(path: str | os.PathLike[str]) -> NetSimManagerConfig:
     """The configuration file at `path`, whatever its bytes: ConfigError for every problem."""
     return parse_config(read_config_file(path), path)
 
 
-def validate_config(config: Message) -> None:
+def validate_config(config: NetSimManagerConfig) -> None:
     """The start-up checks of upstream, in its order; the first failure raises ConfigError."""
     if not config.IsInitialized():
         missing = ", ".join(initialization_errors(config))

@@ -19,6 +19,7 @@ import random
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from google.protobuf import text_format
 from google.protobuf.descriptor import FieldDescriptor
@@ -217,7 +218,7 @@ def parse_value(field: AnyFieldDescriptor, text: str) -> Value:
 def _field_value(field: AnyFieldDescriptor, value: Value):
     """What to assign to the protobuf field (enum names become numbers)."""
     if field.cpp_type == FieldDescriptor.CPPTYPE_ENUM:
-        return enum_type(field).values_by_name[value].number
+        return enum_type(field).values_by_name[str(value)].number
     return value
 
 
@@ -243,7 +244,11 @@ def _axes(sweep: Sweep, base: Scenario, path: Path | None, text: str) -> list[_A
     axes, names = [], set()
     layout_descriptor = sweep.DESCRIPTOR.fields_by_name["layout"].message_type
     for axis in sweep.axis:
-        where = {"file": path, "line": _axis_line(text, axis.field), "field": axis.field}
+        where: dict[str, Any] = {
+            "file": path,
+            "line": _axis_line(text, axis.field),
+            "field": axis.field,
+        }
         try:
             if axis.field.startswith(LAYOUT_PREFIX):
                 if not sweep.HasField("layout"):
@@ -350,11 +355,11 @@ def expand(sweep: Sweep, base: Scenario, path: Path | None = None, text: str = "
         try:
             scenario = point_scenario(sweep, base, axes, values)
         except (ValueError, ScenarioError) as exc:  # (a ScenarioError is a ValueError too)
-            params = ", ".join(f"{a.column.name}={v}" for a, v in zip(axes, values, strict=True))
+            shown = ", ".join(f"{a.column.name}={v}" for a, v in zip(axes, values, strict=True))
             field = getattr(exc, "field", None)
             reason = getattr(exc, "reason", str(exc))
             raise ScenarioError(
-                f"{reason} (point {index}: {params})",
+                f"{reason} (point {index}: {shown})",
                 file=path,
                 line=_axis_line(text, field) if field else None,
                 field=field,
