@@ -26,7 +26,7 @@ log = logging.getLogger(__name__)
 Status = acomms_pb.ModemDriverStatus
 
 
-def driver_name(cfg) -> str:
+def driver_name(cfg: acomms_pb.DriverConfig) -> str:
     """`<DriverType name without DRIVER_>::<modem_id>` (or the plugin name)."""
     if cfg.WhichOneof("driver") == "driver_name":
         kind = cfg.driver_name
@@ -59,7 +59,7 @@ class ModemDriverBase(ABC):
 
     # --- the interface -------------------------------------------------------------------
     @abstractmethod
-    def startup(self, cfg) -> None: ...
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None: ...
 
     @abstractmethod
     def shutdown(self) -> None: ...
@@ -68,9 +68,9 @@ class ModemDriverBase(ABC):
     def do_work(self) -> None: ...
 
     @abstractmethod
-    def handle_initiate_transmission(self, transmission) -> None: ...
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None: ...
 
-    def update_cfg(self, cfg) -> None:
+    def update_cfg(self, cfg: acomms_pb.DriverConfig) -> None:
         log.warning("%s: update_cfg is not implemented by this driver", type(self).__name__)
 
     def report(self):
@@ -89,7 +89,7 @@ class ModemDriverBase(ABC):
         return self.cfg.modem_id
 
     # --- helpers for line-based modems ---------------------------------------------------
-    def modem_start(self, cfg) -> None:
+    def modem_start(self, cfg: acomms_pb.DriverConfig) -> None:
         """Validate the link settings, build (or reuse the injected) link and open it."""
         if not cfg.HasField("modem_id"):
             raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
@@ -104,12 +104,12 @@ class ModemDriverBase(ABC):
             self._raw_log = open(cfg.raw_log.replace("%1%", stamp), "a", encoding="latin-1")  # noqa: SIM115
         self.link.open()
 
-    def line_delimiter(self, cfg) -> str:
+    def line_delimiter(self, cfg: acomms_pb.DriverConfig) -> str:
         if not cfg.HasField("line_delimiter") and self.DEFAULT_LINE_DELIMITER is not None:
             return self.DEFAULT_LINE_DELIMITER
         return cfg.line_delimiter
 
-    def _make_link(self, cfg, delimiter: str) -> LineLink:
+    def _make_link(self, cfg: acomms_pb.DriverConfig, delimiter: str) -> LineLink:
         C = acomms_pb.DriverConfig
         # an implicit connection_type is the documented default, SERIAL (QUIRKS.md Q-ACOMMS-1)
         kind = cfg.connection_type
@@ -205,7 +205,7 @@ def _printable(raw: bytes | str) -> str:
 class NoDriver(ModemDriverBase):
     """DRIVER_NONE: accepts transmissions and does nothing."""
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         self.cfg = cfg
 
     def shutdown(self) -> None:
@@ -214,5 +214,5 @@ class NoDriver(ModemDriverBase):
     def do_work(self) -> None:
         pass
 
-    def handle_initiate_transmission(self, transmission) -> None:
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         log.debug("DRIVER_NONE: ignoring transmission request")

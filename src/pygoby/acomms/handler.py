@@ -44,6 +44,7 @@ from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
 from pygoby.dccl import Codec, DcclError
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
+from pygoby.protobuf.goby.acomms.protobuf.route_pb2 import StaticRoute
 from pygoby.util.clock import Clock
 from pygoby.util.signal import Signal
 
@@ -64,7 +65,7 @@ DISABLE_AND_MOVE_LISTEN_DRIVER_TO_PRIMARY = 3
 # Drivers
 
 
-def _check_slot_rates(mac_cfg, driver: ModemDriverBase) -> None:
+def _check_slot_rates(mac_cfg: acomms_pb.MACConfig, driver: ModemDriverBase) -> None:
     """Every slot's rate is one the driver has: a wrong one would fail every cycle, not once."""
     if driver.RATES is None:
         return
@@ -77,7 +78,7 @@ def _check_slot_rates(mac_cfg, driver: ModemDriverBase) -> None:
             )
 
 
-def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
+def make_driver(cfg: acomms_pb.DriverConfig, clock: Clock) -> ModemDriverBase | None:
     """The driver selected by `cfg` (DriverConfig, through pygoby.acomms.drivers' registry), or
     None for DRIVER_NONE."""
     if cfg.WhichOneof("driver") != "driver_name" and cfg.driver_type == DRIVER_NONE:
@@ -85,7 +86,7 @@ def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
     return drivers.make_driver(cfg, clock)
 
 
-def wire_driver_cfg(driver_cfg, cfg) -> None:
+def wire_driver_cfg(driver_cfg: acomms_pb.DriverConfig, cfg) -> None:
     """pAcommsHandler's special wiring: the uField driver gets the
     top-level `modem_id_lookup_path` and, where its own are unset, the MOOSDB of `common` (so a
     mission on a ServerPort other than 9000 needs no `moos_port`)."""
@@ -96,7 +97,7 @@ def wire_driver_cfg(driver_cfg, cfg) -> None:
             ufld.modem_id_lookup_path = lookup
         common = getattr(cfg, "common", None)
         for ours, theirs in (("moos_server", "server_host"), ("moos_port", "server_port")):
-            if common is not None and common.HasField(theirs) and not ufld.HasField(ours):
+            if common is not None and common.HasField(theirs) and not ufld.HasField(ours):  # type: ignore[arg-type]
                 setattr(ufld, ours, getattr(common, theirs))
 
 
@@ -123,7 +124,9 @@ class AcommsHandler:
         cfg,
         clock: Clock,
         loader: ProtoLoader | None = None,
-        driver_factory: Callable[[object, Clock], ModemDriverBase | None] = make_driver,
+        driver_factory: Callable[
+            [acomms_pb.DriverConfig, Clock], ModemDriverBase | None
+        ] = make_driver,
     ) -> None:
         if cfg.modem_id == acomms_pb.BROADCAST_ID:
             raise HandlerError("modem_id 0 is the broadcast address; set a modem_id of 1 or more")
@@ -301,18 +304,18 @@ class AcommsHandler:
             log.warning("cannot encode %s: %s", message.DESCRIPTOR.full_name, err)
             return None
 
-    def initiate_transmission(self, transmission) -> None:
+    def initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         """A transmission requested from outside the MAC (e.g. an ad-hoc ping)."""
         if self.primary is None:
             log.warning("no primary driver: transmission request ignored")
             return
         self._initiate_on_primary(transmission)
 
-    def inject_receive(self, transmission) -> None:
+    def inject_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         """Treat `transmission` as received by a driver (queue only)."""
         self.queue.handle_modem_receive(transmission)
 
-    def apply_mac_update(self, update) -> None:
+    def apply_mac_update(self, update: acomms_pb.MACUpdate) -> None:
         """MACUpdate addressed to this node; silences/restores Micro-Modems."""
         state = self.mac.apply_update(update)
         if state is None:
@@ -322,7 +325,7 @@ class AcommsHandler:
             if set_silent is not None and slot.running:
                 set_silent(not state)
 
-    def update_driver_cfg(self, cfg) -> None:
+    def update_driver_cfg(self, cfg: acomms_pb.DriverConfig) -> None:
         """DriverConfig update for every running driver with the same modem_id."""
         for slot in self.slots:
             if slot.running and slot.cfg.modem_id == cfg.modem_id:
@@ -339,7 +342,7 @@ class AcommsHandler:
     def route_cfg(self):
         return self.router.cfg
 
-    def replace_route(self, route) -> None:
+    def replace_route(self, route: StaticRoute) -> None:
         self.router.set_route(route)
         log.info("route replaced: %s", list(route.hop))
 
@@ -350,7 +353,7 @@ class AcommsHandler:
             self.replace_route(message.new_route)  # type: ignore[attr-defined]  # (a RouteCommand)
 
     # ------------------------------------------------------------------ internals
-    def _initiate_on_primary(self, transmission) -> None:
+    def _initiate_on_primary(self, transmission: acomms_pb.ModemTransmission) -> None:
         if self.primary is None or not self.primary.running:
             return
         try:

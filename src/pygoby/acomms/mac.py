@@ -50,7 +50,7 @@ class MACManager:
         self.glog = group_logger("goby::acomms::amac::0")
 
     # ------------------------------------------------------------------ control
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.MACConfig) -> None:
         self.cfg = acomms_pb.MACConfig()
         self.cfg.CopyFrom(cfg)
         self.glog = group_logger(f"goby::acomms::amac::{cfg.modem_id}")
@@ -173,7 +173,7 @@ class MACManager:
         if self.cfg.type == MAC_AUTO_DECENTRALIZED:
             self._auto_expire()
 
-    def _initiates(self, slot) -> bool:
+    def _initiates(self, slot: acomms_pb.ModemTransmission) -> bool:
         kind = self.cfg.type
         if kind == MAC_FIXED_DECENTRALIZED:
             return slot.src == self.cfg.modem_id or slot.always_initiate
@@ -184,7 +184,7 @@ class MACManager:
         return False
 
     # ------------------------------------------------------------------ MACUpdate
-    def apply_update(self, update) -> bool | None:
+    def apply_update(self, update: acomms_pb.MACUpdate) -> bool | None:
         """Apply a MACUpdate addressed to this node.
 
         Returns None when `cycle_state` is absent, else True for STARTED / False for STOPPED
@@ -225,7 +225,7 @@ class MACManager:
         return False
 
     # ------------------------------------------------------------------ auto-discovery (Goby 1.1)
-    def handle_modem_receive(self, transmission) -> None:
+    def handle_modem_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         """Learn sources heard on the link (MAC_AUTO_DECENTRALIZED only)."""
         if self.cfg.type != MAC_AUTO_DECENTRALIZED or transmission.src <= 0:
             return
@@ -286,7 +286,7 @@ def _clock_text(t: float) -> str:
     return time.strftime("%H:%M:%S", time.gmtime(t)) + f".{int(t % 1 * 1000):03d}"
 
 
-def _copy(slot):
+def _copy(slot: acomms_pb.ModemTransmission):
     out = acomms_pb.ModemTransmission()
     out.CopyFrom(slot)
     return out

@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import logging
 
+from google.protobuf.message import Message
+
 from pygoby.acomms import messages as acomms_pb
 from pygoby.protobuf.goby.acomms.protobuf import route_pb2
+from pygoby.protobuf.goby.acomms.protobuf.route_pb2 import StaticRoute
 
 log = logging.getLogger(__name__)
 
@@ -22,13 +25,13 @@ NO_ROUTE = -1
 
 
 class RouteManager:
-    def __init__(self, cfg=None) -> None:
+    def __init__(self, cfg: route_pb2.RouteManagerConfig | None = None) -> None:
         self.cfg = RouteManagerConfig()
         if cfg is not None:
             self.cfg.CopyFrom(cfg)
         self.subnets: list = []  # QueueManagers
 
-    def set_route(self, route) -> None:
+    def set_route(self, route: StaticRoute) -> None:
         """Replace the hop list (RouteCommand.new_route)."""
         self.cfg.route.CopyFrom(route)
 
@@ -53,7 +56,7 @@ class RouteManager:
         if hop != NO_ROUTE:
             item.dest = hop
 
-    def handle_in(self, msg, encoded: bytes, dest: int, modem_id: int) -> None:
+    def handle_in(self, msg: Message, encoded: bytes, dest: int, modem_id: int) -> None:
         if dest in (modem_id, acomms_pb.BROADCAST_ID):
             return
         hop = self.find_next_hop(modem_id, dest)

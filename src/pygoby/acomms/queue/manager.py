@@ -60,7 +60,7 @@ class QueueManager:
         return self.cfg.modem_id
 
     # ------------------------------------------------------------------ configuration
-    def set_cfg(self, cfg) -> None:
+    def set_cfg(self, cfg: acomms_pb.QueueManagerConfig) -> None:
         self.cfg = acomms_pb.QueueManagerConfig()
         self.cfg.CopyFrom(cfg)
         self.log = QueueLog(cfg.modem_id)
@@ -78,7 +78,9 @@ class QueueManager:
         for queue_cfg in cfg.queue:
             self.add_ccl_queue(queue_cfg)
 
-    def add_queue(self, entry, message_class=None) -> MessageQueue:
+    def add_queue(
+        self, entry: acomms_pb.QueuedMessageEntry, message_class: type[Message] | None = None
+    ) -> MessageQueue:
         """Create (or update the options of) the queue for `entry.protobuf_name`.
 
         The type must be known to the codec's loader or given as `message_class`."""
@@ -114,7 +116,7 @@ class QueueManager:
         self._size_changed(queue)
         return queue
 
-    def add_ccl_queue(self, cfg) -> CCLQueue:
+    def add_ccl_queue(self, cfg: acomms_pb.V1QueueConfig) -> CCLQueue:
         """Create (or update) a Goby 1.1 CCL queue from a goby.transitional.protobuf.QueueConfig."""
         if not cfg.HasField("key") or cfg.key.type != acomms_pb.QUEUE_CCL:
             raise QueueError(
@@ -144,7 +146,7 @@ class QueueManager:
         self.ccl_queues[ccl_id] = queue
         return queue
 
-    def push_ccl(self, ccl_id: int, transmission) -> None:
+    def push_ccl(self, ccl_id: int, transmission: acomms_pb.V1ModemDataTransmission) -> None:
         """Queue a raw frame (a Goby 1.1 ModemDataTransmission: `data`, `base.dest`) on the CCL
         queue `ccl_id`; its first byte must be that id."""
         queue = self.ccl_queues.get(ccl_id)
@@ -232,7 +234,7 @@ class QueueManager:
         )
 
     # ------------------------------------------------------------------ push
-    def push_message(self, msg, encoded: bytes | None = None) -> None:
+    def push_message(self, msg: Message, encoded: bytes | None = None) -> None:
         """Queue a message. `encoded`: its DCCL bytes as received (a relayed message keeps
         them untouched, so encrypted bodies pass through)."""
         queue = self._by_name.get(msg.DESCRIPTOR.full_name)
@@ -275,19 +277,19 @@ class QueueManager:
             self.log.dropped(queue, victim)
         self._size_changed(queue)
 
-    def message_dest(self, msg) -> int:
+    def message_dest(self, msg: Message) -> int:
         """A message's own destination (its DESTINATION_ID role; 0 without one)."""
         queue = self._by_name.get(msg.DESCRIPTOR.full_name)
         return 0 if queue is None else self._role(queue, Role.DESTINATION_ID, msg, 0)
 
-    def _role(self, queue: MessageQueue, role: int, msg, default: int) -> int:
+    def _role(self, queue: MessageQueue, role: int, msg: Message, default: int) -> int:
         getter = queue.roles.get(role)
         if getter is None:
             return default
         value = getter.get(msg)
         return default if value is None else int(value)
 
-    def flush_queue(self, flush) -> None:
+    def flush_queue(self, flush: acomms_pb.QueueFlush) -> None:
         queue = self.queues.get(flush.dccl_id)
         if queue is None:
             self.log.push.warning("flush: no queue with DCCL id %d", flush.dccl_id)
@@ -299,7 +301,7 @@ class QueueManager:
         return len(self.queues[dccl_id])
 
     # ------------------------------------------------------------------ data request
-    def handle_modem_data_request(self, request) -> None:
+    def handle_modem_data_request(self, request: acomms_pb.ModemTransmission) -> None:
         now = self.clock.now()
         for queue in self._all_queues():
             queue.clear_stale_waits(request.frame_start, now, self.cfg.minimum_ack_wait_seconds)
@@ -344,7 +346,12 @@ class QueueManager:
         self.log.transmission(request, given)
 
     def _contest(
-        self, request, used: int, limit: int | None, now: float, first: bool
+        self,
+        request: acomms_pb.ModemTransmission,
+        used: int,
+        limit: int | None,
+        now: float,
+        first: bool,
     ) -> MessageQueue | None:
         """The queue that sends next; CCL queues only compete for the start of a frame."""
         best: MessageQueue | None = None
@@ -373,7 +380,11 @@ class QueueManager:
 
     @staticmethod
     def _excluded(
-        queue: MessageQueue, request, used: int, limit: int | None, now: float
+        queue: MessageQueue,
+        request: acomms_pb.ModemTransmission,
+        used: int,
+        limit: int | None,
+        now: float,
     ) -> str | None:
         """Why `queue` cannot take part in the contest for this frame; None when it can."""
         if len(queue) <= queue.waiting_count:
@@ -401,7 +412,9 @@ class QueueManager:
             return "next message needs an ack and the packet has none"
         return None
 
-    def _refresh_on_demand(self, queue: MessageQueue, request, now: float) -> None:
+    def _refresh_on_demand(
+        self, queue: MessageQueue, request: acomms_pb.ModemTransmission, now: float
+    ) -> None:
         newest = queue.back()
         if newest is not None and now * 1e6 - newest.time <= self.cfg.on_demand_skew_seconds * 1e6:
             return
@@ -429,7 +442,7 @@ class QueueManager:
         return item
 
     # ------------------------------------------------------------------ receive
-    def handle_modem_receive(self, transmission) -> None:
+    def handle_modem_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         if transmission.type == acomms_pb.ACK:
             self._handle_ack(transmission)
         elif transmission.type == acomms_pb.DATA and not self.cfg.skip_decoding:
@@ -447,13 +460,15 @@ class QueueManager:
                     names += self._decode_frame(data, route)
             self.log.reception(transmission, names)
 
-    def _receive_ccl(self, transmission, data: bytes, index: int) -> None:
+    def _receive_ccl(
+        self, transmission: acomms_pb.ModemTransmission, data: bytes, index: int
+    ) -> None:
         if transmission.dest not in (acomms_pb.BROADCAST_ID, self.modem_id):
             return  # not for us (Goby 1.1 ignores messages to other modems)
         frame = transmission.frame_start + index
         self.signal_receive_ccl.emit(ccl.received(transmission, data, data[0], frame))
 
-    def _handle_ack(self, ack) -> None:
+    def _handle_ack(self, ack: acomms_pb.ModemTransmission) -> None:
         if ack.dest != self.modem_id:
             self.log.ack_for_another(ack, self.modem_id)
             return
@@ -506,7 +521,7 @@ class QueueManager:
         src = self._role(queue, Role.SOURCE_ID, header, 0) if queue is not None else 0
         return self._peer_codecs.get(src, self.codec)
 
-    def _deliver(self, msg) -> None:
+    def _deliver(self, msg: Message) -> None:
         queue = self._by_name.get(msg.DESCRIPTOR.full_name)
         if queue is None:
             self.signal_receive.emit(msg)

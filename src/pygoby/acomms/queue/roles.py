@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass
 
 from google.protobuf.descriptor import FieldDescriptor
+from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import RoleError
@@ -34,7 +35,7 @@ class RoleGetter:
     static_value: int = 0
     kind: int = FieldDescriptor.TYPE_INT32
 
-    def get(self, msg):
+    def get(self, msg: Message):
         if self.path is None:
             return self.static_value
         value = msg
@@ -45,7 +46,9 @@ class RoleGetter:
         return value
 
 
-def compile_roles(entry, descriptor: AnyDescriptor) -> dict[int, RoleGetter]:
+def compile_roles(
+    entry: acomms_pb.QueuedMessageEntry, descriptor: AnyDescriptor
+) -> dict[int, RoleGetter]:
     """Validate the roles of `entry` against `descriptor`."""
     getters: dict[int, RoleGetter] = {}
     for role in entry.role:
@@ -81,7 +84,7 @@ def compile_roles(entry, descriptor: AnyDescriptor) -> dict[int, RoleGetter]:
     return getters
 
 
-def timestamp_us(getter: RoleGetter, msg) -> int | None:
+def timestamp_us(getter: RoleGetter, msg: Message) -> int | None:
     value = getter.get(msg)
     if value is None:
         return None

@@ -33,6 +33,7 @@ from pygoby.acomms.drivers.micromodem.statistics import (
 )
 from pygoby.acomms.errors import ModemDriverError
 from pygoby.protobuf.goby.acomms.protobuf.mm_driver_pb2 import TransmissionType
+from pygoby.util.clock import Clock
 from pygoby.util.errors import LinkClosedError, NMEAError
 from pygoby.util.nmea import NMEASentence
 
@@ -75,7 +76,7 @@ class MMDriver(ModemDriverBase):
     DEFAULT_LINE_DELIMITER = "\r"
     RATES = range(len(RATE_NUM_FRAMES))
 
-    def __init__(self, clock=None, link=None) -> None:
+    def __init__(self, clock: Clock | None = None, link=None) -> None:
         super().__init__(clock, link)
         self.mm_cfg = acomms_pb.MMConfig()
         self.phase = Phase.STOPPED
@@ -122,7 +123,7 @@ class MMDriver(ModemDriverBase):
     def is_mm2(self) -> bool:
         return self.revision[0] >= 2
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         self._reset_state()
         self.mm_cfg = cfg.Extensions[acomms_pb.MM_CONFIG]
         self._buoy = self.mm_cfg.hydroid_gateway_id
@@ -157,7 +158,7 @@ class MMDriver(ModemDriverBase):
                 entry = entry.upper()
             self._out.append(NMEASentence.build("$CCCFG", entry.split(",")))
 
-    def update_cfg(self, cfg) -> None:
+    def update_cfg(self, cfg: acomms_pb.DriverConfig) -> None:
         """ACOMMS_DRIVER_CONFIG_UPDATE: send the update's Micro-Modem `nvram_cfg` entries (as at
         start-up) and keep them in the configuration, so that a restart sends them too."""
         entries = list(cfg.Extensions[acomms_pb.MM_CONFIG].nvram_cfg)
@@ -201,7 +202,7 @@ class MMDriver(ModemDriverBase):
         else:
             self._try_write(now)
 
-    def handle_initiate_transmission(self, transmission) -> None:
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         if self.link is None or not self.link.is_open:
             # nothing is taken from the queue, so queued messages wait for the link
             log.warning("link to the modem is down: transmission not started")
@@ -442,7 +443,7 @@ class MMDriver(ModemDriverBase):
         return bool(self._out) and self._written_at is not None and self._out[0].sentence_id == kind
 
     # ------------------------------------------------------------------ data transmission
-    def _initiate_data(self, msg) -> None:
+    def _initiate_data(self, msg: acomms_pb.ModemTransmission) -> None:
         try:
             check_rate(msg.rate)
         except ValueError as exc:
@@ -469,7 +470,7 @@ class MMDriver(ModemDriverBase):
         firmware_ack = c.ack_requested and self.app_acks is None
         self._push("$CCCYC", 0, c.src, c.dest, c.rate, firmware_ack, len(c.frame))
 
-    def _request_data(self, msg) -> bool:
+    def _request_data(self, msg: acomms_pb.ModemTransmission) -> bool:
         """Fill `msg` from the queue (with the application ack if enabled) and cache it;
         False if there is nothing to send."""
         self._expected_acks.clear()
@@ -652,7 +653,7 @@ class MMDriver(ModemDriverBase):
         if rx is not None:
             self._emit_data(rx)
 
-    def _emit_data(self, rx) -> None:
+    def _emit_data(self, rx: acomms_pb.ModemTransmission) -> None:
         """Deliver a data reception (after taking out an application ack, if enabled)."""
         if self.app_acks is not None:
             for ack in self.app_acks.strip(rx):
@@ -687,7 +688,7 @@ class MMDriver(ModemDriverBase):
         msg.Extensions[acomms_pb.MM_TRANSMISSION].type = kind
         return msg
 
-    def _initiate_mini(self, msg) -> None:
+    def _initiate_mini(self, msg: acomms_pb.ModemTransmission) -> None:
         msg.max_num_frames, msg.max_frame_bytes = 1, 2
         if msg.src < 0:
             msg.src = self.modem_id
@@ -701,7 +702,7 @@ class MMDriver(ModemDriverBase):
             data[0] &= 0x1F
         self._push("$CCMUC", msg.src, msg.dest, data.hex().upper())
 
-    def _initiate_fdp(self, msg) -> None:
+    def _initiate_fdp(self, msg: acomms_pb.ModemTransmission) -> None:
         msg.max_num_frames = 1
         if not msg.HasField("max_frame_bytes"):
             msg.max_frame_bytes = FDP_MAX_FRAME_BYTES
@@ -760,7 +761,7 @@ class MMDriver(ModemDriverBase):
         acomms_pb.MICROMODEM_M_SEQUENCE: "_initiate_m_sequence",
     }
 
-    def _lbl_params(self, msg, name: str):
+    def _lbl_params(self, msg: acomms_pb.ModemTransmission, name: str):
         """Configured LBL parameters merged with the request's own."""
         params = type(getattr(self.mm_cfg, name))()
         params.CopyFrom(getattr(self.mm_cfg, name))
@@ -769,7 +770,7 @@ class MMDriver(ModemDriverBase):
             self._push("$CCCFG", "TAT", params.turnaround_ms)
         return params, int(params.lbl_max_range * 2 / 1500 * 1000 + params.turnaround_ms)
 
-    def _initiate_remus_lbl(self, msg) -> None:
+    def _initiate_remus_lbl(self, msg: acomms_pb.ModemTransmission) -> None:
         params, timeout = self._lbl_params(msg, "remus_lbl")
         bits = params.enable_beacons
         self._last_lbl_type = acomms_pb.MICROMODEM_REMUS_LBL_RANGING
@@ -777,7 +778,7 @@ class MMDriver(ModemDriverBase):
             "$CCPDT", 1, self.modem_id % 4 + 1, 0, 0, timeout, *((bits >> i) & 1 for i in range(4))
         )
 
-    def _initiate_narrowband_lbl(self, msg) -> None:
+    def _initiate_narrowband_lbl(self, msg: acomms_pb.ModemTransmission) -> None:
         p, timeout = self._lbl_params(msg, "narrowband_lbl")
         freqs = [*list(p.receive_freq)[:4], 0, 0, 0, 0][:4]
         self._last_lbl_type = acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING
@@ -791,7 +792,7 @@ class MMDriver(ModemDriverBase):
             int(p.transmit_flag),
         )
 
-    def _initiate_generic_lbl(self, msg) -> None:
+    def _initiate_generic_lbl(self, msg: acomms_pb.ModemTransmission) -> None:
         p, timeout = self._lbl_params(msg, "generic_lbl")
         codes = [*list(p.receive_seq_code)[:4], 0, 0, 0, 0][:4]
         self._last_lbl_type = acomms_pb.MICROMODEM_GENERIC_LBL_RANGING
@@ -807,12 +808,12 @@ class MMDriver(ModemDriverBase):
             0,
         )
 
-    def _initiate_hardware_control(self, msg) -> None:
+    def _initiate_hardware_control(self, msg: acomms_pb.ModemTransmission) -> None:
         hw = msg.Extensions[acomms_pb.MM_TRANSMISSION].hw_ctl
         src = msg.src if msg.src >= 0 else self.modem_id
         self._push("$CCMEC", src, msg.dest, hw.line, hw.mode, hw.arg)
 
-    def _initiate_fm_sweep(self, msg) -> None:
+    def _initiate_fm_sweep(self, msg: acomms_pb.ModemTransmission) -> None:
         p = acomms_pb.MMConfig().fm_sweep
         p.CopyFrom(self.mm_cfg.fm_sweep)
         p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].fm_sweep)
@@ -826,7 +827,7 @@ class MMDriver(ModemDriverBase):
             int(p.repetition_period_ms * 10),
         )
 
-    def _initiate_m_sequence(self, msg) -> None:
+    def _initiate_m_sequence(self, msg: acomms_pb.ModemTransmission) -> None:
         p = acomms_pb.MMConfig().m_sequence
         p.CopyFrom(self.mm_cfg.m_sequence)
         p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].m_sequence)
