@@ -14,6 +14,7 @@ Ctrl-C or Exit quits.
 from __future__ import annotations
 
 import asyncio
+from collections.abc import Sequence
 
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
@@ -106,7 +107,7 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
             await self.stop()
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return iCommander.main(argv)
 
 

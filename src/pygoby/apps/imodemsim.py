@@ -26,6 +26,7 @@ import dataclasses
 import functools
 import ipaddress
 import logging
+from collections.abc import Sequence
 from typing import NoReturn
 
 from pygoby.acomms.mmsim.model import MicroModemModel
@@ -34,6 +35,7 @@ from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.moos.classic_app import ClassicMOOSApp
 from pygoby.moos.protocol import MOOSMessage
+from pygoby.protobuf.pygoby.moos.classic_app_pb2 import ClassicMOOSAppConfig
 from pygoby.util.pty import PtyError, PtyPair, is_live, partner_of
 
 log = logging.getLogger(__name__)
@@ -75,7 +77,7 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
         "ModemID = 1                 // NVRAM SRC before the host configures it (pygoby)",
     )
 
-    def __init__(self, cfg, **kwargs) -> None:
+    def __init__(self, cfg: ClassicMOOSAppConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.settings = {s.name.lower(): s for s in self.params}  # the last of a name wins
         for setting in self.params:
@@ -193,7 +195,7 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
             await super().stop()
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return iModemSim.main(argv)
 
 

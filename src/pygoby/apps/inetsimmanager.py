@@ -11,6 +11,7 @@ The reporting itself is `pygoby.netsim.navreporter.NavReporter`; the manager con
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.app import GobyMOOSApp
@@ -87,7 +88,7 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
             self.publish(self.cfg.status_var, status)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return iNetSimManager.main(argv)
 
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import base64
 import functools
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from google.protobuf.message import Message
 
@@ -35,12 +35,13 @@ from pygoby.moos.protocol import MOOSMessage, text_or_binary
 from pygoby.moos.translator_binding import TranslatorBinding, not_loaded
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
 from pygoby.topside.acomms_config import AcommsMessageSet
+from pygoby.util.clock import Clock
 from pygoby.util.signal import Signal
 
 IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
 
 
-def _make_driver(cfg, clock) -> ModemDriverBase | None:
+def _make_driver(cfg: acomms_pb.DriverConfig, clock: Clock) -> ModemDriverBase | None:
     """The handler's drivers; a uField driver gets its own MOOS connection."""
     driver = make_driver(cfg, clock)
     if isinstance(driver, UFldDriver):
@@ -203,7 +204,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.binding.tick(self.clock.now())
         self._stop_on_failure(self.acomms.do_work)
 
-    def _stop_on_failure(self, work) -> None:
+    def _stop_on_failure(self, work: Callable[[], object]) -> None:
         try:
             work()
         except HandlerError as err:
@@ -222,7 +223,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         ):
             self.acomms.apply_mac_update(update)
 
-    def _on_data_on_demand(self, request, message: Message) -> None:
+    def _on_data_on_demand(self, request: acomms_pb.ModemTransmission, message: Message) -> None:
         """ON_DEMAND: a fresh message from the current variables, queued here (so a bad one is
         logged and skipped); `message` is left empty so the queue does not push it again."""
         created = self.binding.create(message.DESCRIPTOR.full_name)
@@ -241,13 +242,13 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
     def _poster(self, key: str):
         return functools.partial(self.publish_pb, self.var[key])
 
-    def _post_raw(self, incoming: bool, raw) -> None:
+    def _post_raw(self, incoming: bool, raw: acomms_pb.ModemRaw) -> None:
         self.publish(
             self.var["driver_raw_in" if incoming else "driver_raw_out"], text_or_binary(raw.raw)
         )
         self.publish_pb(self.var["driver_raw_msg_in" if incoming else "driver_raw_msg_out"], raw)
 
-    def _on_ack(self, ack, original: Message) -> None:
+    def _on_ack(self, ack: acomms_pb.ModemTransmission, original: Message) -> None:
         self.publish_pb(self.var["queue_ack_transmission"], ack)
         self.publish_pb(self.var["queue_ack_original_msg"], original)
 
@@ -260,7 +261,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.publish_pb(self.var["queue_receive"], message)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return pAcommsHandler.main(argv)
 
 

@@ -13,6 +13,7 @@ from google.protobuf import text_format
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.handler import AcommsHandler
 from pygoby.acomms.queue import QueueError
 from pygoby.acomms.queue.ccl import goby11_time
 from pygoby.moos import goby11_config
@@ -87,7 +88,9 @@ class Goby11Variables:
 
     `app` publishes/subscribes (a GobyMOOSApp); `acomms` is its AcommsHandler."""
 
-    def __init__(self, app, acomms, queue_cfg: acomms_pb.QueueManagerConfig, enabled: bool) -> None:
+    def __init__(
+        self, app, acomms: AcommsHandler, queue_cfg: acomms_pb.QueueManagerConfig, enabled: bool
+    ) -> None:
         self.app, self.acomms = app, acomms
         self.enabled = enabled  # the 1.1 data variables (only for Goby 1.1 style configurations)
         self.in_vars = {q.key.id: q.in_pubsub_var for q in queue_cfg.queue if q.in_pubsub_var}

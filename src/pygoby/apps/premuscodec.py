@@ -15,6 +15,7 @@ with the reason and skipped. LatOrigin/LongOrigin (the datum of NAV_X/NAV_Y) are
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from functools import partial
 
 from pygoby.acomms import messages as acomms_pb
@@ -175,7 +176,7 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
             self._send(self.cfg.mdat_redirect_out, frame, dest)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return pREMUSCodec.main(argv)
 
 

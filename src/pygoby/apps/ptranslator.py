@@ -7,6 +7,8 @@ only wires the configuration to the MOOS application base.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from google.protobuf.message import Message
 
 from pygoby.dccl.libraries import split_libraries
@@ -57,7 +59,7 @@ class pTranslator(GobyMOOSApp):  # noqa: N801 - the program's name
         self.binding.publish(message)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return pTranslator.main(argv)
 
 

@@ -11,6 +11,7 @@ NAV_DEPTH, NAV_HEADING and NAV_SPEED every `nav_period` seconds, and posts scrip
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from pygoby.moos.app import GobyMOOSApp
@@ -119,7 +120,7 @@ class uSimVehicle(GobyMOOSApp):  # noqa: N801 - the program's name
             self._next_event = 0
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return uSimVehicle.main(argv)
 
 

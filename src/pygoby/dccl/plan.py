@@ -20,6 +20,7 @@ from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_options, message_options
 from pygoby.dccl.registry import CodecRegistry, DefaultMessageCodec
 from pygoby.protobuf import message_type
+from pygoby.protobuf.dccl.option_extensions_pb2 import DCCLFieldOptions
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 log = logging.getLogger("pygoby.dccl")
@@ -225,7 +226,7 @@ class Planner:
             self._check_fixed(node)
         return node
 
-    def _codec_name(self, f: AnyFieldDescriptor, fopts) -> str:
+    def _codec_name(self, f: AnyFieldDescriptor, fopts: DCCLFieldOptions) -> str:
         if fopts.HasField("codec"):
             return fopts.codec
         if f.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE:
@@ -234,7 +235,15 @@ class Planner:
                 return sub.codec
         return self.default_name
 
-    def _included(self, f, fopts, part: Part, forced: Part | None, version: int, v2_message: bool):
+    def _included(
+        self,
+        f: AnyFieldDescriptor,
+        fopts: DCCLFieldOptions,
+        part: Part,
+        forced: Part | None,
+        version: int,
+        v2_message: bool,
+    ):
         if forced is not None:
             return forced is part
         if version == 2 and v2_message:
@@ -283,7 +292,9 @@ class Planner:
                 node.items.append(item)
         return node
 
-    def _plan_field(self, f, part, forced, version, stack, oneofs) -> Item | None:
+    def _plan_field(
+        self, f: AnyFieldDescriptor, part, forced, version, stack, oneofs
+    ) -> Item | None:
         fopts = field_options(f)
         where = f.full_name
         oneof = None
@@ -327,7 +338,7 @@ class Planner:
             child_forced = forced
             if fopts.HasField("in_head"):
                 child_forced = Part.HEAD if fopts.in_head else Part.BODY
-            child = self._plan_message(f.message_type, part, child_forced, entry.version, stack)
+            child = self._plan_message(message_type(f), part, child_forced, entry.version, stack)
             if repeated:
                 return self._repeated(f, fopts, child=child, conditions=conditions)
             mode = self._mode(f, oneof)
@@ -367,7 +378,14 @@ class Planner:
             return Mode.REQUIRED
         return Mode.OPTIONAL
 
-    def _info(self, f, fopts, category, codec_name, required) -> FieldInfo:
+    def _info(
+        self,
+        f: AnyFieldDescriptor,
+        fopts: DCCLFieldOptions,
+        category: str,
+        codec_name: str,
+        required: bool,
+    ) -> FieldInfo:
         return FieldInfo(
             descriptor=f,
             options=fopts,
@@ -379,7 +397,14 @@ class Planner:
             registry=self.registry,
         )
 
-    def _repeated(self, f, fopts, codec=None, child=None, conditions=None) -> RepeatedItem:
+    def _repeated(
+        self,
+        f: AnyFieldDescriptor,
+        fopts: DCCLFieldOptions,
+        codec=None,
+        child=None,
+        conditions=None,
+    ) -> RepeatedItem:
         if not fopts.HasField("max_repeat"):
             raise DcclLoadError(f"{f.full_name}: repeated field needs (dccl.field).max_repeat")
         if fopts.max_repeat < 1:

@@ -11,6 +11,8 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from google.protobuf.message import Message
+
 from pygoby.moos.translator.conversions import lexical_double
 from pygoby.moos.translator.errors import TranslatorConfigError
 from pygoby.util.geodesy import UTMGeodesy
@@ -217,7 +219,7 @@ class AlgorithmRegistry:
         return self.modem_ids.type(int(value)) if value.isdigit() and value.isascii() else value
 
 
-def run_publish_algorithms(msg, algorithms, registry: AlgorithmRegistry) -> dict[int, str]:
+def run_publish_algorithms(msg: Message, algorithms, registry: AlgorithmRegistry) -> dict[int, str]:
     """Run publish-side algorithms on `msg`; returns {output_virtual_field: value}.
 
     Algorithms with the same output field chain in declaration order (the later ones take the

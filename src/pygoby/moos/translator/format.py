@@ -81,7 +81,13 @@ def _walk_path(message: Message, parts: list[str], spec: str, create: bool) -> M
 
 
 def _repeated_text(
-    msg, field, start: int, end: int, indexed: bool, delimiter: str, short: bool
+    msg: Message,
+    field: AnyFieldDescriptor,
+    start: int,
+    end: int,
+    indexed: bool,
+    delimiter: str,
+    short: bool,
 ) -> str:
     values = getattr(msg, field.name)
     parts = []
@@ -297,7 +303,7 @@ def parse(
         )
 
 
-def _parse_directive(extract, msg, spec, delimiter, algorithms, short, registry) -> None:
+def _parse_directive(extract, msg: Message, spec, delimiter, algorithms, short, registry) -> None:
     if ":" in spec:
         *path, last = spec.split(":")
         sub = _walk_path(msg, path, spec, create=True)

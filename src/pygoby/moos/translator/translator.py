@@ -251,7 +251,12 @@ class Translator:
         return msg
 
     def _apply_create(
-        self, msg, create, technique: Technique, source: MoosValue, short: bool
+        self,
+        msg: Message,
+        create: TranslatorEntry.CreateParser,
+        technique: Technique,
+        source: MoosValue,
+        short: bool,
     ) -> None:
         if technique in PROTOBUF_TECHNIQUES:
             parse_protobuf(source, msg, technique)

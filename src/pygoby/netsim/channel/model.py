@@ -72,6 +72,7 @@ from pygoby.netsim.channel.levels import (
 from pygoby.netsim.channel.propagation import BellhopLoss
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, harmonic_mean_speed
 from pygoby.netsim.channel.timing import Interval
+from pygoby.protobuf.netsim.messages.netsim_pb2 import EnvironmentNavUpdate
 
 log = logging.getLogger(__name__)
 
@@ -243,7 +244,7 @@ class Channel:
     def update_position(self, port: int, position: Position) -> None:
         self._positions[port] = position
 
-    def on_environment_nav_update(self, update) -> None:
+    def on_environment_nav_update(self, update: EnvironmentNavUpdate) -> None:
         """Listener for `NetSimManager.on_nav` (an EnvironmentNavUpdate)."""
         self.update_position(update.nav.modem_tcp_port, Position.from_nav(update.nav))
 
