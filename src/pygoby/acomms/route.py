@@ -13,6 +13,8 @@ import logging
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.queue import QueueManager
+from pygoby.acomms.queue.queue import QueuedItem
 from pygoby.protobuf.goby.acomms.protobuf import route_pb2
 from pygoby.protobuf.goby.acomms.protobuf.route_pb2 import StaticRoute
 
@@ -35,7 +37,7 @@ class RouteManager:
         """Replace the hop list (RouteCommand.new_route)."""
         self.cfg.route.CopyFrom(route)
 
-    def add_subnet_queue(self, queue) -> None:
+    def add_subnet_queue(self, queue: QueueManager) -> None:
         if queue not in self.subnets:
             self.subnets.append(queue)
 
@@ -48,7 +50,7 @@ class RouteManager:
             return self.cfg.default_gateway
         return NO_ROUTE
 
-    def handle_out(self, item, modem_id: int) -> None:
+    def handle_out(self, item: QueuedItem, modem_id: int) -> None:
         """Rewrite a queued item's link destination to the next hop (broadcasts untouched)."""
         if item.dest == acomms_pb.BROADCAST_ID:
             return
@@ -70,7 +72,7 @@ class RouteManager:
         log.debug("no subnet for next hop %d: message for %d not relayed", hop, dest)
 
 
-def bind_router(queue, router: RouteManager) -> None:
+def bind_router(queue: QueueManager, router: RouteManager) -> None:
     router.add_subnet_queue(queue)
     queue.signal_out_route.connect(router.handle_out)
     queue.signal_in_route.connect(router.handle_in)

@@ -116,7 +116,7 @@ class StoreServer:
             log.info("pruned %d delivered or expired transmissions", pruned)
 
 
-def _error_reply(request, error: str) -> bytes:
+def _error_reply(request: acomms_pb.StoreServerRequest, error: str) -> bytes:
     response = acomms_pb.StoreServerResponse(modem_id=request.modem_id)
     if request.HasField("request_id"):
         response.request_id = request.request_id
