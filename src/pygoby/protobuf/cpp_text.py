@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import struct
+from typing import Any
 
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
@@ -59,7 +60,7 @@ def float_text(value: float) -> str:
     return short if _float32(float(short)) == value else f"{value:.9g}"
 
 
-def scalar_text(field: AnyFieldDescriptor, value) -> str:
+def scalar_text(field: AnyFieldDescriptor, value: Any) -> str:
     """A non-message field value as C++ TextFormat prints it."""
     cpp = field.cpp_type
     if cpp == FieldDescriptor.CPPTYPE_STRING:

@@ -20,6 +20,7 @@ import tempfile
 from collections.abc import Iterable, Sequence
 from importlib import resources
 from pathlib import Path
+from typing import IO
 
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 from google.protobuf.descriptor import Descriptor, FileDescriptor
@@ -207,13 +208,13 @@ class ProtoLoader:
 class _captured_stderr:
     """protoc writes its diagnostics to fd 2; capture them for the error message."""
 
-    def __enter__(self):
+    def __enter__(self) -> IO[str]:
         self._file = tempfile.TemporaryFile(mode="w+")
         self._saved = os.dup(2)
         os.dup2(self._file.fileno(), 2)
         return self._file
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         os.dup2(self._saved, 2)
         os.close(self._saved)
         self._file.seek(0)

@@ -80,7 +80,7 @@ def _located(
     line: int | None,
     column: int | None,
     lines: list[str],
-    file,
+    file: str | os.PathLike[str] | None,
     first_line: int,
 ) -> ConfigError:
     if line is None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from textual import events
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical, VerticalScroll
@@ -153,7 +154,7 @@ class EditScreen(Screen):
     def _field(self, box: Input) -> str:
         return (box.id or "").removeprefix("field-").replace("--", ".")
 
-    def on_descendant_focus(self, event) -> None:
+    def on_descendant_focus(self, event: events.DescendantFocus) -> None:
         if (
             isinstance(event.widget, Input)
             and event.widget.id
@@ -206,7 +207,7 @@ class EditScreen(Screen):
         if self.commit(name):
             self.app.open_actions(name)  # type: ignore[attr-defined]
 
-    def on_descendant_blur(self, event) -> None:
+    def on_descendant_blur(self, event: events.DescendantBlur) -> None:
         if isinstance(event.widget, Input) and (event.widget.id or "").startswith("field-"):
             self.commit(self._field(event.widget))
 

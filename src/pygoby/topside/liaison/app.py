@@ -6,6 +6,8 @@ client of the same MOOSDB sharing pAcommsHandler's message set.
 
 from __future__ import annotations
 
+from typing import Any
+
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.translator import MoosValues, Post
@@ -22,7 +24,7 @@ class Liaison(GobyMOOSApp):
     default_name = "liaison"
 
     def __init__(
-        self, cfg: LiaisonAppConfig, *, acomms: AcommsMessageSet | None = None, **kwargs
+        self, cfg: LiaisonAppConfig, *, acomms: AcommsMessageSet | None = None, **kwargs: Any
     ) -> None:
         """`acomms`: the message set of the pAcommsHandler whose messages, queues and MAC cycle
         the pages show (default: the `liaison.commander.pacommshandler_name` block of the
