@@ -87,8 +87,13 @@ V1ModemDataTransmission = transitional_pb2.ModemDataTransmission
 V1ModemRangingRequest = transitional_pb2.ModemRangingRequest
 V1ModemRangingReply = transitional_pb2.ModemRangingReply
 V1MACUpdate = transitional_pb2.MACUpdate
+V1ModemDataAck = transitional_pb2.ModemDataAck
+V1ModemDataExpire = transitional_pb2.ModemDataExpire
+V1QueueSize = transitional_pb2.QueueSize
+V1QueueFlush = transitional_pb2.QueueFlush
 V1RangingType = transitional_pb2.RangingType
 QUEUE_CCL = transitional_pb2.QUEUE_CCL
+QUEUE_DCCL = transitional_pb2.QUEUE_DCCL
 
 MM_CONFIG = mm_driver_pb2.config
 MM_TRANSMISSION = mm_driver_pb2.transmission
