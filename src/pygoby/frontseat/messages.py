@@ -2,11 +2,14 @@
 
 The files live under src/pygoby/protobuf/goby/middleware/ at their goby3 import paths; this module
 imports their generated modules (which register them in protobuf's default pool), together with
-the basic simulator's Config extension, so configuration text using it parses.
+the drivers' extensions (the basic simulator's and Bluefin's Config extensions, Bluefin's
+InterfaceData and CommandRequest extensions), so configuration text and messages using them parse.
 """
 
 from __future__ import annotations
 
+from pygoby.protobuf.goby.acomms.protobuf import modem_message_pb2
+from pygoby.protobuf.goby.middleware.frontseat.bluefin import bluefin_config_pb2, bluefin_pb2
 from pygoby.protobuf.goby.middleware.frontseat.simulator.basic import (
     basic_simulator_frontseat_driver_config_pb2 as basic_simulator_pb2,
 )
@@ -39,6 +42,16 @@ HelmStateReport = frontseat_pb2.HelmStateReport
 BasicSimulatorFrontSeatConfig = basic_simulator_pb2.BasicSimulatorFrontSeatConfig
 BASIC_SIMULATOR_CONFIG = basic_simulator_pb2.basic_simulator_config
 
+BluefinConfig = bluefin_config_pb2.BluefinConfig
+BluefinExtraData = bluefin_pb2.BluefinExtraData
+BluefinExtraCommands = bluefin_pb2.BluefinExtraCommands
+BuoyancyStatus = bluefin_pb2.BuoyancyStatus
+TrimStatus = bluefin_pb2.TrimStatus
+BLUEFIN_CONFIG = bluefin_config_pb2.bluefin_config
+BLUEFIN_DATA = bluefin_pb2.bluefin_data
+BLUEFIN_COMMAND = bluefin_pb2.bluefin_command
+ModemRaw = modem_message_pb2.ModemRaw  # in BluefinExtraData
+
 # Enum wrappers (`.Name(value)`, `.Value(name)`) and their values
 InterfaceState = frontseat_pb2.InterfaceState
 FrontSeatState = frontseat_pb2.FrontSeatState
@@ -70,5 +83,6 @@ ERROR_FRONTSEAT_NONE = frontseat_pb2.ERROR_FRONTSEAT_NONE
 ERROR_FRONTSEAT_NOT_CONNECTED = frontseat_pb2.ERROR_FRONTSEAT_NOT_CONNECTED
 ERROR_FRONTSEAT_NOT_PROVIDING_DATA = frontseat_pb2.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
 ERROR_FRONTSEAT_IGNORING_COMMANDS = frontseat_pb2.ERROR_FRONTSEAT_IGNORING_COMMANDS
+
 
 ERROR_STATES = frozenset({INTERFACE_HELM_ERROR, INTERFACE_FS_ERROR})
