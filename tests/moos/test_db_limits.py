@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
-from pygoby.moos.dbcore import MAX_NAME_LENGTH, MAX_PATTERN_LENGTH, DBCore
+from pygoby.moos.dbcore import MAX_NAME_LENGTH, MAX_PATTERN_LENGTH, MAX_WILDCARDS, DBCore
 from pygoby.util.clock import VirtualClock
 from tests.moos.rawclient import closed_by_peer, raw_connect
 
@@ -197,6 +197,20 @@ def test_names_and_patterns_beyond_their_caps_are_refused_once_per_client(
     _send(core, "poster", wildcard)
     registered = ("*", pattern) in core.clients["poster"].filters
     assert registered is (pattern_length <= MAX_PATTERN_LENGTH)
+
+
+def test_a_client_keeps_at_most_max_wildcards_registrations(caplog):
+    caplog.set_level(logging.WARNING, logger="pygoby.moos.dbcore")
+    core = _core_with("greedy")
+    for k in range(MAX_WILDCARDS + 10):
+        sval = p.wildcard_sval("*", f"P{k}_*", 0.0)
+        _send(
+            core,
+            "greedy",
+            p.MOOSMessage(p.WILDCARD_REGISTER, p.STRING, "", sval=sval, src="greedy"),
+        )
+    assert len(core.clients["greedy"].filters) == MAX_WILDCARDS
+    assert caplog.text.count("wildcard registration refused") == 1
 
 
 def test_a_long_src_or_client_name_is_refused():

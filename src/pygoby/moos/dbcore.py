@@ -18,7 +18,8 @@ A packet's messages are processed at one DB time (the clock is read once per pac
 
 Bounds (none in the C++ DB; each refusal is logged once per client): variable names and client
 names at most MAX_NAME_LENGTH bytes, wildcard patterns at most MAX_PATTERN_LENGTH (MOOS names
-are identifiers such as NAV_X or ACOMMS_RAW_INCOMING, a few tens of bytes); at most
+are identifiers such as NAV_X or ACOMMS_RAW_INCOMING, a few tens of bytes) and MAX_WILDCARDS
+of them per client (an app registers a handful); at most
 `max_variables` variables; the stored values at most `store_budget` bytes. The summaries keep
 each variable's line until the variable is written again and the sorted name list until a
 variable is added, so a refresh decodes only what changed.
@@ -40,6 +41,7 @@ log = logging.getLogger(__name__)
 REFRESH_PERIOD = 2.0
 MAX_NAME_LENGTH = 256  # bytes of a variable or client name
 MAX_PATTERN_LENGTH = 256  # characters of a wildcard pattern (app or variable)
+MAX_WILDCARDS = 256  # wildcard registrations a client keeps (each new variable tests them all)
 DEFAULT_MAX_VARIABLES = 100_000
 # what a variable costs beside its value and name: its object, its two index entries
 VARIABLE_OVERHEAD = 400
@@ -678,6 +680,17 @@ class DBCore:
                 "pattern",
                 f"wildcard pattern of {max(len(app), len(var_pattern))} characters refused "
                 f"(at most {MAX_PATTERN_LENGTH})",
+            )
+            return
+        if (
+            register
+            and (app, var_pattern) not in client.filters
+            and len(client.filters) >= MAX_WILDCARDS
+        ):
+            self._refuse(
+                sender,
+                "wildcards",
+                f"wildcard registration refused: {client.name} has {MAX_WILDCARDS} already",
             )
             return
         app_glob, var_glob = p.Glob(app), p.Glob(var_pattern)
