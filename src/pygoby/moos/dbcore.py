@@ -22,11 +22,13 @@ are identifiers such as NAV_X or ACOMMS_RAW_INCOMING, a few tens of bytes) and M
 of them per client (an app registers a handful); at most
 `max_variables` variables; the stored values at most `store_budget` bytes. The summaries keep
 each variable's line until the variable is written again and the sorted name list until a
-variable is added, so a refresh decodes only what changed.
+variable is added, so a refresh decodes only what changed, and at most
+SUMMARY_LINES_PER_REFRESH variables (a variable whose new line waits keeps its previous one).
 """
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import struct
@@ -43,8 +45,12 @@ MAX_NAME_LENGTH = 256  # bytes of a variable or client name
 MAX_PATTERN_LENGTH = 256  # characters of a wildcard pattern (app or variable)
 MAX_WILDCARDS = 256  # wildcard registrations a client keeps (each new variable tests them all)
 DEFAULT_MAX_VARIABLES = 100_000
-# what a variable costs beside its value and name: its object, its two index entries
-VARIABLE_OVERHEAD = 400
+# what a variable costs beside its value (measured: 100,000 variables of 20-character names,
+# their index entries and summary lines grow the DB's RSS by ~100 MB)
+VARIABLE_OVERHEAD = 1000
+# DB_VARSUMMARY lines made per refresh (~25 us each: a burst of new variables costs at most
+# ~0.1 s per refresh; the lines not made yet come in the next refreshes, the others stay)
+SUMMARY_LINES_PER_REFRESH = 4000
 DB_VARIABLES = ("DB_TIME", "DB_UPTIME", "DB_CLIENTS", "DB_VARSUMMARY", "DB_QOS", "DB_RWSUMMARY")
 # Outgoing packets are cut at this size: mail merged over one loop iteration can be large.
 MAX_OUTGOING_PACKET = 1 << 20
@@ -102,8 +108,8 @@ class Variable:
         self.subscribers: dict[str, Subscription] = {}
         # routing tables derived from `subscribers` (rebuilt when they change): the held-mail
         # appenders of interval-0 subscribers, and the subscriptions with an interval
-        self.every_update: list = []
-        self.timed: list[Subscription] = []
+        self.every_update: list | tuple = ()  # () until subscribed: less memory per variable
+        self.timed: list[Subscription] | tuple = ()
         # the DB_VARSUMMARY line, and the value it was made from (`raw` is a new object at
         # every write, so the line is current while `summary_of is raw`)
         self.summary = ""
@@ -321,6 +327,7 @@ class DBCore:
         self._by_key: dict[bytes, Variable] = {}
         self._sorted: list[Variable] = []  # by name, but for the variables in `_unsorted`
         self._unsorted: list[Variable] = []
+        self._summary_from = 0  # where in `_sorted` the next refresh starts making lines
         for name in (*DB_VARIABLES, "DB_EVENT"):
             self._variable(name)
         self.clients: dict[str, ClientRecord] = {}
@@ -800,12 +807,22 @@ class DBCore:
         return ",".join(parts)
 
     def _var_summary(self) -> str:
-        return "\n".join(
-            [
-                var.summary if var.summary_of is var.raw else _summary_line(var)
-                for var in self.sorted_variables()
-            ]
-        )
+        """One line per variable, by name; at most SUMMARY_LINES_PER_REFRESH lines made again,
+        taking turns from where the last refresh stopped (a variable without a line yet is
+        left out until its turn)."""
+        variables = self.sorted_variables()
+        count = len(variables)
+        budget = SUMMARY_LINES_PER_REFRESH
+        start = self._summary_from % count if count else 0
+        for index in itertools.chain(range(start, count), range(start)):
+            var = variables[index]
+            if var.summary_of is not var.raw:
+                if budget == 0:
+                    self._summary_from = index
+                    break
+                budget -= 1
+                _summary_line(var)
+        return "\n".join([var.summary for var in variables if var.summary])
 
 
 def _by_name(var: Variable) -> str:
