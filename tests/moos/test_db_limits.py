@@ -15,10 +15,17 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from pygoby.moos import dbcore
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
-from pygoby.moos.dbcore import MAX_NAME_LENGTH, MAX_PATTERN_LENGTH, MAX_WILDCARDS, DBCore
+from pygoby.moos.dbcore import (
+    MAX_NAME_LENGTH,
+    MAX_PATTERN_LENGTH,
+    MAX_WILDCARDS,
+    VARIABLE_OVERHEAD,
+    DBCore,
+)
 from pygoby.util.clock import VirtualClock
 from tests.moos.rawclient import closed_by_peer, raw_connect
 
@@ -266,13 +273,20 @@ async def test_max_variables_refuses_new_ones_and_logs_once(caplog):
 
 def test_summaries_decode_only_the_variables_written_since_the_last_refresh(monkeypatch):
     # issue 25, item 2: every refresh decoded and sorted every variable (0.5-1.9 s at 60k)
-    core = _core_with("poster")
-    _send(core, "poster", *(p.notify(f"V{k}", float(k), time=1000.0) for k in range(2000)))
-    core.clock.advance(3.0)
-    _send(core, "poster", p.notify("V1", 1.5, time=1003.0))  # a refresh: all lines made
     decoded = []
     real = p.decode_message
     monkeypatch.setattr(p, "decode_message", lambda *a: decoded.append(1) or real(*a))
+    monkeypatch.setattr(dbcore, "SUMMARY_LINES_PER_REFRESH", 500)
+    core = _core_with("poster")
+    _send(core, "poster", *(p.notify(f"V{k}", float(k), time=1000.0) for k in range(2000)))
+    for refresh in range(5):  # 500 new lines a refresh, until every variable has one
+        decoded.clear()
+        core.clock.advance(3.0)
+        _send(core, "poster", p.notify("V1", 1.5, time=core.clock.now()))
+        assert len(decoded) <= 500
+        summary = core.variables["DB_VARSUMMARY"].message().string.splitlines()
+        assert len(summary) == min(500 * (refresh + 1), len(core.variables))
+    decoded.clear()
     core.clock.advance(3.0)
     _send(core, "poster", p.notify("V2", 2.5, time=1006.0))  # a refresh: V2 and the DB's own
     assert 0 < len(decoded) < 20
@@ -354,4 +368,5 @@ def test_stored_values_count_in_the_memory_budget(caplog):
     _send(core, "poster", p.notify("BIG_0", b"\0" * 10, time=1000.0))  # smaller: room again
     assert core.stored_bytes == before - 99_990
     _send(core, "poster", p.MOOSMessage(p.SERVER_REQUEST, p.STRING, "DB_CLEAR", src="poster"))
-    assert core.stored_bytes < 20_000  # the variables, not their values
+    # the variables remain, their values are gone
+    assert core.stored_bytes == sum(VARIABLE_OVERHEAD + len(v.key) for v in core.variables.values())
