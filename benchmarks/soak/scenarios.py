@@ -280,7 +280,7 @@ async def long_names_and_patterns(client: MOOSClient, stop: asyncio.Event) -> No
 
 
 # Issue 25 item 2: 200,000 distinct variables as fast as they go (3 s before), from a process
-# of its own (making them would otherwise hold up the probe in this one); the DB keeps 100,000
+# of its own (making them would otherwise hold up the probe in this one); the DB keeps 20,000
 # (--max-variables) and refuses the rest. Argument: the DB's port.
 MANY_VARIABLES = """
 import asyncio, sys
