@@ -1,4 +1,4 @@
-"""The soak's scenarios (issue 16): hostile clients beside a measured one, kill -9 of servers
+"""The soak's scenarios (issues 16, 25): hostile clients beside a measured one, kill -9 of servers
 and apps, and signals and link cuts that used to leave apps behind or disconnected.
 
 Each entry of SCENARIOS is `name: async (seconds, workdir) -> Figures`; a hostile-client one is
