@@ -370,3 +370,20 @@ def test_stored_values_count_in_the_memory_budget(caplog):
     _send(core, "poster", p.MOOSMessage(p.SERVER_REQUEST, p.STRING, "DB_CLEAR", src="poster"))
     # the variables remain, their values are gone
     assert core.stored_bytes == sum(VARIABLE_OVERHEAD + len(v.key) for v in core.variables.values())
+
+
+async def test_stored_variables_take_at_most_half_the_memory_budget(caplog):
+    caplog.set_level(logging.WARNING, logger="pygoby.moos.dbcore")
+    budget = 2 << 20
+    async with (
+        MOOSDB(port=0, memory_budget=budget) as db,
+        MOOSClient("filler", port=db.port) as filler,
+    ):
+        for k in range(30):  # 3 MB of values
+            filler.publish(f"FILL_{k}", b"\0" * 100_000)
+        await filler.flush()
+        await asyncio.sleep(0.3)
+        assert db.core.stored_bytes <= budget // 2
+        assert "would exceed the memory budget" in caplog.text
+        assert filler.connected
+        assert await _delivered(db.port, "ROOM_LEFT")  # the other half serves the clients

@@ -14,8 +14,9 @@ outbox). Resources are bounded: at most `max_clients` connections; a packet must
 within `packet_timeout` of its first byte; at most `max_variables` variables; the stored
 variables, partial packets, mail held for a client (a synchronous client's until it next
 writes) and unsent output together stay within `memory_budget` bytes (a write that would take
-the stored variables alone beyond it is refused; beyond it otherwise the connection holding the
-most is dropped), and one client's unsent output within MAX_WRITE_BUFFER.
+the stored variables beyond half of it is refused, so that the clients' buffers always have the
+other half; beyond it the connection holding the most is dropped), and one client's unsent
+output within MAX_WRITE_BUFFER.
 """
 
 from __future__ import annotations
@@ -239,7 +240,7 @@ class MOOSDB:
             clock,
             hostname or socket.gethostname(),
             max_variables=max_variables,
-            store_budget=memory_budget,
+            store_budget=memory_budget // 2,
         )
         self._server: asyncio.Server | None = None
         self._sweeper: asyncio.Task[None] | None = None
