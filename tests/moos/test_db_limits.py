@@ -379,9 +379,10 @@ async def test_stored_variables_take_at_most_half_the_memory_budget(caplog):
         MOOSDB(port=0, memory_budget=budget) as db,
         MOOSClient("filler", port=db.port) as filler,
     ):
-        for k in range(30):  # 3 MB of values
+        for k in range(30):  # 3 MB of values, 100 kB a packet
             filler.publish(f"FILL_{k}", b"\0" * 100_000)
-        await filler.flush()
+            await filler.flush()
+            await asyncio.sleep(0.01)
         await asyncio.sleep(0.3)
         assert db.core.stored_bytes <= budget // 2
         assert "would exceed the memory budget" in caplog.text
