@@ -1,4 +1,4 @@
-"""The soak's scenarios (issue 16): hostile clients beside a measured one, kill -9 of servers
+"""The soak's scenarios (issues 16, 25): hostile clients beside a measured one, kill -9 of servers
 and apps, and signals and link cuts that used to leave apps behind or disconnected.
 
 Each entry of SCENARIOS is `name: async (seconds, workdir) -> Figures`; a hostile-client one is
@@ -11,7 +11,9 @@ import asyncio
 import contextlib
 import random
 import signal
+import socket
 import struct
+import sys
 import time
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
@@ -51,6 +53,12 @@ MOOSDB_SPEC = ServerSpec(
     "moosdb",
     venv_command("pygoby", "moosdb", "--port", "{port}"),
     r"listening on 127\.0\.0\.1:(\d+)",
+)
+# the budget of issue 25's synchronous-subscriber attack (it reached 666 MB RSS before)
+MOOSDB_BUDGET_32 = ServerSpec(
+    "moosdb",
+    venv_command("pygoby", "moosdb", "--port", "{port}", "--memory-budget", "32"),
+    MOOSDB_SPEC.ready,
 )
 # a 64 MB budget for partial packets and unsent output, a packet deadline the run reaches
 MOOSDB_BUDGET = ServerSpec(
@@ -222,8 +230,8 @@ async def moos_round_trip(port: int, seconds: float, figures: Figures) -> None:
         await paced(seconds, 0.05, step)
 
 
-def moos_handshake(name: str) -> bytes:
-    return p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(name, 0.0)])
+def moos_handshake(name: str, asynchronous: bool = True) -> bytes:
+    return p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(name, 0.0, asynchronous)])
 
 
 @dataclass
@@ -254,6 +262,95 @@ async def wildcard_hog(client: MOOSClient, stop: asyncio.Event) -> None:
         client.publish(f"{k:a>64}".replace("0", "a")[:64], 1.0)
         k += 1
         await asyncio.sleep(0.1)
+
+
+async def long_names_and_patterns(client: MOOSClient, stop: asyncio.Event) -> None:
+    """Issue 25 item 1: a 30 kB name and `*` + 2000 x `?` + `X*` (refused: beyond the caps),
+    then the longest name and pattern allowed (256), a new name every 0.05 s, the pattern
+    registered again each time (tested against every variable)."""
+    k = 0
+    while not stop.is_set():
+        client.publish(f"{k}" + "A" * 30_000, 1.0)
+        client.subscribe_wildcard("*" + "?" * 2000 + "X*")
+        client.publish(f"{k:A>256}", 1.0)
+        client.subscribe_wildcard("*" + "?" * 253 + "X*")
+        await client.flush()
+        k += 1
+        await asyncio.sleep(0.05)
+
+
+# Issue 25 item 2: 200,000 distinct variables as fast as they go (3 s before), from a process
+# of its own (making them would otherwise hold up the probe in this one); the DB keeps 20,000
+# (--max-variables) and refuses the rest. Argument: the DB's port.
+MANY_VARIABLES = """
+import asyncio, sys
+from pygoby.moos.client import MOOSClient
+
+async def main():
+    async with MOOSClient("soak_many", port=int(sys.argv[1])) as client:
+        for batch in range(40):
+            for k in range(5000):
+                client.publish(f"SOAK_MANY_{batch}_{k}", 1.0)
+            await client.flush()
+        await asyncio.sleep(3600)
+
+asyncio.run(main())
+"""
+
+
+@dataclass
+class HostileProcess(Hostile):
+    """`script` run by this Python in a process of its own (argument: the port) until the end."""
+
+    script: str
+
+    async def run(self, port: int, stop: asyncio.Event) -> None:
+        proc = await asyncio.create_subprocess_exec(
+            sys.executable, "-c", self.script, str(port), stderr=asyncio.subprocess.DEVNULL
+        )
+        try:
+            await stop.wait()
+        finally:
+            with contextlib.suppress(ProcessLookupError):
+                proc.kill()
+            await proc.wait()
+
+
+async def flood(client: MOOSClient, stop: asyncio.Event) -> None:
+    """100 kB notifications of ten variables without a pause, until the run ends."""
+    k = 0
+    while not stop.is_set():
+        client.publish(f"SOAK_FLOOD_{k % 10}", b"\0" * 100_000)
+        await client.flush()
+        k += 1
+
+
+@dataclass
+class SyncSleeper(Hostile):
+    """Issue 25 item 3: a synchronous client subscribed to `*` that never writes again (its
+    mail is held for its next packet) nor reads; reconnects when dropped."""
+
+    async def run(self, port: int, stop: asyncio.Event) -> None:
+        name = f"soak_sync_{random.randint(0, 1 << 30)}"
+        register = p.MOOSMessage(
+            p.WILDCARD_REGISTER, p.STRING, "", sval=p.wildcard_sval("*", "*", 0.0), src=name
+        )
+        while not stop.is_set():
+            with contextlib.suppress(OSError):
+                _, writer = await asyncio.open_connection("127.0.0.1", port)
+                sock = writer.get_extra_info("socket")
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+                try:
+                    writer.write(moos_handshake(name, False) + p.encode_packet([register]))
+                    while not stop.is_set() and not writer.is_closing():
+                        with contextlib.suppress(TimeoutError):
+                            async with asyncio.timeout(0.2):
+                                await stop.wait()
+                        if writer.transport.is_closing():
+                            break
+                finally:
+                    writer.transport.abort()
+            await asyncio.sleep(0.2)
 
 
 def packet_hogs(count: int, sent: int) -> list[Trickle]:
@@ -660,6 +757,15 @@ SCENARIOS: dict[str, Scenario] = {
             MoosHostile(post_bulk),
             MoosHostile(post_bulk),
         ],
+    ),
+    "MOOSDB: 30 kB names, 2000-? patterns and the longest allowed, again and again (25.1)": (
+        hostile(MOOSDB_SPEC, moos_round_trip, [MoosHostile(long_names_and_patterns)])
+    ),
+    "MOOSDB: 200,000 distinct variables in a burst (25.2)": hostile(
+        MOOSDB_SPEC, moos_round_trip, [HostileProcess(MANY_VARIABLES)]
+    ),
+    "MOOSDB: a synchronous * subscriber never reading beside a flood, 32 MB budget (25.3)": (
+        hostile(MOOSDB_BUDGET_32, moos_round_trip, [SyncSleeper(), MoosHostile(flood)])
     ),
     "store_server: garbage, trickling and idle clients beside two modems": hostile(
         STORE_SERVER,

@@ -32,7 +32,12 @@ from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
 from pygoby.moos.moosfile import GobyBlock, MissionFile, parse_number
 from pygoby.protobuf import builtin_class
-from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
+from pygoby.protobuf.textconfig import (
+    check_config_values,
+    line_of_field,
+    merge_config_text,
+    printable_text,
+)
 from pygoby.protobuf.wire import length_delimited
 
 log = logging.getLogger(__name__)
@@ -130,6 +135,11 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
     """A MOOS global's text as the field's value; text that is no value of its type is an
     error (MOOS would read "abc" as 0: a mistyped ServerPort must not mean port 9000)."""
     kind = field.type
+    if value.encode("utf-8", "surrogateescape") != value.encode("utf-8", "replace"):
+        # bytes that are not UTF-8 (a Latin-1 file): protobuf strings must be UTF-8
+        raise ConfigError(
+            f"{name} = {printable_text(value)} is not valid UTF-8 text", field=field.name
+        )
     if kind == FieldDescriptor.TYPE_STRING:
         setattr(config, field.name, value)
     elif kind == FieldDescriptor.TYPE_BOOL:
