@@ -99,8 +99,12 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
         path = topside_mission(net, tmp_path, LIAISON % (tmp_path / "autosave.txt"))
         liaison = Liaison.from_mission(path, "liaison")
         async with liaison:
-            base = liaison.web.url.rsplit("/", 1)[0]
+            base = liaison.web.url.split("/scope")[0]
             page = await browser.new_page()
+            # the printed URL leaves the launch token as the page's cookie (and out of the
+            # address bar); the Commander's POSTs need it
+            await page.goto(liaison.web.url)
+            await page.wait_for_function("!location.search.includes('token')")
 
             # Scope: NAV_X changes and the page follows; the history plot of NAV_X.
             r1.client.publish("NAV_X", 10.0)

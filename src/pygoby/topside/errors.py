@@ -22,3 +22,7 @@ class SpecialError(TopsideError, ValueError):
 
 class SaveFileError(TopsideError, ValueError):
     """Not an iCommander save file."""
+
+
+class ScopeFilterError(TopsideError, ValueError):
+    """A Scope filter liaison does not take (too long)."""

@@ -6,6 +6,8 @@ client of the same MOOSDB sharing pAcommsHandler's message set.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
@@ -46,13 +48,16 @@ class Liaison(GobyMOOSApp):
         except CommanderError as err:
             raise ConfigError(str(err), field="liaison.commander") from None
         self.subscribe_pattern("*", "*", self.state.handle)
-        self.web = WebServer(
-            self.state,
-            web.http_address,
-            web.http_port,
-            web.token,
-            1.0 / web.update_freq if web.update_freq > 0 else 1.0,
-        )
+        self.web = WebServer(self.state, web, self._save_dir(web.save_dir))
+
+    def _save_dir(self, configured: str) -> Path:
+        """The Commander page's save folder: `save_dir` (relative to the mission file's
+        folder), else the mission file's folder, else ./liaison_saves."""
+        mission_path = self.mission.path if self.mission is not None else None
+        folder = Path(mission_path).parent if mission_path is not None else None
+        if configured:
+            return (folder or Path.cwd()) / Path(configured).expanduser()
+        return folder if folder is not None else Path("liaison_saves")
 
     @classmethod
     def embedded(cls, host: GobyMOOSApp, acomms: AcommsMessageSet) -> Liaison:

@@ -5,9 +5,10 @@ commander core directly.
 
 from __future__ import annotations
 
+import bisect
 import functools
+import json
 import math
-import re
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import ModemIdLookup, UTMGeodesy, dynamic_parse, parse_for_moos
 from pygoby.moos.translator.keyvalue import val_from_string
 from pygoby.moos.translator.techniques import MoosValue, Technique
+from pygoby.topside.errors import ScopeFilterError
 
 RATE_WINDOW = 10.0  # seconds over which a variable's rate is measured
 _TEXT = Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT
@@ -35,6 +37,33 @@ def _display(value: MoosValue) -> str:
 
 
 # ---------------------------------------------------------------------------------- Scope
+FILTER_MAX = 200  # characters of a Scope filter: room for a dozen variable names or globs
+
+
+class ScopeFilter:
+    """The Scope's `?filter=`: terms separated by spaces or commas, a variable shown when any
+    term matches its name, ignoring case. A term with `*` or `?` is a MOOS glob over the whole
+    name (`NAV_*`); a plain term matches anywhere in the name (`ACOMMS`). Globs never backtrack
+    (`Glob`), terms are capped at FILTER_MAX characters in all, and each name's answer is kept,
+    so no filter can make the Scope slow."""
+
+    def __init__(self, text: str) -> None:
+        if len(text) > FILTER_MAX:
+            raise ScopeFilterError(f"a Scope filter has at most {FILTER_MAX} characters")
+        terms = text.replace(",", " ").lower().split()
+        self.globs = [p.Glob(t if "*" in t or "?" in t else f"*{t}*") for t in terms]
+        self._answers: dict[str, bool] = {}
+
+    def __call__(self, key: str) -> bool:
+        if not self.globs:
+            return True
+        answer = self._answers.get(key)
+        if answer is None:
+            lowered = key.lower()
+            answer = self._answers[key] = any(g.match(lowered) for g in self.globs)
+        return answer
+
+
 @dataclass
 class ScopeRow:
     key: str
@@ -46,15 +75,18 @@ class ScopeRow:
     time: float
     arrivals: deque[float]
     history: deque[tuple[float, float]]
+    version: int = 0
+    shown: tuple[int, float, str] | None = None  # (version, rate, JSON) last built
 
 
 class ScopeModel:
-    """Every variable seen: newest value, type, source, age, rate; numeric history."""
+    """Every variable seen: newest value, type, source, time, rate; numeric history."""
 
     def __init__(self, max_history: int = 1000, patterns: list[str] | None = None) -> None:
         self.max_history = max_history
         self.patterns = patterns or []
         self.rows: dict[str, ScopeRow] = {}
+        self._keys: list[str] = []  # sorted
 
     def wants(self, key: str) -> bool:
         return not self.patterns or any(p.wildcard_match(pat, key) for pat in self.patterns)
@@ -77,36 +109,41 @@ class ScopeModel:
                 deque(maxlen=256),
                 deque(maxlen=self.max_history),
             )
+            bisect.insort(self._keys, msg.key)
         row.value, row.kind, row.time = value, kind, msg.time
         row.source, row.source_aux, row.community = msg.src, msg.src_aux, msg.community
+        row.version += 1
         row.arrivals.append(msg.time)
         if isinstance(value, float) and math.isfinite(value):
             row.history.append((msg.time, value))
 
-    def snapshot(self, now: float, pattern: str = "") -> list[dict]:
-        try:
-            wanted = re.compile(pattern, re.IGNORECASE) if pattern else None
-        except re.error:
-            wanted = None
-        out = []
-        for key in sorted(self.rows):
-            if wanted is not None and not wanted.search(key):
-                continue
+    def rows_json(self, now: float) -> dict[str, str]:
+        """Every row as JSON text, by name in order. A row's text is rebuilt only when its value
+        or rate changed, so that the live pages can send only the rows that did (the page
+        works out ages from `time` and the snapshot's `now`)."""
+        out = {}
+        for key in self._keys:
             row = self.rows[key]
-            recent = sum(1 for t in row.arrivals if now - t <= RATE_WINDOW)
-            out.append(
-                {
-                    "key": key,
-                    "value": _display(row.value),
-                    "type": row.kind,
-                    "source": row.source,
-                    "aux": row.source_aux,
-                    "community": row.community,
-                    "age": round(max(now - row.time, 0.0), 1),
-                    "rate": round(recent / RATE_WINDOW, 2),
-                    "numeric": bool(row.history),
-                }
-            )
+            arrivals = row.arrivals
+            while arrivals and now - arrivals[0] > RATE_WINDOW:
+                arrivals.popleft()
+            rate = round(len(arrivals) / RATE_WINDOW, 2)
+            if row.shown is None or row.shown[:2] != (row.version, rate):
+                text = json.dumps(
+                    {
+                        "key": key,
+                        "value": _display(row.value),
+                        "type": row.kind,
+                        "source": row.source,
+                        "aux": row.source_aux,
+                        "community": row.community,
+                        "time": row.time,
+                        "rate": rate,
+                        "numeric": bool(row.history),
+                    }
+                )
+                row.shown = (row.version, rate, text)
+            out[key] = row.shown[2]
         return out
 
     def history(self, key: str) -> list[tuple[float, float]]:

@@ -58,7 +58,7 @@ def outgoing_view(outgoing: Outgoing) -> dict:
 
 
 class LiaisonState:
-    """`handle(msg)` for every MOOS message; `page(name, now, **options)` for the pages."""
+    """`handle(msg)` for every MOOS message; `page(name, now)` and `scope` for the pages."""
 
     def __init__(
         self,
@@ -111,20 +111,21 @@ class LiaisonState:
         if msg.time >= self.start_time:  # older acks are not ours (Goby's stale-mail rule)
             self.commander.handle_mail(msg.key, msg.value, msg.time)
 
-    def page(self, name: str, now: float, pattern: str = "") -> dict:
-        if name == "scope":
-            return {"rows": self.scope.snapshot(now, pattern)}
-        if name == "acomms":
-            return self.acomms.snapshot(now)
-        if name == "map":
-            return self.map.snapshot(now)
-        if name == "commander":
-            commander = self.commander
-            return {
-                "records": [record_view(r) for r in reversed(commander.records[-50:])],
-                "notices": [n.banner() for n in reversed(commander.notices[-20:])],
-            }
-        raise KeyError(name)
+    def page(self, name: str, now: float) -> dict:
+        """The Commander, Acomms or Map page's view (the Scope's is `scope.rows_json`)."""
+        views = {
+            "commander": self.commander_view,
+            "acomms": self.acomms.snapshot,
+            "map": self.map.snapshot,
+        }
+        return views[name](now)
+
+    def commander_view(self, now: float) -> dict:
+        commander = self.commander
+        return {
+            "records": [record_view(r) for r in reversed(commander.records[-50:])],
+            "notices": [n.banner() for n in reversed(commander.notices[-20:])],
+        }
 
     def commander_types(self) -> list[dict]:
         return [
