@@ -102,7 +102,8 @@ class LiaisonState:
         )
         self.load_warnings: list[str] = []
         for path in commander_cfg.load:
-            self.load_warnings += self.commander.load(path)
+            if path:  # empty means none, as in Goby 1.1
+                self.load_warnings += self.commander.load(path)
 
     def handle(self, msg: MOOSMessage) -> None:
         self.scope.update(msg)
