@@ -73,7 +73,7 @@ def focused_field(app) -> str:
 
 def in_view(app, widget) -> bool:
     region = widget.region
-    return region.height > 0 and 0 <= region.y and region.bottom <= app.size.height
+    return region.height > 0 and region.y >= 0 and region.bottom <= app.size.height
 
 
 @pytest.mark.timeout(60)
