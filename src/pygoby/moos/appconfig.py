@@ -213,7 +213,12 @@ def read_configuration(
         block = mission.goby_block(app_name)
         if block is None:
             raise ConfigError(f"no ProcessConfig block for {app_name}", file=source)
-        translation = goby11_config.translate(block.text, config_class.DESCRIPTOR)
+        try:
+            translation = goby11_config.translate(block.text, config_class.DESCRIPTOR)
+        except goby11_config.BlockSyntaxError as err:
+            raise ConfigError(
+                err.reason, file=source, line=block.first_line + err.line - 1
+            ) from None
         parse_block(config, translation.text, block.first_line, source)
         translated = [f"{source}:{_shift(note, block.first_line)}" for note in translation.notes]
         try:

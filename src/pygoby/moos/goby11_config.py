@@ -79,6 +79,15 @@ _TOKEN = re.compile(
 )
 
 
+class BlockSyntaxError(ValueError):
+    """A mistake TextFormat cannot read past (a scalar without its ':', a block never closed),
+    at `line` of the block: reported as it is, before any field of the block is looked at."""
+
+    def __init__(self, line: int, reason: str) -> None:
+        super().__init__(f"line {line}: {reason}")
+        self.line, self.reason = line, reason
+
+
 def tokenize(text: str) -> list[Token]:
     tokens: list[Token] = []
     line, pos = 1, 0
@@ -127,9 +136,13 @@ class _Parser:
             opening = self.take()
             closing = "}" if opening.text == "{" else ">"
             result.children = self.fields(closing)
+            if self.peek() is None:
+                raise BlockSyntaxError(
+                    name.line, f"the '{opening.text}' after {name.text} is never closed"
+                )
             result.brackets = (opening, self.take())
         elif result.colon is None:
-            raise ValueError(f"line {name.line}: {name.text} needs ':' or a block")
+            raise BlockSyntaxError(name.line, f"expected ':' after {name.text}")
         elif self.peek() == "[":
             result.value.append(self.take())
             while self.peek() not in ("]", None):
@@ -333,11 +346,14 @@ class Translation:
 
 def translate(text: str, descriptor: Descriptor) -> Translation:
     """Rewrite the Goby 1.1/2 forms of a ProcessConfig block for `descriptor` (the app's
-    configuration type). Text that does not tokenize is returned unchanged (protobuf's parser
-    then reports the problem with its line)."""
+    configuration type). Raises BlockSyntaxError for a mistake no parser reads past (protobuf's
+    would first report a field before it that only this rewriting makes valid). Other text that
+    does not tokenize is returned unchanged (protobuf's parser then reports it with its line)."""
     try:
         parser = _Parser(tokenize(text))
         fields = parser.fields(None)
+    except BlockSyntaxError:
+        raise
     except ValueError:  # not TextFormat we understand: left for protobuf to report
         return Translation(text, [])
     notes: list[str] = []
