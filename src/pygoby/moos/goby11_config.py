@@ -30,6 +30,8 @@ from dataclasses import dataclass, field
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
+from pygoby.moos.errors import BlockSyntaxError
+
 # ---------------------------------------------------------------------------------------------
 # Tokens and the field tree
 
@@ -77,15 +79,6 @@ _TOKEN = re.compile(
       |(?P<word>[\w.+-]+)|(?P<punct>[{}<>:,;\[\]])""",
     re.VERBOSE,
 )
-
-
-class BlockSyntaxError(ValueError):
-    """A mistake TextFormat cannot read past (a scalar without its ':', a block never closed),
-    at `line` of the block: reported as it is, before any field of the block is looked at."""
-
-    def __init__(self, line: int, reason: str) -> None:
-        super().__init__(f"line {line}: {reason}")
-        self.line, self.reason = line, reason
 
 
 def tokenize(text: str) -> list[Token]:

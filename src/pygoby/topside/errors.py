@@ -26,3 +26,7 @@ class SaveFileError(TopsideError, ValueError):
 
 class ScopeFilterError(TopsideError, ValueError):
     """A Scope filter liaison does not take (too long)."""
+
+
+class TooManyStreamsError(TopsideError):
+    """Every live-update stream liaison allows is open (max_streams)."""

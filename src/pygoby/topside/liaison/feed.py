@@ -15,16 +15,12 @@ import logging
 from collections import Counter
 from collections.abc import AsyncIterator
 
-from pygoby.topside.errors import TopsideError
+from pygoby.topside.errors import TooManyStreamsError
 from pygoby.topside.liaison.models import ScopeFilter
 from pygoby.topside.liaison.state import LiaisonState
 
 log = logging.getLogger("pygoby.liaison")
 PAGES = ("scope", "commander", "acomms", "map")
-
-
-class TooManyStreams(TopsideError):
-    """Every live-update stream liaison allows is open."""
 
 
 def _json_default(value: object) -> object:
@@ -94,7 +90,7 @@ class PageStream:
 
 class LiveFeed:
     """Ticks `PageSnapshots` every `period` seconds (`run`), and serves `stream`s, at most
-    `max_streams` at once (past that, `admit` raises TooManyStreams)."""
+    `max_streams` at once (past that, `admit` raises TooManyStreamsError)."""
 
     def __init__(self, state: LiaisonState, period: float, max_streams: int) -> None:
         self.snapshots = PageSnapshots(state)
@@ -109,10 +105,10 @@ class LiveFeed:
         return sum(self.watched.values())
 
     def admit(self, name: str, filter_text: str = "") -> ScopeStream | PageStream:
-        """A stream of page `name`, counted until `release`d. Raises TooManyStreams, and
+        """A stream of page `name`, counted until `release`d. Raises TooManyStreamsError, and
         ScopeFilterError for a filter the Scope does not take."""
         if self.open_streams >= self.max_streams:
-            raise TooManyStreams(
+            raise TooManyStreamsError(
                 f"liaison: {self.max_streams} live pages are open already (max_streams)"
             )
         stream = ScopeStream(ScopeFilter(filter_text)) if name == "scope" else PageStream(name)

@@ -45,9 +45,9 @@ from pygoby.topside.commander import (
     FieldValueError,
     SaveFileError,
 )
-from pygoby.topside.errors import ScopeFilterError
+from pygoby.topside.errors import ScopeFilterError, TooManyStreamsError
 from pygoby.topside.liaison.access import Access, SaveFolder, is_loopback
-from pygoby.topside.liaison.feed import PAGES, LiveFeed, PageStream, ScopeStream, TooManyStreams
+from pygoby.topside.liaison.feed import PAGES, LiveFeed, PageStream, ScopeStream
 from pygoby.topside.liaison.state import LiaisonState, field_view, outgoing_view, record_view
 from pygoby.util.aiorun import cancel_and_wait
 
@@ -110,7 +110,7 @@ async def events(request: Request) -> Response:
     feed = _parts(request).feed
     try:
         stream = feed.admit(name, request.query_params.get("filter", ""))
-    except TooManyStreams as err:
+    except TooManyStreamsError as err:
         return PlainTextResponse(str(err), 503, headers={"Retry-After": "5"})
     except ScopeFilterError as err:
         return PlainTextResponse(str(err), 400)
