@@ -42,7 +42,11 @@ def test_ptranslator_with_a_wrong_server_port_warns(tmp_path):
     )
     script = Path(sys.executable).with_name("pTranslator")
     app = subprocess.Popen(
-        [str(script), str(mission)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+        [str(script), str(mission)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        cwd=tmp_path,  # its log file goes there
     )
     try:
         chooser = selectors.DefaultSelector()

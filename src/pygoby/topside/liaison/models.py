@@ -231,7 +231,9 @@ class AcommsModel:
             self.var["driver_receive"]: functools.partial(self._on_modem, False),
             self.var["queue_ack_original_msg"]: self._on_ack,
             self.var["queue_expire"]: self._on_expire,
+            self.var["driver_status"]: self._on_driver_status,
         }
+        self.drivers: dict[str, str] = {}  # "primary driver NAME" -> its state
 
     @property
     def variables(self) -> list[str]:
@@ -249,6 +251,12 @@ class AcommsModel:
         except Exception:  # noqa: BLE001 - bad mail is skipped, never kills the page
             return None
         return out
+
+    def _on_driver_status(self, value: MoosValue, when: float) -> None:
+        text = value.decode("utf-8", "replace") if isinstance(value, bytes) else value
+        driver, sep, state = text.partition(": ")
+        if sep and len(self.drivers) < 16:  # a handful of drivers; never an unbounded table
+            self.drivers[driver] = state[:500]
 
     def _on_qsize(self, value: MoosValue, when: float) -> None:
         size = self._parse(acomms_pb.QueueSize, value)
@@ -344,6 +352,7 @@ class AcommsModel:
         cycle = sum(s["seconds"] for s in self.slots)
         return {
             "modem_id": self.modem_id,
+            "drivers": [f"{name}: {state}" for name, state in self.drivers.items()],
             "queues": [
                 {
                     "name": q.name,

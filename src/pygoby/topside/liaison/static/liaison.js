@@ -244,6 +244,8 @@ function renderCommander(data) {
 // ------------------------------------------------------------------------------ Acomms
 function renderAcomms(data) {
   $("#acomms-modem").textContent = data.modem_id;
+  $("#acomms-drivers").replaceChildren(...data.drivers.map((text) =>
+    el("div", { class: "driver" + (text.endsWith(": running") ? "" : " failed") }, text)));
   $("#acomms-queues tbody").replaceChildren(...data.queues.map((q) =>
     el("tr", { "data-queue": q.name }, el("td", {}, q.name), el("td", {}, q.dccl_id ?? "?"), el("td", { class: "size" }, String(q.size)),
       el("td", {}, q.ack ? "yes" : "no"), el("td", {}, String(q.ttl)), el("td", {}, String(q.value_base)),
