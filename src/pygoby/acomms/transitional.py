@@ -1,4 +1,4 @@
-"""Goby 1.1 XML message files in a pAcommsHandler configuration (spec goby-moos-apps.md §4.10):
+"""Goby 1.1 XML message files in a pAcommsHandler configuration:
 the files of `transitional_cfg` (where Goby 1.1's dccl_cfg/queue_cfg `message_file`s land when
 the configuration is read) become DCCL types in a loader, `queue_cfg.message_entry`s and
 `translator_entry`s, as Goby 2's transitional layer did at start-up. No MOOS needed (e.g. for
@@ -82,7 +82,7 @@ class TransitionalMessages:
         """{message: {source variable: field name}} for the source variables that feed one field
         (the translator reads them with a FORMAT create; the shared ones are key=value pairs
         already). Goby 1.1 read such a variable's string as `name=value` when it holds the
-        field's name, else whole (seed 003 §2.3.8): Translator.read_named_values."""
+        field's name, else whole: Translator.read_named_values."""
         return {name: msg.single_field_sources() for name, msg in self.messages.items()}
 
     @property

@@ -1,5 +1,4 @@
-"""iFrontSeat: a MOOS backseat (pHelmIvP + Goby) driving a vehicle's frontseat (spec
-goby-moos-apps.md section 5).
+"""iFrontSeat: a MOOS backseat (pHelmIvP + Goby) driving a vehicle's frontseat.
 
     IFRONTSEAT_DRIVER_LIBRARY=basic_simulator iFrontSeat mission.moos [AppName]
     IFRONTSEAT_DRIVER_LIBRARY=basic_simulator iFrontSeat --example_config
@@ -17,7 +16,7 @@ onto them:
   processes' IFS_RAW_OUT only in LISTEN or COMMAND;
 * the driver's data, responses and raw traffic are posted on IFS_DATA_IN (plus IFS_NODE_STATUS),
   IFS_COMMAND_RESPONSE, IFS_RAW_IN and IFS_RAW_OUT; IFS_STATUS every `status_period` seconds
-  (0: never, Quirk Q15 fixed as documented);
+  (0: never, as documented; goby3 posts it every iteration: QUIRKS.md Q-APPS-15);
 * IVPHELM_STATE sets the helm state, LAT_ORIGIN/LONG_ORIGIN the driver's local grid;
 * with `exit_on_error`, entering an error state stops the app with exit status 1.
 """

@@ -3,7 +3,7 @@ Micro-Modem emulator on the serial line the mission names.
 
     iModemSim mission.moos [AppName]
 
-ProcessConfig (seed 003 §2.3.15):
+ProcessConfig:
   Port = /tmp/ttyLOOPA1     serial device of the emulated modem; the host (pAcommsHandler)
                             opens its partner, /tmp/ttyLOOPA2. When the pair does not exist (or
                             its links are stale) iModemSim makes it, so pAntler alone is enough.

@@ -1,11 +1,11 @@
-"""pAcommsHandler: goby-acomms on a MOOS community (spec goby-moos-apps.md §4).
+"""pAcommsHandler: goby-acomms on a MOOS community.
 
 Translator entries create DCCL messages from MOOS variables and push them into the priority
 queue; the MAC opens the slots, the driver asks the queue for frames; messages received over
 the link are published through the same entries' publish rules and posted on
-ACOMMS_QUEUE_RECEIVE. Every ACOMMS_* variable of the spec's table is published or handled.
-The modem, the MAC and the queue keep working while the MOOSDB is away (upstream's stop with
-it); their posts are delivered when it is back.
+ACOMMS_QUEUE_RECEIVE. Every ACOMMS_* variable goby3's pAcommsHandler publishes or reads is published
+or handled. The modem, the MAC and the queue keep working while the MOOSDB is away (upstream's stop
+with it); their posts are delivered when it is back.
 The acomms wiring itself is `pygoby.acomms.handler.AcommsHandler`; this module maps the
 configuration, the translator and the MOOS variables onto it.
 

@@ -1,7 +1,6 @@
-"""iFrontSeat's rules between the backseat and a frontseat driver, sans I/O (spec
-goby-moos-apps.md 5.3-5.8). The app reads the backseat's variables from MOOS and hands them over
-as plain values; `Backseat` applies them to the driver (`InterfaceBase`) and returns what is
-to be posted:
+"""iFrontSeat's rules between the backseat and a frontseat driver, sans I/O. The app reads the
+backseat's variables from MOOS and hands them over as plain values; `Backseat` applies them to the
+driver (`InterfaceBase`) and returns what is to be posted:
 
 * `may_command(var)`: a command request goes to the driver only in INTERFACE_COMMAND;
   `may_send(var)`: data and raw traffic only in INTERFACE_LISTEN or INTERFACE_COMMAND (a debug

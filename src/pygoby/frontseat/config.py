@@ -1,4 +1,4 @@
-"""iFrontSeat's configuration, usable without the app (spec goby-moos-apps.md 5.1-5.2, 5.8).
+"""iFrontSeat's configuration, usable without the app.
 
 * The driver is imported before the configuration is parsed, so that its configuration
   extension parses and shows in `--example_config`: `import_driver_from_environment(env)` (as

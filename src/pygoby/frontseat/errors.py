@@ -20,7 +20,8 @@ class FrontSeatError(PygobyError):
 
 
 class FrontSeatDriverError(FrontSeatError):
-    """A driver raises it from loop() to force an error state (T9); goby3's FrontSeatException.
+    """A driver raises it from loop() to force an error state, from any state; goby3's
+    FrontSeatException.
 
     Carries at most one of a HelmError (-> INTERFACE_HELM_ERROR) or a FrontSeatError code
     (-> INTERFACE_FS_ERROR); one with neither is not a state change and propagates out of

@@ -1,4 +1,4 @@
-"""iFrontSeat's legacy MOOS variables (spec goby-moos-apps.md 5.8), sans I/O.
+"""iFrontSeat's legacy MOOS variables, sans I/O.
 
 * `nav_posts(node_status)`: the NAV_* doubles (and GPS_UPDATE_RECEIVED) for one navigation
   solution of the frontseat (`publish_nav`).

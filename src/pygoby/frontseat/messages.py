@@ -1,8 +1,8 @@
 """Message classes and enum constants of the frontseat interface, from our .proto files.
 
-The files live under src/pygoby/protobuf/goby/middleware/ at their goby3 import paths (spec
-goby-moos-apps.md 5.6); this module loads them once into the process-wide pool, together with
-the basic simulator's Config extension, so configuration text using it parses.
+The files live under src/pygoby/protobuf/goby/middleware/ at their goby3 import paths; this module
+loads them once into the process-wide pool, together with the basic simulator's Config extension, so
+configuration text using it parses.
 """
 
 from __future__ import annotations

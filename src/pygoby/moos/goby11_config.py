@@ -1,5 +1,5 @@
 """Goby 1.1 and Goby 2 configuration forms, mapped onto today's (goby3) configuration in one
-step when a ProcessConfig block is read (seed 003 §2.3.5; spec goby-moos-apps.md §4.10).
+step when a ProcessConfig block is read.
 
 The block's TextFormat text is tokenized and walked along the configuration's descriptor, so a
 rule applies to a message *type* wherever it appears (every app's `common`, every DriverConfig,

@@ -1,4 +1,4 @@
-"""QueueManager: the priority contest that fills ModemTransmission frames (spec acomms.md §5).
+"""QueueManager: the priority contest that fills ModemTransmission frames.
 
 Connect a driver with `driver.signal_data_request.connect(queue.handle_modem_data_request)` and
 `driver.signal_receive.connect(queue.handle_modem_receive)` (or pygoby.acomms.bind.bind). Call
@@ -296,6 +296,8 @@ class QueueManager:
             queue.clear_stale_waits(request.frame_start, now, self.cfg.minimum_ack_wait_seconds)
         packet_ack = request.ack_requested if request.HasField("ack_requested") else False
         packet_dest = request.dest
+        # unset max_frame_bytes: no limit, said outright (goby3 gets there by unsigned underflow:
+        # QUIRKS.md Q-ACOMMS-11)
         limit = request.max_frame_bytes if request.HasField("max_frame_bytes") else None
         start = request.frame_start
         given: list[str] = []  # for the log: what goes out

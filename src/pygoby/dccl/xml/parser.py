@@ -1,4 +1,4 @@
-"""Read a Goby 1.1 `<message_set>` file (seed 003 §2.3.8-2.3.10) into the model.
+"""Read a Goby 1.1 `<message_set>` file into the model.
 
 The XML goes through a real parser (expat, hardened by defusedxml: no entity expansion, no
 external references), then every element is checked against the message schema Goby 1.1
@@ -39,7 +39,7 @@ IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 # An XML file is configuration: anything larger is a mistake (and must not eat the memory).
 MAX_FILE_BYTES = 16 * 1024 * 1024
 
-# Goby 1.1 algorithm names (seed 003 §2.3.10) and those Goby 2 added; `alg_TSD_to_soundspeed`
+# Goby 1.1 algorithm names and those Goby 2 added; `alg_TSD_to_soundspeed`
 # is the manual's spelling of the code's TSD_to_soundspeed.
 ALGORITHM_ALIASES = {"alg_TSD_to_soundspeed": "TSD_to_soundspeed"}
 ALGORITHMS = frozenset(
@@ -651,8 +651,9 @@ class _Reader:
                         f"not a variable of message {msg.name}",
                     )
             if create_side and references:
-                # Goby 2's rule (quirk Q13): the translator runs create-side algorithms on one
-                # field's text, before the other fields exist
+                # Goby 2's rule, kept (upstream indexes an empty list instead: QUIRKS.md Q-APPS-13):
+                # the translator runs create-side algorithms on one field's text, before the
+                # other fields exist, so an algorithm with references is refused at load
                 raise self.error(
                     line,
                     f"algorithm {spec!r} on {var.name if var else '?'}: "

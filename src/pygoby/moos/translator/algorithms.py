@@ -66,7 +66,8 @@ def _db_to_power(x: float) -> float:
 
 
 def _nmea_angle(x: float, degree_digits: int) -> str:
-    # floor-based split, reproduced as is: negative input gives odd strings (Quirk Q23).
+    # goby3's floor-based split into degrees and minutes, reproduced as is: negative input gives
+    # odd strings (apply abs first; QUIRKS.md Q-APPS-23).
     if not math.isfinite(x):
         return "nan"
     degrees = math.floor(x)
@@ -206,7 +207,7 @@ class AlgorithmRegistry:
         return render_double(_round_decimals(lat, 12))
 
     def _modem_id2name(self, value: str, _refs: Sequence[str]) -> str:
-        # Empty input is left unchanged (goby3 throws: Quirk Q11).
+        # Empty input is left unchanged (goby3 throws: QUIRKS.md Q-APPS-11).
         return self.modem_ids.name(int(value)) if value.isdigit() and value.isascii() else value
 
     def _modem_id2type(self, value: str, _refs: Sequence[str]) -> str:

@@ -4,7 +4,7 @@ Directives: `%N%`, `%N$<flags><width>.<prec><conv>`, `%|N$...|`, non-positional 
 directives (`%5d`), and `%%`. Missing arguments render as empty (goby disables boost's
 too-few/too-many-arguments errors). Floating-point arguments arrive "grouped" with a fixed
 precision (15 for doubles, 6 for floats) that overrides the directive's precision while
-keeping its flags and conversion (Quirk Q21, reproduced).
+keeping its flags and conversion (goby3's output, reproduced: QUIRKS.md Q-APPS-21).
 """
 
 from __future__ import annotations

@@ -40,7 +40,8 @@ def is_bytes(field: FieldDescriptor) -> bool:
 
 def strip_name_from_enum(value_name: str, field_name: str) -> str:
     """use_short_enum on output: remove the first case-insensitive occurrence of `<field>_`
-    anywhere in the value name (goby3 behaviour, Quirk Q8: not only a prefix)."""
+    anywhere in the value name (goby3's behaviour, reproduced: not only a
+    prefix; QUIRKS.md Q-APPS-8)."""
     needle = field_name.lower() + "_"
     pos = value_name.lower().find(needle)
     return value_name if pos < 0 else value_name[:pos] + value_name[pos + len(needle) :]

@@ -121,7 +121,8 @@ def serialize(
     registry: AlgorithmRegistry | None = None,
 ) -> str:
     descriptor = msg.DESCRIPTOR
-    # Every field counts (goby3 skips the first-declared one: Quirk Q9, fixed here).
+    # Every field counts (goby3 skips the first-declared one, so a directive for it renders
+    # empty when its number is the largest; fixed: QUIRKS.md Q-APPS-9).
     max_field = max([1, *(f.number for f in descriptor.fields)])
     virtual = (
         run_publish_algorithms(msg, algorithms, registry or AlgorithmRegistry())
@@ -313,7 +314,7 @@ def _parse_directive(extract, msg, spec, delimiter, algorithms, short, registry)
         set_element_from_string(msg, field, index, extract, short)
     elif field.is_repeated:
         parts = re.split("[" + re.escape(delimiter) + "]", extract) if delimiter else [extract]
-        for part in parts:
+        for part in parts:  # enums too (goby3 aborts on a repeated enum: QUIRKS.md Q-APPS-10)
             append_from_string(msg, field, part, short)
     elif is_message(field):
         parse_message_bytes(getattr(msg, field.name), hex_decode(extract), field.name)

@@ -40,7 +40,8 @@ LAT_ORIGIN_VAR = "LAT_ORIGIN"
 LONG_ORIGIN_VAR = "LONG_ORIGIN"
 
 # Outputs that may be posted as MOOS doubles when they look like numbers. goby3 converts
-# every non-binary output (Quirk Q5); hex and @PB outputs are kept as strings here.
+# every non-binary output, even an all-digit hex string; hex and @PB outputs are kept as
+# strings here (QUIRKS.md Q-APPS-5).
 _NUMBER_CANDIDATES = frozenset(
     {
         Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT,
@@ -62,6 +63,8 @@ class Post:
 
 
 def make_post(var: str, value: str | bytes, technique: Technique, type_name: str) -> Post:
+    # binary or not is decided for each post from its own value (goby3 keeps the binary flag of
+    # an earlier NATIVE_ENCODED publish for the entry's later ones: QUIRKS.md Q-APPS-6)
     technique = Technique(technique)
     aux = f"{type_name}:{technique.name}"
     if isinstance(value, bytes):
@@ -176,8 +179,8 @@ class Translator:
                 format_technique.check_serialize_format(descriptor, publish.moos_var, virtual)
 
     def read_named_values(self, protobuf_name: str, keys: Mapping[str, str]) -> None:
-        """Goby 1.1's rule for the message's create variables in `keys` ({variable: name},
-        seed 003 §2.3.8): a string value holding `<name>=value` gives that value, any other
+        """Goby 1.1's rule for the message's create variables in `keys` ({variable: name}):
+        a string value holding `<name>=value` gives that value, any other
         value is read whole (`NAV_X: "nav_x=3.5"` and `NAV_X: 3.5` both give 3.5). For the
         messages of Goby 1.1 XML files, whose iCommander posted `name=value` strings."""
         self._entry(protobuf_name)
@@ -269,7 +272,8 @@ class Translator:
     # --- protobuf -> MOOS --------------------------------------------------------------------
 
     def publish(self, msg: Message) -> list[Post]:
-        """The entry's publish rules applied to `msg`, sorted by variable name (stable)."""
+        """The entry's publish rules applied to `msg`, sorted by variable name (stable), not in
+        declaration order, as goby3 posts them (QUIRKS.md Q-APPS-22)."""
         name = msg.DESCRIPTOR.full_name
         entry = self._entries.get(name)
         if entry is None:

@@ -1,7 +1,7 @@
-"""The WHOI Micro-Modem NMEA driver (spec acomms.md §7) as a state machine.
+"""The WHOI Micro-Modem NMEA driver as a state machine.
 
 Everything happens in `do_work()` (read the modem, dispatch, run timers against the Clock) and in
-`handle_initiate_transmission()`; nothing blocks. Start-up (§7.3) is a sequence of phases
+`handle_initiate_transmission()`; nothing blocks. Start-up is a sequence of phases
 advanced by `do_work`; `startup_complete` says when it is done. With an injected MemoryLink the
 driver is fully sans-I/O: feed lines, advance a VirtualClock, read what it wrote. A link with
 `read_sentences` / `write_sentence` (pygoby.acomms.mmsim.link.ModemLink: an emulator in the same
@@ -299,7 +299,7 @@ class MMDriver(ModemDriverBase):
                 self._pop_front()
 
     def _acknowledge(self, sentence: NMEASentence) -> None:
-        """Pop the outstanding sentence if `sentence` answers it (§7.2 table)."""
+        """Pop the outstanding sentence if `sentence` answers it."""
         if not self._out:
             return
         front = self._out[0]
@@ -341,7 +341,7 @@ class MMDriver(ModemDriverBase):
         # WHOI guidance: set between 50 and 100 ms after a whole second, to the next second.
         if not 0.05 <= now % 1.0 < 0.1:
             return
-        t = dt.datetime.fromtimestamp(int(now) + 1, dt.UTC)  # Quirk A6 (sane): carry properly
+        t = dt.datetime.fromtimestamp(int(now) + 1, dt.UTC)  # carry properly (Q-ACOMMS-6)
         if self.is_mm2:
             self._push("$CCTMS", f"{t:%Y-%m-%dT%H:%M:%SZ}", 0)
         else:
@@ -452,7 +452,7 @@ class MMDriver(ModemDriverBase):
             msg.src = self.modem_id
         if msg.src != self.modem_id:
             # third-party initiation (polling): the polled node fills the frames
-            if msg.dest < 0:  # Quirk A14 (sane)
+            if msg.dest < 0:  # goby3 sends it unchanged (QUIRKS.md Q-ACOMMS-14)
                 log.warning("a poll must name a destination; not sending %s", msg)
                 return
             self._push("$CCCYC", 0, msg.src, msg.dest, msg.rate, 1, msg.max_num_frames)
@@ -660,7 +660,8 @@ class MMDriver(ModemDriverBase):
 
     # ------------------------------------------------------------------ ranging, mini-packets
     def _on_mpr(self, s: NMEASentence) -> None:
-        # Quirk A5 (faithful): src/dest copied as they appear in the sentence
+        # src/dest copied as they appear in the sentence, as goby3's code does (its docs say
+        # swapped back to the request's order: QUIRKS.md Q-ACOMMS-5)
         owtt = s.as_float(3, 0.0, MAX_TRAVEL_TIME)
         msg = self._ping_result(*_addresses(s))
         msg.Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply.one_way_travel_time.append(owtt)
@@ -753,7 +754,7 @@ class MMDriver(ModemDriverBase):
     }
 
     def _lbl_params(self, msg, name: str):
-        """Configured LBL parameters merged with the request's own (§7.4)."""
+        """Configured LBL parameters merged with the request's own."""
         params = type(getattr(self.mm_cfg, name))()
         params.CopyFrom(getattr(self.mm_cfg, name))
         params.MergeFrom(getattr(msg.Extensions[acomms_pb.MM_TRANSMISSION], name))
