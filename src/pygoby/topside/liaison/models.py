@@ -17,6 +17,7 @@ from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.dccl import Codec, DcclError
+from pygoby.dccl.ccl import remus
 from pygoby.moos import protocol as p
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import ModemIdLookup, UTMGeodesy, dynamic_parse, parse_for_moos
@@ -219,6 +220,11 @@ class AcommsModel:
             }
             for s in cfg.mac_cfg.slot
         ]
+        self.ccl_queues = {
+            q.key.id: q.name
+            for q in cfg.queue_cfg.queue
+            if q.HasField("key") and q.key.type == acomms_pb.QUEUE_CCL
+        }
         self.slot_index: int | None = None
         self.slot_start: float | None = None
         self.tx: deque[dict] = deque(maxlen=history)
@@ -280,11 +286,23 @@ class AcommsModel:
                 try:
                     msg, used = self.codec.decode_prefix(data[offset:])
                 except (DcclError, Exception):  # noqa: BLE001 - unknown or encrypted frame
-                    names.append("?")
+                    names.append(self._ccl_name(data) if offset == 0 else "?")
                     break
                 names.append(msg.DESCRIPTOR.full_name)
                 offset += max(used, 1)
         return names
+
+    def _ccl_name(self, frame: bytes) -> str:
+        """A frame DCCL does not read: a CCL frame (32 bytes, its type in the first byte) is
+        named after its Goby 1.1 queue (`queue { key { type: QUEUE_CCL id: 14 } name: ... }`),
+        else the REMUS frame type, else `CCL 0x0e`; anything else is `?`."""
+        if len(frame) != remus.FRAME_BYTES:
+            return "?"
+        ccl_id = frame[0]
+        if ccl_id in self.ccl_queues:
+            return self.ccl_queues[ccl_id]
+        frame_type = remus.BY_ID.get(ccl_id)
+        return f"REMUS {frame_type.__name__}" if frame_type else f"CCL 0x{ccl_id:02x}"
 
     def _on_modem(self, sent: bool, value: MoosValue, when: float) -> None:
         """ACOMMS_MODEM_TRANSMIT (sent) / ACOMMS_MODEM_RECEIVE: one row, with the modem's
@@ -334,7 +352,16 @@ class AcommsModel:
         original = dynamic_parse(value, self._resolve, _TEXT)
         name = original.DESCRIPTOR.full_name.rsplit(".", 1)[-1] if original is not None else "?"
         text = str(value).split("] ", 1)[-1] if isinstance(value, str) else ""
-        self.timeline.appendleft({"time": when, "kind": kind, "text": f"{name} {kind}: {text}"})
+        newest = self.timeline[0] if self.timeline else None
+        if newest is not None and (newest["kind"], newest.get("name")) == (kind, name):
+            # a run of the same event for one message type (a telemetry queue expiring every
+            # few seconds) is one line that counts them
+            count = newest["count"] + 1
+            newest.update(time=when, count=count, text=f"{name} {kind} ({count} in a row): {text}")
+            return
+        self.timeline.appendleft(
+            {"time": when, "kind": kind, "name": name, "count": 1, "text": f"{name} {kind}: {text}"}
+        )
 
     def _on_ack(self, value: MoosValue, when: float) -> None:
         self._original("acknowledged", value, when)

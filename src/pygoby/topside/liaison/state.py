@@ -15,6 +15,7 @@ from pygoby.topside.commander import (
     Commander,
     CommandSet,
     Draft,
+    Notice,
     Outgoing,
     SentRecord,
 )
@@ -55,6 +56,21 @@ def record_view(record: SentRecord) -> dict:
 
 def outgoing_view(outgoing: Outgoing) -> dict:
     return {"posts": outgoing.lines(), "warnings": outgoing.warnings}
+
+
+def grouped_notices(notices: list[Notice]) -> list[str]:
+    """Newest first; a run of notices of one kind for one message type (a telemetry queue's
+    expiry every few seconds) is one entry that counts them and keeps the newest's text."""
+    runs: list[tuple[Notice, int]] = []
+    for notice in reversed(notices):
+        if runs and (runs[-1][0].kind, runs[-1][0].type_name) == (notice.kind, notice.type_name):
+            runs[-1] = (runs[-1][0], runs[-1][1] + 1)
+        else:
+            runs.append((notice, 1))
+    return [
+        notice.banner() + (f"\n ({count} in a row; the newest shown)" if count > 1 else "")
+        for notice, count in runs
+    ]
 
 
 class LiaisonState:
@@ -100,6 +116,7 @@ class LiaisonState:
             cfg.link_seconds,
             cfg.max_track_points,
         )
+        self.commands_listed = set(commander_cfg.command)
         self.load_warnings: list[str] = []
         for path in commander_cfg.load:
             if path:  # empty means none, as in Goby 1.1
@@ -125,11 +142,20 @@ class LiaisonState:
         commander = self.commander
         return {
             "records": [record_view(r) for r in reversed(commander.records[-50:])],
-            "notices": [n.banner() for n in reversed(commander.notices[-20:])],
+            "notices": grouped_notices(commander.notices[-200:])[:20],
         }
 
     def commander_types(self) -> list[dict]:
+        """Every sendable message; `command`: offered without "show all" (those of the
+        configuration's `command` list, else the ones it triggers by publishing)."""
+        listed = self.commands_listed
         return [
-            {"name": t.name, "short": t.short_name, "ack": t.ack, "trigger": t.trigger_var}
+            {
+                "name": t.name,
+                "short": t.short_name,
+                "ack": t.ack,
+                "trigger": t.trigger_var,
+                "command": bool({t.name, t.short_name} & listed) if listed else t.command,
+            }
             for t in self.commander.commands.types.values()
         ]

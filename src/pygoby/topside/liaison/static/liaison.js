@@ -70,13 +70,15 @@ function scopeRow(key) {
     value: el("td", { class: "value" }), type: el("td", { class: "type" }), source: el("td", { class: "source" }),
     community: el("td", { class: "community" }), age: el("td", { class: "age" }), rate: el("td", { class: "rate" }),
   };
-  const tr = el("tr", { "data-key": key }, el("td", { class: "key" }, expander, el("span", {}, key)),
+  const tr = el("tr", { "data-key": key }, el("td", { class: "key", title: key }, expander, el("span", {}, key)),
     cells.value, cells.type, cells.source, cells.community, cells.age, cells.rate);
-  expander.onclick = (event) => {
-    event.stopPropagation();
-    expander.textContent = tr.classList.toggle("expanded") ? "▾" : "▸";
+  expander.onclick = () => { expander.textContent = tr.classList.toggle("expanded") ? "▾" : "▸"; };
+  expander.onpointerdown = (event) => event.stopPropagation();
+  // selected as the button goes down: a row that moves under a held button (a new variable
+  // inserted above it) still gets the click
+  tr.onpointerdown = (event) => {
+    if (event.button === 0 && scopeRows.get(key).row.numeric) selectHistory(key);
   };
-  tr.onclick = () => { if (scopeRows.get(key).row.numeric) selectHistory(key); };
   return { tr, cells, row: null };
 }
 
@@ -201,7 +203,15 @@ async function setupCommander() {
   const info = await (await fetch("/api/commander/types")).json();
   modemIds = info.modem_ids;
   const select = $("#cmd-type");
-  for (const t of info.types) select.append(el("option", { value: t.name }, `${t.short}${t.ack ? " (ack)" : ""}`));
+  // the configuration's commands; "show all" adds the other messages (telemetry)
+  const offer = () => {
+    const all = $("#cmd-all").checked;
+    select.replaceChildren(el("option", { value: "" }, "(choose a message)"),
+      ...info.types.filter((t) => all || t.command || t.name === current).map((t) =>
+        el("option", { value: t.name, selected: t.name === current }, `${t.short}${t.ack ? " (ack)" : ""}${t.command ? "" : " (not a command)"}`)));
+  };
+  offer();
+  $("#cmd-all").onchange = offer;
   select.onchange = async () => {
     current = select.value;
     $("#cmd-preview-text").hidden = true;
