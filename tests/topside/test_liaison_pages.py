@@ -104,3 +104,7 @@ def test_the_commander_offers_commands_and_the_rest_behind_show_all(tmp_path):
     s.web._socket.close()
     offered = {t["short"]: t["command"] for t in s.state.commander_types()}
     assert offered == {"Command": True, "SimpleStatus": False}
+    # `command: ""` (as --example_config prints it) lists none
+    s = Served(tmp_path, commander={"command": [""]})
+    s.web._socket.close()
+    assert all(t["command"] for t in s.state.commander_types())

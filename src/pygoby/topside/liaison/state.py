@@ -116,7 +116,7 @@ class LiaisonState:
             cfg.link_seconds,
             cfg.max_track_points,
         )
-        self.commands_listed = set(commander_cfg.command)
+        self.commands_listed = {name for name in commander_cfg.command if name}  # "": none
         self.load_warnings: list[str] = []
         for path in commander_cfg.load:
             if path:  # empty means none, as in Goby 1.1
