@@ -6,6 +6,7 @@ variable changing; the map shows both vehicles. `make screenshots` writes each p
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 from pathlib import Path
@@ -251,3 +252,50 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
             await shot(page, "acomms", tmp_path)
             # no 404 (the favicon was one); the 422s are the refused heading above
             assert [e for e in console_errors if "422" not in e] == []
+
+
+LIAISON_GOBY11 = """
+ProcessConfig = liaison
+{
+  common { log: false  verbosity: WARN  app_tick: 20 }
+  liaison { http_port: 0  update_freq: 5 }
+}
+"""
+
+
+@pytest.mark.timeout(240)
+async def test_liaison_on_the_goby11_ccl_and_dccl_mission(tmp_path, browser):
+    """The Goby 1.1 manual's ccl_and_dccl pair (under `pygoby antler`, as tests/goby11 runs
+    it): CCL frames are named on the Acomms page, SIMPLE_STATUS (a time-triggered telemetry
+    message) is behind 'show all' on the Commander page."""
+    from tests.goby11.test_examples import localize, run_pair, wait_for
+
+    directory, ports = localize(tmp_path, "ccl_and_dccl")
+    mission = directory / "mm1.moos"
+    mission.write_text(mission.read_text() + LIAISON_GOBY11)
+
+    async def check():
+        for _ in range(20):  # the antlers' MOOSDBs are up within seconds, later on a busy machine
+            with contextlib.suppress(TimeoutError):
+                await wait_for(ports["mm2"], "STATUS_REPORT_IN", lambda v: "nav_x=100" in str(v))
+                break
+        liaison = Liaison.from_mission(mission, "liaison")
+        async with liaison:
+            base = liaison.web.url.split("/scope")[0]
+            page = await browser.new_page()
+            await page.goto(liaison.web.url)
+            await page.goto(f"{base}/acomms")
+            named = page.locator("#acomms-rx td", has_text="Remus_State")
+            await named.first.wait_for(timeout=120_000)
+            assert await page.locator("#acomms-rx td", has_text="?").count() == 0
+            await shot(page, "goby11-acomms", tmp_path)
+            await page.goto(f"{base}/commander")
+            options = page.locator("#cmd-type option")
+            await page.locator("#cmd-all").wait_for()
+            await page.wait_for_function("document.querySelectorAll('#cmd-type option').length")
+            values = "os => os.map(o => o.value)"
+            assert "SIMPLE_STATUS" not in await options.evaluate_all(values)
+            await page.check("#cmd-all")
+            assert "SIMPLE_STATUS" in await options.evaluate_all(values)
+
+    await run_pair(directory, ports, check)
