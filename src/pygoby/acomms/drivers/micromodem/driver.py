@@ -18,6 +18,7 @@ import base64
 import contextlib
 import datetime as dt
 import logging
+import math
 from collections import deque
 from enum import Enum, auto
 
@@ -94,7 +95,9 @@ class MMDriver(ModemDriverBase):
         self._hold_until = 0.0  # no writes before this time (after $CAREV,INIT)
         self._multi_reply = False
         self._last_cfg_at = 0.0
-        self._last_rx_at = self.clock.now()
+        # goby3 asks the modem something every keep_alive_seconds, the first time at once: its
+        # first $CCCFQ,SRC follows the start-up $CCMSC in the queue.
+        self._last_keep_alive_at = float("-inf")
         self._clock_set = False
         self._link_was_open = False
         self._last_gps_request = float("-inf")
@@ -194,11 +197,9 @@ class MMDriver(ModemDriverBase):
             self._advance_startup(now)
         if self._written_at is not None:
             self._check_timeout(now)
-        if not self._out:
-            if now - self._last_rx_at > self._keep_alive_seconds and self.phase is Phase.READY:
-                self._keep_alive(now)
-        else:
-            self._try_write(now)
+        if now >= self._last_keep_alive_at + self._keep_alive_seconds:
+            self._keep_alive(now)
+        self._try_write(now)
 
     def handle_initiate_transmission(self, transmission) -> None:
         if self.link is None or not self.link.is_open:
@@ -283,13 +284,15 @@ class MMDriver(ModemDriverBase):
             self._fail_front("timeout")
 
     def _keep_alive(self, now: float) -> None:
-        """Nothing heard for keep_alive_seconds: ask the modem something (and send it)."""
+        """Every keep_alive_seconds (whatever else is queued or heard, as goby3): ask the modem
+        its time (Micro-Modem 2, at the start of a second for a precise answer) or its source
+        address (before the modem's revision is known, and for Micro-Modem 1)."""
         if self.is_mm2:
             self._push("$CCTMQ", 0)
+            self._last_keep_alive_at = float(math.floor(now))
         else:
             self._push("$CCCFQ", "SRC")
-        self._last_rx_at = now
-        self._try_write(now)
+            self._last_keep_alive_at = now
 
     def _check_multi_reply(self, now: float) -> None:
         if self._multi_reply and self._last_cfg_at and now - self._last_cfg_at > MULTI_REPLY_QUIET:
@@ -371,12 +374,10 @@ class MMDriver(ModemDriverBase):
         except NMEAError as exc:
             log.warning("ignoring invalid line from the modem: %s", exc)
             return
-        self._last_rx_at = self.clock.now()
         self._dispatch((sentence,))
 
     def _handle_sentences(self, sentences: list) -> None:
         """Sentences from a typed link (parsed already; `$CACST` as its values)."""
-        self._last_rx_at = self.clock.now()
         if self.signal_raw_incoming or self._raw_log is not None:
             for sentence in sentences:
                 self._log_raw("[rx] ", sentence.message())
