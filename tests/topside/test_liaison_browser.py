@@ -6,7 +6,7 @@ variable changing; the map shows both vehicles. `make screenshots` writes each p
 
 from __future__ import annotations
 
-import contextlib
+import asyncio
 import os
 import shutil
 from pathlib import Path
@@ -275,10 +275,19 @@ async def test_liaison_on_the_goby11_ccl_and_dccl_mission(tmp_path, browser):
     mission.write_text(mission.read_text() + LIAISON_GOBY11)
 
     async def check():
-        for _ in range(20):  # the antlers' MOOSDBs are up within seconds, later on a busy machine
-            with contextlib.suppress(TimeoutError):
-                await wait_for(ports["mm2"], "STATUS_REPORT_IN", lambda v: "nav_x=100" in str(v))
-                break
+        # the antlers' MOOSDBs are up within seconds, later on a busy machine
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + 60
+        while True:
+            try:
+                _, writer = await asyncio.open_connection("127.0.0.1", ports["mm2"])
+            except OSError:
+                assert loop.time() < deadline, "mm2's MOOSDB never started"
+                await asyncio.sleep(0.5)
+                continue
+            writer.close()
+            break
+        await wait_for(ports["mm2"], "STATUS_REPORT_IN", lambda v: "nav_x=100" in str(v))
         liaison = Liaison.from_mission(mission, "liaison")
         async with liaison:
             base = liaison.web.url.split("/scope")[0]
