@@ -8,6 +8,7 @@ from __future__ import annotations
 import asyncio
 import http.client
 import json
+import socket
 import string
 
 import pytest
@@ -84,6 +85,7 @@ def test_host_rules():
     everywhere = Access("0.0.0.0", "t", 1, ["topside.local"])
     assert everywhere.host_allowed("192.168.1.5:1") and everywhere.host_allowed("topside.local")
     assert not everywhere.host_allowed("attacker.example")
+    assert everywhere.host_allowed(f"{socket.gethostname()}:54321")
     assert not everywhere.origin_allowed("http://attacker.example") and everywhere.origin_allowed(
         None
     )

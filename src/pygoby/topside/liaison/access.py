@@ -4,8 +4,8 @@ headers and names, answers with a refusal or a path).
 Three rules, checked on every request before any handler runs:
 
 * Host: the request must name the server by the address it is bound to (or, on loopback,
-  `localhost`), by an IP literal when it listens on every address, or by a name listed in
-  `allowed_host`. A page on another domain that re-points its DNS name at this machine (DNS
+  `localhost`), by an IP literal or this machine's host name when it listens on every address,
+  or by a name listed in `allowed_host`. A page on another domain that re-points its DNS name at this machine (DNS
   rebinding) sends its own name in Host, so it is refused before it can read or send anything.
 * Origin: a request that carries an Origin header must come from a page of this server.
 * Token: a random token is made at every launch and printed in the URL at start-up (as Jupyter
@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import hmac
 import ipaddress
+import socket
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from urllib.parse import parse_qs, urlsplit
@@ -63,6 +64,8 @@ class Access:
         self.names = {_host_name(address), *(_host_name(h) for h in allowed_hosts)}
         if self.loopback:
             self.names |= {"localhost", "127.0.0.1", "::1"}
+        if self.any_address:  # this machine's own names (another site cannot take them over)
+            self.names |= {socket.gethostname().lower(), socket.getfqdn().lower()}
         self.cookie = f"liaison_token_{port}"
 
     def host_allowed(self, host: str) -> bool:
