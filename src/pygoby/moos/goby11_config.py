@@ -378,3 +378,8 @@ def finish(config: Message, notes: list[str]) -> None:
         notes.append(
             f"{moved} XML message file(s) of dccl_cfg/queue_cfg -> transitional_cfg.message_file"
         )
+        # Goby 1.1's form of the files: they travel as Goby 1.1 sent them unless told otherwise
+        transitional = config.transitional_cfg
+        if not transitional.HasField("wire_format"):
+            wire = transitional.DESCRIPTOR.fields_by_name["wire_format"].enum_type
+            transitional.wire_format = wire.values_by_name["DCCL1"].number
