@@ -85,3 +85,7 @@ class SimulatorProtocolError(FrontSeatError, ValueError):
 
 class AbcConfigError(FrontSeatError, ConfigError):
     """The frontseat Config lacks a usable `basic_simulator_config`."""
+
+
+class BluefinConfigError(FrontSeatError, ConfigError):
+    """The frontseat Config lacks a usable `bluefin_config`."""
