@@ -15,6 +15,7 @@ import socket
 import struct
 import sys
 import time
+import urllib.parse
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -714,6 +715,109 @@ async def netsim_manager_hostile(seconds: float, workdir: Path) -> Figures:
     return figures
 
 
+# -- liaison (issue 25.6-7) --------------------------------------------------------------------
+
+LIAISON_VARIABLES = 2000
+LIAISON_STREAMS = 100  # asked for; liaison admits max_streams (16) of them
+# regexes that froze a regex engine for seconds to minutes per name; liaison's filter is words and
+# MOOS globs now, so they are plain text
+LIAISON_FILTERS = [r"((\w+)+)+!", r"(a|aa)+$", "*" + "?*" * 90 + "!", "x" * 200]
+
+
+async def _http_get(port: int, target: str) -> bytes:
+    reader, writer = await asyncio.open_connection("127.0.0.1", port)
+    try:
+        writer.write(
+            f"GET {target} HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n".encode()
+        )
+        await writer.drain()
+        return await reader.read()
+    finally:
+        writer.close()
+
+
+async def _event_stream(port: int, target: str, stop: asyncio.Event) -> None:
+    """A live page that reads everything until `stop` (or until refused)."""
+    with contextlib.suppress(OSError):
+        reader, writer = await asyncio.open_connection("127.0.0.1", port)
+        try:
+            writer.write(f"GET {target} HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n".encode())
+            await writer.drain()
+            while not stop.is_set():
+                with contextlib.suppress(TimeoutError):
+                    async with asyncio.timeout(0.5):
+                        if not await reader.read(65536):
+                            return
+        finally:
+            writer.close()
+
+
+async def liaison_streams_and_filters(seconds: float, workdir: Path) -> Figures:
+    """`pygoby liaison` on a MOOSDB with 2000 variables, 100 live Scope streams asked for and
+    filters that freeze a regex engine, beside a canary GET every 0.1 s."""
+    from tests.topside.test_commander import MISSION
+
+    figures = Figures()
+    async with MOOSDB(port=0, community="topside") as db:
+        mission = workdir / "topside.moos"
+        mission.write_text(
+            f"ServerPort = {db.port}\nCommunity = topside\n{MISSION}\n"
+            "ProcessConfig = liaison\n{\n  common { log: false }\n  liaison { http_port: 0 }\n}\n"
+        )
+        spec = ServerSpec(
+            "liaison",
+            venv_command("pygoby", "liaison", str(mission)),
+            r"serving http://127\.0\.0\.1:(\d+)/",
+        )
+        server = ServerProcess(spec, workdir)
+        port = await server.start()
+        async with MOOSClient("soak_poster", port=db.port) as poster:
+            for i in range(LIAISON_VARIABLES):
+                poster.publish(f"SOAK_VARIABLE_{i:05d}", float(i))
+            await poster.flush()
+            await asyncio.sleep(2)  # liaison has them
+            figures.rss_before_mb = server.rss_mb()
+            stop = asyncio.Event()
+            pages = [
+                asyncio.create_task(
+                    _event_stream(
+                        port,
+                        "/api/events?page=scope&filter="
+                        + urllib.parse.quote(
+                            LIAISON_FILTERS[i % len(LIAISON_FILTERS)] if i % 2 else ""
+                        ),
+                        stop,
+                    )
+                )
+                for i in range(LIAISON_STREAMS)
+            ]
+
+            async def canary() -> None:
+                started = time.monotonic()
+                reply = await _http_get(port, "/api/commander/types")
+                if reply.startswith(b"HTTP/1.1 200"):
+                    figures.answer(time.monotonic() - started)
+
+            deadline = time.monotonic() + seconds
+            while time.monotonic() < deadline:
+                figures.requests += 1
+                with contextlib.suppress(TimeoutError, OSError):
+                    async with asyncio.timeout(ANSWER_TIMEOUT):
+                        await canary()
+                # the variables keep changing: the streams get deltas
+                poster.publish(f"SOAK_VARIABLE_{figures.requests % LIAISON_VARIABLES:05d}", 0.5)
+                await asyncio.sleep(0.1)
+            figures.rss_after_mb = server.rss_mb()
+            stop.set()
+            await asyncio.gather(*pages, return_exceptions=True)
+        await stop_or_fail(server, figures)
+    figures.notes.append(
+        f"{LIAISON_VARIABLES} variables, {LIAISON_STREAMS} streams asked for (16 admitted)"
+    )
+    figures.judge()
+    return figures
+
+
 def _rss(pid: int) -> float | None:
     from kit import rss_mb
 
@@ -798,4 +902,7 @@ SCENARIOS: dict[str, Scenario] = {
     "MOOSDB: kill -9 every ~3 s under uSimVehicle, pAcommsHandler, pTranslator": moosdb_kill9,
     "apps: SIGTERM as the MOOSDB goes away": sigterm_on_drop,
     "apps: link cut, the DB keeps a stale session": stale_session,
+    "liaison: 100 live streams over 2000 variables, regex-bomb filters (25.6-7)": (
+        liaison_streams_and_filters
+    ),
 }
