@@ -28,6 +28,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from pygoby.moos.errors import BlockSyntaxError
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 # ---------------------------------------------------------------------------------------------
@@ -127,9 +128,13 @@ class _Parser:
             opening = self.take()
             closing = "}" if opening.text == "{" else ">"
             result.children = self.fields(closing)
+            if self.peek() is None:
+                raise BlockSyntaxError(
+                    name.line, f"the '{opening.text}' after {name.text} is never closed"
+                )
             result.brackets = (opening, self.take())
         elif result.colon is None:
-            raise ValueError(f"line {name.line}: {name.text} needs ':' or a block")
+            raise BlockSyntaxError(name.line, f"expected ':' after {name.text}")
         elif self.peek() == "[":
             result.value.append(self.take())
             while self.peek() not in ("]", None):
@@ -335,11 +340,14 @@ class Translation:
 
 def translate(text: str, descriptor: AnyDescriptor) -> Translation:
     """Rewrite the Goby 1.1/2 forms of a ProcessConfig block for `descriptor` (the app's
-    configuration type). Text that does not tokenize is returned unchanged (protobuf's parser
-    then reports the problem with its line)."""
+    configuration type). Raises BlockSyntaxError for a mistake no parser reads past (protobuf's
+    would first report a field before it that only this rewriting makes valid). Other text that
+    does not tokenize is returned unchanged (protobuf's parser then reports it with its line)."""
     try:
         parser = _Parser(tokenize(text))
         fields = parser.fields(None)
+    except BlockSyntaxError:
+        raise
     except ValueError:  # not TextFormat we understand: left for protobuf to report
         return Translation(text, [])
     notes: list[str] = []
