@@ -14,13 +14,13 @@ Ctrl-C or Exit quits.
 from __future__ import annotations
 
 import asyncio
-
-from google.protobuf.message import Message
+from collections.abc import Sequence
 
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, Post
+from pygoby.protobuf.pygoby.apps.topside_config_pb2 import iCommanderConfig
 from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.topside.commander import (
     KEY_VALUE,
@@ -37,10 +37,13 @@ QUIET = 1  # goby.util.protobuf.GLogConfig.Verbosity
 
 
 class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = ("pygoby/apps/topside_config.proto", "pygoby.apps.protobuf.iCommanderConfig")
+    config_class = iCommanderConfig
+    cfg: iCommanderConfig
     default_name = "iCommander"
 
-    def __init__(self, cfg: Message, *, acomms: AcommsMessageSet | None = None, **kwargs) -> None:
+    def __init__(
+        self, cfg: iCommanderConfig, *, acomms: AcommsMessageSet | None = None, **kwargs
+    ) -> None:
         super().__init__(cfg, **kwargs)
         if not (self.common.HasField("lat_origin") and self.common.HasField("lon_origin")):
             raise ConfigError(
@@ -122,7 +125,7 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
             await self.stop()
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return iCommander.main(argv)
 
 

@@ -262,7 +262,7 @@ def _decode_messages(
     data: bytes, pos: int, limit: int, count: int
 ) -> tuple[list[MOOSMessage], int]:
     """`count` messages from data[pos:limit]; and the offset after the last."""
-    msgs = []
+    msgs: list[MOOSMessage] = []
     append = msgs.append
     read_start = _START.unpack_from
     read_int = _INT.unpack_from

@@ -22,6 +22,8 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+from typing import Any
+
 import matplotlib.pyplot as plt  # noqa: E402
 
 KIND_COLOURS = {
@@ -61,7 +63,8 @@ def bin_success(
         bins = max(1, math.ceil((high - low) / width + 1e-9))
         high = low + bins * width
     width = (high - low) / bins if high > low else 1.0
-    totals, oks = Counter(), Counter()
+    totals: Counter[Any] = Counter()
+    oks: Counter[Any] = Counter()
     for value, ok in zip(values, good, strict=True):
         index = min(int((value - low) / width), bins - 1)
         totals[index] += 1

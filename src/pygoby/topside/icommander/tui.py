@@ -200,7 +200,7 @@ class EditScreen(Screen):
     def _field(self, box: Input) -> str:
         return (box.id or "").removeprefix("field-").replace("--", ".")
 
-    def on_descendant_focus(self, event) -> None:
+    def on_descendant_focus(self, event: events.DescendantFocus) -> None:
         if (
             isinstance(event.widget, Input)
             and event.widget.id
@@ -260,7 +260,7 @@ class EditScreen(Screen):
         if self.commit(name):
             self.app.open_actions(name)  # type: ignore[attr-defined]
 
-    def on_descendant_blur(self, event) -> None:
+    def on_descendant_blur(self, event: events.DescendantBlur) -> None:
         if isinstance(event.widget, Input) and (event.widget.id or "").startswith("field-"):
             self.commit(self._field(event.widget))
 
@@ -459,7 +459,7 @@ class ICommanderTUI(App):
                 opened = [(d.name, d.type.short_name) for d in commander.drafts.values()]
                 self.push_screen(
                     Menu("Choose an active message to switch to:", opened, "switch"),
-                    lambda name: name and self.edit(name),
+                    lambda name: self.edit(name) if name else None,
                 )
             elif action == "time":
                 commander.insert_time(draft, field)
