@@ -11,12 +11,12 @@ NAV_DEPTH, NAV_HEADING and NAV_SPEED every `nav_period` seconds, and posts scrip
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-
-from google.protobuf.message import Message
 
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
+from pygoby.protobuf.pygoby.apps.usimvehicle_config_pb2 import uSimVehicleConfig
 from pygoby.util.kinematics import advance, slew, turn_toward, wrap_heading
 
 DESIRED = {"DESIRED_HEADING": "heading", "DESIRED_SPEED": "speed", "DESIRED_DEPTH": "depth"}
@@ -53,13 +53,11 @@ class VehicleModel:
 
 
 class uSimVehicle(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "pygoby/apps/usimvehicle_config.proto",
-        "pygoby.apps.protobuf.uSimVehicleConfig",
-    )
+    config_class = uSimVehicleConfig
+    cfg: uSimVehicleConfig
     default_name = "uSimVehicle"
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: uSimVehicleConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.vehicle = VehicleModel(
             x=cfg.start_x,
@@ -120,7 +118,7 @@ class uSimVehicle(GobyMOOSApp):  # noqa: N801 - the program's name
             self._next_event = 0
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return uSimVehicle.main(argv)
 
 

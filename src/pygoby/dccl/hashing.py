@@ -17,14 +17,16 @@ format. A C++ peer built with another standard library (libc++ on macOS: a diffe
 from __future__ import annotations
 
 from google.protobuf import descriptor_pb2
-from google.protobuf.descriptor import Descriptor, EnumDescriptor, FieldDescriptor, OneofDescriptor
+from google.protobuf.descriptor import FieldDescriptor, OneofDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.codecs.enum import EnumCodec
 from pygoby.dccl.codecs.hash import HashCodec
 from pygoby.dccl.options import field_options, message_options
 from pygoby.dccl.plan import MessageItem, RepeatedItem
+from pygoby.protobuf import enum_type, message_type
 from pygoby.protobuf.cpp_text import c_escape, message_text, scalar_text
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyEnumDescriptor, AnyFieldDescriptor
 
 _U64 = (1 << 64) - 1
 _MUL = 0xC6A4A7935BD1E995
@@ -109,19 +111,19 @@ _PROTO_TYPES = {number: "TYPE_" + name.upper() for number, name in _TYPE_NAMES.i
 }
 
 
-def _field_proto(f: FieldDescriptor) -> descriptor_pb2.FieldDescriptorProto:
+def _field_proto(f: AnyFieldDescriptor) -> descriptor_pb2.FieldDescriptorProto:
     proto = descriptor_pb2.DescriptorProto()
-    f.containing_type.CopyToProto(proto)
+    f.containing_type.CopyToProto(proto)  # type: ignore[union-attr]  # (a field of a message)
     return next(p for p in proto.field if p.number == f.number)
 
 
-def _label(f: FieldDescriptor) -> str:
+def _label(f: AnyFieldDescriptor) -> str:
     if f.is_repeated:
         return "LABEL_REPEATED"
     return "LABEL_REQUIRED" if f.is_required else "LABEL_OPTIONAL"
 
 
-def _explicit_json_name(f: FieldDescriptor) -> bool:
+def _explicit_json_name(f: AnyFieldDescriptor) -> bool:
     camel, upper = "", False
     for char in f.name:
         if char == "_":
@@ -132,7 +134,7 @@ def _explicit_json_name(f: FieldDescriptor) -> bool:
     return f.json_name != camel
 
 
-def field_descriptor_text(f: FieldDescriptor) -> str:
+def field_descriptor_text(f: AnyFieldDescriptor) -> str:
     """DebugString() of the FieldDescriptorProto without name, options, type name and
     default (what C++ DCCL hashes for a field)."""
     lines = [f"number: {f.number}\n", f"label: {_label(f)}\n", f"type: {_PROTO_TYPES[f.type]}\n"]
@@ -145,13 +147,13 @@ def field_descriptor_text(f: FieldDescriptor) -> str:
     return "".join(lines)
 
 
-def _field_debug_string(f: FieldDescriptor, depth: int) -> str:
+def _field_debug_string(f: AnyFieldDescriptor, depth: int) -> str:
     """FieldDescriptor::DebugString at `depth` (as inside a oneof)."""
     prefix = " " * (2 * depth)
     if f.type in (FieldDescriptor.TYPE_MESSAGE, FieldDescriptor.TYPE_GROUP):
-        type_name = "." + f.message_type.full_name
+        type_name = "." + message_type(f).full_name
     elif f.type == FieldDescriptor.TYPE_ENUM:
-        type_name = "." + f.enum_type.full_name
+        type_name = "." + enum_type(f).full_name
     else:
         type_name = _TYPE_NAMES[f.type]
     label = "" if f.containing_oneof is not None else _label(f)[6:].lower() + " "
@@ -167,7 +169,7 @@ def oneof_debug_string(oneof: OneofDescriptor) -> str:
     return f"oneof {oneof.name} {{\n{fields}}}\n"
 
 
-def enum_debug_string(enum: EnumDescriptor) -> str:
+def enum_debug_string(enum: AnyEnumDescriptor) -> str:
     proto = descriptor_pb2.EnumDescriptorProto()
     enum.CopyToProto(proto)
     lines = [f"enum {enum.name} {{\n"]
@@ -223,7 +225,7 @@ def node_hash(node) -> int:
     return value
 
 
-def definition_hash(descriptor: Descriptor, head, body) -> int:
+def definition_hash(descriptor: AnyDescriptor, head, body) -> int:
     """The 64-bit hash C++ DCCL's `Codec::load` returns for a root type (from its plans)."""
     opts = message_options(descriptor)
     opts.ClearField("max_bytes")

@@ -19,7 +19,7 @@ import sys
 from collections.abc import Sequence
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
-from typing import TYPE_CHECKING, ClassVar, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 from pygoby.errors import ConfigError
 from pygoby.moos.appconfig import collecting_notes
@@ -118,9 +118,10 @@ def parse_overrides(rest: list[str]) -> Overrides:
             raise ValueError(f"unexpected argument {item!r}")
         key, eq, value = item[2:].partition("=")
         if not eq:
-            value = next(items, None)
-            if value is None:
+            following = next(items, None)
+            if following is None:
                 raise ValueError(f"option --{key} needs a value")
+            value = following
         out.append((key, value))
     return out
 
@@ -160,7 +161,7 @@ def run_app(
     mission = read_mission(known.moos_file or known.mission, name)
     try:
         with collecting_notes() as notes:
-            cfg = app_class.read_config(mission, name, overrides)
+            cfg: Any = app_class.read_config(mission, name, overrides)  # (every app: `common`)
         if known.verbose:  # Verbosity enum: VERBOSE=4, DEBUG1=5, DEBUG2=6, DEBUG3=7
             cfg.common.verbosity = VERBOSE_ENUM + min(known.verbose, 4) - 1
         app = app_class(cfg, name=name, mission=mission)

@@ -26,9 +26,10 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
-from google.protobuf.message import Message
+from pygoby.moos.errors import BlockSyntaxError
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 # ---------------------------------------------------------------------------------------------
 # Tokens and the field tree
@@ -127,9 +128,13 @@ class _Parser:
             opening = self.take()
             closing = "}" if opening.text == "{" else ">"
             result.children = self.fields(closing)
+            if self.peek() is None:
+                raise BlockSyntaxError(
+                    name.line, f"the '{opening.text}' after {name.text} is never closed"
+                )
             result.brackets = (opening, self.take())
         elif result.colon is None:
-            raise ValueError(f"line {name.line}: {name.text} needs ':' or a block")
+            raise BlockSyntaxError(name.line, f"expected ':' after {name.text}")
         elif self.peek() == "[":
             result.value.append(self.take())
             while self.peek() not in ("]", None):
@@ -138,8 +143,8 @@ class _Parser:
         else:
             result.value.append(self.take())
             while (
-                self.peek() is not None
-                and self.peek()[0] in "\"'"
+                (following := self.peek()) is not None
+                and following[0] in "\"'"
                 and result.value[-1].text[0] in "\"'"
             ):
                 result.value.append(self.take())  # adjacent strings concatenate
@@ -300,12 +305,12 @@ RULES: dict[str, Rule] = {
 }
 
 
-def _field_type(descriptor: Descriptor | None, key: str) -> Descriptor | None:
+def _field_type(descriptor: AnyDescriptor | None, key: str) -> AnyDescriptor | None:
     if descriptor is None:
         return None
     if key.startswith("["):
         try:
-            found: FieldDescriptor | None = descriptor.file.pool.FindExtensionByName(key[1:-1])
+            found: AnyFieldDescriptor | None = descriptor.file.pool.FindExtensionByName(key[1:-1])
         except KeyError:
             return None
     else:
@@ -313,7 +318,9 @@ def _field_type(descriptor: Descriptor | None, key: str) -> Descriptor | None:
     return found.message_type if found is not None else None
 
 
-def _rewrite(fields: list[Field], descriptor: Descriptor | None, notes: list[str]) -> list[Field]:
+def _rewrite(
+    fields: list[Field], descriptor: AnyDescriptor | None, notes: list[str]
+) -> list[Field]:
     rule = RULES.get(descriptor.full_name) if descriptor is not None else None
     out: list[Field] = []
     for f in fields:
@@ -331,13 +338,16 @@ class Translation:
     notes: list[str]  # what was changed, one line per change
 
 
-def translate(text: str, descriptor: Descriptor) -> Translation:
+def translate(text: str, descriptor: AnyDescriptor) -> Translation:
     """Rewrite the Goby 1.1/2 forms of a ProcessConfig block for `descriptor` (the app's
-    configuration type). Text that does not tokenize is returned unchanged (protobuf's parser
-    then reports the problem with its line)."""
+    configuration type). Raises BlockSyntaxError for a mistake no parser reads past (protobuf's
+    would first report a field before it that only this rewriting makes valid). Other text that
+    does not tokenize is returned unchanged (protobuf's parser then reports it with its line)."""
     try:
         parser = _Parser(tokenize(text))
         fields = parser.fields(None)
+    except BlockSyntaxError:
+        raise
     except ValueError:  # not TextFormat we understand: left for protobuf to report
         return Translation(text, [])
     notes: list[str] = []
@@ -347,7 +357,7 @@ def translate(text: str, descriptor: Descriptor) -> Translation:
     return Translation(render(fields), notes)
 
 
-def finish(config: Message, notes: list[str]) -> None:
+def finish(config: Any, notes: list[str]) -> None:  # (any app's configuration message)
     """The moves that need the parsed message: Goby 1.1 put XML message files in dccl_cfg and
     queue_cfg (and copied each to the other); they all become transitional_cfg.message_file."""
     fields = config.DESCRIPTOR.fields_by_name

@@ -52,7 +52,9 @@ class Post:
 def split_quoted(text: str, separator: str = ",") -> list[str]:
     """MOOS-IvP's parseStringQ: split on `separator` outside double quotes (every `"` toggles)
     and outside braces."""
-    parts, current, quoted, braces = [], [], False, 0
+    parts: list[str] = []
+    current: list[str] = []
+    quoted, braces = False, 0
     for c in text:
         if c == '"':
             quoted = not quoted
@@ -205,7 +207,8 @@ class TimerScript:
             self.warnings.append(f"unknown uTimerScript parameter {name!r} ignored")
 
     def _add_event(self, text: str) -> None:
-        var, value, quoted, times, amount, quit_app = "", None, False, (0.0, 0.0), 1, False
+        value: Value | None = None
+        var, quoted, times, amount, quit_app = "", False, (0.0, 0.0), 1, False
         for part in split_quoted(text):
             if part.strip().lower() == "quit":
                 var, value, quit_app = "EXITED_NORMALLY", "uTimerScript", True
@@ -276,6 +279,7 @@ class TimerScript:
         if (self.paused or not ok) and self._previous is not None:
             self._paused_time += now - self._previous
         self._previous = now
+        assert self._start is not None  # (set by the start of the script above)
         self._elapsed = ((now - self._start) + self._skip - self._paused_time) * self._warp
         all_posted = False
         if not self.paused and ok:

@@ -92,7 +92,7 @@ def packet_from_json(data: bytes) -> tuple[str, AcousticPacket, list[float] | No
         _int(d["num_frames"]),
         float(d["tx"]),
         float(d["duration"]),
-        None if hw is None else tuple(map(_int, hw[:3])),
+        None if hw is None else (_int(hw[0]), _int(hw[1]), _int(hw[2])),
         bool(d["reply"]),
     )
     if not 0 <= packet.duration < 3600:

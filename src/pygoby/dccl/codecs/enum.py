@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec, ceil_log2
 from pygoby.dccl.errors import DcclLoadError
+from pygoby.protobuf import enum_type
 
 
 class EnumCodec(FixedWidthCodec):
@@ -13,7 +14,7 @@ class EnumCodec(FixedWidthCodec):
 
     def __init__(self, info: FieldInfo) -> None:
         super().__init__(info)
-        values = info.descriptor.enum_type.values
+        values = enum_type(info.descriptor).values
         if not values:
             raise DcclLoadError(f"{info.name}: enum has no values")
         null = 0 if info.required else 1
@@ -50,9 +51,15 @@ class EnumCodec(FixedWidthCodec):
                 return n if n in known else None
 
         self.to_raw, self.from_raw = to_raw, from_raw
+        self.value_names = [f"{v.name}={v.number}" for v in values]
 
     def describe(self) -> str:
-        return f"{'index' if self.packed else 'number'} [{self.lo}, {self.hi}]"
+        """The encoding and the values by name (as the .proto lists them; a long enum's first
+        and last eight)."""
+        names = self.value_names
+        shown = names if len(names) <= 16 else [*names[:8], "...", *names[-8:]]
+        kind = "index" if self.packed else "number"
+        return f"{kind} [{self.lo}, {self.hi}]: {', '.join(shown)}"
 
 
 class EnumCodecV2(EnumCodec):

@@ -49,6 +49,7 @@ from pygoby.frontseat.simulator.protocol import (
     Start,
     parse_line,
 )
+from pygoby.protobuf import initialization_errors
 from pygoby.util.clock import Clock
 from pygoby.util.errors import LinkClosedError
 from pygoby.util.linebased import LineLink, TCPClientLink
@@ -71,7 +72,7 @@ def start_params(cfg: Any) -> Start:
             field="frontseat_cfg",
         )
     sim = cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
-    missing = sim.FindInitializationErrors()
+    missing = initialization_errors(sim)
     if missing:
         raise AbcConfigError(f"lacks required {', '.join(missing)}", field="basic_simulator_config")
     start = sim.start
@@ -112,7 +113,9 @@ class AbcFrontSeat(InterfaceBase):
             else TCPClientLink(sim.tcp_address, sim.tcp_port, reconnect_interval=reconnect_interval)
         )
         self.connect_timeout = connect_timeout
-        self._frontseat_state: int = frontseat_pb.FRONTSEAT_NOT_CONNECTED
+        self._frontseat_state: frontseat_pb.FrontSeatState.ValueType = (
+            frontseat_pb.FRONTSEAT_NOT_CONNECTED
+        )
         self._providing_data = False
         self._last_nav_time: float | None = None
         self._started_connection: int | None = None  # link.connections when START was sent
@@ -139,7 +142,7 @@ class AbcFrontSeat(InterfaceBase):
 
     # --- InterfaceBase hooks -------------------------------------------------------------------
 
-    def frontseat_state(self) -> int:
+    def frontseat_state(self) -> frontseat_pb.FrontSeatState.ValueType:
         return self._frontseat_state
 
     def frontseat_providing_data(self) -> bool:

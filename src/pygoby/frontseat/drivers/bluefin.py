@@ -184,7 +184,9 @@ class BluefinFrontSeat(InterfaceBase):
             table.setdefault(entry.speed, entry.rpm)  # a repeated speed keeps its first rpm
         self.rpm_table = sorted(table.items())
 
-        self._frontseat_state: int = frontseat_pb.FRONTSEAT_NOT_CONNECTED
+        self._frontseat_state: frontseat_pb.FrontSeatState.ValueType = (
+            frontseat_pb.FRONTSEAT_NOT_CONNECTED
+        )
         self._connection: int | None = None  # link.connections at the last start-up
         self._providing_data = False
         self._last_nav_time: float | None = None
@@ -216,7 +218,7 @@ class BluefinFrontSeat(InterfaceBase):
 
     # --- InterfaceBase hooks -------------------------------------------------------------------
 
-    def frontseat_state(self) -> int:
+    def frontseat_state(self) -> frontseat_pb.FrontSeatState.ValueType:
         return self._frontseat_state
 
     def frontseat_providing_data(self) -> bool:
@@ -612,9 +614,9 @@ class BluefinFrontSeat(InterfaceBase):
         boy = data.Extensions[frontseat_pb.BLUEFIN_DATA].buoyancy_status
         status, error = sentences.required_int(sentence, 2), sentences.required_int(sentence, 3)
         if status in frontseat_pb.BuoyancyStatus.Status.values():
-            boy.status = status
+            boy.status = frontseat_pb.BuoyancyStatus.Status.ValueType(status)
         if error in frontseat_pb.BuoyancyStatus.Error.values():
-            boy.error = error
+            boy.error = frontseat_pb.BuoyancyStatus.Error.ValueType(error)
         boy.debug_string = sentences.field(sentence, 4)
         boy.buoyancy_newtons = sentences.required_float(sentence, 5)
         self.signal_data_from_frontseat(data)
@@ -624,9 +626,9 @@ class BluefinFrontSeat(InterfaceBase):
         trim = data.Extensions[frontseat_pb.BLUEFIN_DATA].trim_status
         status, error = sentences.required_int(sentence, 2), sentences.required_int(sentence, 3)
         if status in frontseat_pb.TrimStatus.Status.values():
-            trim.status = status
+            trim.status = frontseat_pb.TrimStatus.Status.ValueType(status)
         if error in frontseat_pb.TrimStatus.Error.values():
-            trim.error = error
+            trim.error = frontseat_pb.TrimStatus.Error.ValueType(error)
         trim.debug_string = sentences.field(sentence, 4)
         trim.pitch_trim_degrees = sentences.required_float(sentence, 5)
         trim.roll_trim_degrees = sentences.required_float(sentence, 6)

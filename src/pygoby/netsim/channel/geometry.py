@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 from pyproj import Geod
 
+from pygoby.protobuf.netsim.messages.netsim_pb2 import NavUpdate
+
 WGS84 = Geod(ellps="WGS84")
 
 
@@ -29,7 +31,7 @@ class NavFix:
     heading: float = 0.0  # degrees true
 
     @classmethod
-    def from_nav(cls, nav) -> NavFix:
+    def from_nav(cls, nav: NavUpdate) -> NavFix:
         """From a netsim NavUpdate."""
         return cls(nav.lat, nav.lon, nav.depth, nav.time, nav.speed, nav.heading)
 

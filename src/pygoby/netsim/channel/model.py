@@ -51,6 +51,7 @@ from __future__ import annotations
 import _random
 import bisect
 import enum
+import functools
 import hashlib
 import heapq
 import logging
@@ -71,6 +72,7 @@ from pygoby.netsim.channel.levels import (
 from pygoby.netsim.channel.propagation import BellhopLoss
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, harmonic_mean_speed
 from pygoby.netsim.channel.timing import Interval
+from pygoby.protobuf.netsim.messages.netsim_pb2 import EnvironmentNavUpdate
 
 log = logging.getLogger(__name__)
 
@@ -209,7 +211,7 @@ class _Pending:
         return (self.interval.start, self.receiver, self.sequence)
 
 
-_arrival_order = _Pending.arrival_order.fget
+_arrival_order = _Pending.arrival_order.fget  # type: ignore[attr-defined]  # (a property)
 
 
 class Channel:
@@ -242,7 +244,7 @@ class Channel:
     def update_position(self, port: int, position: NavFix) -> None:
         self._positions[port] = position
 
-    def on_environment_nav_update(self, update) -> None:
+    def on_environment_nav_update(self, update: EnvironmentNavUpdate) -> None:
         """Listener for `NetSimManager.on_nav` (an EnvironmentNavUpdate)."""
         self.update_position(update.nav.modem_tcp_port, NavFix.from_nav(update.nav))
 
@@ -324,7 +326,7 @@ class Channel:
                 receiver_now = receiver.at(tx.start)
                 if config.moving_receivers:
                     delay = arrival_delay(
-                        lambda tau, rx=receiver: slant_range(source, rx.at(tx.start + tau)), c
+                        functools.partial(_slant_range_at, source, receiver, tx.start), c
                     )
                 else:
                     delay = slant_range(source, receiver_now) / c
@@ -545,7 +547,7 @@ class Channel:
         key = f"{self.seed}:{p.sequence}:{p.receiver}".encode()
         rng = self._rng
         _random.Random.seed(rng, int.from_bytes(key + hashlib.sha512(key).digest()))
-        rng.gauss_next = None
+        rng.gauss_next = None  # type: ignore[attr-defined]  # (Random's cached normal variate)
         return rng
 
     @staticmethod
@@ -581,3 +583,8 @@ class Channel:
             self._finished_at[port] = [p for p in finished if p.interval.end > horizon]
         for port, intervals in self._own_tx.items():
             self._own_tx[port] = [i for i in intervals if i.end > horizon]
+
+
+def _slant_range_at(source: NavFix, receiver: NavFix, start: float, tau: float) -> float:
+    """The slant range from `source` to where `receiver` is `tau` s after `start`."""
+    return slant_range(source, receiver.at(start + tau))

@@ -26,9 +26,8 @@ from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from google.protobuf.message import Message
-
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile
+from pygoby.protobuf.pygoby.netsim.propagation_pb2 import Bellhop, Propagation
 from pygoby.util.errors import MissingExtraError
 from pygoby.util.extras import needs_extra
 
@@ -57,7 +56,7 @@ class BellhopSettings:
     cached_fields: int = 64
 
     @classmethod
-    def from_proto(cls, msg: Message) -> BellhopSettings:
+    def from_proto(cls, msg: Bellhop) -> BellhopSettings:
         return cls(
             ssp=tuple((p.a, p.b) for p in msg.ssp),
             water_depth=msg.water_depth,
@@ -268,7 +267,7 @@ class BellhopLoss:
         return LossGrid(ranges, depths, loss.astype(float).tolist(), seconds, cpu)
 
 
-def propagation_model(msg: Message | None, sound_speed, spreading: float) -> BellhopLoss | None:
+def propagation_model(msg: Propagation | None, sound_speed, spreading: float) -> BellhopLoss | None:
     """The model a `pygoby.netsim.protobuf.Propagation` asks for (None: empirical).
     Raises ValueError."""
     if msg is None or msg.model == msg.EMPIRICAL:

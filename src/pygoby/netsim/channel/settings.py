@@ -6,8 +6,6 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 
-from google.protobuf.message import Message
-
 from pygoby.netsim.channel.absorption import francois_garrison, thorp, thorp_coa
 from pygoby.netsim.channel.frame_errors import (
     DEFAULT_RATE_MODELS,
@@ -21,16 +19,21 @@ from pygoby.netsim.channel.frame_errors import (
 from pygoby.netsim.channel.model import Band, ChannelConfig, PacketKind
 from pygoby.netsim.channel.propagation import BellhopLoss, propagation_model
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, water_profile
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf.netsim.messages.manager_config_pb2 import (
+    ChannelModelConfig,
+    NetSimManagerConfig,
+)
+from pygoby.protobuf.pygoby.netsim.scenario_pb2 import ChannelSettings
+
+# the scenario's channel block and the manager's channel model share these fields
+ChannelSettingsLike = ChannelSettings | ChannelModelConfig
 
 
-def channel_settings_class() -> type[Message]:
-    return builtin_class(
-        "netsim/messages/manager_config.proto", "netsim.protobuf.ChannelModelConfig"
-    )
+def channel_settings_class() -> type[ChannelModelConfig]:
+    return ChannelModelConfig
 
 
-def _rate_model(entry: Message) -> FrameErrorModel:
+def _rate_model(entry: ChannelModelConfig.RateErrorModel) -> FrameErrorModel:
     kind = entry.WhichOneof("model")
     if kind == "table":
         try:
@@ -44,7 +47,7 @@ def _rate_model(entry: Message) -> FrameErrorModel:
     raise ValueError(f"rate_model for rate {entry.rate} has no model")
 
 
-def sound_speed_of(settings: Message) -> float | SoundSpeedProfile:
+def sound_speed_of(settings: ChannelSettingsLike) -> float | SoundSpeedProfile:
     """The sound speed of channel settings with `sound_speed` and `water` fields (an
     environment's ChannelModelConfig, a scenario's ChannelSettings)."""
     if settings.HasField("water"):
@@ -54,13 +57,9 @@ def sound_speed_of(settings: Message) -> float | SoundSpeedProfile:
     return settings.sound_speed
 
 
-def absorption_of(settings: Message) -> Callable[[float], float]:
+def absorption_of(settings: ChannelSettingsLike) -> Callable[[float], float]:
     """The absorption formula (f kHz -> dB/km) of settings with `absorption` and `water`."""
-    name = (
-        settings.DESCRIPTOR.fields_by_name["absorption"]
-        .enum_type.values_by_number[settings.absorption]
-        .name
-    )
+    name = ChannelModelConfig.Absorption.Name(settings.absorption)
     if name == "FRANCOIS_GARRISON":
         w = settings.water  # defaults apply when unset
         return functools.partial(
@@ -69,14 +68,14 @@ def absorption_of(settings: Message) -> Callable[[float], float]:
     return thorp_coa if name == "THORP_COA" else thorp
 
 
-def propagation_of(settings: Message, sound_speed) -> BellhopLoss | None:
+def propagation_of(settings: ChannelSettingsLike, sound_speed) -> BellhopLoss | None:
     """The propagation model of settings with `propagation` and `spreading` fields."""
     if not settings.HasField("propagation"):
         return None
     return propagation_model(settings.propagation, sound_speed, settings.spreading)
 
 
-def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
+def channel_config_from_proto(settings: ChannelModelConfig) -> tuple[ChannelConfig, int]:
     """(ChannelConfig, seed) for a ChannelModelConfig message. Raises ValueError."""
     sound_speed = sound_speed_of(settings)
     absorption = absorption_of(settings)
@@ -117,7 +116,9 @@ def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
     return config, settings.seed
 
 
-def environment_channel_configs(manager_config: Message) -> dict[int, tuple[ChannelConfig, int]]:
+def environment_channel_configs(
+    manager_config: NetSimManagerConfig,
+) -> dict[int, tuple[ChannelConfig, int]]:
     """(ChannelConfig, seed) per environment id of a NetSimManagerConfig; environments without
     an `environment_channel` entry get the defaults. Raises ValueError."""
     defaults = channel_config_from_proto(channel_settings_class()())

@@ -18,6 +18,7 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from pygoby.util.extras import needs_extra
 
@@ -64,7 +65,8 @@ def bin_success(
         bins = max(1, math.ceil((high - low) / width + 1e-9))
         high = low + bins * width
     width = (high - low) / bins if high > low else 1.0
-    totals, oks = Counter(), Counter()
+    totals: Counter[Any] = Counter()
+    oks: Counter[Any] = Counter()
     for value, ok in zip(values, good, strict=True):
         index = min(int((value - low) / width), bins - 1)
         totals[index] += 1

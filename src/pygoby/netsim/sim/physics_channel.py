@@ -37,6 +37,7 @@ import math
 from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import cast
 
 from pygoby.acomms.mmsim.channel import (
     AcousticPacket,
@@ -95,7 +96,7 @@ class PhysicsChannel:
         self.clock = clock
         self.ports = dict(ports or {})
         self.control_rate = control_rate
-        self.signal_event = Signal()
+        self.signal_event: Signal[dict[str, object]] = Signal()
         if on_event is not None:
             self.signal_event.connect(on_event)
         self._endpoints: dict[int, ChannelEndpoint] = {}
@@ -197,7 +198,8 @@ class PhysicsChannel:
     def _detect(self, receiver: int, transmission: Transmission, arrival: float) -> None:
         endpoint = self._endpoints.get(receiver)
         if endpoint is not None:
-            endpoint.detect(transmission.payload.packet, arrival)
+            sent = cast(_Sent, transmission.payload)  # (what transmit() gave the channel)
+            endpoint.detect(sent.packet, arrival)
 
     def next_event_time(self) -> float | None:
         """When `do_work` next has something to deliver (for discrete-event loops)."""
@@ -206,7 +208,7 @@ class PhysicsChannel:
     # -- delivery --------------------------------------------------------------------------------
 
     def _deliver(self, r: Reception) -> None:
-        sent: _Sent = r.transmission.payload
+        sent = cast(_Sent, r.transmission.payload)
         packet = sent.packet
         endpoint = self._endpoints.get(r.receiver)
         delivered = endpoint is not None and self._heard(r, packet)

@@ -14,10 +14,7 @@ import dataclasses
 import math
 import time
 from dataclasses import dataclass
-from functools import cache
 from pathlib import Path
-
-from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, ModemTiming
@@ -27,34 +24,30 @@ from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.channel.settings import absorption_of, propagation_of, sound_speed_of
 from pygoby.netsim.errors import ScenarioError
 from pygoby.netsim.manager.config import config_class as manager_config_class
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf import initialization_errors
+from pygoby.protobuf.goby.acomms.protobuf.amac_config_pb2 import MACConfig
+from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
+from pygoby.protobuf.pygoby.netsim.scenario_pb2 import NodeStatus, Scenario, Track, Waypoint
 from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
 
-SCENARIO_PROTO = "pygoby/netsim/scenario.proto"
 FIRST_MODEM_PORT = 62000
 VIRTUAL_START = 1_700_000_000.0  # default start of a "max"-speed run (repeatable)
-MAC_FIXED_DECENTRALIZED = (
-    acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"]
-    .enum_type.values_by_name["MAC_FIXED_DECENTRALIZED"]
-    .number
-)
+MAC_FIXED_DECENTRALIZED = acomms_pb.MACType.MAC_FIXED_DECENTRALIZED
 
 
-@cache
-def scenario_class() -> type[Message]:
-    return builtin_class(SCENARIO_PROTO, "pygoby.netsim.protobuf.Scenario")
+def scenario_class() -> type[Scenario]:
+    return Scenario
 
 
-@cache
-def node_status_class() -> type[Message]:
-    return builtin_class(SCENARIO_PROTO, "pygoby.netsim.protobuf.NodeStatus")
+def node_status_class() -> type[NodeStatus]:
+    return NodeStatus
 
 
-def load_scenario(path: str | Path) -> Message:
+def load_scenario(path: str | Path) -> Scenario:
     return parse_scenario(read_config_file(path, error=ScenarioError), path)
 
 
-def parse_scenario(text: str, file: str | Path | None = None) -> Message:
+def parse_scenario(text: str, file: str | Path | None = None) -> Scenario:
     scenario = scenario_class()()
     merge_config_text(text, scenario, file=file, error=ScenarioError)
     check_config_values(scenario, text, file=file, error=ScenarioError)
@@ -65,9 +58,9 @@ def parse_scenario(text: str, file: str | Path | None = None) -> Message:
     return scenario
 
 
-def check_scenario(scenario: Message) -> None:
+def check_scenario(scenario: Scenario) -> None:
     if not scenario.IsInitialized():
-        missing = ", ".join(scenario.FindInitializationErrors())
+        missing = ", ".join(initialization_errors(scenario))
         raise ScenarioError(f"scenario is missing required fields: {missing}")
     if not scenario.node:
         raise ScenarioError("a scenario needs at least one node")
@@ -96,7 +89,7 @@ def check_scenario(scenario: Message) -> None:
         channel_config(scenario)  # raises on bad propagation settings (nothing is traced yet)
 
 
-def speed_factor(scenario: Message) -> float | None:
+def speed_factor(scenario: Scenario) -> float | None:
     """None for "max" (virtual clock), else the real-time factor."""
     text = scenario.speed.strip().lower()
     if text == "max":
@@ -110,20 +103,20 @@ def speed_factor(scenario: Message) -> float | None:
     return factor
 
 
-def start_time(scenario: Message) -> float:
+def start_time(scenario: Scenario) -> float:
     if scenario.HasField("start_time"):
         return scenario.start_time
     return VIRTUAL_START if speed_factor(scenario) is None else time.time()
 
 
-def node_ports(scenario: Message) -> list[int]:
+def node_ports(scenario: Scenario) -> list[int]:
     return [
         n.modem_tcp_port if n.HasField("modem_tcp_port") else FIRST_MODEM_PORT + i
         for i, n in enumerate(scenario.node)
     ]
 
 
-def channel_config(scenario: Message) -> ChannelConfig:
+def channel_config(scenario: Scenario) -> ChannelConfig:
     c = scenario.channel
     protocol = None
     if c.HasField("protocol_model"):
@@ -158,7 +151,7 @@ def channel_config(scenario: Message) -> ChannelConfig:
     )
 
 
-def modem_timing(scenario: Message) -> ModemTiming:
+def modem_timing(scenario: Scenario) -> ModemTiming:
     """The emulators' duration table: the defaults with the scenario's `modem_timing` over them."""
     t = scenario.modem_timing
     rates = dict(DEFAULT_TIMING.rates)
@@ -183,7 +176,7 @@ def modem_timing(scenario: Message) -> ModemTiming:
     return dataclasses.replace(DEFAULT_TIMING, rates=rates, **others)
 
 
-def manager_config(scenario: Message, endpoint_ip: str = "127.0.0.1") -> Message:
+def manager_config(scenario: Scenario, endpoint_ip: str = "127.0.0.1") -> NetSimManagerConfig:
     """A netsim_manager configuration for the scenario's nodes (one environment, whole Earth)."""
     cfg = manager_config_class()()
     for port in node_ports(scenario):
@@ -203,7 +196,7 @@ def manager_config(scenario: Message, endpoint_ip: str = "127.0.0.1") -> Message
     return cfg
 
 
-def mac_config(scenario: Message, modem_id: int) -> Message:
+def mac_config(scenario: Scenario, modem_id: int) -> MACConfig:
     """The scenario's TDMA cycle for one node (the same slots at every node)."""
     cfg = acomms_pb.MACConfig()
     cfg.CopyFrom(scenario.mac)
@@ -237,7 +230,7 @@ class _Fix:
 class TrackFollower:
     """A node's scripted position at any time (UNIX seconds, given the run's start time)."""
 
-    def __init__(self, track: Message, scenario: Message) -> None:
+    def __init__(self, track: Track, scenario: Scenario) -> None:
         if not track.waypoint:
             raise ScenarioError("a track needs at least one waypoint")
         self.fixes = [self._fix(w, scenario) for w in track.waypoint]
@@ -249,7 +242,7 @@ class TrackFollower:
         self._times = times
 
     @staticmethod
-    def _fix(w: Message, scenario: Message) -> _Fix:
+    def _fix(w: Waypoint, scenario: Scenario) -> _Fix:
         if w.HasField("lat") and w.HasField("lon"):
             lat, lon = w.lat, w.lon
         elif w.HasField("x") or w.HasField("y"):

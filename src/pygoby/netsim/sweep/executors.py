@@ -104,8 +104,8 @@ class LocalExecutor:
                         broken = True  # the run stays in flight: it runs again
                         continue
                     run = in_flight.pop(future)
-                    if future.exception() is not None:
-                        failed(run, _error_text(future.exception()))
+                    if (error := future.exception()) is not None:
+                        failed(run, _error_text(error))
                     else:
                         done(run, future.result())
         except BaseException:

@@ -35,6 +35,8 @@ from pygoby.acomms.drivers.micromodem.statistics import (
     parse_xst,
 )
 from pygoby.acomms.errors import ModemDriverError
+from pygoby.protobuf.goby.acomms.protobuf.mm_driver_pb2 import TransmissionType
+from pygoby.util.clock import Clock
 from pygoby.util.errors import NMEAError
 from pygoby.util.nmea import NMEASentence
 
@@ -77,7 +79,7 @@ class MMDriver(ModemDriverBase):
     DEFAULT_LINE_DELIMITER = "\r"
     RATES = range(len(RATE_NUM_FRAMES))
 
-    def __init__(self, clock=None, link=None) -> None:
+    def __init__(self, clock: Clock | None = None, link=None) -> None:
         super().__init__(clock, link)
         self.mm_cfg = acomms_pb.MMConfig()
         self.phase = Phase.STOPPED
@@ -126,7 +128,7 @@ class MMDriver(ModemDriverBase):
     def is_mm2(self) -> bool:
         return self.revision[0] >= 2
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         self._reset_state()
         self.mm_cfg = cfg.Extensions[acomms_pb.MM_CONFIG]
         self._buoy = self.mm_cfg.hydroid_gateway_id
@@ -161,7 +163,7 @@ class MMDriver(ModemDriverBase):
                 entry = entry.upper()
             self._out.append(NMEASentence.build("$CCCFG", entry.split(",")))
 
-    def update_cfg(self, cfg) -> None:
+    def update_cfg(self, cfg: acomms_pb.DriverConfig) -> None:
         """ACOMMS_DRIVER_CONFIG_UPDATE: send the update's Micro-Modem `nvram_cfg` entries (as at
         start-up) and keep them in the configuration, so that a restart sends them too."""
         entries = list(cfg.Extensions[acomms_pb.MM_CONFIG].nvram_cfg)
@@ -200,7 +202,7 @@ class MMDriver(ModemDriverBase):
             self._keep_alive(now)
         self._try_write(now)
 
-    def handle_initiate_transmission(self, transmission) -> None:
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         if self.link is None or not self.link.is_open:
             # nothing is taken from the queue, so queued messages wait for the link
             log.warning("link to the modem is down: transmission not started")
@@ -387,9 +389,10 @@ class MMDriver(ModemDriverBase):
 
     def _on_clk(self, s: NMEASentence) -> None:
         if self._outstanding("CLK"):
-            t = dt.datetime(
-                *(s.as_int(i, *bounds) for i, bounds in enumerate(CLOCK_FIELDS, 1)), tzinfo=dt.UTC
+            year, month, day, hour, minute, second = (
+                s.as_int(i, *bounds) for i, bounds in enumerate(CLOCK_FIELDS, 1)
             )
+            t = dt.datetime(year, month, day, hour, minute, second, tzinfo=dt.UTC)
             self._check_clock(t.timestamp(), whole_seconds=True)
 
     def _on_tms(self, s: NMEASentence) -> None:
@@ -404,7 +407,7 @@ class MMDriver(ModemDriverBase):
         return bool(self._out) and self._written_at is not None and self._out[0].sentence_id == kind
 
     # ------------------------------------------------------------------ data transmission
-    def _initiate_data(self, msg) -> None:
+    def _initiate_data(self, msg: acomms_pb.ModemTransmission) -> None:
         try:
             check_rate(msg.rate)
         except ValueError as exc:
@@ -431,7 +434,7 @@ class MMDriver(ModemDriverBase):
         firmware_ack = c.ack_requested and self.app_acks is None
         self._push("$CCCYC", 0, c.src, c.dest, c.rate, firmware_ack, len(c.frame))
 
-    def _request_data(self, msg) -> bool:
+    def _request_data(self, msg: acomms_pb.ModemTransmission) -> bool:
         """Fill `msg` from the queue (with the application ack if enabled) and cache it;
         False if there is nothing to send."""
         self._expected_acks.clear()
@@ -569,7 +572,7 @@ class MMDriver(ModemDriverBase):
                 self._finish_receive()
 
     def _on_cst(self, s: NMEASentence) -> None:
-        if type(s) is CycleStatistics and s.version >= 6:
+        if isinstance(s, CycleStatistics) and s.version >= 6:
             today = _EPOCH_DATE  # (a dated time of arrival: the reader's date is not used)
         else:
             today = _utc_date(self.clock.now())
@@ -614,7 +617,7 @@ class MMDriver(ModemDriverBase):
         if rx is not None:
             self._emit_data(rx)
 
-    def _emit_data(self, rx) -> None:
+    def _emit_data(self, rx: acomms_pb.ModemTransmission) -> None:
         """Deliver a data reception (after taking out an application ack, if enabled)."""
         if self.app_acks is not None:
             for ack in self.app_acks.strip(rx):
@@ -634,7 +637,12 @@ class MMDriver(ModemDriverBase):
     def _on_mpa(self, s: NMEASentence) -> None:
         self.signal_receive.emit(self._ping_result(*_addresses(s)))
 
-    def _ping_result(self, src: int, dest: int, kind: int = acomms_pb.MICROMODEM_TWO_WAY_PING):
+    def _ping_result(
+        self,
+        src: int,
+        dest: int,
+        kind: TransmissionType.ValueType = acomms_pb.MICROMODEM_TWO_WAY_PING,
+    ) -> acomms_pb.ModemTransmission:
         msg = acomms_pb.ModemTransmission(
             type=acomms_pb.DRIVER_SPECIFIC,
             src=src,
@@ -644,7 +652,7 @@ class MMDriver(ModemDriverBase):
         msg.Extensions[acomms_pb.MM_TRANSMISSION].type = kind
         return msg
 
-    def _initiate_mini(self, msg) -> None:
+    def _initiate_mini(self, msg: acomms_pb.ModemTransmission) -> None:
         msg.max_num_frames, msg.max_frame_bytes = 1, 2
         if msg.src < 0:
             msg.src = self.modem_id
@@ -658,7 +666,7 @@ class MMDriver(ModemDriverBase):
             data[0] &= 0x1F
         self._push("$CCMUC", msg.src, msg.dest, data.hex().upper())
 
-    def _initiate_fdp(self, msg) -> None:
+    def _initiate_fdp(self, msg: acomms_pb.ModemTransmission) -> None:
         msg.max_num_frames = 1
         if not msg.HasField("max_frame_bytes"):
             msg.max_frame_bytes = FDP_MAX_FRAME_BYTES
@@ -717,7 +725,7 @@ class MMDriver(ModemDriverBase):
         acomms_pb.MICROMODEM_M_SEQUENCE: "_initiate_m_sequence",
     }
 
-    def _lbl_params(self, msg, name: str):
+    def _lbl_params(self, msg: acomms_pb.ModemTransmission, name: str):
         """Configured LBL parameters merged with the request's own."""
         params = type(getattr(self.mm_cfg, name))()
         params.CopyFrom(getattr(self.mm_cfg, name))
@@ -726,7 +734,7 @@ class MMDriver(ModemDriverBase):
             self._push("$CCCFG", "TAT", params.turnaround_ms)
         return params, int(params.lbl_max_range * 2 / 1500 * 1000 + params.turnaround_ms)
 
-    def _initiate_remus_lbl(self, msg) -> None:
+    def _initiate_remus_lbl(self, msg: acomms_pb.ModemTransmission) -> None:
         params, timeout = self._lbl_params(msg, "remus_lbl")
         bits = params.enable_beacons
         self._last_lbl_type = acomms_pb.MICROMODEM_REMUS_LBL_RANGING
@@ -734,7 +742,7 @@ class MMDriver(ModemDriverBase):
             "$CCPDT", 1, self.modem_id % 4 + 1, 0, 0, timeout, *((bits >> i) & 1 for i in range(4))
         )
 
-    def _initiate_narrowband_lbl(self, msg) -> None:
+    def _initiate_narrowband_lbl(self, msg: acomms_pb.ModemTransmission) -> None:
         p, timeout = self._lbl_params(msg, "narrowband_lbl")
         freqs = [*list(p.receive_freq)[:4], 0, 0, 0, 0][:4]
         self._last_lbl_type = acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING
@@ -748,7 +756,7 @@ class MMDriver(ModemDriverBase):
             int(p.transmit_flag),
         )
 
-    def _initiate_generic_lbl(self, msg) -> None:
+    def _initiate_generic_lbl(self, msg: acomms_pb.ModemTransmission) -> None:
         p, timeout = self._lbl_params(msg, "generic_lbl")
         codes = [*list(p.receive_seq_code)[:4], 0, 0, 0, 0][:4]
         self._last_lbl_type = acomms_pb.MICROMODEM_GENERIC_LBL_RANGING
@@ -764,12 +772,12 @@ class MMDriver(ModemDriverBase):
             0,
         )
 
-    def _initiate_hardware_control(self, msg) -> None:
+    def _initiate_hardware_control(self, msg: acomms_pb.ModemTransmission) -> None:
         hw = msg.Extensions[acomms_pb.MM_TRANSMISSION].hw_ctl
         src = msg.src if msg.src >= 0 else self.modem_id
         self._push("$CCMEC", src, msg.dest, hw.line, hw.mode, hw.arg)
 
-    def _initiate_fm_sweep(self, msg) -> None:
+    def _initiate_fm_sweep(self, msg: acomms_pb.ModemTransmission) -> None:
         p = acomms_pb.MMConfig().fm_sweep
         p.CopyFrom(self.mm_cfg.fm_sweep)
         p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].fm_sweep)
@@ -783,7 +791,7 @@ class MMDriver(ModemDriverBase):
             int(p.repetition_period_ms * 10),
         )
 
-    def _initiate_m_sequence(self, msg) -> None:
+    def _initiate_m_sequence(self, msg: acomms_pb.ModemTransmission) -> None:
         p = acomms_pb.MMConfig().m_sequence
         p.CopyFrom(self.mm_cfg.m_sequence)
         p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].m_sequence)
@@ -799,7 +807,7 @@ class MMDriver(ModemDriverBase):
             src, dest = dest, src
         msg = self._ping_result(src, dest, acomms_pb.MICROMODEM_HARDWARE_CONTROL_REPLY)
         hw = msg.Extensions[acomms_pb.MM_TRANSMISSION].hw_ctl
-        hw.line, hw.mode, hw.arg = line, mode, arg
+        hw.line, hw.mode, hw.arg = line, mode, arg  # type: ignore[assignment]  # (in range)
         self.signal_receive.emit(msg)
 
     def _on_tta(self, s: NMEASentence) -> None:
