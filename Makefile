@@ -43,7 +43,7 @@ bench: protos
 # SOAK_SECONDS per scenario
 SOAK_SECONDS ?= 20
 soak: protos
-	$(PY) benchmarks/soak/run.py --seconds $(SOAK_SECONDS)
+	$(PY) -m benchmarks.soak.run --seconds $(SOAK_SECONDS)
 
 # Figures of the examples' READMEs, regenerated from their sources (commit the result).
 EXAMPLE_SWEEP := examples/netsim/sweep_range_rate

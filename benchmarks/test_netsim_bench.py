@@ -19,8 +19,8 @@ from pathlib import Path
 
 import pytest
 
-from pygoby.netsim.client import NetSimClient
-from pygoby.netsim.protocol import encode_line, request_class
+from pygoby.netsim.manager.client import NetSimClient
+from pygoby.netsim.manager.protocol import encode_line, request_class
 
 CLIENTS = 64
 RATE_HZ = 10.0
@@ -47,7 +47,7 @@ class ManagerProcess:
             [
                 sys.executable,
                 "-m",
-                "pygoby.netsim.server",
+                "pygoby.netsim.manager.server",
                 str(config),
                 "--listen",
                 "127.0.0.1",
@@ -204,14 +204,14 @@ def test_manager_load_full_60s(benchmark, tmp_path):
 
 
 def test_channel_transmit_and_poll_8_nodes(benchmark):
-    from pygoby.netsim.channel import Channel, ChannelConfig, Position, Transmission
+    from pygoby.netsim.channel import Channel, ChannelConfig, NavFix, Transmission
 
     def run() -> int:
         channel = Channel(ChannelConfig(), seed=1)
         delivered = 0
         for k in range(50):
             for i in range(8):  # fresh positions (1 km apart, moving) before each transmission
-                position = Position(42.0 + 0.009 * i, -70.0, 10.0, 10.0 * k, 1.5, 45.0 * i)
+                position = NavFix(42.0 + 0.009 * i, -70.0, 10.0, 10.0 * k, 1.5, 45.0 * i)
                 channel.update_position(62000 + i, position)
             channel.transmit(Transmission(62000 + k % 8, 10.0 * k, rate=1, frames=3))
             delivered += len(channel.poll(10.0 * k + 9.9))
@@ -221,7 +221,7 @@ def test_channel_transmit_and_poll_8_nodes(benchmark):
 
 
 def test_line_decoder_throughput(benchmark):
-    from pygoby.netsim.protocol import LineDecoder, request_names
+    from pygoby.netsim.manager.protocol import LineDecoder, request_names
 
     request = request_class()(id=1)
     request.nav.add(modem_tcp_port=62000, time=1.7e9, lat=42, lon=-70, depth=1, speed=1, heading=0)

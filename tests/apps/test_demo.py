@@ -8,7 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from pygoby.netsim.eventlog import read_events
+from pygoby.netsim.report.eventlog import read_events
 
 DEMO = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / "run_demo.py"
 

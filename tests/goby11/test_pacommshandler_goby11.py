@@ -156,7 +156,7 @@ def test_xml_error_stops_pacommshandler_with_file_and_line(tmp_path):
 
 
 def test_transitional_messages_expand_into_the_configuration(tmp_path):
-    from pygoby.acomms.transitional import TransitionalMessages
+    from pygoby.moosacomms.transitional import TransitionalMessages
     from pygoby.protobuf import ProtoLoader, builtin_class
 
     cfg = builtin_class(

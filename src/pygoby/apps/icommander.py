@@ -20,8 +20,8 @@ from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, Post
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
 from pygoby.protobuf.pygoby.apps.topside_config_pb2 import iCommanderConfig
-from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.topside.commander import (
     KEY_VALUE,
     MULTIPLEX,
@@ -30,7 +30,6 @@ from pygoby.topside.commander import (
     CommandSet,
     SaveFileError,
 )
-from pygoby.topside.icommander import ICommanderTUI
 
 SEND_MULTIPLEX = 2  # pygoby.apps.protobuf.SendStyle
 QUIET = 1  # goby.util.protobuf.GLogConfig.Verbosity
@@ -72,6 +71,9 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
         # empty values mean none, as in Goby 1.1 (its manual's block and --example_config
         # carry `show_variable: ""` and `load: ""`)
         shown = [var for var in cfg.show_variable if var]
+        # textual (pip extra `topside`) is imported here, where a missing one is reported cleanly
+        from pygoby.topside.icommander import ICommanderTUI
+
         self.tui = ICommanderTUI(self.commander, shown, on_exit=self.request_stop)
         for var in self.commander.watched_variables:
             self.subscribe(var, self._on_ack_or_expire)

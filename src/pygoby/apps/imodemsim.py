@@ -38,7 +38,7 @@ from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.moos.classic_app import ClassicMOOSApp
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.netsim.range_link import RangeLink
+from pygoby.netsim.sim.range_link import RangeLink
 from pygoby.protobuf.pygoby.moos.classic_app_pb2 import ClassicMOOSAppConfig
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.pty import PtyError, PtyPair, is_live, partner_of

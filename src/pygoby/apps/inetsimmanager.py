@@ -4,8 +4,8 @@ Subscribes to the vehicle's NAV_LAT/NAV_LONG (or NAV_X/NAV_Y with LatOrigin/Long
 NAV_DEPTH, NAV_SPEED and NAV_HEADING and sends a NavUpdate for its `modem_tcp_port` every
 `nav_period` seconds; every Micro-Modem reception pAcommsHandler posts (ACOMMS_MODEM_RECEIVE)
 is pushed as ReceiveStats. The manager's answer is posted to NETSIM_STATUS when it changes.
-The reporting itself is `pygoby.netsim.navreporter.NavReporter`; the manager connection
-(reconnecting) is `pygoby.netsim.client.NetSimClient`.
+The reporting itself is `pygoby.netsim.manager.navreporter.NavReporter`; the manager connection
+(reconnecting) is `pygoby.netsim.manager.client.NetSimClient`.
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from collections.abc import Sequence
 from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.netsim.client import NetSimClient, status_name
-from pygoby.netsim.navreporter import NavReporter
-from pygoby.netsim.protocol import NetSimManagerResponse
+from pygoby.netsim.manager.client import NetSimClient, status_name
+from pygoby.netsim.manager.navreporter import NavReporter
+from pygoby.netsim.manager.protocol import NetSimManagerResponse
 from pygoby.protobuf.pygoby.netsim.inetsimmanager_config_pb2 import iNetSimManagerConfig
 
 

@@ -25,16 +25,16 @@ from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase, driver_name
 from pygoby.acomms.drivers.ufield import UFldDriver
 from pygoby.acomms.handler import AcommsHandler, DriverSlot, HandlerError, make_driver
-from pygoby.apps.pacommshandler_goby11 import Goby11Variables
-from pygoby.apps.ufield_link import MOOSMailLink
 from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import locate, prefixed_var_names
 from pygoby.moos.protocol import MOOSMessage, text_or_binary
-from pygoby.moos.translator_binding import TranslatorBinding, not_loaded
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
+from pygoby.moosacomms.goby11 import Goby11Variables
+from pygoby.moosacomms.translator_binding import TranslatorBinding, not_loaded
+from pygoby.moosacomms.ufield_link import MOOSMailLink
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
-from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.util.clock import Clock
 from pygoby.util.signal import Signal
 

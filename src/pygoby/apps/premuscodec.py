@@ -5,7 +5,7 @@
 
 REMUS frames arrive on the `mdat_*_var` variables as Goby 1.1 ModemDataTransmission text (what
 pAcommsHandler's CCL queues post on their `in_pubsub_var`) and become NODE_REPORT,
-STATUS_REPORT_IN, CCL_*_IN and `<NAME>_NAV_*` (pygoby.apps.premuscodec_reports). With
+STATUS_REPORT_IN, CCL_*_IN and `<NAME>_NAV_*` (pygoby.moosacomms.remus_reports). With
 `create_status`, our NAV_* become a State frame on `mdat_state_out` every 10 s (once all five
 have arrived); an OUTGOING_COMMAND `MessageType=CCL_REDIRECT,...` becomes a Redirect frame on
 `mdat_redirect_out`, addressed to its DestinationPlatformId. A bad frame or command is logged
@@ -19,12 +19,12 @@ from collections.abc import Sequence
 from functools import partial
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.apps.premuscodec_reports import RemusReports
 from pygoby.dccl import DcclError
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import Technique, TranslatorError, parse_for_moos, serialize_for_moos
+from pygoby.moosacomms.remus_reports import RemusReports
 from pygoby.protobuf.pygoby.apps.premuscodec_config_pb2 import pREMUSCodecConfig
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup, atoi

@@ -13,7 +13,7 @@ from google.protobuf.message import Message
 
 from pygoby.dccl.libraries import split_libraries
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
+from pygoby.moosacomms.translator_binding import MessageTypes, TranslatorBinding
 from pygoby.protobuf.goby.apps.moos.protobuf.pTranslator_config_pb2 import pTranslatorConfig
 
 

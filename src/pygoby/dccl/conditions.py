@@ -41,18 +41,18 @@ from pygoby.dccl.errors import DcclError, DcclLoadError
 from pygoby.protobuf import enum_type
 from pygoby.protobuf.dccl.option_extensions_pb2 import DCCLFieldOptions
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
+from pygoby.util.errors import MissingExtraError
+from pygoby.util.extras import needs_extra
 
 _INT64 = (FieldDescriptor.CPPTYPE_INT64, FieldDescriptor.CPPTYPE_UINT64)
 
 
 def _lupa():
     try:
-        from lupa import lua53
-    except ImportError as exc:
-        raise DcclLoadError(
-            "dynamic_conditions are Lua expressions and need the 'lupa' package with Lua 5.3"
-            f" (pip install lupa): {exc}"
-        ) from None
+        with needs_extra("lua", "dynamic_conditions (Lua 5.3 expressions)"):
+            from lupa import lua53
+    except MissingExtraError as exc:
+        raise DcclLoadError(str(exc)) from None
     return lua53
 
 

@@ -16,16 +16,14 @@ format. A C++ peer built with another standard library (libc++ on macOS: a diffe
 
 from __future__ import annotations
 
-import dataclasses
-
 from google.protobuf import descriptor_pb2
 from google.protobuf.descriptor import FieldDescriptor, OneofDescriptor
 from google.protobuf.message import Message
 
-from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec
-from pygoby.dccl.codecs.numeric import NumericCodec
-from pygoby.dccl.errors import DcclDecodeError, DcclLoadError
+from pygoby.dccl.codecs.enum import EnumCodec
+from pygoby.dccl.codecs.hash import HashCodec
 from pygoby.dccl.options import field_options, message_options
+from pygoby.dccl.plan import MessageItem, RepeatedItem
 from pygoby.protobuf import enum_type, message_type
 from pygoby.protobuf.cpp_text import c_escape, message_text, scalar_text
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyEnumDescriptor, AnyFieldDescriptor
@@ -206,9 +204,6 @@ def enum_debug_string(enum: AnyEnumDescriptor) -> str:
 def _codec_hash(item) -> int:
     """FieldCodecBase::hash() of a field's codec: a sub-message's own hash, an enum's
     DebugString for the default enum codecs, 0 otherwise."""
-    from pygoby.dccl.codecs.enum import EnumCodec
-    from pygoby.dccl.plan import MessageItem, RepeatedItem
-
     if isinstance(item, MessageItem) or (isinstance(item, RepeatedItem) and item.child is not None):
         return node_hash(item.child)
     codec = getattr(item, "codec", None)
@@ -242,54 +237,8 @@ def definition_hash(descriptor: AnyDescriptor, head, body) -> int:
     return value
 
 
-# ------------------------------------------------------------------ the codec
-class HashCodec(FixedWidthCodec):
-    """A uint32 field sending `definition hash & max` (always, in the required encoding); on
-    decode a different value is an error. The hash is set when the whole type is planned."""
-
-    def __init__(self, info: FieldInfo) -> None:
-        super().__init__(info)
-        opts = info.options
-        lo, hi = opts.min, opts.max
-        if lo != 0:
-            raise DcclLoadError(f"{info.name}: dccl.hash needs (dccl.field).min = 0")
-        if hi > 2**32 - 1 or hi != 2 ** (int(hi).bit_length()) - 1 or hi != int(hi):
-            raise DcclLoadError(
-                f"{info.name}: dccl.hash needs (dccl.field).max = 2^k - 1 (e.g. 255, 4294967295)"
-            )
-        required = dataclasses.replace(info, required=True)
-        self.inner = NumericCodec(required, bounds=(0.0, hi), resolution=1.0, category="uint32")
-        self.bits = self.inner.bits
-        self.mask = int(hi)
-        self.expected = 0
-        inner_to_raw, inner_from_raw = self.inner.to_raw, self.inner.from_raw
-
-        def to_raw(value, strict: bool) -> int:
-            return inner_to_raw(self.expected, strict)
-
-        def from_raw(raw: int) -> int:
-            received = inner_from_raw(raw)
-            if received != self.expected:
-                raise DcclDecodeError(
-                    f"{info.name}: hash mismatch (expected {self.expected}, received {received}):"
-                    " sender and receiver do not use the same DCCL definition"
-                )
-            return received
-
-        self.to_raw, self.from_raw = to_raw, from_raw
-
-    def set_hash(self, full_hash: int) -> None:
-        self.expected = full_hash & self.mask
-        self.null_raw = self.inner.to_raw(self.expected, False)
-
-    def describe(self) -> str:
-        return f"definition hash & {self.mask:#x}"
-
-
 def hash_codecs(node):
     """Every HashCodec in a plan."""
-    from pygoby.dccl.plan import MessageItem, RepeatedItem
-
     for item in node.items:
         codec = getattr(item, "codec", None)
         if isinstance(codec, HashCodec):

@@ -119,6 +119,7 @@ from pygoby.protobuf.descriptors import MessageT
 from pygoby.protobuf.goby.moos.protobuf.goby_moos_app_pb2 import GobyMOOSAppConfig
 from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock
+from pygoby.util.errors import MissingExtraError
 
 Handler = Callable[[MOOSMessage], None]
 
@@ -423,15 +424,20 @@ class GobyMOOSApp:
         self.request_stop()
 
     async def run(self) -> None:
-        gui = None
+        gui, missing = None, None
         if self.common.show_gui:
-            from pygoby.moos.appgui import gui_for  # textual, only when asked for
-
-            gui = gui_for(self)
-            if gui is not None:
-                self.terminal_handler = gui.handler
+            try:
+                from pygoby.moos.appgui import gui_for  # textual, only when asked for
+            except MissingExtraError as exc:
+                missing = exc
+            else:
+                gui = gui_for(self)
+                if gui is not None:
+                    self.terminal_handler = gui.handler
         await self.start()
-        if self.common.show_gui and gui is None:
+        if missing is not None:
+            self.log.warning("show_gui: %s; the log stays plain text", missing)
+        elif self.common.show_gui and gui is None:
             self.log.info("show_gui: standard output is not a terminal; the log stays plain text")
         try:
             if gui is not None:

@@ -28,6 +28,8 @@ from dataclasses import dataclass, field
 
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile
 from pygoby.protobuf.pygoby.netsim.propagation_pb2 import Bellhop, Propagation
+from pygoby.util.errors import MissingExtraError
+from pygoby.util.extras import needs_extra
 
 log = logging.getLogger(__name__)
 
@@ -137,12 +139,11 @@ class BellhopLoss:
                 f"bellhop: the ssp must run from 0 m to the deepest bottom ({s.deepest:g} m)"
             )
         self.ssp = list(s.ssp) if s.ssp else self._sampled_profile()
-        try:
-            import pelagic  # noqa: F401  (checked now: a missing package is a configuration error)
-        except ImportError:
-            raise ValueError(
-                "the BELLHOP model needs the pelagic package: pip install 'pygoby[bellhop]'"
-            ) from None
+        try:  # checked now: a missing package is a configuration error
+            with needs_extra("bellhop", "the BELLHOP model"):
+                import pelagic  # noqa: F401
+        except MissingExtraError as exc:
+            raise ValueError(str(exc)) from None
 
     def _sampled_profile(self) -> list[tuple[float, float]]:
         deepest, c = self.settings.deepest, self.sound_speed

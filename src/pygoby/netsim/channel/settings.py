@@ -7,7 +7,7 @@ import functools
 from collections.abc import Callable
 
 from pygoby.netsim.channel.absorption import francois_garrison, thorp, thorp_coa
-from pygoby.netsim.channel.errors import (
+from pygoby.netsim.channel.frame_errors import (
     DEFAULT_RATE_MODELS,
     FrameErrorModel,
     LogisticModel,

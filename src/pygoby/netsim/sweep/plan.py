@@ -27,7 +27,7 @@ from google.protobuf.message import Message
 
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.errors import ScenarioError
-from pygoby.netsim.scenario import check_scenario, parse_scenario
+from pygoby.netsim.sim.scenario import check_scenario, parse_scenario
 from pygoby.protobuf import enum_type
 from pygoby.protobuf.descriptors import AnyFieldDescriptor
 from pygoby.protobuf.pygoby.netsim.scenario_pb2 import Scenario

@@ -1,5 +1,5 @@
 """The messages an operator can send, with where each field's value comes from, read from the
-message set pAcommsHandler loads (`pygoby.topside.acomms_config.AcommsMessageSet`: its
+message set pAcommsHandler loads (`pygoby.moosacomms.acomms_config.AcommsMessageSet`: its
 `load_proto_file`/`load_shared_library` definitions, `translator_entry` blocks, queues, and the
 Goby 1.1 XML `message_file`s).
 
@@ -30,11 +30,11 @@ from pygoby.dccl.xml import XmlMessage
 from pygoby.moos.translator import ModemIdLookup, Technique, Translator, UTMGeodesy
 from pygoby.moos.translator.format import parsed_fields
 from pygoby.moos.translator.techniques import PROTOBUF_TECHNIQUES
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
 from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 from pygoby.protobuf.goby.acomms.protobuf.queue_pb2 import QueuedMessageEntry
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
 from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
-from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.topside.commander.fields import FieldSpec
 
 TRIGGER_PUBLISH = 1

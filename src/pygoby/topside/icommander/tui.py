@@ -18,14 +18,17 @@ import asyncio
 from collections import deque
 from collections.abc import Callable
 
-from textual import events
-from textual.app import App, ComposeResult
-from textual.binding import Binding
-from textual.containers import Vertical, VerticalScroll
-from textual.message_pump import MessagePump
-from textual.screen import ModalScreen, Screen
-from textual.widgets import Footer, Input, Label, OptionList, Static
-from textual.widgets.option_list import Option
+from pygoby.util.extras import needs_extra
+
+with needs_extra("topside", "iCommander's terminal interface"):
+    from textual import events
+    from textual.app import App, ComposeResult
+    from textual.binding import Binding
+    from textual.containers import Vertical, VerticalScroll
+    from textual.message_pump import MessagePump
+    from textual.screen import ModalScreen, Screen
+    from textual.widgets import Footer, Input, Label, OptionList, Static
+    from textual.widgets.option_list import Option
 
 from pygoby.errors import PygobyError
 from pygoby.topside.commander import Commander, Draft, FieldValueError, Notice, Outgoing

@@ -17,8 +17,8 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import MoosValues, Post
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
 from pygoby.protobuf.pygoby.apps.topside_config_pb2 import LiaisonAppConfig
-from pygoby.topside.acomms_config import AcommsMessageSet
 from pygoby.topside.commander import CommanderError, CommandSet
 from pygoby.topside.liaison.state import LiaisonState
 from pygoby.topside.liaison.web import WebServer

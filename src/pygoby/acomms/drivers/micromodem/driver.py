@@ -20,12 +20,14 @@ import datetime as dt
 import logging
 import math
 from collections import deque
+from collections.abc import Callable, Iterable
 from enum import Enum, auto
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
 from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
+from pygoby.acomms.drivers.micromodem.sentence_link import SentenceLink, sentence_link
 from pygoby.acomms.drivers.micromodem.statistics import (
     CycleStatistics,
     add_cst,
@@ -35,7 +37,7 @@ from pygoby.acomms.drivers.micromodem.statistics import (
 from pygoby.acomms.errors import ModemDriverError
 from pygoby.protobuf.goby.acomms.protobuf.mm_driver_pb2 import TransmissionType
 from pygoby.util.clock import Clock
-from pygoby.util.errors import LinkClosedError, NMEAError
+from pygoby.util.errors import NMEAError
 from pygoby.util.nmea import NMEASentence
 
 log = logging.getLogger(__name__)
@@ -84,7 +86,7 @@ class MMDriver(ModemDriverBase):
         self.app_acks: ApplicationAcks | None = None
         self.nvram: dict[str, int] = {}
         self.revision: tuple[int, int, int] = (0, 0, 0)
-        self._typed = False  # the link carries sentences, not text
+        self._sentences: SentenceLink | None = None  # the link, read and written as sentences
         self._buoy = 0  # Hydroid gateway buoy id (prefixes)
         self._keep_alive_seconds = 0
         self._reset_state()
@@ -132,7 +134,7 @@ class MMDriver(ModemDriverBase):
         self._buoy = self.mm_cfg.hydroid_gateway_id
         self._keep_alive_seconds = self.mm_cfg.keep_alive_seconds
         self.modem_start(cfg)
-        self._typed = hasattr(self.link, "read_sentences")
+        self._sentences = sentence_link(self, self._buoy)
         self.app_acks = None
         if self.mm_cfg.use_application_acks:
             ids = {cfg.modem_id, *self.mm_cfg.additional_application_ack_modem_id}
@@ -180,13 +182,10 @@ class MMDriver(ModemDriverBase):
         if link_open and not self._link_was_open:
             self._written_at = None  # (re)connected: rewrite the outstanding sentence now
         self._link_was_open = link_open
-        if self._typed:
-            sentences = self.link.read_sentences()  # type: ignore[attr-defined]  # (hasattr)
-            if sentences:
-                self._handle_sentences(sentences)
-        else:
-            for line in self.modem_read():
-                self._handle_line(line)
+        assert self._sentences is not None
+        sentences = self._sentences.read_sentences()
+        if sentences:  # (a direct link's empty list: the common case in a simulation)
+            self._handle_sentences(sentences)
         if not link_open:
             return  # a dead link is the link's business (it reconnects); do not count failures
         now = self.clock.now()
@@ -239,20 +238,8 @@ class MMDriver(ModemDriverBase):
     def _try_write(self, now: float) -> None:
         if not self._out or self._written_at is not None or now < self._hold_until:
             return
-        sentence = self._out[0]
-        if self._typed:
-            try:
-                self.link.write_sentence(sentence)  # type: ignore[union-attr]  # (_typed)
-            except LinkClosedError as exc:
-                raise ModemDriverError(str(exc), Status.CONNECTION_TO_MODEM_FAILED) from exc
-            if self.signal_raw_outgoing or self._raw_log is not None:
-                self._log_raw("[tx] ", sentence.message())
-                self.emit_raw(False, sentence.message())
-        else:
-            text = sentence.message()
-            buoy = self._buoy
-            self.modem_write((f"#M{buoy}" if buoy else "") + text + "\r\n")
-            self.emit_raw(False, text)
+        assert self._sentences is not None
+        self._sentences.write_sentence(self._out[0])
         self._written_at = now
         self._tries += 1
 
@@ -364,31 +351,7 @@ class MMDriver(ModemDriverBase):
             self._clock_set = False
 
     # ------------------------------------------------------------------ incoming
-    def _handle_line(self, line: str) -> None:
-        if self._buoy:
-            line = line[3:]
-        text = line.strip()
-        if not text:
-            return
-        self.emit_raw(True, text)
-        try:
-            sentence = NMEASentence.parse(line)
-        except NMEAError as exc:
-            log.warning("ignoring invalid line from the modem: %s", exc)
-            return
-        self._dispatch((sentence,))
-
-    def _handle_sentences(self, sentences: list) -> None:
-        """Sentences from a typed link (parsed already; `$CACST` as its values)."""
-        if self.signal_raw_incoming or self._raw_log is not None:
-            for sentence in sentences:
-                self._log_raw("[rx] ", sentence.message())
-                self.emit_raw(True, sentence.message())
-                self._dispatch((sentence,))
-        else:
-            self._dispatch(sentences)
-
-    def _dispatch(self, sentences) -> None:
+    def _handle_sentences(self, sentences: Iterable[NMEASentence]) -> None:
         """Handle valid sentences from the modem (received now), in order."""
         for sentence in sentences:
             self._fails = 0
@@ -882,9 +845,25 @@ def _hex(text: str, max_bytes: int) -> bytes:
     return bytes.fromhex(text)
 
 
-# sentence id -> handler (`_on_xyz` handles `XYZ`, whatever the talker)
-_HANDLERS = {
-    name[4:].upper(): handler
-    for name, handler in vars(MMDriver).items()
-    if name.startswith("_on_") and callable(handler)
+# sentence id (whatever the talker) -> its handler
+_HANDLERS: dict[str, Callable[[MMDriver, NMEASentence], None]] = {
+    "REV": MMDriver._on_rev,
+    "ERR": MMDriver._on_err,
+    "CFG": MMDriver._on_cfg,
+    "CLK": MMDriver._on_clk,
+    "TMS": MMDriver._on_tms,
+    "TMQ": MMDriver._on_tmq,
+    "CYC": MMDriver._on_cyc,
+    "DRQ": MMDriver._on_drq,
+    "XST": MMDriver._on_xst,
+    "ACK": MMDriver._on_ack,
+    "RXD": MMDriver._on_rxd,
+    "MSG": MMDriver._on_msg,
+    "CST": MMDriver._on_cst,
+    "MPR": MMDriver._on_mpr,
+    "MPA": MMDriver._on_mpa,
+    "RDP": MMDriver._on_rdp,
+    "MUA": MMDriver._on_mua,
+    "MER": MMDriver._on_mer,
+    "TTA": MMDriver._on_tta,
 }

@@ -10,7 +10,7 @@ arrive (the channel and the modem emulators use this).
 
 `ManagerConnection` adds the line protocol for one client connection: feed it the bytes received
 and it returns the response lines to write, logging and skipping bad lines. It has no I/O of its
-own; `pygoby.netsim.server` runs it on asyncio TCP connections.
+own; `pygoby.netsim.manager.server` runs it on asyncio TCP connections.
 
 Difference from upstream (configurable, `reject_nonfinite_position`, default on): a NaN or
 infinite lat, lon or depth is answered UPDATE_FAILED_OUT_OF_DEFINED_REGION; upstream accepts NaN
@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from typing import Final, cast
 
 from pygoby.netsim.errors import LineError
-from pygoby.netsim.protocol import (
+from pygoby.netsim.manager.protocol import (
     LEGACY_RESPONSE_NAME,
     RESPONSE_NAME,
     EnvironmentNavUpdate,

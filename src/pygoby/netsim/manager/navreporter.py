@@ -15,7 +15,7 @@ import math
 from collections.abc import Mapping
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.netsim.protocol import NavUpdate, ReceiveStats
+from pygoby.netsim.manager.protocol import NavUpdate, ReceiveStats
 from pygoby.util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)

@@ -21,9 +21,9 @@ from collections.abc import Callable
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mmsim.server import MMSimServer
-from pygoby.netsim.scenario import speed_factor
-from pygoby.netsim.server import ManagerServer
-from pygoby.netsim.sim import EventSink, RunSummary, Simulation, driver_config
+from pygoby.netsim.manager.server import ManagerServer
+from pygoby.netsim.sim.scenario import speed_factor
+from pygoby.netsim.sim.simulation import EventSink, RunSummary, Simulation, driver_config
 from pygoby.protobuf.pygoby.netsim.scenario_pb2 import Scenario
 from pygoby.util.clock import Clock, WallClock
 

@@ -7,7 +7,7 @@
   `ports` maps emulator names to ports, or an emulator named by its port ("62000") needs none;
 * positions are whatever the physics Channel knows: follow a NetSimManager with
   ``manager.on_nav(physics.channel.on_environment_nav_update)``, or feed scripted tracks with
-  ``physics.channel.update_position(port, Position(...))``;
+  ``physics.channel.update_position(port, NavFix(...))``;
 * `transmit` registers the packet as a Transmission starting at its `tx_time` and lasting its
   `duration` (the emulator's duration table, pygoby.acomms.mmsim.timing); `do_work` asks the
   Channel at the clock's now which receptions have locked their receivers (the emulator prints
@@ -22,7 +22,7 @@
 * `$CACST` numbers (SNR, SPL, Doppler, ...) come from `pygoby.netsim.channel.stats`; ping replies
   are timed by the emulators themselves (travel times from the arrival times the physics gives);
 * every transmission and reception is emitted by `signal_event` (the `on_event` argument is
-  connected to it) as a dict (JSON-ready), which `pygoby.netsim.eventlog` writes as the run's
+  connected to it) as a dict (JSON-ready), which `pygoby.netsim.report.eventlog` writes as the run's
   event log; an event is only made when someone listens, and `transmissions` and `outcomes`
   (receptions by outcome) count them in any case.
 
@@ -39,9 +39,12 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import cast
 
-from pygoby.acomms.mmsim.channel import AcousticPacket, ChannelEndpoint
-from pygoby.acomms.mmsim.channel import PacketKind as ModemPacketKind
-from pygoby.acomms.mmsim.channel import Reception as ModemReception
+from pygoby.acomms.mmsim.channel import (
+    AcousticPacket,
+    ChannelEndpoint,
+    ModemPacketKind,
+    ModemReception,
+)
 from pygoby.netsim.channel import Channel, Outcome, PacketKind, Reception, Transmission
 from pygoby.netsim.channel.stats import link_statistics
 from pygoby.util.clock import Clock
@@ -105,7 +108,7 @@ class PhysicsChannel:
         self.outcomes: Counter[str] = Counter()  # receptions by outcome
         self.delivered: Counter[int] = Counter()  # packets handed to each port's modem
 
-    # -- the mmsim Channel interface -----------------------------------------------------------
+    # -- the mmsim ModemChannel interface --------------------------------------------------------
 
     def port_of(self, endpoint: ChannelEndpoint) -> int:
         port = self.ports.get(endpoint.name)

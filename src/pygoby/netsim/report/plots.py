@@ -18,13 +18,15 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
 from typing import Any
 
-import matplotlib.pyplot as plt  # noqa: E402
+from pygoby.util.extras import needs_extra
+
+with needs_extra("sim", "netsim reports"):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
 
 KIND_COLOURS = {
     "data": "tab:blue",

@@ -12,7 +12,7 @@ import logging
 import math
 from collections.abc import Callable
 
-from pygoby.netsim.protocol import EnvironmentNavUpdate, NavUpdate
+from pygoby.netsim.manager.protocol import EnvironmentNavUpdate, NavUpdate
 from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
 from pygoby.util.clock import Clock
 from pygoby.util.nmea import with_checksum

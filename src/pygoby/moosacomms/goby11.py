@@ -1,5 +1,5 @@
-"""pAcommsHandler's wiring of the Goby 1.1 MOOS variables that goby3 lacks or spells differently
-(the XML message sets themselves are pygoby.acomms.transitional):
+"""pAcommsHandler's handling of the Goby 1.1 MOOS variables that goby3 lacks or spells
+differently (the XML message sets themselves are pygoby.moosacomms.transitional):
 
 * `Goby11Variables`: CCL queues (`out_pubsub_var` -> queue, received frames ->
   `in_pubsub_var`), ACOMMS_INCOMING_DATA / ACOMMS_OUTGOING_DATA (ModemDataTransmission text),

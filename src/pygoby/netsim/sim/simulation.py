@@ -14,11 +14,11 @@ discrete-event simulation: the sans-I/O cores are connected in memory
 (pygoby.acomms.mmsim.link.ModemLink: the driver's sentences go straight into its emulator and the
 emulator's answers, parsed, into the driver's buffer) and the clock jumps to the next thing that
 can happen — an emulator's timed event, a reception's delivery, a MAC slot, a position update,
-periodic housekeeping — so a day of TDMA traffic runs in seconds. `pygoby.netsim.realtime` runs
+periodic housekeeping — so a day of TDMA traffic runs in seconds. `pygoby.netsim.sim.realtime` runs
 the same objects on the wall clock over TCP.
 
 Events go to `on_event` (`summary()` counts them): `tx` and `rx` from the channel (see
-`pygoby.netsim.physics_channel`), `app_rx` when a queue delivers a status message (port of the
+`pygoby.netsim.sim.physics_channel`), `app_rx` when a queue delivers a status message (port of the
 receiver, src, msg_t: the message's time stamp), `range` when a driver reports a ranging reply (port, src, dest, owtt list).
 """
 
@@ -40,11 +40,11 @@ from pygoby.acomms.mmsim import MicroModemModel
 from pygoby.acomms.mmsim.link import ModemLink
 from pygoby.acomms.queue import QueueManager
 from pygoby.dccl import Codec
-from pygoby.netsim.channel import Channel, Position
-from pygoby.netsim.manager import NetSimManager
-from pygoby.netsim.physics_channel import PhysicsChannel
-from pygoby.netsim.protocol import request_class
-from pygoby.netsim.scenario import (
+from pygoby.netsim.channel import Channel, NavFix
+from pygoby.netsim.manager.core import NetSimManager
+from pygoby.netsim.manager.protocol import request_class
+from pygoby.netsim.sim.physics_channel import PhysicsChannel
+from pygoby.netsim.sim.scenario import (
     TrackFollower,
     channel_config,
     mac_config,
@@ -266,7 +266,7 @@ class Simulation:
 
     # -- positions -------------------------------------------------------------------------------
 
-    def track_positions(self) -> list[tuple[int, Position]]:
+    def track_positions(self) -> list[tuple[int, NavFix]]:
         """(modem port, position now) of every node with a scripted track."""
         now = self.clock.now()
         elapsed = now - self.start

@@ -18,12 +18,12 @@ from pathlib import Path
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, ModemTiming
-from pygoby.netsim.channel import Band, ChannelConfig, Position
-from pygoby.netsim.channel.errors import ProtocolModel
+from pygoby.netsim.channel import Band, ChannelConfig, NavFix
+from pygoby.netsim.channel.frame_errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.channel.settings import absorption_of, propagation_of, sound_speed_of
-from pygoby.netsim.config import config_class as manager_config_class
 from pygoby.netsim.errors import ScenarioError
+from pygoby.netsim.manager.config import config_class as manager_config_class
 from pygoby.protobuf import initialization_errors
 from pygoby.protobuf.goby.acomms.protobuf.amac_config_pb2 import MACConfig
 from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
@@ -256,24 +256,24 @@ class TrackFollower:
             raise ScenarioError(f"waypoint out of range: lat {lat}, lon {lon}, depth {w.depth}")
         return _Fix(w.t, lat, lon, w.depth)
 
-    def position(self, elapsed: float, now: float) -> Position:
+    def position(self, elapsed: float, now: float) -> NavFix:
         """The position `elapsed` seconds after the start, stamped with `now`."""
         fixes = self.fixes
         if len(fixes) == 1:
             f = fixes[0]
             if not self.speed:  # a fixed node: what dead-reckoning below gives, in one step
-                return Position(f.lat, f.lon, f.depth, now, self.speed, self.heading)
-            start = Position(f.lat, f.lon, f.depth, now - elapsed + f.t, self.speed, self.heading)
+                return NavFix(f.lat, f.lon, f.depth, now, self.speed, self.heading)
+            start = NavFix(f.lat, f.lon, f.depth, now - elapsed + f.t, self.speed, self.heading)
             return start.at(now)
         i = bisect.bisect_right(self._times, elapsed)
         if i == 0 or i == len(fixes):  # before the first or after the last: hold
             f = fixes[0 if i == 0 else -1]
-            return Position(f.lat, f.lon, f.depth, now)
+            return NavFix(f.lat, f.lon, f.depth, now)
         a, b = fixes[i - 1], fixes[i]
         azimuth, _, distance = WGS84.inv(a.lon, a.lat, b.lon, b.lat)
         fraction = (elapsed - a.t) / (b.t - a.t)
         lon, lat, _ = WGS84.fwd(a.lon, a.lat, azimuth, distance * fraction)
-        return Position(
+        return NavFix(
             lat,
             lon,
             a.depth + (b.depth - a.depth) * fraction,

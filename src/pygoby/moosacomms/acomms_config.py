@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.transitional import TransitionalMessages
 from pygoby.dccl import Codec, DcclError
 from pygoby.dccl.libraries import BuiltinLibrary, split_libraries
 from pygoby.errors import ConfigError
@@ -30,7 +29,8 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import Translator
-from pygoby.moos.translator_binding import MessageTypes, not_found
+from pygoby.moosacomms.transitional import TransitionalMessages
+from pygoby.moosacomms.translator_binding import MessageTypes, not_found
 from pygoby.protobuf import ProtoLoader
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
     pAcommsHandlerConfig,

@@ -24,7 +24,7 @@ from collections.abc import Callable, Iterable
 from typing import cast
 
 from pygoby.netsim.errors import LineError
-from pygoby.netsim.protocol import (
+from pygoby.netsim.manager.protocol import (
     LEGACY_REQUEST_NAME,
     REQUEST_NAME,
     LineDecoder,
