@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from pygoby.acomms.drivers.micromodem.statistics import CycleStatistics, parse_cst
 from pygoby.acomms.mmsim import AcousticPacket, LoopbackChannel, MicroModemModel, ModemPacketKind
 from pygoby.acomms.mmsim.channel import ModemReception
+from pygoby.acomms.mmsim.model import COMMAND_HANDLERS
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.util.clock import VirtualClock
 from pygoby.util.nmea import NMEASentence
@@ -390,29 +391,7 @@ def test_mm2_statistics_carry_their_version_and_date():
     assert fields[1:4] == ("6", "0", "20231114221320.2500")
 
 
-HOST_COMMANDS = [
-    "CFG",
-    "CFQ",
-    "MSC",
-    "CLK",
-    "CLQ",
-    "TMS",
-    "TMQ",
-    "ALQ",
-    "CYC",
-    "TXD",
-    "MPC",
-    "MUC",
-    "TDP",
-    "MEC",
-    "PDT",
-    "PNT",
-    "PGT",
-    "SWP",
-    "MSQ",
-    "RSP",
-    "XYZ",
-]
+HOST_COMMANDS = [*COMMAND_HANDLERS, "XYZ"]  # every command the model knows, and one it does not
 FIELDS = st.one_of(
     st.integers(-(2**70), 2**70).map(str),
     st.sampled_from(

@@ -21,6 +21,7 @@ from pygoby.dccl.xml import load_message_set
 from pygoby.moos.client import MOOSClient
 from pygoby.util.clock import WallClock
 from tests.apps.acomms_mission import Recorder, modem_and_db, two_vehicle_missions
+from tests.goby11.missions import micromodem_driver_goby11
 from tests.goby11.seed_listings import EXAMPLES
 
 DATA = Path(__file__).parents[1] / "data" / "vectors" / "goby11-dccl1"
@@ -90,14 +91,7 @@ ProcessConfig = pAcommsHandler
     initializer {{ type: INI_DOUBLE moos_var: "NAV_DEPTH" dval: 7 }}
   }}
   modem_id: 2
-  driver_type: DRIVER_WHOI_MICROMODEM
-  driver_cfg
-  {{
-    connection_type: CONNECTION_TCP_AS_CLIENT
-    tcp_server: "127.0.0.1"
-    tcp_port: {modem_port}
-    [MicroModemConfig.reset_nvram]: false
-  }}
+{micromodem_driver_goby11(modem_port)}
   mac_cfg
   {{
     type: MAC_FIXED_DECENTRALIZED
@@ -188,14 +182,7 @@ ProcessConfig = pAcommsHandler
 {{
   common {{ verbosity: VERBOSITY_WARN log: false app_tick: 20 }}
   modem_id: {modem_id}
-  driver_type: DRIVER_WHOI_MICROMODEM
-  driver_cfg
-  {{
-    connection_type: CONNECTION_TCP_AS_CLIENT
-    tcp_server: "127.0.0.1"
-    tcp_port: {modem_port}
-    [MicroModemConfig.reset_nvram]: false
-  }}
+{micromodem_driver_goby11(modem_port)}
   mac_cfg
   {{
     type: MAC_FIXED_DECENTRALIZED

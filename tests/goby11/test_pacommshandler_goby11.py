@@ -19,6 +19,7 @@ from pygoby.dccl.xml import load_message_set
 from pygoby.moos.client import MOOSClient
 from pygoby.util.clock import WallClock
 from tests.apps.acomms_mission import two_vehicle_missions
+from tests.goby11.missions import micromodem_driver_goby11
 from tests.goby11.seed_listings import EXAMPLES
 
 SIMPLE_STATUS = EXAMPLES / "xml" / "simple_status.xml"
@@ -48,14 +49,7 @@ ProcessConfig = pAcommsHandler
     initializer {{ type: INI_DOUBLE moos_var: "NAV_DEPTH" dval: 20 }}
   }}
   modem_id: {modem_id}
-  driver_type: DRIVER_WHOI_MICROMODEM
-  driver_cfg
-  {{
-    connection_type: CONNECTION_TCP_AS_CLIENT
-    tcp_server: "127.0.0.1"
-    tcp_port: {modem_port}
-    [MicroModemConfig.reset_nvram]: false
-  }}
+{micromodem_driver_goby11(modem_port)}
   mac_cfg
   {{
     type: MAC_FIXED_DECENTRALIZED

@@ -217,23 +217,31 @@ def test_rx_event_figures_are_rounded():
     """Every rx event carries the reception's figures rounded, a zero and the sign of a
     negative zero included (links recur: the same figures each time)."""
 
-    def fresh(range_m, owtt, rl, noise, sinr):
-        snr = rl - noise
-        return (
-            round(range_m, 3),
-            round(owtt, 6),
-            round(rl, 2),
-            round(snr, 2),
-            round(sinr, 2),
-            sinr < snr - 0.01,
-        )
-
-    cases = [
-        (1234.56789, 0.8230452, 120.4449, 62.3, 58.1449),
-        (1234.56789, 0.8230452, 120.4449, 62.3, 50.0),  # a collision
-        (0.0, 0.0, 185.0, 62.3, -0.004),  # a zero: not remembered
-        (10.0, 0.0066, 62.3, 62.3, -0.0),  # -0.0 keeps its sign
-    ] * 2
+    # (range, owtt, received level, noise, sinr) -> (range, owtt, rl, snr, sinr, collision)
+    figures = {
+        (1234.56789, 0.8230452, 120.4449, 62.3, 58.1449): (
+            1234.568,
+            0.823045,
+            120.44,
+            58.14,
+            58.14,
+            False,
+        ),
+        # a collision: the sinr is below the snr
+        (1234.56789, 0.8230452, 120.4449, 62.3, 50.0): (
+            1234.568,
+            0.823045,
+            120.44,
+            58.14,
+            50.0,
+            True,
+        ),
+        # a zero: not remembered
+        (0.0, 0.0, 185.0, 62.3, -0.004): (0.0, 0.0, 185.0, 122.7, -0.0, True),
+        # -0.0 keeps its sign
+        (10.0, 0.0066, 62.3, 62.3, -0.0): (10.0, 0.0066, 62.3, 0.0, -0.0, False),
+    }
+    cases = list(figures) * 2
     events: list[dict] = []
     net = Net({62000: 0.0, 62001: 1500.0}, events=events.append)
     # the physics' receptions, with the levels of the cases in turn
@@ -256,8 +264,8 @@ def test_rx_event_figures_are_rounded():
     assert len(rx) == len(cases)
     for event, case in zip(rx, cases, strict=True):
         got = tuple(event[key] for key in ("range_m", "owtt", "rl", "snr", "sinr", "collision"))
-        assert got == fresh(*case)
-        assert [str(x) for x in got] == [str(x) for x in fresh(*case)]
+        assert got == figures[case]
+        assert [str(x) for x in got] == [str(x) for x in figures[case]]
 
 
 def test_a_cycle_init_run_late_still_precedes_its_data():

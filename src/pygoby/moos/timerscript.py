@@ -44,7 +44,9 @@ class Event:
 
 
 @dataclass
-class Post:
+class TimedPost:
+    """One post the script makes when an event comes due."""
+
     var: str
     value: Value
 
@@ -262,10 +264,10 @@ class TimerScript:
                 self.paused = not self.paused
         self.values[var] = value
 
-    def tick(self, now: float) -> list[Post]:
+    def tick(self, now: float) -> list[TimedPost]:
         if self.db_start is None:
             self.db_start = now
-        posts: list[Post] = []
+        posts: list[TimedPost] = []
         ok = all(c.evaluate(self.values) for c in self.conditions)
         if ok and not self.conditions_ok:  # an awakening
             if self.upon_awake == "reset" and self._elapsed > 0:
@@ -311,7 +313,7 @@ class TimerScript:
         self._previous = None
         self._posted = 0
 
-    def _ready_posts(self, now: float, posts: list[Post]) -> bool:
+    def _ready_posts(self, now: float, posts: list[TimedPost]) -> bool:
         for index, event in enumerate(self.events):
             if event.posted or self._elapsed - self._delay < event.time:
                 continue
@@ -323,13 +325,13 @@ class TimerScript:
             posts.append(self._post(event, index, now))
         return all(e.posted for e in self.events)
 
-    def _post(self, event: Event, index: int, now: float) -> Post:
+    def _post(self, event: Event, index: int, now: float) -> TimedPost:
         if event.quit:
             self.quit = True
-            return Post(event.var, event.value)
+            return TimedPost(event.var, event.value)
         value = event.value
         if not isinstance(value, str):
-            return Post(event.var, value)
+            return TimedPost(event.var, value)
         uptime = now - (self.db_start or now)
         macros = {
             "DBTIME": f"{uptime:.2f}",
@@ -341,12 +343,12 @@ class TimerScript:
         }
         whole = re.fullmatch(r"\$[(\[](DBTIME|UTCTIME|UTC|COUNT|TCOUNT)[)\]]", value)
         if whole:  # the macro is the whole value: posted as a double
-            return Post(event.var, float(macros[whole.group(1)]))
+            return TimedPost(event.var, float(macros[whole.group(1)]))
         for name, text in macros.items():
             value = value.replace(f"$({name})", text).replace(f"$[{name}]", text)
         if _is_number(value) and not event.quoted:
-            return Post(event.var, float(value))
-        return Post(event.var, value)
+            return TimedPost(event.var, float(value))
+        return TimedPost(event.var, value)
 
     def _reset(self) -> None:
         if self.reset_max is not None and self.reset_count >= self.reset_max:

@@ -24,3 +24,20 @@ else:  # the upb module exists only with protobuf's C backend
 
 # a function that makes or parses a message of the class it is given returns that class
 MessageT = TypeVar("MessageT", bound=Message)
+
+_FD = descriptor.FieldDescriptor
+# the integer field types (every width and encoding; enums not included)
+INTEGER_FIELD_TYPES = frozenset(
+    {
+        _FD.TYPE_INT32,
+        _FD.TYPE_INT64,
+        _FD.TYPE_UINT32,
+        _FD.TYPE_UINT64,
+        _FD.TYPE_SINT32,
+        _FD.TYPE_SINT64,
+        _FD.TYPE_FIXED32,
+        _FD.TYPE_FIXED64,
+        _FD.TYPE_SFIXED32,
+        _FD.TYPE_SFIXED64,
+    }
+)

@@ -21,23 +21,9 @@ from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
-from pygoby.protobuf.descriptors import AnyFieldDescriptor
+from pygoby.protobuf.descriptors import INTEGER_FIELD_TYPES, AnyFieldDescriptor
 
 PORT_MAX = 65535
-_INTEGER_TYPES = frozenset(
-    {
-        FieldDescriptor.TYPE_INT32,
-        FieldDescriptor.TYPE_INT64,
-        FieldDescriptor.TYPE_UINT32,
-        FieldDescriptor.TYPE_UINT64,
-        FieldDescriptor.TYPE_SINT32,
-        FieldDescriptor.TYPE_SINT64,
-        FieldDescriptor.TYPE_FIXED32,
-        FieldDescriptor.TYPE_FIXED64,
-        FieldDescriptor.TYPE_SFIXED32,
-        FieldDescriptor.TYPE_SFIXED64,
-    }
-)
 
 
 def read_config_file(
@@ -211,5 +197,5 @@ def _integer_values(message: Message, prefix: str) -> Iterator[tuple[str, AnyFie
             item_path = f"{path}[{index}]" if field.is_repeated else path
             if field.type == FieldDescriptor.TYPE_MESSAGE:
                 yield from _integer_values(item, item_path + ".")
-            elif field.type in _INTEGER_TYPES:
+            elif field.type in INTEGER_FIELD_TYPES:
                 yield item_path, field, item

@@ -273,7 +273,7 @@ class MicroModemModel:
 
     def handle_sentence(self, s: NMEASentence) -> None:
         sentence_id = s.sentence_id
-        command = _COMMANDS.get(sentence_id) if s.talker_id == "CC" else None
+        command = COMMAND_HANDLERS.get(sentence_id) if s.talker_id == "CC" else None
         if command is None or (sentence_id in _MM2_COMMANDS and not self.mm2):
             self._error("NMEA", 2, f"Unknown command {s.fields[0][1:]}")
             return
@@ -822,30 +822,37 @@ _RATE, _BAD_FRAMES = CST_FIELD_INDEX["rate"], CST_FIELD_INDEX["number_bad_frames
 _RXP = NMEASentence.build("$CARXP", [0])  # (sentences are immutable: one serves every packet)
 _XST_KINDS = (ModemPacketKind.DATA, ModemPacketKind.CYCLE, ModemPacketKind.FDP)
 # sentence id -> handler; those only a Micro-Modem 2 knows
-_COMMANDS = {
-    name: getattr(MicroModemModel, "_cmd_" + name.lower())
-    for name in (
-        "CFG",
-        "CFQ",
-        "MSC",
-        "CLK",
-        "CLQ",
-        "TMS",
-        "TMQ",
-        "ALQ",
-        "CYC",
-        "TXD",
-        "MPC",
-        "MUC",
-        "TDP",
-        "MEC",
-        "PDT",
-        "PNT",
-        "PGT",
-        "SWP",
-        "MSQ",
-        "RSP",
-    )
+COMMAND_HANDLERS = {
+    "CFG": MicroModemModel._cmd_cfg,
+    "CFQ": MicroModemModel._cmd_cfq,
+    "MSC": MicroModemModel._cmd_msc,
+    "CLK": MicroModemModel._cmd_clk,
+    "CLQ": MicroModemModel._cmd_clq,
+    "TMS": MicroModemModel._cmd_tms,
+    "TMQ": MicroModemModel._cmd_tmq,
+    "ALQ": MicroModemModel._cmd_alq,
+    "CYC": MicroModemModel._cmd_cyc,
+    "TXD": MicroModemModel._cmd_txd,
+    "MPC": MicroModemModel._cmd_mpc,
+    "MUC": MicroModemModel._cmd_muc,
+    "TDP": MicroModemModel._cmd_tdp,
+    "MEC": MicroModemModel._cmd_mec,
+    "PDT": MicroModemModel._cmd_pdt,
+    "PNT": MicroModemModel._cmd_pnt,
+    "PGT": MicroModemModel._cmd_pgt,
+    "SWP": MicroModemModel._cmd_swp,
+    "MSQ": MicroModemModel._cmd_msq,
+    "RSP": MicroModemModel._cmd_rsp,
 }
 _MM2_COMMANDS = frozenset({"TMS", "TMQ", "ALQ", "TDP"})
-_HEARD = {kind: getattr(MicroModemModel, "_heard_" + kind.value) for kind in ModemPacketKind}
+_HEARD = {
+    ModemPacketKind.DATA: MicroModemModel._heard_data,
+    ModemPacketKind.CYCLE: MicroModemModel._heard_cycle,
+    ModemPacketKind.ACK: MicroModemModel._heard_ack,
+    ModemPacketKind.PING: MicroModemModel._heard_ping,
+    ModemPacketKind.PING_REPLY: MicroModemModel._heard_ping_reply,
+    ModemPacketKind.MINI: MicroModemModel._heard_mini,
+    ModemPacketKind.FDP: MicroModemModel._heard_fdp,
+    ModemPacketKind.HW_CONTROL: MicroModemModel._heard_hw_control,
+    ModemPacketKind.SIGNAL: MicroModemModel._heard_signal,
+}

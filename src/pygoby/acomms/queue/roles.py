@@ -11,22 +11,10 @@ from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import RoleError
-from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
+from pygoby.protobuf.descriptors import INTEGER_FIELD_TYPES, AnyDescriptor, AnyFieldDescriptor
 
 Role = acomms_pb.QueuedMessageEntry.Role
-_INTEGER_TYPES = {
-    FieldDescriptor.TYPE_INT32,
-    FieldDescriptor.TYPE_INT64,
-    FieldDescriptor.TYPE_UINT32,
-    FieldDescriptor.TYPE_UINT64,
-    FieldDescriptor.TYPE_SINT32,
-    FieldDescriptor.TYPE_SINT64,
-    FieldDescriptor.TYPE_FIXED32,
-    FieldDescriptor.TYPE_FIXED64,
-    FieldDescriptor.TYPE_SFIXED32,
-    FieldDescriptor.TYPE_SFIXED64,
-    FieldDescriptor.TYPE_ENUM,
-}
+_INTEGER_TYPES = INTEGER_FIELD_TYPES | {FieldDescriptor.TYPE_ENUM}  # (an enum id is a number)
 
 
 @dataclass(frozen=True)

@@ -75,22 +75,26 @@ def propagation_of(settings: ChannelSettingsLike, sound_speed) -> BellhopLoss | 
     return propagation_model(settings.propagation, sound_speed, settings.spreading)
 
 
+def protocol_model_of(settings: ChannelSettingsLike) -> ProtocolModel | None:
+    """The range-based protocol model of settings with a `protocol_model` field, if set."""
+    if not settings.HasField("protocol_model"):
+        return None
+    p = settings.protocol_model
+    return ProtocolModel(
+        p.communication_range,
+        p.detection_range,
+        p.interference_range,
+        p.p_detection,
+        p.p_decoding,
+    )
+
+
 def channel_config_from_proto(settings: ChannelModelConfig) -> tuple[ChannelConfig, int]:
     """(ChannelConfig, seed) for a ChannelModelConfig message. Raises ValueError."""
     sound_speed = sound_speed_of(settings)
     absorption = absorption_of(settings)
     by_rate = dict(DEFAULT_RATE_MODELS)
     by_rate.update({entry.rate: _rate_model(entry) for entry in settings.rate_model})
-    protocol = None
-    if settings.HasField("protocol_model"):
-        p = settings.protocol_model
-        protocol = ProtocolModel(
-            p.communication_range,
-            p.detection_range,
-            p.interference_range,
-            p.p_detection,
-            p.p_decoding,
-        )
     config = ChannelConfig(
         sound_speed=sound_speed,
         source_level=settings.source_level,
@@ -110,7 +114,7 @@ def channel_config_from_proto(settings: ChannelModelConfig) -> tuple[ChannelConf
         receiver_lock=settings.receiver_lock,
         decode_latency=settings.decode_latency,
         position_staleness=settings.position_staleness,
-        protocol_model=protocol,
+        protocol_model=protocol_model_of(settings),
         propagation=propagation_of(settings, sound_speed),
     )
     return config, settings.seed

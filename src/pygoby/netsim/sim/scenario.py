@@ -19,9 +19,13 @@ from pathlib import Path
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, ModemTiming
 from pygoby.netsim.channel import Band, ChannelConfig, NavFix
-from pygoby.netsim.channel.frame_errors import ProtocolModel
 from pygoby.netsim.channel.geometry import WGS84
-from pygoby.netsim.channel.settings import absorption_of, propagation_of, sound_speed_of
+from pygoby.netsim.channel.settings import (
+    absorption_of,
+    propagation_of,
+    protocol_model_of,
+    sound_speed_of,
+)
 from pygoby.netsim.errors import ScenarioError
 from pygoby.netsim.manager.config import config_class as manager_config_class
 from pygoby.protobuf import initialization_errors
@@ -118,16 +122,6 @@ def node_ports(scenario: Scenario) -> list[int]:
 
 def channel_config(scenario: Scenario) -> ChannelConfig:
     c = scenario.channel
-    protocol = None
-    if c.HasField("protocol_model"):
-        p = c.protocol_model
-        protocol = ProtocolModel(
-            p.communication_range,
-            p.detection_range,
-            p.interference_range,
-            p.p_detection,
-            p.p_decoding,
-        )
     sound_speed = sound_speed_of(c)
     try:
         propagation = propagation_of(c, sound_speed)
@@ -145,7 +139,7 @@ def channel_config(scenario: Scenario) -> ChannelConfig:
         band=Band(c.carrier_hz, c.bandwidth_hz),
         half_duplex=c.half_duplex,
         receiver_lock=c.receiver_lock,
-        protocol_model=protocol,
+        protocol_model=protocol_model_of(c),
         decode_latency=c.decode_latency,
         position_staleness=c.position_staleness,
     )

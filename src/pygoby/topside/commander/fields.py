@@ -15,23 +15,11 @@ from google.protobuf.descriptor import FieldDescriptor
 from pygoby.dccl.options import field_options
 from pygoby.moos.translator.fields import enum_name
 from pygoby.protobuf import enum_type, message_type
-from pygoby.protobuf.descriptors import AnyFieldDescriptor
+from pygoby.protobuf.descriptors import INTEGER_FIELD_TYPES, AnyFieldDescriptor
 from pygoby.topside.commander import specials
 from pygoby.topside.errors import FieldValueError
 
 _FD = FieldDescriptor
-_INT_TYPES = {
-    _FD.TYPE_INT32,
-    _FD.TYPE_INT64,
-    _FD.TYPE_UINT32,
-    _FD.TYPE_UINT64,
-    _FD.TYPE_SINT32,
-    _FD.TYPE_SINT64,
-    _FD.TYPE_FIXED32,
-    _FD.TYPE_FIXED64,
-    _FD.TYPE_SFIXED32,
-    _FD.TYPE_SFIXED64,
-}
 _UNSIGNED = {_FD.TYPE_UINT32, _FD.TYPE_UINT64, _FD.TYPE_FIXED32, _FD.TYPE_FIXED64}
 _FLOAT_TYPES = {_FD.TYPE_DOUBLE, _FD.TYPE_FLOAT}
 
@@ -39,7 +27,7 @@ _FLOAT_TYPES = {_FD.TYPE_DOUBLE, _FD.TYPE_FLOAT}
 def _kind(field: AnyFieldDescriptor, codec: str) -> str:
     if codec == "_static" or codec.startswith("dccl.static"):
         return "static"
-    if field.type in _INT_TYPES:
+    if field.type in INTEGER_FIELD_TYPES:
         return "int"
     if field.type in _FLOAT_TYPES:
         return "float"

@@ -220,8 +220,8 @@ class MMDriver(ModemDriverBase):
                 self._initiate_mini(msg)
             elif kind == acomms_pb.MICROMODEM_FLEXIBLE_DATA:
                 self._initiate_fdp(msg)
-            elif kind in self._SIMPLE_COMMANDS:
-                getattr(self, self._SIMPLE_COMMANDS[kind])(msg)
+            elif kind in _SIMPLE_INITIATORS:
+                _SIMPLE_INITIATORS[kind](self, msg)
             else:
                 log.warning("Micro-Modem transmission type %d is not supported", kind)
         else:
@@ -716,15 +716,6 @@ class MMDriver(ModemDriverBase):
         msg.frame.append(_hex(s[3], 2))
         self.signal_receive.emit(msg)
 
-    _SIMPLE_COMMANDS = {
-        acomms_pb.MICROMODEM_REMUS_LBL_RANGING: "_initiate_remus_lbl",
-        acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING: "_initiate_narrowband_lbl",
-        acomms_pb.MICROMODEM_GENERIC_LBL_RANGING: "_initiate_generic_lbl",
-        acomms_pb.MICROMODEM_HARDWARE_CONTROL: "_initiate_hardware_control",
-        acomms_pb.MICROMODEM_FM_SWEEP: "_initiate_fm_sweep",
-        acomms_pb.MICROMODEM_M_SEQUENCE: "_initiate_m_sequence",
-    }
-
     def _lbl_params(self, msg: acomms_pb.ModemTransmission, name: str):
         """Configured LBL parameters merged with the request's own."""
         params = type(getattr(self.mm_cfg, name))()
@@ -866,4 +857,15 @@ _HANDLERS: dict[str, Callable[[MMDriver, NMEASentence], None]] = {
     "MUA": MMDriver._on_mua,
     "MER": MMDriver._on_mer,
     "TTA": MMDriver._on_tta,
+}
+
+
+# Micro-Modem transmission type -> the method that starts it by sending its sentences
+_SIMPLE_INITIATORS: dict[int, Callable[[MMDriver, acomms_pb.ModemTransmission], None]] = {
+    acomms_pb.MICROMODEM_REMUS_LBL_RANGING: MMDriver._initiate_remus_lbl,
+    acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING: MMDriver._initiate_narrowband_lbl,
+    acomms_pb.MICROMODEM_GENERIC_LBL_RANGING: MMDriver._initiate_generic_lbl,
+    acomms_pb.MICROMODEM_HARDWARE_CONTROL: MMDriver._initiate_hardware_control,
+    acomms_pb.MICROMODEM_FM_SWEEP: MMDriver._initiate_fm_sweep,
+    acomms_pb.MICROMODEM_M_SEQUENCE: MMDriver._initiate_m_sequence,
 }
