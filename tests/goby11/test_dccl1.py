@@ -114,7 +114,7 @@ def test_the_recorded_set_reaches_encryption_edges_and_lossy_cases() -> None:
 
 def test_the_layout_set_reaches_every_layout_rule() -> None:
     messages = {v["message"] for v in LAYOUTS}
-    assert messages == {"Arrays", "Deltas", "Repeated", "HexStatic", "Renamed", "Big"}
+    assert messages == {"Arrays", "Deltas", "Repeated", "HexStatic", "Renamed", "Big", "Edges"}
     cases = {(v["message"], v["case"]) for v in LAYOUTS}
     assert {
         ("Deltas", "beyond_max_delta"),
