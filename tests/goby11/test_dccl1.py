@@ -361,6 +361,28 @@ def test_cli_encode_decode_and_analyze(monkeypatch, capsys, tmp_path) -> None:
     assert any("Timestamp" in line and "17" in line for line in shown)
 
 
+def test_cli_writes_and_reads_a_recorded_libqueue_frame(monkeypatch, capsys) -> None:
+    # the way a user meets frames: a JSON list of messages in, Goby 1.1.2's frame out, and back
+    recorded = {(v["message"], v["case"]): v for v in LAYOUTS}
+    frame = next(f for f in FRAMES if f["case"] == "broadcast_middle")
+    requests = []
+    for part in frame["messages"]:
+        vector = recorded[(part["message"], part["case"])]
+        requests.append({k: vector[k] for k in ("message", "src", "dest", "time")})
+        requests[-1]["values"] = vector_values(vector)
+    xmls = ["--xml", str(DATA / "xml" / "layouts.xml")]
+    status, out = run_cli(
+        monkeypatch, capsys, "encode", "--goby11", *xmls, stdin=json.dumps(requests)
+    )
+    assert (status, out) == (0, [frame["frame"]])
+    status, decoded = run_cli(monkeypatch, capsys, "decode", "--goby11", *xmls, stdin=out[0])
+    parts = json.loads(decoded[0])
+    assert [m["values"] for m in parts] == [p["values"] for p in frame["parts"]]
+    # a broadcast message's header carries destination 0 (the 5-bit id)
+    assert [m["dest"] for m in parts] == [m["dest"] & 0x1F for m in frame["messages"]]
+    assert 0 in [m["dest"] for m in parts]
+
+
 def test_two_message_sets_with_one_id_are_refused() -> None:
     codec = Dccl1Codec()
     codec.load(MESSAGE_SETS["example1.xml"])
