@@ -1,6 +1,7 @@
-"""DCCL1 (Goby 1.1's own DCCL bytes) against 199 messages recorded from the real Goby 1.1.2
-libdccl, both ways; the layout rules the recorded set does not reach (arrays, <max_delta>,
-<repeat/>, hex); multi-message frames; the CLI; a fuzzed decoder."""
+"""DCCL1 (Goby 1.1's own DCCL bytes) against messages and multi-message frames recorded from the
+real Goby 1.1.2 libdccl, both ways (the manual's examples; our own set of arrays, <max_delta>,
+<repeat/>, hex, static, negative precision, renamed header fields); the layout rules spelled out
+bit by bit; the CLI; a fuzzed decoder."""
 
 from __future__ import annotations
 
@@ -20,7 +21,15 @@ from pygoby.errors import ConfigError
 
 DATA = Path(__file__).parents[1] / "data" / "vectors" / "goby11-dccl1"
 VECTORS = [json.loads(line) for line in (DATA / "vectors.jsonl").read_text().splitlines()]
-MESSAGE_SETS = {name: load_message_set(DATA / "xml" / name) for name in {v["xml"] for v in VECTORS}}
+# our own message set (arrays, <max_delta>, <repeat/>, hex, static, negative precision, renamed
+# header fields), recorded from the same Goby 1.1.2 libdccl
+LAYOUTS = [json.loads(line) for line in (DATA / "layouts.jsonl").read_text().splitlines()]
+# libqueue 1.1 frames of those messages, stitched and split by libqueue's byte rules around the
+# same libdccl's header coder
+FRAMES = [json.loads(line) for line in (DATA / "frames.jsonl").read_text().splitlines()]
+MESSAGE_SETS = {
+    name: load_message_set(DATA / "xml" / name) for name in {v["xml"] for v in VECTORS + LAYOUTS}
+}
 
 
 def codec_for(vector: dict) -> Dccl1Codec:
@@ -34,7 +43,7 @@ def vector_values(vector: dict) -> dict:
     return {key.split(":")[0]: value for key, value in vector["values"].items()}
 
 
-@pytest.mark.parametrize("vector", VECTORS, ids=lambda v: f"{v['message']}-{v['case']}")
+@pytest.mark.parametrize("vector", VECTORS + LAYOUTS, ids=lambda v: f"{v['message']}-{v['case']}")
 def test_encode_is_goby_112s_bytes(vector: dict) -> None:
     codec = codec_for(vector)
     encode = lambda: codec.encode(  # noqa: E731
@@ -51,14 +60,30 @@ def test_encode_is_goby_112s_bytes(vector: dict) -> None:
         assert encode().hex() == vector["hex"]
 
 
+# Goby 1.1.2 adds a delta to an unset key and reads NaN (floats) or the x86 cast of NaN to long
+# (ints); pygoby reads such an element as unset
+UNSET_KEY_GARBAGE = ("NaN", -(2**63))
+
+
+def unset_key_garbage_as_none(values: dict) -> dict:
+    return {
+        name: [None if v in UNSET_KEY_GARBAGE else v for v in value]
+        if isinstance(value, list)
+        else value
+        for name, value in values.items()
+    }
+
+
 @pytest.mark.parametrize(
-    "vector", [v for v in VECTORS if v["hex"]], ids=lambda v: f"{v['message']}-{v['case']}"
+    "vector",
+    [v for v in VECTORS + LAYOUTS if v["hex"]],
+    ids=lambda v: f"{v['message']}-{v['case']}",
 )
 def test_decode_reads_what_goby_112_read(vector: dict) -> None:
     decoded = codec_for(vector).decode(bytes.fromhex(vector["hex"]))
     expected = vector["decoded"]
     assert decoded.message == vector["message"]
-    assert decoded.values == expected["values"]
+    assert decoded.values == unset_key_garbage_as_none(expected["values"])
     head = expected["header"]
     assert (
         decoded.header.id,
@@ -85,6 +110,38 @@ def test_the_recorded_set_reaches_encryption_edges_and_lossy_cases() -> None:
     assert {"below", "above", "hdr_time_round_to_86400", "hdr_flags_set"} <= cases
     assert {v["passphrase"] for v in VECTORS} == {None, "my_passphrase!", "twinkletoes%24"}
     assert any(v["roundtrip"] == "lossy" for v in VECTORS)
+
+
+def test_the_layout_set_reaches_every_layout_rule() -> None:
+    messages = {v["message"] for v in LAYOUTS}
+    assert messages == {"Arrays", "Deltas", "Repeated", "HexStatic", "Renamed", "Big", "Edges"}
+    cases = {(v["message"], v["case"]) for v in LAYOUTS}
+    assert {
+        ("Deltas", "beyond_max_delta"),
+        ("Deltas", "key_unset"),
+        ("HexStatic", "short_hex"),
+    } <= cases
+    assert any(v["hex"] is None for v in LAYOUTS)
+    assert {v["passphrase"] for v in LAYOUTS} == {None, "layouts!", "renamed header"}
+
+
+@pytest.mark.parametrize("frame", FRAMES, ids=lambda f: f["case"])
+def test_frames_are_libqueue_112s_bytes_both_ways(frame: dict) -> None:
+    # stitch flags a message broadcast when the destination its header carries (5 bits) is 0
+    messages = [(bytes.fromhex(m["hex"]), m["dest"] & 0x1F) for m in frame["messages"]]
+    assert stitch(messages).hex() == frame["frame"]
+    parts = unstitch(bytes.fromhex(frame["frame"]))
+    assert [(p.data.hex(), p.broadcast) for p in parts] == [
+        (p["hex"], p["broadcast"]) for p in frame["parts"]
+    ]
+    codec = Dccl1Codec(passphrase=frame["passphrase"])
+    codec.load(MESSAGE_SETS[frame["xml"]])
+    for part, expected in zip(parts, frame["parts"], strict=True):
+        if expected.get("values") is None:
+            with pytest.raises(DcclDecodeError):
+                codec.decode(part.data)
+        else:
+            assert codec.decode(part.data).values == unset_key_garbage_as_none(expected["values"])
 
 
 def xml(body: str) -> str:
@@ -302,6 +359,28 @@ def test_cli_encode_decode_and_analyze(monkeypatch, capsys, tmp_path) -> None:
     status, shown = run_cli(monkeypatch, capsys, "analyze", "--goby11", *xmls[2:])
     assert status == 0 and "SIMPLE_STATUS (DCCL1 id 20)" in shown[0]
     assert any("Timestamp" in line and "17" in line for line in shown)
+
+
+def test_cli_writes_and_reads_a_recorded_libqueue_frame(monkeypatch, capsys) -> None:
+    # the way a user meets frames: a JSON list of messages in, Goby 1.1.2's frame out, and back
+    recorded = {(v["message"], v["case"]): v for v in LAYOUTS}
+    frame = next(f for f in FRAMES if f["case"] == "broadcast_middle")
+    requests = []
+    for part in frame["messages"]:
+        vector = recorded[(part["message"], part["case"])]
+        requests.append({k: vector[k] for k in ("message", "src", "dest", "time")})
+        requests[-1]["values"] = vector_values(vector)
+    xmls = ["--xml", str(DATA / "xml" / "layouts.xml")]
+    status, out = run_cli(
+        monkeypatch, capsys, "encode", "--goby11", *xmls, stdin=json.dumps(requests)
+    )
+    assert (status, out) == (0, [frame["frame"]])
+    status, decoded = run_cli(monkeypatch, capsys, "decode", "--goby11", *xmls, stdin=out[0])
+    parts = json.loads(decoded[0])
+    assert [m["values"] for m in parts] == [p["values"] for p in frame["parts"]]
+    # a broadcast message's header carries destination 0 (the 5-bit id)
+    assert [m["dest"] for m in parts] == [m["dest"] & 0x1F for m in frame["messages"]]
+    assert 0 in [m["dest"] for m in parts]
 
 
 def test_two_message_sets_with_one_id_are_refused() -> None:

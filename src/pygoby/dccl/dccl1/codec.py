@@ -158,7 +158,9 @@ class Dccl1Field:
             number = float(bits - 1) / math.pow(10.0, self.precision)
             if is_delta:
                 if key is None:
-                    return None  # 1.1 adds the delta to "no value" and gets NaN
+                    # 1.1 adds the delta to "no value" (NaN; for ints NaN cast to long): such an
+                    # element carries nothing, so it arrives unset
+                    return None
                 number += float(key) - float(self.var.max_delta or 0)  # type: ignore[arg-type]
             else:
                 number += self.bounds[0]
