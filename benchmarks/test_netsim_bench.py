@@ -17,8 +17,6 @@ import sys
 import time
 from pathlib import Path
 
-import pytest
-
 from pygoby.netsim.client import NetSimClient
 from pygoby.netsim.protocol import encode_line, request_class
 
@@ -198,7 +196,6 @@ def test_manager_load_short_with_garbage_clients(benchmark, tmp_path):
     _run_load(benchmark, tmp_path, duration=5.0, garbage_clients=4)
 
 
-@pytest.mark.slow
 def test_manager_load_full_60s(benchmark, tmp_path):
     _run_load(benchmark, tmp_path, duration=60.0)
 

@@ -1,4 +1,5 @@
-"""Shared test fixtures: where ../shared (specs and reference vectors) lives."""
+"""Shared test fixtures: where ../shared (specs and reference vectors) lives; the hypothesis
+profile (tests/hypothesis_profiles.py)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,10 @@ import os
 from pathlib import Path
 
 import pytest
+
+from tests import hypothesis_profiles
+
+hypothesis_profiles.load()
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = Path(os.environ.get("PYGOBY_SHARED", REPO.parent / "shared"))

@@ -16,6 +16,7 @@ from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.util.clock import VirtualClock
 from pygoby.util.nmea import NMEASentence
 from pygoby.util.timeline import Timeline
+from tests.hypothesis_profiles import examples
 
 T0 = 1_700_000_000.0  # 2023-11-14T22:13:20Z
 
@@ -438,7 +439,7 @@ FIELDS = st.one_of(
 )
 
 
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=examples(400), deadline=None)
 @given(
     st.lists(
         st.one_of(

@@ -21,6 +21,7 @@ from pygoby.moos.db import MOOSDB
 from pygoby.moos.moosfile import MissionFile
 from pygoby.util.aiorun import STOP_GRACE
 from tests.faults import CuttableRelay
+from tests.hypothesis_profiles import examples
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from example_app import pTestApp  # noqa: E402
@@ -379,7 +380,7 @@ async def test_log_file_named_after_app_and_community(tmp_path):
     assert "hello log" in (tmp_path / files[1]).read_text()
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.text(alphabet=st.sampled_from('abc_:{}"#/ \n0123.-=common gain out_var'), max_size=120))
 def test_fuzz_config_block_gives_config_errors_only(text):
     mission = MissionFile.from_text(f"ProcessConfig = pTestApp\n{{\n{text}\n}}\n")

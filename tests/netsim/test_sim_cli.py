@@ -21,6 +21,7 @@ from pygoby.netsim.protocol import LineDecoder, encode_line, request_class, resp
 from pygoby.netsim.realtime import RealTimeRun
 from pygoby.netsim.report import bin_success, node_labels, timeline_window
 from pygoby.netsim.scenario import ScenarioError, parse_scenario
+from tests.hypothesis_profiles import examples
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "netsim" / "tdma8.pb.cfg"
 
@@ -139,14 +140,14 @@ def test_real_time_needs_a_speed_factor_or_a_clock():
     assert run.sim.start == pytest.approx(clock.now(), abs=5)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.text(max_size=200))
 def test_fuzz_scenario_parser_only_raises_scenario_error(text):
     with contextlib.suppress(ScenarioError):
         parse_scenario(text)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     st.lists(
         st.one_of(
