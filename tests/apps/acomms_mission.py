@@ -1,6 +1,11 @@
 """Two pAcommsHandler communities for end-to-end tests: embedded MOOSDBs, Micro-Modem emulators
 on real loopback TCP (one perfect acoustic channel), and a MOOS client per community that
-records everything it sees."""
+records everything it sees.
+
+The missions run at MOOSTimeWarp WARP: the apps, the DBs, the recorders and the emulated modems
+share MOOS time (UNIX time x WARP), so the TDMA slots and the modem's timing (the packets on the
+water, the sentences on the serial line) pass WARP times faster than real time; the mission is
+the same one, only its clock runs fast."""
 
 from __future__ import annotations
 
@@ -15,7 +20,8 @@ from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.util.clock import WallClock
+from pygoby.moos.timewarp import moos_clock
+from pygoby.util.clock import Clock
 
 PROTO = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / "two_vehicles.proto"
 STATUS = "pygoby.examples.SimpleStatus"
@@ -26,6 +32,9 @@ COMMAND = "pygoby.examples.Command"
 # modem's transmissions would queue behind each other, later every cycle (a rate-0 packet alone,
 # cycle-init and data, is ~4.3 s), and the sender's next cycle would come before the ack.
 SLOT_SECONDS = 3
+# (a TDMA cycle is then 0.6 s of real time: slack enough for the host's own delays between the
+# sentences, which the warp does not shorten)
+WARP = 10
 SLOTS = "".join(
     f"    slot {{ src: {src} dest: -1 rate: 1 type: DATA slot_seconds: {SLOT_SECONDS} }}\n"
     for src in (1, 2)
@@ -96,6 +105,7 @@ def mission_text(
     slots: str | None = None,
     driver: str | None = None,
     common: str = "log: false  app_tick: 20  verbosity: WARN",
+    warp: float = WARP,
 ) -> str:
     """vehicle<modem_id>'s mission: `driver` (a driver_cfg block; default: a Micro-Modem on
     `modem_port`), TDMA slots for 1 and 2, the status and command queues and translators."""
@@ -107,6 +117,7 @@ def mission_text(
 ServerHost = localhost
 ServerPort = {db_port}
 Community  = vehicle{modem_id}
+MOOSTimeWarp = {warp:g}
 
 ProcessConfig = pAcommsHandler
 {{
@@ -122,10 +133,11 @@ ProcessConfig = pAcommsHandler
 
 
 class Recorder:
-    """A MOOS client that keeps every notification it receives, by variable."""
+    """A MOOS client that keeps every notification it receives, by variable (`clock`: MOOS time,
+    the DB's)."""
 
-    def __init__(self, name: str, port: int) -> None:
-        self.client = MOOSClient(name, port=port)
+    def __init__(self, name: str, port: int, clock: Clock | None = None) -> None:
+        self.client = MOOSClient(name, port=port, clock=clock)
         self.seen: dict[str, list[MOOSMessage]] = {}
         self._task: asyncio.Task | None = None
 
@@ -199,9 +211,15 @@ async def start_modem(
     return sim
 
 
+def mission_clock() -> Clock:
+    """MOOS time at the missions' warp."""
+    return moos_clock(WARP)
+
+
 async def start_db(stack: contextlib.AsyncExitStack, modem_id: int) -> MOOSDB:
-    """The MOOSDB of community `vehicle<modem_id>`, closed with `stack`."""
-    return await stack.enter_async_context(MOOSDB(port=0, community=f"vehicle{modem_id}"))
+    """The MOOSDB of community `vehicle<modem_id>` at the missions' warp, closed with `stack`."""
+    db = MOOSDB(port=0, community=f"vehicle{modem_id}", clock=mission_clock())
+    return await stack.enter_async_context(db)
 
 
 async def modem_and_db(
@@ -215,7 +233,8 @@ async def modem_and_db(
 async def two_vehicle_missions(tmp_path: Path, mission, watched: list[str], channel, clock):
     """Vehicles 1 and 2, each an emulated Micro-Modem on `channel`, a MOOSDB, the pAcommsHandler
     of the mission file `mission(modem_id, db_port, modem_port)` writes and a recorder of
-    `watched`: yields ([app1, app2], [recorder1, recorder2])."""
+    `watched`, all on `clock` (the missions' MOOS time): yields ([app1, app2], [recorder1,
+    recorder2])."""
     async with contextlib.AsyncExitStack() as stack:
         apps, recorders = [], []
         for modem_id in (1, 2):
@@ -223,7 +242,7 @@ async def two_vehicle_missions(tmp_path: Path, mission, watched: list[str], chan
             path = tmp_path / f"mm{modem_id}.moos"
             path.write_text(mission(modem_id, db.port, sim.port))
             app = pAcommsHandler.from_mission(path, "pAcommsHandler")
-            recorder = Recorder(f"recorder{modem_id}", db.port)
+            recorder = Recorder(f"recorder{modem_id}", db.port, clock)
             await recorder.start(watched)
             stack.push_async_callback(recorder.close)
             await stack.enter_async_context(app)
@@ -237,12 +256,12 @@ class MicroModemLink:
 
     def __init__(self) -> None:
         self.sims: list[MMSimServer] = []
-        self.channel = LoopbackChannel()
+        self.clock = mission_clock()
+        self.channel = LoopbackChannel(self.clock)
 
     async def start(self, stack: contextlib.AsyncExitStack, dbs: list[MOOSDB]) -> None:
-        clock = WallClock()
         for modem_id in (1, 2):
-            self.sims.append(await start_modem(stack, modem_id, self.channel, clock))
+            self.sims.append(await start_modem(stack, modem_id, self.channel, self.clock))
 
     def driver_cfg(self, modem_id: int) -> str:
         return micromodem_driver(self.sims[modem_id - 1].port)
@@ -293,7 +312,7 @@ class TwoCommunities:
                 )
             )
             app = pAcommsHandler.from_mission(path, "pAcommsHandler")
-            recorder = Recorder(f"recorder{modem_id}", db.port)
+            recorder = Recorder(f"recorder{modem_id}", db.port, mission_clock())
             await recorder.start(WATCHED)
             self.stack.push_async_callback(recorder.close)
             await self.stack.enter_async_context(app)

@@ -16,7 +16,7 @@ from .mission import topside_mission
 ICOMMANDER = """
 ProcessConfig = iCommander
 {
-  common { log: false  app_tick: 20 }
+  common { log: false  app_tick: 2 }
   commander { autosave_path: "%s" }
   show_variable: "DESIRED_HEADING"
 }
