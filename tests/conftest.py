@@ -22,3 +22,16 @@ def vectors_dir() -> Path:
     if not VECTORS.is_dir():
         pytest.fail(f"reference vectors not found at {VECTORS} (set PYGOBY_SHARED)")
     return VECTORS
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item, call):
+    """Captured output as UTF-8 can carry it: a decoder fuzzed with bytes logs what it refused,
+    undecodable bytes included (surrogate escapes), and pytest-xdist's workers send each
+    report to the controller as UTF-8."""
+    report = yield
+    report.sections = [
+        (name, text.encode("utf-8", "backslashreplace").decode("utf-8"))
+        for name, text in report.sections
+    ]
+    return report

@@ -5,6 +5,8 @@ import asyncio
 import json
 import socket
 
+import pytest
+
 from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
 from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind
 from pygoby.acomms.mmsim.multicast_channel import (
@@ -15,6 +17,8 @@ from pygoby.acomms.mmsim.multicast_channel import (
 from pygoby.acomms.mmsim.server import ANONYMOUS_PTY, MMSimServer
 from pygoby.util.clock import WallClock
 from pygoby.util.nmea import NMEASentence
+
+pytestmark = pytest.mark.e2e
 
 QUERY_ALL = (NMEASentence.parse("$CCCFQ,ALL").message() + "\r\n").encode()  # ~70 lines back
 

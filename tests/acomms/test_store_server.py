@@ -23,6 +23,8 @@ from tests.hypothesis_profiles import examples
 from .mm_e2e import run_until
 from .queue_helpers import status_link
 
+pytestmark = pytest.mark.e2e
+
 
 def schoolbook_convert(data: bytes, source_base: int, sink_base: int) -> bytes:
     """The conversion digit by digit, as C++ Goby's base_convert does it: the oracle."""

@@ -211,14 +211,14 @@ async def start_modem(
     return sim
 
 
-def mission_clock() -> Clock:
+def mission_clock(warp: float = WARP) -> Clock:
     """MOOS time at the missions' warp."""
-    return moos_clock(WARP)
+    return moos_clock(warp)
 
 
-async def start_db(stack: contextlib.AsyncExitStack, modem_id: int) -> MOOSDB:
+async def start_db(stack: contextlib.AsyncExitStack, modem_id: int, warp: float = WARP) -> MOOSDB:
     """The MOOSDB of community `vehicle<modem_id>` at the missions' warp, closed with `stack`."""
-    db = MOOSDB(port=0, community=f"vehicle{modem_id}", clock=mission_clock())
+    db = MOOSDB(port=0, community=f"vehicle{modem_id}", clock=mission_clock(warp))
     return await stack.enter_async_context(db)
 
 
@@ -254,9 +254,9 @@ async def two_vehicle_missions(tmp_path: Path, mission, watched: list[str], chan
 class MicroModemLink:
     """Micro-Modem emulators on loopback TCP sharing one perfect acoustic channel."""
 
-    def __init__(self) -> None:
+    def __init__(self, warp: float = WARP) -> None:
         self.sims: list[MMSimServer] = []
-        self.clock = mission_clock()
+        self.clock = mission_clock(warp)
         self.channel = LoopbackChannel(self.clock)
 
     async def start(self, stack: contextlib.AsyncExitStack, dbs: list[MOOSDB]) -> None:
@@ -273,7 +273,7 @@ class MicroModemLink:
 class TwoCommunities:
     """Link (default: emulated Micro-Modems) + DBs + pAcommsHandlers + recorders; `extra` adds
     config to both apps. A link has `start(stack, dbs)` and `driver_cfg(modem_id)` (the
-    driver_cfg block of that vehicle's mission)."""
+    driver_cfg block of that vehicle's mission); `warp` the missions' MOOSTimeWarp."""
 
     def __init__(
         self,
@@ -282,9 +282,10 @@ class TwoCommunities:
         slots: str | None = None,
         link=None,
         common: str | None = None,
+        warp: float = WARP,
     ) -> None:
-        self.tmp_path, self.extra, self.slots = tmp_path, extra, slots
-        self.link = link if link is not None else MicroModemLink()
+        self.tmp_path, self.extra, self.slots, self.warp = tmp_path, extra, slots, warp
+        self.link = link if link is not None else MicroModemLink(warp)
         self.common = common
         self.stack = contextlib.AsyncExitStack()
 
@@ -295,7 +296,7 @@ class TwoCommunities:
     async def __aenter__(self) -> TwoCommunities:
         self.dbs, self.apps, self.recorders = [], [], []
         for modem_id in (1, 2):
-            self.dbs.append(await start_db(self.stack, modem_id))
+            self.dbs.append(await start_db(self.stack, modem_id, self.warp))
         await self.link.start(self.stack, self.dbs)
         for modem_id, db in zip((1, 2), self.dbs, strict=True):
             path = self.tmp_path / f"vehicle{modem_id}.moos"
@@ -309,10 +310,11 @@ class TwoCommunities:
                     self.slots,
                     self.link.driver_cfg(modem_id),
                     **options,
+                    warp=self.warp,
                 )
             )
             app = pAcommsHandler.from_mission(path, "pAcommsHandler")
-            recorder = Recorder(f"recorder{modem_id}", db.port, mission_clock())
+            recorder = Recorder(f"recorder{modem_id}", db.port, mission_clock(self.warp))
             await recorder.start(WATCHED)
             self.stack.push_async_callback(recorder.close)
             await self.stack.enter_async_context(app)

@@ -18,6 +18,8 @@ from pygoby.moos.translator import parse_for_moos
 
 from .acomms_mission import PROTO, WARP, Recorder, mission_clock, two_vehicle_missions
 
+pytestmark = pytest.mark.e2e
+
 STATE = "dccl.legacyccl.protobuf.CCLMDATState"
 STATUS = "pygoby.examples.SimpleStatus"
 # as the example writes it in the mission file (quotes and backslashes escaped in the sval)

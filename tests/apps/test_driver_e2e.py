@@ -20,6 +20,8 @@ from pygoby.moos.db import MOOSDB
 
 from .acomms_mission import MicroModemLink, TwoCommunities, mission_clock
 
+pytestmark = pytest.mark.e2e
+
 NAV = {"NAV_X": 100.0, "NAV_Y": -50.0, "NAV_SPEED": 1.5, "NAV_HEADING": -90.0, "NAV_DEPTH": 10.0}
 REPORT = "src=1,x=100,y=-50,speed=1.5,heading=270,depth=10"
 

@@ -21,6 +21,8 @@ from pygoby.errors import ConfigError
 
 from .acomms_mission import Recorder
 
+pytestmark = pytest.mark.e2e
+
 DATA = Path(__file__).resolve().parent / "data" / "dual_status"
 BIN = str(Path(sys.executable).parent)
 LIBRARY_LINE = 'load_shared_library: "../../../../../build/lib/libgobyexample_protobuf.so"'

@@ -11,6 +11,7 @@ import re
 import sys
 from pathlib import Path
 
+import pytest
 from textual.widgets import OptionList, RichLog, Static
 
 from pygoby.acomms import messages as acomms_pb
@@ -32,6 +33,8 @@ from .acomms_mission import (
     mission_text,
     start_db,
 )
+
+pytestmark = pytest.mark.e2e
 
 PACOMMSHANDLER = str(Path(sys.executable).with_name("pAcommsHandler"))
 NAV = {"NAV_X": 100.0, "NAV_Y": -50.0, "NAV_SPEED": 1.5, "NAV_HEADING": -90.0, "NAV_DEPTH": 10.0}

@@ -14,6 +14,8 @@ import signal
 import sys
 from pathlib import Path
 
+import pytest
+
 from pygoby.acomms.mmsim import LoopbackChannel
 from pygoby.acomms.queue.persist import QueueStore
 from pygoby.apps.pacommshandler import pAcommsHandler
@@ -27,6 +29,8 @@ from .acomms_mission import (
     mission_text,
     modem_and_db,
 )
+
+pytestmark = pytest.mark.e2e
 
 PACOMMSHANDLER = str(Path(sys.executable).with_name("pAcommsHandler"))
 # the commands' ttl, in real seconds (the mission runs at MOOSTimeWarp WARP): the first command

@@ -16,6 +16,8 @@ from pygoby.apps.imodemsim import iModemSim
 from pygoby.errors import ConfigError
 from pygoby.util.pty import PtyEnd, PtyError, PtyPair, is_live, open_serial, partner_of
 
+pytestmark = pytest.mark.e2e
+
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))
 
 

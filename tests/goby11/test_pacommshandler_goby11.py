@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from google.protobuf import text_format
 
 from pygoby.acomms import messages as acomms_pb
@@ -17,6 +18,8 @@ from pygoby.acomms.mmsim.channel import DEFAULT_SOUND_SPEED
 from pygoby.moos.client import MOOSClient
 from tests.apps.acomms_mission import WARP, mission_clock, two_vehicle_missions
 from tests.goby11.seed_listings import EXAMPLES
+
+pytestmark = pytest.mark.e2e
 
 SIMPLE_STATUS = EXAMPLES / "xml" / "simple_status.xml"
 

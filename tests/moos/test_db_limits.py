@@ -11,10 +11,14 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from pygoby.moos import protocol as p
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from tests.moos.rawclient import closed_by_peer, raw_connect
+
+pytestmark = pytest.mark.e2e
 
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))
 

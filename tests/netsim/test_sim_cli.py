@@ -23,6 +23,8 @@ from pygoby.netsim.report import bin_success, node_labels, timeline_window
 from pygoby.netsim.scenario import ScenarioError, parse_scenario
 from tests.hypothesis_profiles import examples
 
+pytestmark = pytest.mark.e2e
+
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "netsim" / "tdma8.pb.cfg"
 
 SMALL = """duration: 300

@@ -18,6 +18,8 @@ PROGRAM = """
 import asyncio, sys, time
 from pygoby.util.aiorun import run_until_signal
 
+pytestmark = pytest.mark.e2e
+
 async def serve():
     try:
         print("ready", flush=True)
