@@ -1,9 +1,8 @@
-"""Shared test fixtures: where ../shared (specs and reference vectors) lives; the hypothesis
+"""Shared test fixtures: where the reference vectors (tests/data/vectors) live; the hypothesis
 profile (tests/hypothesis_profiles.py)."""
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
@@ -13,14 +12,13 @@ from tests import hypothesis_profiles
 hypothesis_profiles.load()
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED = Path(os.environ.get("PYGOBY_SHARED", REPO.parent / "shared"))
-VECTORS = SHARED / "vectors"
+# byte-exact recordings of the reference implementations (C++ DCCL, MOOS, netsim, Goby 1.1
+# libdccl), each folder with a README.md saying how it was made
+VECTORS = REPO / "tests" / "data" / "vectors"
 
 
 @pytest.fixture(scope="session")
 def vectors_dir() -> Path:
-    if not VECTORS.is_dir():
-        pytest.fail(f"reference vectors not found at {VECTORS} (set PYGOBY_SHARED)")
     return VECTORS
 
 

@@ -15,6 +15,8 @@ SUBCOMMAND_MODULES = [
     "pygoby.dccl.cli",
     "pygoby.acomms.cli",
     "pygoby.moos.cli",
+    "pygoby.moos.alog.cli",
+    "pygoby.frontseat.cli",
     "pygoby.netsim.sim_cli",
     "pygoby.apps.topside_cli",
 ]

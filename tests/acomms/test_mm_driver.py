@@ -57,7 +57,9 @@ class Harness:
         assert self.modem(f"$CACFG,SRC,{mid}") == [cs("$CCCFG,REV,1")]
         assert self.modem("$CACFG,REV,1") == [cs("$CCCFG,RXP,1")]
         assert self.modem("$CACFG,RXP,1") == [cs(f"$CCMSC,{mid},{mid},0")]
-        assert self.modem("$CAREV,000000,AUV,0.94.0.00") == []  # waits for 50-100 ms past a second
+        # goby3's first keep-alive, queued behind $CCMSC (the revision is not known yet)
+        assert self.modem("$CAREV,000000,AUV,0.94.0.00") == [cs("$CCCFQ,SRC")]
+        assert self.modem(f"$CACFG,SRC,{mid}") == []  # waits for 50-100 ms past a second
         self.clock.set(T0 + 0.07)
         assert self.work() == [cs("$CCCLK,2023,11,14,22,13,21")]
         self.clock.set(T0 + 1.0)
@@ -78,7 +80,8 @@ def test_startup_queries_all_nvram_until_two_seconds_of_silence():
     h.work()
     for reply in ["$CACFG,CST,1", "$CACFG,SRC,1", "$CACFG,REV,1", "$CACFG,RXP,1"]:
         h.modem(reply)
-    h.modem("$CAREV,000000,AUV,2.0.16421")
+    assert h.modem("$CAREV,000000,AUV,2.0.16421") == [cs("$CCCFQ,SRC")]  # first keep-alive
+    h.modem("$CACFG,SRC,1")
     h.clock.set(T0 + 0.06)
     assert h.work() == [cs("$CCTMS,2023-11-14T22:13:21Z,0")]  # MM2 clock command
     h.clock.set(T0 + 0.5)
@@ -284,11 +287,35 @@ def test_sentences_without_a_handler_are_skipped():
 
 def test_caerr_nmea_fails_outstanding_and_keep_alive():
     h = Harness().start()
-    h.clock.advance(10.5)
+    h.clock.set(T0 + 9.9)
+    assert h.work() == []  # 10 s after the first keep-alive (at T0), heard or not
+    h.clock.set(T0 + 10.0)
     assert h.work() == [cs("$CCCFQ,SRC")]  # MM1 keep-alive
     assert h.modem("$CAERR,000000,NMEA,3,bad") == [cs("$CCCFQ,SRC")]  # resent at once
     h.modem("$CACFG,SRC,1")
     assert h.work() == []
+
+
+def test_mm2_keep_alive_asks_the_time_at_the_start_of_a_second():
+    h = Harness()
+    h.driver.startup(h.cfg)
+    h.work()
+    for reply in ["$CACFG,CST,1", "$CACFG,SRC,1", "$CACFG,REV,1", "$CACFG,RXP,1"]:
+        h.modem(reply)
+    assert h.modem("$CAREV,000000,AUV,2.0.16421") == [cs("$CCCFQ,SRC")]
+    h.modem("$CACFG,SRC,1")
+    h.clock.set(T0 + 0.06)
+    h.work()
+    h.clock.set(T0 + 0.5)
+    assert h.modem("$CATMS,0,2023-11-14T22:13:20.5Z") == []
+    assert h.driver.startup_complete
+    h.clock.set(T0 + 10.3)
+    assert h.work() == [cs("$CCTMQ,0")]
+    h.modem("$CATMQ,2023-11-14T22:13:30.3Z,0")
+    h.clock.set(T0 + 19.9)
+    assert h.work() == []
+    h.clock.set(T0 + 20.0)  # 10 s after the whole second of the last one
+    assert h.work() == [cs("$CCTMQ,0")]
 
 
 def test_rev_init_resets_clock():

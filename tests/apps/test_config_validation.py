@@ -63,10 +63,10 @@ def load_error(tmp_path, old: str, new: str) -> tuple[ConfigError, object]:
         ),
         (
             'moos_var: "NODE_REPORT_IN" }',
-            'moos_var: "NODE_REPORT_IN" }\n    publish { technique: TECHNIQUE_FORMAT moos_var: "X" format: "%77%" }',
+            'moos_var: "NODE_REPORT_IN" }\n    publish { technique: TECHNIQUE_FORMAT moos_var: "X" format: "%77:1%" }',
             "translator_entry {",
             "translator_entry[0]",
-            "77",
+            "Invalid ':' syntax",  # goby3 throws at every publication: pAcommsHandler ends
         ),
         ('format: "%11%"', 'format: "%11"', "translator_entry {", "translator_entry[0]", "%11"),
     ],

@@ -1,7 +1,7 @@
 """iFrontSeat's command line and configuration: the driver named by IFRONTSEAT_DRIVER_LIBRARY
 or `driver_library` (resolved before the options, so --example_config shows its block), clear
-failures listing the installed drivers, the Goby 2 `[abc_config]` form, options pygoby cannot
-honour, and `exit_on_error` (a real iFrontSeat process on the embedded MOOSDB)."""
+failures listing the installed drivers, the Goby 2 `[abc_config]` form and `exit_on_error` (a real iFrontSeat process on the
+embedded MOOSDB)."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ pytestmark = pytest.mark.e2e
 
 REPO = Path(__file__).resolve().parents[2]
 LOOPBACK = "tests.apps.ifs_loopback_driver"
-FOUND = "drivers found: abc, basic_simulator"
+FOUND = "drivers found: abc, basic_simulator, bluefin"
 
 SIMULATOR_BLOCK = """
   [goby.middleware.frontseat.protobuf.basic_simulator_config] {
@@ -65,11 +65,23 @@ def test_a_wrong_driver_name_exits_1_listing_the_drivers(monkeypatch, capsys, tm
     monkeypatch.delenv("IFRONTSEAT_DRIVER_LIBRARY")
     path = mission(
         tmp_path,
+        f'  driver_library: "libgoby_frontseat_iver.so.30"\n  frontseat_cfg {{ {SIMULATOR_BLOCK} }}',
+    )
+    assert iFrontSeat.main([str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "fatal configuration error" in err and "'iver'" in err and FOUND in err
+
+    # goby3's Bluefin library name is pygoby's bluefin driver, which needs its own block
+    path = mission(
+        tmp_path,
         f'  driver_library: "libgoby_frontseat_bluefin.so.30"\n  frontseat_cfg {{ {SIMULATOR_BLOCK} }}',
     )
     assert iFrontSeat.main([str(path)]) == 1
     err = capsys.readouterr().err
-    assert "fatal configuration error" in err and "'bluefin'" in err and FOUND in err
+    assert (
+        "'bluefin' failed to start" in err
+        and "has no [goby.middleware.frontseat.protobuf.bluefin_config]" in err
+    )
 
     path = mission(tmp_path, f"  frontseat_cfg {{ {SIMULATOR_BLOCK} }}")
     assert iFrontSeat.main([str(path)]) == 1
@@ -116,16 +128,6 @@ def test_goby2_abc_config_is_read_as_the_basic_simulator_block(tmp_path, caplog)
     missing = '  driver_library: "abc"'
     with pytest.raises(ConfigError, match="missing required configuration fields: frontseat_cfg"):
         iFrontSeat.read_config(MissionFile.read(mission(tmp_path, missing)), "iFrontSeat")
-
-
-@pytest.mark.parametrize("option", ["subscribe_acomms_raw", "pub_sub_bf_commands"])
-def test_bluefin_legacy_options_are_refused(tmp_path, capsys, option):
-    body = (
-        f'  driver_library: "{LOOPBACK}"\n  frontseat_cfg {{ }}\n  legacy_cfg {{ {option}: true }}'
-    )
-    assert iFrontSeat.main([str(mission(tmp_path, body))]) == 1
-    err = capsys.readouterr().err
-    assert f"{option}: true" in err and "Bluefin" in err and "does not implement" in err
 
 
 async def test_exit_on_error_stops_the_process_with_status_1(tmp_path):

@@ -1,6 +1,6 @@
 """C++ DCCL 4.2's answers recorded by tests/dccl/oracle/record.py (files in tests/dccl/data/).
 
-Records name their .proto by `where` ("shared": ../shared/vectors/dccl, "tests":
+Records name their .proto by `where` ("shared": tests/data/vectors/dccl, "tests":
 tests/dccl/protos, "builtin": pygoby's own .proto files) and carry the receiver clock (`now`),
 passphrase and, for encodings, strict mode. A decoded message is compared with the C++ one
 parsed from protobuf's binary form (`decoded_bin`), which keeps string bytes exactly.

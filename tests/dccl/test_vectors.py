@@ -1,4 +1,4 @@
-"""Every reference vector in ../shared/vectors/dccl/, in both directions."""
+"""Every reference vector in tests/data/vectors/dccl/, in both directions."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Access to the reference DCCL vectors in ../shared/vectors/dccl/."""
+"""Access to the reference DCCL vectors in tests/data/vectors/dccl/."""
 
 from __future__ import annotations
 

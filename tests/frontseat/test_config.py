@@ -72,15 +72,6 @@ def test_goby2_abc_config_migrates_once(config_class, caplog):
         fs_config.migrate_goby2_abc_config(cfg)
 
 
-@pytest.mark.parametrize("option", fs_config.UNSUPPORTED_LEGACY)
-def test_bluefin_legacy_options_are_refused(config_class, option):
-    cfg = config_class()
-    fs_config.refuse_unsupported_legacy(cfg.legacy_cfg)
-    setattr(cfg.legacy_cfg, option, True)
-    with pytest.raises(ConfigError, match=f"{option}: true.*Bluefin"):
-        fs_config.refuse_unsupported_legacy(cfg.legacy_cfg)
-
-
 def test_frontseat_config_takes_name_datum_and_warp_from_common(config_class):
     cfg = config_class()
     cfg.frontseat_cfg.status_period = 7

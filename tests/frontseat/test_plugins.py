@@ -110,7 +110,7 @@ def test_find_driver_imports_without_constructing(scripted_entry_point) -> None:
     assert find_driver("libgoby_frontseat_scripted.so.30") is scripted_driver.frontseat_driver_load
     assert find_driver(f"{TEST_MODULE}:not_a_driver") is scripted_driver.not_a_driver
     with pytest.raises(DriverLoadError, match="drivers found: .*abc"):
-        find_driver("libgoby_frontseat_bluefin.so.30")
+        find_driver("libgoby_frontseat_iver.so.30")
 
 
 def test_factory_returning_no_driver() -> None:
@@ -133,7 +133,7 @@ def test_factory_that_raises() -> None:
 
 
 @pytest.mark.parametrize(
-    "name", ["bluefin", "libgoby_frontseat_bluefin.so.30", "no_such_pkg.driver", "not a name!", ""]
+    "name", ["iver", "libgoby_frontseat_iver.so.30", "no_such_pkg.driver", "not a name!", ""]
 )
 def test_wrong_name_lists_the_drivers_found(name) -> None:
     with pytest.raises(DriverLoadError) as info:

@@ -1,5 +1,6 @@
 """Virtual serial pairs with stable links (util.pty, `pygoby loopbacks`) and iModemSim: two
-emulators of one host sharing a UDP port (BroadcastAddr 127.0.0.1) hear each other."""
+emulators of one host sharing a UDP port (BroadcastAddr 127.0.0.1) hear each other, through
+netsim's acoustic model at their positions unless the perfect channel is asked for."""
 
 from __future__ import annotations
 
@@ -12,8 +13,13 @@ from pathlib import Path
 
 import pytest
 
-from pygoby.apps.imodemsim import iModemSim
+from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind, Reception
+from pygoby.acomms.mmsim.multicast_channel import MulticastChannel
+from pygoby.apps.imodemsim import MULTICAST_GROUP, iModemSim
 from pygoby.errors import ConfigError
+from pygoby.netsim.range_link import RangeLink
+from pygoby.util.clock import WallClock
+from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.pty import PtyEnd, PtyError, PtyPair, is_live, open_serial, partner_of
 
 pytestmark = pytest.mark.e2e
@@ -190,6 +196,7 @@ async def test_imodemsim_uses_a_pair_made_by_loopbacks(tmp_path):
         ("BroadcastAddr = far.away\n", "BroadcastAddr: 'far.away' is not an IPv4 address"),
         ("InputLocType = gps\n", "InputLocType: 'gps' is not one of"),
         ("Speed = fast\n", "Speed: must be a number, not 'fast'"),
+        ("ChannelModel = bellhop\n", "ChannelModel: 'bellhop' is not one of range, perfect"),
     ],
 )
 def test_imodemsim_configuration_errors(tmp_path, extra, reason):
@@ -234,5 +241,81 @@ async def test_example_config_is_a_block_imodemsim_reads(tmp_path):
             [0.0, 0.0, 0.0],
         )
         assert (app.cfg.common.app_tick, app.cfg.common.comm_tick) == (4, 4)
+    finally:
+        app.pair.close()
+
+
+class Listener:
+    """A channel endpoint that keeps what it hears."""
+
+    def __init__(self, name: str) -> None:
+        self.name, self.modem_id = name, 9
+        self.heard: list[tuple[AcousticPacket, Reception]] = []
+
+    def detect(self, packet, arrival) -> None:
+        pass
+
+    def receive(self, packet, reception) -> None:
+        self.heard.append((packet, reception))
+
+
+async def test_positions_travel_with_packets_and_the_range_decides(tmp_path):
+    """Emulators in three processes' stead (three channels on one multicast port): 1.5 km away
+    a packet arrives after range / 1500 m/s of travel; 11 km away it is not heard at all; with
+    the perfect channel it is heard at once whatever the range."""
+    udp = free_udp_port()
+    geodesy = UTMGeodesy(42.35, -70.95)
+    clock = WallClock()
+
+    def at(y: float):
+        lat, lon = geodesy.to_geo(0.0, y)
+        return lambda: [lat, lon, 10.0]
+
+    receiver = MulticastChannel(MULTICAST_GROUP, udp, clock, position=at(0), link=RangeLink())
+    perfect = MulticastChannel(MULTICAST_GROUP, udp, clock, position=at(0))
+    far = MulticastChannel(MULTICAST_GROUP, udp, clock, position=at(11_000))
+    near = MulticastChannel(MULTICAST_GROUP, udp, clock, position=at(1_500))
+    listeners = {"range": Listener("range"), "perfect": Listener("perfect")}
+    receiver.attach(listeners["range"])
+    perfect.attach(listeners["perfect"])
+    channels = [receiver, perfect, far, near]
+    for channel in channels:
+        channel.open()
+    try:
+        for sender, src in ((far, 1), (near, 2)):
+            packet = AcousticPacket(PacketKind.MINI, src, 9, frames=[b"\x01\x23"])
+            packet.tx_time, packet.duration = clock.now(), 0.5
+            sender.transmit(Listener(f"sender{src}"), packet)
+        async with asyncio.timeout(10):
+            while len(listeners["perfect"].heard) < 2 or not listeners["range"].heard:
+                for channel in channels:
+                    channel.do_work()
+                await asyncio.sleep(0.01)
+    finally:
+        for channel in channels:
+            channel.close()
+    assert sorted(p.src for p, _ in listeners["perfect"].heard) == [1, 2]
+    ((packet, reception),) = listeners["range"].heard
+    assert packet.src == 2
+    assert reception.arrival_time - packet.tx_time == pytest.approx(1_500 / 1_500, abs=0.01)
+    assert receiver.timeline.next_time() is None  # nothing of the far packet is on its way
+
+
+def test_imodemsim_hears_through_the_range_model_unless_told_perfect(tmp_path):
+    path = imodemsim_mission(tmp_path, "A", free_udp_port(), "  ConstantPosY = 1000\n")
+    path.write_text(
+        path.read_text().replace("Community", "LatOrigin = 42.35\nLongOrigin = -70.95\nCommunity")
+    )
+    app = iModemSim.from_mission(path)
+    try:
+        assert isinstance(app.channel.link, RangeLink)
+        lat, lon, depth = app.geo_position()
+        assert (lat, lon) == pytest.approx(UTMGeodesy(42.35, -70.95).to_geo(0, 1000))
+    finally:
+        app.pair.close()
+    path = imodemsim_mission(tmp_path, "B", free_udp_port(), "  ChannelModel = perfect\n")
+    app = iModemSim.from_mission(path)
+    try:
+        assert app.channel.link is None
     finally:
         app.pair.close()

@@ -15,6 +15,8 @@ from google.protobuf import text_format
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mmsim import LoopbackChannel
 from pygoby.acomms.mmsim.channel import DEFAULT_SOUND_SPEED
+from pygoby.dccl.dccl1 import Dccl1Codec, unstitch
+from pygoby.dccl.xml import load_message_set
 from pygoby.moos.client import MOOSClient
 from tests.apps.acomms_mission import WARP, mission_clock, two_vehicle_missions
 from tests.goby11.seed_listings import EXAMPLES
@@ -95,7 +97,18 @@ async def test_goby11_configuration_runs_with_the_11_variables(tmp_path):
         incoming = await recorders[1].wait_for("ACOMMS_INCOMING_DATA")
         data = acomms_pb.V1ModemDataTransmission()
         text_format.Parse(incoming, data)
-        assert data.data[0] == 40 and (data.base.src, data.base.dest) == (1, 2)  # DCCL id 20
+        # Goby 1.1's bytes (DCCL1): 0x20, then DCCL id 20 in the next 9 bits; a Goby 1.1
+        # decoder (no passphrase configured: key SHA-256 of "") reads the values
+        assert data.data[0] == 0x20 and (data.base.src, data.base.dest) == (1, 2)
+        goby11 = Dccl1Codec()
+        goby11.load(load_message_set(SIMPLE_STATUS))
+        (part,) = unstitch(data.data)
+        decoded = goby11.decode(part.data)
+        assert (decoded.message, decoded.header.src, decoded.values["nav_x"]) == (
+            "SIMPLE_STATUS",
+            1,
+            100,
+        )
 
         async with MOOSClient("poker", port=mm1.client.port, clock=mission_clock()) as poker:
             poker.publish("ACOMMS_RANGE_COMMAND", "base { dest: 2 } type: MODEM_TWO_WAY_PING")

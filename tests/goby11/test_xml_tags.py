@@ -185,7 +185,7 @@ def test_queuing_defaults_are_goby_1_1s():
         queue.newest_first,
         queue.value_base,
         queue.ttl,
-    ) == (False, 0, 0, True, 1.0, 1800)
+    ) == (True, 0, 0, True, 1.0, 1800)  # ack: Goby 1.1.2's code, not its manual
 
 
 def test_deprecated_tags_are_accepted_with_warnings():
@@ -207,8 +207,6 @@ def test_deprecated_tags_are_accepted_with_warnings():
     joined = "\n".join(message_set.warnings)
     for word in (
         "<repeat/>",
-        "incoming_hex_moos_var",
-        "outgoing_hex_moos_var",
         "key=",
         "<max_delta>",
         "priority_base",
@@ -217,6 +215,7 @@ def test_deprecated_tags_are_accepted_with_warnings():
         assert word in joined, word
     assert all(re.match(r"test\.xml:\d+: ", w) for w in message_set.warnings)
     (msg,) = message_set.messages
+    assert msg.hex_vars() == ("IN_D_HEX", "OUT_D_HEX")  # Goby 1.1 configurations post on them
     assert (msg.trigger_var, msg.header["dest_id"].name, msg.header["dest_id"].source_var) == (
         "D_OUT",
         "Dest",

@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import json
 import math
-import os
 from functools import cache
-from pathlib import Path
 
 from google.protobuf import json_format
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
-REPO = Path(__file__).resolve().parents[2]
-NETSIM = Path(os.environ.get("PYGOBY_SHARED", REPO.parent / "shared")) / "vectors" / "netsim"
+from tests.conftest import VECTORS
+
+NETSIM = VECTORS / "netsim"
 
 
 @cache

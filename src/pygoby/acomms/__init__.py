@@ -1,4 +1,4 @@
-"""goby-acomms: moving DCCL messages over slow, lossy acoustic links (spec acomms.md).
+"""goby-acomms: moving DCCL messages over slow, lossy acoustic links.
 
 Layers (all sans-I/O cores advanced by `do_work()` against a pygoby.util.clock.Clock; signals
 are synchronous `pygoby.util.signal.Signal`s with `connect`/`disconnect`/`emit`):

@@ -1,4 +1,4 @@
-"""The ABC example modem's text protocol (spec acomms.md §9.1): `KEY,NAME:VALUE,...` lines."""
+"""The ABC example modem's text protocol: `KEY,NAME:VALUE,...` lines."""
 
 from __future__ import annotations
 

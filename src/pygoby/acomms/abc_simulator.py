@@ -1,4 +1,4 @@
-"""ABC modem simulator (spec acomms.md §9.3): each TCP client is one modem; no delay, no loss.
+"""ABC modem simulator: each TCP client is one modem; no delay, no loss.
 
 Bad lines are logged and skipped, one line per client per turn of the event loop, and a modem
 that does not read what is sent to it loses packets (as an acoustic modem out of range would)

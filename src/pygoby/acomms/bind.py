@@ -1,4 +1,4 @@
-"""Wire the layers together with their signals (spec acomms.md §2, goby3 bind.h)."""
+"""Wire the layers together with their signals (as goby3's bind.h)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""ModemDriverBase: the interface every modem driver implements (spec acomms.md §4).
+"""ModemDriverBase: the interface every modem driver implements.
 
 A driver is advanced by calling `do_work()` regularly (>= 5 Hz); it reads its link, runs its
 timers against the Clock, and emits signals synchronously. Line-based drivers talk through a
@@ -112,7 +112,7 @@ class ModemDriverBase(ABC):
 
     def _make_link(self, cfg, delimiter: str) -> LineLink:
         C = acomms_pb.DriverConfig
-        # Quirk A1 (sane): an implicit connection_type is the documented default, SERIAL.
+        # an implicit connection_type is the documented default, SERIAL (QUIRKS.md Q-ACOMMS-1)
         kind = cfg.connection_type
         if kind == C.CONNECTION_SERIAL:
             if not cfg.HasField("serial_port"):

@@ -1,5 +1,5 @@
 """AcommsHandler: modem drivers, MAC, priority queue and DCCL wired together as pAcommsHandler
-wires them (spec goby-moos-apps.md §4.2-4.3, §4.8-4.9; acomms.md §2), without any MOOS.
+wires them, without any MOOS.
 
     handler = AcommsHandler(cfg, clock, loader)     # cfg: pAcommsHandlerConfig (or any message
                                                     # with the same acomms fields)
@@ -89,7 +89,7 @@ def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
 
 
 def wire_driver_cfg(driver_cfg, cfg) -> None:
-    """pAcommsHandler's special wiring (spec goby-moos-apps.md 4.3): the uField driver gets the
+    """pAcommsHandler's special wiring: the uField driver gets the
     top-level `modem_id_lookup_path` and, where its own are unset, the MOOSDB of `common` (so a
     mission on a ServerPort other than 9000 needs no `moos_port`)."""
     if driver_cfg.WhichOneof("driver") == "driver_type" and driver_cfg.driver_type == UFIELD:
@@ -200,7 +200,7 @@ class AcommsHandler:
             self.mac.signal_initiate_transmission.connect(self._initiate_on_primary)
             self.primary.driver.signal_receive.connect(self.mac.handle_modem_receive)
 
-        # Static routing (spec acomms.md §12): the queue is the router's one subnet here.
+        # Static routing: the queue is the router's one subnet here.
         self.router = RouteManager(cfg.route_cfg)
         bind_router(self.queue, self.router)
 
@@ -259,7 +259,9 @@ class AcommsHandler:
         if self.queue.store is not None:
             self.queue.store.close()
 
-    # ------------------------------------------------------------------ main loop (§4.9 3-6)
+    # ------------------------------------------------------------------ main loop
+    # pAcommsHandler's order each tick: restart due drivers, run the drivers, the MAC (not while
+    # the primary driver waits to restart), then the queue's expiry.
     def do_work(self) -> None:
         now = self.clock.now()
         for slot in list(self.slots):
@@ -308,7 +310,7 @@ class AcommsHandler:
         self.queue.handle_modem_receive(transmission)
 
     def apply_mac_update(self, update) -> None:
-        """MACUpdate addressed to this node (§4.8); silences/restores Micro-Modems."""
+        """MACUpdate addressed to this node; silences/restores Micro-Modems."""
         state = self.mac.apply_update(update)
         if state is None:
             return

@@ -1,7 +1,7 @@
-"""MACManager: TDMA slot scheduling aligned to UTC (spec acomms.md §6).
+"""MACManager: TDMA slot scheduling aligned to UTC.
 
 Schemes: MAC_NONE, MAC_FIXED_DECENTRALIZED, MAC_POLLED (goby3) and MAC_AUTO_DECENTRALIZED (Goby
-1.1 passive auto-discovery, §6.7). Call `do_work()` regularly (>= 5 Hz) with a Clock; at each slot
+1.1 passive auto-discovery). Call `do_work()` regularly (>= 5 Hz) with a Clock; at each slot
 start the MAC may emit `signal_initiate_transmission(slot)` and always emits
 `signal_slot_start(slot)`. For auto-discovery connect the driver's receptions to
 `handle_modem_receive`.
@@ -84,6 +84,8 @@ class MACManager:
     def reference_time(self, now: float) -> float:
         if self.cfg.ref_time_type == acomms_pb.MACConfig.REFERENCE_FIXED:
             return float(self.cfg.fixed_ref_time)
+        # UTC midnight: a cycle that does not divide 86400 s changes phase at midnight until the
+        # next update(), as in goby3 (QUIRKS.md Q-ACOMMS-12)
         return math.floor(now / SECONDS_PER_DAY) * SECONDS_PER_DAY
 
     def update(self) -> None:
@@ -182,7 +184,7 @@ class MACManager:
 
     # ------------------------------------------------------------------ MACUpdate
     def apply_update(self, update) -> bool | None:
-        """Apply a MACUpdate addressed to this node (§6.6).
+        """Apply a MACUpdate addressed to this node.
 
         Returns None when `cycle_state` is absent, else True for STARTED / False for STOPPED
         (the caller silences or restores a Micro-Modem with `SRC,0` / `SRC,<id>`).
@@ -254,7 +256,9 @@ class MACManager:
         self._log_cycle()
 
     def _auto_place_blank(self, cycle_start: float) -> None:
-        """Blank position = N-1-[(k mod 5) == (S mod 5)] (k: cycles since midnight)."""
+        """Blank position = N-1-[(k mod 5) == (S mod 5)] (k: cycles since midnight, S: the sum of
+        the heard ids), from the slot count (Goby 1.x stepped a list iterator past its end:
+        QUIRKS.md Q-ACOMMS-3)."""
         ids = sorted(self.heard)
         n = len(ids) + 1
         k = round((cycle_start - self.reference_time(cycle_start)) / self.cycle_duration)

@@ -90,9 +90,18 @@ V1ModemDataTransmission = _cls("goby.transitional.protobuf.ModemDataTransmission
 V1ModemRangingRequest = _cls("goby.transitional.protobuf.ModemRangingRequest")
 V1ModemRangingReply = _cls("goby.transitional.protobuf.ModemRangingReply")
 V1MACUpdate = _cls("goby.transitional.protobuf.MACUpdate")
+V1ModemDataAck = _cls("goby.transitional.protobuf.ModemDataAck")
+V1ModemDataExpire = _cls("goby.transitional.protobuf.ModemDataExpire")
+V1QueueSize = _cls("goby.transitional.protobuf.QueueSize")
+V1QueueFlush = _cls("goby.transitional.protobuf.QueueFlush")
 QUEUE_CCL = (
     _loader.pool.FindEnumTypeByName("goby.transitional.protobuf.QueueType")
     .values_by_name["QUEUE_CCL"]
+    .number
+)
+QUEUE_DCCL = (
+    _loader.pool.FindEnumTypeByName("goby.transitional.protobuf.QueueType")
+    .values_by_name["QUEUE_DCCL"]
     .number
 )
 

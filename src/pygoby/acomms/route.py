@@ -1,4 +1,4 @@
-"""Static routing between subnets of queue managers (spec acomms.md §12; experimental upstream).
+"""Static routing between subnets of queue managers (experimental upstream).
 
 `bind_router(queue, router)` makes a QueueManager one of the router's subnets: outgoing items
 get the next hop as their link destination, and messages received on the link for us but

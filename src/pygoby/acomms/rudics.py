@@ -1,4 +1,4 @@
-""" "RUDICS packet" framing used by the store-server (and Iridium) drivers (spec acomms.md §11).
+""" "RUDICS packet" framing used by the store-server (and Iridium) drivers.
 
 Serialize: append the CRC-32 of the bytes (big-endian), re-express the byte string in base
 256 - len(reserved) (little-endian digits: byte 0 is the least significant; zero bytes at the

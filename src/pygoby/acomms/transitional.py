@@ -1,4 +1,4 @@
-"""Goby 1.1 XML message files in a pAcommsHandler configuration (spec goby-moos-apps.md §4.10):
+"""Goby 1.1 XML message files in a pAcommsHandler configuration:
 the files of `transitional_cfg` (where Goby 1.1's dccl_cfg/queue_cfg `message_file`s land when
 the configuration is read) become DCCL types in a loader, `queue_cfg.message_entry`s and
 `translator_entry`s, as Goby 2's transitional layer did at start-up. No MOOS needed (e.g. for
@@ -7,6 +7,8 @@ tools that show a pAcommsHandler's message set).
     messages = TransitionalMessages.expand(cfg, loader, find=str)   # ConfigError file:line
     messages.complete(created, now, modem_id)   # Goby 1.1's header defaults
     messages.single_field_sources()             # where Goby 1.1's `name=value` rule applies
+    if messages.speaks_dccl1(cfg):              # Goby 1.1's own bytes on the wire
+        queue.use_dccl1(messages.dccl1_bridge(cfg, loader, clock.now))
 """
 
 from __future__ import annotations
@@ -17,6 +19,8 @@ from pathlib import Path
 
 from google.protobuf.message import Message
 
+from pygoby.dccl.dccl1 import Dccl1Codec
+from pygoby.dccl.dccl1.bridge import Dccl1Bridge
 from pygoby.dccl.xml import MessageSet, XmlMessage, load_message_set
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
@@ -82,8 +86,26 @@ class TransitionalMessages:
         """{message: {source variable: field name}} for the source variables that feed one field
         (the translator reads them with a FORMAT create; the shared ones are key=value pairs
         already). Goby 1.1 read such a variable's string as `name=value` when it holds the
-        field's name, else whole (seed 003 §2.3.8): Translator.read_named_values."""
+        field's name, else whole: Translator.read_named_values."""
         return {name: msg.single_field_sources() for name, msg in self.messages.items()}
+
+    def speaks_dccl1(self, cfg: Message) -> bool:
+        """Whether the XML messages travel as Goby 1.1's DCCL1 (transitional_cfg.wire_format;
+        a Goby 1.1 configuration gets DCCL1 when it does not set it)."""
+        transitional = cfg.transitional_cfg
+        wire = transitional.DESCRIPTOR.fields_by_name["wire_format"].enum_type
+        return bool(self.sets) and transitional.wire_format == wire.values_by_name["DCCL1"].number
+
+    def dccl1_bridge(
+        self, cfg: Message, loader: ProtoLoader, clock: Callable[[], float]
+    ) -> Dccl1Bridge:
+        """A DCCL1 codec for the XML messages (dccl_cfg.crypto_passphrase; Goby 1.1 encrypts
+        with an empty passphrase when none is set), for the queue (QueueManager.use_dccl1)."""
+        codec = Dccl1Codec(cfg.dccl_cfg.crypto_passphrase or None, cfg.modem_id, clock)
+        bridge = Dccl1Bridge(codec, loader.message_class)
+        for message_set in self.sets:
+            bridge.add(message_set)  # ConfigError file:line: a message too big for DCCL1
+        return bridge
 
     @property
     def warnings(self) -> list[str]:

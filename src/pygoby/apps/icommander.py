@@ -1,4 +1,4 @@
-"""iCommander: compose and send command messages from a terminal (Goby 1.1, seed 003 §2.4).
+"""iCommander: compose and send command messages from a terminal (Goby 1.1).
 
     iCommander mission.moos [AppName]
     iCommander --example_config

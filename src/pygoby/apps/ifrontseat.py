@@ -1,5 +1,4 @@
-"""iFrontSeat: a MOOS backseat (pHelmIvP + Goby) driving a vehicle's frontseat (spec
-goby-moos-apps.md section 5).
+"""iFrontSeat: a MOOS backseat (pHelmIvP + Goby) driving a vehicle's frontseat.
 
     IFRONTSEAT_DRIVER_LIBRARY=basic_simulator iFrontSeat mission.moos [AppName]
     IFRONTSEAT_DRIVER_LIBRARY=basic_simulator iFrontSeat --example_config
@@ -17,8 +16,14 @@ onto them:
   processes' IFS_RAW_OUT only in LISTEN or COMMAND;
 * the driver's data, responses and raw traffic are posted on IFS_DATA_IN (plus IFS_NODE_STATUS),
   IFS_COMMAND_RESPONSE, IFS_RAW_IN and IFS_RAW_OUT; IFS_STATUS every `status_period` seconds
-  (0: never, Quirk Q15 fixed as documented);
+  (0: never, as documented; goby3 posts it every iteration: QUIRKS.md Q-APPS-15);
 * IVPHELM_STATE sets the helm state, LAT_ORIGIN/LONG_ORIGIN the driver's local grid;
+* legacy_cfg: DESIRED_* and CTD_* become IFS_COMMAND_REQUEST / IFS_DATA_OUT; with
+  `pub_sub_bf_commands`, BUOYANCY_CONTROL, TRIM_CONTROL, FRONTSEAT_BHVOFF, FRONTSEAT_SILENT and
+  BACKSEAT_ABORT become Bluefin command requests and the driver's trim/buoyancy status
+  TRIM_REPORT / BUOYANCY_REPORT; with `subscribe_acomms_raw`, ACOMMS_RAW_INCOMING/OUTGOING
+  (ModemRaw) become IFS_DATA_OUT with the Bluefin micro_modem_raw_in/out (rules:
+  `pygoby.frontseat.legacy`);
 * with `exit_on_error`, entering an error state stops the app with exit status 1.
 """
 
@@ -36,7 +41,15 @@ from pygoby.frontseat import config as fs_config
 from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.backseat import HELM_STATE_VAR, Backseat
 from pygoby.frontseat.errors import DriverLoadError, FrontSeatFatalError
-from pygoby.frontseat.legacy import CTD_FIELDS, DESIRED_FIELDS, Post, ready_posts
+from pygoby.frontseat.legacy import (
+    ACOMMS_RAW_VARS,
+    BLUEFIN_COMMAND_VARS,
+    CTD_FIELDS,
+    DESIRED_FIELDS,
+    Post,
+    modem_raw_data,
+    ready_posts,
+)
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import prefixed_var_names, read_configuration
 from pygoby.moos.moosfile import MissionFile
@@ -89,7 +102,6 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def __init__(self, cfg: Message, **kwargs: Any) -> None:
         super().__init__(cfg, **kwargs)
-        fs_config.refuse_unsupported_legacy(cfg.legacy_cfg)
         self.var = prefixed_var_names(cfg.moos_var)
         driver, self.interface = fs_config.load_configured_driver(cfg, os.environ, self.clock)
         # the driver's log lines (state changes, link trouble) go to the app's log
@@ -131,6 +143,12 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         if self.backseat.ctd_samples is not None:
             for var in CTD_FIELDS:
                 self.subscribe(var, self._on_ctd, blackout=LEGACY_BLACKOUT)
+        if self.cfg.legacy_cfg.subscribe_acomms_raw:
+            for var in ACOMMS_RAW_VARS:
+                self.subscribe(var, self._on_acomms_raw)
+        if self.backseat.bluefin_commands is not None:
+            for var in BLUEFIN_COMMAND_VARS:
+                self.subscribe(var, self._on_bluefin_command)
 
     # -- running ---------------------------------------------------------------------------
 
@@ -207,6 +225,16 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
             and (data := self.backseat.ctd(msg.key, msg.dval, msg.time)) is not None
         ):
             self.publish_pb(self.var["data_to_frontseat"], data)
+
+    def _on_acomms_raw(self, msg: MOOSMessage) -> None:
+        if (raw := self.parse_pb(msg, frontseat_pb.ModemRaw)) is not None:
+            data = modem_raw_data(raw, ACOMMS_RAW_VARS[msg.key])
+            self.publish_pb(self.var["data_to_frontseat"], data)
+
+    def _on_bluefin_command(self, msg: MOOSMessage) -> None:
+        text, number = ("", msg.dval) if msg.is_double else (msg.string, None)
+        if (request := self.backseat.bluefin_command(msg.key, text, number)) is not None:
+            self.publish_pb(self.var["command_request"], request)
 
     def _is_number(self, msg: MOOSMessage) -> bool:
         if not msg.is_double:

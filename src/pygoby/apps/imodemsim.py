@@ -3,7 +3,7 @@ Micro-Modem emulator on the serial line the mission names.
 
     iModemSim mission.moos [AppName]
 
-ProcessConfig (seed 003 §2.3.15):
+ProcessConfig:
   Port = /tmp/ttyLOOPA1     serial device of the emulated modem; the host (pAcommsHandler)
                             opens its partner, /tmp/ttyLOOPA2. When the pair does not exist (or
                             its links are stale) iModemSim makes it, so pAntler alone is enough.
@@ -13,10 +13,13 @@ ProcessConfig (seed 003 §2.3.15):
   BroadcastAddr = 127.0.0.1 loopback: every emulator on this host hears every other one (UDP
                             multicast on the loopback); another address: UDP broadcast to it
   InputLocType = constant_local | constant_global | moos_local | moos_global
-  ConstantPosX/ConstantPosY/ConstantDepth (local) or ConstantLat/ConstantLon/ConstantDepth
-                            the modem's position (logged; the emulated channel is perfect: no
-                            loss, no travel time, so the position does not change what is heard;
-                            packets take the modem's time on the water)
+  ConstantPosX/ConstantPosY/ConstantDepth (local, metres from the mission's LatOrigin/
+  LongOrigin) or ConstantLat/ConstantLon/ConstantDepth
+                            the modem's position: every packet carries its sender's, and the
+                            receiving emulator hears it through netsim's acoustic model at that
+                            range (travel time, received level, frame errors, out of reach)
+  ChannelModel = range      range: as above; perfect: every packet heard at once, no loss,
+                            whatever the positions (pygoby extension)
   ModemID = 1               NVRAM SRC before the host configures it (pygoby extension)
 """
 
@@ -33,6 +36,8 @@ from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.moos.classic_app import ClassicMOOSApp
 from pygoby.moos.protocol import MOOSMessage
+from pygoby.netsim.range_link import RangeLink
+from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.pty import PtyError, PtyPair, is_live, partner_of
 
 log = logging.getLogger(__name__)
@@ -55,8 +60,10 @@ KNOWN_NAMES = (
     "ConstantDepth",
     "ConstantLat",
     "ConstantLon",
+    "ChannelModel",
     "ModemID",
 )
+CHANNEL_MODELS = ("range", "perfect")
 KNOWN = {name.lower() for name in KNOWN_NAMES}
 
 
@@ -71,6 +78,7 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
         "ConstantPosX = 0",
         "ConstantPosY = 0",
         "ConstantDepth = 0",
+        "ChannelModel = range        // range (netsim's model at the positions) | perfect",
         "ModemID = 1                 // NVRAM SRC before the host configures it (pygoby)",
     )
 
@@ -94,12 +102,9 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
             loopback = ipaddress.ip_address(address).is_loopback
         except ValueError:
             self._error("broadcastaddr", f"{address!r} is not an IPv4 address")
-        # (the channel's deliveries on the app's clock, which MOOSTimeWarp speeds up)
-        self.channel = (
-            MulticastChannel(MULTICAST_GROUP, udp_port, self.clock)
-            if loopback
-            else BroadcastChannel(address, udp_port, self.clock)
-        )
+        model = self._text("channelmodel", "range").lower()
+        if model not in CHANNEL_MODELS:
+            self._error("channelmodel", f"{model!r} is not one of {', '.join(CHANNEL_MODELS)}")
         location = self._text("inputloctype", "constant_local").lower()
         if location not in LOCATION_TYPES:
             self._error("inputloctype", f"{location!r} is not one of {', '.join(LOCATION_TYPES)}")
@@ -110,7 +115,19 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
         else:
             for index, var in enumerate(LOCATION_TYPES[location]):
                 self.subscribe(var, lambda msg, i=index: self._on_position(i, msg))
+        self.is_local = location.endswith("local")
+        self.geodesy = UTMGeodesy(self.cfg.common.lat_origin, self.cfg.common.lon_origin)
         modem_id = int(self._number("modemid", 1))
+        # (the channel's deliveries on the app's clock, which MOOSTimeWarp speeds up)
+        link = RangeLink(seed=modem_id) if model == "range" else None
+        channel_type = MulticastChannel if loopback else BroadcastChannel
+        self.channel = channel_type(
+            MULTICAST_GROUP if loopback else address,
+            udp_port,
+            self.clock,
+            position=self.geo_position,
+            link=link,
+        )
         self.pair = self._make_pair()
         self.model = MicroModemModel(
             modem_id,
@@ -162,6 +179,14 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
             "made the loopback %s <-> %s (the host opens %s)", self.port_path, partner, partner
         )
         return pair
+
+    def geo_position(self) -> list[float]:
+        """[lat, lon, depth] of the modem (local x/y from the mission's origin)."""
+        first, second, depth = self.position
+        if self.is_local:
+            lat, lon = self.geodesy.to_geo(first, second)
+            return [lat, lon, depth]
+        return [first, second, depth]
 
     def _on_position(self, index: int, msg: MOOSMessage) -> None:
         if isinstance(msg.value, float):

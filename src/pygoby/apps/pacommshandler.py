@@ -1,11 +1,11 @@
-"""pAcommsHandler: goby-acomms on a MOOS community (spec goby-moos-apps.md §4).
+"""pAcommsHandler: goby-acomms on a MOOS community.
 
 Translator entries create DCCL messages from MOOS variables and push them into the priority
 queue; the MAC opens the slots, the driver asks the queue for frames; messages received over
 the link are published through the same entries' publish rules and posted on
-ACOMMS_QUEUE_RECEIVE. Every ACOMMS_* variable of the spec's table is published or handled.
-The modem, the MAC and the queue keep working while the MOOSDB is away (upstream's stop with
-it); their posts are delivered when it is back.
+ACOMMS_QUEUE_RECEIVE. Every ACOMMS_* variable goby3's pAcommsHandler publishes or reads is published
+or handled. The modem, the MAC and the queue keep working while the MOOSDB is away (upstream's stop
+with it); their posts are delivered when it is back.
 The acomms wiring itself is `pygoby.acomms.handler.AcommsHandler`; this module maps the
 configuration, the translator and the MOOS variables onto it.
 
@@ -73,6 +73,12 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         except HandlerError as err:
             raise ConfigError(str(err)) from None
         self.queue = self.acomms.queue
+        dccl1 = None
+        if self.messages.transitional.speaks_dccl1(cfg):  # Goby 1.1's bytes and variables
+            dccl1 = self.messages.transitional.dccl1_bridge(
+                cfg, self.messages.loader, self.clock.now
+            )
+            self.queue.use_dccl1(dccl1)
         self.publish("MODEM_ID", float(cfg.modem_id))
         self.publish("VEHICLE_ID", float(cfg.modem_id))
         self.messages.apply_libraries(self.acomms.codec)
@@ -86,13 +92,15 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         )
         self.translator = self.binding.translator
         self.messages.read_named_values(self.translator)
-        self._connect_signals()
         self.goby11 = Goby11Variables(
             self,
             self.acomms,
             cfg.queue_cfg,
             enabled=bool(cfg.queue_cfg.queue or cfg.transitional_cfg.message_file),
+            dccl1=dccl1,
+            var=self.var,
         )
+        self._connect_signals()
         self._configure_queue()
         self._subscribe_all()
         self.frontseat_forward = self.messages.require(
@@ -131,10 +139,13 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             (mac.signal_slot_start, self._poster("mac_slot_start")),
             (queue.signal_receive, self._on_queue_receive),
             (queue.signal_ack, self._on_ack),
-            (queue.signal_expire, self._poster("queue_expire")),
-            (queue.signal_queue_size_change, self._poster("queue_size")),
             (queue.signal_data_on_demand, self._on_data_on_demand),
         ]
+        if not self.goby11.goby11_forms:  # else Goby11Variables posts Goby 1.1's forms
+            connections += [
+                (queue.signal_expire, self._poster("queue_expire")),
+                (queue.signal_queue_size_change, self._poster("queue_size")),
+            ]
         for signal, slot in connections:
             signal.connect(slot, contain_errors=True, logger=self.log)
 
@@ -147,7 +158,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         for key, handler in from_others.items():
             self.subscribe_pb(self.var[key], acomms_pb.ModemTransmission, handler, ignore_own=True)
         self.subscribe(self.var["mac_cycle_update"], self._on_mac_update)
-        self.subscribe_pb(self.var["queue_flush"], acomms_pb.QueueFlush, self.queue.flush_queue)
+        self.subscribe(self.var["queue_flush"], self._on_flush)
         self.subscribe(self.var["config_file_request"], self._on_config_request)
         self.subscribe(self.var["driver_reset"], self._on_driver_reset)
         self.subscribe_pb(
@@ -220,6 +231,13 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         ):
             self.acomms.apply_mac_update(update)
 
+    def _on_flush(self, msg: MOOSMessage) -> None:
+        """Today's QueueFlush, or Goby 1.1's (by queue key, CCL queues too)."""
+        if not (self.goby11.goby11_forms and self.goby11.apply_flush(msg)) and (
+            flush := self.parse_pb(msg, acomms_pb.QueueFlush)
+        ):
+            self.queue.flush_queue(flush)
+
     def _on_data_on_demand(self, request, message: Message) -> None:
         """ON_DEMAND: a fresh message from the current variables, queued here (so a bad one is
         logged and skipped); `message` is left empty so the queue does not push it again."""
@@ -246,7 +264,8 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.publish_pb(self.var["driver_raw_msg_in" if incoming else "driver_raw_msg_out"], raw)
 
     def _on_ack(self, ack, original: Message) -> None:
-        self.publish_pb(self.var["queue_ack_transmission"], ack)
+        if not self.goby11.goby11_forms:  # else Goby 1.1's ModemDataAck (Goby11Variables)
+            self.publish_pb(self.var["queue_ack_transmission"], ack)
         self.publish_pb(self.var["queue_ack_original_msg"], original)
 
     def _on_queue_receive(self, message: Message) -> None:

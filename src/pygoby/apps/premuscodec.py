@@ -1,5 +1,4 @@
-"""pREMUSCodec: MOOS vehicles talking to REMUS vehicles in CCL (Goby 1.1, seed 003 §2.5; spec
-goby-moos-apps.md §7).
+"""pREMUSCodec: MOOS vehicles talking to REMUS vehicles in CCL (Goby 1.1).
 
     pREMUSCodec mission.moos [AppName]
     pREMUSCodec --example_config

@@ -1,4 +1,4 @@
-"""pREMUSCodec's translation, sans I/O (spec goby-moos-apps.md §7): REMUS CCL frames
+"""pREMUSCodec's translation, sans I/O: REMUS CCL frames
 (pygoby.dccl.ccl.remus) to the Goby 1.1 MOOS strings and contact variables, and our NAV_* /
 OUTGOING_COMMAND to State / Redirect frames. Numbers are printed as Goby 1.1's `as<string>`
 prints them (doubles with 17 significant digits, integers plainly).

@@ -1,4 +1,4 @@
-"""pTranslator: MOOS variables -> protobuf messages -> MOOS variables (spec goby-moos-apps.md 3).
+"""pTranslator: MOOS variables -> protobuf messages -> MOOS variables.
 
 Every message created by a translator_entry's trigger is published straight back through the
 same entry's publish rules. The translation itself is `pygoby.moos.translator`; this module
@@ -27,6 +27,8 @@ class pTranslator(GobyMOOSApp):  # noqa: N801 - the program's name
             cfg.load_shared_library,
             lambda reason, name: self.config_error(reason, "load_shared_library", name),
         )
+        # load_proto_file entries are compiled and loaded as pAcommsHandler does (goby3's
+        # pTranslator looks the path up as a type name and aborts: QUIRKS.md Q-APPS-4)
         types = MessageTypes(
             [*(p for library in libraries for p in library.proto_files), *cfg.load_proto_file],
             others,

@@ -28,7 +28,15 @@ def register(subparsers) -> None:
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--proto", help=".proto file defining the message")
     source.add_argument(
-        "--xml", metavar="FILE", help="Goby 1.1 XML message set (converted to DCCL in memory)"
+        "--xml",
+        metavar="FILE",
+        action="append",
+        help="Goby 1.1 XML message set (converted to DCCL in memory; with --goby11 repeatable)",
+    )
+    parser.add_argument(
+        "--goby11",
+        action="store_true",
+        help="with --xml: Goby 1.1's own bytes (DCCL1), one JSON object per line for encode",
     )
     parser.add_argument(
         "-I",
@@ -96,7 +104,7 @@ def register(subparsers) -> None:
 def _load_xml(codec: Codec, args: argparse.Namespace) -> list:
     from pygoby.dccl.xml import load_message_set
 
-    message_set = load_message_set(args.xml)
+    message_set = load_message_set(args.xml[0])
     classes = message_set.load_into(codec)
     if args.write_proto:
         print(f"wrote {message_set.write_proto(args.write_proto)}", file=sys.stderr)
@@ -105,7 +113,7 @@ def _load_xml(codec: Codec, args: argparse.Namespace) -> list:
     if args.message not in message_set.names:
         raise ConfigError(
             f"no message named {args.message!r}{did_you_mean(args.message, message_set.names)}",
-            file=args.xml,
+            file=args.xml[0],
         )
     return [classes[message_set.names.index(args.message)]]
 
@@ -114,6 +122,8 @@ def run(args: argparse.Namespace) -> int:
     if args.write_proto and not args.xml:
         print("error: --write-proto needs --xml", file=sys.stderr)
         return 2
+    if args.goby11 or (args.xml and len(args.xml) > 1):
+        return _run_goby11(args)
     if args.message is None and args.action != "analyze":
         print("error: --message is required", file=sys.stderr)
         return 2
@@ -169,6 +179,25 @@ def _run(args: argparse.Namespace) -> int:
         return text_format.MessageToString(codec.decode(data, cls), as_one_line=True)
 
     return process_lines(sys.stdin, encode if args.action == "encode" else decode)
+
+
+def _run_goby11(args: argparse.Namespace) -> int:
+    from pygoby.dccl.dccl1 import Dccl1Codec
+    from pygoby.dccl.dccl1.cli import run as run_dccl1
+    from pygoby.dccl.xml import load_message_set
+
+    if not args.goby11 or not args.xml:
+        print("error: several --xml files need --goby11; --goby11 needs --xml", file=sys.stderr)
+        return 2
+    try:
+        codec = Dccl1Codec(passphrase=read_passphrase(args))
+        for path in args.xml:
+            codec.load(load_message_set(path))
+    except (DcclError, ConfigError, OSError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    names = None if args.message is None else [args.message]
+    return run_dccl1(args.action, codec, names, sys.stdin)
 
 
 def read_passphrase(args: argparse.Namespace) -> str | bytes | None:

@@ -1,4 +1,4 @@
-"""The DCCL codec: load message types, encode, decode, sizes (spec §§2-4, 20-22)."""
+"""The DCCL codec: load message types, encode, decode, sizes."""
 
 from __future__ import annotations
 
@@ -288,7 +288,7 @@ class Codec:
 
     # ---------------------------------------------------------------- decoding
     def read_id(self, data: bytes) -> tuple[int, int]:
-        """(DCCL ID, ID width in bits) from the first bytes (spec §4), by this Codec's
+        """(DCCL ID, ID width in bits) from the first bytes, by this Codec's
         identifier codec."""
         return self._id_codec.decode(data)
 

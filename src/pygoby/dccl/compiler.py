@@ -197,7 +197,7 @@ class _PartCompiler:
             self.src.add(ind, f"_trace({path!r}, {value}, {start}, pos, {self.bits_var})")
 
     def _trace_id(self, ind: int) -> None:
-        """The id opens the head: bits 0..pos hold it, shifted left by its form bit (spec §4)."""
+        """The id opens the head: bits 0..pos hold it, shifted left by its form bit."""
         if self.tracer is not None and self.part is Part.HEAD:
             bits = self.bits_var
             self.src.add(

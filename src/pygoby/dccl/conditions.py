@@ -1,4 +1,4 @@
-"""Dynamic conditions: `(dccl.field).dynamic_conditions` Lua expressions (spec §18), evaluated
+"""Dynamic conditions: `(dccl.field).dynamic_conditions` Lua expressions, evaluated
 with a real Lua 5.3 (the `lupa` package) as C++ DCCL does.
 
 A condition sees three globals: `this` (the message holding the field; for a message-typed

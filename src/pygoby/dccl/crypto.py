@@ -1,4 +1,4 @@
-"""Body encryption (spec §20): AES-256-CTR, key SHA-256(passphrase), IV SHA-256(header)[:16].
+"""Body encryption: AES-256-CTR, key SHA-256(passphrase), IV SHA-256(header)[:16].
 
 The AES key schedule is set up once per passphrase: an ECB encryptor of the key makes the CTR
 keystream (the encrypted counter blocks IV, IV+1, ...) for every message, instead of a new CTR

@@ -1,4 +1,4 @@
-"""Identifier codecs: the ID at the start of every encoding (spec §4) and the legacy CCL one.
+"""Identifier codecs: the ID at the start of every encoding and the legacy CCL one.
 
 * `dccl.default.id`: 1 byte `id << 1` for ids 0..127, 2 bytes `(id << 1) | 1` up to 32767.
 * `dccl.ccl.id` (C++ DCCL's libdccl_ccl_compat): lets REMUS CCL frames and DCCL messages share a

@@ -1,4 +1,4 @@
-"""The message plan: which fields go where, with which codec (spec §§5, 6, 11, 12, 13).
+"""The message plan: which fields go where, with which codec.
 
 A root message is planned twice, once for the HEAD part and once for the BODY part. A plan is a
 tree of items in wire order; sizes, header validation, `analyze` and the code generator

@@ -1,4 +1,4 @@
-"""The codec registry: codec name + field type family -> codec factory (spec §6)."""
+"""The codec registry: codec name + field type family -> codec factory."""
 
 from __future__ import annotations
 

@@ -43,7 +43,7 @@ class FieldTracer:
         self.fields: dict[str, FieldDescriptor] = {}  # by the paths the generated code passes
 
     def __call__(self, path: str, value: Any, start: int, end: int, bits: int) -> None:
-        """`bits` holds the field's bits at positions start..end (LSB first, spec §3.2)."""
+        """`bits` holds the field's bits at positions start..end (LSB first)."""
         if not log.isEnabledFor(logging.DEBUG):
             return
         nbits = end - start

@@ -1,7 +1,6 @@
-"""iFrontSeat's rules between the backseat and a frontseat driver, sans I/O (spec
-goby-moos-apps.md 5.3-5.8). The app reads the backseat's variables from MOOS and hands them over
-as plain values; `Backseat` applies them to the driver (`InterfaceBase`) and returns what is
-to be posted:
+"""iFrontSeat's rules between the backseat and a frontseat driver, sans I/O. The app reads the
+backseat's variables from MOOS and hands them over as plain values; `Backseat` applies them to the
+driver (`InterfaceBase`) and returns what is to be posted:
 
 * `may_command(var)`: a command request goes to the driver only in INTERFACE_COMMAND;
   `may_send(var)`: data and raw traffic only in INTERFACE_LISTEN or INTERFACE_COMMAND (a debug
@@ -13,8 +12,11 @@ to be posted:
   DESIRED_SPEED (legacy `subscribe_desired`);
 * `ctd(var, value, time)`: a CTD_* double; the InterfaceData to post after CTD_TEMPERATURE,
   its missing fields computed (legacy `subscribe_ctd`);
+* `bluefin_command(var, text, number)`: a Bluefin command variable; the CommandRequest to post
+  (legacy `pub_sub_bf_commands`);
 * `legacy_posts(data)`: the NAV_* (MOOS variable, value) posts for the driver's data (legacy
-  `publish_nav`); its position also places the next CTD sample.
+  `publish_nav`), and TRIM_REPORT / BUOYANCY_REPORT (legacy `pub_sub_bf_commands`); its
+  position also places the next CTD sample.
 """
 
 from __future__ import annotations
@@ -26,7 +28,15 @@ from typing import Any
 from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.helm import helm_state_from_ivphelm
 from pygoby.frontseat.interface import InterfaceBase
-from pygoby.frontseat.legacy import CtdSamples, DesiredCourseCommands, Post, nav_posts
+from pygoby.frontseat.legacy import (
+    BluefinCommands,
+    CtdSamples,
+    DesiredCourseCommands,
+    Post,
+    RequestIds,
+    bluefin_report_posts,
+    nav_posts,
+)
 
 CONTROL_STATES = frozenset({frontseat_pb.INTERFACE_LISTEN, frontseat_pb.INTERFACE_COMMAND})
 HELM_STATE_VAR = "IVPHELM_STATE"
@@ -48,8 +58,10 @@ class Backseat:
         self.origin = origin
         self.log = log
         self.publish_nav = legacy_cfg.publish_nav
-        self.desired_course = DesiredCourseCommands() if legacy_cfg.subscribe_desired else None
+        ids = RequestIds()  # one count for every command iFrontSeat makes (as goby3)
+        self.desired_course = DesiredCourseCommands(ids) if legacy_cfg.subscribe_desired else None
         self.ctd_samples = CtdSamples() if legacy_cfg.subscribe_ctd else None
+        self.bluefin_commands = BluefinCommands(ids) if legacy_cfg.pub_sub_bf_commands else None
 
     # -- backseat -> frontseat -------------------------------------------------------------
 
@@ -107,12 +119,20 @@ class Backseat:
         self.interface.compute_missing_ctd(sample)
         return frontseat_pb.InterfaceData(ctd_sample=sample)
 
+    def bluefin_command(self, var: str, text: str, number: float | None) -> Any | None:
+        assert self.bluefin_commands is not None
+        return self.bluefin_commands.update(var, text, number)
+
     # -- frontseat -> backseat -------------------------------------------------------------
 
     def legacy_posts(self, data: Any) -> list[Post]:
-        if not data.HasField("node_status"):
-            return []
-        status = data.node_status
-        if self.ctd_samples is not None:
-            self.ctd_samples.update_position(status)
-        return nav_posts(status) if self.publish_nav else []
+        posts: list[Post] = []
+        if data.HasField("node_status"):
+            status = data.node_status
+            if self.ctd_samples is not None:
+                self.ctd_samples.update_position(status)
+            if self.publish_nav:
+                posts += nav_posts(status)
+        if self.bluefin_commands is not None:
+            posts += bluefin_report_posts(data)
+        return posts

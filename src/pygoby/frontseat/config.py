@@ -1,4 +1,4 @@
-"""iFrontSeat's configuration, usable without the app (spec goby-moos-apps.md 5.1-5.2, 5.8).
+"""iFrontSeat's configuration, usable without the app.
 
 * The driver is imported before the configuration is parsed, so that its configuration
   extension parses and shows in `--example_config`: `import_driver_from_environment(env)` (as
@@ -8,7 +8,6 @@
 * `migrate_goby2_abc_config(cfg)`: the Goby 2 form `[abc_config] { ... }` directly in the
   ProcessConfig becomes frontseat_cfg's basic simulator block (`load_goby2_extensions()` makes
   the form parse).
-* `refuse_unsupported_legacy(legacy_cfg)`: legacy options pygoby cannot honour.
 * `load_configured_driver(cfg, env, clock)`: the driver of an iFrontSeatConfig, made from
   frontseat_cfg completed by `frontseat_config(frontseat_cfg, common)` with what the MOOS
   community says (vehicle name, datum, time warp).
@@ -42,9 +41,6 @@ from pygoby.util.clock import Clock
 # The Goby 2 ABC driver's block, `[abc_config] { ... }` directly in the ProcessConfig.
 ABC_CONFIG_PROTO = "goby/moos/frontseat/abc_frontseat_driver_config.proto"
 ABC_CONFIG = "abc_config"
-
-# legacy_cfg options that need goby3's Bluefin messages, which pygoby does not have.
-UNSUPPORTED_LEGACY = ("subscribe_acomms_raw", "pub_sub_bf_commands")
 
 _log = logging.getLogger(__name__)
 
@@ -127,15 +123,6 @@ def migrate_goby2_abc_config(cfg: Message) -> None:
         frontseat_pb.BASIC_SIMULATOR_CONFIG.full_name,
         text_format.MessageToString(sim_cfg, as_one_line=True),
     )
-
-
-def refuse_unsupported_legacy(legacy_cfg: Message) -> None:
-    for option in UNSUPPORTED_LEGACY:
-        if getattr(legacy_cfg, option):
-            raise ConfigError(
-                f"legacy_cfg {{ {option}: true }} needs goby3's Bluefin frontseat "
-                "extensions, which pygoby does not implement; remove the option"
-            )
 
 
 # -- the driver, from the parsed configuration -----------------------------------------------

@@ -1,5 +1,4 @@
-"""Sea-water properties a CTD sample lacks, by the UNESCO algorithms goby3 uses (spec
-goby-moos-apps.md 5.7).
+"""Sea-water properties a CTD sample lacks, by the UNESCO algorithms goby3 uses.
 
 Sources: Fofonoff & Millard (1983), "Algorithms for computation of fundamental properties of
 seawater", UNESCO Tech. Pap. Mar. Sci. 44 (practical salinity PSS-78, Perkin & Lewis 1980; depth,

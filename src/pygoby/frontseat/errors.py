@@ -20,7 +20,8 @@ class FrontSeatError(PygobyError):
 
 
 class FrontSeatDriverError(FrontSeatError):
-    """A driver raises it from loop() to force an error state (T9); goby3's FrontSeatException.
+    """A driver raises it from loop() to force an error state, from any state; goby3's
+    FrontSeatException.
 
     Carries at most one of a HelmError (-> INTERFACE_HELM_ERROR) or a FrontSeatError code
     (-> INTERFACE_FS_ERROR); one with neither is not a state change and propagates out of
@@ -84,3 +85,7 @@ class SimulatorProtocolError(FrontSeatError, ValueError):
 
 class AbcConfigError(FrontSeatError, ConfigError):
     """The frontseat Config lacks a usable `basic_simulator_config`."""
+
+
+class BluefinConfigError(FrontSeatError, ConfigError):
+    """The frontseat Config lacks a usable `bluefin_config`."""

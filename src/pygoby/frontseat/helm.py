@@ -1,10 +1,10 @@
-"""The IvP Helm's state, read from its IVPHELM_STATE posts (spec goby-moos-apps.md 5.4).
+"""The IvP Helm's state, read from its IVPHELM_STATE posts.
 
 Only the posting process tells whether a helm is running: pHelmIvP posts DRIVE/PARK, a standby
 helm (pHelmIvP_standby) posts DRIVE+/PARK+, and a post from any other process means the helm
 is not running. No staleness here: a helm that dies after posting DRIVE stays DRIVE (goby3's
-documented design, Quirk Q24, the default); InterfaceBase's pygoby option `helm_state_timeout`
-adds a timeout for helms that re-post their state.
+documented design, the default: QUIRKS.md Q-APPS-24); InterfaceBase's pygoby option
+`helm_state_timeout` adds a timeout for helms that re-post their state.
 """
 
 from __future__ import annotations

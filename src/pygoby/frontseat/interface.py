@@ -2,27 +2,40 @@
 
 A driver (one vehicle's frontseat protocol) subclasses `InterfaceBase` and implements the
 abstract hooks; the application calls `do_work()` once per tick, `set_helm_state()` from the
-helm's posts, and forwards commands/data only in the states that allow them (spec
-goby-moos-apps.md 5.3, 5.7). Sans-I/O: time comes from the given Clock.
+helm's posts, and forwards commands/data only in the states that allow them (commands only in
+COMMAND, data and raw traffic only in LISTEN or COMMAND). Sans-I/O: time comes from the given
+Clock.
 
-State machine (spec 5.3), run by `do_work()` before the driver's `loop()`:
+State machine (goby3's), run by `do_work()` before the driver's `loop()`:
 
-* STANDBY -> LISTEN when the frontseat provides data (T1), else error check E1-E3 (T2);
+* STANDBY -> LISTEN when the frontseat provides data, else the error check below (whose
+  not-providing-data rule cannot fire in STANDBY);
 * LISTEN -> COMMAND when the frontseat accepts commands and the helm drives (or the helm is not
-  required) (T3), else error check E1-E4 (T4);
-* COMMAND -> LISTEN when the frontseat is IDLE or IN_CONTROL, whatever the helm (T5), else error
-  check E1-E4 with the helm rule applied without its start-up grace period (T6);
-* HELM_ERROR -> STANDBY when the helm drives (T7); FS_ERROR -> STANDBY when the condition behind
-  the last frontseat error is gone (T8); an IGNORING_COMMANDS error has no automatic exit;
-* a driver raising `FrontSeatDriverError` from `loop()` forces the matching error state (T9).
+  required), else the error check;
+* COMMAND -> LISTEN when the frontseat is IDLE or IN_CONTROL, whatever the helm, else the error
+  check, with the helm-not-running rule applied without its start-up grace period;
+* HELM_ERROR -> STANDBY when the helm drives (the helm error is cleared); FS_ERROR -> STANDBY when
+  the condition behind the last frontseat error is gone (the frontseat connects again after
+  NOT_CONNECTED, provides data again after NOT_PROVIDING_DATA); an IGNORING_COMMANDS error has no
+  automatic exit;
+* a driver raising `FrontSeatDriverError` from `loop()` forces the matching error state, from any
+  state.
 
-goby3 keeps the helm's last reported state with no timeout (Quirk Q24, the default here too).
-The pygoby option `helm_state_timeout` (> 0) turns a helm that has not reported for that long
-into NOT_RUNNING before the check, so a helm that dies in DRIVE leads to HELM_ERROR (E2).
+The error check, first rule that fires wins: the helm PARKed -> HELM_ERROR (PARKED); the helm
+required and NOT_RUNNING, in COMMAND or once `helm_running_timeout` has passed since start ->
+HELM_ERROR (NOT_RUNNING); the frontseat NOT_CONNECTED, outside STANDBY or once
+`frontseat_connected_timeout` has passed -> FS_ERROR (NOT_CONNECTED); the frontseat not providing
+data outside STANDBY -> FS_ERROR (NOT_PROVIDING_DATA).
+
+goby3 keeps the helm's last reported state with no timeout (reproduced, the default here too:
+QUIRKS.md Q-APPS-24). The pygoby option `helm_state_timeout` (> 0) turns a helm that has not
+reported for that long into NOT_RUNNING before the check, so a helm that dies in DRIVE leads to
+HELM_ERROR (NOT_RUNNING).
 
 When the transition check enters an error state, `loop()` is skipped for that tick. Each error
-code is kept until its own exit (T7 clears the helm error, T8 the frontseat error), as goby3 does:
-so after a T9 jump from one error state to the other, `status()` can carry both codes.
+code is kept until its own exit (the helm driving again clears the helm error, the frontseat's
+recovery the frontseat error), as goby3 does: so after a driver's exception moves the interface
+from one error state to the other, `status()` can carry both codes.
 """
 
 from __future__ import annotations
@@ -166,7 +179,7 @@ class InterfaceBase(abc.ABC):
             status.frontseat_error = self._last_frontseat_error
         return status
 
-    # --- data helpers (spec 5.7) ---------------------------------------------------------------
+    # --- data helpers -----------------------------------------------------------------------------
 
     def update_utm_datum(self, lat: float, lon: float) -> None:
         """Re-centre the local grid used by compute_missing on (lat, lon) degrees."""
@@ -253,7 +266,8 @@ class InterfaceBase(abc.ABC):
             self._helm_state = HELM_NOT_RUNNING
 
     def _check_change_state(self) -> bool:
-        """Applies T1-T8; True when it has just entered an error state (loop() is skipped)."""
+        """Applies the transitions above (all but the driver-raised error); True when it has just
+        entered an error state (loop() is skipped)."""
         state = self._state
         if state in (INTERFACE_STANDBY, INTERFACE_LISTEN, INTERFACE_COMMAND):
             target = self._normal_transition(state)
@@ -273,22 +287,22 @@ class InterfaceBase(abc.ABC):
 
     def _normal_transition(self, state: int) -> int | None:
         if state == INTERFACE_STANDBY:
-            return INTERFACE_LISTEN if self.frontseat_providing_data() else None  # T1
-        if state == INTERFACE_LISTEN:  # T3
+            return INTERFACE_LISTEN if self.frontseat_providing_data() else None
+        if state == INTERFACE_LISTEN:  # -> COMMAND: the frontseat accepts commands, the helm drives
             helm_ok = self._helm_state == HELM_DRIVE or not self.cfg.require_helm
             accepting = self.frontseat_state() == FRONTSEAT_ACCEPTING_COMMANDS
             return INTERFACE_COMMAND if accepting and helm_ok else None
-        # COMMAND (T5): the helm is not consulted
+        # COMMAND -> LISTEN when the frontseat is idle or in control: the helm is not consulted
         if self.frontseat_state() in (FRONTSEAT_IN_CONTROL, FRONTSEAT_IDLE):
             return INTERFACE_LISTEN
         return None
 
     def _error_check(self) -> tuple[int | None, int | None] | None:
-        """E1-E4 in order (used from STANDBY, LISTEN, COMMAND): (helm error, frontseat error)
-        of the first rule that fires, or None."""
+        """The error rules in order (used from STANDBY, LISTEN, COMMAND): (helm error, frontseat
+        error) of the first rule that fires, or None."""
         now = self.clock.now()
         helm = self._helm_state
-        if helm == HELM_PARK:  # E1
+        if helm == HELM_PARK:
             return ERROR_HELM_PARKED, None
         if (
             self.cfg.require_helm
@@ -297,19 +311,19 @@ class InterfaceBase(abc.ABC):
                 self._state == INTERFACE_COMMAND
                 or now > self.start_time + self.cfg.helm_running_timeout
             )
-        ):  # E2
+        ):
             return ERROR_HELM_NOT_RUNNING, None
         if self.frontseat_state() == FRONTSEAT_NOT_CONNECTED and (
             self._state != INTERFACE_STANDBY
             or now > self.start_time + self.cfg.frontseat_connected_timeout
-        ):  # E3
+        ):
             return None, ERROR_FRONTSEAT_NOT_CONNECTED
-        if not self.frontseat_providing_data() and self._state != INTERFACE_STANDBY:  # E4
+        if not self.frontseat_providing_data() and self._state != INTERFACE_STANDBY:
             return None, ERROR_FRONTSEAT_NOT_PROVIDING_DATA
         return None
 
     def _helm_error_exit(self) -> int | None:
-        if self._helm_state == HELM_DRIVE:  # T7
+        if self._helm_state == HELM_DRIVE:  # the helm drives again: its error is cleared
             self._last_helm_error = ERROR_HELM_NONE
             return INTERFACE_STANDBY
         return None
@@ -320,14 +334,14 @@ class InterfaceBase(abc.ABC):
             error == ERROR_FRONTSEAT_NOT_CONNECTED
             and self.frontseat_state() != FRONTSEAT_NOT_CONNECTED
         ) or (error == ERROR_FRONTSEAT_NOT_PROVIDING_DATA and self.frontseat_providing_data())
-        if cleared:  # T8
+        if cleared:  # the condition behind the last frontseat error is gone
             self._last_frontseat_error = ERROR_FRONTSEAT_NONE
             return INTERFACE_STANDBY
         return None
 
     def _enter_error(self, helm_error: int | None, frontseat_error: int | None) -> None:
-        """Error entry (from the E rules or T9). Signals even when the state stays the same
-        (a T9 report while already in that error state), as goby3 does."""
+        """Error entry (from the error rules or a driver's exception). Signals even when the state
+        stays the same (a driver reporting the error state it is already in), as goby3 does."""
         if helm_error is not None:
             self._last_helm_error = helm_error
             target = INTERFACE_HELM_ERROR

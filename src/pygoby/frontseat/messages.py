@@ -1,8 +1,9 @@
 """Message classes and enum constants of the frontseat interface, from our .proto files.
 
-The files live under src/pygoby/protobuf/goby/middleware/ at their goby3 import paths (spec
-goby-moos-apps.md 5.6); this module loads them once into the process-wide pool, together with
-the basic simulator's Config extension, so configuration text using it parses.
+The files live under src/pygoby/protobuf/goby/middleware/ at their goby3 import paths; this module
+loads them once into the process-wide pool, together with the drivers' extensions (the basic
+simulator's and Bluefin's Config extensions, Bluefin's InterfaceData and CommandRequest extensions),
+so configuration text and messages using them parse.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ _PROTO_FILES = (
     "goby/middleware/protobuf/frontseat.proto",
     "goby/middleware/protobuf/frontseat_config.proto",
     "goby/middleware/frontseat/simulator/basic/basic_simulator_frontseat_driver_config.proto",
+    "goby/middleware/frontseat/bluefin/bluefin.proto",
+    "goby/middleware/frontseat/bluefin/bluefin_config.proto",
 )
 
 _loader = default_loader()
@@ -53,6 +56,16 @@ HelmStateReport = _cls("HelmStateReport")
 
 BasicSimulatorFrontSeatConfig = _cls("BasicSimulatorFrontSeatConfig")
 BASIC_SIMULATOR_CONFIG = _loader.pool.FindExtensionByName(f"{PACKAGE}.basic_simulator_config")
+
+BluefinConfig = _cls("BluefinConfig")
+BluefinExtraData = _cls("BluefinExtraData")
+BluefinExtraCommands = _cls("BluefinExtraCommands")
+BuoyancyStatus = _cls("BuoyancyStatus")
+TrimStatus = _cls("TrimStatus")
+BLUEFIN_CONFIG = _loader.pool.FindExtensionByName(f"{PACKAGE}.bluefin_config")
+BLUEFIN_DATA = _loader.pool.FindExtensionByName(f"{PACKAGE}.bluefin_data")
+BLUEFIN_COMMAND = _loader.pool.FindExtensionByName(f"{PACKAGE}.bluefin_command")
+ModemRaw = _loader.message_class("goby.acomms.protobuf.ModemRaw")  # in BluefinExtraData
 
 # Enum wrappers (`.Name(value)`, `.Value(name)`) and their values as plain ints.
 InterfaceState = _enum("InterfaceState")

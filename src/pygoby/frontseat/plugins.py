@@ -1,4 +1,4 @@
-"""Finding and loading an iFrontSeat driver (spec goby-moos-apps.md 5.1).
+"""Finding and loading an iFrontSeat driver.
 
 goby3 dlopen()s the shared library named by $IFRONTSEAT_DRIVER_LIBRARY and calls its
 `frontseat_driver_load(Config*)`. Here a driver is named by either

@@ -1,4 +1,4 @@
-"""`pygoby antler mission.moos`: pAntler for pygoby (spec moos.md 19).
+"""`pygoby antler mission.moos`: pAntler for pygoby.
 
 Starts the embedded MOOSDB (as `python -m pygoby.cli moosdb mission.moos`), then every `Run =`
 program of the ANTLER block as a subprocess with the argument vector `<program> <mission> <MOOS

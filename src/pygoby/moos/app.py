@@ -1,5 +1,5 @@
 """GobyMOOSApp: the base class of pygoby's Goby MOOS applications (pTranslator, pAcommsHandler,
-iFrontSeat, ...), per spec goby-moos-apps.md section 2.
+iFrontSeat, ...): goby3's GobyMOOSApp conventions.
 
 Writing an application
 ----------------------

@@ -1,4 +1,4 @@
-"""The command line of every Goby MOOS application (spec goby-moos-apps.md section 2.1).
+"""The command line of every Goby MOOS application.
 
     APP [options] mission.moos [moos_name]
 

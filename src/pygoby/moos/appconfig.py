@@ -1,4 +1,4 @@
-"""Goby MOOS application configuration (spec goby-moos-apps.md 2.2-2.5), sans I/O.
+"""Goby MOOS application configuration, sans I/O.
 
 * `read_configuration(config_class, mission, app_name, overrides)`: the app's ProcessConfig block
   parsed as protobuf TextFormat, then the MOOS globals
@@ -93,7 +93,8 @@ def apply_moos_globals(config: Message, mission: MissionFile) -> None:
     """Fill every non-repeated, non-oneof field that names a MOOS global (recursively through
     non-repeated sub-messages) from the mission file's globals (lines outside ProcessConfig
     blocks). A field already set in the block keeps its value: goby3 lets the global win, its
-    documentation says globals apply only to empty fields (quirks Q2, Q3: fixed as documented)."""
+    documentation says globals apply only to empty fields: fixed as documented, QUIRKS.md
+    Q-APPS-2 and Q-APPS-3)."""
     for field in config.DESCRIPTOR.fields:
         if field.is_repeated or field.containing_oneof is not None:
             continue
@@ -358,7 +359,7 @@ def example_config(config_class: type[Message], app_name: str) -> str:
 def initializer_posts(
     common: Message, mission: MissionFile | None, log: logging.Logger = log
 ) -> list[tuple[str, float | str]]:
-    """The (MOOS variable, value) posts of `common.initializer` (spec 2.5): a constant, or a
+    """The (MOOS variable, value) posts of `common.initializer`: a constant, or a
     global of the mission file (a double that does not parse is NaN); a missing global is
     warned about on `log` and not posted."""
     posts = []

@@ -1,4 +1,4 @@
-"""A Goby MOOS application's log (spec goby-moos-apps.md section 2.8): the terminal at
+"""A Goby MOOS application's log: the terminal at
 `common.verbosity`, and with `common.log` a text file `<name>_<community>_<UTC stamp>.txt` in
 `common.log_path` (else ./) at `common.log_verbosity`, with a `<name>_<community>_latest.txt`
 symlink to the newest one. Both get the app's own lines and every group of the library (the

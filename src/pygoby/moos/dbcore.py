@@ -3,12 +3,12 @@
 `DBCore` is fed events (a handshake, a packet's bytes from a named client, a disconnect); what
 they cause to be sent collects in each client's outgoing buffer, which the asyncio server in
 `db.py` takes (`take_ready`) and writes once per event-loop iteration. Behaviour follows the
-C++ MOOSDB (spec moos.md sections 8-13): the first write fixes a variable's type (S and B
-differ) and other writes are dropped silently; subscribing queues the current value at once;
-an interval drops updates that come too soon; wildcard filters are tested when a variable is
-first written or when the filter is registered; the DB publishes DB_TIME, DB_UPTIME,
-DB_CLIENTS, DB_VARSUMMARY, DB_QOS, DB_RWSUMMARY (refreshed at most every 2 s of DB time, when
-a packet with more than a T message arrives) and DB_EVENT on connect and disconnect.
+C++ MOOSDB (QUIRKS.md Q-MOOS-1 to 4): the first write fixes a variable's type (S and B differ)
+and other writes are dropped silently; subscribing queues the current value at once; an interval
+drops updates that come too soon; wildcard filters are tested when a variable is first written
+or when the filter is registered; the DB publishes DB_TIME, DB_UPTIME, DB_CLIENTS,
+DB_VARSUMMARY, DB_QOS, DB_RWSUMMARY (refreshed at most every 2 s of DB time, when a packet with
+more than a T message arrives) and DB_EVENT on connect and disconnect.
 
 The hot path is a notification: it is forwarded to its subscribers as the bytes it arrived in
 (the DB's community spliced in when the publisher left it empty, as the C++ DB does), parsing
@@ -230,7 +230,7 @@ class _Source:
         if community:  # bridged from another community: forwarded untouched
             self.forwarded: bytes | None = None
             self.growth = 0
-        else:  # the DB fills in its own community (moos.md 10.3)
+        else:  # the DB fills in its own community
             self.forwarded = self.head[:-4] + core.community_field
             self.growth = len(core.community_field) - 4
 

@@ -1,5 +1,5 @@
 """Goby 1.1 and Goby 2 configuration forms, mapped onto today's (goby3) configuration in one
-step when a ProcessConfig block is read (seed 003 §2.3.5; spec goby-moos-apps.md §4.10).
+step when a ProcessConfig block is read.
 
 The block's TextFormat text is tokenized and walked along the configuration's descriptor, so a
 rule applies to a message *type* wherever it appears (every app's `common`, every DriverConfig,
@@ -369,3 +369,8 @@ def finish(config: Message, notes: list[str]) -> None:
         notes.append(
             f"{moved} XML message file(s) of dccl_cfg/queue_cfg -> transitional_cfg.message_file"
         )
+        # Goby 1.1's form of the files: they travel as Goby 1.1 sent them unless told otherwise
+        transitional = config.transitional_cfg
+        if not transitional.HasField("wire_format"):
+            wire = transitional.DESCRIPTOR.fields_by_name["wire_format"].enum_type
+            transitional.wire_format = wire.values_by_name["DCCL1"].number

@@ -1,5 +1,5 @@
-"""`.moos` mission files: globals, ProcessConfig blocks, the ANTLER block (spec moos.md 17, 19)
-and the Goby TextFormat block (goby-moos-apps.md 2.2).
+"""`.moos` mission files: globals, ProcessConfig blocks, the ANTLER block
+and the Goby TextFormat block.
 
     mission = MissionFile.read("alpha.moos")
     mission.get_value("ServerPort")          # "9000": first match anywhere, white space removed
@@ -64,7 +64,8 @@ def parse_number(value: str) -> float | None:
 
 
 def _strip_textformat_comments(line: str) -> str:
-    """`//` becomes `#` only outside quoted strings (goby-moos-apps.md quirk Q1, fixed)."""
+    """`//` becomes `#` only outside quoted strings (goby3 replaces every `//`, even in
+    quoted strings; fixed: QUIRKS.md Q-APPS-1)."""
     out = []
     quote = ""
     i = 0
@@ -193,12 +194,13 @@ class MissionFile:
                 inside = False
         return mask
 
-    # -- globals (moos.md 17.2) ----------------------------------------------------------------
+    # -- globals -----------------------------------------------------------------------------------
 
     def get_value(self, name: str, outside_blocks: bool = False) -> str | None:
         """The value of the first `name = value` line anywhere in the file (case-insensitive
         name), with all white space removed, as MOOS's GetValue does. With `outside_blocks`,
-        lines inside ProcessConfig blocks are skipped (goby-moos-apps.md quirk Q3, fixed)."""
+        lines inside ProcessConfig blocks are skipped, so a block's line never passes for a global
+        (QUIRKS.md Q-APPS-3)."""
         wanted = name.lower()
         for line, in_block in zip(self.lines, self._in_block, strict=True):
             if outside_blocks and in_block:
@@ -250,7 +252,7 @@ class MissionFile:
         number = self.get_float(name)
         return number is not None and number > 0
 
-    # -- ProcessConfig blocks (moos.md 17.3) ---------------------------------------------------
+    # -- ProcessConfig blocks ----------------------------------------------------------------------
 
     def _block_lines(self, app: str, keep_quotes: bool = False) -> list[tuple[int, str]] | None:
         """The block's lines as (file line, text)."""
@@ -300,7 +302,7 @@ class MissionFile:
                 return value
         return None
 
-    # -- Goby TextFormat blocks (goby-moos-apps.md 2.2) ----------------------------------------
+    # -- Goby TextFormat blocks --------------------------------------------------------------------
 
     def goby_block(self, app: str) -> GobyBlock | None:
         """The text between the first `{` and the last `}` of the app's block, with `//`
@@ -323,7 +325,7 @@ class MissionFile:
         body = text[open_at + 1 : close_at]
         return GobyBlock("\n".join(map(_strip_textformat_comments, body.split("\n"))), first_line)
 
-    # -- pAntler (moos.md 19) ------------------------------------------------------------------
+    # -- pAntler -----------------------------------------------------------------------------------
 
     def antler(self) -> AntlerConfig:
         settings = self.process_config("ANTLER")

@@ -3,7 +3,7 @@
 Everything here is pure: functions and classes take bytes and numbers and return bytes, messages
 or errors. The asyncio client (`client.py`) and the embedded DB (`db.py`) do the socket work.
 
-Layout (spec moos.md sections 3-7): little-endian throughout;
+Layout: little-endian throughout;
 packet = int32 total_len, int32 n_msgs, uint8 0, messages;
 message = int32 msg_len, int32 id, char msg_type, char data_type, str src, str src_aux,
 str community, str key, f64 time, f64 dval, f64 dval2, str sval (str = int32 length + bytes).
@@ -29,7 +29,7 @@ ASYNC_HANDSHAKE_KEY = "asynchronous"
 TIMING_KEY = "_async_timing"
 SERVER_REQUEST_ID = -2
 
-# Message types (moos.md 6.1).
+# Message types.
 NOTIFY = "N"
 REGISTER = "R"
 UNREGISTER = "U"
@@ -43,7 +43,7 @@ WELCOME = "W"
 POISON = "K"
 COMMAND = "C"
 
-# Data types (moos.md 6.2).
+# Data types.
 DOUBLE = "D"
 STRING = "S"
 BINARY = "B"
@@ -80,7 +80,7 @@ def text_or_binary(data: bytes) -> str | bytes:
 
 @dataclass(slots=True)
 class MOOSMessage:
-    """One CMOOSMsg. Defaults are the C++ default constructor's (moos.md 5), so that messages
+    """One CMOOSMsg. Defaults are the C++ default constructor's, so that messages
     built here serialise to the same bytes as C++ clients'."""
 
     msg_type: str = NULL
@@ -413,7 +413,7 @@ class PacketFramer:
 
 
 # ---------------------------------------------------------------------------------------------
-# Handshake (moos.md 7)
+# Handshake
 
 
 def check_protocol_string(raw: bytes) -> bool:
@@ -452,7 +452,7 @@ def name_in_use_reason(name: str) -> str:
 
 
 def timing_message(local_time: float) -> MOOSMessage:
-    """The V10 client's keep-alive / clock-sync message (moos.md 8.1)."""
+    """The V10 client's keep-alive / clock-sync message."""
     return MOOSMessage(TIMING, DOUBLE, TIMING_KEY, local_time, 0.0, -1.0)
 
 
@@ -462,7 +462,7 @@ def welcome_hostname(welcome: MOOSMessage) -> str:
 
 
 # ---------------------------------------------------------------------------------------------
-# Wildcards (moos.md 11.4)
+# Wildcards
 
 
 def format_interval(interval: float) -> str:
@@ -556,7 +556,7 @@ def wildcard_match(pattern: str, name: str) -> bool:
 
 @dataclass(slots=True)
 class SkewFilter:
-    """Client-side clock skew estimate from timing echoes (moos.md 14.2)."""
+    """Client-side clock skew estimate from timing echoes."""
 
     skew: float = 0.0
 

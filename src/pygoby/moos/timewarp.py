@@ -1,9 +1,9 @@
 """MOOS time and time warp.
 
-MOOS multiplies the whole epoch by the warp (`MOOSLocalTime() = UNIX time x warp`, spec moos.md
-14.1), so warped time stamps are about warp x 1.8e9. Every process in a community must use the
-same warp. `moos_clock(warp)` returns the Clock the client, DB and apps use for MOOS time;
-durations the protocol measures in real time (keep-alive, timeouts) use the event loop's clock.
+MOOS multiplies the whole epoch by the warp (`MOOSLocalTime() = UNIX time x warp`), so warped time
+stamps are about warp x 1.8e9. Every process in a community must use the same warp.
+`moos_clock(warp)` returns the Clock the client, DB and apps use for MOOS time; durations the
+protocol measures in real time (keep-alive, timeouts) use the event loop's clock.
 """
 
 from __future__ import annotations

@@ -181,10 +181,13 @@ class TranslatorBinding:
         )
         for index, entry in enumerate(entries):
             try:
-                self.translator.add_entry(entry)
+                notes = self.translator.add_entry(entry)
             except TranslatorError as err:
                 error = ConfigError(str(err), field=f"translator_entry[{index}]")
                 raise locate(error, app.mission, app.name) from None
+            for note in notes:  # runs as in goby3, but probably not what was meant: say once
+                where = ConfigError(note.message, field=f"translator_entry[{index}].{note.field}")
+                app.log.warning("%s", locate(where, app.mission, app.name))
         self.moos_technique = app.moos_technique
         self.runner: TranslatorRunner | None = None
 
@@ -209,6 +212,7 @@ class TranslatorBinding:
             start_time=self.app.start_time,
             multiplex_vars=self.multiplex_vars,
             variables=MoosValues(self.app.dynamic_vars),
+            clock=self.app.clock,
         )
 
     def tick(self, now: float) -> None:

@@ -1,4 +1,4 @@
-"""The manager's optional ``$GPRMC`` output (spec netsim.md §4.6).
+"""The manager's optional ``$GPRMC`` output.
 
 For each ``gps_out`` entry of the configuration, every nav forwarded for that modem port is
 written to a serial port as a ``$GPRMC`` sentence stamped with the manager's own clock (not the

@@ -1,6 +1,6 @@
 """netsim_manager's request processing, sans-I/O.
 
-`NetSimManager.handle_request(request, peer_ip)` applies the checks of spec §4.3 in upstream's
+`NetSimManager.handle_request(request, peer_ip)` applies netsim_manager's checks in its
 order (for each nav: configured port -> source address -> region; stop at the first failure;
 stats are passed on regardless) and returns a `RequestOutcome` with the one response to send,
 the navs accepted for the simulation and the stats received. Accepted, complete navs become the

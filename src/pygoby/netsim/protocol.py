@@ -5,7 +5,7 @@ single ``\\n``). Reading: a `LineDecoder` is fed raw bytes as they arrive and re
 complete line, either a `ReceivedMessage` or a `LineError` (an exception *value*, never raised),
 so one bad line is reported and skipped while the stream carries on at the next newline.
 
-Tolerance follows the spec (netsim.md §2.5/§2.6):
+Tolerance (upstream netsim's and libb64's rules, where they have one):
 
 * every ``\\n``-terminated line is handled on its own; blank lines are skipped; a line longer than
   `max_line_length` is discarded (without buffering it) and reported once as `LineTooLongError`;

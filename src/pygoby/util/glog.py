@@ -1,5 +1,4 @@
-"""Goby's verbosity levels and log groups on the standard `logging` module (spec
-goby-moos-apps.md 2.8).
+"""Goby's verbosity levels and log groups on the standard `logging` module.
 
 Levels: `VERBOSE` is logging.INFO, `DEBUG1` is logging.DEBUG, `DEBUG2` and `DEBUG3` are below it
 (registered with logging under those names); `QUIET` is above CRITICAL. `VERBOSITY_LEVELS` maps

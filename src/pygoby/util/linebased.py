@@ -299,6 +299,11 @@ class TCPServerLink(_StreamLinkBase):
         finally:
             server.close()  # close() may already have dropped self._server
 
+    def drop_connections(self) -> None:
+        """Close every client connection and keep listening."""
+        for transport in list(self._transports):
+            transport.close()
+
     def close(self) -> None:
         if self._server is not None:
             self._server.close()

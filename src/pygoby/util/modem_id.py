@@ -42,7 +42,7 @@ class ModemIdLookup:
         entries = []
         for number, raw in enumerate(text.splitlines(), start=1):
             # Cut comments, then strip whitespace around every field (goby3 only deletes
-            # spaces and keeps tabs: Quirk Q14, fixed here).
+            # spaces and keeps tabs; fixed: QUIRKS.md Q-APPS-14).
             line = raw.split("#", 1)[0].split("//", 1)[0].strip()
             if not line:
                 continue
@@ -80,8 +80,8 @@ class ModemIdLookup:
         return entry.location if entry else str(modem_id)
 
     def modem_id(self, name: str) -> int:
-        """Case-insensitive name lookup; an unknown name gives atoi(name) (Goby 1.1 rule,
-        instead of goby3's undefined int(NaN): Quirk Q12)."""
+        """Case-insensitive name lookup; an unknown name gives atoi(name) (Goby 1.1 rule: the
+        leading integer, else 0; goby3 gives an undefined int(NaN): QUIRKS.md Q-APPS-12)."""
         found = self._by_name.get(name.lower())
         return found if found is not None else atoi(name)
 

@@ -54,7 +54,7 @@ OUT = REPO / "tests" / "dccl" / "data"
 NOW = 1_700_000_000
 ANSWERS = ("ok", "error", "hex", "text", "size", "pong")
 
-# a record's "proto" is found in PROTO_DIRS[record["where"]]: "shared" (../shared/vectors/dccl),
+# a record's "proto" is found in PROTO_DIRS[record["where"]]: "shared" (tests/data/vectors/dccl),
 # "tests" (tests/dccl/protos), "builtin" (pygoby's own .proto files)
 CORPUS_PROTOS = [
     ("shared", "example.proto"),

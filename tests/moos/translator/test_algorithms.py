@@ -87,6 +87,11 @@ def test_value_rule(value, text):
         ("modem_id2name", "7", [], "7"),
         ("modem_id2name", "unicorn", [], "unicorn"),
         ("modem_id2name", "", [], ""),
+        ("modem_id2name", "0003", [], "unicorn"),
+        # beyond an unsigned int (goby3 throws) and beyond Python's int() digit limit: unchanged
+        ("modem_id2name", "4294967296", [], "4294967296"),
+        ("modem_id2name", "9" * 5000, [], "9" * 5000),
+        ("modem_id2type", "9" * 5000, [], "9" * 5000),
         ("modem_id2type", "4", [], "auv"),
         ("modem_id2type", "9", [], "unknown_type"),
         ("modem_id2type", "x", [], "x"),
@@ -114,14 +119,21 @@ def test_utm_origin_zero_and_datum_change():
     assert registry.run("utm_y2lat", "0", ["0"]) == "42.35"
 
 
-def test_unknown_algorithm_is_a_config_error(registry):
-    with pytest.raises(TranslatorConfigError, match="unknown algorithm 'alg_TSD_to_soundspeed'"):
-        registry.get("alg_TSD_to_soundspeed")
+def test_an_unknown_algorithm_passes_the_value_through(registry):
+    # goby3's algorithm performer does nothing for a name it does not know.
+    assert registry.find("alg_TSD_to_soundspeed") is None
+    assert registry.run("alg_TSD_to_soundspeed", "10.5", ["35", "3"]) == "10.5"
+    assert registry.unknown_reason("alg_TSD_to_soundspeed") == (
+        "unknown algorithm 'alg_TSD_to_soundspeed'"
+    )
 
 
 def test_modem_id_algorithms_need_lookup_table():
-    with pytest.raises(TranslatorConfigError, match="needs modem_id_lookup_path"):
-        AlgorithmRegistry().get("modem_id2name")
+    registry = AlgorithmRegistry()
+    assert registry.run("modem_id2name", "3") == "3"
+    assert registry.unknown_reason("modem_id2name") == (
+        "unknown algorithm 'modem_id2name' (needs modem_id_lookup_path)"
+    )
 
 
 def test_missing_references_is_a_config_error(registry):

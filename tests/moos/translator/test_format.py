@@ -3,8 +3,9 @@ import math
 
 import pytest
 
-from pygoby.moos.translator import TranslatorConfigError, TranslatorError
+from pygoby.moos.translator import TranslatorConfigError
 from pygoby.moos.translator import format as fmt
+from pygoby.moos.translator.algorithms import AlgorithmRegistry
 from pygoby.moos.translator.boostformat import FloatArg, IntArg, boost_format, parse_format
 
 REPEAT = [1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6, -6]
@@ -153,9 +154,46 @@ def test_parse_bytes_and_submessage_hex(msgs):
     assert out.msg_default_optional.val == 1
 
 
-def test_parse_mismatch_is_an_error(msgs):
-    with pytest.raises(TranslatorError, match="does not match format"):
-        fmt.parse("hello", msgs.BasicNodeReport(), "NAME=%1%")
+def test_a_literal_missing_from_the_input_skips_nothing_and_parsing_goes_on(msgs):
+    # goby3's scanner: a format character that does not occur leaves the input as it is; one
+    # that occurs drops the input through it ('e' of "hello" -> "llo").
+    out = msgs.BasicNodeReport()
+    mismatch = fmt.parse("hello", out, "NAME=%1%")
+    assert out.Name == "llo"
+    assert mismatch == fmt.FormatMismatch("n", 0, 0)
+    assert str(mismatch) == "no 'n' (format character 0) in the input after character 0"
+
+
+def test_an_empty_input_fills_fields_as_goby3_leaves_them(msgs):
+    # goby3's as<T>("") gives NaN for floating point and the type's maximum for integers;
+    # a repeated index pads with the field's default value.
+    out = msgs.BasicNodeReport()
+    mismatch = fmt.parse("", out, "depth:=%6%;t=%200%;r=%10.2%")
+    assert math.isnan(out.depth)
+    assert math.isnan(out.time)
+    assert out.repeat[:] == [0, 0, 2**31 - 1]
+    assert mismatch == fmt.FormatMismatch("d", 0, 0)
+
+
+def test_the_first_missing_literal_is_reported_after_what_matched(msgs):
+    out = msgs.BasicNodeReport()
+    mismatch = fmt.parse("x=550,y", out, "x=%202%,y=%3%;n=%1%")
+    assert out.x == 550
+    assert math.isnan(out.y)  # "" after the last match
+    assert out.Name == ""
+    assert mismatch == fmt.FormatMismatch("=", 9, 7)
+
+
+def test_a_whole_match_reports_nothing(msgs):
+    assert fmt.parse("x=550,y=3", msgs.BasicNodeReport(), "x=%202%,y=%3%") is None
+
+
+def test_adjacent_directives_read_the_same_input(msgs):
+    # goby3: the second directive's value starts where the first one's did (nothing is
+    # consumed between them).
+    out = msgs.BasicNodeReport()
+    assert fmt.parse("12", out, "%202%%3%") is None
+    assert (out.x, out.y) == (12, 12)
 
 
 def test_parse_unknown_enum_warns(msgs, caplog):
@@ -171,8 +209,7 @@ def test_parse_unknown_enum_warns(msgs, caplog):
     [
         ("%99%", "Bad field: 99"),
         ("%x%", "Bad specifier: x"),
-        ("%1%%3%", "adjacent directives"),
-        ("a%%b%1%", "adjacent directives"),
+        ("a%%b%1%", "empty directive"),
         ("%3:1%", "Invalid ':' syntax"),
         ("%117:1%", "Invalid '.' syntax"),
         ("%1", "unterminated"),
@@ -205,3 +242,73 @@ def test_boost_format_subset():
     )
     assert boost_format(parse_format("%s,%d"), ["x", IntArg(-3, 32)]) == "x,-3"
     assert boost_format(parse_format("%1$5.1s|"), ["hello"]) == "    h|"
+
+
+def test_an_integer_beyond_pythons_digit_limit_is_one_warning_and_the_maximum(msgs, caplog):
+    # goby3's as<int32> of an out-of-range integer gives INT32_MAX; Python's int() refuses
+    # strings of more than 4300 digits, which must not escape as a traceback.
+    out = msgs.BasicNodeReport()
+    with caplog.at_level(logging.WARNING):
+        assert fmt.parse("9" * 5000 + ";-" + "9" * 5000, out, "%10.0%;%10.1%") is None
+    assert out.repeat[:] == [2**31 - 1, 2**31 - 1]
+    assert [r.getMessage() for r in caplog.records] == [
+        "field repeat: a 5000-digit integer is out of range; set to the int32 maximum as goby3 "
+        "does",
+        "field repeat: a 5001-digit integer is out of range; set to the int32 maximum as goby3 "
+        "does",
+    ]
+
+
+@pytest.mark.parametrize(
+    ("directive", "printed"),
+    [
+        # An algorithm's output is a string to Boost.Format: the conversion character and a
+        # precision do not change it (goby3 prints %101$.6lf of utm_x2lon in full) ...
+        ("%101%", "-70.94887000425"),
+        ("%101$.6lf", "-70.94887000425"),
+        ("%101$lf", "-70.94887000425"),
+        ("%101$.3f", "-70.94887000425"),
+        ("%101$e", "-70.94887000425"),
+        ("%101$.2E", "-70.94887000425"),
+        ("%101$g", "-70.94887000425"),
+        ("%101$d", "-70.94887000425"),
+        ("%101$x", "-70.94887000425"),
+        ("%101$s", "-70.94887000425"),
+        ("%|101$|", "-70.94887000425"),
+        ("%|101$.3f|", "-70.94887000425"),
+        ("%101$+f", "-70.94887000425"),
+        ("%100$+f", "42.352720906492"),  # showpos does nothing to a string
+        # ... except `s` with a precision (at most that many characters) and `c` (one)
+        ("%101$.3s", "-70"),
+        ("%|101$.2s|", "-7"),
+        ("%101$.0s", ""),
+        ("%101$c", "-"),
+        ("%100$C", "4"),
+        # width and the padding flags apply
+        ("%101$20f", "     -70.94887000425"),
+        ("%101$-20s|", "-70.94887000425     |"),
+        ("%101$020f", "00000-70.94887000425"),
+        ("%101$-020f|", "-70.94887000425     |"),
+        ("%100$ f", " 42.352720906492"),
+        ("%101$ f", "-70.94887000425"),
+        ("%100$+ f", "42.352720906492"),
+        ("%101$10f", "-70.94887000425"),  # already wider than 10
+        # a number field printed with s/c is cut the same way
+        ("%202$.2s", "10"),
+        ("%202$c", "1"),
+        ("%202$5.2s", "   10"),
+    ],
+)
+def test_printf_directives_on_algorithm_outputs_print_as_goby3(msgs, Entry, directive, printed):
+    algorithm = Entry.PublishSerializer.Algorithm
+    algorithms = [
+        algorithm(
+            name="utm_x2lon", output_virtual_field=101, primary_field=202, reference_field=[3]
+        ),
+        algorithm(
+            name="utm_y2lat", output_virtual_field=100, primary_field=3, reference_field=[202]
+        ),
+    ]
+    report = msgs.BasicNodeReport(x=100, y=300)
+    registry = AlgorithmRegistry(42.35, -70.95)
+    assert fmt.serialize(report, directive, algorithms=algorithms, registry=registry) == printed

@@ -33,13 +33,16 @@ PREFIXES = [
     b'@PB[pygoby.test.translator.TestMsg] string_default_optional: "',
     b'string_default_optional: "',
     b"msg_default_optional { val: 1 } ",
+    b"enum_default_optional=",
+    b"int32_default_optional=" + b"9" * 5000 + b",",  # beyond Python's int() digit limit
+    b"9" * 5000 + b";",
 ]
 moos_bytes = st.builds(lambda p, b: p + b, st.sampled_from(PREFIXES), st.binary(max_size=60))
 # a MOOS string value as the client library hands it over, or the raw bytes themselves
 moos_value = moos_bytes.flatmap(lambda raw: st.sampled_from([decode_text(raw), raw]))
 
 BAD_CREATES = {
-    Technique.TECHNIQUE_FORMAT: 'format: "%14%;%1%;%114%"',
+    Technique.TECHNIQUE_FORMAT: 'format: "%3%;%14%;%1%;%114%;%16%"',
     Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS: "",
     Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT: "",
     Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT: "",

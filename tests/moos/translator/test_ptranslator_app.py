@@ -164,18 +164,57 @@ async def test_time_trigger_and_datum_from_origin_mail(tmp_path, lookup_file):
 
 
 def test_configuration_errors(tmp_path, lookup_file):
-    bad = f'  translator_entry {{ protobuf_name: "{BNR}" publish {{ technique: TECHNIQUE_FORMAT moos_var: "X" format: "%1%" algorithm {{ name: "alg_nope" output_virtual_field: 90 primary_field: 1 }} }} }}'
-    mission = MissionFile.from_text(mission_text(9000, lookup_file, bad))
-    with pytest.raises(ConfigError, match="unknown algorithm 'alg_nope'"):
-        pTranslator(
-            pTranslator.read_config(mission, "pTranslator"), name="pTranslator", mission=mission
-        )
     missing = '  translator_entry { protobuf_name: "no.Such" }'
     mission = MissionFile.from_text(mission_text(9000, lookup_file, missing))
     with pytest.raises(ConfigError, match='"no.Such" is not a loaded message type'):
         pTranslator(
             pTranslator.read_config(mission, "pTranslator"), name="pTranslator", mission=mission
         )
+
+
+async def test_entries_goby3_runs_start_with_one_warning_per_oddity(tmp_path, lookup_file, caplog):
+    # goby3 starts with these: an unknown algorithm passes the value through, a publish
+    # directive naming no field prints "unknown" (or nothing past the highest field number,
+    # 202 here; the two indexed directives become 203 and 204), an index on a field that is not
+    # repeated prints the whole field.
+    entries = f"""\
+  translator_entry {{
+    protobuf_name: "{BNR}"
+    trigger {{ type: TRIGGER_PUBLISH  moos_var: "NAV_X" }}
+    create {{ technique: TECHNIQUE_FORMAT  moos_var: "NAV_X"  format: "%202%"
+             algorithm {{ name: "alg_nope"  primary_field: 202 }} }}
+    publish {{ technique: TECHNIQUE_FORMAT  moos_var: "ODD"
+              format: "a=%5%;b=%6.0%;c=%104%;d=%202%;e=%11.1%;f=%300%" }}
+  }}
+"""
+    async with (
+        MOOSDB(port=0, community="alpha") as db,
+        MOOSClient("tester", port=db.port) as tester,
+    ):
+        path = tmp_path / "mission.moos"
+        path.write_text(mission_text(db.port, lookup_file, entries))
+        with caplog.at_level(logging.WARNING):
+            app = pTranslator.from_mission(path, "pTranslator")
+        assert [r.getMessage() for r in caplog.records] == [
+            f"{path}:16: translator_entry[0].create[0].algorithm[0].name: {BNR}: unknown "
+            "algorithm 'alg_nope': the value passes through unchanged, as in goby3",
+            f"{path}:18: translator_entry[0].publish[0].format: {BNR}: %6.0%: field 6 (depth) "
+            "is not repeated: the whole field prints, as in goby3",
+            f"{path}:18: translator_entry[0].publish[0].format: {BNR}: %11.1% names no field of "
+            f"{BNR}: it prints 'unknown', as in goby3",
+        ] + [
+            f"{path}:18: translator_entry[0].publish[0].format: {BNR}: %{n}% names no field of "
+            f"{BNR} (nor an algorithm's output_virtual_field): it prints 'unknown' or nothing, "
+            "as in goby3"
+            for n in (5, 104, 300)
+        ]
+        async with app:
+            tester.subscribe("ODD")
+            await tester.flush()
+            await asyncio.sleep(0.2)
+            tester.publish("NAV_X", 550.0)
+            msg = await tester.receive(3)
+        assert (msg.key, msg.value) == ("ODD", "a=unknown;b=0;c=unknown;d=550;e=unknown;f=")
 
 
 def test_example_config_command():

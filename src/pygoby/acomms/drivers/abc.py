@@ -1,4 +1,4 @@
-"""ABC example modem driver (DRIVER_ABC_EXAMPLE_MODEM, spec acomms.md §9.2). A teaching toy."""
+"""ABC example modem driver (DRIVER_ABC_EXAMPLE_MODEM). A teaching toy."""
 
 from __future__ import annotations
 
@@ -52,7 +52,7 @@ class ABCDriver(ModemDriverBase):
         msg.max_frame_bytes = MAX_FRAME_BYTES
         if not msg.frame:
             self.signal_data_request.emit(msg)
-        if not msg.frame or not msg.frame[0]:  # Quirk A8 (sane): nothing to send
+        if not msg.frame or not msg.frame[0]:  # nothing to send (QUIRKS.md Q-ACOMMS-8)
             return
         rate = msg.rate if 0 <= msg.rate < len(BITRATE) else len(BITRATE) - 1
         self._last_sent_frames = [msg.frame_start]  # only frame 0 is sent
@@ -96,7 +96,8 @@ class ABCDriver(ModemDriverBase):
             msg = acomms_pb.ModemTransmission(
                 type=acomms_pb.ACK, src=int(fields["FROM"]), dest=int(fields["TO"]), time=now
             )
-            msg.acked_frame.extend(self._last_sent_frames)  # Quirk A9 (sane)
+            # goby3's ACK names no frame, which the queue cannot match (QUIRKS.md Q-ACOMMS-9)
+            msg.acked_frame.extend(self._last_sent_frames)
         else:
             msg = acomms_pb.ModemTransmission(type=acomms_pb.DATA, time=now)
         self.signal_receive.emit(msg)

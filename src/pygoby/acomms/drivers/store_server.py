@@ -1,4 +1,4 @@
-"""Store-server driver (DRIVER_STORE_SERVER, spec acomms.md §11): polls a goby_store_server.
+"""Store-server driver (DRIVER_STORE_SERVER): polls a goby_store_server.
 
 Every `query_interval_seconds` (when no reply is pending) it sends a StoreServerRequest with the
 pending outbox over its line link (TCP client, CR-delimited RUDICS packets); each response's

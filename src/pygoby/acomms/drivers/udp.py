@@ -1,4 +1,4 @@
-"""UDP driver (DRIVER_UDP, spec acomms.md §8.1-8.2): one datagram = one binary ModemTransmission.
+"""UDP driver (DRIVER_UDP): one datagram = one binary ModemTransmission.
 
 Wire-compatible with goby3's UDPDriver: no header or checksum, immediate ACK datagrams naming
 the Goby frame numbers (`frame_start` from a running counter). The socket is non-blocking and

@@ -1,4 +1,4 @@
-"""UDP multicast driver (DRIVER_UDP_MULTICAST, spec acomms.md §8.3).
+"""UDP multicast driver (DRIVER_UDP_MULTICAST).
 
 Every transmission goes to `multicast_address:multicast_port` as one binary ModemTransmission;
 our own datagrams heard back are ignored; DATA addressed to us with an ack request is

@@ -1,4 +1,4 @@
-"""uField simulation driver (DRIVER_UFIELD_SIM_DRIVER, spec acomms.md §10), MOOS-agnostic core.
+"""uField simulation driver (DRIVER_UFIELD_SIM_DRIVER), MOOS-agnostic core.
 
 The driver tunnels hex-encoded ModemTransmissions through MOOS-IvP's uField toolbox. This core
 takes either a `publish(variable, text)` callable for outgoing MOOS mail (then it is fed
@@ -165,7 +165,7 @@ class UFldDriver(ModemDriverBase):
             return
         try:
             owtt = float(pairs["range"]) / SOUND_SPEED
-            when = math.floor(float(pairs["time"]))  # Quirk A13 (faithful): whole seconds
+            when = math.floor(float(pairs["time"]))  # whole seconds, as goby3 (Q-ACOMMS-13)
         except (KeyError, ValueError) as exc:
             log.warning("ignoring bad range report %r: %s", text, exc)
             return

@@ -16,9 +16,9 @@ leaves TAT (NVRAM) after the ping has been heard; `$CAMPR` reports the one-way t
 the measured round trip. `$CATMQ` comes 0.5 s after `$CCTMQ`; a clock set ($CCCLK, $CCTMS mode 0)
 takes effect, and is answered, at the modem's next whole second.
 
-Commands answered (spec acomms.md §7.4 and WHOI's pyacomms): CFG/CFQ (NVRAM: the real modem's
-keys only), MSC, CLK/CLQ, TMS/TMQ/ALQ (Micro-Modem 2), CYC/TXD (local and third-party cycles),
-MPC, MUC, TDP (FDP, Micro-Modem 2), MEC, PDT/PNT/PGT (navigation pings: there are no
+Commands answered (those goby3's driver sends, and WHOI's pyacomms): CFG/CFQ (NVRAM: the real
+modem's keys only), MSC, CLK/CLQ, TMS/TMQ/ALQ (Micro-Modem 2), CYC/TXD (local and third-party
+cycles), MPC, MUC, TDP (FDP, Micro-Modem 2), MEC, PDT/PNT/PGT (navigation pings: there are no
 transponders, so $SNTTA reports no travel times at the timeout), SWP/MSQ/RSP (signals). Anything
 else gets `$CAERR,<time>,NMEA,2,...`; a bad field `$CAERR,<time>,NMEA,3,...` (the emulator's
 wording: the real modem's error texts are not documented here).

@@ -8,6 +8,10 @@ The socket is bound to the group address on the loopback interface and only data
 from 127.0.0.1 count: a unicast datagram, or one from another host, is never taken for an
 acoustic packet. `BroadcastChannel` does the same with UDP broadcast to an address (Goby 1.1's
 iModemSim `BroadcastAddr`), to span the hosts of a LAN.
+
+With `position` (the local modem's [lat, lon, depth]) each datagram carries where it was sent
+from, and with `link` a received packet is heard as that link model decides from the two
+positions (travel time, lost frames, not heard at all) instead of perfectly.
 """
 
 from __future__ import annotations
@@ -16,9 +20,11 @@ import asyncio
 import base64
 import json
 import logging
+import math
 import os
 import socket
 import struct
+from collections.abc import Callable, Sequence
 
 from pygoby.acomms.mmsim.channel import (
     DEFAULT_SOUND_SPEED,
@@ -26,6 +32,7 @@ from pygoby.acomms.mmsim.channel import (
     ChannelEndpoint,
     LoopbackChannel,
     PacketKind,
+    Reception,
 )
 from pygoby.util.clock import Clock
 
@@ -34,11 +41,16 @@ log = logging.getLogger(__name__)
 LOOPBACK = "127.0.0.1"
 MAX_DATAGRAM = 16384
 MAX_FRAMES, MAX_FRAME_BYTES = 8, 256  # (the largest packet: rate 5)
+# (sender's [lat, lon, depth], receiver's, packet) -> how the receiver hears it (None: not at all)
+LinkModel = Callable[[Sequence[float], Sequence[float], AcousticPacket], Reception | None]
 
 
-def packet_to_json(packet: AcousticPacket, sender: str) -> bytes:
+def packet_to_json(
+    packet: AcousticPacket, sender: str, position: Sequence[float] | None = None
+) -> bytes:
     return json.dumps(
         {
+            "pos": None if position is None else [float(v) for v in position],
             "sender": sender,
             "kind": packet.kind.value,
             "src": packet.src,
@@ -56,9 +68,15 @@ def packet_to_json(packet: AcousticPacket, sender: str) -> bytes:
     ).encode()
 
 
-def packet_from_json(data: bytes) -> tuple[str, AcousticPacket]:
-    """ValueError (or KeyError, TypeError) if the datagram is not a packet this channel sent."""
+def packet_from_json(data: bytes) -> tuple[str, AcousticPacket, list[float] | None]:
+    """(sender, packet, sender's position or None); ValueError (or KeyError, TypeError) if the
+    datagram is not a packet this channel sent."""
     d = json.loads(data)
+    position = d.get("pos")
+    if position is not None:
+        position = [float(v) for v in position]
+        if len(position) != 3 or not all(math.isfinite(v) for v in position):
+            raise ValueError(f"bad position {position}")
     frames = [base64.b64decode(f, validate=True) for f in d["frames"]]
     if len(frames) > MAX_FRAMES or any(len(f) > MAX_FRAME_BYTES for f in frames):
         raise ValueError("more data than a packet carries")
@@ -79,7 +97,7 @@ def packet_from_json(data: bytes) -> tuple[str, AcousticPacket]:
     )
     if not 0 <= packet.duration < 3600:
         raise ValueError(f"bad duration {packet.duration}")
-    return str(d["sender"]), packet
+    return str(d["sender"]), packet, position
 
 
 def _int(value: object) -> int:
@@ -96,9 +114,12 @@ class MulticastChannel(LoopbackChannel):
         clock: Clock | None = None,
         range_m: float = 0.0,
         sound_speed: float = DEFAULT_SOUND_SPEED,
+        position: Callable[[], Sequence[float]] | None = None,
+        link: LinkModel | None = None,
     ) -> None:
         super().__init__(clock, range_m, sound_speed)
         self.group, self.port = group, port
+        self.position, self.link = position, link
         self.token = f"{os.getpid()}-{id(self)}"
         self._sock: socket.socket | None = None
 
@@ -131,7 +152,8 @@ class MulticastChannel(LoopbackChannel):
     def transmit(self, sender: ChannelEndpoint, packet: AcousticPacket) -> None:
         super().transmit(sender, packet)
         if self._sock is not None:
-            self._sock.sendto(packet_to_json(packet, self.token), (self.group, self.port))
+            where = None if self.position is None else self.position()
+            self._sock.sendto(packet_to_json(packet, self.token, where), (self.group, self.port))
 
     def _readable(self) -> None:
         assert self._sock is not None
@@ -144,12 +166,23 @@ class MulticastChannel(LoopbackChannel):
             log.warning("ignoring a channel datagram from %s (not this host's loopback)", address)
             return
         try:
-            sender, packet = packet_from_json(data)
+            sender, packet, where = packet_from_json(data)
         except (ValueError, KeyError, TypeError, IndexError) as exc:
             log.warning("ignoring bad channel datagram: %s", exc)
             return
-        if sender != self.token:
+        if sender == self.token:
+            return
+        if self.link is None or where is None or self.position is None:
             self.deliver(packet, list(self.endpoints))
+            return
+        heard = self.link(where, self.position(), packet)
+        if heard is None:
+            return  # too far, or lost in the noise
+        for endpoint in list(self.endpoints):
+            self.timeline.at(heard.arrival_time, self._detect, endpoint, packet, heard.arrival_time)
+            self.timeline.at(
+                heard.arrival_time + packet.duration, self._receive, endpoint, packet, heard
+            )
 
     def _sender_ok(self, address: str) -> bool:
         return address == LOOPBACK
@@ -168,8 +201,10 @@ class BroadcastChannel(MulticastChannel):
         clock: Clock | None = None,
         range_m: float = 0.0,
         sound_speed: float = DEFAULT_SOUND_SPEED,
+        position: Callable[[], Sequence[float]] | None = None,
+        link: LinkModel | None = None,
     ) -> None:
-        super().__init__(address, port, clock, range_m, sound_speed)
+        super().__init__(address, port, clock, range_m, sound_speed, position, link)
 
     def open(self) -> None:
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)

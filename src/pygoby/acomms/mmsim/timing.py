@@ -1,8 +1,8 @@
-"""How long things take on a WHOI Micro-Modem: the emulator's duration table (netsim.md §7.10).
+"""How long things take on a WHOI Micro-Modem: the emulator's duration table.
 
 One table serves every channel: the emulator computes each packet's time on the water from it
 (`AcousticPacket.duration`) and the plain channels and the netsim physics use that duration.
-Figures and their confidence (spec netsim.md §7.10 and the sources it cites):
+Figures and their confidence (WHOI's published rate tables):
 
 * rate 0 (FH-FSK, 1 x 32 bytes): WHOI gives 80 bit/s as its burst rate, defined as user bytes over
   the whole packet time: 32 * 8 / 80 = 3.2 s on the water. KNOWN (WHOI).
@@ -11,7 +11,7 @@ Figures and their confidence (spec netsim.md §7.10 and the sources it cites):
   KNOWN (WHOI).
 * rate 5 (PSK, 8 x 256 bytes): "~5000 bps" burst rate: 2048 * 8 / 5000 = 3.28 s in all. DERIVED.
 * rates 1-4 (PSK, 3 x 64 / 2 x 256 bytes): durations are not published in any source available
-  here. ESTIMATE: a full packet takes 3.25 s like rate 6 (the spec's suggested default).
+  here. ESTIMATE: a full packet takes 3.25 s like rate 6.
 * PSK probe and null before the frames: 0.30 s. KNOWN for rate 6, ESTIMATE for rates 1-5. A
   packet with fewer frames than the rate allows is shorter by the missing frames' time.
 * mini-packets (the rate-0 cycle-init, acknowledgements, $CCMUC user mini-packets, hardware

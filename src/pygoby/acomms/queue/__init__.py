@@ -1,4 +1,4 @@
-"""Priority queuing of DCCL messages for the acoustic link (spec acomms.md §5)."""
+"""Priority queuing of DCCL messages for the acoustic link."""
 
 from pygoby.acomms.errors import QueueError
 from pygoby.acomms.queue.manager import QueueManager

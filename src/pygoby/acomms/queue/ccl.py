@@ -1,4 +1,4 @@
-"""Goby 1.1 raw CCL queues (spec acomms.md §5.8, seed 003 §2.3.5 `queue_cfg.queue`).
+"""Goby 1.1 raw CCL queues (Goby 1.1's `queue_cfg.queue` entries with a CCL id).
 
 A CCL queue holds frames whose first byte is its CCL id (e.g. 14 for a REMUS MDAT_STATE). A CCL
 frame always travels alone, as the first and only message of a modem frame; a received frame

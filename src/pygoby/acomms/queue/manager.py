@@ -1,4 +1,4 @@
-"""QueueManager: the priority contest that fills ModemTransmission frames (spec acomms.md §5).
+"""QueueManager: the priority contest that fills ModemTransmission frames.
 
 Connect a driver with `driver.signal_data_request.connect(queue.handle_modem_data_request)` and
 `driver.signal_receive.connect(queue.handle_modem_receive)` (or pygoby.acomms.bind.bind). Call
@@ -20,6 +20,7 @@ from pygoby.acomms.queue.persist import QueueStore
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
 from pygoby.dccl import DcclError
+from pygoby.dccl.dccl1 import DCCL1_FIRST_BYTE, Dccl1Header, is_dccl1_frame, stitch, unstitch
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.signal import Signal
 
@@ -34,12 +35,18 @@ class QueueManager:
         self.queues: dict[int, MessageQueue] = {}  # by DCCL id, kept in ascending order
         self._by_name: dict[str, MessageQueue] = {}
         self.ccl_queues: dict[int, CCLQueue] = {}  # Goby 1.1 raw CCL queues, by CCL id
+        # Goby 1.1's own bytes (DCCL1) for the XML types: a pygoby.dccl.dccl1.Dccl1Bridge
+        self.dccl1 = None
         self.store: QueueStore | None = None  # the persistent queue (attach_store)
         self.signal_receive = Signal()  # (message)
         self.signal_receive_ccl = Signal()  # (Goby 1.1 ModemDataTransmission of a CCL frame)
         self.signal_ack = Signal()  # (ack ModemTransmission, original message)
         self.signal_expire = Signal()  # (original message)
         self.signal_queue_size_change = Signal()  # (QueueSize)
+        self.signal_ccl_queue_size_change = Signal()  # (CCL id, size)
+        self.signal_queued = Signal()  # (queue name, QueuedItem): a message was queued
+        # (ModemTransmission, message bytes, DCCL id): a Goby 1.1 DCCL message for us arrived
+        self.signal_receive_dccl1 = Signal()
         self.signal_data_on_demand = Signal()  # (request ModemTransmission, message to fill)
         # routing (pygoby.acomms.route): the router may rewrite an outgoing item's link dest;
         # link packets for us are offered as (message, its bytes, its own dest, our id)
@@ -70,6 +77,23 @@ class QueueManager:
         for queue_cfg in cfg.queue:
             self.add_ccl_queue(queue_cfg)
 
+    def use_dccl1(self, bridge) -> None:
+        """Send and receive the types `bridge` (a pygoby.dccl.dccl1.Dccl1Bridge) handles as
+        Goby 1.1 does: DCCL1 messages, several stitched into one frame starting with 0x20.
+        Call it before the queues are added."""
+        if DCCL1_FIRST_BYTE in self.ccl_queues:
+            raise QueueError(
+                f"CCL queue {self.ccl_queues[DCCL1_FIRST_BYTE].name} has id 32 (0x20), the first "
+                "byte of every Goby 1.1 DCCL frame"
+            )
+        self.dccl1 = bridge
+
+    def _is_dccl1(self, name: str) -> bool:
+        return self.dccl1 is not None and self.dccl1.handles(name)
+
+    def _first_byte(self, name: str, dccl_id: int) -> int:
+        return DCCL1_FIRST_BYTE if self._is_dccl1(name) else ccl.dccl_first_byte(dccl_id)
+
     def add_queue(self, entry, message_class=None) -> MessageQueue:
         """Create (or update the options of) the queue for `entry.protobuf_name`.
 
@@ -82,7 +106,17 @@ class QueueManager:
         compiled = self.codec.compiled(message_class)
         if compiled.id is None:
             raise QueueError(f"{entry.protobuf_name} has no DCCL id")
-        first = ccl.dccl_first_byte(compiled.id)
+        first = self._first_byte(entry.protobuf_name, compiled.id)
+        if (
+            self.dccl1 is not None
+            and first == DCCL1_FIRST_BYTE
+            and not self._is_dccl1(entry.protobuf_name)
+        ):
+            raise QueueError(
+                f"{entry.protobuf_name}: DCCL id {compiled.id} starts its frames with byte 32 "
+                "(0x20), the first byte of Goby 1.1 DCCL frames; received frames could not be "
+                "told apart"
+            )
         if first in self.ccl_queues:
             raise QueueError(
                 f"{entry.protobuf_name}: DCCL id {compiled.id} starts its frames with byte "
@@ -116,9 +150,14 @@ class QueueManager:
         ccl_id = cfg.key.id
         if ccl_id > ccl.MAX_CCL_ID:
             raise QueueError(f"queue {cfg.name!r}: CCL id {ccl_id} is not a byte (0-255)")
+        if self.dccl1 is not None and ccl_id == DCCL1_FIRST_BYTE:
+            raise QueueError(
+                f"queue {cfg.name!r}: CCL id 32 (0x20) is the first byte of Goby 1.1 DCCL frames"
+            )
         for loaded in self.codec.loaded():
             dccl_id = self.codec.compiled(loaded).id
-            if dccl_id is not None and ccl.dccl_first_byte(dccl_id) == ccl_id:
+            name = loaded.DESCRIPTOR.full_name
+            if dccl_id is not None and self._first_byte(name, dccl_id) == ccl_id:
                 raise QueueError(
                     f"queue {cfg.name!r}: CCL id {ccl_id} is also the first byte of DCCL "
                     f"id {dccl_id} ({loaded.DESCRIPTOR.full_name}); received frames could not "
@@ -164,6 +203,7 @@ class QueueManager:
                 transmission, data, self.modem_id, dest, acomms_pb.now_us(self.clock.now()), ack
             )
         )
+        self._size_changed(queue)
 
     def _all_queues(self) -> list[MessageQueue]:
         return [*self.queues.values(), *self.ccl_queues.values()]
@@ -216,8 +256,9 @@ class QueueManager:
         return restored
 
     def _size_changed(self, queue: MessageQueue) -> None:
-        if isinstance(queue, CCLQueue):
-            return  # QueueSize names DCCL ids only
+        if isinstance(queue, CCLQueue):  # QueueSize names DCCL ids only
+            self.signal_ccl_queue_size_change.emit(queue.dccl_id, len(queue))
+            return
         self.signal_queue_size_change.emit(
             acomms_pb.QueueSize(dccl_id=queue.dccl_id, size=len(queue))
         )
@@ -255,7 +296,9 @@ class QueueManager:
         getter = queue.roles.get(Role.TIMESTAMP)
         when = timestamp_us(getter, msg) if getter is not None else None
         item.time = when if when is not None else acomms_pb.now_us(self.clock.now())
-        if encoded is None:  # encrypt_rule: the passphrase of the message's destination
+        if encoded is None and self._is_dccl1(queue.name):
+            encoded = self.dccl1.encode(msg)  # type: ignore[union-attr]
+        elif encoded is None:  # encrypt_rule: the passphrase of the message's destination
             encoded = self._peer_codecs.get(dest, self.codec).encode(msg)
         item.encoded = encoded
         if not item.encoded:
@@ -265,6 +308,7 @@ class QueueManager:
         if victim is not None:
             self.log.dropped(queue, victim)
         self._size_changed(queue)
+        self.signal_queued.emit(queue.name, item)
 
     def message_dest(self, msg) -> int:
         """A message's own destination (its DESTINATION_ID role; 0 without one)."""
@@ -277,6 +321,14 @@ class QueueManager:
             return default
         value = getter.get(msg)
         return default if value is None else int(value)
+
+    def flush_ccl_queue(self, ccl_id: int) -> None:
+        queue = self.ccl_queues.get(ccl_id)
+        if queue is None:
+            self.log.push.warning("flush: no CCL queue with id %d", ccl_id)
+            return
+        queue.clear()
+        self._size_changed(queue)
 
     def flush_queue(self, flush) -> None:
         queue = self.queues.get(flush.dccl_id)
@@ -296,6 +348,8 @@ class QueueManager:
             queue.clear_stale_waits(request.frame_start, now, self.cfg.minimum_ack_wait_seconds)
         packet_ack = request.ack_requested if request.HasField("ack_requested") else False
         packet_dest = request.dest
+        # unset max_frame_bytes: no limit, said outright (goby3 gets there by unsigned underflow:
+        # QUIRKS.md Q-ACOMMS-11)
         limit = request.max_frame_bytes if request.HasField("max_frame_bytes") else None
         start = request.frame_start
         given: list[str] = []  # for the log: what goes out
@@ -307,11 +361,14 @@ class QueueManager:
                 request.frame.append(b"")
                 prefix = b""
             parts = [prefix]
+            dccl1_parts: list[tuple[bytes, int]] = []  # stitched as Goby 1.1 does
             used = len(prefix)
             winner = self._contest(request, used, limit, now, first=not prefix)
             if winner is None:
                 request.dest = packet_dest
                 continue
+            # a frame holds Goby 1.1 DCCL messages only or other messages only
+            dccl1 = self._is_dccl1(winner.name)
             while winner is not None:
                 item = self._give_data(winner, frame_no, now)
                 given.append(winner.name)
@@ -323,23 +380,39 @@ class QueueManager:
                         request.src = self.modem_id
                     if packet_dest in (0, -1):
                         packet_dest = request.dest
-                parts.append(item.encoded)
+                if dccl1:
+                    dccl1_parts.append((item.encoded, item.dest))
+                else:
+                    parts.append(item.encoded)
+                # stitched DCCL1 takes as many bytes as the messages (each message's first
+                # byte is dropped, a length byte added)
                 used += len(item.encoded)
                 if (limit is not None and limit - used <= 0) or isinstance(winner, CCLQueue):
                     break  # full, or a CCL frame, which travels alone
-                winner = self._contest(request, used, limit, now, first=False)
+                winner = self._contest(request, used, limit, now, first=False, dccl1=dccl1)
+            if dccl1_parts:
+                parts.append(stitch(dccl1_parts))
             request.frame[index] = b"".join(parts)
         request.ack_requested = packet_ack
         self.log.transmission(request, given)
 
     def _contest(
-        self, request, used: int, limit: int | None, now: float, first: bool
+        self,
+        request,
+        used: int,
+        limit: int | None,
+        now: float,
+        first: bool,
+        dccl1: bool | None = None,
     ) -> MessageQueue | None:
-        """The queue that sends next; CCL queues only compete for the start of a frame."""
+        """The queue that sends next; CCL queues only compete for the start of a frame; after
+        the first message only queues of the same wire format (`dccl1`: Goby 1.1's or not)."""
         best: MessageQueue | None = None
         best_priority = 0.0
         entries: list[tuple[str, str]] | None = [] if self.log.contests else None
         for queue in self._all_queues() if first and self.ccl_queues else self.queues.values():
+            if dccl1 is not None and self._is_dccl1(queue.name) != dccl1:
+                continue
             if queue.has("ON_DEMAND"):
                 self._refresh_on_demand(queue, request, now)
             excluded = self._excluded(queue, request, used, limit, now)
@@ -432,6 +505,8 @@ class QueueManager:
                 if data and data[0] in self.ccl_queues:
                     self._receive_ccl(transmission, data, index)
                     names.append(f"CCL {data[0]}")
+                elif self.dccl1 is not None and is_dccl1_frame(data):
+                    names += self._decode_dccl1_frame(transmission, data)
                 else:
                     names += self._decode_frame(data, route)
             self.log.reception(transmission, names)
@@ -478,6 +553,34 @@ class QueueManager:
             names.append(msg.DESCRIPTOR.full_name)
             self._deliver(msg)
         return names
+
+    def _decode_dccl1_frame(self, transmission, data: bytes) -> list[str]:
+        """The messages of a Goby 1.1 frame, each decoded and delivered on its own."""
+        names = []
+        try:
+            parts = unstitch(data)
+        except DcclError as exc:
+            self.log.undecodable(0, exc)
+            return names
+        for part in parts:
+            header = Dccl1Header.unpack(part.data)
+            if part.broadcast or header.dest in (acomms_pb.BROADCAST_ID, self.modem_id):
+                self.signal_receive_dccl1.emit(transmission, part.data, header.id)
+            name = self.receive_dccl1_message(part.data)
+            if name is not None:
+                names.append(name)
+        return names
+
+    def receive_dccl1_message(self, data: bytes) -> str | None:
+        """Decode and deliver one Goby 1.1 DCCL message; its type name, None if it does not
+        decode (logged: the other messages of its frame still count)."""
+        try:
+            msg = self.dccl1.decode(data, self.clock.now())  # type: ignore[union-attr]
+        except DcclError as exc:
+            self.log.undecodable(0, exc)
+            return None
+        self._deliver(msg)
+        return msg.DESCRIPTOR.full_name
 
     def _codec_for_source(self, data: bytes):
         """encrypt_rule on receipt: the passphrase of the sender, read from the clear header."""

@@ -1,4 +1,4 @@
-"""One queue per DCCL type: items in push order, ack waits, priority (spec acomms.md §5.1-5.3).
+"""One queue per DCCL type: items in push order, ack waits, priority.
 
 Items live in a deque in push order. Removing one from the middle (an acknowledged item) only
 marks it; marked items are dropped when they reach either end, so push, pop from either end and
@@ -164,7 +164,7 @@ class MessageQueue:
 
     def priority(self, now: float) -> float:
         ttl = self.entry.ttl
-        if ttl == 0:  # Quirk A2 (sane): documented infinite life, constant priority
+        if ttl == 0:  # documented infinite life, constant priority (Q-ACOMMS-2)
             return self.entry.value_base
         return self.entry.value_base * (now - self.last_send_time) / ttl
 

@@ -45,7 +45,7 @@ class RoleGetter:
 
 
 def compile_roles(entry, descriptor: Descriptor) -> dict[int, RoleGetter]:
-    """Validate the roles of `entry` against `descriptor` (rules of spec §3.5)."""
+    """Validate the roles of `entry` against `descriptor`."""
     getters: dict[int, RoleGetter] = {}
     for role in entry.role:
         if role.type in getters:
@@ -88,7 +88,7 @@ def timestamp_us(getter: RoleGetter, msg) -> int | None:
     if getter.kind == FieldDescriptor.TYPE_DOUBLE:
         if not math.isfinite(value):
             raise RoleError(f"TIMESTAMP field {'.'.join(getter.path or ())} is {value}, not a time")
-        return int(round(value * 1e6))  # Quirk A10 (sane): keep sub-second precision
+        return int(round(value * 1e6))  # keep sub-second precision (Q-ACOMMS-10)
     try:
         parsed = dt.datetime.fromisoformat(str(value).replace("Z", "+00:00"))
     except ValueError:

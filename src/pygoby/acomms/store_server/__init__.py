@@ -1,4 +1,4 @@
-"""goby_store_server: a mailbox of ModemTransmissions kept in SQLite (spec acomms.md §11)."""
+"""goby_store_server: a mailbox of ModemTransmissions kept in SQLite."""
 
 from pygoby.acomms.store_server.server import StoreServer, serve_store
 from pygoby.acomms.store_server.store import TransmissionStore

@@ -1,5 +1,6 @@
-"""Shared-secret authentication of store-server requests (a pygoby addition, spec acomms.md §11
-has none: any client could read and consume another modem's mail by sending its modem id).
+"""Shared-secret authentication of store-server requests (a pygoby addition: upstream's
+store-server has none: any client could read and consume another modem's mail by sending its modem
+id).
 
 A driver with a secret appends `auth_time` and, last, `auth_hmac` = HMAC-SHA256(secret, every
 byte before it) to its request. The server with a secret for that modem id answers only a

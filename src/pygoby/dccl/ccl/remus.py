@@ -1,5 +1,5 @@
 """REMUS CCL frames: the 32-byte messages of WHOI's Compact Control Language that REMUS vehicles
-exchange through Micro-Modems (spec goby-moos-apps.md §7), as typed objects. No MOOS needed.
+exchange through Micro-Modems, as typed objects. No MOOS needed.
 
     data = State(latitude=42.35, longitude=-70.95, heading=45, depth=111).encode()  # 32 bytes
     state = State.decode(data)      # CCLFrameError: too short, wrong id, field out of range
@@ -14,7 +14,8 @@ source of these frames) differed, this module follows C++ DCCL and says so:
 * Redirect speeds are m/s (x30) whatever the thrust-mode bits of `speed_depth_flags` say, as
   Goby 1.1 did; C++ DCCL scales a speed whose bit says RPM differently, so the bytes are equal
   when both bits say m/s (`THRUST_MPS_TRANSIT | THRUST_MPS_SURVEY`);
-* latitude/longitude are sign-extended (Goby 1.1's decoder was not: Quirk Q19);
+* latitude/longitude are sign-extended (Goby 1.1's decoder was not, which biased negative
+  values by about 4.3e-5 degrees; fixed: QUIRKS.md Q-APPS-19);
 * Redirect row_length keeps all 16 bits (1.1's decoder kept 13).
 
 Inputs beyond a field's range follow C++ DCCL too: depths saturate at 0 and 6000 m, speeds at
@@ -26,8 +27,9 @@ Multi-byte fields are little-endian, except the Ranger's BCD fields (most signif
 first). Frames longer than 32 bytes are read up to byte 31; a frame may be shorter than 32 bytes
 as long as it holds every field its type reads (the rest counts as zeros).
 
-Alert and Alert2 carry OASIS array contacts; the spec gives no id for them (Goby 1.1 decoded
-whatever arrived on their variables), so their id byte is a field (`mode`, default MDAT_OASIS).
+Alert and Alert2 carry OASIS array contacts; the REMUS CCL definitions give no id for them (Goby 1.1
+decoded whatever arrived on their variables), so their id byte is a field (`mode`, default
+MDAT_OASIS).
 """
 
 from __future__ import annotations

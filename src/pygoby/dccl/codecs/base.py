@@ -8,7 +8,7 @@ A field codec turns one field value into bits and back. Two shapes exist:
   `decode(bits, pos, end) -> (value, new_pos)`, plus `min_size()`/`max_size()`.
 
 `value` is None when the field is unset; `from_raw`/`decode` return None for "not set". A raw value
-of `nbits` bits is written least-significant bit first at the current bit position (spec §3.2).
+of `nbits` bits is written least-significant bit first at the current bit position.
 User codecs subclass one of these and are registered with `CodecRegistry.register`.
 
 A codec whose encoding depends on other fields of the message (e.g. the legacy CCL speed, scaled
@@ -67,7 +67,10 @@ class FieldInfo:
     descriptor: FieldDescriptor
     options: Message  # dccl.DCCLFieldOptions
     category: str
-    required: bool  # required encoding (no "not set" state), spec §6.4
+    # required encoding (no "not set" state): v4 `required`, `repeated` elements, oneof members
+    # and fields whose dynamic condition makes them required; v3 the same but oneofs; v2
+    # `required` only
+    required: bool
     version: int  # the root message's codec_version
     codec_name: str  # the resolved registry name, e.g. "dccl.default4"
     now: Callable[[], float]  # receiver clock (UNIX seconds), for time codecs

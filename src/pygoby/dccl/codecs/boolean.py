@@ -1,4 +1,4 @@
-"""Bool codec (spec §8): 1 bit required; 2 bits optional (0 unset, 1 false, 2 true)."""
+"""Bool codec: 1 bit required; 2 bits optional (0 unset, 1 false, 2 true)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Enum codecs (spec §9): an int32 numeric field over the value index (packed) or number."""
+"""Enum codecs: an int32 numeric field over the value index (packed) or number."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Bounded numeric codec (spec §7), used by every codec version for integers, float and double.
+"""Bounded numeric codec, used by every codec version for integers, float and double.
 
 The arithmetic reproduces the reference exactly: rounding is floor(x + 0.5), resolutions below 1
 multiply by inv = 1.0 / res, float fields round every intermediate to float32, and integer fields

@@ -1,4 +1,4 @@
-"""Presence codec (spec §14): a presence bit before the version's default codec (required form)."""
+"""Presence codec: a presence bit before the version's default codec (required form)."""
 
 from __future__ import annotations
 

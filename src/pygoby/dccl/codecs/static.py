@@ -1,4 +1,4 @@
-"""Static codec (spec §15): 0 bits; decodes to `static_value` parsed like C++ `istream >> value`."""
+"""Static codec: 0 bits; decodes to `static_value` parsed like C++ `istream >> value`."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""String and bytes codecs (spec §10): v2/v3 strings, var_bytes (v4) and fixed-length bytes."""
+"""String and bytes codecs: v2/v3 strings, var_bytes (v4) and fixed-length bytes."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Time codec (spec §16): the time within a window of num_days days; the receiver's clock
+"""Time codec: the time within a window of num_days days; the receiver's clock
 supplies the rest."""
 
 from __future__ import annotations

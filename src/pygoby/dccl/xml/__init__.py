@@ -1,4 +1,4 @@
-"""Goby 1.1 DCCL XML message sets (seed 003 §2.3.8-2.3.10), usable without MOOS.
+"""Goby 1.1 DCCL XML message sets, usable without MOOS.
 
     from pygoby.dccl import Codec
     from pygoby.dccl.xml import load_message_set
@@ -11,8 +11,8 @@
     message_set.queue_entries()       # goby.acomms.protobuf.QueuedMessageEntry per message
     message_set.translator_entries()  # goby.moos.protobuf.TranslatorEntry per message
 
-The messages are converted in memory as Goby 2's transitional layer did (spec
-goby-moos-apps.md §4.10) and then go through pygoby's DCCL codec, queue and MOOS translator.
+The messages are converted in memory as Goby 2's transitional layer did and then go through pygoby's
+DCCL codec, queue and MOOS translator.
 """
 
 from __future__ import annotations

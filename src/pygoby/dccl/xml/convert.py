@@ -1,5 +1,5 @@
 """Goby 1.1 XML messages -> DCCL protobuf descriptors, queue entries and translator entries,
-following Goby 2's transitional layer (spec goby-moos-apps.md §4.10).
+following Goby 2's transitional layer.
 
 * One protobuf message per XML message, named as in the XML (no package), codec version 2
   (Goby 2's DCCL): field 1 = header time (`_time` codec, in the head), 2 = source id, 3 =

@@ -38,6 +38,7 @@ class Var:
     max_length: int | None = None
     num_bytes: int | None = None
     array_length: int = 1
+    max_delta: float | None = None  # <max_delta>: DCCL1 sends array elements 1.. as deltas
     static_value: str | None = None
     enum_values: list[str] = field(default_factory=list)
     number: int = 0  # field number in the converted protobuf message
@@ -75,7 +76,7 @@ class Publish:
 class Queuing:
     """`<queuing>` with Goby 1.1's defaults for what the XML leaves out."""
 
-    ack: bool = False
+    ack: bool = True  # Goby 1.1.2's code (its manual says false)
     blackout_time: int = 0
     max_queue: int = 0  # 0: no limit
     newest_first: bool = True
@@ -94,10 +95,18 @@ class XmlMessage:
     trigger_var: str = ""
     mandatory_content: str = ""
     trigger_time: int | None = None
+    repeat: bool = False  # <repeat/>: DCCL1 packs as many copies as <size> allows
+    incoming_hex_var: str = ""  # <incoming_hex_moos_var>; "" for 1.1's IN_<NAME>_HEX_<size>B
+    outgoing_hex_var: str = ""  # <outgoing_hex_moos_var>; "" for OUT_<NAME>_HEX_<size>B
     header: dict[str, Var] = field(default_factory=dict)  # by tag: time, src_id, dest_id
     layout: list[Var] = field(default_factory=list)
     publishes: list[Publish] = field(default_factory=list)
     queuing: Queuing = field(default_factory=Queuing)
+
+    def hex_vars(self) -> tuple[str, str]:
+        """(incoming, outgoing) MOOS variables of the encoded message, as Goby 1.1 named them."""
+        stem = f"{self.name.upper()}_HEX_{self.size}B"
+        return (self.incoming_hex_var or f"IN_{stem}", self.outgoing_hex_var or f"OUT_{stem}")
 
     def header_vars(self) -> list[Var]:
         return [self.header[tag] for tag in HEADER_PARTS]

@@ -1,4 +1,4 @@
-"""Read a Goby 1.1 `<message_set>` file (seed 003 §2.3.8-2.3.10) into the model.
+"""Read a Goby 1.1 `<message_set>` file into the model.
 
 The XML goes through a real parser (expat, hardened by defusedxml: no entity expansion, no
 external references), then every element is checked against the message schema Goby 1.1
@@ -39,7 +39,7 @@ IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 # An XML file is configuration: anything larger is a mistake (and must not eat the memory).
 MAX_FILE_BYTES = 16 * 1024 * 1024
 
-# Goby 1.1 algorithm names (seed 003 §2.3.10) and those Goby 2 added; `alg_TSD_to_soundspeed`
+# Goby 1.1 algorithm names and those Goby 2 added; `alg_TSD_to_soundspeed`
 # is the manual's spelling of the code's TSD_to_soundspeed.
 ALGORITHM_ALIASES = {"alg_TSD_to_soundspeed": "TSD_to_soundspeed"}
 ALGORITHMS = frozenset(
@@ -422,13 +422,13 @@ class _Reader:
         msg.name = self.identifier(groups["name"][0], "message name")
         context = f"message {msg.name}"
         msg.size = self.integer(groups["size"][0], 1, 65535)
-        for tag in ("repeat",):
-            if tag in groups:
-                self.warn(
-                    groups[tag][0].line,
-                    "<repeat/> is deprecated and ignored (as in Goby 2): "
-                    "post the message several times instead",
-                )
+        if "repeat" in groups:
+            msg.repeat = True
+            self.warn(
+                groups["repeat"][0].line,
+                "<repeat/> is deprecated and ignored in the Goby 2 form (as in Goby 2): "
+                "post the message several times instead (DCCL1, the Goby 1.1 form, honours it)",
+            )
         self.trigger(msg, groups)
         header_groups = (
             self.check_structure(groups["header"][0], context) if "header" in groups else {}
@@ -465,12 +465,11 @@ class _Reader:
             msg.publishes = [self.publish(p, msg) for p in receipt_groups["publish"]]
         if "queuing" in groups:
             msg.queuing = self.queuing(groups["queuing"][0], context)
-        self.ignored(
-            groups,
-            ("incoming_hex_moos_var", "outgoing_hex_moos_var"),
-            self.text,
-            "is accepted and not used: pygoby (like Goby 2) does not post encoded DCCL hex",
-        )
+        # the variables the encoded message is posted on (Goby 1.1 configurations only)
+        if "incoming_hex_moos_var" in groups:
+            msg.incoming_hex_var = self.text(groups["incoming_hex_moos_var"][0])
+        if "outgoing_hex_moos_var" in groups:
+            msg.outgoing_hex_var = self.text(groups["outgoing_hex_moos_var"][0])
         return msg
 
     def ignored(
@@ -571,10 +570,11 @@ class _Reader:
         if "array_length" in groups:
             var.array_length = self.integer(groups["array_length"][0], 1, 1_000_000)
         if "max_delta" in groups:
-            self.number(groups["max_delta"][0])
+            var.max_delta = abs(self.number(groups["max_delta"][0]))
             self.warn(
                 groups["max_delta"][0].line,
-                "<max_delta> (delta encoding) is ignored, as in Goby 2: the value is sent in full",
+                "<max_delta> (delta encoding) is ignored in the Goby 2 form, as in Goby 2: the "
+                "value is sent in full (DCCL1, the Goby 1.1 form, honours it)",
             )
         if kind == "static":
             var.static_value = self.text(groups["value"][0])
@@ -651,8 +651,9 @@ class _Reader:
                         f"not a variable of message {msg.name}",
                     )
             if create_side and references:
-                # Goby 2's rule (quirk Q13): the translator runs create-side algorithms on one
-                # field's text, before the other fields exist
+                # Goby 2's rule, kept (upstream indexes an empty list instead: QUIRKS.md Q-APPS-13):
+                # the translator runs create-side algorithms on one field's text, before the
+                # other fields exist, so an algorithm with references is refused at load
                 raise self.error(
                     line,
                     f"algorithm {spec!r} on {var.name if var else '?'}: "

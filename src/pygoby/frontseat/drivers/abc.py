@@ -1,4 +1,4 @@
-"""The ABC / basic simulator frontseat driver (spec goby-moos-apps §5.9, "Driver behaviour").
+"""The ABC / basic simulator frontseat driver.
 
 Talks to `basic_frontseat_simulator` (pygoby.frontseat.simulator) over TCP. Configuration:
 the `basic_simulator_config` extension (1001) of the frontseat Config:

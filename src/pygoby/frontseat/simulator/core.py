@@ -1,4 +1,4 @@
-"""The basic (ABC) frontseat simulator, sans-I/O (spec goby-moos-apps §5.9).
+"""The basic (ABC) frontseat simulator, sans-I/O.
 
 `BasicFrontSeatSimulator` is fed the lines a backseat sends (`handle_line`) and is ticked once
 per control period (`tick`); both return the lines to send back to every client. The caller
@@ -11,7 +11,8 @@ Behaviour, as upstream goby3 basic_frontseat_simulator:
   those it carries, sets the UTM datum to (LAT, LON), restarts the mission tick count and
   answers `CTRL,STATE:PAYLOAD`. The Goby 2 ABC `START,LAT:..,LON:..,DURATION:..` is a valid
   START too. The vehicle state (position, depth, speed, heading and the desired course) is NOT
-  reset: x/y continue on the grid of the new datum (Quirk Q16, reproduced).
+  reset: x/y continue on the grid of the new datum (upstream's behaviour,
+  reproduced: QUIRKS.md Q-APPS-16).
 * `CMD,HEADING:h,SPEED:v,DEPTH:d` during a mission sets the desired course and answers
   `CMD,RESULT:OK`; a CMD lacking one of the three answers `CMD,RESULT:ERROR`. A CMD before any
   START or after the mission ended is not answered (logged). Unknown keys and malformed lines
@@ -24,9 +25,9 @@ Behaviour, as upstream goby3 basic_frontseat_simulator:
   target when within one step), then x += v cos(theta) dt, y += v sin(theta) dt with
   theta = (90 - heading) deg, on the local UTM grid of the START datum.
 
-Deviations (the "Sane" recommendations of the spec's quirk ledger and of bad-input handling):
+Deviations from upstream (listed in QUIRKS.md, and bad-input handling):
 
-* Quirk Q17: the heading is kept in [0, 360). Upstream lets it run past 360 (or below 0) after
+* The heading is kept in [0, 360) (Q-APPS-17). Upstream lets it run past 360 (or below 0) after
   turns through north, prints e.g. HEADING:370 and, once it is more than 540 deg away from a
   new desired heading, turns the long way round. Here the desired heading is wrapped when it is
   received and the heading after every step, so the vehicle always turns the shorter way and

@@ -1,4 +1,4 @@
-"""The basic (ABC) frontseat simulator's wire protocol (spec goby-moos-apps §5.9).
+"""The basic (ABC) frontseat simulator's wire protocol.
 
 ASCII lines `KEY,NAME:VALUE,NAME:VALUE,...` terminated by "\\r\\n" (the terminator is the link's
 business; these functions see lines without it). `parse_line` splits a line into a `Message`;

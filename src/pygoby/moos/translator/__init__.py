@@ -10,13 +10,18 @@
 
 * MOOS values are float (double), str (string) or bytes (binary string); a Post with a float
   value is a MOOS double, bytes a binary string. Posts are sorted by variable name.
-* Entry problems (unknown type or algorithm, bad FORMAT, duplicates) raise
-  TranslatorConfigError when the Translator is built; bad data raises TranslatorError from
-  create()/publish() and nothing partial is returned. Warnings (unknown keys, unknown enum
-  values) go to the "pygoby.moos.translator" logger.
-* TranslatorRunner(translator, start_time, multiplex_vars, variables=MoosValues(app.dynamic_vars))
-  is the trigger logic: subscriptions(), on_mail(var, value, stale=) and tick(now) return the
-  created messages; on_multiplex(value, technique) returns inverse-publish posts.
+* Entry problems goby3 would crash on (unknown type, a FORMAT that cannot work, duplicates)
+  raise TranslatorConfigError when the Translator is built; what goby3 runs but looks like a
+  mistake (an unknown algorithm, a publish directive naming no field) is returned by
+  add_entry() as EntryNote(field, message) for the app to log once. Bad data raises
+  TranslatorError from create()/publish() and nothing partial is returned, except a FORMAT
+  input matching part of its format, which fills what it can as goby3 does and is reported in
+  create()'s `mismatches` list (`strict_format: true` on the entry: TranslatorError). Warnings
+  (unknown keys, unknown enum values) go to the "pygoby.moos.translator" logger.
+* TranslatorRunner(translator, start_time, multiplex_vars, variables=MoosValues(app.dynamic_vars),
+  clock=app.clock) is the trigger logic: subscriptions(), on_mail(var, value, stale=) and
+  tick(now) return the created messages (partial FORMAT matches: one warning per create rule
+  per minute of `clock`); on_multiplex(value, technique) returns inverse-publish posts.
 * serialize_for_moos / parse_for_moos / post_for_moos: app-internal messages (default
   `@PB[type] text`); moos_technique_from_config(common) picks the technique.
 """

@@ -11,7 +11,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from pygoby.moos.translator.conversions import lexical_double
+from pygoby.moos.translator.conversions import lexical_double, significant_digits
 from pygoby.moos.translator.errors import TranslatorConfigError
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup
@@ -66,7 +66,8 @@ def _db_to_power(x: float) -> float:
 
 
 def _nmea_angle(x: float, degree_digits: int) -> str:
-    # floor-based split, reproduced as is: negative input gives odd strings (Quirk Q23).
+    # goby3's floor-based split into degrees and minutes, reproduced as is: negative input gives
+    # odd strings (apply abs first; QUIRKS.md Q-APPS-23).
     if not math.isfinite(x):
         return "nan"
     degrees = math.floor(x)
@@ -128,17 +129,21 @@ class AlgorithmRegistry:
     def names(self) -> list[str]:
         return sorted(self._algorithms)
 
-    def get(self, name: str) -> Algorithm:
-        try:
-            return self._algorithms[name]
-        except KeyError:
-            hint = ""
-            if name in ("modem_id2name", "modem_id2type", "name2modem_id"):
-                hint = " (needs modem_id_lookup_path)"
-            raise TranslatorConfigError(f"unknown algorithm {name!r}{hint}") from None
+    def find(self, name: str) -> Algorithm | None:
+        return self._algorithms.get(name)
+
+    def unknown_reason(self, name: str) -> str:
+        """Why `name` is not an algorithm of this registry."""
+        hint = ""
+        if name in ("modem_id2name", "modem_id2type", "name2modem_id"):
+            hint = " (needs modem_id_lookup_path)"
+        return f"unknown algorithm {name!r}{hint}"
 
     def run(self, name: str, value: str, references: Sequence[str] = ()) -> str:
-        return self.get(name).run(value, references)
+        algorithm = self._algorithms.get(name)
+        # goby3 ignores an algorithm it does not know: the value passes through unchanged
+        # (QUIRKS.md Q-APPS-26).
+        return value if algorithm is None else algorithm.run(value, references)
 
     def _add(self, name: str, run: Callable[[str, Sequence[str]], str], refs: bool = False) -> None:
         self._algorithms[name] = Algorithm(name, refs, run)
@@ -205,12 +210,22 @@ class AlgorithmRegistry:
         lat = self.geodesy.to_geo(x, numeric(value))[0]
         return render_double(_round_decimals(lat, 12))
 
+    @staticmethod
+    def _modem_id(value: str) -> int | None:
+        """The id a modem_id2* algorithm looks up; None leaves the value unchanged (goby3
+        throws on an empty value or one beyond an unsigned int: QUIRKS.md Q-APPS-11)."""
+        if not (value.isascii() and value.isdigit()) or significant_digits(value) > 10:
+            return None
+        modem_id = int(value)
+        return modem_id if modem_id < 2**32 else None
+
     def _modem_id2name(self, value: str, _refs: Sequence[str]) -> str:
-        # Empty input is left unchanged (goby3 throws: Quirk Q11).
-        return self.modem_ids.name(int(value)) if value.isdigit() and value.isascii() else value
+        modem_id = self._modem_id(value)
+        return value if modem_id is None else self.modem_ids.name(modem_id)
 
     def _modem_id2type(self, value: str, _refs: Sequence[str]) -> str:
-        return self.modem_ids.type(int(value)) if value.isdigit() and value.isascii() else value
+        modem_id = self._modem_id(value)
+        return value if modem_id is None else self.modem_ids.type(modem_id)
 
 
 def run_publish_algorithms(msg, algorithms, registry: AlgorithmRegistry) -> dict[int, str]:

@@ -4,7 +4,7 @@ Directives: `%N%`, `%N$<flags><width>.<prec><conv>`, `%|N$...|`, non-positional 
 directives (`%5d`), and `%%`. Missing arguments render as empty (goby disables boost's
 too-few/too-many-arguments errors). Floating-point arguments arrive "grouped" with a fixed
 precision (15 for doubles, 6 for floats) that overrides the directive's precision while
-keeping its flags and conversion (Quirk Q21, reproduced).
+keeping its flags and conversion (goby3's output, reproduced: QUIRKS.md Q-APPS-21).
 """
 
 from __future__ import annotations
@@ -41,9 +41,8 @@ class Directive:
 
 
 _PRINTF_SPEC = re.compile(
-    r"([-+ 0#']*)([0-9]*)(?:\.([0-9]*))?(?:hh|h|ll|l|L|j|z|t|q)?([diuoxXeEfFgGaAcsS]?)"
+    r"([-+ 0#']*)([0-9]*)(?:\.([0-9]*))?(?:hh|h|ll|l|L|j|z|t|q)?([diuoxXeEfFgGaAcCsS]?)"
 )
-_CONVERSIONS = "diuoxXeEfFgGaAcsS"
 
 
 def parse_format(fmt: str) -> list[str | Directive]:
@@ -159,20 +158,50 @@ def _render_float(arg: FloatArg, d: Directive) -> tuple[str, str]:
     return sign, body
 
 
+def _render_text(d: Directive, text: str) -> str:
+    """A string argument (an algorithm's output, a string or enum field...) as Boost.Format
+    streams it: the conversion character does not convert it; only `s`/`S` with a precision
+    (at most that many characters) and `c`/`C` (one character) cut it. Flags: `-` pads on
+    the right, `0` (unless `-`) fills with zeros on the left, ` ` (unless `+` or `0`) puts a
+    space before text that does not start with a sign."""
+    cut = _cut(d)
+    text = text if cut is None else text[:cut]
+    zero_fill = "0" in d.flags and "-" not in d.flags
+    if " " in d.flags and "+" not in d.flags and not zero_fill and text[:1] not in ("+", "-"):
+        text = " " + text
+    padding = d.width - len(text)
+    if padding <= 0:
+        return text
+    if "-" in d.flags:
+        return text + " " * padding
+    return ("0" if zero_fill else " ") * padding + text
+
+
+def _cut(d: Directive) -> int | None:
+    """How many characters Boost.Format keeps of an argument's output (None: all)."""
+    if d.conversion in ("s", "S"):
+        return d.precision
+    return 1 if d.conversion in ("c", "C") else None
+
+
 def render(d: Directive, arg: Arg) -> str:
     if isinstance(arg, str):
-        text = arg if d.precision is None else arg[: d.precision]
-        prefix, body = "", text
-    elif isinstance(arg, IntArg):
+        return _render_text(d, arg)
+    if isinstance(arg, IntArg):
         prefix, body = _render_int(arg, d)
     else:
         prefix, body = _render_float(arg, d)
+    cut = _cut(d)
+    if cut is not None:  # a number printed with %s/%c is cut like text
+        return _render_text(
+            Directive(d.argument, d.flags.replace(" ", ""), d.width), (prefix + body)[:cut]
+        )
     padding = d.width - len(prefix) - len(body)
     if padding <= 0:
         return prefix + body
     if "-" in d.flags:
         return prefix + body + " " * padding
-    if "0" in d.flags and not isinstance(arg, str):
+    if "0" in d.flags:
         return prefix + "0" * padding + body
     return " " * padding + prefix + body
 

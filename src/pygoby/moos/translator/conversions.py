@@ -57,11 +57,27 @@ def to_float32(value: float) -> float:
         return math.copysign(math.inf, value)
 
 
+# More significant digits than any 64-bit integer has.
+MAX_INT_DIGITS = 20
+
+
+def is_integer_literal(text: str) -> bool:
+    """What boost::lexical_cast reads as an integer: an optional sign and decimal digits."""
+    return _INT_RE.fullmatch(text) is not None
+
+
+def significant_digits(integer_text: str) -> int:
+    """The number of digits of an integer literal without its sign and leading zeros."""
+    return len(integer_text.lstrip("+-").lstrip("0"))
+
+
 def as_int(text: str, kind: str) -> int:
     """goby `as<intN>`: the type's maximum on failure; '-1' wraps for unsigned types."""
     low, high = INT_LIMITS[kind]
-    if not _INT_RE.fullmatch(text):
+    if not is_integer_literal(text):
         return high
+    if significant_digits(text) > MAX_INT_DIGITS:
+        return high  # out of every type's range and of Python's int() limit: Q-APPS-30
     value = int(text)
     if kind.startswith("u"):
         if value < 0:

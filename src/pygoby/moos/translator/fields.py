@@ -9,6 +9,7 @@ from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import DecodeError, Message
 
 from pygoby.moos.translator.conversions import (
+    MAX_INT_DIGITS,
     as_bool,
     as_double,
     as_float,
@@ -17,6 +18,8 @@ from pygoby.moos.translator.conversions import (
     format_float,
     hex_decode,
     hex_encode,
+    is_integer_literal,
+    significant_digits,
 )
 from pygoby.moos.translator.errors import TranslatorError, UnconvertibleError
 
@@ -40,7 +43,8 @@ def is_bytes(field: FieldDescriptor) -> bool:
 
 def strip_name_from_enum(value_name: str, field_name: str) -> str:
     """use_short_enum on output: remove the first case-insensitive occurrence of `<field>_`
-    anywhere in the value name (goby3 behaviour, Quirk Q8: not only a prefix)."""
+    anywhere in the value name (goby3's behaviour, reproduced: not only a
+    prefix; QUIRKS.md Q-APPS-8)."""
     needle = field_name.lower() + "_"
     pos = value_name.lower().find(needle)
     return value_name if pos < 0 else value_name[:pos] + value_name[pos + len(needle) :]
@@ -100,6 +104,13 @@ def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
     """Convert `text` to a scalar value for `field` (not for message fields)."""
     cpp = field.cpp_type
     if cpp in INT_KINDS:
+        if is_integer_literal(text) and significant_digits(text) > MAX_INT_DIGITS:
+            log.warning(
+                "field %s: a %d-digit integer is out of range; set to the %s maximum as goby3 does",
+                field.name,
+                len(text),
+                INT_KINDS[cpp],
+            )
         return as_int(text, INT_KINDS[cpp])
     if cpp == FieldDescriptor.CPPTYPE_BOOL:
         return as_bool(text)
@@ -118,6 +129,9 @@ def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
     if cpp == FieldDescriptor.CPPTYPE_DOUBLE:
         return as_double(text)
     wanted = field.name.upper() + "_" + text if use_short_enum else text
+    if not wanted.isascii():
+        # Enum value names are identifiers; protobuf's lookup fails on undecodable bytes.
+        raise UnconvertibleError(f"{text!r} is not a value of enum {field.enum_type.full_name}")
     for candidate in (wanted, wanted.upper(), wanted.lower()):
         value = field.enum_type.values_by_name.get(candidate)
         if value is not None:

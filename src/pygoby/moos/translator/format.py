@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Collection, Sequence
+from dataclasses import dataclass
 
 from google.protobuf import message_factory
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
@@ -18,7 +19,7 @@ from google.protobuf.message import Message
 from pygoby.moos.translator import boostformat
 from pygoby.moos.translator.algorithms import AlgorithmRegistry, run_publish_algorithms
 from pygoby.moos.translator.conversions import hex_decode
-from pygoby.moos.translator.errors import TranslatorConfigError, TranslatorError
+from pygoby.moos.translator.errors import TranslatorConfigError
 from pygoby.moos.translator.fields import (
     INT_KINDS,
     append_from_string,
@@ -121,7 +122,8 @@ def serialize(
     registry: AlgorithmRegistry | None = None,
 ) -> str:
     descriptor = msg.DESCRIPTOR
-    # Every field counts (goby3 skips the first-declared one: Quirk Q9, fixed here).
+    # Every field counts (goby3 skips the first-declared one, so a directive for it renders
+    # empty when its number is the largest; fixed: QUIRKS.md Q-APPS-9).
     max_field = max([1, *(f.number for f in descriptor.fields)])
     virtual = (
         run_publish_algorithms(msg, algorithms, registry or AlgorithmRegistry())
@@ -168,25 +170,32 @@ def serialize(
     return boostformat.boost_format(boostformat.parse_format(working), args)
 
 
-def _directives(fmt: str):
-    """Yield ('directive', spec, separator) and ('literal', char, None) for a parse format."""
+def _scan(fmt: str):
+    """Yield ('literal', position, char) and ('directive', position, spec, separator) for a
+    parse format. The separator is the format character after the directive's closing '%'
+    (itself scanned next, as a literal or the next directive's '%': adjacent directives read
+    the same text, QUIRKS.md Q-APPS-28), or NUL when the directive ends the format: goby3
+    reads the string's terminator there."""
     i = 0
     while i < len(fmt):
         if fmt[i] != "%":
-            yield "literal", fmt[i], None
+            yield "literal", i, fmt[i]
             i += 1
             continue
         close = fmt.find("%", i + 1)
         if close < 0:
+            # goby3 reads past the end of the format looking for the '%' (Q-APPS-29).
             raise TranslatorConfigError(f"format {fmt!r}: unterminated directive")
         spec = fmt[i + 1 : close]
-        i = close + 1
-        separator = fmt[i] if i < len(fmt) else None
-        if not spec or separator == "%":
+        if not spec:
+            # goby3 throws "Bad specifier" at every creation, uncaught: pTranslator ends
+            # (QUIRKS.md Q-APPS-29).
             raise TranslatorConfigError(
-                f"format {fmt!r} cannot be parsed: adjacent directives or a literal '%%'"
+                f"format {fmt!r}: empty directive '%%' at position {i} (a literal '%' cannot "
+                "be parsed)"
             )
-        yield "directive", spec, separator
+        yield "directive", i, spec, fmt[close + 1] if close + 1 < len(fmt) else "\0"
+        i = close + 1
 
 
 def _field_spec(descriptor: Descriptor, spec: str) -> tuple[FieldDescriptor, int | None]:
@@ -205,7 +214,7 @@ def _field_spec(descriptor: Descriptor, spec: str) -> tuple[FieldDescriptor, int
 
 def check_parse_format(descriptor: Descriptor, fmt: str) -> None:
     """Reject create formats that cannot work, before any mail arrives."""
-    for kind, spec, _sep in _directives(fmt.lower()):
+    for kind, _position, spec, *_separator in _scan(fmt.lower()):
         if kind != "directive":
             continue
         current = descriptor
@@ -231,28 +240,37 @@ def parsed_fields(descriptor: Descriptor, fmt: str) -> set[int]:
     field's value comes from)."""
     return {
         _field_spec(descriptor, spec.split(":")[0])[0].number
-        for kind, spec, _sep in _directives(fmt.lower())
+        for kind, _position, spec, *_separator in _scan(fmt.lower())
         if kind == "directive"
     }
 
 
 def check_serialize_format(
     descriptor: Descriptor, fmt: str, virtual_fields: Collection[int] = ()
-) -> None:
-    """Reject publish formats that cannot render (bad sub-message paths, bad directives) or
-    that name a field the message does not have (upstream renders such a directive as empty
-    or "unknown": a typo would be published silently). `virtual_fields`: the publish
+) -> list[str]:
+    """Reject publish formats that cannot render (bad sub-message paths, where goby3 throws
+    at every publication; bad directives). Return what renders, as in goby3, but is likely a
+    mistake: a directive naming a field the message does not have (rendered "unknown", or
+    nothing past the highest field number) and an element index on a field that is not
+    repeated (the whole field is rendered): QUIRKS.md Q-APPS-27. `virtual_fields`: the publish
     algorithms' output_virtual_field numbers."""
     probe = message_factory.GetMessageClass(descriptor)()
     for match in _SUBMESSAGE_DIRECTIVE.finditer(fmt):
         spec = match.group(0).strip("%")
         _walk_path(probe, spec.split(":")[:-1], spec, create=False)
+    notes = []
     for match in _INDEXED_DIRECTIVE.finditer(_SUBMESSAGE_DIRECTIVE.sub("%%", fmt)):
         number = int(match.group(0).strip("%").split(".")[0])
         field = descriptor.fields_by_number.get(number)
-        if field is None or not field.is_repeated:
-            raise TranslatorConfigError(
-                f"format {fmt!r}: {match.group(0)} names no repeated field of {descriptor.full_name}"
+        if field is None:
+            notes.append(
+                f"{match.group(0)} names no field of {descriptor.full_name}: it prints "
+                "'unknown', as in goby3"
+            )
+        elif not field.is_repeated:
+            notes.append(
+                f"{match.group(0)}: field {number} ({field.name}) is not repeated: the whole "
+                "field prints, as in goby3"
             )
     plain = _SUBMESSAGE_DIRECTIVE.sub("%%", _INDEXED_DIRECTIVE.sub("%%", fmt))
     for item in boostformat.parse_format(plain):
@@ -262,10 +280,27 @@ def check_serialize_format(
             and number not in descriptor.fields_by_number
             and (number not in virtual_fields)
         ):
-            raise TranslatorConfigError(
-                f"format {fmt!r}: %{number}% names no field of {descriptor.full_name} "
-                "(nor an algorithm's output_virtual_field)"
+            notes.append(
+                f"%{number}% names no field of {descriptor.full_name} (nor an algorithm's "
+                "output_virtual_field): it prints 'unknown' or nothing, as in goby3"
             )
+    return notes
+
+
+@dataclass(frozen=True)
+class FormatMismatch:
+    """Where a create input stopped matching its format: the first format literal that does
+    not occur in what remains of the input."""
+
+    literal: str
+    format_position: int  # of the literal in the format
+    input_position: int  # characters of the input consumed when the literal was looked for
+
+    def __str__(self) -> str:
+        return (
+            f"no {self.literal!r} (format character {self.format_position}) in the input "
+            f"after character {self.input_position}"
+        )
 
 
 def parse(
@@ -276,27 +311,34 @@ def parse(
     algorithms: Sequence = (),
     use_short_enum: bool = False,
     registry: AlgorithmRegistry | None = None,
-) -> None:
-    """Scan `text` with `fmt`, setting the fields it names. Literal format characters skip to
-    their next occurrence in the input (case-insensitive); a literal that does not occur at all
-    means the input does not match and raises TranslatorError."""
+) -> FormatMismatch | None:
+    """Scan `text` with `fmt`, setting the fields it names, as goby3 does. A literal format
+    character skips the input to just past its next occurrence (case-insensitive); a literal
+    that does not occur skips nothing and the scan goes on, so every directive is still
+    parsed (from whatever input remains; an empty value gives NaN or the integer maximum).
+    Returns the first such literal, None when the whole format matched (QUIRKS.md
+    Q-APPS-25)."""
     remaining = text
     lower = text.lower()
-    for kind, spec, separator in _directives(fmt.lower()):
+    consumed = 0
+    mismatch: FormatMismatch | None = None
+    for kind, position, spec, *separator in _scan(fmt.lower()):
         if kind == "literal":
-            position = lower.find(spec)
-            if position < 0:
-                raise TranslatorError(
-                    f"input {text!r} does not match format {fmt!r} (no {spec!r} where expected)"
-                )
-            lower = lower[position + 1 :]
-            remaining = remaining[position + 1 :]
+            found = lower.find(spec)
+            if found < 0:
+                if mismatch is None:
+                    mismatch = FormatMismatch(spec, position, consumed)
+                continue
+            lower = lower[found + 1 :]
+            remaining = remaining[found + 1 :]
+            consumed += found + 1
             continue
-        end = lower.find(separator) if separator is not None else -1
+        end = lower.find(separator[0])
         extract = remaining if end < 0 else remaining[:end]
         _parse_directive(
             extract, msg, spec, repeated_delimiter, algorithms, use_short_enum, registry
         )
+    return mismatch
 
 
 def _parse_directive(extract, msg, spec, delimiter, algorithms, short, registry) -> None:
@@ -313,7 +355,7 @@ def _parse_directive(extract, msg, spec, delimiter, algorithms, short, registry)
         set_element_from_string(msg, field, index, extract, short)
     elif field.is_repeated:
         parts = re.split("[" + re.escape(delimiter) + "]", extract) if delimiter else [extract]
-        for part in parts:
+        for part in parts:  # enums too (goby3 aborts on a repeated enum: QUIRKS.md Q-APPS-10)
             append_from_string(msg, field, part, short)
     elif is_message(field):
         parse_message_bytes(getattr(msg, field.name), hex_decode(extract), field.name)

@@ -1,8 +1,8 @@
 """TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS: `key=value,key={v1,v2},...`.
 
 Sub-messages are flattened one level as `<field>_<subfield>`. Parsing lower-cases the whole
-input first (goby3 does, so string values arrive in lower case: Quirk Q20, kept because
-missions depend on it).
+input first (goby3 does, so string values arrive in lower case; kept because missions depend on it:
+QUIRKS.md Q-APPS-20).
 """
 
 from __future__ import annotations

@@ -105,7 +105,7 @@ def split_prefix(value: MoosValue) -> tuple[str, bytes] | None:
     """(type name, body) of an `@PB[type] body` value; None if it has no prefix.
 
     Exactly one separator character after `]` is skipped (goby3's dynamic parse skips none,
-    corrupting binary bodies: Quirk Q7, fixed here)."""
+    corrupting binary bodies; fixed: QUIRKS.md Q-APPS-7)."""
     data = as_bytes(value)
     magic = MAGIC_PROTOBUF_HEADER.encode()
     if len(data) <= len(magic) or not data.startswith(magic):

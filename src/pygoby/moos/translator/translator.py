@@ -30,6 +30,7 @@ from pygoby.moos.translator.techniques import (
     serialize_for_moos,
     serialize_protobuf,
 )
+from pygoby.util.clock import Clock, WallClock
 from pygoby.util.modem_id import ModemIdLookup
 
 log = logging.getLogger("pygoby.moos.translator")
@@ -38,9 +39,12 @@ TRIGGER_PUBLISH = 1
 TRIGGER_TIME = 2
 LAT_ORIGIN_VAR = "LAT_ORIGIN"
 LONG_ORIGIN_VAR = "LONG_ORIGIN"
+# Seconds between two warnings about the same create rule's partly matching input.
+MISMATCH_WARNING_INTERVAL = 60.0
 
 # Outputs that may be posted as MOOS doubles when they look like numbers. goby3 converts
-# every non-binary output (Quirk Q5); hex and @PB outputs are kept as strings here.
+# every non-binary output, even an all-digit hex string; hex and @PB outputs are kept as
+# strings here (QUIRKS.md Q-APPS-5).
 _NUMBER_CANDIDATES = frozenset(
     {
         Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT,
@@ -48,6 +52,32 @@ _NUMBER_CANDIDATES = frozenset(
         Technique.TECHNIQUE_FORMAT,
     }
 )
+
+
+@dataclass(frozen=True)
+class EntryNote:
+    """Something in a translator entry that behaves as in goby3 but looks like a mistake.
+    `field`: its path in the entry, e.g. "publish[0].format"."""
+
+    field: str
+    message: str
+
+
+@dataclass(frozen=True)
+class CreateMismatch:
+    """A TECHNIQUE_FORMAT create whose input matched only part of its format."""
+
+    protobuf_name: str
+    var: str
+    format: str
+    value: MoosValue
+    where: format_technique.FormatMismatch
+
+    def __str__(self) -> str:
+        return (
+            f"{self.protobuf_name} from {self.var}: input {as_text(self.value)[:80]!r} does not "
+            f"match format {self.format!r}: {self.where}"
+        )
 
 
 @dataclass(frozen=True)
@@ -62,6 +92,8 @@ class Post:
 
 
 def make_post(var: str, value: str | bytes, technique: Technique, type_name: str) -> Post:
+    # binary or not is decided for each post from its own value (goby3 keeps the binary flag of
+    # an earlier NATIVE_ENCODED publish for the entry's later ones: QUIRKS.md Q-APPS-6)
     technique = Technique(technique)
     aux = f"{type_name}:{technique.name}"
     if isinstance(value, bytes):
@@ -118,7 +150,10 @@ class Translator:
 
     # --- configuration -------------------------------------------------------------------
 
-    def add_entry(self, entry: Message) -> None:
+    def add_entry(self, entry: Message) -> list[EntryNote]:
+        """Add one entry; returns what in it behaves as in goby3 but looks like a mistake (to
+        log once at start-up); raises TranslatorConfigError where goby3 would crash or
+        corrupt data."""
         name = entry.protobuf_name
         if name in self._entries:
             raise TranslatorConfigError(f"Duplicate translator entry for {name}")
@@ -128,23 +163,38 @@ class Translator:
             raise TranslatorConfigError(
                 f"translator_entry protobuf_name {name!r} is not a loaded message type: {exc}"
             ) from None
-        self._check_entry(entry, cls)
+        notes = self._check_entry(entry, cls)
         self._entries[name] = entry
         self._classes[name] = cls
+        return notes
 
-    def _check_entry(self, entry: Message, cls: type[Message]) -> None:
+    def _check_algorithms(self, name: str, algorithms, where: str) -> list[EntryNote]:
+        return [
+            EntryNote(
+                f"{where}.algorithm[{index}].name",
+                f"{name}: {self.registry.unknown_reason(algorithm.name)}: the value passes through "
+                "unchanged, as in goby3",
+            )
+            for index, algorithm in enumerate(algorithms)
+            if self.registry.find(algorithm.name) is None
+        ]
+
+    def _check_entry(self, entry: Message, cls: type[Message]) -> list[EntryNote]:
         name = entry.protobuf_name
         descriptor = cls.DESCRIPTOR
+        notes: list[EntryNote] = []
         if entry.HasField("trigger"):
             trigger = entry.trigger
             if trigger.type == TRIGGER_PUBLISH and not trigger.moos_var:
                 raise TranslatorConfigError(f"{name}: TRIGGER_PUBLISH needs trigger.moos_var")
             if trigger.type == TRIGGER_TIME and trigger.period == 0:
                 raise TranslatorConfigError(f"{name}: TRIGGER_TIME needs a period > 0")
-        for create in entry.create:
+        for index, create in enumerate(entry.create):
             technique = Technique(create.technique)
+            notes += self._check_algorithms(name, create.algorithm, f"create[{index}]")
             for algorithm in create.algorithm:
-                if self.registry.get(algorithm.name).needs_references:
+                known = self.registry.find(algorithm.name)
+                if known is not None and known.needs_references:
                     raise TranslatorConfigError(
                         f"{name}: algorithm {algorithm.name!r} needs reference fields and cannot "
                         "be used in a create rule"
@@ -155,10 +205,10 @@ class Translator:
                         f"{name}: create from {create.moos_var} needs a format"
                     )
                 format_technique.check_parse_format(descriptor, create.format)
-        for publish in entry.publish:
+        for index, publish in enumerate(entry.publish):
             technique = Technique(publish.technique)
+            notes += self._check_algorithms(name, publish.algorithm, f"publish[{index}]")
             for algorithm in publish.algorithm:
-                self.registry.get(algorithm.name)
                 for number in algorithm.reference_field:
                     field = descriptor.fields_by_number.get(number)
                     if field is None or field.is_repeated:
@@ -172,12 +222,18 @@ class Translator:
                         f"{name}: publish to {publish.moos_var} needs a format"
                     )
                 virtual = {algorithm.output_virtual_field for algorithm in publish.algorithm}
-                format_technique.check_serialize_format(descriptor, publish.format, virtual)
-                format_technique.check_serialize_format(descriptor, publish.moos_var, virtual)
+                for field_name in ("format", "moos_var"):
+                    notes += [
+                        EntryNote(f"publish[{index}].{field_name}", f"{name}: {note}")
+                        for note in format_technique.check_serialize_format(
+                            descriptor, getattr(publish, field_name), virtual
+                        )
+                    ]
+        return notes
 
     def read_named_values(self, protobuf_name: str, keys: Mapping[str, str]) -> None:
-        """Goby 1.1's rule for the message's create variables in `keys` ({variable: name},
-        seed 003 §2.3.8): a string value holding `<name>=value` gives that value, any other
+        """Goby 1.1's rule for the message's create variables in `keys` ({variable: name}):
+        a string value holding `<name>=value` gives that value, any other
         value is read whole (`NAV_X: "nav_x=3.5"` and `NAV_X: 3.5` both give 3.5). For the
         messages of Goby 1.1 XML files, whose iCommander posted `name=value` strings."""
         self._entry(protobuf_name)
@@ -226,10 +282,18 @@ class Translator:
 
     # --- MOOS -> protobuf --------------------------------------------------------------------
 
-    def create(self, protobuf_name: str, variables: Mapping[str, MoosValue]) -> Message:
+    def create(
+        self,
+        protobuf_name: str,
+        variables: Mapping[str, MoosValue],
+        mismatches: list[CreateMismatch] | None = None,
+    ) -> Message:
         """Build a message from the newest variable values with the entry's create rules.
 
-        Raises TranslatorError if any rule fails: no partially built message comes out."""
+        A TECHNIQUE_FORMAT input that matches only part of its format still fills the fields
+        (as goby3 does) and is reported in `mismatches`; with the entry's `strict_format` it
+        is a TranslatorError instead. Raises TranslatorError if any rule fails: no partially
+        built message comes out."""
         entry = self._entry(protobuf_name)
         msg = self._classes[protobuf_name]()
         named = self._named_values.get(protobuf_name, {})
@@ -241,14 +305,21 @@ class Translator:
                 value = keyvalue.val_from_string(source, key)
                 source = source if value is None else value
             try:
-                self._apply_create(msg, create, technique, source, entry.use_short_enum)
+                mismatch = self._apply_create(msg, create, technique, source, entry.use_short_enum)
             except TranslatorError as exc:
                 raise type(exc)(f"{protobuf_name} from {create.moos_var}: {exc}") from None
+            if mismatch is None:
+                continue
+            found = CreateMismatch(protobuf_name, create.moos_var, create.format, source, mismatch)
+            if entry.strict_format:
+                raise TranslatorError(f"{found} (strict_format: nothing created)")
+            if mismatches is not None:
+                mismatches.append(found)
         return msg
 
     def _apply_create(
         self, msg, create, technique: Technique, source: MoosValue, short: bool
-    ) -> None:
+    ) -> format_technique.FormatMismatch | None:
         if technique in PROTOBUF_TECHNIQUES:
             parse_protobuf(source, msg, technique)
         elif technique == Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
@@ -256,7 +327,7 @@ class Translator:
                 as_text(source), msg, create.algorithm, short, self.registry, create.moos_var
             )
         else:
-            format_technique.parse(
+            return format_technique.parse(
                 as_text(source),
                 msg,
                 create.format,
@@ -265,11 +336,13 @@ class Translator:
                 short,
                 self.registry,
             )
+        return None
 
     # --- protobuf -> MOOS --------------------------------------------------------------------
 
     def publish(self, msg: Message) -> list[Post]:
-        """The entry's publish rules applied to `msg`, sorted by variable name (stable)."""
+        """The entry's publish rules applied to `msg`, sorted by variable name (stable), not in
+        declaration order, as goby3 posts them (QUIRKS.md Q-APPS-22)."""
         name = msg.DESCRIPTOR.full_name
         entry = self._entries.get(name)
         if entry is None:
@@ -361,8 +434,12 @@ class TranslatorRunner:
         start_time: float,
         multiplex_vars: Iterable[str] = (),
         variables: Mapping[str, MoosValue] | None = None,
+        clock: Clock | None = None,
     ) -> None:
         self.translator = translator
+        self.clock = clock or WallClock()
+        # (entry, create variable) -> when its partial-match warning was last logged
+        self._mismatch_warned: dict[tuple[str, str], float] = {}
         # The newest value per variable: our own table, or the application's (e.g. a view of
         # GobyMOOSApp.dynamic_vars, which also holds mail from before the start).
         self._owns_variables = variables is None
@@ -424,8 +501,21 @@ class TranslatorRunner:
 
     def create(self, name: str) -> Message | None:
         """`name` made now from the newest values; None, with a warning, when a rule fails."""
+        mismatches: list[CreateMismatch] = []
         try:
-            return self.translator.create(name, self.variables)
+            msg = self.translator.create(name, self.variables, mismatches)
         except TranslatorError as exc:
             log.warning("not creating %s: %s", name, exc)
             return None
+        now = self.clock.now()
+        for mismatch in mismatches:
+            key = (mismatch.protobuf_name, mismatch.var)
+            last = self._mismatch_warned.get(key)
+            if last is None or not 0 <= now - last < MISMATCH_WARNING_INTERVAL:
+                self._mismatch_warned[key] = now
+                log.warning(
+                    "%s; created from the part that matched, as goby3 does (this warning at "
+                    "most once a minute; strict_format: true creates nothing instead)",
+                    mismatch,
+                )
+        return msg

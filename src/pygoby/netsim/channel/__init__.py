@@ -1,4 +1,4 @@
-"""Packet-level acoustic channel for the netsim simulator (spec netsim.md §7).
+"""Packet-level acoustic channel for the netsim simulator.
 
 The physics are pure functions in small modules (`soundspeed`, `absorption`, `levels`,
 `geometry`, `errors`, `timing`); `model.Channel` combines them into the sans-I/O channel the

@@ -1,4 +1,4 @@
-"""Absorption of sound in sea water, alpha in dB/km with f in kHz (spec netsim.md §7.5)."""
+"""Absorption of sound in sea water, alpha in dB/km with f in kHz."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Frame and packet error models (spec netsim.md §7.8), pluggable per rate.
+"""Frame and packet error models, pluggable per rate.
 
 A `FrameErrorModel` maps the SINR of a reception (dB, in the modem's own `snr_in` sense) to the
 probability that one frame fails; frames fail independently. `RateErrorModels` picks the model
@@ -127,7 +127,7 @@ class BerModel:
 
 # -- per-rate selection --------------------------------------------------------------------------
 
-# WHOI ros_acomms per-rate tables (spec §7.8, table 3).
+# WHOI ros_acomms per-rate tables: (SINR dB, frame error rate) rows, interpolated.
 ROS_ACOMMS_TABLES: dict[int, TableModel] = {
     1: TableModel(
         (
@@ -145,7 +145,7 @@ ROS_ACOMMS_TABLES: dict[int, TableModel] = {
 }
 ROS_ACOMMS_FRAMES = {1: 2, 3: 1, 5: 7}
 
-# Logistic fits to the tables above (ours, spec §7.8 model 2).
+# Logistic fits to the tables above (ours): (snr50, width) of each rate's FER curve.
 LOGISTIC_FITS: dict[int, LogisticModel] = {
     1: LogisticModel(-7.09, 0.155),
     3: LogisticModel(-1.49, 0.33),

@@ -1,4 +1,4 @@
-"""Positions, ranges and travel times (spec netsim.md §7.2, §7.4).
+"""Positions, ranges and travel times.
 
 Positions are geographic (lat/lon degrees, depth metres positive down); horizontal ranges are
 WGS-84 geodesics (pyproj). Between position reports a node is dead-reckoned with its speed and

@@ -1,4 +1,4 @@
-"""Transmission loss, ambient noise (Stojanovic 2007) and the SNR / SINR budget (spec §7.5-7.7).
+"""Transmission loss, ambient noise (Stojanovic 2007) and the SNR / SINR budget.
 
 Levels in dB re 1 uPa (source level at 1 m); noise spectral density in dB re 1 uPa^2/Hz;
 f in kHz, r in metres, alpha in dB/km.

@@ -1,4 +1,4 @@
-"""The packet-level acoustic channel, sans-I/O (spec netsim.md §7.1 pipeline).
+"""The packet-level acoustic channel, sans-I/O.
 
 API (what a modem emulator calls):
 
@@ -97,7 +97,7 @@ DEFAULT_DURATIONS = {PacketKind.DATA: 3.25, PacketKind.MINI: 1.0, PacketKind.PIN
 
 @dataclass(frozen=True)
 class ChannelConfig:
-    """Every knob of the model; defaults from spec §7.13."""
+    """Every knob of the model, with its default."""
 
     sound_speed: float | SoundSpeedProfile = 1500.0  # m/s, or a profile c(depth)
     source_level: float = 185.0  # dB re 1 uPa @ 1 m

@@ -1,4 +1,4 @@
-"""Sound speed in sea water and depth -> pressure (spec netsim.md §7.3).
+"""Sound speed in sea water and depth -> pressure.
 
 Units: T in deg C, S in ppt (PSU), D depth in metres (positive down), P in dbar, c in m/s.
 TEOS-10 functions take Absolute Salinity SA (g/kg) and Conservative Temperature CT (deg C).

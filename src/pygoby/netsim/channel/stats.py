@@ -1,5 +1,5 @@
-"""Micro-Modem receive statistics ($CACST / ReceiveStatistics) synthesized for a reception
-(spec netsim.md §7.12). The mapping of the channel's numbers onto the modem's fields follows
+"""Micro-Modem receive statistics ($CACST / ReceiveStatistics) synthesized for a reception.
+The mapping of the channel's numbers onto the modem's fields follows
 ros_acomms; fields the model has no physics for get plausible values inside goby3's DCCL ranges.
 These are modelling choices, not measured modem behaviour.
 """

@@ -1,4 +1,4 @@
-"""Time intervals, half-duplex and ranging arithmetic (spec netsim.md §7.9-7.11)."""
+"""Time intervals, half-duplex and ranging arithmetic."""
 
 from __future__ import annotations
 

@@ -3,12 +3,12 @@
     commander = Commander(commands, community="topside", now=app.moos_time, publish=post)
     draft = commander.open("pygoby.examples.Command")
     commander.set_value(draft, "heading", "90")        # FieldValueError: above the maximum 360
-    outgoing = commander.preview(draft)                 # the posts, nothing published (Q18 fixed)
+    outgoing = commander.preview(draft)                 # the posts, nothing published
     record = commander.send(draft)                      # published; autosaved; awaiting ack
     for notice in commander.handle_mail(var, value):    # ACOMMS_ACK_ORIGINAL / ACOMMS_EXPIRE
         print(notice.banner())
 
-What "send" publishes (spec goby-moos-apps.md §6):
+What "send" publishes:
 
 * key=value style (Goby 1.1 iCommander): for a Goby 1.1 XML message, one
   `name1=value1,name2=value2,...` string per source variable (the fields it feeds, in message
@@ -261,7 +261,8 @@ class Commander:
 
     # ------------------------------------------------------------------ sending
     def preview(self, draft: Draft) -> Outgoing:
-        """What `send` would publish, without publishing anything (Quirk Q18 fixed)."""
+        """What `send` would publish, without publishing anything (an old iCommander's preview
+        published the message: QUIRKS.md Q-APPS-18)."""
         return self._compose(draft)
 
     def send(self, draft: Draft) -> SentRecord:
@@ -522,7 +523,7 @@ def _close(a: object, b: object, precision: int | None) -> bool:
         tolerance = 0.5 * 10.0 ** -(precision if precision is not None else 9) + 1e-9
         return math.isclose(float(a), float(b), rel_tol=1e-9, abs_tol=tolerance)  # type: ignore[arg-type]
     if isinstance(a, str) and isinstance(b, str):
-        return a.lower() == b.lower()  # CSV parsing lower-cases strings (Quirk Q20)
+        return a.lower() == b.lower()  # the key=value parser lower-cases strings (Q-APPS-20)
     return a == b
 
 

@@ -1,4 +1,4 @@
-"""iCommander save files (spec goby-moos-apps.md §6).
+"""iCommander save files.
 
     %%% iCommander message save file: Thu Mar  3 22:38:12 2011 %%%
     message::Command

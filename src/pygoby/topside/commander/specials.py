@@ -1,4 +1,4 @@
-"""iCommander's "specials" (seed 003 §2.4): placeholders typed into numeric fields and replaced
+"""iCommander's "specials": placeholders typed into numeric fields and replaced
 when the message is sent.
 
 * `_time`: the current time (UNIX seconds).

@@ -1,4 +1,4 @@
-"""iCommander's screens (seed 003 §2.4) as a textual app over the commander core: the main
+"""iCommander's screens as a textual app over the commander core: the main
 menu, message selection, the editing screen and its action menu, keyboard-driven as in Goby 1.
 
 Editing: Up/Down (or Tab) move between fields, typing is checked as it goes (a key that would

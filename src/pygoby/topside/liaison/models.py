@@ -16,6 +16,7 @@ from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.dccl import Codec, DcclError
+from pygoby.dccl.dccl1 import Dccl1Header, is_dccl1_frame, unstitch
 from pygoby.moos import protocol as p
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import ModemIdLookup, UTMGeodesy, dynamic_parse, parse_for_moos
@@ -215,11 +216,17 @@ class AcommsModel:
 
     def _on_qsize(self, value: MoosValue, when: float) -> None:
         size = self._parse(acomms_pb.QueueSize, value)
-        if size is None:
+        if size is not None and size.HasField("dccl_id"):
+            dccl_id, count = size.dccl_id, size.size
+        elif (old := self._parse(acomms_pb.V1QueueSize, value)) is not None:
+            if old.key.type != acomms_pb.QUEUE_DCCL:
+                return  # a Goby 1.1 CCL queue: not one of the DCCL queues shown
+            dccl_id, count = old.key.id, old.size  # Goby 1.1's form
+        else:
             return
         for queue in self.queues.values():
-            if queue.dccl_id == size.dccl_id:
-                queue.size = size.size
+            if queue.dccl_id == dccl_id:
+                queue.size = count
 
     def _on_slot(self, value: MoosValue, when: float) -> None:
         slot = self._parse(acomms_pb.ModemTransmission, value)
@@ -231,6 +238,9 @@ class AcommsModel:
         names = []
         for frame in transmission.frame:
             data, offset = bytes(frame), 0
+            if is_dccl1_frame(data):  # Goby 1.1's bytes: the types from the clear headers
+                names += self._dccl1_names(data)
+                continue
             while offset < len(data):
                 try:
                     msg, used = self.codec.decode_prefix(data[offset:])
@@ -240,6 +250,14 @@ class AcommsModel:
                 names.append(msg.DESCRIPTOR.full_name)
                 offset += max(used, 1)
         return names
+
+    def _dccl1_names(self, frame: bytes) -> list[str]:
+        try:
+            parts = unstitch(frame)
+        except DcclError:
+            return ["?"]
+        by_id = {q.dccl_id: name for name, q in self.queues.items()}
+        return [by_id.get(Dccl1Header.unpack(p.data).id, "?") for p in parts]
 
     def _on_modem(self, sent: bool, value: MoosValue, when: float) -> None:
         """ACOMMS_MODEM_TRANSMIT (sent) / ACOMMS_MODEM_RECEIVE: one row, with the modem's

@@ -1,4 +1,4 @@
-"""WHOI Micro-Modem NMEA driver (spec acomms.md §7)."""
+"""WHOI Micro-Modem NMEA driver."""
 
 from pygoby.acomms.drivers.micromodem.driver import MMDriver
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES

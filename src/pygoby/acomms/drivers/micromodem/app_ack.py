@@ -1,4 +1,4 @@
-"""Micro-Modem application acknowledgements (`use_application_acks`, spec acomms.md §7.8).
+"""Micro-Modem application acknowledgements (`use_application_acks`).
 
 Acks travel in software, as an MMApplicationAck DCCL message (id 10) at the start of frame 0:
 one part per peer we owe acks to, with a bitmask of its Goby frame numbers (0-31), plus our own

@@ -1,7 +1,7 @@
-"""The WHOI Micro-Modem NMEA driver (spec acomms.md §7) as a state machine.
+"""The WHOI Micro-Modem NMEA driver as a state machine.
 
 Everything happens in `do_work()` (read the modem, dispatch, run timers against the Clock) and in
-`handle_initiate_transmission()`; nothing blocks. Start-up (§7.3) is a sequence of phases
+`handle_initiate_transmission()`; nothing blocks. Start-up is a sequence of phases
 advanced by `do_work`; `startup_complete` says when it is done. With an injected MemoryLink the
 driver is fully sans-I/O: feed lines, advance a VirtualClock, read what it wrote. A link with
 `read_sentences` / `write_sentence` (pygoby.acomms.mmsim.link.ModemLink: an emulator in the same
@@ -18,6 +18,7 @@ import base64
 import contextlib
 import datetime as dt
 import logging
+import math
 from collections import deque
 from enum import Enum, auto
 
@@ -94,7 +95,9 @@ class MMDriver(ModemDriverBase):
         self._hold_until = 0.0  # no writes before this time (after $CAREV,INIT)
         self._multi_reply = False
         self._last_cfg_at = 0.0
-        self._last_rx_at = self.clock.now()
+        # goby3 asks the modem something every keep_alive_seconds, the first time at once: its
+        # first $CCCFQ,SRC follows the start-up $CCMSC in the queue.
+        self._last_keep_alive_at = float("-inf")
         self._clock_set = False
         self._link_was_open = False
         self._last_gps_request = float("-inf")
@@ -194,11 +197,9 @@ class MMDriver(ModemDriverBase):
             self._advance_startup(now)
         if self._written_at is not None:
             self._check_timeout(now)
-        if not self._out:
-            if now - self._last_rx_at > self._keep_alive_seconds and self.phase is Phase.READY:
-                self._keep_alive(now)
-        else:
-            self._try_write(now)
+        if now >= self._last_keep_alive_at + self._keep_alive_seconds:
+            self._keep_alive(now)
+        self._try_write(now)
 
     def handle_initiate_transmission(self, transmission) -> None:
         if self.link is None or not self.link.is_open:
@@ -283,13 +284,15 @@ class MMDriver(ModemDriverBase):
             self._fail_front("timeout")
 
     def _keep_alive(self, now: float) -> None:
-        """Nothing heard for keep_alive_seconds: ask the modem something (and send it)."""
+        """Every keep_alive_seconds (whatever else is queued or heard, as goby3): ask the modem
+        its time (Micro-Modem 2, at the start of a second for a precise answer) or its source
+        address (before the modem's revision is known, and for Micro-Modem 1)."""
         if self.is_mm2:
             self._push("$CCTMQ", 0)
+            self._last_keep_alive_at = float(math.floor(now))
         else:
             self._push("$CCCFQ", "SRC")
-        self._last_rx_at = now
-        self._try_write(now)
+            self._last_keep_alive_at = now
 
     def _check_multi_reply(self, now: float) -> None:
         if self._multi_reply and self._last_cfg_at and now - self._last_cfg_at > MULTI_REPLY_QUIET:
@@ -299,7 +302,7 @@ class MMDriver(ModemDriverBase):
                 self._pop_front()
 
     def _acknowledge(self, sentence: NMEASentence) -> None:
-        """Pop the outstanding sentence if `sentence` answers it (§7.2 table)."""
+        """Pop the outstanding sentence if `sentence` answers it."""
         if not self._out:
             return
         front = self._out[0]
@@ -341,7 +344,7 @@ class MMDriver(ModemDriverBase):
         # WHOI guidance: set between 50 and 100 ms after a whole second, to the next second.
         if not 0.05 <= now % 1.0 < 0.1:
             return
-        t = dt.datetime.fromtimestamp(int(now) + 1, dt.UTC)  # Quirk A6 (sane): carry properly
+        t = dt.datetime.fromtimestamp(int(now) + 1, dt.UTC)  # carry properly (Q-ACOMMS-6)
         if self.is_mm2:
             self._push("$CCTMS", f"{t:%Y-%m-%dT%H:%M:%SZ}", 0)
         else:
@@ -371,12 +374,10 @@ class MMDriver(ModemDriverBase):
         except NMEAError as exc:
             log.warning("ignoring invalid line from the modem: %s", exc)
             return
-        self._last_rx_at = self.clock.now()
         self._dispatch((sentence,))
 
     def _handle_sentences(self, sentences: list) -> None:
         """Sentences from a typed link (parsed already; `$CACST` as its values)."""
-        self._last_rx_at = self.clock.now()
         if self.signal_raw_incoming or self._raw_log is not None:
             for sentence in sentences:
                 self._log_raw("[rx] ", sentence.message())
@@ -452,7 +453,7 @@ class MMDriver(ModemDriverBase):
             msg.src = self.modem_id
         if msg.src != self.modem_id:
             # third-party initiation (polling): the polled node fills the frames
-            if msg.dest < 0:  # Quirk A14 (sane)
+            if msg.dest < 0:  # goby3 sends it unchanged (QUIRKS.md Q-ACOMMS-14)
                 log.warning("a poll must name a destination; not sending %s", msg)
                 return
             self._push("$CCCYC", 0, msg.src, msg.dest, msg.rate, 1, msg.max_num_frames)
@@ -660,7 +661,8 @@ class MMDriver(ModemDriverBase):
 
     # ------------------------------------------------------------------ ranging, mini-packets
     def _on_mpr(self, s: NMEASentence) -> None:
-        # Quirk A5 (faithful): src/dest copied as they appear in the sentence
+        # src/dest copied as they appear in the sentence, as goby3's code does (its docs say
+        # swapped back to the request's order: QUIRKS.md Q-ACOMMS-5)
         owtt = s.as_float(3, 0.0, MAX_TRAVEL_TIME)
         msg = self._ping_result(*_addresses(s))
         msg.Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply.one_way_travel_time.append(owtt)
@@ -753,7 +755,7 @@ class MMDriver(ModemDriverBase):
     }
 
     def _lbl_params(self, msg, name: str):
-        """Configured LBL parameters merged with the request's own (§7.4)."""
+        """Configured LBL parameters merged with the request's own."""
         params = type(getattr(self.mm_cfg, name))()
         params.CopyFrom(getattr(self.mm_cfg, name))
         params.MergeFrom(getattr(msg.Extensions[acomms_pb.MM_TRANSMISSION], name))

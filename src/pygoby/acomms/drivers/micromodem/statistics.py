@@ -1,4 +1,4 @@
-"""$CACST / $CAXST statistics sentences <-> ReceiveStatistics / TransmitStatistics (§7.12)."""
+"""$CACST / $CAXST statistics sentences <-> ReceiveStatistics / TransmitStatistics."""
 
 from __future__ import annotations
 
@@ -70,7 +70,8 @@ def parse_toa(text: str, today: dt.date) -> int:
 
 
 def cst_offset(sentence: NMEASentence) -> tuple[int, int]:
-    """(version, offset): version-0 layout has no version field; >= 6 has one (Quirk A7)."""
+    """(version, offset): version-0 layout has no version field; every version >= 6 has one
+    (goby3 reads versions 7 and 8 at the version-0 offset: QUIRKS.md Q-ACOMMS-7)."""
     first = sentence.as_int(1)
     return (first, 1) if first >= 6 else (0, 0)
 

@@ -1,0 +1,44 @@
+"""MOOS .alog files (`make bench`): pLogger's cost per logged message (one formatted line) and
+the reader's and `pygoby log convert`'s throughput (lines per second = rows x ops)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from pygoby.moos.alog import AlogFile, AlogFormatter, banner
+from pygoby.moos.alog.tools import convert
+
+ROWS = 20_000
+FORMATTER = AlogFormatter(1000.0, log_aux_src=True)
+
+
+@pytest.fixture(scope="module")
+def alog(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("alog") / "bench.alog"
+    lines = [banner(str(path), 1000.0)]
+    for i in range(ROWS):
+        if i % 2:
+            lines.append(FORMATTER.line(1000 + i * 0.01, "NAV_X", "uSimMarine", i * 0.5))
+        else:
+            report = "NAME=alpha,X=12.5,Y=-3.2,SPD=1.5,HDG=90,TYPE=kayak"
+            lines.append(FORMATTER.line(1000 + i * 0.01, "NODE_REPORT", "pNodeRep", report, "a"))
+    path.write_text("".join(lines))
+    return path
+
+
+@pytest.mark.benchmark(group="alog")
+def test_format_one_double_line(benchmark):
+    benchmark(FORMATTER.line, 1001.25, "NAV_X", "uSimMarine", -12.5)
+
+
+@pytest.mark.benchmark(group="alog")
+def test_read_20k_lines(benchmark, alog):
+    assert benchmark(lambda: sum(1 for _ in AlogFile(alog))) == ROWS
+
+
+@pytest.mark.benchmark(group="alog")
+@pytest.mark.parametrize("suffix", [".parquet", ".csv"])
+def test_convert_20k_lines(benchmark, alog, tmp_path, suffix):
+    assert benchmark(convert, [alog], tmp_path / f"out{suffix}") == ROWS

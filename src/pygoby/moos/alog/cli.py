@@ -1,0 +1,173 @@
+"""`pygoby log`: look at, cut, convert and replay MOOS .alog files (pLogger's).
+
+  pygoby log grep FILE VAR... [--source S]       entries of these variables (VAR* = prefix)
+  pygoby log summary FILE                        per variable: lines, first/last time, rate, sources
+  pygoby log clip FILE T0 T1 -o OUT.alog         the entries between two log times
+  pygoby log convert FILE... -o OUT.parquet      one row per message (.parquet, .csv or .jsonl)
+  pygoby log replay FILE --port P [--warp W]     post the messages into a MOOSDB, original spacing
+
+Damaged lines are skipped; their count is printed on stderr.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import functools
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from pygoby.moos.alog.files import AlogFile
+from pygoby.moos.alog.tools import LogToolError
+
+Command = Callable[[argparse.Namespace], int]
+
+
+def reporting_errors(command: Command) -> Command:
+    """Missing inputs, unwritable outputs, no MOOSDB to replay into (TimeoutError is an
+    OSError) and refused requests: one line on stderr, status 1."""
+
+    @functools.wraps(command)
+    def run(args: argparse.Namespace) -> int:
+        inputs = getattr(args, "files", None) or [args.file]
+        missing = [name for name in inputs if not Path(name).is_file()]
+        if missing:
+            print(f"pygoby log: no such file: {', '.join(missing)}", file=sys.stderr)
+            return 1
+        try:
+            return command(args)
+        except (LogToolError, OSError) as err:
+            print(f"pygoby log: {err}", file=sys.stderr)
+            return 1
+
+    return run
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "log",
+        help="MOOS .alog files: grep, summary, clip, convert, replay",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    actions = parser.add_subparsers(dest="log_command", required=True, metavar="ACTION")
+
+    grep = actions.add_parser("grep", help="print the entries of some variables (aloggrep)")
+    grep.add_argument("file")
+    grep.add_argument("variables", nargs="+", metavar="VAR", help="name, or prefix ending in *")
+    grep.add_argument("--source", action="append", default=[], help="only from this source")
+    grep.set_defaults(func=grep_command)
+
+    summary = actions.add_parser("summary", help="per-variable counts and rates (alogscan)")
+    summary.add_argument("file")
+    summary.set_defaults(func=summary_command)
+
+    clip = actions.add_parser("clip", help="keep the entries between two log times (alogclip)")
+    clip.add_argument("file")
+    clip.add_argument("t0", type=float, help="from this time (s since LOGSTART)")
+    clip.add_argument("t1", type=float, help="to this time (s since LOGSTART)")
+    clip.add_argument("-o", "--output", required=True, help="the .alog to write")
+    clip.set_defaults(func=clip_command)
+
+    convert = actions.add_parser("convert", help="to Parquet, CSV or JSON lines")
+    convert.add_argument("files", nargs="+", metavar="FILE")
+    convert.add_argument("-o", "--output", required=True, help="OUT.parquet, OUT.csv or OUT.jsonl")
+    convert.set_defaults(func=convert_command)
+
+    replay = actions.add_parser("replay", help="post a log's messages into a MOOSDB (uPlayBack)")
+    replay.add_argument("file")
+    replay.add_argument("--host", default="127.0.0.1")
+    replay.add_argument("--port", type=int, required=True)
+    replay.add_argument("--warp", type=float, default=1.0, help="play this many times faster")
+    replay.add_argument("--from", dest="start", type=float, default=0.0, help="start at log time")
+    replay.add_argument("--only", nargs="+", default=[], metavar="VAR", help="only these (VAR*)")
+    replay.set_defaults(func=replay_command)
+
+
+def _report_bad_lines(log: AlogFile) -> None:
+    if log.reader.bad_lines:
+        print(
+            f"{log.path}: {log.reader.bad_lines} damaged lines skipped "
+            f"(the first at line {log.reader.first_bad_line})",
+            file=sys.stderr,
+        )
+    if log.unresolved_binary:
+        print(
+            f"{log.path}: {log.unresolved_binary} binary values not found in the .blog",
+            file=sys.stderr,
+        )
+
+
+@reporting_errors
+def grep_command(args: argparse.Namespace) -> int:
+    from pygoby.moos.alog.tools import grep, value_text
+
+    log = AlogFile(args.file)
+    out = sys.stdout
+    for entry in grep(log, args.variables, args.source):
+        out.write(
+            f"{entry.time:<15.3f} {entry.name:<20} {entry.full_source:<15} {value_text(entry)}\n"
+        )
+    _report_bad_lines(log)
+    return 0
+
+
+@reporting_errors
+def summary_command(args: argparse.Namespace) -> int:
+    from pygoby.moos.alog.tools import summarize, summary_lines
+
+    log = AlogFile(args.file)
+    table = summarize(log)
+    print("\n".join(summary_lines(log, table)))
+    _report_bad_lines(log)
+    return 0
+
+
+@reporting_errors
+def clip_command(args: argparse.Namespace) -> int:
+    from pygoby.moos.alog.tools import clip
+
+    log = AlogFile(args.file)
+    with open(args.output, "w", encoding="utf-8", errors="surrogateescape") as out:
+        count = clip(log, args.t0, args.t1, out)
+    print(f"{args.output}: {count} entries")
+    _report_bad_lines(log)
+    return 0
+
+
+@reporting_errors
+def convert_command(args: argparse.Namespace) -> int:
+    from pygoby.moos.alog.tools import convert
+
+    def progress(rows: int) -> None:
+        if sys.stderr.isatty():
+            sys.stderr.write(f"\r{rows} rows")
+
+    count = convert(args.files, args.output, progress)
+    if sys.stderr.isatty():
+        sys.stderr.write("\n")
+    print(f"{args.output}: {count} rows")
+    return 0
+
+
+@reporting_errors
+def replay_command(args: argparse.Namespace) -> int:
+    from pygoby.moos.alog.tools import print_progress, replay
+
+    log = AlogFile(args.file)
+    progress = print_progress() if sys.stderr.isatty() else None
+    count = asyncio.run(
+        replay(
+            log,
+            args.host,
+            args.port,
+            warp=args.warp,
+            start=args.start,
+            only=args.only,
+            progress=progress,
+        )
+    )
+    print(f"{count} messages posted")
+    _report_bad_lines(log)
+    return 0

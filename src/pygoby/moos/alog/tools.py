@@ -1,0 +1,339 @@
+"""What `pygoby log` does with .alog files: grep, summary, clip, convert and replay.
+
+Every tool streams its input (memory does not grow with the log's size).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import csv
+import json
+import logging
+import math
+import os
+import sys
+import time
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any
+
+from pygoby.moos.alog.files import AlogFile
+from pygoby.moos.alog.format import AlogEntry, AlogFormatter, banner
+from pygoby.moos.errors import MoosError, MoosRefusedError
+
+logger = logging.getLogger(__name__)
+
+CONVERT_FORMATS = (".parquet", ".csv", ".jsonl")
+CONVERT_COLUMNS = ("time", "utc_time", "name", "source", "type", "value", "value_double")
+PARQUET_BATCH = 65_536  # rows per Parquet row group written
+CONNECT_TIMEOUT = 5.0  # s for each source's client to reach the DB
+DB_SOURCE_PREFIX = "MOOSDB"  # MOOSDB_<community>: the DB's own posts
+
+
+class LogToolError(MoosError):
+    """A `pygoby log` request that cannot be done (an unknown output format, ...)."""
+
+
+def value_text(entry: AlogEntry) -> str:
+    """The value as a string column: doubles as Python prints them, binary as hex."""
+    value = entry.value
+    if isinstance(value, bytes):
+        return value.hex()
+    if isinstance(value, float):
+        return repr(value)
+    return value
+
+
+# -- grep ----------------------------------------------------------------------------------------
+
+
+def matches(name: str, patterns: Sequence[str]) -> bool:
+    """aloggrep's rule: a pattern matches the whole name, or its start when it ends with `*`."""
+    for pattern in patterns:
+        if pattern.endswith("*"):
+            if name.startswith(pattern[:-1]):
+                return True
+        elif name == pattern:
+            return True
+    return False
+
+
+def grep(
+    log: AlogFile, variables: Sequence[str], sources: Sequence[str] = ()
+) -> Iterator[AlogEntry]:
+    """Entries whose variable (or, with `sources`, also whose source) matches."""
+    for entry in log:
+        if variables and not matches(entry.name, variables):
+            continue
+        if sources and not matches(entry.source, sources):
+            continue
+        yield entry
+
+
+# -- summary -------------------------------------------------------------------------------------
+
+
+@dataclass
+class VariableSummary:
+    name: str
+    count: int = 0
+    first: float = math.inf
+    last: float = -math.inf
+    chars: int = 0
+    sources: set[str] = field(default_factory=set)
+
+    @property
+    def rate(self) -> float:
+        span = self.last - self.first
+        return (self.count - 1) / span if self.count > 1 and span > 0 else 0.0
+
+
+def summarize(log: AlogFile) -> dict[str, VariableSummary]:
+    """Per variable: count, first and last time, characters of values, sources (alogscan)."""
+    table: dict[str, VariableSummary] = {}
+    for entry in log:
+        row = table.get(entry.name)
+        if row is None:
+            row = table[entry.name] = VariableSummary(entry.name)
+        row.count += 1
+        row.first = min(row.first, entry.time)
+        row.last = max(row.last, entry.time)
+        row.chars += len(value_text(entry))
+        if len(row.sources) < 64:
+            row.sources.add(entry.source)
+    return table
+
+
+def summary_lines(log: AlogFile, table: dict[str, VariableSummary]) -> list[str]:
+    width = max([len("Variable Name"), *(len(name) for name in table)])
+    lines = [
+        f"{'Variable Name':<{width}}  {'Lines':>8}  {'Chars':>10}  {'Start':>10}  {'Stop':>10}"
+        f"  {'Rate/s':>8}  Sources",
+        f"{'-' * width}  {'-' * 8}  {'-' * 10}  {'-' * 10}  {'-' * 10}  {'-' * 8}  -------",
+    ]
+    for name in sorted(table):
+        row = table[name]
+        lines.append(
+            f"{name:<{width}}  {row.count:>8}  {row.chars:>10}  {row.first:>10.2f}  "
+            f"{row.last:>10.2f}  {row.rate:>8.2f}  {','.join(sorted(row.sources))}"
+        )
+    total = sum(row.count for row in table.values())
+    lines.append(
+        f"{len(table)} variables, {total} lines, log start {log.log_start:.2f}"
+        f", {log.reader.bad_lines} bad lines skipped"
+    )
+    return lines
+
+
+# -- clip ----------------------------------------------------------------------------------------
+
+
+def clip(log: AlogFile, t0: float, t1: float, out: IO[str]) -> int:
+    """Write the entries with t0 <= time <= t1 as a new .alog (same LOGSTART, same times);
+    returns how many. Binary values are written inline as hex (the clip has no .blog)."""
+    # times are already relative to LOGSTART; sources keep their :aux and @community
+    formatter = AlogFormatter(0.0, log_aux_src=True, mark_external=True, mark_binary=True)
+    name = getattr(out, "name", "clip.alog")
+    count = 0
+    wrote_banner = False
+    for entry in log:
+        if not wrote_banner:  # LOGSTART is known once the header has been read
+            out.write(banner(name, log.log_start, mark_binary=True))
+            wrote_banner = True
+        if not t0 <= entry.time <= t1:
+            continue
+        out.write(
+            formatter.line(
+                entry.time,
+                entry.name,
+                entry.source,
+                entry.value,
+                entry.source_aux,
+                entry.community,
+            )
+        )
+        count += 1
+    if not wrote_banner:
+        out.write(banner(name, log.log_start, mark_binary=True))
+    return count
+
+
+# -- convert -------------------------------------------------------------------------------------
+
+
+def rows(paths: Iterable[str | os.PathLike[str]]) -> Iterator[tuple[Any, ...]]:
+    """One tuple per entry of each file, in CONVERT_COLUMNS order."""
+    for path in paths:
+        log = AlogFile(path)
+        for entry in log:
+            double = entry.value if isinstance(entry.value, float) else None
+            yield (
+                entry.time,
+                log.log_start + entry.time,
+                entry.name,
+                entry.full_source,
+                entry.type,
+                value_text(entry),
+                double,
+            )
+
+
+def convert(
+    paths: Sequence[str | os.PathLike[str]],
+    output: str | os.PathLike[str],
+    progress: Callable[[int], None] | None = None,
+) -> int:
+    """Write every entry of `paths` to `output` (.parquet, .csv or .jsonl); returns the rows."""
+    suffix = Path(output).suffix.lower()
+    writer = {".parquet": _write_parquet, ".csv": _write_csv, ".jsonl": _write_jsonl}.get(suffix)
+    if writer is None:
+        raise LogToolError(
+            f"{output}: unknown output format {suffix!r} (use {', '.join(CONVERT_FORMATS)})"
+        )
+    return writer(rows(paths), Path(output), progress or (lambda n: None))
+
+
+def _write_csv(source: Iterator[tuple], path: Path, progress: Callable[[int], None]) -> int:
+    count = 0
+    with open(path, "w", newline="") as out:
+        writer = csv.writer(out)
+        writer.writerow(CONVERT_COLUMNS)
+        for row in source:
+            writer.writerow(row)
+            count += 1
+            if count % PARQUET_BATCH == 0:
+                progress(count)
+    return count
+
+
+def _write_jsonl(source: Iterator[tuple], path: Path, progress: Callable[[int], None]) -> int:
+    count = 0
+    with open(path, "w") as out:
+        for row in source:
+            record = dict(zip(CONVERT_COLUMNS, row, strict=True))
+            if record["value_double"] is not None and not math.isfinite(record["value_double"]):
+                record["value_double"] = None  # JSON has no inf or nan
+            out.write(json.dumps(record, ensure_ascii=False) + "\n")
+            count += 1
+            if count % PARQUET_BATCH == 0:
+                progress(count)
+    return count
+
+
+def _write_parquet(source: Iterator[tuple], path: Path, progress: Callable[[int], None]) -> int:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    schema = pa.schema(
+        [
+            ("time", pa.float64()),
+            ("utc_time", pa.float64()),
+            ("name", pa.string()),
+            ("source", pa.string()),
+            ("type", pa.string()),
+            ("value", pa.string()),
+            ("value_double", pa.float64()),
+        ]
+    )
+    count = 0
+    with pq.ParquetWriter(path, schema) as writer:
+        while True:
+            batch = [row for _, row in zip(range(PARQUET_BATCH), source, strict=False)]
+            if not batch:
+                break
+            columns: list[Sequence[Any]] = list(zip(*batch, strict=True))
+            # strings keep undecodable bytes as surrogates; Parquet wants valid UTF-8
+            for index in (2, 3, 5):
+                columns[index] = [_utf8(text) for text in columns[index]]
+            writer.write_table(
+                pa.Table.from_arrays(
+                    [pa.array(col, type=schema.field(i).type) for i, col in enumerate(columns)],
+                    schema=schema,
+                )
+            )
+            count += len(batch)
+            progress(count)
+    return count
+
+
+def _utf8(text: str) -> str:
+    try:
+        text.encode()
+        return text
+    except UnicodeEncodeError:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+
+
+# -- replay --------------------------------------------------------------------------------------
+
+
+async def replay(
+    log: AlogFile,
+    host: str,
+    port: int,
+    *,
+    warp: float = 1.0,
+    start: float = 0.0,
+    only: Sequence[str] = (),
+    progress: Callable[[float], None] | None = None,
+) -> int:
+    """Post the entries (from log time `start`, only `only` variables when given) into the
+    MOOSDB at host:port with their original spacing divided by `warp`, each under its
+    original source name (one client per source, as uPlayBack does); returns how many. A source
+    the DB refuses (its name is taken) is skipped with a warning; no DB at all: TimeoutError."""
+    from pygoby.moos.client import MOOSClient
+
+    clients: dict[str, MOOSClient] = {}
+    refused: set[str] = set()
+    loop = asyncio.get_running_loop()
+    origin: tuple[float, float] | None = None  # (loop time, log time) of the first post
+    count = 0
+    try:
+        for entry in log:
+            if entry.time < start or (only and not matches(entry.name, only)):
+                continue
+            if entry.source.startswith(DB_SOURCE_PREFIX):
+                continue  # the DB's own variables (DB_TIME, ...): the target DB posts its own
+            if origin is None:
+                origin = (loop.time(), entry.time)
+            delay = origin[0] + (entry.time - origin[1]) / warp - loop.time()
+            if delay > 0:
+                await asyncio.sleep(delay)
+            if entry.source in refused:
+                continue
+            client = clients.get(entry.source)
+            if client is None:
+                client = clients[entry.source] = MOOSClient(entry.source, host, port)
+                try:
+                    await client.connect(CONNECT_TIMEOUT)
+                except MoosRefusedError as err:
+                    # a process of that name is connected already (a live pLogger, ...)
+                    logger.warning("not replaying %s's messages: %s", entry.source, err)
+                    refused.add(entry.source)
+                    await clients.pop(entry.source).close()
+                    continue
+            client.publish(entry.name, entry.value, src_aux=entry.source_aux)
+            count += 1
+            if progress is not None and count % 100 == 0:
+                progress(entry.time)
+    finally:
+        for client in clients.values():
+            try:
+                await client.flush(timeout=2.0)
+            finally:
+                await client.close()
+    return count
+
+
+def print_progress(stream: IO[str] = sys.stderr) -> Callable[[float], None]:
+    last = [0.0]
+
+    def show(log_time: float) -> None:
+        now = time.monotonic()
+        if now - last[0] >= 0.5:
+            last[0] = now
+            stream.write(f"\rlog time {log_time:10.2f} s")
+            stream.flush()
+
+    return show
