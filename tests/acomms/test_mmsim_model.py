@@ -491,6 +491,7 @@ async def test_pygoby_mmsim_command_answers_over_tcp():
         await proc.wait()
 
 
+@pytest.mark.e2e  # (two processes)
 async def test_two_mmsim_processes_hear_each_other_over_their_range(tmp_path):
     import random
 

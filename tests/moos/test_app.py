@@ -295,6 +295,7 @@ async def test_a_second_instance_with_a_taken_name_exits_with_a_clear_error(tmp_
             assert await asyncio.wait_for(first.wait(), 10) == 0
 
 
+@pytest.mark.e2e  # (an app process)
 async def test_an_app_refused_on_reconnect_keeps_trying(tmp_path):
     # The app's link to the DB breaks without the DB noticing (it keeps the stale session for
     # its client timeout and refuses the name meanwhile): the app must come back by itself.
@@ -325,6 +326,7 @@ async def test_an_app_refused_on_reconnect_keeps_trying(tmp_path):
         assert proc.returncode == 0
 
 
+@pytest.mark.e2e  # (an app process, its stop hanging)
 @pytest.mark.parametrize("signals", [["SIGTERM"], ["SIGINT"], ["SIGTERM", "SIGINT"]])
 async def test_a_signal_ends_an_app_whose_stop_hangs(tmp_path, signals):
     async with MOOSDB(port=0) as db:

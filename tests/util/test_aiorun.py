@@ -14,11 +14,11 @@ import pytest
 
 from pygoby.util.aiorun import STOP_GRACE, cancel_and_wait
 
+pytestmark = pytest.mark.e2e
+
 PROGRAM = """
 import asyncio, sys, time
 from pygoby.util.aiorun import run_until_signal
-
-pytestmark = pytest.mark.e2e
 
 async def serve():
     try:
