@@ -44,6 +44,7 @@ class Figures:
     rss_before_mb: float | None = None
     rss_after_mb: float | None = None
     lost: int | None = None
+    rss_peak_mb: float | None = None  # sampled while the hostiles ran
     given_ms: tuple[float | None, float | None] | None = None  # (p50, p99) measured elsewhere
     latency_limit: float = FREEZE_SECONDS  # s; a p99 above it breaks the scenario's promise
     notes: list[str] = field(default_factory=list)
@@ -305,11 +306,15 @@ def hostile(
             await probe(port, 1.0, Figures())  # warm-up, not counted
             figures.rss_before_mb = server.rss_mb()
             stop = asyncio.Event()
+            sampler = asyncio.create_task(_sample_rss_peak(server, figures, stop))
             tasks = [asyncio.create_task(h.run(port, stop)) for h in hostiles]
             await asyncio.sleep(0.5)  # the hostiles are in
             await probe(port, seconds, figures)
             figures.rss_after_mb = server.rss_mb()
             stop.set()
+            await sampler
+            if figures.rss_peak_mb is not None:
+                figures.notes.append(f"RSS peak {figures.rss_peak_mb:.0f} MB")
             # a hostile blocked writing to a server that stopped reading is cancelled
             _, pending = await asyncio.wait(tasks, timeout=1.0)
             for task in pending:
@@ -322,6 +327,16 @@ def hostile(
         return figures
 
     return scenario
+
+
+async def _sample_rss_peak(server: ServerProcess, figures: Figures, stop: asyncio.Event) -> None:
+    while not stop.is_set():
+        rss = server.rss_mb()
+        if rss is not None:
+            figures.rss_peak_mb = max(rss, figures.rss_peak_mb or 0.0)
+        with contextlib.suppress(TimeoutError):
+            async with asyncio.timeout(0.1):
+                await stop.wait()
 
 
 async def stop_or_fail(server: ServerProcess, figures: Figures) -> None:

@@ -1,4 +1,4 @@
-"""The soak's scenarios (issue 16): hostile clients beside a measured one, kill -9 of servers
+"""The soak's scenarios (issues 16, 25): hostile clients beside a measured one, kill -9 of servers
 and apps, and signals and link cuts that used to leave apps behind or disconnected.
 
 Each entry of SCENARIOS is `name: async (seconds, workdir) -> Figures`; a hostile-client one is
@@ -11,8 +11,11 @@ import asyncio
 import contextlib
 import random
 import signal
+import socket
 import struct
+import sys
 import time
+import urllib.parse
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,6 +54,12 @@ MOOSDB_SPEC = ServerSpec(
     "moosdb",
     venv_command("pygoby", "moosdb", "--port", "{port}"),
     r"listening on 127\.0\.0\.1:(\d+)",
+)
+# the budget of issue 25's synchronous-subscriber attack (it reached 666 MB RSS before)
+MOOSDB_BUDGET_32 = ServerSpec(
+    "moosdb",
+    venv_command("pygoby", "moosdb", "--port", "{port}", "--memory-budget", "32"),
+    MOOSDB_SPEC.ready,
 )
 # a 64 MB budget for partial packets and unsent output, a packet deadline the run reaches
 MOOSDB_BUDGET = ServerSpec(
@@ -222,8 +231,8 @@ async def moos_round_trip(port: int, seconds: float, figures: Figures) -> None:
         await paced(seconds, 0.05, step)
 
 
-def moos_handshake(name: str) -> bytes:
-    return p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(name, 0.0)])
+def moos_handshake(name: str, asynchronous: bool = True) -> bytes:
+    return p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(name, 0.0, asynchronous)])
 
 
 @dataclass
@@ -254,6 +263,95 @@ async def wildcard_hog(client: MOOSClient, stop: asyncio.Event) -> None:
         client.publish(f"{k:a>64}".replace("0", "a")[:64], 1.0)
         k += 1
         await asyncio.sleep(0.1)
+
+
+async def long_names_and_patterns(client: MOOSClient, stop: asyncio.Event) -> None:
+    """Issue 25 item 1: a 30 kB name and `*` + 2000 x `?` + `X*` (refused: beyond the caps),
+    then the longest name and pattern allowed (256), a new name every 0.05 s, the pattern
+    registered again each time (tested against every variable)."""
+    k = 0
+    while not stop.is_set():
+        client.publish(f"{k}" + "A" * 30_000, 1.0)
+        client.subscribe_wildcard("*" + "?" * 2000 + "X*")
+        client.publish(f"{k:A>256}", 1.0)
+        client.subscribe_wildcard("*" + "?" * 253 + "X*")
+        await client.flush()
+        k += 1
+        await asyncio.sleep(0.05)
+
+
+# Issue 25 item 2: 200,000 distinct variables as fast as they go (3 s before), from a process
+# of its own (making them would otherwise hold up the probe in this one); the DB keeps 20,000
+# (--max-variables) and refuses the rest. Argument: the DB's port.
+MANY_VARIABLES = """
+import asyncio, sys
+from pygoby.moos.client import MOOSClient
+
+async def main():
+    async with MOOSClient("soak_many", port=int(sys.argv[1])) as client:
+        for batch in range(40):
+            for k in range(5000):
+                client.publish(f"SOAK_MANY_{batch}_{k}", 1.0)
+            await client.flush()
+        await asyncio.sleep(3600)
+
+asyncio.run(main())
+"""
+
+
+@dataclass
+class HostileProcess(Hostile):
+    """`script` run by this Python in a process of its own (argument: the port) until the end."""
+
+    script: str
+
+    async def run(self, port: int, stop: asyncio.Event) -> None:
+        proc = await asyncio.create_subprocess_exec(
+            sys.executable, "-c", self.script, str(port), stderr=asyncio.subprocess.DEVNULL
+        )
+        try:
+            await stop.wait()
+        finally:
+            with contextlib.suppress(ProcessLookupError):
+                proc.kill()
+            await proc.wait()
+
+
+async def flood(client: MOOSClient, stop: asyncio.Event) -> None:
+    """100 kB notifications of ten variables without a pause, until the run ends."""
+    k = 0
+    while not stop.is_set():
+        client.publish(f"SOAK_FLOOD_{k % 10}", b"\0" * 100_000)
+        await client.flush()
+        k += 1
+
+
+@dataclass
+class SyncSleeper(Hostile):
+    """Issue 25 item 3: a synchronous client subscribed to `*` that never writes again (its
+    mail is held for its next packet) nor reads; reconnects when dropped."""
+
+    async def run(self, port: int, stop: asyncio.Event) -> None:
+        name = f"soak_sync_{random.randint(0, 1 << 30)}"
+        register = p.MOOSMessage(
+            p.WILDCARD_REGISTER, p.STRING, "", sval=p.wildcard_sval("*", "*", 0.0), src=name
+        )
+        while not stop.is_set():
+            with contextlib.suppress(OSError):
+                _, writer = await asyncio.open_connection("127.0.0.1", port)
+                sock = writer.get_extra_info("socket")
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+                try:
+                    writer.write(moos_handshake(name, False) + p.encode_packet([register]))
+                    while not stop.is_set() and not writer.is_closing():
+                        with contextlib.suppress(TimeoutError):
+                            async with asyncio.timeout(0.2):
+                                await stop.wait()
+                        if writer.transport.is_closing():
+                            break
+                finally:
+                    writer.transport.abort()
+            await asyncio.sleep(0.2)
 
 
 def packet_hogs(count: int, sent: int) -> list[Trickle]:
@@ -617,6 +715,109 @@ async def netsim_manager_hostile(seconds: float, workdir: Path) -> Figures:
     return figures
 
 
+# -- liaison (issue 25.6-7) --------------------------------------------------------------------
+
+LIAISON_VARIABLES = 2000
+LIAISON_STREAMS = 100  # asked for; liaison admits max_streams (16) of them
+# regexes that froze a regex engine for seconds to minutes per name; liaison's filter is words and
+# MOOS globs now, so they are plain text
+LIAISON_FILTERS = [r"((\w+)+)+!", r"(a|aa)+$", "*" + "?*" * 90 + "!", "x" * 200]
+
+
+async def _http_get(port: int, target: str) -> bytes:
+    reader, writer = await asyncio.open_connection("127.0.0.1", port)
+    try:
+        writer.write(
+            f"GET {target} HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n".encode()
+        )
+        await writer.drain()
+        return await reader.read()
+    finally:
+        writer.close()
+
+
+async def _event_stream(port: int, target: str, stop: asyncio.Event) -> None:
+    """A live page that reads everything until `stop` (or until refused)."""
+    with contextlib.suppress(OSError):
+        reader, writer = await asyncio.open_connection("127.0.0.1", port)
+        try:
+            writer.write(f"GET {target} HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n".encode())
+            await writer.drain()
+            while not stop.is_set():
+                with contextlib.suppress(TimeoutError):
+                    async with asyncio.timeout(0.5):
+                        if not await reader.read(65536):
+                            return
+        finally:
+            writer.close()
+
+
+async def liaison_streams_and_filters(seconds: float, workdir: Path) -> Figures:
+    """`pygoby liaison` on a MOOSDB with 2000 variables, 100 live Scope streams asked for and
+    filters that freeze a regex engine, beside a canary GET every 0.1 s."""
+    from tests.topside.test_commander import MISSION
+
+    figures = Figures()
+    async with MOOSDB(port=0, community="topside") as db:
+        mission = workdir / "topside.moos"
+        mission.write_text(
+            f"ServerPort = {db.port}\nCommunity = topside\n{MISSION}\n"
+            "ProcessConfig = liaison\n{\n  common { log: false }\n  liaison { http_port: 0 }\n}\n"
+        )
+        spec = ServerSpec(
+            "liaison",
+            venv_command("pygoby", "liaison", str(mission)),
+            r"serving http://127\.0\.0\.1:(\d+)/",
+        )
+        server = ServerProcess(spec, workdir)
+        port = await server.start()
+        async with MOOSClient("soak_poster", port=db.port) as poster:
+            for i in range(LIAISON_VARIABLES):
+                poster.publish(f"SOAK_VARIABLE_{i:05d}", float(i))
+            await poster.flush()
+            await asyncio.sleep(2)  # liaison has them
+            figures.rss_before_mb = server.rss_mb()
+            stop = asyncio.Event()
+            pages = [
+                asyncio.create_task(
+                    _event_stream(
+                        port,
+                        "/api/events?page=scope&filter="
+                        + urllib.parse.quote(
+                            LIAISON_FILTERS[i % len(LIAISON_FILTERS)] if i % 2 else ""
+                        ),
+                        stop,
+                    )
+                )
+                for i in range(LIAISON_STREAMS)
+            ]
+
+            async def canary() -> None:
+                started = time.monotonic()
+                reply = await _http_get(port, "/api/commander/types")
+                if reply.startswith(b"HTTP/1.1 200"):
+                    figures.answer(time.monotonic() - started)
+
+            deadline = time.monotonic() + seconds
+            while time.monotonic() < deadline:
+                figures.requests += 1
+                with contextlib.suppress(TimeoutError, OSError):
+                    async with asyncio.timeout(ANSWER_TIMEOUT):
+                        await canary()
+                # the variables keep changing: the streams get deltas
+                poster.publish(f"SOAK_VARIABLE_{figures.requests % LIAISON_VARIABLES:05d}", 0.5)
+                await asyncio.sleep(0.1)
+            figures.rss_after_mb = server.rss_mb()
+            stop.set()
+            await asyncio.gather(*pages, return_exceptions=True)
+        await stop_or_fail(server, figures)
+    figures.notes.append(
+        f"{LIAISON_VARIABLES} variables, {LIAISON_STREAMS} streams asked for (16 admitted)"
+    )
+    figures.judge()
+    return figures
+
+
 def _rss(pid: int) -> float | None:
     from kit import rss_mb
 
@@ -661,6 +862,15 @@ SCENARIOS: dict[str, Scenario] = {
             MoosHostile(post_bulk),
         ],
     ),
+    "MOOSDB: 30 kB names, 2000-? patterns and the longest allowed, again and again (25.1)": (
+        hostile(MOOSDB_SPEC, moos_round_trip, [MoosHostile(long_names_and_patterns)])
+    ),
+    "MOOSDB: 200,000 distinct variables in a burst (25.2)": hostile(
+        MOOSDB_SPEC, moos_round_trip, [HostileProcess(MANY_VARIABLES)]
+    ),
+    "MOOSDB: a synchronous * subscriber never reading beside a flood, 32 MB budget (25.3)": (
+        hostile(MOOSDB_BUDGET_32, moos_round_trip, [SyncSleeper(), MoosHostile(flood)])
+    ),
     "store_server: garbage, trickling and idle clients beside two modems": hostile(
         STORE_SERVER,
         store_round_trips,
@@ -692,4 +902,7 @@ SCENARIOS: dict[str, Scenario] = {
     "MOOSDB: kill -9 every ~3 s under uSimVehicle, pAcommsHandler, pTranslator": moosdb_kill9,
     "apps: SIGTERM as the MOOSDB goes away": sigterm_on_drop,
     "apps: link cut, the DB keeps a stale session": stale_session,
+    "liaison: 100 live streams over 2000 variables, regex-bomb filters (25.6-7)": (
+        liaison_streams_and_filters
+    ),
 }

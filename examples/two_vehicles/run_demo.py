@@ -32,6 +32,7 @@ from pathlib import Path
 
 from google.protobuf import text_format
 
+from pygoby.acomms.messages import MM_CONFIG
 from pygoby.dccl import Codec
 from pygoby.dccl.analyze import describe
 
@@ -361,6 +362,13 @@ async def run_mission(
                 cfg.common.verbosity = _QUIET  # the monitors report instead
                 if app_class is pAcommsHandler:
                     cfg.driver_cfg.tcp_port = sim.port
+                    # The modem waits DTO seconds of its (warped) clock for the host's data
+                    # after $CADRQ: the emulator's 2 s are 80 ms of real time at warp 25, less
+                    # than a busy machine may take to answer the first slots (the modem then
+                    # says $CAERR DATA_TIMEOUT and the driver gives up on its $CCTXD). The
+                    # longest a Micro-Modem allows, 30 s, is 1.2 s of real time.
+                    mm_cfg = cfg.driver_cfg.Extensions[MM_CONFIG]
+                    mm_cfg.nvram_cfg.append("DTO,30")
                 app = app_class(cfg, name=app_class.default_name, mission=mission, port=db.port)
                 await stack.enter_async_context(app)
         start = clock.now()

@@ -277,6 +277,71 @@ def test_only_the_holder_of_a_modem_ids_secret_reads_its_mail():
     assert error == "" and len(response.inbox) == 1
 
 
+@settings(max_examples=examples(50), deadline=None)
+@given(st.lists(st.integers(0, 4), max_size=6))
+def test_a_signed_modem_cannot_post_mail_as_another(claimed_sources):
+    # issue 25, item 8: modem 1, signing with its own secret, claims other sources
+    from pygoby.util.clock import VirtualClock
+
+    clock = VirtualClock(1000.0)
+    server = StoreServer(TransmissionStore(), clock, secrets={1: b"one", 3: b"three"})
+    outbox = [
+        acomms_pb.ModemTransmission(src=src, dest=3, type=acomms_pb.DATA, frame=[bytes([k])])
+        for k, src in enumerate(claimed_sources)
+    ]
+    _, error = answer(server, signed(1, b"one", 1000.0, outbox=outbox))
+    assert error == ""
+    clock.set(1001.0)
+    response, error = answer(server, signed(3, b"three", 1001.0))
+    assert error == ""
+    assert [(t.src, bytes(t.frame[0])) for t in response.inbox] == [
+        (1, bytes([k])) for k, src in enumerate(claimed_sources) if src == 1
+    ]
+
+
+def test_a_secrets_file_others_may_read_is_refused(tmp_path):
+    # issue 25, item 9: as ssh refuses a private key others can read
+    import subprocess
+    import sys
+
+    from pygoby.acomms.store_server.auth import read_secrets
+    from pygoby.errors import ConfigError
+
+    path = tmp_path / "secrets"
+    path.write_text("1 alpha\n")
+    for mode in (0o644, 0o640, 0o604, 0o620):
+        path.chmod(mode)
+        with pytest.raises(ConfigError, match=f"permissions {mode:04o} let others"):
+            read_secrets(path)
+        assert read_secrets(path, allow_readable=True) == {1: b"alpha"}
+    path.chmod(0o600)
+    assert read_secrets(path) == {1: b"alpha"}
+    path.chmod(0o644)
+    command = [
+        sys.executable,
+        "-m",
+        "pygoby.cli",
+        "store_server",
+        "--port",
+        "0",
+        "--db",
+        str(tmp_path / "s.db"),
+        "--secrets",
+        str(path),
+    ]
+    run = subprocess.run(command, capture_output=True, text=True, timeout=30)
+    assert run.returncode == 1
+    assert f"{path}: permissions 0644 let others than its owner use it (chmod 600" in run.stderr
+    server = subprocess.Popen(
+        [*command, "--allow-readable-secrets"], stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert "store_server listening on" in server.stdout.readline()
+    finally:
+        server.kill()
+        server.wait()
+
+
 def test_a_locked_database_gets_an_error_reply_and_the_driver_sends_again(tmp_path):
     """Issue 16 item 13: SQLite's lock timeout used to drop the connection (and the outbox)."""
     import sqlite3
@@ -335,6 +400,7 @@ async def test_signed_drivers_exchange_mail_through_a_server_with_secrets(tmp_pa
     clock = WallClock()
     store = TransmissionStore(tmp_path / "s.db")
     (tmp_path / "secrets").write_text("# modem secrets\n1 alpha\n2 bravo\n")
+    (tmp_path / "secrets").chmod(0o600)
     from pygoby.acomms.store_server.auth import read_secrets
 
     tcp = await serve_store(
@@ -371,6 +437,7 @@ def test_store_server_refuses_a_bad_secrets_file(tmp_path):
     import sys
 
     (tmp_path / "secrets").write_text("1 alpha\ntwo bravo\n")
+    (tmp_path / "secrets").chmod(0o600)
     run = subprocess.run(
         [
             sys.executable,

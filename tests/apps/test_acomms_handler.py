@@ -169,3 +169,29 @@ def test_a_transmission_the_driver_rejects_costs_only_that_slot(plugins, caplog)
     run(handler, clock, 31)  # three slots: each one fails alone, the MAC keeps its schedule
     assert len(driver.initiated) == 3 and handler.primary.running
     assert caplog.text.count("cannot start the transmission") == 3
+
+
+def test_a_driver_that_cannot_start_says_why_and_when_it_is_tried_again(plugins, caplog):
+    """One warning per attempt (every driver_backoff_sec: once a minute by default), the state
+    in show_gui's words and on ACOMMS_DRIVER_STATUS (liaison's Acomms page shows it)."""
+    clock = VirtualClock(1000.0)
+    ScriptedDriver.fail_startups = 2
+    handler = AcommsHandler(config(f"modem_id: 3 driver_cfg {{ {SCRIPTED} }} {SLOT}"), clock)
+    states: list[str] = []
+    handler.signal_driver_status.connect(lambda slot, text: states.append(text))
+    handler.start()
+    with caplog.at_level("WARNING", logger="pygoby"):
+        handler.do_work()
+        (failed,) = [r.getMessage() for r in caplog.records]
+        assert "driver SCRIPTED::3 failed (STARTUP_FAILED: " in failed
+        assert failed.endswith("; trying again in 60 s")
+        run(handler, clock, 30)
+        assert handler.primary.describe(clock.now()).endswith("; next attempt in 30 s")
+        assert handler.primary.describe(clock.now()).startswith("failed (1x): STARTUP_FAILED: ")
+        run(handler, clock, 30)  # the second attempt fails too: a second warning, a minute on
+        assert len(caplog.records) == 2
+        run(handler, clock, 60)
+        assert handler.primary.running and handler.primary.describe(clock.now()) == "running"
+        handler_warnings = [r.getMessage() for r in caplog.records if r.name.endswith("handler")]
+        assert handler_warnings[-1] == "driver SCRIPTED::3 running again (after 2 failures)"
+    assert [s.split(":")[0] for s in states] == ["failed (1x)", "failed (2x)", "running"]

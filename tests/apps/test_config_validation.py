@@ -112,6 +112,48 @@ def test_non_utf8_bytes_in_a_mission_file(tmp_path):
     assert "not valid UTF-8" in str(info.value) and "DQF,\\xe9" in str(info.value)
 
 
+def _not_utf8(text: str) -> bool:
+    try:
+        text.encode("latin-1").decode("utf-8")
+    except UnicodeDecodeError:
+        return True
+    return False
+
+
+latin1_values = st.text(
+    st.characters(min_codepoint=0x21, max_codepoint=0xFF, exclude_characters='#"\\'),
+    min_size=1,
+    max_size=12,
+).filter(_not_utf8)
+
+
+@FUZZ
+@given(value=latin1_values, quoted=st.booleans())
+def test_latin1_in_an_enum_value_or_a_moos_global_is_a_located_error(tmp_path, value, quoted):
+    # issue 25, item 11: Latin-1 bytes in an enum value (protobuf's parser: SystemError) or in
+    # a MOOS global copied into a string field (UnicodeEncodeError) are errors at their line
+    enum_value = f'"{value}"' if quoted else value
+    path = tmp_path / "latin1.moos"
+    for lines, line in (
+        (
+            [
+                "Community = v1",
+                "ProcessConfig = pAcommsHandler",
+                "{",
+                f"  driver_type: {enum_value}",
+                "}",
+            ],
+            4,
+        ),
+        ([f"Community = {value}", "ProcessConfig = pAcommsHandler", "{", "  modem_id: 1", "}"], 1),
+    ):
+        path.write_bytes("\n".join(lines).encode("latin-1"))
+        with pytest.raises(ConfigError) as info:
+            pAcommsHandler.read_config(MissionFile.read(path), "pAcommsHandler")
+        assert (info.value.file, info.value.line) == (str(path), line)
+        assert "not valid UTF-8" in str(info.value)
+
+
 def test_netsim_config_errors_say_file_line_and_field(tmp_path):
     path = tmp_path / "netsim.cfg"
     path.write_bytes(

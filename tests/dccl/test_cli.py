@@ -184,3 +184,62 @@ def test_passphrase_from_a_file_or_the_environment_not_the_command_line(pygoby, 
     assert (
         missing.returncode == 2 and "nope" in missing.stderr and "Traceback" not in missing.stderr
     )
+
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def in_process(capsys, monkeypatch, *args: str, stdin: str = "") -> tuple[int, str, str]:
+    """`pygoby ARGS` in this process (pygoby.cli.main), stdin given, (status, out, err)."""
+    import io
+
+    from pygoby.cli import main
+
+    monkeypatch.setattr(sys, "stdin", io.StringIO(stdin))
+    status = main(list(args))
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def test_decode_xml_without_message_picks_each_lines_type_by_its_dccl_id(capsys, monkeypatch):
+    xml = str(EXAMPLES / "goby1.1" / "xml" / "example1.xml")
+    lines = {"GoToCommand": "goto_x: 120", "VehicleStatus": "nav_x: 10 health: HEALTH_abort"}
+    encoded = {}
+    for name, text in lines.items():
+        status, out, err = in_process(
+            capsys, monkeypatch, "dccl", "encode", "--xml", xml, "--message", name, stdin=text
+        )
+        assert status == 0, err
+        encoded[name] = out.strip()
+    status, out, err = in_process(
+        capsys,
+        monkeypatch,
+        "dccl",
+        "decode",
+        "--xml",
+        xml,
+        stdin=f"{encoded['VehicleStatus']}\n{encoded['GoToCommand']}\n",
+    )
+    assert status == 0, err
+    first, second = out.splitlines()
+    assert "VehicleStatus: " in first and "health: HEALTH_abort" in first
+    assert "GoToCommand: " in second and "goto_x: 120" in second
+    # encoding still needs to know which message, and says which there are
+    status, _, err = in_process(capsys, monkeypatch, "dccl", "encode", "--xml", xml)
+    assert status == 2 and "--message is required to encode" in err and "GoToCommand" in err
+
+
+def test_a_files_only_message_needs_no_name(capsys, monkeypatch):
+    xml = str(EXAMPLES / "goby1.1" / "xml" / "simple_status.xml")
+    status, out, err = in_process(capsys, monkeypatch, "dccl", "encode", "--xml", xml, stdin="")
+    assert status == 0, err
+
+
+def test_analyze_lists_enum_values_by_name(capsys, monkeypatch):
+    xml = str(EXAMPLES / "goby1.1" / "xml" / "example1.xml")
+    status, out, err = in_process(
+        capsys, monkeypatch, "dccl", "analyze", "--xml", xml, "--message", "VehicleStatus"
+    )
+    assert status == 0, err
+    (health,) = [line for line in out.splitlines() if line.strip().startswith("health ")]
+    assert "index [0, 2]: HEALTH_good=0, HEALTH_low_battery=1, HEALTH_abort=2" in health

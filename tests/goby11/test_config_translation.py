@@ -193,3 +193,34 @@ def test_goby11_mac_updates_become_todays():
         == acomms_pb.MICROMODEM_TWO_WAY_PING
     )
     assert mac_update_from_goby11("src: 1 dest: 1 update_type: PUSH_BACK", current, 1) is None
+
+
+@pytest.mark.parametrize(
+    ("right", "wrong", "reason"),
+    [
+        (
+            'in_pubsub_var: "IN_REMUS_STATUS"',
+            'in_pubsub_var "IN_REMUS_STATUS"',
+            "expected ':' after in_pubsub_var",
+        ),
+        (
+            'message_file { path: "../../xml/simple_status.xml" }',
+            'message_file { path: "../../xml/simple_status.xml"',
+            "the '{' after dccl_cfg is never closed",
+        ),
+    ],
+)
+def test_a_syntax_error_is_reported_at_its_line_in_the_users_words(tmp_path, right, wrong, reason):
+    """The manual's mission with one mistake past its Goby 1.1 forms (which were reported
+    instead, at their own line, as not registered extensions or unknown enum values)."""
+    text = (EXAMPLES / "MOOS" / "ccl_and_dccl" / "mm1.moos").read_text()
+    assert text.count(right) == 1
+    text = text.replace(right, wrong)
+    path = tmp_path / "mm1.moos"
+    path.write_text(text)
+    line = next(n for n, x in enumerate(text.splitlines(), 1) if wrong.strip() in x)
+    if "never closed" in reason:  # the next '}' closes message_file: dccl_cfg's stays open
+        line -= 2
+    with pytest.raises(ConfigError) as caught:
+        read_configuration(PACOMMS, MissionFile.read(path), "pAcommsHandler")
+    assert str(caught.value) == f"{path}:{line}: {reason}"

@@ -7,11 +7,13 @@ import asyncio
 from pygoby.moos import protocol as p
 
 
-async def raw_connect(port: int, name: str | None = None):
-    """A TCP connection to the DB on `port`; with `name`, handshaken (welcome read)."""
+async def raw_connect(port: int, name: str | None = None, asynchronous: bool = True):
+    """A TCP connection to the DB on `port`; with `name`, handshaken (welcome read) as an
+    asynchronous client, or as a synchronous one (its mail waits for its next packet)."""
     reader, writer = await asyncio.open_connection("127.0.0.1", port)
     if name is not None:
-        writer.write(p.PROTOCOL_STRING + p.encode_packet([p.handshake_message(name, 0.0)]))
+        handshake = p.handshake_message(name, 0.0, asynchronous)
+        writer.write(p.PROTOCOL_STRING + p.encode_packet([handshake]))
         await writer.drain()
         framer = p.PacketFramer()
         while True:

@@ -175,6 +175,20 @@ def test_glob_has_no_catastrophic_backtracking():
     assert p.Glob("*a*a*a*a*a*a*a*a*a*a").match(name)
 
 
+@settings(max_examples=examples(1000), deadline=None)
+@given(st.text("a?*", max_size=30), st.text("ab", max_size=40))
+def test_glob_with_many_question_marks_agrees_with_the_definition(pattern, name):
+    assert p.Glob(pattern).match(name) is _reference_glob(pattern, name)
+
+
+@pytest.mark.timeout(10)  # a match cost len(name) x len(pattern) steps: ~21 s here (issue 25, 1)
+def test_glob_matching_is_linear_in_the_name():
+    name = "a" * 30_000
+    for pattern in ("*" + "?" * 2000 + "X*", "*" + "a?" * 1000 + "X*", "*?a?*" * 300 + "X"):
+        assert not p.Glob(pattern).match(name)
+    assert p.Glob("*" + "?" * 2000 + "a*").match(name)
+
+
 def test_rejects_malformed_packets():
     good = p.encode_packet([p.notify("X", 1.0, time=1.0, src="a")])
     with pytest.raises(p.MoosProtocolError):

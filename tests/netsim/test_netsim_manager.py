@@ -6,6 +6,7 @@ from __future__ import annotations
 import asyncio
 import os
 import random
+import socket
 import subprocess
 import sys
 
@@ -283,3 +284,24 @@ def test_fuzz_manager_answers_each_request_line_exactly_once(chunks):
     assert len(replies) == len(expected)
     decoded = LineDecoder(response_names()).feed(b"".join(replies))
     assert [e.message.request_id for e in decoded] == [e.message.id for e in expected]
+
+
+async def test_close_with_a_client_blocked_on_output_logs_no_traceback(server):
+    # issue 25, item 13: at SIGTERM the manager cancels every client's task; one that waited
+    # for a peer that never reads must end quietly, not as an "Exception in callback" traceback
+    loop = asyncio.get_running_loop()
+    reported: list[dict] = []
+    loop.set_exception_handler(lambda _loop, context: reported.append(context))
+    sock = socket.socket()
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    sock.connect(("127.0.0.1", server.bound_port))
+    sock.setblocking(False)
+    _, writer = await asyncio.open_connection(sock=sock)
+    burst = encode_line(_nav_request(1)) * 200
+    for _ in range(100):  # answers pile up unread until the server waits in drain()
+        writer.write(burst)
+        await asyncio.sleep(0.01)
+    await server.close()
+    await asyncio.sleep(0.1)  # the task's done callbacks run
+    writer.transport.abort()
+    assert reported == []

@@ -289,10 +289,14 @@ def test_sweep_report_draws_the_figures_and_the_page(tmp_path, capsys):
     assert main(["netsim", "sweep", str(sweep), "-o", str(output), "--jobs", "1"]) == 0
     assert main(["netsim", "sweep-report", str(output)]) == 0
     report = output / "report"
-    for name in ("success_vs_range", "throughput_vs_nodes", "latency_vs_nodes", "snr_vs_range"):
+    for name in ("success_vs_range", "snr_vs_range"):
         width, height = png_size(report / f"{name}.png")
         assert width >= 600 and height >= 400
+    # three nodes in every run: no figure against the node count (it had a single x value)
+    assert not (report / "throughput_vs_nodes.png").exists()
+    assert not (report / "latency_vs_nodes.png").exists()
     page = (report / "index.html").read_text()
+    assert "not drawn: every run has 3 nodes" in page
     assert all(f'src="{n}.png"' in page for n in ("success_vs_range", "snr_vs_range"))
     assert "95 % Wilson" in page and "8 runs" in page
     rows = read_results(output).to_pylist()
@@ -346,3 +350,21 @@ axis { field: "channel.water.sound_speed_formula" value: "MACKENZIE_1981" value:
         parse_scenario(plan.runs[2].scenario_text)
     ).sound_speed(10.0)
     assert channel_config(parse_scenario(plan.runs[0].scenario_text)).propagation is None
+
+
+def test_sweep_report_draws_the_node_count_figures_when_the_node_count_is_swept(tmp_path):
+    text = sweep_text(duration=300, replicates=1).replace(
+        'axis { field: "layout.spacing" name: "spacing_m" span { from: 1000 to: 4000 steps: 4 } }',
+        'axis { field: "layout.nodes" name: "vehicles" value: "2" value: "3" }',
+    )
+    assert "layout.nodes" in text
+    sweep = tmp_path / "sweep.pb.cfg"
+    sweep.write_text(text)
+    output = tmp_path / "out"
+    assert main(["netsim", "sweep", str(sweep), "-o", str(output), "--jobs", "1"]) == 0
+    assert main(["netsim", "sweep-report", str(output)]) == 0
+    report = output / "report"
+    for name in ("throughput_vs_nodes", "latency_vs_nodes"):
+        width, height = png_size(report / f"{name}.png")
+        assert width >= 600 and height >= 400
+    assert "not drawn" not in (report / "index.html").read_text()

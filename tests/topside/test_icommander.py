@@ -101,9 +101,9 @@ async def test_send_refusal_preview_and_ack(tmp_path):
             assert await r2.wait_for("DESIRED_HEADING", timeout=30) == 90.0
             assert r1.values("COMMAND_OUT") == ["dest=2,command_id=7,heading=90,speed=1.5,depth=20"]
             async with asyncio.timeout(30):
-                while "acknowledged" not in str(app.tui.query_one("#banner").render()):
+                while "acknowledged" not in str(app.tui.screen.query_one("#status").render()):
                     await pilot.pause(0.1)
-            banner = str(app.tui.query_one("#banner").render())
+            banner = str(app.tui.screen.query_one("#status").render())
             assert "Message acknowledged from queue: Command" in banner
             assert "for destination: 2" in banner
             assert app.commander.records[0].status == "acknowledged"

@@ -6,6 +6,7 @@ variable changing; the map shows both vehicles. `make screenshots` writes each p
 
 from __future__ import annotations
 
+import asyncio
 import os
 import shutil
 from pathlib import Path
@@ -43,7 +44,7 @@ ProcessConfig = liaison
     http_port: 0
     update_freq: 5
     node_report_var: "STATUS_REPORT_IN"
-    commander { autosave_path: "%s" }
+    commander { autosave_path: "%s"  command: "Command" }
   }
 }
 """
@@ -101,8 +102,16 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
         path = topside_mission(net, tmp_path, LIAISON % (tmp_path / "autosave.txt"))
         liaison = Liaison.from_mission(path, "liaison")
         async with liaison:
-            base = liaison.web.url.rsplit("/", 1)[0]
+            base = liaison.web.url.split("/scope")[0]
             page = await browser.new_page()
+            console_errors: list[str] = []
+            page.on(
+                "console", lambda m: console_errors.append(m.text) if m.type == "error" else None
+            )
+            # the printed URL leaves the launch token as the page's cookie (and out of the
+            # address bar); the Commander's POSTs need it
+            await page.goto(liaison.web.url)
+            await page.wait_for_function("!location.search.includes('token')")
 
             # Scope: NAV_X changes and the page follows; the history plot of NAV_X.
             r1.client.publish("NAV_X", 10.0)
@@ -123,12 +132,45 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
                 "NAV_DEPTH": 0.0,
             }.items():
                 r1.client.publish(var, value)
-            await page.locator('#scope-table tr[data-key="NAV_X"]').click()
+            # a normal click (the button held 150 ms) selects, however often the rows update,
+            # and the History panel is in view
+            r1.client.publish("LONG_TEXT", "x" * 3000)
+            long_row = page.locator('#scope-table tr[data-key="LONG_TEXT"]')
+            await long_row.wait_for()
+            for key in ("NAV_Y", "NAV_HEADING", "NAV_SPEED", "NAV_X"):
+                await page.locator(f'#scope-table tr[data-key="{key}"]').click(delay=150)
+                assert await page.locator("#history-key").text_content() == key
+                assert (
+                    await page.locator("#scope-table tr.selected").get_attribute("data-key") == key
+                )
+                assert await page.locator("#history-canvas").is_visible()
+                box = await page.locator("#history-canvas").bounding_box()
+                assert box is not None and box["y"] >= 0 and box["y"] + box["height"] <= 760
+            # a long value is one line until its expander opens it
+            one_line = (await long_row.bounding_box())["height"]
+            assert one_line < 40
+            await long_row.locator("button.expander").click()
+            assert (await long_row.bounding_box())["height"] > 3 * one_line
+            await long_row.locator("button.expander").click()
+            await page.evaluate("scrollTo(0, 0)")
             await page.wait_for_timeout(500)
             await shot(page, "scope", tmp_path)
 
             # Commander: compose a command, a refused value, send; it arrives and is acked.
             await page.goto(f"{base}/commander")
+            # the configuration's commands; the rest (telemetry) behind "show all"
+            options = page.locator("#cmd-type option")
+            await page.locator('#cmd-type option[value="pygoby.examples.Command"]').wait_for(
+                state="attached"
+            )
+            assert "pygoby.examples.SimpleStatus" not in await options.evaluate_all(
+                "os => os.map(o => o.value)"
+            )
+            await page.check("#cmd-all")
+            assert "pygoby.examples.SimpleStatus" in await options.evaluate_all(
+                "os => os.map(o => o.value)"
+            )
+            await page.uncheck("#cmd-all")
             await page.select_option("#cmd-type", "pygoby.examples.Command")
             heading = page.locator('input[data-field="heading"]')
             await heading.wait_for()
@@ -187,6 +229,19 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
             await page.locator(
                 '#map-svg line.link[data-from="vehicle2"][data-to="vehicle1"]'
             ).wait_for()
+            # the grid reaches every edge of the map, whatever the window's shape
+            reach = await page.evaluate(
+                """() => {
+                const map = document.querySelector('#map-svg').getBoundingClientRect();
+                const lines = [...document.querySelectorAll('#map-svg .gridline')]
+                  .map((l) => l.getBoundingClientRect());
+                return [Math.min(...lines.map((r) => r.left)) - map.left,
+                        map.right - Math.max(...lines.map((r) => r.right)),
+                        Math.min(...lines.map((r) => r.top)) - map.top,
+                        map.bottom - Math.max(...lines.map((r) => r.bottom))];
+              }"""
+            )
+            assert all(gap <= 0 for gap in reach), reach
             await shot(page, "map", tmp_path)
 
             # Acomms: queues, the MAC cycle, transmissions and receptions with statistics.
@@ -197,3 +252,61 @@ async def test_liaison_pages_in_chromium(tmp_path, browser):
             await page.locator("#acomms-timeline li.acknowledged").first.wait_for()
             await page.locator("#acomms-slots .slot.current").wait_for()
             await shot(page, "acomms", tmp_path)
+            # no 404 (the favicon was one); the 422s are the refused heading above
+            assert [e for e in console_errors if "422" not in e] == []
+
+
+LIAISON_GOBY11 = """
+ProcessConfig = liaison
+{
+  common { log: false  verbosity: WARN  app_tick: 20 }
+  liaison { http_port: 0  update_freq: 5 }
+}
+"""
+
+
+@pytest.mark.timeout(240)
+async def test_liaison_on_the_goby11_ccl_and_dccl_mission(tmp_path, browser):
+    """The Goby 1.1 manual's ccl_and_dccl pair (under `pygoby antler`, as tests/goby11 runs
+    it): CCL frames are named on the Acomms page, SIMPLE_STATUS (a time-triggered telemetry
+    message) is behind 'show all' on the Commander page."""
+    from tests.goby11.test_examples import localize, run_pair, wait_for
+
+    directory, ports = localize(tmp_path, "ccl_and_dccl")
+    mission = directory / "mm1.moos"
+    mission.write_text(mission.read_text() + LIAISON_GOBY11)
+
+    async def check():
+        # the antlers' MOOSDBs are up within seconds, later on a busy machine
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + 60
+        while True:
+            try:
+                _, writer = await asyncio.open_connection("127.0.0.1", ports["mm2"])
+            except OSError:
+                assert loop.time() < deadline, "mm2's MOOSDB never started"
+                await asyncio.sleep(0.5)
+                continue
+            writer.close()
+            break
+        await wait_for(ports["mm2"], "STATUS_REPORT_IN", lambda v: "nav_x=100" in str(v))
+        liaison = Liaison.from_mission(mission, "liaison")
+        async with liaison:
+            base = liaison.web.url.split("/scope")[0]
+            page = await browser.new_page()
+            await page.goto(liaison.web.url)
+            await page.goto(f"{base}/acomms")
+            named = page.locator("#acomms-rx td", has_text="Remus_State")
+            await named.first.wait_for(timeout=120_000)
+            assert await page.locator("#acomms-rx td", has_text="?").count() == 0
+            await shot(page, "goby11-acomms", tmp_path)
+            await page.goto(f"{base}/commander")
+            options = page.locator("#cmd-type option")
+            await page.locator("#cmd-all").wait_for()
+            await page.wait_for_function("document.querySelectorAll('#cmd-type option').length")
+            values = "os => os.map(o => o.value)"
+            assert "SIMPLE_STATUS" not in await options.evaluate_all(values)
+            await page.check("#cmd-all")
+            assert "SIMPLE_STATUS" in await options.evaluate_all(values)
+
+    await run_pair(directory, ports, check)

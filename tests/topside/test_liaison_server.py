@@ -72,7 +72,8 @@ async def test_embedded_liaison_offers_the_goby11_xml_messages(tmp_path):
 
     extra = f'liaison {{ http_port: 0 }}\n  dccl_cfg {{ message_file {{ path: "{EXAMPLES}/xml/example1.xml" }} }}'
     async with TwoCommunities(tmp_path, extra=extra) as net:
-        base = f"http://127.0.0.1:{net.apps[0].liaison.web.port}"
+        web = net.apps[0].liaison.web
+        base = f"http://127.0.0.1:{web.port}"
         types = json.loads((await asyncio.to_thread(fetch, f"{base}/api/commander/types"))[1])
         assert {t["short"] for t in types["types"]} == {
             "Command",
@@ -80,7 +81,11 @@ async def test_embedded_liaison_offers_the_goby11_xml_messages(tmp_path):
             "GoToCommand",
             "VehicleStatus",
         }
-        headers = {"X-Liaison": "1", "Content-Type": "application/json"}
+        headers = {
+            "X-Liaison": "1",
+            "Content-Type": "application/json",
+            "Authorization": f"Bearer {web.token}",
+        }
 
         async def command(**body) -> tuple[int, dict]:
             status, reply = await asyncio.to_thread(fetch, f"{base}/api/commander", body, headers)

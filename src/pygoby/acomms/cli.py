@@ -85,7 +85,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--secrets",
         metavar="FILE",
         help="'MODEM_ID SECRET' per line: each modem id's requests must be signed "
-        "with its secret, ids not listed are refused (default: no check)",
+        "with its secret, ids not listed are refused (default: no check); the file must "
+        "be readable by its owner only",
+    )
+    s.add_argument(
+        "--allow-readable-secrets",
+        action="store_true",
+        help="accept a --secrets file that its group or others may read",
     )
     s.set_defaults(func=run_store_server)
 
@@ -191,7 +197,7 @@ async def _serve_store(args: argparse.Namespace) -> None:
     from pygoby.acomms.store_server import StoreServer, TransmissionStore, serve_store
     from pygoby.acomms.store_server.auth import read_secrets
 
-    secrets = read_secrets(args.secrets) if args.secrets else None
+    secrets = read_secrets(args.secrets, args.allow_readable_secrets) if args.secrets else None
     store = TransmissionStore(args.db, args.max_lookback, args.retention, args.lock_timeout)
     server = await serve_store(StoreServer(store, secrets=secrets), args.host, args.port)
     port = server.sockets[0].getsockname()[1]

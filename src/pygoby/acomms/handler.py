@@ -111,10 +111,23 @@ class DriverSlot:
     cfg: object  # DriverConfig
     restart_at: float | None = 0.0
     failures: int = 0
+    problem: str = ""  # why it last failed
 
     @property
     def running(self) -> bool:
         return self.restart_at is None
+
+    def describe(self, now: float) -> str:
+        """The state for an operator: running, or why not and when it is tried again."""
+        if self.running:
+            return "running"
+        if not self.problem:
+            return "starting"
+        assert self.restart_at is not None
+        return (
+            f"failed ({self.failures}x): {self.problem}; "
+            f"next attempt in {max(self.restart_at - now, 0):.0f} s"
+        )
 
 
 # --------------------------------------------------------------------------------------------
@@ -142,6 +155,9 @@ class AcommsHandler:
         self.signal_raw_outgoing = Signal()
         self.signal_modem_receive = Signal()  # (ModemTransmission) received by the primary
         self.signal_modem_transmit = Signal()  # (ModemTransmission) transmit result
+        # (DriverSlot, text) when a driver starts or fails: "running" or why it failed and
+        # when it is tried again
+        self.signal_driver_status = Signal()
         primary_cfg = acomms_pb.DriverConfig()
         primary_cfg.CopyFrom(cfg.driver_cfg)
         top_level = primary_cfg.WhichOneof("driver") is None and cfg.HasField("driver_type")
@@ -382,6 +398,10 @@ class AcommsHandler:
             self._driver_failed(slot, _status_of(exc, Status.STARTUP_FAILED), exc, started=False)
             return
         slot.restart_at = None
+        if slot.problem:
+            log.warning("driver %s running again (after %d failures)", _name(slot), slot.failures)
+            slot.problem = ""
+        self.signal_driver_status.emit(slot, "running")
 
     def _shutdown_driver(self, slot: DriverSlot) -> None:
         try:
@@ -391,14 +411,23 @@ class AcommsHandler:
 
     def _driver_failed(self, slot: DriverSlot, status: int, why, started: bool = True) -> None:
         slot.failures += 1
-        log.warning("driver %s failed (%s): %s", _name(slot), Status.Status.Name(status), why)
+        slot.problem = f"{Status.Status.Name(status)}: {why}"
         if started or slot.running:
             self._shutdown_driver(slot)
         now = self.clock.now()
         technique = self.failure.technique
         if technique == CONTINUALLY_RESTART_DRIVER or slot is not self.primary:
+            # restarted every driver_backoff_sec (60 s by default, as goby3): one warning each
             slot.restart_at = now + self.failure.driver_backoff_sec
+            log.warning(
+                "driver %s failed (%s); trying again in %d s",
+                _name(slot),
+                slot.problem,
+                self.failure.driver_backoff_sec,
+            )
+            self.signal_driver_status.emit(slot, slot.describe(now))
             return
+        log.warning("driver %s failed (%s)", _name(slot), slot.problem)
         if len(self.slots) < 2:
             raise HandlerError(
                 f"primary driver {_name(slot)} failed and there is no listen driver to replace it"
@@ -418,6 +447,7 @@ class AcommsHandler:
         else:
             slot.restart_at = now + self.failure.driver_backoff_sec
         log.warning("driver %s is now the primary driver", _name(new))
+        self.signal_driver_status.emit(slot, slot.describe(now))
 
     def _make_primary(self, new: DriverSlot) -> None:
         if self.primary is not None:

@@ -22,7 +22,14 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, Post
 from pygoby.topside.acomms_config import AcommsMessageSet
-from pygoby.topside.commander import KEY_VALUE, MULTIPLEX, Commander, CommanderError, CommandSet
+from pygoby.topside.commander import (
+    KEY_VALUE,
+    MULTIPLEX,
+    Commander,
+    CommanderError,
+    CommandSet,
+    SaveFileError,
+)
 from pygoby.topside.icommander import ICommanderTUI
 
 SEND_MULTIPLEX = 2  # pygoby.apps.protobuf.SendStyle
@@ -59,17 +66,28 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
             )
         except CommanderError as err:
             raise ConfigError(str(err), field="commander") from None
-        self.tui = ICommanderTUI(self.commander, list(cfg.show_variable), on_exit=self.request_stop)
+        # empty values mean none, as in Goby 1.1 (its manual's block and --example_config
+        # carry `show_variable: ""` and `load: ""`)
+        shown = [var for var in cfg.show_variable if var]
+        self.tui = ICommanderTUI(self.commander, shown, on_exit=self.request_stop)
         for var in self.commander.watched_variables:
             self.subscribe(var, self._on_ack_or_expire)
-        for var in cfg.show_variable:
+        for var in shown:
             self.subscribe(var, self._on_show)
         self._sources: set[str] = set()
         self._subscribe_sources()
         self.commander.signal_import.connect(lambda names: self._subscribe_sources())
         self.load_warnings = []
         for path in [*cfg.load, *options.load]:
-            self.load_warnings += self.commander.load(path)
+            if not path:
+                continue
+            try:
+                self.load_warnings += self.commander.load(self.find_file(path))
+            except (OSError, SaveFileError) as err:
+                reason = err.strerror if isinstance(err, OSError) and err.strerror else err
+                raise self.config_error(
+                    f"cannot open the save file {path!r}: {reason}", "load", path
+                ) from None
 
     def _subscribe_sources(self) -> None:
         """Keep the values of the variables a send posts to (a number goes where one is)."""

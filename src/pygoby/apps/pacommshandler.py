@@ -23,7 +23,7 @@ from google.protobuf.message import Message
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase, driver_name
 from pygoby.acomms.drivers.ufield import UFldDriver
-from pygoby.acomms.handler import AcommsHandler, HandlerError, make_driver
+from pygoby.acomms.handler import AcommsHandler, DriverSlot, HandlerError, make_driver
 from pygoby.apps.pacommshandler_goby11 import Goby11Variables
 from pygoby.apps.ufield_link import MOOSMailLink
 from pygoby.errors import ConfigError
@@ -148,6 +148,13 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             ]
         for signal, slot in connections:
             signal.connect(slot, contain_errors=True, logger=self.log)
+        acomms.signal_driver_status.connect(
+            self._on_driver_status, contain_errors=True, logger=self.log
+        )
+
+    def _on_driver_status(self, slot: DriverSlot, text: str) -> None:
+        role = "primary" if slot is self.acomms.primary else "listen"
+        self.publish(self.var["driver_status"], f"{role} driver {driver_name(slot.cfg)}: {text}")
 
     def _subscribe_all(self) -> None:
         acomms = self.acomms
@@ -190,7 +197,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         """show_gui's panel: the drivers, the MAC's current slot, every queue's size."""
         lines = super().status_lines()
         for slot in self.acomms.slots:
-            state = "running" if slot.running else f"restarts at {slot.restart_at:.0f}"
+            state = slot.describe(self.clock.now())
             role = "primary" if slot is self.acomms.primary else "listen"
             lines.append(f"{role} driver {driver_name(slot.cfg)}: {state}")
         mac = self.acomms.mac

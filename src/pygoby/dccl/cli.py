@@ -49,8 +49,9 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--message",
         metavar="FULL.NAME",
-        help="fully qualified message name (with --xml: the XML <name>; "
-        "analyze without it shows every DCCL message of the file)",
+        help="fully qualified message name (with --xml: the XML <name>); without it: the "
+        "file's only message, or decode picks each line's type by its DCCL id and names it, "
+        "analyze shows every DCCL message of the file",
     )
     parser.add_argument(
         "--write-proto",
@@ -124,9 +125,6 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if args.goby11 or (args.xml and len(args.xml) > 1):
         return _run_goby11(args)
-    if args.message is None and args.action != "analyze":
-        print("error: --message is required", file=sys.stderr)
-        return 2
     if not args.trace:
         return _run(args)
     # the trace goes to this command's stderr, and only while it runs (`main` may be called again
@@ -164,7 +162,16 @@ def _run(args: argparse.Namespace) -> int:
         show = generated_source if args.source else describe
         print("\n\n".join(show(codec.compiled(c)) for c in classes))
         return 0
+    if not classes:
+        print("error: the file defines no DCCL message", file=sys.stderr)
+        return 2
+    if args.action == "encode" and len(classes) > 1:
+        names = ", ".join(c.DESCRIPTOR.full_name for c in classes)
+        print(f"error: --message is required to encode: the file defines {names}", file=sys.stderr)
+        return 2
     cls = classes[0]
+    # several types (no --message): each line's DCCL id picks its type, named in the output
+    by_id = len(classes) > 1
 
     def encode(line: str) -> str:
         msg = cls()
@@ -176,7 +183,9 @@ def _run(args: argparse.Namespace) -> int:
             data = bytes.fromhex(line)
         except ValueError:
             raise ValueError(f"not a hex string: {line!r}") from None
-        return text_format.MessageToString(codec.decode(data, cls), as_one_line=True)
+        msg = codec.decode(data, None if by_id else cls)
+        text = text_format.MessageToString(msg, as_one_line=True)
+        return f"{msg.DESCRIPTOR.full_name}: {text}" if by_id else text
 
     return process_lines(sys.stdin, encode if args.action == "encode" else decode)
 

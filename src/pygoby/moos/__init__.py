@@ -16,6 +16,7 @@ from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.errors import (
     AntlerError,
+    BlockSyntaxError,
     MissionFileError,
     MoosError,
     MoosProtocolError,
@@ -27,6 +28,7 @@ from pygoby.moos.timewarp import moos_clock
 
 __all__ = [
     "AntlerError",
+    "BlockSyntaxError",
     "MOOSDB",
     "MOOSClient",
     "MOOSMessage",

@@ -32,7 +32,12 @@ from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
 from pygoby.moos.moosfile import GobyBlock, MissionFile, parse_number
 from pygoby.protobuf import builtin_class
-from pygoby.protobuf.textconfig import check_config_values, line_of_field, merge_config_text
+from pygoby.protobuf.textconfig import (
+    check_config_values,
+    line_of_field,
+    merge_config_text,
+    printable_text,
+)
 from pygoby.protobuf.wire import length_delimited
 
 log = logging.getLogger(__name__)
@@ -130,6 +135,11 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
     """A MOOS global's text as the field's value; text that is no value of its type is an
     error (MOOS would read "abc" as 0: a mistyped ServerPort must not mean port 9000)."""
     kind = field.type
+    if value.encode("utf-8", "surrogateescape") != value.encode("utf-8", "replace"):
+        # bytes that are not UTF-8 (a Latin-1 file): protobuf strings must be UTF-8
+        raise ConfigError(
+            f"{name} = {printable_text(value)} is not valid UTF-8 text", field=field.name
+        )
     if kind == FieldDescriptor.TYPE_STRING:
         setattr(config, field.name, value)
     elif kind == FieldDescriptor.TYPE_BOOL:
@@ -202,21 +212,29 @@ def read_configuration(
     overrides: Sequence[tuple[str, str]] = (),
     complete: Callable[[Message], None] | None = None,
     notes: list[str] | None = None,
+    block_optional: bool = False,
 ) -> Message:
     """`complete(config)`, if given, runs after the overrides and before the check for required
-    fields (an app's own rewriting of older configuration forms). Goby 1.1 and Goby 2 forms are
+    fields (an app's own rewriting of older configuration forms). `block_optional`: a mission
+    without the app's ProcessConfig block gives the defaults (with the mission's globals). Goby 1.1 and Goby 2 forms are
     mapped onto today's configuration first (pygoby.moos.goby11_config); what was mapped is
     appended to `notes` (for the app to log once)."""
     config = config_class()
     source = str(mission.path) if mission is not None and mission.path else "mission file"
     translated: list[str] = []
+    block_text, first_line = "", 1
     if mission is not None:
         block = mission.goby_block(app_name)
-        if block is None:
+        if block is None and not block_optional:
             raise ConfigError(f"no ProcessConfig block for {app_name}", file=source)
-        translation = goby11_config.translate(block.text, config_class.DESCRIPTOR)
-        parse_block(config, translation.text, block.first_line, source)
-        translated = [f"{source}:{_shift(note, block.first_line)}" for note in translation.notes]
+        if block is not None:
+            block_text, first_line = block.text, block.first_line
+        try:
+            translation = goby11_config.translate(block_text, config_class.DESCRIPTOR)
+        except goby11_config.BlockSyntaxError as err:
+            raise ConfigError(err.reason, file=source, line=first_line + err.line - 1) from None
+        parse_block(config, translation.text, first_line, source)
+        translated = [f"{source}:{_shift(note, first_line)}" for note in translation.notes]
         try:
             apply_moos_globals(config, mission)
         except ConfigError as err:
@@ -233,7 +251,6 @@ def read_configuration(
     missing = config.FindInitializationErrors()
     if missing:
         raise ConfigError(f"missing required configuration fields: {', '.join(missing)}")
-    block_text, first_line = (block.text, block.first_line) if mission is not None else ("", 1)
     check_config_values(config, block_text, file=source, first_line=first_line)
     return config
 

@@ -23,6 +23,7 @@ from pygoby.moos.db import (
     DEFAULT_PACKET_TIMEOUT,
     MOOSDB,
 )
+from pygoby.moos.dbcore import DEFAULT_MAX_VARIABLES
 from pygoby.moos.errors import MoosRefusedError
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.timewarp import moos_clock
@@ -67,7 +68,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--memory-budget",
         type=float,
         default=DEFAULT_MEMORY_BUDGET / 2**20,
-        help="MB of partial packets and unsent output for all clients together",
+        help="MB of stored variables, partial packets, held and unsent mail, all clients together",
+    )
+    db.add_argument(
+        "--max-variables",
+        type=int,
+        default=DEFAULT_MAX_VARIABLES,
+        help="most variables the DB holds (new ones beyond are refused)",
     )
     db.add_argument("-v", "--verbose", action="store_true")
     db.set_defaults(func=_run_moosdb)
@@ -175,6 +182,7 @@ def _run_moosdb(args: argparse.Namespace) -> int:
         packet_timeout=args.packet_timeout,
         max_clients=args.max_clients,
         memory_budget=int(args.memory_budget * 2**20),
+        max_variables=args.max_variables,
     )
     return _run(_serve(db))
 

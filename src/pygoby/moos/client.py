@@ -42,6 +42,36 @@ TIMING_PERIOD = 1.0
 MAX_PACKET_MESSAGES = 4096
 HANDSHAKE_TIMEOUT = 5.0  # s for the DB's answer to the handshake
 MAX_REFUSED_BACKOFF = 10.0  # s between attempts while the DB refuses the name on reconnect
+# A DB that cannot be reached is reported at WARN once attempts have failed for this long (a DB
+# launched beside the app by antler is up by then), then once a minute while it stays so.
+UNREACHABLE_FIRST_WARNING = 3.0
+UNREACHABLE_WARNING_EVERY = 60.0
+
+
+class UnreachableWarnings:
+    """When to say that connection attempts keep failing (sans-I/O: fed loop times):
+    `failed(now)` is True when a warning is due; `reset()` on a connection."""
+
+    def __init__(
+        self, first: float = UNREACHABLE_FIRST_WARNING, every: float = UNREACHABLE_WARNING_EVERY
+    ) -> None:
+        self.first, self.every = first, every
+        self._since: float | None = None
+        self._next = 0.0
+
+    def failed(self, now: float) -> bool:
+        if self._since is None:
+            self._since, self._next = now, now + self.first
+        if now < self._next:
+            return False
+        self._next = now + self.every
+        return True
+
+    def reset(self) -> None:
+        self._since = None
+
+    def failing_for(self, now: float) -> float:
+        return 0.0 if self._since is None else now - self._since
 
 
 class MOOSClient:
@@ -83,6 +113,7 @@ class MOOSClient:
         self.signal_disconnect = Signal()
         self.signal_refused = Signal(contain_errors=True, logger=log)
         self.reconnect_interval = reconnect_interval
+        self.unreachable = UnreachableWarnings()
         self.outbox_limit = outbox_limit
         self.inbox_limit = inbox_limit
         self.max_packet_size = max_packet_size
@@ -310,16 +341,27 @@ class MOOSClient:
 
     async def _run(self) -> None:
         refusals = 0  # in a row, on reconnection
+        loop = asyncio.get_running_loop()
         try:
             while True:
                 try:
                     reader, writer = await asyncio.open_connection(self.host, self.port)
                 except OSError as err:
-                    log.debug(
-                        "%s: cannot connect to %s:%d: %s", self.name, self.host, self.port, err
+                    now = loop.time()
+                    due = self.unreachable.failed(now)
+                    log.log(
+                        logging.WARNING if due else logging.DEBUG,
+                        "%s: cannot connect to the MOOSDB at %s:%d (ServerHost/ServerPort): "
+                        "%s; still trying (for %.0f s)",
+                        self.name,
+                        self.host,
+                        self.port,
+                        err.strerror or err,
+                        self.unreachable.failing_for(now),
                     )
                     await asyncio.sleep(self.reconnect_interval)
                     continue
+                self.unreachable.reset()
                 delay = self.reconnect_interval
                 connections = self.connections
                 try:

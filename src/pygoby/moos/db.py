@@ -11,9 +11,12 @@ packets, or a packet above `max_packet_size`, is dropped with a log line; the ot
 Mail for a client is collected in one outgoing buffer and written once per event-loop
 iteration, so a burst of notifications leaves in a few large packets (as libMOOS packs its
 outbox). Resources are bounded: at most `max_clients` connections; a packet must arrive whole
-within `packet_timeout` of its first byte; partial packets and unsent output together stay
-within `memory_budget` bytes (beyond it the connection holding the most is dropped), and one
-client's unsent output within MAX_WRITE_BUFFER.
+within `packet_timeout` of its first byte; at most `max_variables` variables; the stored
+variables, partial packets, mail held for a client (a synchronous client's until it next
+writes) and unsent output together stay within `memory_budget` bytes (a write that would take
+the stored variables beyond half of it is refused, so that the clients' buffers always have the
+other half; beyond it the connection holding the most is dropped), and one client's unsent
+output within MAX_WRITE_BUFFER.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ import logging
 import socket
 
 from pygoby.moos import protocol as p
-from pygoby.moos.dbcore import DBCore
+from pygoby.moos.dbcore import DEFAULT_MAX_VARIABLES, DBCore
 from pygoby.moos.errors import MoosProtocolError
 from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock
@@ -204,7 +207,8 @@ class MOOSDB:
     client_timeout (s of silence before a client is dropped), handshake_timeout,
     packet_timeout (s from a packet's first byte to its last), max_packet_size (bytes; larger
     packets are refused from their header), max_clients (connections, handshaking ones
-    included), memory_budget (bytes of partial packets and unsent output, all clients).
+    included), max_variables, memory_budget (bytes of stored variables, partial packets, held
+    mail and unsent output, all clients).
     """
 
     def __init__(
@@ -220,6 +224,7 @@ class MOOSDB:
         max_packet_size: int = p.DEFAULT_MAX_PACKET_SIZE,
         max_clients: int = DEFAULT_MAX_CLIENTS,
         memory_budget: int = DEFAULT_MEMORY_BUDGET,
+        max_variables: int = DEFAULT_MAX_VARIABLES,
         hostname: str | None = None,
     ) -> None:
         self.host = host
@@ -230,7 +235,13 @@ class MOOSDB:
         self.max_packet_size = max_packet_size
         self.max_clients = max_clients
         self.memory_budget = memory_budget
-        self.core = DBCore(community, clock, hostname or socket.gethostname())
+        self.core = DBCore(
+            community,
+            clock,
+            hostname or socket.gethostname(),
+            max_variables=max_variables,
+            store_budget=memory_budget // 2,
+        )
         self._server: asyncio.Server | None = None
         self._sweeper: asyncio.Task[None] | None = None
         self._connections: set[_Connection] = set()
@@ -256,8 +267,17 @@ class MOOSDB:
 
     @property
     def buffered(self) -> int:
-        """Bytes of partial packets and unsent output held for all clients (as last seen)."""
-        return self._pending_total + self._unsent_total
+        """Bytes of partial packets, held mail and unsent output for all clients (as last
+        seen); with the stored variables (`core.stored_bytes`), what `memory_budget` bounds."""
+        return self._pending_total + self._unsent_total + self._held_total()
+
+    def _held_total(self) -> int:
+        return sum(record.held_size() for record in self.core.clients.values())
+
+    def _holding(self, conn: _Connection) -> int:
+        record = self.core.clients.get(conn.name) if conn.name is not None else None
+        held = record.held_size() if record is not None else 0
+        return conn.pending + conn.unsent + held
 
     async def start(self) -> None:
         self._loop = asyncio.get_running_loop()
@@ -313,14 +333,18 @@ class MOOSDB:
         self._check_budget()
 
     def _check_budget(self) -> None:
-        while self._pending_total + self._unsent_total > self.memory_budget:
-            biggest = max(self._connections, key=lambda c: c.pending + c.unsent, default=None)
-            if biggest is None or biggest.pending + biggest.unsent == 0:
+        while self.buffered + self.core.stored_bytes > self.memory_budget:
+            biggest = max(self._connections, key=self._holding, default=None)
+            holding = self._holding(biggest) if biggest is not None else 0
+            if biggest is None or holding == 0:
                 return
             biggest._drop(
-                f"holding {biggest.pending + biggest.unsent} bytes while all clients' buffers "
-                f"exceed the memory budget of {self.memory_budget} bytes"
+                f"holding {holding} bytes while the stored variables and all clients' "
+                f"buffers exceed the memory budget of {self.memory_budget} bytes"
             )
+            if biggest.name is not None and biggest.name in self.core.clients:
+                # its held mail goes with it now, not when the transport reports the loss
+                self.core.clients[biggest.name].drop_held()
 
     async def _sweep(self) -> None:
         loop = self._loop

@@ -15,10 +15,20 @@ The hot path is a notification: it is forwarded to its subscribers as the bytes 
 only what routing needs (key, data type, source). A variable keeps its last message as those
 bytes and decodes it only when asked (a snapshot for a new subscriber, `Q ALL`, summaries).
 A packet's messages are processed at one DB time (the clock is read once per packet).
+
+Bounds (none in the C++ DB; each refusal is logged once per client): variable names and client
+names at most MAX_NAME_LENGTH bytes, wildcard patterns at most MAX_PATTERN_LENGTH (MOOS names
+are identifiers such as NAV_X or ACOMMS_RAW_INCOMING, a few tens of bytes) and MAX_WILDCARDS
+of them per client (an app registers a handful); at most
+`max_variables` variables; the stored values at most `store_budget` bytes. The summaries keep
+each variable's line until the variable is written again and the sorted name list until a
+variable is added, so a refresh decodes only what changed, and at most
+SUMMARY_LINES_PER_REFRESH variables (a variable whose new line waits keeps its previous one).
 """
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import struct
@@ -31,6 +41,18 @@ from pygoby.util.clock import Clock, WallClock
 log = logging.getLogger(__name__)
 
 REFRESH_PERIOD = 2.0
+MAX_NAME_LENGTH = 256  # bytes of a variable or client name
+MAX_PATTERN_LENGTH = 256  # characters of a wildcard pattern (app or variable)
+MAX_WILDCARDS = 256  # wildcard registrations a client keeps (each new variable tests them all)
+# ten times a large community; a `*` subscription or `Q ALL` then costs the DB at most ~0.5 s
+# (~25 us a variable)
+DEFAULT_MAX_VARIABLES = 20_000
+# what a variable costs beside its value (measured: 100,000 variables of 20-character names,
+# their index entries and summary lines grow the DB's RSS by ~100 MB)
+VARIABLE_OVERHEAD = 1000
+# DB_VARSUMMARY lines made per refresh (~25 us each: a burst of new variables costs at most
+# ~0.1 s per refresh; the lines not made yet come in the next refreshes, the others stay)
+SUMMARY_LINES_PER_REFRESH = 4000
 DB_VARIABLES = ("DB_TIME", "DB_UPTIME", "DB_CLIENTS", "DB_VARSUMMARY", "DB_QOS", "DB_RWSUMMARY")
 # Outgoing packets are cut at this size: mail merged over one loop iteration can be large.
 MAX_OUTGOING_PACKET = 1 << 20
@@ -71,6 +93,8 @@ class Variable:
         "subscribers",
         "every_update",
         "timed",
+        "summary",
+        "summary_of",
     )
 
     def __init__(self, name: str) -> None:
@@ -86,8 +110,12 @@ class Variable:
         self.subscribers: dict[str, Subscription] = {}
         # routing tables derived from `subscribers` (rebuilt when they change): the held-mail
         # appenders of interval-0 subscribers, and the subscriptions with an interval
-        self.every_update: list = []
-        self.timed: list[Subscription] = []
+        self.every_update: list | tuple = ()  # () until subscribed: less memory per variable
+        self.timed: list[Subscription] | tuple = ()
+        # the DB_VARSUMMARY line, and the value it was made from (`raw` is a new object at
+        # every write, so the line is current while `summary_of is raw`)
+        self.summary = ""
+        self.summary_of: object = self
 
     @property
     def data_type(self) -> str:
@@ -129,11 +157,16 @@ class Variable:
 
     def subscribe(self, client: ClientRecord, interval: float) -> Subscription:
         sub = self.subscribers[client.name] = Subscription(client, interval)
+        client.subscribed.add(self.name)
+        client.rw_summary = None
         self._reroute()
         return sub
 
     def unsubscribe(self, name: str) -> None:
-        if self.subscribers.pop(name, None) is not None:
+        sub = self.subscribers.pop(name, None)
+        if sub is not None:
+            sub.client.subscribed.discard(self.name)
+            sub.client.rw_summary = None
             self._reroute()
 
     def _reroute(self) -> None:
@@ -141,12 +174,17 @@ class Variable:
         self.every_update = [s.client.held.append for s in subs if s.interval == 0.0]
         self.timed = [s for s in subs if s.interval != 0.0]
 
-    def clear(self) -> None:
+    def clear(self) -> int:
+        """Forget the value; the bytes it held."""
+        held = 0
         if self.raw is not None:
             self.community = self.message().community
+            held = len(self.raw)
         self.raw = None
+        self.summary_of = self  # its line is out of date (an unwritten variable's was None)
         self.accepts = -1
         self.write_time, self.write_rate = -1.0, 0.0
+        return held
 
 
 class ClientRecord:
@@ -162,6 +200,11 @@ class ClientRecord:
         "filters",
         "latencies_ms",
         "published",
+        "subscribed",
+        "rw_summary",
+        "refused",
+        "held_counted",
+        "held_bytes",
     )
 
     def __init__(self, name: str, asynchronous: bool) -> None:
@@ -173,6 +216,25 @@ class ClientRecord:
         self.filters: dict[tuple[str, str], tuple[p.Glob, p.Glob, float]] = {}
         self.latencies_ms: list[float] = []
         self.published: set[str] = set()
+        self.subscribed: set[str] = set()
+        self.rw_summary: str | None = None  # its DB_RWSUMMARY entry, None when out of date
+        self.refused: set[str] = set()  # the kinds of refusal already logged for it
+        # the bytes of held mail: `held_bytes` counts held[:held_counted] (see held_size)
+        self.held_counted = 0
+        self.held_bytes = 0
+
+    def held_size(self) -> int:
+        """Bytes of mail held for this client (counting only what was added since last time;
+        mail queued for several clients is counted for each)."""
+        held = self.held
+        if len(held) > self.held_counted:
+            self.held_bytes += sum(map(len, held[self.held_counted :]))
+            self.held_counted = len(held)
+        return self.held_bytes
+
+    def drop_held(self) -> None:
+        self.held.clear()
+        self.held_counted = self.held_bytes = 0
 
     def release(self, head: bytes | None = None, tail: list[bytes] | None = None) -> None:
         """Make [head] + held mail + [tail] due, as one packet (merged with mail made due
@@ -183,7 +245,7 @@ class ClientRecord:
             out.append(head)
         if self.held:
             out += self.held
-            self.held.clear()
+            self.drop_held()
         if tail:
             out += tail
 
@@ -220,6 +282,10 @@ class _Source:
 
     def __init__(self, core: DBCore, data: bytes, at: int, stop: int) -> None:
         src, pos = p.read_str(data, at, stop, "src")
+        if len(src) > MAX_NAME_LENGTH:  # the src is a client name: app patterns test it
+            raise MoosProtocolError(
+                f"src of {len(src)} bytes is longer than a name may be ({MAX_NAME_LENGTH})"
+            )
         _aux, pos = p.read_str(data, pos, stop, "src_aux")
         community, pos = p.read_str(data, pos, stop, "community")
         self.head = bytes(data[at:pos])
@@ -243,7 +309,11 @@ class DBCore:
         community: str = p.DEFAULT_COMMUNITY,
         clock: Clock | None = None,
         hostname: str = "localhost",
+        max_variables: int = DEFAULT_MAX_VARIABLES,
+        store_budget: int | None = None,
     ) -> None:
+        """`max_variables`: most variables (refused beyond); `store_budget`: most bytes of
+        stored values and variables (a write beyond it is refused; None: no bound)."""
         self.community = community or p.DEFAULT_COMMUNITY
         community_bytes = p.encode_text(self.community)
         self.community_field = _INT.pack(len(community_bytes)) + community_bytes
@@ -252,8 +322,14 @@ class DBCore:
         self.name = f"MOOSDB_{self.community}"
         self.start_time = self.clock.now()
         self._last_refresh = self.start_time
+        self.max_variables = max_variables
+        self.store_budget = store_budget if store_budget is not None else math.inf
+        self.stored_bytes = 0  # the variables and their values (VARIABLE_OVERHEAD each)
         self.variables: dict[str, Variable] = {}
         self._by_key: dict[bytes, Variable] = {}
+        self._sorted: list[Variable] = []  # by name, but for the variables in `_unsorted`
+        self._unsorted: list[Variable] = []
+        self._summary_from = 0  # where in `_sorted` the next refresh starts making lines
         for name in (*DB_VARIABLES, "DB_EVENT"):
             self._variable(name)
         self.clients: dict[str, ClientRecord] = {}
@@ -268,8 +344,14 @@ class DBCore:
         the caller sends before anything else to that client."""
         now = self.clock.now()
         name = handshake.string
-        if name in self.clients or not name:
-            reason = p.name_in_use_reason(name) if name else "Failed to read receive client's name"
+        if name in self.clients or not name or len(handshake.sval) > MAX_NAME_LENGTH:
+            if len(handshake.sval) > MAX_NAME_LENGTH:
+                reason = f"a client name is at most {MAX_NAME_LENGTH} bytes"
+                name = name[:40] + "..."
+            elif name:
+                reason = p.name_in_use_reason(name)
+            else:
+                reason = "Failed to read receive client's name"
             log.warning("refusing client %r: %s", name, reason)
             return p.poison_message(reason, now)
         asynchronous = handshake.key.lower() == p.ASYNC_HANDSHAKE_KEY
@@ -281,12 +363,13 @@ class DBCore:
 
     def disconnect(self, name: str) -> None:
         """Forget a client: its subscriptions, filters, held and unwritten mail."""
-        if self.clients.pop(name, None) is None:
+        client = self.clients.pop(name, None)
+        if client is None:
             return
         self._ready.pop(name, None)
         self._relearn_source()
-        for var in self.variables.values():
-            var.unsubscribe(name)
+        for var_name in list(client.subscribed):
+            self.variables[var_name].unsubscribe(name)
         self._write_own("DB_EVENT", f"disconnected={name}")
         self._push(exclude=None)
 
@@ -419,20 +502,28 @@ class DBCore:
             var = by_key.get(data[key_at + 4 : key_end])
             if var is None or var.accepts != data_type:
                 var = self._first_or_mistyped_write(
-                    var, data[key_at + 4 : key_end], data_type, source.src, now
+                    client, var, data[key_at + 4 : key_end], data_type, source.src, now, len(raw)
                 )
                 if var is None:
                     pos = stop
                     continue
-            elif now != var.write_time:
-                if now > var.write_time:
-                    var.write_rate = 0.9 * var.write_rate + 0.1 / (now - var.write_time)
-                var.write_time = now
+            else:
+                grown = len(raw) - len(var.raw)  # type: ignore[arg-type]  # written: bytes
+                if grown > 0 and self.stored_bytes + grown > self.store_budget:
+                    self._refuse_store(client, var.name)
+                    pos = stop
+                    continue
+                self.stored_bytes += grown
+                if now != var.write_time:
+                    if now > var.write_time:
+                        var.write_rate = 0.9 * var.write_rate + 0.1 / (now - var.write_time)
+                    var.write_time = now
             var.raw = raw
             if var.last_source is not source:
                 var.last_source = source
                 if source.publisher is not None:
                     source.publisher.published.add(var.name)
+                    source.publisher.rw_summary = None
             for append in var.every_update:
                 append(raw)
             for sub in var.timed:
@@ -447,12 +538,26 @@ class DBCore:
         return had_notify
 
     def _first_or_mistyped_write(
-        self, var: Variable | None, key: bytes, data_type: int, src: str, now: float
+        self,
+        client: ClientRecord | None,
+        var: Variable | None,
+        key: bytes,
+        data_type: int,
+        src: str,
+        now: float,
+        size: int,
     ) -> Variable | None:
-        """The variable a write of `data_type` goes to, or None when the type lock drops it."""
+        """The variable a write of `data_type` (`size` bytes) goes to, or None when the type
+        lock drops it or a bound refuses it."""
         if var is None:
-            var = self._variable(p.decode_text(key))
+            var = self._new_variable(client, key)
+            if var is None:
+                return None
         if var.raw is None:
+            if self.stored_bytes + size > self.store_budget:
+                self._refuse_store(client, var.name)
+                return None
+            self.stored_bytes += size
             var.type_code = var.accepts = data_type
             var.write_time = now  # no write rate from a first write
             self._apply_filters_on_creation(var, src)
@@ -477,15 +582,20 @@ class DBCore:
         kind = msg.msg_type
         if kind == p.REGISTER:
             interval = msg.dval if math.isfinite(msg.dval) and msg.dval > 0 else 0.0
+            if (
+                msg.key not in self.variables
+                and self._new_variable(client, p.encode_text(msg.key)) is None
+            ):
+                return
             self._on_register(msg.src, msg.key, interval, now)
         elif kind == p.UNREGISTER:
             var = self.variables.get(msg.key)
             if var is not None:
                 var.unsubscribe(msg.src)
         elif kind == p.WILDCARD_REGISTER:
-            self._on_wildcard(msg.src, msg.sval, now, register=True)
+            self._on_wildcard(client, msg.src, msg.sval, now, register=True)
         elif kind == p.WILDCARD_UNREGISTER:
-            self._on_wildcard(msg.src, msg.sval, now, register=False)
+            self._on_wildcard(client, msg.src, msg.sval, now, register=False)
         elif kind == p.SERVER_REQUEST and client is not None:
             answers += map(p.encode_message, self._server_request(msg, now))
 
@@ -496,7 +606,55 @@ class DBCore:
         if var is None:
             var = self.variables[name] = Variable(name)
             self._by_key[var.key] = var
+            self._unsorted.append(var)
+            self.stored_bytes += VARIABLE_OVERHEAD + len(var.key)
         return var
+
+    def _new_variable(self, client: ClientRecord | None, key: bytes) -> Variable | None:
+        """A new variable named `key`, or None (logged) when a bound refuses it."""
+        if len(key) > MAX_NAME_LENGTH:
+            self._refuse(
+                client,
+                "name",
+                f"variable name of {len(key)} bytes refused (at most {MAX_NAME_LENGTH})",
+            )
+            return None
+        if len(self.variables) >= self.max_variables:
+            self._refuse(
+                client,
+                "max_variables",
+                f"new variable {p.decode_text(key[:64])!r} refused: the DB holds "
+                f"{len(self.variables)} variables (max_variables)",
+            )
+            return None
+        if self.stored_bytes + VARIABLE_OVERHEAD + len(key) > self.store_budget:
+            self._refuse_store(client, p.decode_text(key[:64]))
+            return None
+        return self._variable(p.decode_text(key))
+
+    def _refuse_store(self, client: ClientRecord | None, name: str) -> None:
+        self._refuse(
+            client,
+            "store",
+            f"write to {name!r} refused: the stored variables would exceed the memory "
+            f"budget of {self.store_budget:.0f} bytes",
+        )
+
+    def _refuse(self, client: ClientRecord | None, kind: str, text: str) -> None:
+        """Log a refusal once per client and kind (a client repeating it is not logged again)."""
+        if client is None:
+            log.warning("%s", text)
+        elif kind not in client.refused:
+            client.refused.add(kind)
+            log.warning("client %s: %s (logged once per client)", client.name, text)
+
+    def sorted_variables(self) -> list[Variable]:
+        """Every variable by name (sorted again only when variables were added)."""
+        if self._unsorted:
+            self._sorted += self._unsorted
+            self._unsorted.clear()
+            self._sorted.sort(key=_by_name)
+        return self._sorted
 
     def _write_own(self, name: str, value: float | str) -> None:
         now = self.clock.now()
@@ -513,16 +671,43 @@ class DBCore:
             client.held.append(var.snapshot())
             sub.last_sent = now
 
-    def _on_wildcard(self, subscriber: str, sval: bytes, now: float, register: bool) -> None:
+    def _on_wildcard(
+        self,
+        sender: ClientRecord | None,
+        subscriber: str,
+        sval: bytes,
+        now: float,
+        register: bool,
+    ) -> None:
         client = self.clients.get(subscriber)
         if client is None:
             return
         app, var_pattern, interval = p.parse_wildcard_sval(sval)
+        if max(len(app), len(var_pattern)) > MAX_PATTERN_LENGTH:
+            self._refuse(
+                sender,
+                "pattern",
+                f"wildcard pattern of {max(len(app), len(var_pattern))} characters refused "
+                f"(at most {MAX_PATTERN_LENGTH})",
+            )
+            return
+        if (
+            register
+            and (app, var_pattern) not in client.filters
+            and len(client.filters) >= MAX_WILDCARDS
+        ):
+            self._refuse(
+                sender,
+                "wildcards",
+                f"wildcard registration refused: {client.name} has {MAX_WILDCARDS} already",
+            )
+            return
         app_glob, var_glob = p.Glob(app), p.Glob(var_pattern)
         if register:
             client.filters.setdefault((app, var_pattern), (app_glob, var_glob, interval))
-        for var in sorted(self.variables.values(), key=lambda v: v.name):  # the C++ map's order
-            if var_glob.match(var.name) and app_glob.match(var.src):
+        for var in self.sorted_variables():  # the C++ map's order
+            # `*` matches every publisher: no need to decode each value for its src
+            if var_glob.match(var.name) and (app == "*" or app_glob.match(var.src)):
                 if register:
                     self._on_register(subscriber, var.name, interval, now)
                 else:
@@ -541,7 +726,7 @@ class DBCore:
         key = msg.key
         if key == "ALL":
             out = []
-            for var in sorted(self.variables.values(), key=lambda v: v.name, reverse=True):
+            for var in reversed(self.sorted_variables()):
                 m = var.message()
                 is_double = var.type_code == _DOUBLE
                 rel = var.write_time - self.start_time if var.written else -1.0
@@ -562,21 +747,21 @@ class DBCore:
                 )
             return out
         if "VAR_SUMMARY" in key:
-            names = ",".join(sorted(self.variables))
+            names = ",".join([var.name for var in self.sorted_variables()])
             return [self._reply("VAR_SUMMARY", now, names, msg.id, community="")]
         if "PROC_SUMMARY" in key:
             out = []
             for client in self.clients.values():
-                subs = "".join(f",{n}" for n in self._subscribed(client.name))
+                subs = "".join(f",{n}" for n in sorted(client.subscribed))
                 pubs = "".join(f",{n}" for n in sorted(client.published))
                 text = f"{client.name}:SUBSCRIBED={subs},PUBLISHED={pubs}"
                 out.append(self._reply("PROC_SUMMARY", now - self.start_time, text, msg.id, ""))
             return out
         if "DB_CLEAR" in key:
             for var in self.variables.values():
-                var.clear()
+                self.stored_bytes -= var.clear()
             for client in self.clients.values():
-                client.held.clear()
+                client.drop_held()
             self.start_time = now
             return []
         return []
@@ -587,9 +772,6 @@ class DBCore:
         msg = p.notify(key, text, time=time, src=self.name, msg_id=msg_id)
         msg.community = self.community if community is None else community
         return msg
-
-    def _subscribed(self, name: str) -> list[str]:
-        return sorted(v.name for v in self.variables.values() if name in v.subscribers)
 
     # -- DB_* variables ------------------------------------------------------------------------
 
@@ -616,28 +798,55 @@ class DBCore:
         return "".join(parts)
 
     def _rw_summary(self) -> str:
-        return ",".join(
-            f"{c.name}={':'.join(self._subscribed(c.name))}&{':'.join(sorted(c.published))}"
-            for c in self.clients.values()
-        )
+        parts = []
+        for c in self.clients.values():
+            if c.rw_summary is None:
+                subscribed, published = (
+                    ":".join(sorted(c.subscribed)),
+                    ":".join(sorted(c.published)),
+                )
+                c.rw_summary = f"{c.name}={subscribed}&{published}"
+            parts.append(c.rw_summary)
+        return ",".join(parts)
 
     def _var_summary(self) -> str:
-        lines = []
-        for var in sorted(self.variables.values(), key=lambda v: v.name):
-            m = var.message()
-            when = _time.strftime("%H:%M:%S", _time.gmtime(var.write_time)) if var.written else "-"
-            writer = m.src if var.written else "(write pending)"
-            if var.type_code == _DOUBLE:
-                value = f"{m.dval:.1f}"
-            elif var.data_type == p.BINARY:
-                value = _binary_size(len(m.sval))
-            else:
-                text = m.string
-                value = text[:22] + "..." if len(text) > 25 else text
-            lines.append(
-                f"{var.name} {when} {writer} {var.write_rate:.1f} Hz {var.data_type} {value}"
-            )
-        return "\n".join(lines)
+        """One line per variable, by name; at most SUMMARY_LINES_PER_REFRESH lines made again,
+        taking turns from where the last refresh stopped (a variable without a line yet is
+        left out until its turn)."""
+        variables = self.sorted_variables()
+        count = len(variables)
+        budget = SUMMARY_LINES_PER_REFRESH
+        start = self._summary_from % count if count else 0
+        for index in itertools.chain(range(start, count), range(start)):
+            var = variables[index]
+            if var.summary_of is not var.raw:
+                if budget == 0:
+                    self._summary_from = index
+                    break
+                budget -= 1
+                _summary_line(var)
+        return "\n".join([var.summary for var in variables if var.summary])
+
+
+def _by_name(var: Variable) -> str:
+    return var.name
+
+
+def _summary_line(var: Variable) -> str:
+    """The variable's DB_VARSUMMARY line, kept in it until its next write."""
+    m = var.message()
+    when = _time.strftime("%H:%M:%S", _time.gmtime(var.write_time)) if var.written else "-"
+    writer = m.src if var.written else "(write pending)"
+    if var.type_code == _DOUBLE:
+        value = f"{m.dval:.1f}"
+    elif var.data_type == p.BINARY:
+        value = _binary_size(len(m.sval))
+    else:
+        text = m.string
+        value = text[:22] + "..." if len(text) > 25 else text
+    var.summary = f"{var.name} {when} {writer} {var.write_rate:.1f} Hz {var.data_type} {value}"
+    var.summary_of = var.raw
+    return var.summary
 
 
 def _binary_size(n: int) -> str:

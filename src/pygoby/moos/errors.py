@@ -23,3 +23,12 @@ class AntlerError(MoosError):
 
 class MissionFileError(MoosError, ConfigError):
     """A .moos mission file lacks what is asked of it (e.g. the ANTLER block)."""
+
+
+class BlockSyntaxError(MoosError, ValueError):
+    """A mistake TextFormat cannot read past (a scalar without its ':', a block never closed),
+    at `line` of the block: reported as it is, before any field of the block is looked at."""
+
+    def __init__(self, line: int, reason: str) -> None:
+        super().__init__(f"line {line}: {reason}")
+        self.line, self.reason = line, reason

@@ -30,6 +30,8 @@ from dataclasses import dataclass, field
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
+from pygoby.moos.errors import BlockSyntaxError
+
 # ---------------------------------------------------------------------------------------------
 # Tokens and the field tree
 
@@ -127,9 +129,13 @@ class _Parser:
             opening = self.take()
             closing = "}" if opening.text == "{" else ">"
             result.children = self.fields(closing)
+            if self.peek() is None:
+                raise BlockSyntaxError(
+                    name.line, f"the '{opening.text}' after {name.text} is never closed"
+                )
             result.brackets = (opening, self.take())
         elif result.colon is None:
-            raise ValueError(f"line {name.line}: {name.text} needs ':' or a block")
+            raise BlockSyntaxError(name.line, f"expected ':' after {name.text}")
         elif self.peek() == "[":
             result.value.append(self.take())
             while self.peek() not in ("]", None):
@@ -333,11 +339,14 @@ class Translation:
 
 def translate(text: str, descriptor: Descriptor) -> Translation:
     """Rewrite the Goby 1.1/2 forms of a ProcessConfig block for `descriptor` (the app's
-    configuration type). Text that does not tokenize is returned unchanged (protobuf's parser
-    then reports the problem with its line)."""
+    configuration type). Raises BlockSyntaxError for a mistake no parser reads past (protobuf's
+    would first report a field before it that only this rewriting makes valid). Other text that
+    does not tokenize is returned unchanged (protobuf's parser then reports it with its line)."""
     try:
         parser = _Parser(tokenize(text))
         fields = parser.fields(None)
+    except BlockSyntaxError:
+        raise
     except ValueError:  # not TextFormat we understand: left for protobuf to report
         return Translation(text, [])
     notes: list[str] = []

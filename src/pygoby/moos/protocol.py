@@ -500,16 +500,18 @@ class Glob:
     """A MOOS glob, compiled once: `*` any sequence, `?` one character, everything else
     literal, case-sensitive, whole name (unlike fnmatch, `[` and `]` are ordinary characters).
 
-    Matching never backtracks: the text between stars is placed at its leftmost possible
-    position, one piece after the other (which finds a match whenever there is one), so a test
-    costs at most len(name) x len(pattern) character comparisons whatever the pattern."""
+    Matching never backtracks and costs time linear in the name: the text between stars is
+    placed at its leftmost possible position, one piece after the other (which finds a match
+    whenever there is one); a piece holding `?` is searched for by bit-parallel matching
+    (shift-and: one step per character of the name, whatever the piece's length)."""
 
-    __slots__ = ("pattern", "_pieces", "_min_len")
+    __slots__ = ("pattern", "_pieces", "_min_len", "_searches")
 
     def __init__(self, pattern: str) -> None:
         self.pattern = pattern
         self._pieces = pattern.split("*")  # one piece: no star; else head, middles..., tail
         self._min_len = len(pattern) - len(self._pieces) + 1
+        self._searches = [_PieceSearch(piece) for piece in self._pieces[1:-1]]
 
     def match(self, name: str) -> bool:
         pieces = self._pieces
@@ -519,11 +521,10 @@ class Glob:
             return False
         tail_start = len(name) - len(pieces[-1])
         pos = len(pieces[0])
-        for piece in pieces[1:-1]:
-            pos = _find_piece(piece, name, pos, tail_start)
+        for search in self._searches:
+            pos = search.find(name, pos, tail_start)
             if pos < 0:
                 return False
-            pos += len(piece)
         return _piece_at(pieces[-1], name, tail_start)
 
     def __repr__(self) -> str:
@@ -539,14 +540,38 @@ def _piece_at(piece: str, name: str, at: int) -> bool:
     return all(c == "?" or c == name[at + i] for i, c in enumerate(piece))
 
 
-def _find_piece(piece: str, name: str, start: int, stop: int) -> int:
-    """Leftmost offset >= start where `piece` matches and ends at or before `stop`; -1 if none."""
-    if "?" not in piece:
-        return name.find(piece, start, stop)
-    for at in range(start, stop - len(piece) + 1):
-        if _piece_at(piece, name, at):
-            return at
-    return -1
+class _PieceSearch:
+    """The leftmost place of one star-free piece in a name."""
+
+    __slots__ = ("piece", "_masks", "_wild", "_last")
+
+    def __init__(self, piece: str) -> None:
+        self.piece = piece
+        # shift-and tables: bit i of a character's mask is set when piece[i] accepts it
+        self._wild = sum(1 << i for i, c in enumerate(piece) if c == "?")
+        self._masks: dict[str, int] = {}
+        for i, c in enumerate(piece):
+            if c != "?":
+                self._masks[c] = self._masks.get(c, self._wild) | 1 << i
+        self._last = 1 << (len(piece) - 1) if piece else 0
+
+    def find(self, name: str, start: int, stop: int) -> int:
+        """The end (exclusive) of the leftmost match at or after `start` that ends at or
+        before `stop`; -1 if none."""
+        piece = self.piece
+        if not self._masks:  # no literal character: only the length counts
+            end = start + len(piece)
+            return end if end <= stop else -1
+        if not self._wild:
+            at = name.find(piece, start, stop)
+            return at + len(piece) if at >= 0 else -1
+        masks, wild, last = self._masks, self._wild, self._last
+        state = 0
+        for end in range(start, stop):
+            state = ((state << 1) | 1) & masks.get(name[end], wild)
+            if state & last:
+                return end + 1
+        return -1
 
 
 def wildcard_match(pattern: str, name: str) -> bool:

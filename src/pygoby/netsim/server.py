@@ -76,6 +76,8 @@ class ManagerServer:
                 await asyncio.sleep(0)
         except (ConnectionError, OSError) as exc:
             log.info("client %s: %s", peer, exc)
+        except asyncio.CancelledError:  # closing: end quietly (asyncio 3.11's stream callback
+            pass  # would log the cancelled task's CancelledError as an unhandled exception)
         finally:
             self._tasks.discard(task)
             writer.close()

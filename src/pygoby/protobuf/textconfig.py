@@ -61,6 +61,7 @@ def merge_config_text(
     """Merge TextFormat `text` (starting at `first_line` of `file`) into `message`; problems
     raise `error` (ConfigError or a subclass, e.g. ScenarioError)."""
     lines = text.split("\n")
+    _refuse_non_utf8(lines, file, first_line, error)
     try:
         if parser is None:
             text_format.Merge(text, message)
@@ -91,8 +92,8 @@ def _located(
         detail = detail[len(quoted) :]
     if "surrogates not allowed" in detail:  # bytes of the file that are not UTF-8
         detail = "string is not valid UTF-8 (protobuf strings must be)"
-    shown = _printable(line_text.strip())
-    detail = _printable(detail)
+    shown = printable_text(line_text.strip())
+    detail = printable_text(detail)
     return error(
         f"{detail}\n    {shown}",
         file=file,
@@ -101,7 +102,46 @@ def _located(
     )
 
 
-def _printable(text: str) -> str:
+_SURROGATE = re.compile("[\udc80-\udcff]")  # a byte of the file that is not UTF-8
+
+
+def _refuse_non_utf8(lines: list[str], file, first_line: int, error: type[ConfigError]) -> None:
+    """A non-UTF-8 byte outside comments is a located error here: in a string protobuf could
+    not store it, and in an enum value (quoted or not) its parser fails with a SystemError.
+    In a `#` comment it is harmless."""
+    for number, line in enumerate(lines, start=1):
+        if _SURROGATE.search(line) is None:
+            continue
+        quote = ""
+        escaped = False
+        for column, char in enumerate(line):
+            if quote:
+                if escaped:
+                    escaped = False
+                elif char == "\\":
+                    escaped = True
+                elif char == quote:
+                    quote = ""
+            elif char in "\"'":
+                quote = char
+            elif char == "#":
+                break
+            if _SURROGATE.match(char):
+                reason = (
+                    "string is not valid UTF-8 (protobuf strings must be)"
+                    if quote
+                    else f"byte 0x{ord(char) - 0xDC00:02X} is not valid UTF-8 (configuration "
+                    "text must be UTF-8 outside comments)"
+                )
+                raise error(
+                    f"{reason}\n    {printable_text(line.strip())}",
+                    file=file,
+                    line=first_line + number - 1,
+                    field=_field_near(line, column + 1),
+                )
+
+
+def printable_text(text: str) -> str:
     """Text with the file's non-UTF-8 bytes shown as \\xNN escapes."""
     raw = text.encode("utf-8", "surrogateescape")
     return raw.decode("utf-8", "backslashreplace")

@@ -7,7 +7,9 @@ from pygoby.topside.errors import (
     CommanderError,
     FieldValueError,
     SaveFileError,
+    ScopeFilterError,
     SpecialError,
+    TooManyStreamsError,
     TopsideError,
 )
 from pygoby.util.modules import lazy_exports
@@ -37,7 +39,9 @@ __all__ = [
     "Liaison",
     "LiaisonState",
     "SaveFileError",
+    "ScopeFilterError",
     "SpecialError",
+    "TooManyStreamsError",
     "TopsideError",
     "WebServer",
     "read_acomms_config",

@@ -22,3 +22,11 @@ class SpecialError(TopsideError, ValueError):
 
 class SaveFileError(TopsideError, ValueError):
     """Not an iCommander save file."""
+
+
+class ScopeFilterError(TopsideError, ValueError):
+    """A Scope filter liaison does not take (too long)."""
+
+
+class TooManyStreamsError(TopsideError):
+    """Every live-update stream liaison allows is open (max_streams)."""

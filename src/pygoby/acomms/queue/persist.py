@@ -82,12 +82,28 @@ class QueueStore:
                     )
                 db.execute(_SCHEMA)
                 db.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
+                # a damaged page would otherwise surface later, in the middle of a read
+                problems = [
+                    line
+                    for (text,) in db.execute("PRAGMA quick_check(3)")
+                    for line in text.splitlines()
+                    if line != "ok" and not line.startswith("*** in database")
+                ]
+                if problems:
+                    more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
+                    raise sqlite3.DatabaseError(problems[0] + more)
         except (sqlite3.Error, QueueError) as exc:
             if db is not None:
                 db.close()
             if isinstance(exc, QueueError):
                 raise
-            why = "in use by another process" if "locked" in str(exc) else str(exc)
+            if "locked" in str(exc):
+                why = "in use by another process"
+            else:
+                why = (
+                    f"{exc}: the file is damaged or not a queue file; move it aside to start "
+                    "with an empty queue (the messages in it are lost)"
+                )
             raise QueueError(f"persistent queue {self.path}: {why}") from None
         self.db = db
 

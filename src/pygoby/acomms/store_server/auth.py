@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import hmac
 import os
+import stat
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import StoreServerAuthError
@@ -58,13 +59,23 @@ def read_secret_file(path: str | os.PathLike[str]) -> bytes:
     return secret
 
 
-def read_secrets(path: str | os.PathLike[str]) -> dict[int, bytes]:
-    """The server's secrets: one `MODEM_ID SECRET` per line (# comments, blank lines)."""
+def read_secrets(path: str | os.PathLike[str], allow_readable: bool = False) -> dict[int, bytes]:
+    """The server's secrets: one `MODEM_ID SECRET` per line (# comments, blank lines).
+
+    A file that its group or others may read or write is refused unless `allow_readable`
+    (as ssh refuses such a private key): anyone who can read it can sign as every modem."""
     try:
         with open(path, "rb") as file:
+            mode = os.fstat(file.fileno()).st_mode
             lines = file.read().split(b"\n")
     except OSError as exc:
         raise ConfigError(exc.strerror or str(exc), file=path) from None
+    if mode & (stat.S_IRWXG | stat.S_IRWXO) and not allow_readable:
+        raise ConfigError(
+            f"permissions {stat.S_IMODE(mode):04o} let others than its owner use it "
+            f"(chmod 600 {os.fspath(path)}, or --allow-readable-secrets)",
+            file=path,
+        )
     secrets: dict[int, bytes] = {}
     for number, raw in enumerate(lines, start=1):
         line = raw.strip()

@@ -40,7 +40,9 @@ class StoreServer:
     """Sans-I/O request handling: packet bytes in, packet bytes out (or None if invalid).
 
     `secrets`: modem id -> shared secret; when given, only requests signed with their modem
-    id's secret (store_server.auth) are carried out, and ids without a secret are refused.
+    id's secret (store_server.auth) are carried out, ids without a secret are refused, and
+    outbox transmissions whose `src` is not the signing modem are dropped (a modem must not
+    post mail as another).
     `auth_window`: how far (s) a signed request's time may be from the server's clock.
     """
 
@@ -77,6 +79,8 @@ class StoreServer:
         now = self.clock.now()
         try:
             auth_time = self._authenticate(request.modem_id, payload, now)
+            if auth_time is not None:
+                _drop_forged(request)
             response = self.store.exchange(request, now, max_data_bytes(), auth_time)
         except StoreServerAuthError as exc:
             log.warning("refusing a request for modem id %d: %s", request.modem_id, exc)
@@ -114,6 +118,22 @@ class StoreServer:
             return
         if pruned:
             log.info("pruned %d delivered or expired transmissions", pruned)
+
+
+def _drop_forged(request) -> None:
+    """Remove the outbox transmissions that claim another modem as their source."""
+    forged = [t for t in request.outbox if t.src != request.modem_id]
+    if not forged:
+        return
+    log.warning(
+        "dropping %d transmission(s) from modem id %d that claim another source (src %s)",
+        len(forged),
+        request.modem_id,
+        ", ".join(sorted({str(t.src) for t in forged})),
+    )
+    kept = [t for t in request.outbox if t.src == request.modem_id]
+    del request.outbox[:]
+    request.outbox.extend(kept)
 
 
 def _error_reply(request, error: str) -> bytes:

@@ -50,9 +50,15 @@ class EnumCodec(FixedWidthCodec):
                 return n if n in known else None
 
         self.to_raw, self.from_raw = to_raw, from_raw
+        self.value_names = [f"{v.name}={v.number}" for v in values]
 
     def describe(self) -> str:
-        return f"{'index' if self.packed else 'number'} [{self.lo}, {self.hi}]"
+        """The encoding and the values by name (as the .proto lists them; a long enum's first
+        and last eight)."""
+        names = self.value_names
+        shown = names if len(names) <= 16 else [*names[:8], "...", *names[-8:]]
+        kind = "index" if self.packed else "number"
+        return f"{kind} [{self.lo}, {self.hi}]: {', '.join(shown)}"
 
 
 class EnumCodecV2(EnumCodec):

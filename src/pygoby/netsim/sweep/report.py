@@ -6,10 +6,10 @@ HTML page that shows them with the numbers behind them.
   Packets are pooled over the runs and links of a range bin and treated as independent
   Bernoulli trials (packets on one link in one run are correlated, so read the interval as a
   lower bound on the real uncertainty);
-* `throughput_vs_nodes.png` and `latency_vs_nodes.png`: per run, NodeStatus messages delivered
-  per hour over all links, and their mean delivery latency (delivery time minus the message's
-  time stamp), against the node count, one line per rate: mean over the runs, bars ±1.96
-  standard errors of that mean;
+* `throughput_vs_nodes.png` and `latency_vs_nodes.png` (only when the node count is an axis of
+  the sweep): per run, NodeStatus messages delivered per hour over all links, and their mean
+  delivery latency (delivery time minus the message's time stamp), against the node count, one
+  line per rate: mean over the runs, bars ±1.96 standard errors of that mean;
 * `snr_vs_range.png`: every link's mean SNR (and SINR, interference included) against range.
 
 Ranges are grouped by their distinct values (rounded to 1 m) when there are at most
@@ -216,36 +216,47 @@ def plot_snr_vs_range(rows: list[dict], path: Path) -> Path:
 
 
 def write_sweep_report(table: pa.Table, out_dir: str | Path) -> list[Path]:
-    """The four figures and index.html in `out_dir`; returns their paths."""
+    """The figures and index.html in `out_dir`; returns their paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     rows = table.to_pylist()
     points = success_by_range(rows)
     runs = per_run(rows)
-    figures = [
-        plot_success_vs_range(points, out / "success_vs_range.png"),
-        _plot_vs_nodes(
-            runs,
-            "throughput_per_hour",
-            "NodeStatus messages delivered per hour",
-            "Throughput vs node count (mean over runs, ±1.96 SE)",
-            out / "throughput_vs_nodes.png",
-        ),
-        _plot_vs_nodes(
-            runs,
-            "latency_s",
-            "mean message latency (s)",
-            "Latency vs node count (mean over runs, ±1.96 SE)",
-            out / "latency_vs_nodes.png",
-        ),
-        plot_snr_vs_range(rows, out / "snr_vs_range.png"),
-    ]
+    figures = [plot_success_vs_range(points, out / "success_vs_range.png")]
+    node_counts = sorted({r.nodes for r in runs})
+    notes = []
+    # a figure against the node count says something only when the node count was swept
+    if len(node_counts) > 1:
+        figures += [
+            _plot_vs_nodes(
+                runs,
+                "throughput_per_hour",
+                "NodeStatus messages delivered per hour",
+                "Throughput vs node count (mean over runs, ±1.96 SE)",
+                out / "throughput_vs_nodes.png",
+            ),
+            _plot_vs_nodes(
+                runs,
+                "latency_s",
+                "mean message latency (s)",
+                "Latency vs node count (mean over runs, ±1.96 SE)",
+                out / "latency_vs_nodes.png",
+            ),
+        ]
+    else:
+        for stale in ("throughput_vs_nodes.png", "latency_vs_nodes.png"):
+            (out / stale).unlink(missing_ok=True)  # from an earlier report of other results
+        notes.append(
+            "Throughput and latency against the node count are not drawn: every run has "
+            f"{node_counts[0] if node_counts else 0} nodes (sweep layout.nodes to see them)."
+        )
+    figures.append(plot_snr_vs_range(rows, out / "snr_vs_range.png"))
     page = out / "index.html"
-    page.write_text(_html(table, rows, runs, points, figures))
+    page.write_text(_html(table, rows, runs, points, figures, notes))
     return [*figures, page]
 
 
-def _html(table: pa.Table, rows, runs, points, figures) -> str:
+def _html(table: pa.Table, rows, runs, points, figures, notes: Sequence[str] = ()) -> str:
     esc = html.escape
     fixed = {"run_id", "point", "replicate", "seed"}
     columns = [c for c in table.column_names if c not in fixed]
@@ -273,7 +284,7 @@ img{{max-width:40em}}</style></head><body>
 <h1>netsim sweep report</h1>
 <p>{len(runs)} runs, {seeds} seeds, {table.num_rows} link rows.</p>
 <h2>Axes</h2><table><tr><th>column</th><th>values</th></tr>{axes}</table>
-<h2>Figures</h2>{images}
+<h2>Figures</h2>{"".join(f"<p>{esc(n)}</p>" for n in notes)}{images}
 <h2>Packet success by rate and range</h2>
 <p>Success = data packets received with every frame good / packets sent, pooled over runs and
 links; interval: 95 % Wilson score.</p>

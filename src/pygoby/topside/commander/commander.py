@@ -217,6 +217,24 @@ class Commander:
         draft.values.clear()
 
     # ------------------------------------------------------------------ specials
+    def specials(self, kind: CommandType, field_name: str) -> list[str]:
+        """The specials that make sense in a field: `time` in a double field or an integer
+        one named for a time, `xy` in a latitude/longitude pair, `modem_id` in an integer
+        field, `community` in a string field (none in a field the operator does not edit)."""
+        spec = kind.field(field_name)
+        if not spec.editable:
+            return []
+        out = []
+        if spec.kind == "float" or (spec.kind == "int" and "time" in field_name.lower()):
+            out.append("time")
+        if self._xy_axis(kind, field_name):
+            out.append("xy")
+        if spec.kind == "int":
+            out.append("modem_id")
+        if spec.kind == "string":
+            out.append("community")
+        return out
+
     def insert_time(self, draft: Draft, field_name: str) -> None:
         self.set_value(draft, field_name, specials.TIME)
 

@@ -57,6 +57,9 @@ class CommandType:
     dest_field: str
     goby11: bool = False
     single_field_vars: frozenset[str] = frozenset()
+    # offered as a command: a goby3 entry's publish trigger, a Goby 1.1 message's
+    # <trigger>publish</trigger> (a time-triggered one is telemetry)
+    command: bool = True
 
     @property
     def short_name(self) -> str:
@@ -176,6 +179,7 @@ def goby11_command_type(
         dest_field=_dest_field(queue_entry),
         goby11=True,
         single_field_vars=frozenset(msg.single_field_sources()),
+        command=msg.trigger != "time",
     )
 
 

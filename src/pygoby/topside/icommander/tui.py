@@ -1,19 +1,28 @@
 """iCommander's screens as a textual app over the commander core: the main
 menu, message selection, the editing screen and its action menu, keyboard-driven as in Goby 1.
 
-Editing: Up/Down (or Tab) move between fields, typing is checked as it goes (a key that would
-make the value invalid, e.g. beyond the DCCL maximum, is refused and the reason shown), Enter
-opens the action menu. In numeric fields `t` inserts the current time, `x`/`y` the local x/y
-placeholders of a latitude/longitude pair, `m` a modem id from the lookup file.
+Editing: Up/Down (or Tab/Shift+Tab) move between fields and the view follows, typing is checked
+as it goes (a key that would make the value invalid, e.g. beyond the DCCL maximum, is refused and
+the reason shown), Enter opens the action menu. Single-letter specials, only where they make
+sense (the footer names those of the field): `t` the current time (time and double fields), `x`/`y`
+the local x/y placeholders (a latitude/longitude pair), `m` a modem id (integer fields).
+
+A status line on every screen shows the last acknowledgement or expiry and the `show_variable`
+values. Keys are delivered one after the other to the screen that is current once the previous
+key's effect (a menu choice opening the next screen) has settled, so fast typing loses none.
 """
 
 from __future__ import annotations
 
+import asyncio
+from collections import deque
 from collections.abc import Callable
 
+from textual import events
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical, VerticalScroll
+from textual.message_pump import MessagePump
 from textual.screen import ModalScreen, Screen
 from textual.widgets import Footer, Input, Label, OptionList, Static
 from textual.widgets.option_list import Option
@@ -42,6 +51,44 @@ def box_id(field: str) -> str:
     return "field-" + field.replace(".", "--")
 
 
+# the letter typed in a field -> the special it inserts (where Commander.specials allows it)
+SPECIAL_KEYS = {"t": "time", "x": "xy", "y": "xy", "m": "modem_id"}
+SPECIAL_HELP = {"time": "t time", "xy": "x/y local x,y", "modem_id": "m modem id"}
+
+
+class StatusLine(Static):
+    """The last acknowledgement or expiry and the shown variables, on every screen."""
+
+    DEFAULT_CSS = """
+    StatusLine { dock: bottom; height: auto; max-height: 3; background: $warning 30%; padding: 0 1; }
+    StatusLine.empty { display: none; }
+    """
+
+    def __init__(self) -> None:
+        super().__init__(id="status", classes="empty")
+
+    def on_mount(self) -> None:
+        self.show(getattr(self.app, "status_text", ""))
+
+    def show(self, text: str) -> None:
+        self.update(text)
+        self.set_class(not text, "empty")
+
+
+class FieldInput(Input):
+    """A field's box: Up/Down and Tab move between fields (an enclosing scroll view must not
+    take them to scroll, which left the focus, and so the typing, in a field out of view)."""
+
+    BINDINGS = [
+        Binding("down", "app.focus_next", "Next field"),
+        Binding("up", "app.focus_previous", "Previous field"),
+    ]
+
+
+class FieldList(VerticalScroll, can_focus=False):
+    """The fields; scrolled by the focus moving, never focused itself."""
+
+
 class Menu(ModalScreen[str | None]):
     """A titled list of choices; Enter picks, Escape cancels."""
 
@@ -52,6 +99,7 @@ class Menu(ModalScreen[str | None]):
         self.title_text, self.choices = title, choices
 
     def compose(self) -> ComposeResult:
+        yield StatusLine()
         with Vertical(classes="box"):
             yield Static(self.title_text, classes="title")
             yield OptionList(*(Option(text, id=key) for key, text in self.choices))
@@ -73,6 +121,7 @@ class Prompt(ModalScreen[str | None]):
         self.title_text = title
 
     def compose(self) -> ComposeResult:
+        yield StatusLine()
         with Vertical(classes="box"):
             yield Static(self.title_text, classes="title")
             yield Input(placeholder="File name", id="path")
@@ -92,6 +141,7 @@ class Report(ModalScreen[str | None]):
         self.text, self.choices = text, choices
 
     def compose(self) -> ComposeResult:
+        yield StatusLine()
         with Vertical(classes="box"):
             yield Static(self.text, id="report-text")
             yield OptionList(*(Option(text, id=key) for key, text in self.choices))
@@ -103,11 +153,6 @@ class Report(ModalScreen[str | None]):
 class EditScreen(Screen):
     """The editing screen: an information box and one line per message variable."""
 
-    BINDINGS = [
-        Binding("down", "app.focus_next", "Next field", show=False),
-        Binding("up", "app.focus_previous", "Previous field", show=False),
-    ]
-
     def __init__(self, commander: Commander, draft: Draft) -> None:
         super().__init__(id="edit")
         self.commander, self.draft = commander, draft
@@ -118,21 +163,23 @@ class EditScreen(Screen):
         kind = self.draft.type
         yield Static(id="info", classes="info")
         yield Static(
-            f"Message (Type: {kind.short_name})  {len(kind.fields)} entries total   "
-            "{Enter} for options   {Up/Down} for more message variables",
+            f"Message (Type: {kind.short_name})  {len(kind.fields)} entries total",
             classes="title",
         )
-        with VerticalScroll():
+        yield Static(id="keys", classes="keys")
+        with FieldList():
             for number, spec in enumerate(kind.fields, start=1):
                 label = "static" if spec.kind == "static" else spec.kind
                 yield Label(f"{number}. {spec.name} ({label})", classes="field-name")
-                box = Input(
+                box = FieldInput(
                     value=self.draft.value(spec.name),
                     id=box_id(spec.name),
                     disabled=not spec.editable,
+                    compact=True,
                 )
                 self._values[spec.name] = box.value
                 yield box
+        yield StatusLine()
         yield Footer()
 
     def on_mount(self) -> None:
@@ -166,19 +213,26 @@ class EditScreen(Screen):
                 f"Editing message variable {index} of {len(kind.fields)}: {name}\n"
                 f"{kind.field(name).describe()}"
             )
+            specials = self.commander.specials(kind, name)
+            self.query_one("#keys", Static).update(
+                "Up/Down/Tab: fields  Enter: options"
+                + (
+                    f"  specials: {', '.join(SPECIAL_HELP[s] for s in specials if s in SPECIAL_HELP)}"
+                    if specials
+                    else ""
+                )
+            )
 
     def on_input_changed(self, event: Input.Changed) -> None:
         if self._quiet or not (event.input.id or "").startswith("field-"):
             return
         name, box = self._field(event.input), event.input
         before, text = self._values.get(name, ""), event.value
-        spec = self.draft.type.field(name)
         typed = text[len(before) :] if text.startswith(before) else ""
-        if spec.kind in ("int", "float") and typed in ("t", "x", "y", "m") and len(typed) == 1:
+        special = SPECIAL_KEYS.get(typed)
+        if special is not None and special in self.commander.specials(self.draft.type, name):
             self._revert(box, before)
-            self.app.run_action_for(
-                self, {"t": "time", "x": "xy", "y": "xy", "m": "modem_id"}[typed], name
-            )  # type: ignore[attr-defined]
+            self.app.run_action_for(self, special, name)  # type: ignore[attr-defined]
             return
         try:
             self.commander.check(self.draft, name, text, partial=True)
@@ -215,12 +269,9 @@ class ICommanderTUI(App):
     CSS = """
     .box { border: round $accent; padding: 0 1; height: auto; max-height: 90%; width: 90%; margin: 1 4; }
     .title { text-style: bold; padding: 0 0 1 0; }
-    .info { border: round $secondary; padding: 0 1; height: auto; min-height: 4; }
-    #banner { background: $warning 30%; padding: 0 1; height: auto; }
-    #banner.empty { display: none; }
-    #lower { border: round $secondary; padding: 0 1; height: auto; }
-    #lower.empty { display: none; }
-    Input { margin: 0 0 0 2; }
+    .info { border: round $secondary; padding: 0 1; height: auto; min-height: 4; max-height: 6; }
+    .keys { color: $text-muted; }
+    FieldInput { margin: 0 0 0 4; }
     """
     TITLE = TITLE
 
@@ -232,28 +283,69 @@ class ICommanderTUI(App):
     ) -> None:
         super().__init__()
         self.commander = commander
-        self.show_variables = {name: "" for name in show_variables or []}
+        self.show_variables = {name: "" for name in show_variables or [] if name}
         self._on_exit = on_exit
+        self.notice_text = ""
+        self._typed: deque[events.Key] = deque()
+        self._typing: asyncio.Task | None = None
 
     def compose(self) -> ComposeResult:
-        yield Static(id="banner", classes="empty")
-        yield Static(id="lower", classes="empty")
+        yield StatusLine()
 
     def on_mount(self) -> None:
         self._main_menu()
 
+    # ------------------------------------------------------------------ keys, one at a time
+    async def on_event(self, event: events.Event) -> None:
+        if isinstance(event, events.Key) and not event.is_forwarded:
+            self._typed.append(event)
+            if self._typing is None or self._typing.done():
+                self._typing = asyncio.create_task(self._deliver_typed())
+            return
+        await super().on_event(event)
+
+    async def _deliver_typed(self) -> None:
+        """Each key in turn, once what the previous one set off has been handled: a key typed
+        right after the Enter that opens a screen goes to that screen (textual forwards keys
+        as they come, to whichever widget had the focus, and a menu then lost them)."""
+        while self._typed:
+            await super().on_event(self._typed.popleft())
+            await self._settled()
+
+    async def _settled(self, limit: float = 1.0) -> None:
+        """Until the app, the current screen and the focused widget (with its containers) have
+        had no message waiting for a few loop turns in a row (a handler that awaits, e.g. a
+        screen being mounted, takes some); at most `limit` seconds."""
+        loop = asyncio.get_running_loop()
+        deadline, quiet = loop.time() + limit, 0
+        while quiet < 5 and loop.time() < deadline:
+            await asyncio.sleep(0)
+            pumps: list[MessagePump] = [self, self.screen]
+            if self.focused is not None:
+                pumps += list(self.focused.ancestors_with_self)
+            busy = any(not pump._message_queue.empty() for pump in pumps)
+            quiet = 0 if busy else quiet + 1
+
     # ------------------------------------------------------------------ the MOOS side
+    @property
+    def status_text(self) -> str:
+        shown = "  ".join(f"{k}: {v}" for k, v in self.show_variables.items() if v)
+        return "\n".join(t for t in (self.notice_text, shown) if t)
+
+    def _show_status(self) -> None:
+        text = self.status_text
+        for screen in self.screen_stack:
+            for line in screen.query(StatusLine):
+                line.show(text)
+
     def show_notice(self, notice: Notice) -> None:
-        banner = self.query_one("#banner", Static)
-        banner.update(notice.banner())
-        banner.remove_class("empty")
+        self.notice_text = " ".join(line.strip() for line in notice.banner().splitlines())
+        self._show_status()
 
     def show_variable(self, name: str, value: object) -> None:
         if name in self.show_variables:
             self.show_variables[name] = f"{value:g}" if isinstance(value, float) else str(value)
-            lower = self.query_one("#lower", Static)
-            lower.update("\n".join(f"{k}: {v}" for k, v in self.show_variables.items()))
-            lower.remove_class("empty")
+            self._show_status()
 
     # ------------------------------------------------------------------ screens
     def _edit_screen(self) -> EditScreen | None:

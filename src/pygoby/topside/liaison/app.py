@@ -6,10 +6,15 @@ client of the same MOOSDB sharing pAcommsHandler's message set.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from pathlib import Path
+
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
+from pygoby.moos.appconfig import read_configuration
+from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import MoosValues, Post
 from pygoby.protobuf import builtin_class
 from pygoby.topside.acomms_config import AcommsMessageSet
@@ -46,13 +51,27 @@ class Liaison(GobyMOOSApp):
         except CommanderError as err:
             raise ConfigError(str(err), field="liaison.commander") from None
         self.subscribe_pattern("*", "*", self.state.handle)
-        self.web = WebServer(
-            self.state,
-            web.http_address,
-            web.http_port,
-            web.token,
-            1.0 / web.update_freq if web.update_freq > 0 else 1.0,
+        self.web = WebServer(self.state, web, self._save_dir(web.save_dir))
+        # run from a mission without its block: the defaults, said once at start
+        self.without_block = self.mission is not None and self.mission.goby_block(self.name) is None
+
+    @classmethod
+    def read_config(
+        cls, mission: MissionFile | None, name: str, overrides: Sequence[tuple[str, str]] = ()
+    ) -> Message:
+        """Without a `ProcessConfig = liaison` block: the defaults (said once at start)."""
+        return read_configuration(
+            cls.load_config_class(), mission, name, overrides, block_optional=True
         )
+
+    def _save_dir(self, configured: str) -> Path:
+        """The Commander page's save folder: `save_dir` (relative to the mission file's
+        folder), else the mission file's folder, else ./liaison_saves."""
+        mission_path = self.mission.path if self.mission is not None else None
+        folder = Path(mission_path).parent if mission_path is not None else None
+        if configured:
+            return (folder or Path.cwd()) / Path(configured).expanduser()
+        return folder if folder is not None else Path("liaison_saves")
 
     @classmethod
     def embedded(cls, host: GobyMOOSApp, acomms: AcommsMessageSet) -> Liaison:
@@ -62,7 +81,7 @@ class Liaison(GobyMOOSApp):
         cfg.common.CopyFrom(host.common)
         cfg.common.log = False
         cfg.liaison.CopyFrom(acomms.cfg.liaison)
-        return cls(
+        liaison = cls(
             cfg,
             acomms=acomms,
             name=f"{host.name}_liaison",
@@ -71,6 +90,8 @@ class Liaison(GobyMOOSApp):
             host=host.client.host,
             port=host.client.port,
         )
+        liaison.without_block = False  # configured by the host's `liaison` section
+        return liaison
 
     def _post(self, post: Post) -> None:
         self.publish(post.var, post.value, src_aux=post.source_aux)
@@ -80,6 +101,12 @@ class Liaison(GobyMOOSApp):
 
     async def start(self, connect_timeout: float | None = None) -> None:
         await super().start(connect_timeout)
+        if self.without_block:
+            self.log.warning(
+                "no ProcessConfig = %s block in %s: serving with the defaults",
+                self.name,
+                self.mission.path or "the mission",
+            )
         await self.web.start()
         print(f"{self.name}: serving {self.web.url}", flush=True)
         self.log.info("serving %s", self.web.url)

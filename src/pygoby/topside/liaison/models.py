@@ -5,9 +5,10 @@ commander core directly.
 
 from __future__ import annotations
 
+import bisect
 import functools
+import json
 import math
-import re
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -16,12 +17,14 @@ from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.dccl import Codec, DcclError
+from pygoby.dccl.ccl import remus
 from pygoby.dccl.dccl1 import Dccl1Header, is_dccl1_frame, unstitch
 from pygoby.moos import protocol as p
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import ModemIdLookup, UTMGeodesy, dynamic_parse, parse_for_moos
 from pygoby.moos.translator.keyvalue import val_from_string
 from pygoby.moos.translator.techniques import MoosValue, Technique
+from pygoby.topside.errors import ScopeFilterError
 
 RATE_WINDOW = 10.0  # seconds over which a variable's rate is measured
 _TEXT = Technique.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT
@@ -36,6 +39,33 @@ def _display(value: MoosValue) -> str:
 
 
 # ---------------------------------------------------------------------------------- Scope
+FILTER_MAX = 200  # characters of a Scope filter: room for a dozen variable names or globs
+
+
+class ScopeFilter:
+    """The Scope's `?filter=`: terms separated by spaces or commas, a variable shown when any
+    term matches its name, ignoring case. A term with `*` or `?` is a MOOS glob over the whole
+    name (`NAV_*`); a plain term matches anywhere in the name (`ACOMMS`). Globs never backtrack
+    (`Glob`), terms are capped at FILTER_MAX characters in all, and each name's answer is kept,
+    so no filter can make the Scope slow."""
+
+    def __init__(self, text: str) -> None:
+        if len(text) > FILTER_MAX:
+            raise ScopeFilterError(f"a Scope filter has at most {FILTER_MAX} characters")
+        terms = text.replace(",", " ").lower().split()
+        self.globs = [p.Glob(t if "*" in t or "?" in t else f"*{t}*") for t in terms]
+        self._answers: dict[str, bool] = {}
+
+    def __call__(self, key: str) -> bool:
+        if not self.globs:
+            return True
+        answer = self._answers.get(key)
+        if answer is None:
+            lowered = key.lower()
+            answer = self._answers[key] = any(g.match(lowered) for g in self.globs)
+        return answer
+
+
 @dataclass
 class ScopeRow:
     key: str
@@ -47,15 +77,18 @@ class ScopeRow:
     time: float
     arrivals: deque[float]
     history: deque[tuple[float, float]]
+    version: int = 0
+    shown: tuple[int, float, str] | None = None  # (version, rate, JSON) last built
 
 
 class ScopeModel:
-    """Every variable seen: newest value, type, source, age, rate; numeric history."""
+    """Every variable seen: newest value, type, source, time, rate; numeric history."""
 
     def __init__(self, max_history: int = 1000, patterns: list[str] | None = None) -> None:
         self.max_history = max_history
         self.patterns = patterns or []
         self.rows: dict[str, ScopeRow] = {}
+        self._keys: list[str] = []  # sorted
 
     def wants(self, key: str) -> bool:
         return not self.patterns or any(p.wildcard_match(pat, key) for pat in self.patterns)
@@ -78,36 +111,41 @@ class ScopeModel:
                 deque(maxlen=256),
                 deque(maxlen=self.max_history),
             )
+            bisect.insort(self._keys, msg.key)
         row.value, row.kind, row.time = value, kind, msg.time
         row.source, row.source_aux, row.community = msg.src, msg.src_aux, msg.community
+        row.version += 1
         row.arrivals.append(msg.time)
         if isinstance(value, float) and math.isfinite(value):
             row.history.append((msg.time, value))
 
-    def snapshot(self, now: float, pattern: str = "") -> list[dict]:
-        try:
-            wanted = re.compile(pattern, re.IGNORECASE) if pattern else None
-        except re.error:
-            wanted = None
-        out = []
-        for key in sorted(self.rows):
-            if wanted is not None and not wanted.search(key):
-                continue
+    def rows_json(self, now: float) -> dict[str, str]:
+        """Every row as JSON text, by name in order. A row's text is rebuilt only when its value
+        or rate changed, so that the live pages can send only the rows that did (the page
+        works out ages from `time` and the snapshot's `now`)."""
+        out = {}
+        for key in self._keys:
             row = self.rows[key]
-            recent = sum(1 for t in row.arrivals if now - t <= RATE_WINDOW)
-            out.append(
-                {
-                    "key": key,
-                    "value": _display(row.value),
-                    "type": row.kind,
-                    "source": row.source,
-                    "aux": row.source_aux,
-                    "community": row.community,
-                    "age": round(max(now - row.time, 0.0), 1),
-                    "rate": round(recent / RATE_WINDOW, 2),
-                    "numeric": bool(row.history),
-                }
-            )
+            arrivals = row.arrivals
+            while arrivals and now - arrivals[0] > RATE_WINDOW:
+                arrivals.popleft()
+            rate = round(len(arrivals) / RATE_WINDOW, 2)
+            if row.shown is None or row.shown[:2] != (row.version, rate):
+                text = json.dumps(
+                    {
+                        "key": key,
+                        "value": _display(row.value),
+                        "type": row.kind,
+                        "source": row.source,
+                        "aux": row.source_aux,
+                        "community": row.community,
+                        "time": row.time,
+                        "rate": rate,
+                        "numeric": bool(row.history),
+                    }
+                )
+                row.shown = (row.version, rate, text)
+            out[key] = row.shown[2]
         return out
 
     def history(self, key: str) -> list[tuple[float, float]]:
@@ -183,6 +221,11 @@ class AcommsModel:
             }
             for s in cfg.mac_cfg.slot
         ]
+        self.ccl_queues = {
+            q.key.id: q.name
+            for q in cfg.queue_cfg.queue
+            if q.HasField("key") and q.key.type == acomms_pb.QUEUE_CCL
+        }
         self.slot_index: int | None = None
         self.slot_start: float | None = None
         self.tx: deque[dict] = deque(maxlen=history)
@@ -195,7 +238,9 @@ class AcommsModel:
             self.var["driver_receive"]: functools.partial(self._on_modem, False),
             self.var["queue_ack_original_msg"]: self._on_ack,
             self.var["queue_expire"]: self._on_expire,
+            self.var["driver_status"]: self._on_driver_status,
         }
+        self.drivers: dict[str, str] = {}  # "primary driver NAME" -> its state
 
     @property
     def variables(self) -> list[str]:
@@ -213,6 +258,12 @@ class AcommsModel:
         except Exception:  # noqa: BLE001 - bad mail is skipped, never kills the page
             return None
         return out
+
+    def _on_driver_status(self, value: MoosValue, when: float) -> None:
+        text = value.decode("utf-8", "replace") if isinstance(value, bytes) else value
+        driver, sep, state = text.partition(": ")
+        if sep and len(self.drivers) < 16:  # a handful of drivers; never an unbounded table
+            self.drivers[driver] = state[:500]
 
     def _on_qsize(self, value: MoosValue, when: float) -> None:
         size = self._parse(acomms_pb.QueueSize, value)
@@ -245,11 +296,23 @@ class AcommsModel:
                 try:
                     msg, used = self.codec.decode_prefix(data[offset:])
                 except (DcclError, Exception):  # noqa: BLE001 - unknown or encrypted frame
-                    names.append("?")
+                    names.append(self._ccl_name(data) if offset == 0 else "?")
                     break
                 names.append(msg.DESCRIPTOR.full_name)
                 offset += max(used, 1)
         return names
+
+    def _ccl_name(self, frame: bytes) -> str:
+        """A frame DCCL does not read: a CCL frame (32 bytes, its type in the first byte) is
+        named after its Goby 1.1 queue (`queue { key { type: QUEUE_CCL id: 14 } name: ... }`),
+        else the REMUS frame type, else `CCL 0x0e`; anything else is `?`."""
+        if len(frame) != remus.FRAME_BYTES:
+            return "?"
+        ccl_id = frame[0]
+        if ccl_id in self.ccl_queues:
+            return self.ccl_queues[ccl_id]
+        frame_type = remus.BY_ID.get(ccl_id)
+        return f"REMUS {frame_type.__name__}" if frame_type else f"CCL 0x{ccl_id:02x}"
 
     def _dccl1_names(self, frame: bytes) -> list[str]:
         try:
@@ -307,7 +370,16 @@ class AcommsModel:
         original = dynamic_parse(value, self._resolve, _TEXT)
         name = original.DESCRIPTOR.full_name.rsplit(".", 1)[-1] if original is not None else "?"
         text = str(value).split("] ", 1)[-1] if isinstance(value, str) else ""
-        self.timeline.appendleft({"time": when, "kind": kind, "text": f"{name} {kind}: {text}"})
+        newest = self.timeline[0] if self.timeline else None
+        if newest is not None and (newest["kind"], newest.get("name")) == (kind, name):
+            # a run of the same event for one message type (a telemetry queue expiring every
+            # few seconds) is one line that counts them
+            count = newest["count"] + 1
+            newest.update(time=when, count=count, text=f"{name} {kind} ({count} in a row): {text}")
+            return
+        self.timeline.appendleft(
+            {"time": when, "kind": kind, "name": name, "count": 1, "text": f"{name} {kind}: {text}"}
+        )
 
     def _on_ack(self, value: MoosValue, when: float) -> None:
         self._original("acknowledged", value, when)
@@ -325,6 +397,7 @@ class AcommsModel:
         cycle = sum(s["seconds"] for s in self.slots)
         return {
             "modem_id": self.modem_id,
+            "drivers": [f"{name}: {state}" for name, state in self.drivers.items()],
             "queues": [
                 {
                     "name": q.name,

@@ -15,6 +15,7 @@ from pygoby.topside.commander import (
     Commander,
     CommandSet,
     Draft,
+    Notice,
     Outgoing,
     SentRecord,
 )
@@ -57,8 +58,23 @@ def outgoing_view(outgoing: Outgoing) -> dict:
     return {"posts": outgoing.lines(), "warnings": outgoing.warnings}
 
 
+def grouped_notices(notices: list[Notice]) -> list[str]:
+    """Newest first; a run of notices of one kind for one message type (a telemetry queue's
+    expiry every few seconds) is one entry that counts them and keeps the newest's text."""
+    runs: list[tuple[Notice, int]] = []
+    for notice in reversed(notices):
+        if runs and (runs[-1][0].kind, runs[-1][0].type_name) == (notice.kind, notice.type_name):
+            runs[-1] = (runs[-1][0], runs[-1][1] + 1)
+        else:
+            runs.append((notice, 1))
+    return [
+        notice.banner() + (f"\n ({count} in a row; the newest shown)" if count > 1 else "")
+        for notice, count in runs
+    ]
+
+
 class LiaisonState:
-    """`handle(msg)` for every MOOS message; `page(name, now, **options)` for the pages."""
+    """`handle(msg)` for every MOOS message; `page(name, now)` and `scope` for the pages."""
 
     def __init__(
         self,
@@ -100,9 +116,11 @@ class LiaisonState:
             cfg.link_seconds,
             cfg.max_track_points,
         )
+        self.commands_listed = {name for name in commander_cfg.command if name}  # "": none
         self.load_warnings: list[str] = []
         for path in commander_cfg.load:
-            self.load_warnings += self.commander.load(path)
+            if path:  # empty means none, as in Goby 1.1
+                self.load_warnings += self.commander.load(path)
 
     def handle(self, msg: MOOSMessage) -> None:
         self.scope.update(msg)
@@ -111,23 +129,33 @@ class LiaisonState:
         if msg.time >= self.start_time:  # older acks are not ours (Goby's stale-mail rule)
             self.commander.handle_mail(msg.key, msg.value, msg.time)
 
-    def page(self, name: str, now: float, pattern: str = "") -> dict:
-        if name == "scope":
-            return {"rows": self.scope.snapshot(now, pattern)}
-        if name == "acomms":
-            return self.acomms.snapshot(now)
-        if name == "map":
-            return self.map.snapshot(now)
-        if name == "commander":
-            commander = self.commander
-            return {
-                "records": [record_view(r) for r in reversed(commander.records[-50:])],
-                "notices": [n.banner() for n in reversed(commander.notices[-20:])],
-            }
-        raise KeyError(name)
+    def page(self, name: str, now: float) -> dict:
+        """The Commander, Acomms or Map page's view (the Scope's is `scope.rows_json`)."""
+        views = {
+            "commander": self.commander_view,
+            "acomms": self.acomms.snapshot,
+            "map": self.map.snapshot,
+        }
+        return views[name](now)
+
+    def commander_view(self, now: float) -> dict:
+        commander = self.commander
+        return {
+            "records": [record_view(r) for r in reversed(commander.records[-50:])],
+            "notices": grouped_notices(commander.notices[-200:])[:20],
+        }
 
     def commander_types(self) -> list[dict]:
+        """Every sendable message; `command`: offered without "show all" (those of the
+        configuration's `command` list, else the ones it triggers by publishing)."""
+        listed = self.commands_listed
         return [
-            {"name": t.name, "short": t.short_name, "ack": t.ack, "trigger": t.trigger_var}
+            {
+                "name": t.name,
+                "short": t.short_name,
+                "ack": t.ack,
+                "trigger": t.trigger_var,
+                "command": bool({t.name, t.short_name} & listed) if listed else t.command,
+            }
             for t in self.commander.commands.types.values()
         ]

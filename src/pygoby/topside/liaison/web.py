@@ -1,197 +1,324 @@
 """liaison's web layer: a Starlette application served by uvicorn inside the app's own asyncio
 loop. Pages are one static HTML/JS/CSS bundle shipped in the package (no CDN); live data comes
-as Server-Sent Events (one JSON snapshot of the open page per update); commands are JSON POSTs.
+as Server-Sent Events (`feed`: one snapshot per tick, deltas to each page); commands are JSON
+POSTs. Every request passes `access.Access` first (Host, Origin and the per-launch token).
 
-Access: loopback addresses need nothing. Any other address needs the token (printed at
-start-up): `?token=...` on the first page (then a cookie), or `Authorization: Bearer ...`.
-Every POST must carry the `X-Liaison` header, which a page from another site cannot add without
-a CORS permission this server never gives (so other sites cannot send commands through a
-browser that has liaison open).
+The routes and the Commander's operations are the literal tables ROUTES, COMMANDER_ACTIONS and
+SPECIALS below; the handlers find the server's parts in `request.app.state.liaison`.
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
-import hmac
-import ipaddress
-import json
 import logging
 import secrets
 import socket
-from collections.abc import AsyncIterator, Callable
+from collections.abc import Callable
+from dataclasses import dataclass
+from http.cookies import SimpleCookie
 from pathlib import Path
+from typing import Any
 
 import uvicorn
+from google.protobuf.message import Message as ProtobufMessage
 from starlette.applications import Starlette
+from starlette.middleware import Middleware
 from starlette.requests import Request
 from starlette.responses import (
     FileResponse,
     JSONResponse,
+    PlainTextResponse,
     RedirectResponse,
     Response,
     StreamingResponse,
 )
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from pygoby.errors import ConfigError, PygobyError
-from pygoby.topside.commander import CommanderError, FieldValueError, SaveFileError
+from pygoby.topside.commander import (
+    Commander,
+    CommanderError,
+    Draft,
+    FieldValueError,
+    SaveFileError,
+)
+from pygoby.topside.errors import ScopeFilterError, TooManyStreamsError
+from pygoby.topside.liaison.access import Access, SaveFolder, is_loopback
+from pygoby.topside.liaison.feed import PAGES, LiveFeed, PageStream, ScopeStream
 from pygoby.topside.liaison.state import LiaisonState, field_view, outgoing_view, record_view
 from pygoby.util.aiorun import cancel_and_wait
 
+__all__ = ["WebServer", "is_loopback", "make_app"]
+
 log = logging.getLogger("pygoby.liaison")
 STATIC = Path(__file__).parent / "static"
-PAGES = ("scope", "commander", "acomms", "map")
-COOKIE = "liaison_token"
 
 
-def is_loopback(address: str) -> bool:
-    if address in ("localhost", ""):
-        return address == "localhost"
+@dataclass
+class Parts:
+    """What the handlers use, kept in `app.state.liaison`."""
+
+    state: LiaisonState
+    feed: LiveFeed
+    saves: SaveFolder
+
+
+def _parts(request: Request) -> Parts:
+    return request.app.state.liaison
+
+
+# ---------------------------------------------------------------------------------- pages
+async def index(request: Request) -> Response:
+    query = f"?{request.url.query}" if request.url.query else ""
+    return RedirectResponse(f"/scope{query}")
+
+
+async def page(request: Request) -> Response:
+    return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-store"})
+
+
+async def favicon(request: Request) -> Response:
+    return FileResponse(STATIC / "favicon.svg", media_type="image/svg+xml")
+
+
+class EventStream(StreamingResponse):
+    """A live page's Server-Sent Events; its place among the feed's streams is given back
+    however the response ends (finished, client gone, server stopping)."""
+
+    def __init__(self, feed: LiveFeed, stream: ScopeStream | PageStream) -> None:
+        super().__init__(
+            feed.stream(stream),
+            media_type="text/event-stream",
+            headers={"Cache-Control": "no-store"},
+        )
+        self.feed, self.stream = feed, stream
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        try:
+            await super().__call__(scope, receive, send)
+        finally:
+            self.feed.release(self.stream)
+
+
+async def events(request: Request) -> Response:
+    name = request.query_params.get("page", "scope")
+    if name not in PAGES:
+        return PlainTextResponse(f"no page {name!r}", 404)
+    feed = _parts(request).feed
     try:
-        return ipaddress.ip_address(address).is_loopback
-    except ValueError:
-        return False
+        stream = feed.admit(name, request.query_params.get("filter", ""))
+    except TooManyStreamsError as err:
+        return PlainTextResponse(str(err), 503, headers={"Retry-After": "5"})
+    except ScopeFilterError as err:
+        return PlainTextResponse(str(err), 400)
+    return EventStream(feed, stream)
 
 
-def _json_default(value: object) -> object:
-    if isinstance(value, float | int):
-        return value
-    return str(value)
+async def history(request: Request) -> Response:
+    key = request.query_params.get("key", "")
+    return JSONResponse({"key": key, "points": _parts(request).state.scope.history(key)})
+
+
+async def types(request: Request) -> Response:
+    state = _parts(request).state
+    return JSONResponse(
+        {
+            "types": state.commander_types(),
+            "community": state.commander.community,
+            "modem_ids": state.commander.modem_ids(),
+            "style": state.commander.style,
+        }
+    )
+
+
+# ---------------------------------------------------------------------------------- commander
+Action = Callable[[Parts, Draft | None, dict], dict[str, Any]]
+
+
+def _needs_draft(draft: Draft | None) -> Draft:
+    if draft is None:
+        raise CommanderError("this action needs a message `type`")
+    return draft
+
+
+def _special_time(commander: Commander, draft: Draft, body: dict) -> None:
+    commander.insert_time(draft, body["field"])
+
+
+def _special_xy(commander: Commander, draft: Draft, body: dict) -> None:
+    commander.insert_xy(draft, body["field"])
+
+
+def _special_community(commander: Commander, draft: Draft, body: dict) -> None:
+    commander.insert_community(draft, body["field"])
+
+
+def _special_modem_id(commander: Commander, draft: Draft, body: dict) -> None:
+    commander.insert_modem_id(draft, body["field"], int(body["modem_id"]))
+
+
+SPECIALS: dict[str, Callable[[Commander, Draft, dict], None]] = {
+    "time": _special_time,
+    "xy": _special_xy,
+    "community": _special_community,
+    "modem_id": _special_modem_id,
+}
+
+
+def _open(parts: Parts, draft: Draft | None, body: dict) -> dict:
+    _needs_draft(draft)
+    return {}
+
+
+def _check(parts: Parts, draft: Draft | None, body: dict) -> dict:
+    parts.state.commander.check(
+        _needs_draft(draft), body["field"], body.get("text", ""), partial=bool(body.get("partial"))
+    )
+    return {}
+
+
+def _set(parts: Parts, draft: Draft | None, body: dict) -> dict:
+    parts.state.commander.set_value(_needs_draft(draft), body["field"], body.get("text", ""))
+    return {}
+
+
+def _special(parts: Parts, draft: Draft | None, body: dict) -> dict:
+    special = SPECIALS.get(body["special"])
+    if special is None:
+        raise CommanderError(f"no special {body['special']!r}")
+    special(parts.state.commander, _needs_draft(draft), body)
+    return {}
+
+
+def _clear(parts: Parts, draft: Draft | None, body: dict) -> dict:
+    parts.state.commander.clear(_needs_draft(draft))
+    return {}
+
+
+def _preview(parts: Parts, draft: Draft | None, body: dict) -> dict:
+    return {"preview": outgoing_view(parts.state.commander.preview(_needs_draft(draft)))}
+
+
+def _send(parts: Parts, draft: Draft | None, body: dict) -> dict:
+    return {"record": record_view(parts.state.commander.send(_needs_draft(draft)))}
+
+
+def _save(parts: Parts, draft: Draft | None, body: dict) -> dict:
+    name = str(body["path"])
+    parts.state.commander.save(parts.saves.for_saving(name))
+    return {}
+
+
+def _load(parts: Parts, draft: Draft | None, body: dict) -> dict:
+    name = str(body["path"])
+    path = parts.saves.path(name)
+    if not path.is_file():
+        raise SaveFileError(f"no save file {name!r} in the save folder")
+    try:
+        return {"warnings": parts.state.commander.load(path)}
+    except OSError as err:
+        raise SaveFileError(f"{name}: cannot read ({err.strerror})") from None
+
+
+COMMANDER_ACTIONS: dict[str, Action] = {
+    "open": _open,
+    "check": _check,
+    "set": _set,
+    "special": _special,
+    "clear": _clear,
+    "preview": _preview,
+    "send": _send,
+    "save": _save,
+    "load": _load,
+}
+
+
+async def command(request: Request) -> Response:
+    """POST {action, type, field?, text?, ...}: one commander operation."""
+    parts = _parts(request)
+    try:
+        body = await request.json()
+        if not isinstance(body, dict):
+            raise CommanderError("the request is a JSON object {action, type, ...}")
+        action = COMMANDER_ACTIONS.get(body["action"])
+        if action is None:
+            raise CommanderError(f"no action {body['action']!r}")
+        draft = parts.state.commander.open(body["type"]) if "type" in body else None
+        result: dict = {"ok": True, **action(parts, draft, body)}
+        if draft is not None:
+            result["fields"] = field_view(draft)
+            result["type"] = draft.type.name
+        return JSONResponse(result)
+    except (PygobyError, KeyError, ValueError, TypeError, OSError) as err:
+        reason = err.args[0] if isinstance(err, KeyError) and err.args else str(err)
+        status = 422 if isinstance(err, FieldValueError | SaveFileError) else 400
+        return JSONResponse({"ok": False, "error": str(reason)}, status_code=status)
+
+
+ROUTES = [
+    Route("/", index),
+    Route("/scope", page),
+    Route("/commander", page),
+    Route("/acomms", page),
+    Route("/map", page),
+    Route("/favicon.ico", favicon),
+    Route("/api/events", events),
+    Route("/api/scope/history", history),
+    Route("/api/commander/types", types),
+    Route("/api/commander", command, methods=["POST"]),
+    Mount("/static", StaticFiles(directory=STATIC), name="static"),
+]
+
+
+# ---------------------------------------------------------------------------------- access
+class AccessGuard:
+    """ASGI middleware: `Access` decides on every HTTP request before any route; a valid
+    `?token=` leaves the token as the page's cookie."""
+
+    def __init__(self, app: ASGIApp, access: Access) -> None:
+        self.app = app
+        self.access = access
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        request = Request(scope)
+        headers = {k: v for k, v in request.headers.items()}
+        query = scope.get("query_string", b"").decode("latin-1")
+        refusal = self.access.refusal(scope["method"], headers, query, request.cookies)
+        if refusal is not None:
+            status, reason = refusal
+            await PlainTextResponse(reason, status)(scope, receive, send)
+            return
+        from_query = request.query_params.get("token", "")
+        if not self.access.token_ok(from_query):
+            await self.app(scope, receive, send)
+            return
+
+        async def send_with_cookie(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                cookie: SimpleCookie = SimpleCookie()
+                cookie[self.access.cookie] = self.access.token
+                morsel = cookie[self.access.cookie]
+                morsel["httponly"], morsel["samesite"], morsel["path"] = True, "Strict", "/"
+                header = (b"set-cookie", morsel.OutputString().encode("latin-1"))
+                message = {**message, "headers": [*message.get("headers", []), header]}
+            await send(message)
+
+        await self.app(scope, receive, send_with_cookie)
 
 
 def make_app(
-    state: LiaisonState,
-    *,
-    token: str | None,
-    update_period: float,
-    stopping: asyncio.Event | None = None,
+    state: LiaisonState, *, access: Access, feed: LiveFeed, saves: SaveFolder
 ) -> Starlette:
-    """The ASGI application. `token`: None when no token is needed; `stopping` ends the live
-    streams (so that the server can stop while pages are open)."""
-    stopping = stopping or asyncio.Event()
-
-    def authorised(request: Request) -> bool:
-        if token is None:
-            return True
-        offered = (
-            request.query_params.get("token")
-            or request.cookies.get(COOKIE)
-            or request.headers.get("authorization", "").removeprefix("Bearer ")
-        )
-        return bool(offered) and hmac.compare_digest(offered, token)
-
-    def guard(handler: Callable) -> Callable:
-        async def guarded(request: Request) -> Response:
-            if not authorised(request):
-                return Response("liaison: access token required (?token=...)", 401)
-            if request.method == "POST" and request.headers.get("x-liaison") != "1":
-                return Response("liaison: POST without the X-Liaison header", 403)
-            response = await handler(request)
-            if token is not None and request.query_params.get("token"):
-                response.set_cookie(COOKIE, token, httponly=True, samesite="strict")
-            return response
-
-        return guarded
-
-    async def index(request: Request) -> Response:
-        return RedirectResponse("/scope")
-
-    async def page(request: Request) -> Response:
-        return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-store"})
-
-    async def events(request: Request) -> Response:
-        name = request.query_params.get("page", "scope")
-        pattern = request.query_params.get("filter", "")
-        if name not in PAGES:
-            return Response(f"no page {name!r}", 404)
-
-        async def stream() -> AsyncIterator[str]:
-            while not stopping.is_set() and not await request.is_disconnected():
-                data = state.page(name, state.now(), pattern)
-                yield f"data: {json.dumps(data, default=_json_default)}\n\n"
-                with contextlib.suppress(TimeoutError):
-                    async with asyncio.timeout(update_period):
-                        await stopping.wait()
-
-        return StreamingResponse(
-            stream(), media_type="text/event-stream", headers={"Cache-Control": "no-store"}
-        )
-
-    async def history(request: Request) -> Response:
-        key = request.query_params.get("key", "")
-        return JSONResponse({"key": key, "points": state.scope.history(key)})
-
-    async def types(request: Request) -> Response:
-        return JSONResponse(
-            {
-                "types": state.commander_types(),
-                "community": state.commander.community,
-                "modem_ids": state.commander.modem_ids(),
-                "style": state.commander.style,
-            }
-        )
-
-    async def command(request: Request) -> Response:
-        """POST {action, type, field?, text?, ...}: one commander operation."""
-        try:
-            body = await request.json()
-            action = body["action"]
-            commander = state.commander
-            draft = commander.open(body["type"]) if "type" in body else None
-            result: dict = {"ok": True}
-            if action == "open":
-                pass
-            elif action == "check":
-                commander.check(
-                    draft, body["field"], body.get("text", ""), partial=bool(body.get("partial"))
-                )
-            elif action == "set":
-                commander.set_value(draft, body["field"], body.get("text", ""))
-            elif action == "special":
-                special = body["special"]
-                if special == "time":
-                    commander.insert_time(draft, body["field"])
-                elif special == "xy":
-                    commander.insert_xy(draft, body["field"])
-                elif special == "community":
-                    commander.insert_community(draft, body["field"])
-                elif special == "modem_id":
-                    commander.insert_modem_id(draft, body["field"], int(body["modem_id"]))
-                else:
-                    raise CommanderError(f"no special {special!r}")
-            elif action == "clear":
-                commander.clear(draft)
-            elif action == "preview":
-                result["preview"] = outgoing_view(commander.preview(draft))
-            elif action == "send":
-                result["record"] = record_view(commander.send(draft))
-            elif action == "save":
-                commander.save(body["path"])
-            elif action == "load":
-                result["warnings"] = commander.load(body["path"])
-            else:
-                raise CommanderError(f"no action {action!r}")
-            if draft is not None:
-                result["fields"] = field_view(draft)
-                result["type"] = draft.type.name
-            return JSONResponse(result)
-        except (PygobyError, KeyError, ValueError, TypeError, OSError) as err:
-            reason = err.args[0] if isinstance(err, KeyError) and err.args else str(err)
-            status = 400 if not isinstance(err, FieldValueError | SaveFileError) else 422
-            return JSONResponse({"ok": False, "error": str(reason)}, status_code=status)
-
-    routes = [
-        Route("/", guard(index)),
-        *(Route(f"/{name}", guard(page)) for name in PAGES),
-        Route("/api/events", guard(events)),
-        Route("/api/scope/history", guard(history)),
-        Route("/api/commander/types", guard(types)),
-        Route("/api/commander", guard(command), methods=["POST"]),
-        Mount("/static", StaticFiles(directory=STATIC), name="static"),
-    ]
-    return Starlette(routes=routes)
+    """The ASGI application: ROUTES behind the AccessGuard."""
+    app = Starlette(routes=ROUTES, middleware=[Middleware(AccessGuard, access=access)])
+    app.state.liaison = Parts(state, feed, saves)
+    return app
 
 
 class _EmbeddedServer(uvicorn.Server):
@@ -221,26 +348,22 @@ class WebServer:
     """uvicorn in the running asyncio loop, on a socket bound at construction; `url` once
     started."""
 
-    def __init__(
-        self,
-        state: LiaisonState,
-        address: str,
-        port: int,
-        token: str = "",
-        update_period: float = 0.2,
-    ) -> None:
-        self.address = address
-        self.token: str | None = None
-        if not is_loopback(address):
-            self.token = token or secrets.token_urlsafe(16)
+    def __init__(self, state: LiaisonState, cfg: ProtobufMessage, save_dir: str | Path) -> None:
+        """`cfg`: the LiaisonConfig (address, port, token, update_freq, max_streams,
+        allowed_host); `save_dir`: the Commander page's save folder."""
+        self.address = address = cfg.http_address
+        self._socket = listen(address, cfg.http_port)
+        self.port = self._socket.getsockname()[1]
+        self.token = cfg.token or secrets.token_urlsafe(16)
         self._stopping = asyncio.Event()
-        app = make_app(
-            state, token=self.token, update_period=update_period, stopping=self._stopping
-        )
+        period = 1.0 / cfg.update_freq if cfg.update_freq > 0 else 1.0
+        self.feed = LiveFeed(state, period, cfg.max_streams)
+        access = Access(address, self.token, self.port, cfg.allowed_host)
+        app = make_app(state, access=access, feed=self.feed, saves=SaveFolder(save_dir))
         config = uvicorn.Config(
             app,
             host=address,
-            port=port,
+            port=self.port,
             log_level="warning",
             lifespan="off",
             access_log=False,
@@ -248,16 +371,15 @@ class WebServer:
         )
         self._server = _EmbeddedServer(config)
         self._task: asyncio.Task | None = None
-        self._socket = listen(address, port)
-        self.port = self._socket.getsockname()[1]
+        self._feed_task: asyncio.Task | None = None
 
     @property
     def url(self) -> str:
         host = f"[{self.address}]" if ":" in self.address else self.address
-        suffix = f"/scope?token={self.token}" if self.token else "/scope"
-        return f"http://{host}:{self.port}{suffix}"
+        return f"http://{host}:{self.port}/scope?token={self.token}"
 
     async def start(self) -> None:
+        self._feed_task = asyncio.create_task(self.feed.run(self._stopping), name="liaison-feed")
         self._task = asyncio.create_task(
             self._server.serve(sockets=[self._socket]), name="liaison-http"
         )
@@ -272,6 +394,8 @@ class WebServer:
             self._socket.close()  # never served (once served, the server closes it)
             return
         self._stopping.set()
+        if self._feed_task is not None:
+            await self._feed_task
         self._server.should_exit = True
         task, self._task = self._task, None
         # not wait_for in a suppress(CancelledError): that swallowed our caller's cancellation

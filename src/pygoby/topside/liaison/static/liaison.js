@@ -21,13 +21,17 @@ const svg = (tag, attrs = {}) => {
 const clock = (t) => new Date(t * 1000).toISOString().substring(11, 19);
 
 async function post(body) {
+  // the token travels as the cookie the printed URL's ?token= left (HttpOnly: never seen here)
   const response = await fetch("/api/commander", {
     method: "POST",
     headers: { "Content-Type": "application/json", "X-Liaison": "1" },
     body: JSON.stringify(body),
   });
-  return response.json();
+  if ((response.headers.get("content-type") || "").startsWith("application/json")) return response.json();
+  return { ok: false, error: await response.text() };
 }
+// the token is kept as a cookie: take it out of the address bar (as Jupyter does)
+if (new URLSearchParams(location.search).has("token")) history.replaceState(null, "", location.pathname);
 
 // ------------------------------------------------------------------------------ live updates
 let source = null;
@@ -46,19 +50,68 @@ function listen(extra = "") {
 }
 
 // ------------------------------------------------------------------------------ Scope
+// The server sends every row once, then only the rows that changed: rows are updated in place
+// (a click never lands on a row that is being replaced), ages worked out here from `now`.
 let historyKey = "";
+const scopeRows = new Map(); // key -> { tr, row, cells }
+let scopeKeys = []; // sorted, as the table
+function selectHistory(key) {
+  const old = scopeRows.get(historyKey);
+  if (old) old.tr.classList.remove("selected");
+  historyKey = key;
+  scopeRows.get(key).tr.classList.add("selected");
+  $("#history-key").textContent = key;
+  drawHistory();
+}
+
+function scopeRow(key) {
+  const expander = el("button", { class: "expander", title: "show the whole value" }, "▸");
+  const cells = {
+    value: el("td", { class: "value" }), type: el("td", { class: "type" }), source: el("td", { class: "source" }),
+    community: el("td", { class: "community" }), age: el("td", { class: "age" }), rate: el("td", { class: "rate" }),
+  };
+  const tr = el("tr", { "data-key": key }, el("td", { class: "key", title: key }, expander, el("span", {}, key)),
+    cells.value, cells.type, cells.source, cells.community, cells.age, cells.rate);
+  expander.onclick = () => { expander.textContent = tr.classList.toggle("expanded") ? "▾" : "▸"; };
+  expander.onpointerdown = (event) => event.stopPropagation();
+  // selected as the button goes down: a row that moves under a held button (a new variable
+  // inserted above it) still gets the click
+  tr.onpointerdown = (event) => {
+    if (event.button === 0 && scopeRows.get(key).row.numeric) selectHistory(key);
+  };
+  return { tr, cells, row: null };
+}
+
+function setText(node, text) { if (node.textContent !== text) node.textContent = text; }
+
 function renderScope(data) {
   const body = $("#scope-table tbody");
-  body.replaceChildren(...data.rows.map((row) => {
-    const tr = el("tr", { "data-key": row.key, class: (row.numeric ? "numeric" : "") + (row.key === historyKey ? " selected" : "") },
-      el("td", { class: "key" }, row.key), el("td", { class: "value" }, row.value), el("td", {}, row.type),
-      el("td", {}, row.source), el("td", {}, row.community), el("td", { class: "age" }, row.age.toFixed(1)),
-      el("td", { class: "rate" }, row.rate.toFixed(2)));
-    if (row.numeric) tr.onclick = () => { historyKey = row.key; $("#history-key").textContent = row.key; };
-    return tr;
-  }));
-  $("#scope-count").textContent = `${data.rows.length} variables`;
-  if (historyKey) drawHistory();
+  if (data.full) { body.replaceChildren(); scopeRows.clear(); scopeKeys = []; }
+  for (const key of data.removed) {
+    const entry = scopeRows.get(key);
+    if (!entry) continue;
+    entry.tr.remove(); scopeRows.delete(key); scopeKeys.splice(scopeKeys.indexOf(key), 1);
+  }
+  for (const row of data.changed) {
+    let entry = scopeRows.get(row.key);
+    if (!entry) {
+      entry = scopeRow(row.key);
+      let [lo, hi] = [0, scopeKeys.length];
+      while (lo < hi) { const mid = (lo + hi) >> 1; if (scopeKeys[mid] < row.key) lo = mid + 1; else hi = mid; }
+      const next = lo < scopeKeys.length ? scopeRows.get(scopeKeys[lo]).tr : null;
+      body.insertBefore(entry.tr, next);
+      scopeKeys.splice(lo, 0, row.key); scopeRows.set(row.key, entry);
+      if (row.key === historyKey) entry.tr.classList.add("selected");
+    }
+    entry.row = row;
+    const c = entry.cells;
+    setText(c.value, row.value); setText(c.type, row.type); setText(c.source, row.source);
+    setText(c.community, row.community); setText(c.rate, row.rate.toFixed(2));
+    entry.tr.classList.toggle("numeric", row.numeric);
+  }
+  for (const entry of scopeRows.values()) setText(entry.cells.age, Math.max(data.now - entry.row.time, 0).toFixed(1));
+  $("#scope-count").textContent = `${data.count} variables`;
+  if (historyKey && data.changed.some((row) => row.key === historyKey)) drawHistory();
 }
 
 async function drawHistory() {
@@ -150,7 +203,15 @@ async function setupCommander() {
   const info = await (await fetch("/api/commander/types")).json();
   modemIds = info.modem_ids;
   const select = $("#cmd-type");
-  for (const t of info.types) select.append(el("option", { value: t.name }, `${t.short}${t.ack ? " (ack)" : ""}`));
+  // the configuration's commands; "show all" adds the other messages (telemetry)
+  const offer = () => {
+    const all = $("#cmd-all").checked;
+    select.replaceChildren(el("option", { value: "" }, "(choose a message)"),
+      ...info.types.filter((t) => all || t.command || t.name === current).map((t) =>
+        el("option", { value: t.name, selected: t.name === current }, `${t.short}${t.ack ? " (ack)" : ""}${t.command ? "" : " (not a command)"}`)));
+  };
+  offer();
+  $("#cmd-all").onchange = offer;
   select.onchange = async () => {
     current = select.value;
     $("#cmd-preview-text").hidden = true;
@@ -193,6 +254,8 @@ function renderCommander(data) {
 // ------------------------------------------------------------------------------ Acomms
 function renderAcomms(data) {
   $("#acomms-modem").textContent = data.modem_id;
+  $("#acomms-drivers").replaceChildren(...data.drivers.map((text) =>
+    el("div", { class: "driver" + (text.endsWith(": running") ? "" : " failed") }, text)));
   $("#acomms-queues tbody").replaceChildren(...data.queues.map((q) =>
     el("tr", { "data-queue": q.name }, el("td", {}, q.name), el("td", {}, q.dccl_id ?? "?"), el("td", { class: "size" }, String(q.size)),
       el("td", {}, q.ack ? "yes" : "no"), el("td", {}, String(q.ttl)), el("td", {}, String(q.value_base)),
@@ -228,11 +291,13 @@ function renderMap(data) {
   const px = (x) => W / 2 + (x - cx) * scale, py = (y) => H / 2 - (y - cy) * scale;
   const children = [];
   const step = Math.pow(10, Math.floor(Math.log10(span / 2)));
-  for (let g = Math.ceil((cx - span) / step) * step; g <= cx + span; g += step) {
-    children.push(svg("line", { class: "gridline", x1: px(g), x2: px(g), y1: 0, y2: H }));
+  // the picture keeps its aspect in a window of any shape, so the grid reaches well beyond the
+  // 900 x 600 box to every edge of the window
+  for (let g = Math.ceil((cx - 3 * span) / step) * step; g <= cx + 3 * span; g += step) {
+    children.push(svg("line", { class: "gridline", x1: px(g), x2: px(g), y1: -2 * H, y2: 3 * H }));
   }
-  for (let g = Math.ceil((cy - span) / step) * step; g <= cy + span; g += step) {
-    children.push(svg("line", { class: "gridline", y1: py(g), y2: py(g), x1: 0, x2: W }));
+  for (let g = Math.ceil((cy - 3 * span) / step) * step; g <= cy + 3 * span; g += step) {
+    children.push(svg("line", { class: "gridline", y1: py(g), y2: py(g), x1: -2 * W, x2: 3 * W }));
   }
   const where = Object.fromEntries(data.nodes.map((n) => [n.name, n]));
   for (const link of data.links) {
