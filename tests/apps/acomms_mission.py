@@ -20,7 +20,7 @@ from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.moos.timewarp import moos_clock
+from pygoby.moos.timewarp import clock_warp, moos_clock
 from pygoby.util.clock import Clock
 
 PROTO = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / "two_vehicles.proto"
@@ -225,8 +225,10 @@ async def start_db(stack: contextlib.AsyncExitStack, modem_id: int, warp: float 
 async def modem_and_db(
     stack: contextlib.AsyncExitStack, modem_id: int, channel, clock
 ) -> tuple[MMSimServer, MOOSDB]:
-    """An emulated Micro-Modem and the MOOSDB of community `vehicle<modem_id>`."""
-    return await start_modem(stack, modem_id, channel, clock), await start_db(stack, modem_id)
+    """An emulated Micro-Modem and the MOOSDB of community `vehicle<modem_id>`, both on `clock`
+    (MOOS time, at its warp)."""
+    modem = await start_modem(stack, modem_id, channel, clock)
+    return modem, await start_db(stack, modem_id, clock_warp(clock))
 
 
 @contextlib.asynccontextmanager

@@ -18,7 +18,8 @@ from pygoby.acomms.mmsim.channel import DEFAULT_SOUND_SPEED
 from pygoby.dccl.dccl1 import Dccl1Codec, unstitch
 from pygoby.dccl.xml import load_message_set
 from pygoby.moos.client import MOOSClient
-from tests.apps.acomms_mission import WARP, mission_clock, two_vehicle_missions
+from pygoby.util.clock import WallClock
+from tests.apps.acomms_mission import two_vehicle_missions
 from tests.goby11.seed_listings import EXAMPLES
 
 pytestmark = pytest.mark.e2e
@@ -31,7 +32,6 @@ def mission(modem_id: int, db_port: int, modem_port: int) -> str:
     return f"""ServerHost = localhost
 ServerPort = {db_port}
 Community = mm{modem_id}
-MOOSTimeWarp = {WARP}
 LatOrigin = 42.35
 LongOrigin = -70.95
 modem_id_lookup_path = {EXAMPLES}/MOOS/ccl_and_dccl/modemidlookup.txt
@@ -73,7 +73,9 @@ WATCHED = ["STATUS_REPORT_IN", "ACOMMS_INCOMING_DATA", "ACOMMS_RANGE_RESPONSE", 
 
 
 def two_nodes(tmp_path: Path):
-    clock = mission_clock()
+    # in real time: Goby 1.1's header time is the time of day, placed in the day by the
+    # receiver's clock
+    clock = WallClock()
     channel = LoopbackChannel(clock, range_m=0.25 * DEFAULT_SOUND_SPEED)  # 0.25 s away
     return two_vehicle_missions(tmp_path, mission, WATCHED, channel, clock)
 
@@ -92,8 +94,7 @@ async def test_goby11_configuration_runs_with_the_11_variables(tmp_path):
             "1.5",
             "20",
         )  # angle_0_360
-        now = mission_clock().now()
-        assert abs(float(fields["Timestamp"]) - now) < 60 * WARP  # 1.1 header default: now
+        assert abs(float(fields["Timestamp"]) - WallClock().now()) < 60  # 1.1 header default
         incoming = await recorders[1].wait_for("ACOMMS_INCOMING_DATA")
         data = acomms_pb.V1ModemDataTransmission()
         text_format.Parse(incoming, data)
@@ -110,7 +111,7 @@ async def test_goby11_configuration_runs_with_the_11_variables(tmp_path):
             100,
         )
 
-        async with MOOSClient("poker", port=mm1.client.port, clock=mission_clock()) as poker:
+        async with MOOSClient("poker", port=mm1.client.port) as poker:
             poker.publish("ACOMMS_RANGE_COMMAND", "base { dest: 2 } type: MODEM_TWO_WAY_PING")
             reply = await recorders[0].wait_for("ACOMMS_RANGE_RESPONSE", timeout=20)
             ranging = acomms_pb.V1ModemRangingReply()
