@@ -1,6 +1,3 @@
-import sys
-from pathlib import Path
+"""Benchmarks use the tests' fixtures (reference vectors)."""
 
-# Benchmarks reuse the test helpers (vector paths, fixtures).
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from tests.conftest import vectors_dir  # noqa: E402,F401
+from tests.conftest import vectors_dir  # noqa: F401 - a fixture, found by pytest by its name

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import pytest
 
-from pygoby.netsim.scenario import parse_scenario
-from pygoby.netsim.sim import Simulation
+from pygoby.netsim.sim.scenario import parse_scenario
+from pygoby.netsim.sim.simulation import Simulation
 
 
 def tdma_scenario(nodes: int, duration: float, spacing: float, columns: int) -> str:

@@ -16,8 +16,8 @@ import time
 
 import pytest
 
-from pygoby.netsim.scenario import parse_scenario
-from pygoby.netsim.sim import Simulation
+from pygoby.netsim.sim.scenario import parse_scenario
+from pygoby.netsim.sim.simulation import Simulation
 from pygoby.netsim.sweep.engine import run_sweep
 from pygoby.netsim.sweep.executors import LocalExecutor, default_jobs
 from pygoby.netsim.sweep.plan import expand, parse_sweep

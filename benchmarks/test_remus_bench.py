@@ -4,8 +4,8 @@ show the headroom, e.g. for replaying logs."""
 
 from __future__ import annotations
 
-from pygoby.apps.premuscodec_reports import RemusReports
 from pygoby.dccl.ccl.remus import Ranger, State, TimeDate
+from pygoby.moosacomms.remus_reports import RemusReports
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup
 

@@ -7,8 +7,12 @@ from pathlib import Path
 
 import pytest
 
+from pygoby.protobuf import generate
 from tests import hypothesis_profiles
 
+# the _pb2 modules of our .proto files, for a run of pytest in a fresh clone (pip install and
+# `make` make them too; a no-op when they are newer than every .proto)
+generate.main([])
 hypothesis_profiles.load()
 
 REPO = Path(__file__).resolve().parents[1]

@@ -20,7 +20,7 @@ from pygoby.moos.translator import TranslatorConfigError
 from pygoby.netsim import NetsimError, ScenarioError
 from pygoby.protobuf import ProtoError
 from pygoby.topside import TopsideError
-from pygoby.util import LinkClosedError, NMEAError, PluginError, PtyError
+from pygoby.util import LinkClosedError, MissingExtraError, NMEAError, PluginError, PtyError
 
 # the root(s) every error class of a package derives from
 PACKAGE_ROOTS: dict[str, tuple[type[BaseException], ...]] = {
@@ -31,7 +31,8 @@ PACKAGE_ROOTS: dict[str, tuple[type[BaseException], ...]] = {
     "pygoby.netsim": (NetsimError,),
     "pygoby.protobuf": (ProtoError,),
     "pygoby.topside": (TopsideError,),
-    "pygoby.util": (NMEAError, LinkClosedError, PtyError, PluginError),  # one root per kind
+    # one root per kind
+    "pygoby.util": (NMEAError, LinkClosedError, PtyError, PluginError, MissingExtraError),
     "pygoby.errors": (PygobyError,),
 }
 
@@ -125,7 +126,7 @@ def test_located_fills_only_what_is_missing():
 
 
 def test_a_text_format_parse_error_names_the_line_of_the_file():
-    from pygoby.netsim.config import config_class
+    from pygoby.netsim.manager.config import config_class
     from pygoby.protobuf.textconfig import merge_config_text
 
     with pytest.raises(ConfigError) as info:
@@ -141,7 +142,7 @@ def test_a_text_format_parse_error_names_the_line_of_the_file():
 def test_configuration_errors_from_files_carry_file_and_line(tmp_path):
     from pygoby.moos.appconfig import read_configuration
     from pygoby.moos.moosfile import MissionFile
-    from pygoby.netsim.scenario import load_scenario
+    from pygoby.netsim.sim.scenario import load_scenario
     from pygoby.protobuf import builtin_class
 
     scenario = tmp_path / "run.pb.cfg"

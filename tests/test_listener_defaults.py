@@ -11,9 +11,9 @@ from pygoby.acomms.drivers.store_server import StoreServerDriver
 from pygoby.acomms.store_server import StoreServer, TransmissionStore, serve_store
 from pygoby.cli import build_parser as pygoby_parser
 from pygoby.frontseat.simulator import server as frontseat_server
-from pygoby.netsim import server as netsim_server
-from pygoby.netsim.config import EXAMPLE_CONFIG, parse_config
-from pygoby.netsim.manager import NetSimManager
+from pygoby.netsim.manager import server as netsim_server
+from pygoby.netsim.manager.config import EXAMPLE_CONFIG, parse_config
+from pygoby.netsim.manager.core import NetSimManager
 from pygoby.util.linebased import TCPServerLink
 
 LOOPBACK = "127.0.0.1"

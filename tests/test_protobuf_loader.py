@@ -66,3 +66,52 @@ def test_different_definition_under_a_loaded_name_is_refused(tmp_path: Path) -> 
     loader.load_file(first / "x.proto")
     with pytest.raises(ProtoError, match="different definition"):
         loader.load_file(second / "y.proto")
+
+
+def test_default_loader_uses_the_generated_modules() -> None:
+    from pygoby.protobuf import default_loader
+    from pygoby.protobuf.goby.acomms.protobuf import modem_message_pb2
+
+    loader = default_loader()
+    file = loader.load_file("goby/acomms/protobuf/modem_message.proto")
+    assert file is modem_message_pb2.DESCRIPTOR
+    cls = loader.message_class("goby.acomms.protobuf.ModemTransmission")
+    assert cls is modem_message_pb2.ModemTransmission
+
+
+def test_users_file_in_the_default_pool_imports_our_classes(tmp_path: Path) -> None:
+    from pygoby.protobuf import default_loader
+    from pygoby.protobuf.goby.acomms.protobuf import modem_message_pb2
+
+    (tmp_path / "uses_ours_in_default_pool.proto").write_text(
+        'syntax = "proto2"; import "goby/acomms/protobuf/modem_message.proto";'
+        " package uses_ours; message Wrapper {"
+        " optional goby.acomms.protobuf.ModemTransmission transmission = 1; }"
+    )
+    loader = default_loader()
+    loader.load_file(tmp_path / "uses_ours_in_default_pool.proto")
+    wrapper = loader.message_class("uses_ours.Wrapper")(transmission={"src": 3})
+    assert type(wrapper.transmission) is modem_message_pb2.ModemTransmission
+    assert wrapper.transmission.src == 3
+
+
+def test_generated_modules_import_each_other_inside_the_package(tmp_path: Path) -> None:
+    from pygoby.protobuf import generate
+
+    (tmp_path / "goby").mkdir()
+    (tmp_path / "goby" / "base.proto").write_text(
+        'syntax = "proto2"; package g; message Base { optional int32 v = 1; }'
+    )
+    (tmp_path / "goby" / "top.proto").write_text(
+        'syntax = "proto2"; import "goby/base.proto"; package g;'
+        " message Top { optional Base base = 1; }"
+    )
+    generate.generate(tmp_path)
+    module, stub = generate.outputs("goby/top.proto", tmp_path)
+    assert "from pygoby.protobuf.goby import base_pb2" in module.read_text()
+    assert "'pygoby.protobuf.goby.top_pb2'" in module.read_text()
+    assert "from pygoby.protobuf.goby import base_pb2" in stub.read_text()
+    assert "class Top(" in stub.read_text()
+    assert not generate.is_stale(tmp_path)
+    (tmp_path / "goby" / "base.proto").unlink()  # a .proto gone: its outputs are stale
+    assert generate.is_stale(tmp_path)

@@ -34,7 +34,7 @@ def test_lazy_exports_are_the_submodules_objects():
     from pygoby.acomms import QueueManager
     from pygoby.acomms.queue.manager import QueueManager as defined
     from pygoby.netsim import Simulation
-    from pygoby.netsim.sim import Simulation as simulation_defined
+    from pygoby.netsim.sim.simulation import Simulation as simulation_defined
 
     assert QueueManager is defined and Simulation is simulation_defined
     with pytest.raises(AttributeError, match="has no attribute 'NoSuchThing'"):

@@ -4,7 +4,7 @@ after, messages lost). Not part of `make test`; exit status 1 when a scenario br
 (a request unanswered, a freeze, memory growing without bound, a message lost, a process left
 behind).
 
-    .venv/bin/python benchmarks/soak/run.py [--seconds S] [--only TEXT] [--list]
+    .venv/bin/python -m benchmarks.soak.run [--seconds S] [--only TEXT] [--list]   # from the repository root
 """
 
 from __future__ import annotations
@@ -12,16 +12,12 @@ from __future__ import annotations
 import argparse
 import asyncio
 import logging
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path[:0] = [str(HERE), str(HERE.parent), str(HERE.parents[1])]  # kit, the benchmarks, tests
-
-from kit import HEADER, Figures  # noqa: E402
-from scenarios import SCENARIOS  # noqa: E402
+from benchmarks.soak.kit import HEADER, Figures
+from benchmarks.soak.scenarios import SCENARIOS
 
 
 def time_limit(seconds: float) -> float:

@@ -20,7 +20,7 @@ from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from kit import (
+from benchmarks.soak.kit import (
     ANSWER_TIMEOUT,
     Figures,
     Garbage,
@@ -35,7 +35,6 @@ from kit import (
     stop_or_fail,
     venv_command,
 )
-
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.rudics import parse_rudics_packet, serialize_rudics_packet
 from pygoby.moos import protocol as p
@@ -692,7 +691,7 @@ async def stale_session(seconds: float, workdir: Path) -> Figures:
 
 async def netsim_manager_hostile(seconds: float, workdir: Path) -> Figures:
     """64 clients x 10 Hz NavUpdates with garbage clients (benchmarks/test_netsim_bench.py)."""
-    from test_netsim_bench import ManagerProcess, _config, _load
+    from benchmarks.test_netsim_bench import ManagerProcess, _config, _load
 
     figures = Figures()
     manager = ManagerProcess(_config(workdir))
@@ -819,7 +818,7 @@ async def liaison_streams_and_filters(seconds: float, workdir: Path) -> Figures:
 
 
 def _rss(pid: int) -> float | None:
-    from kit import rss_mb
+    from benchmarks.soak.kit import rss_mb
 
     return rss_mb(pid)
 

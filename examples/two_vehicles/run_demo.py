@@ -283,7 +283,7 @@ def summary_line(
 
 def _channel_config():
     from pygoby.netsim.channel import ChannelConfig, LogisticModel, RateErrorModels
-    from pygoby.netsim.channel.errors import DEFAULT_RATE_MODELS
+    from pygoby.netsim.channel.frame_errors import DEFAULT_RATE_MODELS
 
     rate0 = LogisticModel(**RATE0_FRAME_ERRORS)
     errors = RateErrorModels(by_rate={**DEFAULT_RATE_MODELS, 0: rate0})
@@ -319,8 +319,8 @@ async def run_mission(
     from pygoby.moos.moosfile import MissionFile
     from pygoby.moos.timewarp import moos_clock
     from pygoby.netsim.channel import Channel
-    from pygoby.netsim.eventlog import EventLogWriter
-    from pygoby.netsim.physics_channel import PhysicsChannel
+    from pygoby.netsim.report.eventlog import EventLogWriter
+    from pygoby.netsim.sim.physics_channel import PhysicsChannel
 
     clock = moos_clock(warp)
     codec = Codec(clock=clock)
@@ -387,13 +387,13 @@ async def run_mission(
 def _position_feed(channel, port: int, geodesy):
     """A Monitor's `on_nav`: the vehicle's position (local x/y to lat/lon about the mission's
     origin), with speed and heading for dead reckoning, to the acoustic channel."""
-    from pygoby.netsim.channel import Position
+    from pygoby.netsim.channel import NavFix
 
     def update(nav: dict[str, float], t: float) -> None:
         lat, lon = geodesy.to_geo(nav["NAV_X"], nav["NAV_Y"])
         channel.channel.update_position(
             port,
-            Position(lat, lon, nav["NAV_DEPTH"], t, nav["NAV_SPEED"], nav["NAV_HEADING"]),
+            NavFix(lat, lon, nav["NAV_DEPTH"], t, nav["NAV_SPEED"], nav["NAV_HEADING"]),
         )
 
     return update

@@ -9,6 +9,7 @@ from collections.abc import Sequence
 
 from pygoby import __version__
 from pygoby.util.console import quiet_broken_pipe
+from pygoby.util.errors import MissingExtraError
 
 # Each module has `register(subparsers)`, which adds parsers whose `func(args) -> int` runs them.
 SUBCOMMAND_MODULES = [
@@ -17,7 +18,7 @@ SUBCOMMAND_MODULES = [
     "pygoby.moos.cli",
     "pygoby.moos.alog.cli",
     "pygoby.frontseat.cli",
-    "pygoby.netsim.sim_cli",
+    "pygoby.netsim.cli",
     "pygoby.apps.topside_cli",
 ]
 
@@ -39,6 +40,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             return int(args.func(args) or 0)
         except KeyboardInterrupt:
             return 130
+        except MissingExtraError as exc:  # a feature installed by a pip extra
+            print(f"pygoby {args.command}: {exc}", file=sys.stderr)
+            return 1
 
     return quiet_broken_pipe(run)
 

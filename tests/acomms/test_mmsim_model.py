@@ -10,8 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pygoby.acomms.drivers.micromodem.statistics import CycleStatistics, parse_cst
-from pygoby.acomms.mmsim import AcousticPacket, LoopbackChannel, MicroModemModel, PacketKind
-from pygoby.acomms.mmsim.channel import Reception
+from pygoby.acomms.mmsim import AcousticPacket, LoopbackChannel, MicroModemModel, ModemPacketKind
+from pygoby.acomms.mmsim.channel import ModemReception
+from pygoby.acomms.mmsim.model import COMMAND_HANDLERS
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.util.clock import VirtualClock
 from pygoby.util.nmea import NMEASentence
@@ -368,10 +369,10 @@ def test_a_rate_0_poll_heard_before_the_host_spoke_goes_on_the_water_at_once():
 
 def test_channel_statistics_reach_cacst():
     model = MicroModemModel(2, VirtualClock(T0), firmware="0.94.0.00")
-    packet = AcousticPacket(PacketKind.DATA, 1, 2, rate=1, frames=[b"a", b"b"], duration=1.0)
+    packet = AcousticPacket(ModemPacketKind.DATA, 1, 2, rate=1, frames=[b"a", b"b"], duration=1.0)
     model.receive(
         packet,
-        Reception(
+        ModemReception(
             T0 + 0.25, frame_ok=[True, False], stats={"snr_in": 7.6, "doppler": -0.44, "bogus": 1}
         ),
     )
@@ -384,36 +385,14 @@ def test_channel_statistics_reach_cacst():
 
 def test_mm2_statistics_carry_their_version_and_date():
     model = MicroModemModel(2, VirtualClock(T0))
-    packet = AcousticPacket(PacketKind.DATA, 1, 2, rate=0, frames=[b"a"], duration=3.2)
-    model.receive(packet, Reception(T0 + 0.25))
+    packet = AcousticPacket(ModemPacketKind.DATA, 1, 2, rate=0, frames=[b"a"], duration=3.2)
+    model.receive(packet, ModemReception(T0 + 0.25))
     (cst,) = [s for s in model.take_output() if isinstance(s, CycleStatistics)]
     fields = NMEASentence.parse(cst.message()).fields
     assert fields[1:4] == ("6", "0", "20231114221320.2500")
 
 
-HOST_COMMANDS = [
-    "CFG",
-    "CFQ",
-    "MSC",
-    "CLK",
-    "CLQ",
-    "TMS",
-    "TMQ",
-    "ALQ",
-    "CYC",
-    "TXD",
-    "MPC",
-    "MUC",
-    "TDP",
-    "MEC",
-    "PDT",
-    "PNT",
-    "PGT",
-    "SWP",
-    "MSQ",
-    "RSP",
-    "XYZ",
-]
+HOST_COMMANDS = [*COMMAND_HANDLERS, "XYZ"]  # every command the model knows, and one it does not
 FIELDS = st.one_of(
     st.integers(-(2**70), 2**70).map(str),
     st.sampled_from(

@@ -8,7 +8,7 @@ import socket
 import pytest
 
 from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
-from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind
+from pygoby.acomms.mmsim.channel import AcousticPacket, ModemPacketKind
 from pygoby.acomms.mmsim.multicast_channel import (
     BroadcastChannel,
     MulticastChannel,
@@ -118,7 +118,9 @@ async def only_the_real_packet_is_heard(make_channel, address: str, forgeries) -
 
 
 def forged_mini_packet() -> bytes:
-    forged = AcousticPacket(PacketKind.MINI, 7, 2, frames=[b"\x01\x02"], tx_time=WallClock().now())
+    forged = AcousticPacket(
+        ModemPacketKind.MINI, 7, 2, frames=[b"\x01\x02"], tx_time=WallClock().now()
+    )
     return packet_to_json(forged, "intruder")
 
 

@@ -93,9 +93,8 @@ def test_multicast_queue_to_queue_with_ack():
     import random
 
     from pygoby.acomms.drivers import make_driver
-    from pygoby.protobuf import default_loader
 
-    ext = default_loader().pool.FindExtensionByName("goby.acomms.udp_multicast.protobuf.config")
+    ext = acomms_pb.UDP_MULTICAST_CONFIG
     port = random.randint(40000, 60000)
     clock = VirtualClock(1_700_000_000.0)
     drivers = []

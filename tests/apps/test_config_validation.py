@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.errors import ConfigError
 from pygoby.moos.moosfile import MissionFile
-from pygoby.netsim.config import EXAMPLE_CONFIG, load_config, parse_config
-from pygoby.netsim.scenario import ScenarioError, load_scenario, parse_scenario
+from pygoby.netsim.manager.config import EXAMPLE_CONFIG, load_config, parse_config
+from pygoby.netsim.sim.scenario import ScenarioError, load_scenario, parse_scenario
 from tests.hypothesis_profiles import examples
 
 from .acomms_mission import PROTO
@@ -176,7 +176,7 @@ def test_netsim_config_errors_say_file_line_and_field(tmp_path):
         load_config(path)
     # the console script: one clear line, exit 1, no traceback
     run = subprocess.run(
-        [sys.executable, "-m", "pygoby.netsim.server", str(path)],
+        [sys.executable, "-m", "pygoby.netsim.manager.server", str(path)],
         capture_output=True,
         text=True,
         timeout=30,

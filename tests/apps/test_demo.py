@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from pygoby.netsim.eventlog import read_events
+from pygoby.netsim.report.eventlog import read_events
 
 pytestmark = pytest.mark.e2e
 

@@ -106,22 +106,35 @@ async def start_recorders(
     return recorders
 
 
-async def test_dual_status_mission_runs_with_paths_changed(tmp_path):
-    missions = copy_mission(tmp_path, random.randint(40000, 60000))
-    with_proto_file(missions)
+async def run_until_heard(
+    missions: dict[int, tuple[Path, int]], variables: list[str], wanted: list[tuple[int, str]]
+) -> tuple[list[str], list[Recorder], list[asyncio.subprocess.Process], list[str]]:
+    """Both vehicles' antlers, run until each (recorder index, variable) of `wanted` is heard
+    (60 s each), then stopped with SIGINT: the values heard, the recorders, the antlers and
+    their outputs."""
     antlers = await start_antlers(missions)
-    recorders = []
+    recorders: list[Recorder] = []
     try:
-        recorders = await start_recorders(missions, ["STATUS_REPORT_IN", "STATUS_REPORT_IN_PB"])
-        # 10 s TDMA slots each, a status every 5 s: one cycle (20 s) plus start-up
-        from_1 = await recorders[1].wait_for("STATUS_REPORT_IN", timeout=60)
-        from_2 = await recorders[0].wait_for("STATUS_REPORT_IN", timeout=60)
+        recorders = await start_recorders(missions, variables)
+        heard = [await recorders[i].wait_for(var, timeout=60) for i, var in wanted]
     finally:
         for recorder in recorders:
             await recorder.close()
         for antler in antlers:
             antler.send_signal(signal.SIGINT)
         outputs = [(await asyncio.wait_for(a.communicate(), 30))[0].decode() for a in antlers]
+    return heard, recorders, antlers, outputs
+
+
+async def test_dual_status_mission_runs_with_paths_changed(tmp_path):
+    missions = copy_mission(tmp_path, random.randint(40000, 60000))
+    with_proto_file(missions)
+    # 10 s TDMA slots each, a status every 5 s: one cycle (20 s) plus start-up
+    (from_1, from_2), recorders, antlers, outputs = await run_until_heard(
+        missions,
+        ["STATUS_REPORT_IN", "STATUS_REPORT_IN_PB"],
+        [(1, "STATUS_REPORT_IN"), (0, "STATUS_REPORT_IN")],
+    )
     # the initializers' values, across the multicast link
     assert re.fullmatch(
         r"timestamp=[\d.]+,src=1,dest=2,x=150,y=200,speed=1\.4,heading=125,depth=23", from_1
@@ -160,19 +173,12 @@ async def test_ccl_and_dccl_mission_runs_with_paths_changed(tmp_path):
     # rest filled) and sends it, and so do we, with one warning.
     missions = copy_mission(tmp_path, random.randint(40000, 60000), CCL_DATA)
     with_proto_file(missions)
-    antlers = await start_antlers(missions)
-    recorders = []
-    try:
-        recorders = await start_recorders(missions, ["STATUS_REPORT_IN", "REMUS_STATUS_REPORT_IN"])
-        # 10 s TDMA slots each, a message every 5 s: one cycle (20 s) plus start-up
-        from_2 = await recorders[0].wait_for("STATUS_REPORT_IN", timeout=60)
-        from_1 = await recorders[1].wait_for("REMUS_STATUS_REPORT_IN", timeout=60)
-    finally:
-        for recorder in recorders:
-            await recorder.close()
-        for antler in antlers:
-            antler.send_signal(signal.SIGINT)
-        outputs = [(await asyncio.wait_for(a.communicate(), 30))[0].decode() for a in antlers]
+    # 10 s TDMA slots each, a message every 5 s: one cycle (20 s) plus start-up
+    (from_2, from_1), _, antlers, outputs = await run_until_heard(
+        missions,
+        ["STATUS_REPORT_IN", "REMUS_STATUS_REPORT_IN"],
+        [(0, "STATUS_REPORT_IN"), (1, "REMUS_STATUS_REPORT_IN")],
+    )
     # The NaN depth crosses DCCL as goby3's x86-64 build sends it: as the field's minimum.
     assert re.fullmatch(
         r"timestamp=[\d.]+,src=2,dest=1,x=550,y=125,speed=1\.6,heading=213,depth=0", from_2

@@ -158,7 +158,7 @@ def test_unparsable_text_is_left_to_protobuf():
 
 
 def test_goby11_mac_updates_become_todays():
-    from pygoby.apps.pacommshandler_goby11 import mac_update_from_goby11
+    from pygoby.moosacomms.goby11 import mac_update_from_goby11
 
     U = acomms_pb.MACUpdate.UpdateType
     current = [

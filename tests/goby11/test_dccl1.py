@@ -221,6 +221,16 @@ def test_decoder_fuzz_raises_only_decode_errors(data: bytes) -> None:
             pass
 
 
+@pytest.mark.parametrize("huge", [1.79e306, -1.79e306, "1e308"])
+def test_a_value_too_large_to_scale_travels_as_out_of_range(huge) -> None:
+    """A double that overflows when scaled by 10^precision is out of range (sent as unset),
+    as 1.1 sends it, instead of an OverflowError (hypothesis found 1.79e306)."""
+    codec = Dccl1Codec()
+    codec.load(MESSAGE_SETS["example1.xml"])
+    decoded = codec.decode(codec.encode("GoToCommand", {"goto_speed": huge}, src=3, dest=4, time=0))
+    assert decoded.values["goto_speed"] is None
+
+
 @settings(max_examples=examples(200), deadline=None)
 @given(
     st.dictionaries(

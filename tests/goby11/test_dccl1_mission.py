@@ -14,7 +14,7 @@ from google.protobuf import text_format
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mmsim import LoopbackChannel
-from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind, Reception
+from pygoby.acomms.mmsim.channel import AcousticPacket, ModemPacketKind, ModemReception
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.dccl.dccl1 import Dccl1Codec, stitch, unstitch
 from pygoby.dccl.xml import load_message_set
@@ -26,6 +26,7 @@ from tests.apps.acomms_mission import (
     modem_and_db,
     two_vehicle_missions,
 )
+from tests.goby11.missions import micromodem_driver_goby11
 from tests.goby11.seed_listings import EXAMPLES
 
 DATA = Path(__file__).parents[1] / "data" / "vectors" / "goby11-dccl1"
@@ -63,12 +64,12 @@ class Goby11Vehicle:
     def detect(self, packet: AcousticPacket, arrival: float) -> None:
         pass
 
-    def receive(self, packet: AcousticPacket, reception: Reception) -> None:
+    def receive(self, packet: AcousticPacket, reception: ModemReception) -> None:
         self.heard.append(packet)
 
     def send(self, frame: bytes, dest: int) -> None:
         packet = AcousticPacket(
-            PacketKind.DATA, GOBY11_ID, dest, rate=1, frames=[frame], tx_time=self.clock.now()
+            ModemPacketKind.DATA, GOBY11_ID, dest, rate=1, frames=[frame], tx_time=self.clock.now()
         )
         packet.duration = 1.0
         self.channel.transmit(self, packet)
@@ -96,14 +97,7 @@ ProcessConfig = pAcommsHandler
     initializer {{ type: INI_DOUBLE moos_var: "NAV_DEPTH" dval: 7 }}
   }}
   modem_id: 2
-  driver_type: DRIVER_WHOI_MICROMODEM
-  driver_cfg
-  {{
-    connection_type: CONNECTION_TCP_AS_CLIENT
-    tcp_server: "127.0.0.1"
-    tcp_port: {modem_port}
-    [MicroModemConfig.reset_nvram]: false
-  }}
+{micromodem_driver_goby11(modem_port)}
   mac_cfg
   {{
     type: MAC_FIXED_DECENTRALIZED
@@ -157,9 +151,9 @@ async def test_recorded_goby11_frames_in_and_goby11_bytes_out(tmp_path):
 
         # pygoby's answer, heard by the 1.1 side, in Goby 1.1's bytes
         async with asyncio.timeout(30):
-            while not any(p.kind is PacketKind.DATA and p.frames for p in goby11.heard):
+            while not any(p.kind is ModemPacketKind.DATA and p.frames for p in goby11.heard):
                 await asyncio.sleep(0.05)
-    frame = next(p for p in goby11.heard if p.kind is PacketKind.DATA and p.frames).frames[0]
+    frame = next(p for p in goby11.heard if p.kind is ModemPacketKind.DATA and p.frames).frames[0]
     assert frame[0] == 0x20
     codec = Dccl1Codec()  # a Goby 1.1 node with no passphrase configured
     codec.load(load_message_set(SIMPLE_STATUS))
@@ -195,14 +189,7 @@ ProcessConfig = pAcommsHandler
 {{
   common {{ verbosity: VERBOSITY_WARN log: false app_tick: 20 }}
   modem_id: {modem_id}
-  driver_type: DRIVER_WHOI_MICROMODEM
-  driver_cfg
-  {{
-    connection_type: CONNECTION_TCP_AS_CLIENT
-    tcp_server: "127.0.0.1"
-    tcp_port: {modem_port}
-    [MicroModemConfig.reset_nvram]: false
-  }}
+{micromodem_driver_goby11(modem_port)}
   mac_cfg
   {{
     type: MAC_FIXED_DECENTRALIZED
@@ -309,8 +296,8 @@ async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
 
 
 def test_liaison_names_goby11_frames_and_reads_goby11_queue_sizes():
-    from pygoby.acomms.transitional import TransitionalMessages
     from pygoby.moos import protocol
+    from pygoby.moosacomms.transitional import TransitionalMessages
     from pygoby.protobuf import ProtoLoader, builtin_class
     from pygoby.topside.liaison.models import AcommsModel
 

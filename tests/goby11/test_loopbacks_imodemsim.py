@@ -13,11 +13,11 @@ from pathlib import Path
 
 import pytest
 
-from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind, Reception
+from pygoby.acomms.mmsim.channel import AcousticPacket, ModemPacketKind, ModemReception
 from pygoby.acomms.mmsim.multicast_channel import MulticastChannel
 from pygoby.apps.imodemsim import MULTICAST_GROUP, iModemSim
 from pygoby.errors import ConfigError
-from pygoby.netsim.range_link import RangeLink
+from pygoby.netsim.sim.range_link import RangeLink
 from pygoby.util.clock import WallClock
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.pty import PtyEnd, PtyError, PtyPair, is_live, open_serial, partner_of
@@ -250,7 +250,7 @@ class Listener:
 
     def __init__(self, name: str) -> None:
         self.name, self.modem_id = name, 9
-        self.heard: list[tuple[AcousticPacket, Reception]] = []
+        self.heard: list[tuple[AcousticPacket, ModemReception]] = []
 
     def detect(self, packet, arrival) -> None:
         pass
@@ -283,7 +283,7 @@ async def test_positions_travel_with_packets_and_the_range_decides(tmp_path):
         channel.open()
     try:
         for sender, src in ((far, 1), (near, 2)):
-            packet = AcousticPacket(PacketKind.MINI, src, 9, frames=[b"\x01\x23"])
+            packet = AcousticPacket(ModemPacketKind.MINI, src, 9, frames=[b"\x01\x23"])
             packet.tx_time, packet.duration = clock.now(), 0.5
             sender.transmit(Listener(f"sender{src}"), packet)
         async with asyncio.timeout(10):

@@ -20,6 +20,7 @@ from pygoby.dccl.xml import load_message_set
 from pygoby.moos.client import MOOSClient
 from pygoby.util.clock import WallClock
 from tests.apps.acomms_mission import two_vehicle_missions
+from tests.goby11.missions import micromodem_driver_goby11
 from tests.goby11.seed_listings import EXAMPLES
 
 pytestmark = pytest.mark.e2e
@@ -51,14 +52,7 @@ ProcessConfig = pAcommsHandler
     initializer {{ type: INI_DOUBLE moos_var: "NAV_DEPTH" dval: 20 }}
   }}
   modem_id: {modem_id}
-  driver_type: DRIVER_WHOI_MICROMODEM
-  driver_cfg
-  {{
-    connection_type: CONNECTION_TCP_AS_CLIENT
-    tcp_server: "127.0.0.1"
-    tcp_port: {modem_port}
-    [MicroModemConfig.reset_nvram]: false
-  }}
+{micromodem_driver_goby11(modem_port)}
   mac_cfg
   {{
     type: MAC_FIXED_DECENTRALIZED
@@ -161,7 +155,7 @@ def test_xml_error_stops_pacommshandler_with_file_and_line(tmp_path):
 
 
 def test_transitional_messages_expand_into_the_configuration(tmp_path):
-    from pygoby.acomms.transitional import TransitionalMessages
+    from pygoby.moosacomms.transitional import TransitionalMessages
     from pygoby.protobuf import ProtoLoader, builtin_class
 
     cfg = builtin_class(

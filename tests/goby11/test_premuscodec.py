@@ -15,7 +15,6 @@ from google.protobuf import text_format
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.apps.premuscodec import pREMUSCodec
-from pygoby.apps.premuscodec_reports import RemusReports
 from pygoby.dccl.ccl.remus import (
     Alert,
     Alert2,
@@ -33,6 +32,7 @@ from pygoby.errors import ConfigError
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.timewarp import moos_clock
+from pygoby.moosacomms.remus_reports import RemusReports
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup
 

@@ -21,8 +21,8 @@ import pytest
 from pygoby.netsim.channel.absorption import francois_garrison, thorp, thorp_coa
 from pygoby.netsim.channel.propagation import BellhopLoss, BellhopSettings
 from pygoby.netsim.channel.soundspeed import t68_from_t90, unesco_1983
-from pygoby.netsim.scenario import channel_config, parse_scenario
-from pygoby.netsim.sim import Simulation
+from pygoby.netsim.sim.scenario import channel_config, parse_scenario
+from pygoby.netsim.sim.simulation import Simulation
 from pygoby.util.ocean import mackenzie_1981
 
 pelagic = pytest.importorskip("pelagic")  # (installed by `make test`: pygoby[dev])

@@ -13,10 +13,10 @@ from pygoby.apps.inetsimmanager import iNetSimManager
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.translator import serialize_for_moos
-from pygoby.netsim.config import parse_config
-from pygoby.netsim.manager import NetSimManager
-from pygoby.netsim.navreporter import NavReporter
-from pygoby.netsim.server import ManagerServer
+from pygoby.netsim.manager.config import parse_config
+from pygoby.netsim.manager.core import NetSimManager
+from pygoby.netsim.manager.navreporter import NavReporter
+from pygoby.netsim.manager.server import ManagerServer
 from pygoby.util.geodesy import UTMGeodesy
 
 MANAGER = """

@@ -13,30 +13,30 @@ from pygoby.netsim.channel import (
     Channel,
     ChannelConfig,
     LogisticModel,
+    NavFix,
     Outcome,
     PacketKind,
-    Position,
     RateErrorModels,
     Transmission,
 )
 from pygoby.netsim.channel.absorption import thorp
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.channel.levels import noise_level_integrated, transmission_loss
-from pygoby.netsim.config import parse_config
-from pygoby.netsim.manager import NetSimManager
-from pygoby.netsim.protocol import encode_line, message_class, request_class
+from pygoby.netsim.manager.config import parse_config
+from pygoby.netsim.manager.core import NetSimManager
+from pygoby.netsim.manager.protocol import encode_line, message_class, request_class
 
 ORIGIN = (42.0, -70.0)
 T0 = 1_700_000_000.0
 
 
-def at(east_m: float, north_m: float = 0.0, depth: float = 10.0, **kw) -> Position:
+def at(east_m: float, north_m: float = 0.0, depth: float = 10.0, **kw) -> NavFix:
     lon, lat, _ = WGS84.fwd(ORIGIN[1], ORIGIN[0], 90.0, east_m)
     lon, lat, _ = WGS84.fwd(lon, lat, 0.0, north_m)
-    return Position(lat, lon, depth, time=kw.pop("time", T0), **kw)
+    return NavFix(lat, lon, depth, time=kw.pop("time", T0), **kw)
 
 
-def channel(nodes: dict[int, Position], seed: int = 1, **config) -> Channel:
+def channel(nodes: dict[int, NavFix], seed: int = 1, **config) -> Channel:
     ch = Channel(ChannelConfig(**config), seed=seed)
     for port, position in nodes.items():
         ch.update_position(port, position)
@@ -303,7 +303,7 @@ def test_link_statistics_of_recurring_levels_are_computed_the_same():
 
 
 def test_protocol_model_ranges_and_collisions():
-    from pygoby.netsim.channel.errors import ProtocolModel
+    from pygoby.netsim.channel.frame_errors import ProtocolModel
 
     nodes = {1: at(0), 2: at(1999), 3: at(-2200), 4: at(2800, 100), 5: at(-3100)}
     ch = channel(nodes, protocol_model=ProtocolModel())

@@ -6,7 +6,7 @@ import pytest
 
 from pygoby.netsim.channel import Band, PacketKind
 from pygoby.netsim.channel.absorption import francois_garrison, thorp
-from pygoby.netsim.channel.errors import (
+from pygoby.netsim.channel.frame_errors import (
     DEFAULT_RATE_MODELS,
     LogisticModel,
     ProtocolModel,
@@ -14,7 +14,7 @@ from pygoby.netsim.channel.errors import (
     ThresholdModel,
 )
 from pygoby.netsim.channel.settings import environment_channel_configs
-from pygoby.netsim.config import EXAMPLE_CONFIG, ConfigError, parse_config
+from pygoby.netsim.manager.config import EXAMPLE_CONFIG, ConfigError, parse_config
 
 BOUNDS = (
     "env_bounds { environment_id: 0 lat_min: 0 lon_min: 0 lat_max: 1 lon_max: 1 depth_max: 10 }\n"

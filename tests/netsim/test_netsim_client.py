@@ -10,16 +10,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from netsim_vectors import from_vector_dict, of_kind
 
-from pygoby.netsim.client import MAX_REQUEST_ID, NetSimClient, RequestTracker, status_name
-from pygoby.netsim.config import parse_config
-from pygoby.netsim.manager import NetSimManager
-from pygoby.netsim.protocol import (
+from pygoby.netsim.manager.client import MAX_REQUEST_ID, NetSimClient, RequestTracker, status_name
+from pygoby.netsim.manager.config import parse_config
+from pygoby.netsim.manager.core import NetSimManager
+from pygoby.netsim.manager.protocol import (
     LEGACY_REQUEST_NAME,
     encode_line,
     request_class,
     response_class,
 )
-from pygoby.netsim.server import ManagerServer
+from pygoby.netsim.manager.server import ManagerServer
 from tests.hypothesis_profiles import examples
 
 LOOPBACK = {v["name"]: v["textformat"] for v in of_kind("manager_config")}["loopback"]

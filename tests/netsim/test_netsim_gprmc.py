@@ -8,10 +8,10 @@ import select
 import pytest
 from netsim_vectors import from_vector_dict, of_kind
 
-from pygoby.netsim.config import parse_config
-from pygoby.netsim.gprmc import GpsOutputs, gprmc_sentence
-from pygoby.netsim.manager import NetSimManager
-from pygoby.netsim.protocol import encode_line, message_class, request_class
+from pygoby.netsim.manager.config import parse_config
+from pygoby.netsim.manager.core import NetSimManager
+from pygoby.netsim.manager.gprmc import GpsOutputs, gprmc_sentence
+from pygoby.netsim.manager.protocol import encode_line, message_class, request_class
 from pygoby.util.clock import VirtualClock
 
 

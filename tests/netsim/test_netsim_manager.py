@@ -15,9 +15,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from netsim_vectors import of_kind, to_vector_dict
 
-from pygoby.netsim.config import EXAMPLE_CONFIG, ConfigError, parse_config
-from pygoby.netsim.manager import NetSimManager, peer_ip_string
-from pygoby.netsim.protocol import (
+from pygoby.netsim.manager.config import EXAMPLE_CONFIG, ConfigError, parse_config
+from pygoby.netsim.manager.core import NetSimManager, peer_ip_string
+from pygoby.netsim.manager.protocol import (
     LineDecoder,
     ReceivedMessage,
     encode_line,
@@ -26,7 +26,7 @@ from pygoby.netsim.protocol import (
     request_names,
     response_names,
 )
-from pygoby.netsim.server import ManagerServer
+from pygoby.netsim.manager.server import ManagerServer
 from tests.hypothesis_profiles import examples
 
 CONFIGS = {v["name"]: v["textformat"] for v in of_kind("manager_config")}
@@ -82,7 +82,7 @@ def test_example_config_is_valid():
 
 def test_console_script_prints_example_config():
     result = subprocess.run(
-        [sys.executable, "-m", "pygoby.netsim.server", "--example_config"],
+        [sys.executable, "-m", "pygoby.netsim.manager.server", "--example_config"],
         capture_output=True,
         text=True,
         check=True,

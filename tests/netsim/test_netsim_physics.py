@@ -7,7 +7,7 @@ import math
 import pytest
 from netsim_vectors import physics
 
-from pygoby.netsim.channel import absorption, errors, geometry, levels, soundspeed, timing
+from pygoby.netsim.channel import absorption, frame_errors, geometry, levels, soundspeed, timing
 
 P = physics()
 TOL = 0.01  # default absolute tolerance in the printed unit
@@ -172,18 +172,18 @@ PE = P["packet_error"]
 
 def test_builtin_tables_equal_the_vector_tables():
     for rate, table in PE["table_ros_acomms"]["tables"].items():
-        model = errors.ROS_ACOMMS_TABLES[int(rate)]
+        model = frame_errors.ROS_ACOMMS_TABLES[int(rate)]
         assert list(model.snr_db) == table["snr_db"]
         assert list(model.frame_error_rate) == table["frame_error"]
-        assert errors.ROS_ACOMMS_FRAMES[int(rate)] == table["frames"]
+        assert frame_errors.ROS_ACOMMS_FRAMES[int(rate)] == table["frames"]
 
 
 @_cases(PE["table_ros_acomms"], "checks")
 def test_table_model(case):
-    fer = errors.ROS_ACOMMS_TABLES[case["rate"]].frame_error(case["snr_db"])
+    fer = frame_errors.ROS_ACOMMS_TABLES[case["rate"]].frame_error(case["snr_db"])
     assert fer == pytest.approx(case["frame_error"], abs=1e-6)
-    frames = errors.ROS_ACOMMS_FRAMES[case["rate"]]
-    assert errors.packet_success_probability(fer, frames) == pytest.approx(
+    frames = frame_errors.ROS_ACOMMS_FRAMES[case["rate"]]
+    assert frame_errors.packet_success_probability(fer, frames) == pytest.approx(
         case["p_packet_ok"], abs=1e-6
     )
 
@@ -191,39 +191,39 @@ def test_table_model(case):
 @_cases(PE["logistic"], "checks")
 def test_logistic_model(case):
     fit = PE["logistic"]["fitted_to_ros_acomms"][str(case["rate"])]
-    model = errors.LogisticModel(fit["snr50_db"], fit["width_db"])
-    assert model == errors.LOGISTIC_FITS[case["rate"]]
+    model = frame_errors.LogisticModel(fit["snr50_db"], fit["width_db"])
+    assert model == frame_errors.LOGISTIC_FITS[case["rate"]]
     assert model.frame_error(case["snr_db"]) == pytest.approx(case["frame_error"], abs=1e-4)
 
 
 @_cases(PE["threshold"])
 def test_threshold_model(case):
-    fer = errors.ThresholdModel(case["threshold_db"]).frame_error(case["snr_db"])
+    fer = frame_errors.ThresholdModel(case["threshold_db"]).frame_error(case["snr_db"])
     assert (fer == 0.0) is case["ok"]
 
 
 @_cases(PE["ber_to_per"])
 def test_ber_and_per(case):
     g = 10 ** (case["ebn0_db"] / 10)
-    assert errors.ber_bpsk(g) == pytest.approx(case["ber_bpsk"], rel=1e-5)
-    assert errors.ber_noncoherent_fsk(g) == pytest.approx(case["ber_ncfsk"], rel=1e-5)
-    assert errors.ber_rayleigh_noncoherent_fsk(g) == pytest.approx(
+    assert frame_errors.ber_bpsk(g) == pytest.approx(case["ber_bpsk"], rel=1e-5)
+    assert frame_errors.ber_noncoherent_fsk(g) == pytest.approx(case["ber_ncfsk"], rel=1e-5)
+    assert frame_errors.ber_rayleigh_noncoherent_fsk(g) == pytest.approx(
         case["ber_rayleigh_ncfsk"], rel=1e-5
     )
-    per_bpsk = errors.packet_error_from_ber(errors.ber_bpsk(g), 32)
+    per_bpsk = frame_errors.packet_error_from_ber(frame_errors.ber_bpsk(g), 32)
     assert per_bpsk == pytest.approx(case["per_bpsk_32_bytes"], abs=1e-5)
-    per_fsk = errors.packet_error_from_ber(errors.ber_noncoherent_fsk(g), 32)
+    per_fsk = frame_errors.packet_error_from_ber(frame_errors.ber_noncoherent_fsk(g), 32)
     assert per_fsk == pytest.approx(case["per_ncfsk_32_bytes"], abs=1e-5)
 
 
 @_cases(PE["ber_to_per"], "ebn0_from_snr")
 def test_ebn0_from_snr(case):
-    ebn0 = errors.ebn0_db(case["snr_db"], case["B_hz"], case["R_bps"])
+    ebn0 = frame_errors.ebn0_db(case["snr_db"], case["B_hz"], case["R_bps"])
     assert ebn0 == pytest.approx(case["ebn0_db"], abs=1e-4)
 
 
 def test_ber_model_matches_per():
-    model = errors.BerModel("bpsk", bandwidth_hz=5000, bit_rate=500, frame_bytes=32)
+    model = frame_errors.BerModel("bpsk", bandwidth_hz=5000, bit_rate=500, frame_bytes=32)
     # SNR 0 dB at B/R = 10 -> Eb/N0 10 dB
     (case,) = [c for c in PE["ber_to_per"]["cases"] if c["ebn0_db"] == 10]
     assert model.frame_error(0.0) == pytest.approx(case["per_bpsk_32_bytes"], abs=1e-6)
@@ -234,19 +234,19 @@ def test_range_table(case):
     table = [
         (row["range"], row["success_probability"]) for row in PE["netsim_udp_range_table"]["table"]
     ]
-    assert errors.range_table_probability(table, case["approx_range"]) == pytest.approx(
+    assert frame_errors.range_table_probability(table, case["approx_range"]) == pytest.approx(
         case["p"], abs=1e-9
     )
 
 
 @_cases(PE["netsim_udp_mpp"], "checks")
 def test_mpp(case):
-    assert errors.mpp_probability(case["mpp"]) == pytest.approx(case["p"], abs=1e-9)
+    assert frame_errors.mpp_probability(case["mpp"]) == pytest.approx(case["p"], abs=1e-9)
 
 
 def test_protocol_model_defaults_and_ranges():
     d = PE["unetstack_protocol_model"]["defaults"]
-    model = errors.ProtocolModel()
+    model = frame_errors.ProtocolModel()
     assert (
         model.communication_range,
         model.detection_range,
@@ -279,8 +279,8 @@ GEO = P["geometry_and_delay"]
 
 @_cases(GEO, "geodesic_wgs84")
 def test_geodesic(case):
-    a = geometry.Position(case["lat1"], case["lon1"], 0.0)
-    b = geometry.Position(case["lat2"], case["lon2"], case["dz_m"])
+    a = geometry.NavFix(case["lat1"], case["lon1"], 0.0)
+    b = geometry.NavFix(case["lat2"], case["lon2"], case["dz_m"])
     distance, azimuth = geometry.horizontal_range(a, b)
     assert distance == pytest.approx(case["horizontal_m"], abs=1e-3)
     assert azimuth == pytest.approx(case["azimuth_deg"], abs=1e-3)
@@ -315,7 +315,7 @@ def test_dead_reckoning(case):
 
 
 def test_position_dead_reckons_on_the_ellipsoid():
-    start = geometry.Position(42.0, -70.0, 5.0, time=100.0, speed=1.0, heading=200.0)
+    start = geometry.NavFix(42.0, -70.0, 5.0, time=100.0, speed=1.0, heading=200.0)
     later = start.at(160.0)
     distance, azimuth = geometry.horizontal_range(start, later)
     assert distance == pytest.approx(60.0, abs=1e-6)
@@ -326,13 +326,13 @@ def test_remembered_geodesics_are_the_geodesics():
     """Fixed nodes ask for the same geodesics again and again (they are remembered): every
     answer, the first or a recurring one, is the geodesic's, zero coordinates of either sign
     included."""
-    a = geometry.Position(42.0, -70.0, 5.0)
+    a = geometry.NavFix(42.0, -70.0, 5.0)
     ends = [
-        geometry.Position(42.01, -69.99, 30.0),
-        geometry.Position(0.0, -70.0, 5.0),
-        geometry.Position(-0.0, -70.0, 5.0),
-        geometry.Position(42.01, 0.0, 5.0),
-        geometry.Position(42.01, -0.0, 5.0),
+        geometry.NavFix(42.01, -69.99, 30.0),
+        geometry.NavFix(0.0, -70.0, 5.0),
+        geometry.NavFix(-0.0, -70.0, 5.0),
+        geometry.NavFix(42.01, 0.0, 5.0),
+        geometry.NavFix(42.01, -0.0, 5.0),
     ]
     for b in ends * 2:
         azimuth, _, distance = geometry.WGS84.inv(a.lon, a.lat, b.lon, b.lat)

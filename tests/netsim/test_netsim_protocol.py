@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from netsim_vectors import by_id, from_vector_dict, of_kind, to_vector_dict
 
-from pygoby.netsim.protocol import (
+from pygoby.netsim.manager.protocol import (
     LEGACY_REQUEST_NAME,
     REQUEST_NAME,
     LineDecoder,

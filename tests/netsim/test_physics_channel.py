@@ -12,12 +12,12 @@ import pytest
 from pygoby.acomms.drivers.micromodem.statistics import parse_cst
 from pygoby.acomms.mmsim import MicroModemModel
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
-from pygoby.netsim.channel import Channel, ChannelConfig, Position
+from pygoby.netsim.channel import Channel, ChannelConfig, NavFix
 from pygoby.netsim.channel.absorption import thorp
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.channel.levels import transmission_loss
-from pygoby.netsim.eventlog import EventLogWriter, read_events
-from pygoby.netsim.physics_channel import PhysicsChannel
+from pygoby.netsim.report.eventlog import EventLogWriter, read_events
+from pygoby.netsim.sim.physics_channel import PhysicsChannel
 from pygoby.util.clock import VirtualClock
 from pygoby.util.nmea import NMEASentence
 from pygoby.util.timeline import Timeline
@@ -26,9 +26,9 @@ ORIGIN = (42.0, -70.0)
 T0 = 1_700_000_000.0
 
 
-def at(east_m: float, depth: float = 10.0, time: float = T0, **kw) -> Position:
+def at(east_m: float, depth: float = 10.0, time: float = T0, **kw) -> NavFix:
     lon, lat, _ = WGS84.fwd(ORIGIN[1], ORIGIN[0], 90.0, east_m)
-    return Position(lat, lon, depth, time=time, **kw)
+    return NavFix(lat, lon, depth, time=time, **kw)
 
 
 class Net:
@@ -217,23 +217,31 @@ def test_rx_event_figures_are_rounded():
     """Every rx event carries the reception's figures rounded, a zero and the sign of a
     negative zero included (links recur: the same figures each time)."""
 
-    def fresh(range_m, owtt, rl, noise, sinr):
-        snr = rl - noise
-        return (
-            round(range_m, 3),
-            round(owtt, 6),
-            round(rl, 2),
-            round(snr, 2),
-            round(sinr, 2),
-            sinr < snr - 0.01,
-        )
-
-    cases = [
-        (1234.56789, 0.8230452, 120.4449, 62.3, 58.1449),
-        (1234.56789, 0.8230452, 120.4449, 62.3, 50.0),  # a collision
-        (0.0, 0.0, 185.0, 62.3, -0.004),  # a zero: not remembered
-        (10.0, 0.0066, 62.3, 62.3, -0.0),  # -0.0 keeps its sign
-    ] * 2
+    # (range, owtt, received level, noise, sinr) -> (range, owtt, rl, snr, sinr, collision)
+    figures = {
+        (1234.56789, 0.8230452, 120.4449, 62.3, 58.1449): (
+            1234.568,
+            0.823045,
+            120.44,
+            58.14,
+            58.14,
+            False,
+        ),
+        # a collision: the sinr is below the snr
+        (1234.56789, 0.8230452, 120.4449, 62.3, 50.0): (
+            1234.568,
+            0.823045,
+            120.44,
+            58.14,
+            50.0,
+            True,
+        ),
+        # a zero: not remembered
+        (0.0, 0.0, 185.0, 62.3, -0.004): (0.0, 0.0, 185.0, 122.7, -0.0, True),
+        # -0.0 keeps its sign
+        (10.0, 0.0066, 62.3, 62.3, -0.0): (10.0, 0.0066, 62.3, 0.0, -0.0, False),
+    }
+    cases = list(figures) * 2
     events: list[dict] = []
     net = Net({62000: 0.0, 62001: 1500.0}, events=events.append)
     # the physics' receptions, with the levels of the cases in turn
@@ -256,8 +264,8 @@ def test_rx_event_figures_are_rounded():
     assert len(rx) == len(cases)
     for event, case in zip(rx, cases, strict=True):
         got = tuple(event[key] for key in ("range_m", "owtt", "rl", "snr", "sinr", "collision"))
-        assert got == fresh(*case)
-        assert [str(x) for x in got] == [str(x) for x in fresh(*case)]
+        assert got == figures[case]
+        assert [str(x) for x in got] == [str(x) for x in figures[case]]
 
 
 def test_a_cycle_init_run_late_still_precedes_its_data():
@@ -265,16 +273,16 @@ def test_a_cycle_init_run_late_still_precedes_its_data():
     poll, so the channel moved its start), its data on time. One transducer: the data starts
     when the cycle-init has ended, and the receiver hears both (regression: the late cycle-init
     overlapped its own data, a collision at a receiver 370 m away in the demo)."""
-    from pygoby.acomms.mmsim.channel import AcousticPacket, PacketKind
+    from pygoby.acomms.mmsim.channel import AcousticPacket, ModemPacketKind
 
     events = []
     net = Net({62000: 0.0, 62001: 370.0}, events=events.append)
     sender = net.modems[1]
     net.clock.set(T0 + 0.004)
     net.physics.do_work()  # polled past the cycle-init's start
-    cycle = AcousticPacket(PacketKind.CYCLE, 1, 0, 0, num_frames=1, tx_time=T0, duration=1.0)
+    cycle = AcousticPacket(ModemPacketKind.CYCLE, 1, 0, 0, num_frames=1, tx_time=T0, duration=1.0)
     data = AcousticPacket(
-        PacketKind.DATA, 1, 0, 0, frames=[b"status"], tx_time=T0 + 1.0, duration=3.2
+        ModemPacketKind.DATA, 1, 0, 0, frames=[b"status"], tx_time=T0 + 1.0, duration=3.2
     )
     net.physics.transmit(sender, cycle)
     net.clock.set(T0 + 1.0)

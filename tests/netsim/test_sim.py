@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import pytest
 
-from pygoby.netsim.eventlog import EventLogWriter, read_events
-from pygoby.netsim.report import summary_lines
-from pygoby.netsim.scenario import ScenarioError, parse_scenario
-from pygoby.netsim.sim import Simulation
+from pygoby.netsim.report.eventlog import EventLogWriter, read_events
+from pygoby.netsim.report.plots import summary_lines
+from pygoby.netsim.sim.scenario import ScenarioError, parse_scenario
+from pygoby.netsim.sim.simulation import Simulation
 
 ORIGIN = "origin { lat: 42 lon: -70 }"
 

@@ -16,11 +16,11 @@ from hypothesis import strategies as st
 from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.cli import main
 from pygoby.moos.timewarp import moos_clock
-from pygoby.netsim.eventlog import read_events
-from pygoby.netsim.protocol import LineDecoder, encode_line, request_class, response_names
-from pygoby.netsim.realtime import RealTimeRun
-from pygoby.netsim.report import bin_success, node_labels, timeline_window
-from pygoby.netsim.scenario import ScenarioError, parse_scenario
+from pygoby.netsim.manager.protocol import LineDecoder, encode_line, request_class, response_names
+from pygoby.netsim.report.eventlog import read_events
+from pygoby.netsim.report.plots import bin_success, node_labels, timeline_window
+from pygoby.netsim.sim.realtime import RealTimeRun
+from pygoby.netsim.sim.scenario import ScenarioError, parse_scenario
 from tests.hypothesis_profiles import examples
 
 pytestmark = pytest.mark.e2e

@@ -12,8 +12,8 @@ import pytest
 from pygoby.cli import main
 from pygoby.errors import ConfigError
 from pygoby.netsim.channel.geometry import WGS84
-from pygoby.netsim.scenario import channel_config, parse_scenario
-from pygoby.netsim.sim import Simulation
+from pygoby.netsim.sim.scenario import channel_config, parse_scenario
+from pygoby.netsim.sim.simulation import Simulation
 from pygoby.netsim.sweep.plan import expand, parse_sweep
 from pygoby.netsim.sweep.report import read_results, success_by_range, wilson_interval
 from pygoby.netsim.sweep.run import execute_run

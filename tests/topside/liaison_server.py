@@ -10,8 +10,8 @@ from pathlib import Path
 
 from pygoby.moos import protocol as p
 from pygoby.moos.moosfile import MissionFile
+from pygoby.moosacomms.acomms_config import read_acomms_config
 from pygoby.protobuf import builtin_class
-from pygoby.topside.acomms_config import read_acomms_config
 from pygoby.topside.commander import CommandSet
 from pygoby.topside.liaison.state import LiaisonState
 from pygoby.topside.liaison.web import WebServer

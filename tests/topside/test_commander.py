@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import serialize_for_moos
-from pygoby.topside.acomms_config import read_acomms_config
+from pygoby.moosacomms.acomms_config import read_acomms_config
 from pygoby.topside.commander import (
     MULTIPLEX,
     Commander,

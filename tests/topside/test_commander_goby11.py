@@ -17,7 +17,7 @@ from pygoby.dccl import Codec
 from pygoby.errors import ConfigError
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import ModemIdLookup, Translator, TranslatorError
-from pygoby.topside.acomms_config import AcommsMessageSet, read_acomms_config
+from pygoby.moosacomms.acomms_config import AcommsMessageSet, read_acomms_config
 from pygoby.topside.commander import Commander, CommandSet, FieldValueError
 from pygoby.util.clock import VirtualClock
 from tests.hypothesis_profiles import examples

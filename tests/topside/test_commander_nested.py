@@ -9,7 +9,7 @@ import pytest
 
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import serialize_for_moos
-from pygoby.topside.acomms_config import AcommsMessageSet, read_acomms_config
+from pygoby.moosacomms.acomms_config import AcommsMessageSet, read_acomms_config
 from pygoby.topside.commander import MULTIPLEX, Commander, CommandSet, FieldValueError
 from pygoby.topside.icommander import ICommanderTUI
 

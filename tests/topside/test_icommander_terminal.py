@@ -10,7 +10,7 @@ from textual import events
 
 from pygoby.apps.icommander import iCommander
 from pygoby.moos.moosfile import MissionFile
-from pygoby.topside.acomms_config import read_acomms_config
+from pygoby.moosacomms.acomms_config import read_acomms_config
 from pygoby.topside.commander import Commander, CommandSet, Notice
 from pygoby.topside.icommander import ICommanderTUI
 

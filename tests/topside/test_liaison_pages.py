@@ -84,7 +84,7 @@ def test_ccl_frames_are_named(tmp_path):
 
 def test_the_commander_offers_commands_and_the_rest_behind_show_all(tmp_path):
     from pygoby.moos.moosfile import MissionFile
-    from pygoby.topside.acomms_config import read_acomms_config
+    from pygoby.moosacomms.acomms_config import read_acomms_config
     from pygoby.topside.commander import CommandSet
     from tests.goby11.test_examples import EXAMPLES
 

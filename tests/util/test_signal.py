@@ -85,3 +85,12 @@ def test_containment_can_be_chosen_per_connection(caplog):
     containing.connect(broken, contain_errors=False)
     with pytest.raises(RuntimeError):
         containing.emit(2)
+
+
+def test_a_typed_signal_passes_positional_and_keyword_arguments():
+    signal: Signal[[int, str]] = Signal[[int, str]]()  # subscripted at run time too
+    seen = []
+    signal.connect(lambda number, text: seen.append((number, text)))
+    signal.emit(1, "a")
+    signal.emit(2, text="b")
+    assert seen == [(1, "a"), (2, "b")]

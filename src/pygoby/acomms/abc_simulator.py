@@ -10,6 +10,7 @@ from __future__ import annotations
 import asyncio
 import logging
 from collections.abc import Hashable
+from typing import cast
 
 from pygoby.acomms.abc_protocol import format_abc, parse_abc
 from pygoby.util.linebased import LineSplitter
@@ -66,7 +67,8 @@ async def serve_abc(sim: ABCSimulator, host: str = "127.0.0.1", port: int = 0) -
         try:
             while data := await reader.read(READ_SIZE):
                 for line in splitter.feed(data):
-                    for target, text in sim.handle(writer, line + "\n"):
+                    for endpoint, text in sim.handle(writer, line + "\n"):
+                        target = cast(asyncio.StreamWriter, endpoint)  # (the endpoints we gave)
                         if target.transport.get_write_buffer_size() > MAX_UNREAD_BYTES:
                             log.warning("dropping a packet for a modem that does not read")
                             continue

@@ -26,13 +26,12 @@ log = logging.getLogger(__name__)
 Status = acomms_pb.ModemDriverStatus
 
 
-def driver_name(cfg) -> str:
+def driver_name(cfg: acomms_pb.DriverConfig) -> str:
     """`<DriverType name without DRIVER_>::<modem_id>` (or the plugin name)."""
     if cfg.WhichOneof("driver") == "driver_name":
         kind = cfg.driver_name
     else:
-        driver_type = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
-        kind = driver_type.values_by_number[cfg.driver_type].name.removeprefix("DRIVER_")
+        kind = acomms_pb.DriverType.Name(cfg.driver_type).removeprefix("DRIVER_")
     return f"{kind}::{cfg.modem_id}"
 
 
@@ -45,22 +44,22 @@ class ModemDriverBase(ABC):
 
     def __init__(self, clock: Clock | None = None, link: LineLink | None = None) -> None:
         self.clock: Clock = clock if clock is not None else WallClock()
-        self.signal_receive = Signal()
-        self.signal_transmit_result = Signal()
-        self.signal_data_request = Signal()
-        self.signal_modify_transmission = Signal()
-        self.signal_raw_incoming = Signal()
-        self.signal_raw_outgoing = Signal()
+        self.signal_receive: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_transmit_result: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_data_request: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_modify_transmission: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_raw_incoming: Signal[acomms_pb.ModemRaw] = Signal()
+        self.signal_raw_outgoing: Signal[acomms_pb.ModemRaw] = Signal()
         self.cfg = acomms_pb.DriverConfig()
         self.link: LineLink | None = link
         self._injected_link = link is not None
         self._raw_log: IO[str] | None = None
-        self._traffic_logs: tuple[logging.Logger, logging.Logger] = (log, log)
+        self._traffic_logs: tuple[logging.Logger, ...] = (log, log)  # (out, in)
         self._traffic_logs_for: object = None  # the cfg the traffic loggers are named for
 
     # --- the interface -------------------------------------------------------------------
     @abstractmethod
-    def startup(self, cfg) -> None: ...
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None: ...
 
     @abstractmethod
     def shutdown(self) -> None: ...
@@ -69,9 +68,9 @@ class ModemDriverBase(ABC):
     def do_work(self) -> None: ...
 
     @abstractmethod
-    def handle_initiate_transmission(self, transmission) -> None: ...
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None: ...
 
-    def update_cfg(self, cfg) -> None:
+    def update_cfg(self, cfg: acomms_pb.DriverConfig) -> None:
         log.warning("%s: update_cfg is not implemented by this driver", type(self).__name__)
 
     def report(self):
@@ -90,7 +89,7 @@ class ModemDriverBase(ABC):
         return self.cfg.modem_id
 
     # --- helpers for line-based modems ---------------------------------------------------
-    def modem_start(self, cfg) -> None:
+    def modem_start(self, cfg: acomms_pb.DriverConfig) -> None:
         """Validate the link settings, build (or reuse the injected) link and open it."""
         if not cfg.HasField("modem_id"):
             raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
@@ -105,12 +104,12 @@ class ModemDriverBase(ABC):
             self._raw_log = open(cfg.raw_log.replace("%1%", stamp), "a", encoding="latin-1")  # noqa: SIM115
         self.link.open()
 
-    def line_delimiter(self, cfg) -> str:
+    def line_delimiter(self, cfg: acomms_pb.DriverConfig) -> str:
         if not cfg.HasField("line_delimiter") and self.DEFAULT_LINE_DELIMITER is not None:
             return self.DEFAULT_LINE_DELIMITER
         return cfg.line_delimiter
 
-    def _make_link(self, cfg, delimiter: str) -> LineLink:
+    def _make_link(self, cfg: acomms_pb.DriverConfig, delimiter: str) -> LineLink:
         C = acomms_pb.DriverConfig
         # an implicit connection_type is the documented default, SERIAL (QUIRKS.md Q-ACOMMS-1)
         kind = cfg.connection_type
@@ -206,7 +205,7 @@ def _printable(raw: bytes | str) -> str:
 class NoDriver(ModemDriverBase):
     """DRIVER_NONE: accepts transmissions and does nothing."""
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         self.cfg = cfg
 
     def shutdown(self) -> None:
@@ -215,5 +214,5 @@ class NoDriver(ModemDriverBase):
     def do_work(self) -> None:
         pass
 
-    def handle_initiate_transmission(self, transmission) -> None:
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         log.debug("DRIVER_NONE: ignoring transmission request")

@@ -44,17 +44,15 @@ from pygoby.acomms.route import RouteCommand, RouteManager, bind_router
 from pygoby.dccl import Codec, DcclError
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
+from pygoby.protobuf.goby.acomms.protobuf.route_pb2 import StaticRoute
 from pygoby.util.clock import Clock
 from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
 Status = acomms_pb.ModemDriverStatus
-DriverType = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name[
-    "driver_type"
-].enum_type.values_by_name
-DRIVER_NONE = DriverType["DRIVER_NONE"].number
-UFIELD = DriverType["DRIVER_UFIELD_SIM_DRIVER"].number
+DRIVER_NONE = acomms_pb.DriverType.DRIVER_NONE
+UFIELD = acomms_pb.DriverType.DRIVER_UFIELD_SIM_DRIVER
 
 ROUTE_COMMAND = RouteCommand.DESCRIPTOR.full_name
 
@@ -67,7 +65,7 @@ DISABLE_AND_MOVE_LISTEN_DRIVER_TO_PRIMARY = 3
 # Drivers
 
 
-def _check_slot_rates(mac_cfg, driver: ModemDriverBase) -> None:
+def _check_slot_rates(mac_cfg: acomms_pb.MACConfig, driver: ModemDriverBase) -> None:
     """Every slot's rate is one the driver has: a wrong one would fail every cycle, not once."""
     if driver.RATES is None:
         return
@@ -80,7 +78,7 @@ def _check_slot_rates(mac_cfg, driver: ModemDriverBase) -> None:
             )
 
 
-def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
+def make_driver(cfg: acomms_pb.DriverConfig, clock: Clock) -> ModemDriverBase | None:
     """The driver selected by `cfg` (DriverConfig, through pygoby.acomms.drivers' registry), or
     None for DRIVER_NONE."""
     if cfg.WhichOneof("driver") != "driver_name" and cfg.driver_type == DRIVER_NONE:
@@ -88,7 +86,7 @@ def make_driver(cfg, clock: Clock) -> ModemDriverBase | None:
     return drivers.make_driver(cfg, clock)
 
 
-def wire_driver_cfg(driver_cfg, cfg) -> None:
+def wire_driver_cfg(driver_cfg: acomms_pb.DriverConfig, cfg) -> None:
     """pAcommsHandler's special wiring: the uField driver gets the
     top-level `modem_id_lookup_path` and, where its own are unset, the MOOSDB of `common` (so a
     mission on a ServerPort other than 9000 needs no `moos_port`)."""
@@ -99,7 +97,7 @@ def wire_driver_cfg(driver_cfg, cfg) -> None:
             ufld.modem_id_lookup_path = lookup
         common = getattr(cfg, "common", None)
         for ours, theirs in (("moos_server", "server_host"), ("moos_port", "server_port")):
-            if common is not None and common.HasField(theirs) and not ufld.HasField(ours):
+            if common is not None and common.HasField(theirs) and not ufld.HasField(ours):  # type: ignore[arg-type]
                 setattr(ufld, ours, getattr(common, theirs))
 
 
@@ -108,7 +106,7 @@ class DriverSlot:
     """One configured driver and its run state (`restart_at` is None while it runs)."""
 
     driver: ModemDriverBase
-    cfg: object  # DriverConfig
+    cfg: acomms_pb.DriverConfig
     restart_at: float | None = 0.0
     failures: int = 0
     problem: str = ""  # why it last failed
@@ -139,7 +137,9 @@ class AcommsHandler:
         cfg,
         clock: Clock,
         loader: ProtoLoader | None = None,
-        driver_factory: Callable[[object, Clock], ModemDriverBase | None] = make_driver,
+        driver_factory: Callable[
+            [acomms_pb.DriverConfig, Clock], ModemDriverBase | None
+        ] = make_driver,
     ) -> None:
         if cfg.modem_id == acomms_pb.BROADCAST_ID:
             raise HandlerError("modem_id 0 is the broadcast address; set a modem_id of 1 or more")
@@ -151,13 +151,19 @@ class AcommsHandler:
         # Drivers first (as upstream): a bad driver configuration fails before anything runs.
         self.slots: list[DriverSlot] = []
         self.primary: DriverSlot | None = None
-        self.signal_raw_incoming = Signal()  # (ModemRaw) of the primary driver
-        self.signal_raw_outgoing = Signal()
-        self.signal_modem_receive = Signal()  # (ModemTransmission) received by the primary
-        self.signal_modem_transmit = Signal()  # (ModemTransmission) transmit result
+        self.signal_raw_incoming: Signal[acomms_pb.ModemRaw] = (
+            Signal()
+        )  # (ModemRaw) of the primary driver
+        self.signal_raw_outgoing: Signal[acomms_pb.ModemRaw] = Signal()
+        self.signal_modem_receive: Signal[acomms_pb.ModemTransmission] = (
+            Signal()
+        )  # (ModemTransmission) received by the primary
+        self.signal_modem_transmit: Signal[acomms_pb.ModemTransmission] = (
+            Signal()
+        )  # (ModemTransmission) transmit result
         # (DriverSlot, text) when a driver starts or fails: "running" or why it failed and
         # when it is tried again
-        self.signal_driver_status = Signal()
+        self.signal_driver_status: Signal[[DriverSlot, str]] = Signal()
         primary_cfg = acomms_pb.DriverConfig()
         primary_cfg.CopyFrom(cfg.driver_cfg)
         top_level = primary_cfg.WhichOneof("driver") is None and cfg.HasField("driver_type")
@@ -314,18 +320,18 @@ class AcommsHandler:
             log.warning("cannot encode %s: %s", message.DESCRIPTOR.full_name, err)
             return None
 
-    def initiate_transmission(self, transmission) -> None:
+    def initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         """A transmission requested from outside the MAC (e.g. an ad-hoc ping)."""
         if self.primary is None:
             log.warning("no primary driver: transmission request ignored")
             return
         self._initiate_on_primary(transmission)
 
-    def inject_receive(self, transmission) -> None:
+    def inject_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         """Treat `transmission` as received by a driver (queue only)."""
         self.queue.handle_modem_receive(transmission)
 
-    def apply_mac_update(self, update) -> None:
+    def apply_mac_update(self, update: acomms_pb.MACUpdate) -> None:
         """MACUpdate addressed to this node; silences/restores Micro-Modems."""
         state = self.mac.apply_update(update)
         if state is None:
@@ -335,7 +341,7 @@ class AcommsHandler:
             if set_silent is not None and slot.running:
                 set_silent(not state)
 
-    def update_driver_cfg(self, cfg) -> None:
+    def update_driver_cfg(self, cfg: acomms_pb.DriverConfig) -> None:
         """DriverConfig update for every running driver with the same modem_id."""
         for slot in self.slots:
             if slot.running and slot.cfg.modem_id == cfg.modem_id:
@@ -352,7 +358,7 @@ class AcommsHandler:
     def route_cfg(self):
         return self.router.cfg
 
-    def replace_route(self, route) -> None:
+    def replace_route(self, route: StaticRoute) -> None:
         self.router.set_route(route)
         log.info("route replaced: %s", list(route.hop))
 
@@ -360,10 +366,10 @@ class AcommsHandler:
         """A RouteCommand received over the link replaces the route when routing is configured
         (pAcommsHandler's rule); any other message is left alone."""
         if message.DESCRIPTOR.full_name == ROUTE_COMMAND and self.route_cfg.route.hop:
-            self.replace_route(message.new_route)
+            self.replace_route(message.new_route)  # type: ignore[attr-defined]  # (a RouteCommand)
 
     # ------------------------------------------------------------------ internals
-    def _initiate_on_primary(self, transmission) -> None:
+    def _initiate_on_primary(self, transmission: acomms_pb.ModemTransmission) -> None:
         if self.primary is None or not self.primary.running:
             return
         try:
@@ -409,7 +415,13 @@ class AcommsHandler:
         except Exception:
             log.exception("driver %s failed to shut down cleanly", _name(slot))
 
-    def _driver_failed(self, slot: DriverSlot, status: int, why, started: bool = True) -> None:
+    def _driver_failed(
+        self,
+        slot: DriverSlot,
+        status: acomms_pb.ModemDriverStatus.Status.ValueType,
+        why,
+        started: bool = True,
+    ) -> None:
         slot.failures += 1
         slot.problem = f"{Status.Status.Name(status)}: {why}"
         if started or slot.running:
@@ -456,8 +468,8 @@ class AcommsHandler:
         new.driver.signal_receive.connect(self.mac.handle_modem_receive)
 
 
-def _status_of(exc: BaseException, default: int) -> int:
-    return exc.status if isinstance(exc, ModemDriverError) else default
+def _status_of(exc: BaseException, default: Status.Status.ValueType) -> Status.Status.ValueType:
+    return exc.status if isinstance(exc, ModemDriverError) else default  # type: ignore[return-value]
 
 
 def _name(slot: DriverSlot) -> str:

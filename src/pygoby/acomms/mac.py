@@ -16,6 +16,7 @@ import math
 import time
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.protobuf import enum_type
 from pygoby.util.clock import Clock
 from pygoby.util.glog import DEBUG1, DEBUG2, VERBOSE, group_logger
 from pygoby.util.signal import Signal
@@ -24,12 +25,12 @@ SKEW_TOLERANCE = 2.0  # s late before a slot is skipped and the schedule re-anch
 AUTO_ENTROPY = 5
 SECONDS_PER_DAY = 86400
 
-MACType = acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_name
+MACType = enum_type(acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"]).values_by_name
 MAC_NONE = MACType["MAC_NONE"].number
 MAC_FIXED_DECENTRALIZED = MACType["MAC_FIXED_DECENTRALIZED"].number
 MAC_AUTO_DECENTRALIZED = MACType["MAC_AUTO_DECENTRALIZED"].number
 MAC_POLLED = MACType["MAC_POLLED"].number
-_MAC_TYPE_NAMES = acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_number
+_MAC_TYPE_NAMES = enum_type(acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"]).values_by_number
 U = acomms_pb.MACUpdate
 
 
@@ -37,8 +38,8 @@ class MACManager:
     def __init__(self, clock: Clock) -> None:
         self.clock = clock
         self.cfg = acomms_pb.MACConfig()
-        self.signal_initiate_transmission = Signal()
-        self.signal_slot_start = Signal()
+        self.signal_initiate_transmission: Signal[acomms_pb.ModemTransmission] = Signal()
+        self.signal_slot_start: Signal[acomms_pb.ModemTransmission] = Signal()
         self.slots: list = []  # the cycle: ModemTransmissions, in order
         self.running = False
         self.current = 0  # index of the next slot to run
@@ -49,7 +50,7 @@ class MACManager:
         self.glog = group_logger("goby::acomms::amac::0")
 
     # ------------------------------------------------------------------ control
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.MACConfig) -> None:
         self.cfg = acomms_pb.MACConfig()
         self.cfg.CopyFrom(cfg)
         self.glog = group_logger(f"goby::acomms::amac::{cfg.modem_id}")
@@ -172,7 +173,7 @@ class MACManager:
         if self.cfg.type == MAC_AUTO_DECENTRALIZED:
             self._auto_expire()
 
-    def _initiates(self, slot) -> bool:
+    def _initiates(self, slot: acomms_pb.ModemTransmission) -> bool:
         kind = self.cfg.type
         if kind == MAC_FIXED_DECENTRALIZED:
             return slot.src == self.cfg.modem_id or slot.always_initiate
@@ -183,7 +184,7 @@ class MACManager:
         return False
 
     # ------------------------------------------------------------------ MACUpdate
-    def apply_update(self, update) -> bool | None:
+    def apply_update(self, update: acomms_pb.MACUpdate) -> bool | None:
         """Apply a MACUpdate addressed to this node.
 
         Returns None when `cycle_state` is absent, else True for STARTED / False for STOPPED
@@ -224,7 +225,7 @@ class MACManager:
         return False
 
     # ------------------------------------------------------------------ auto-discovery (Goby 1.1)
-    def handle_modem_receive(self, transmission) -> None:
+    def handle_modem_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         """Learn sources heard on the link (MAC_AUTO_DECENTRALIZED only)."""
         if self.cfg.type != MAC_AUTO_DECENTRALIZED or transmission.src <= 0:
             return
@@ -285,7 +286,7 @@ def _clock_text(t: float) -> str:
     return time.strftime("%H:%M:%S", time.gmtime(t)) + f".{int(t % 1 * 1000):03d}"
 
 
-def _copy(slot):
+def _copy(slot: acomms_pb.ModemTransmission):
     out = acomms_pb.ModemTransmission()
     out.CopyFrom(slot)
     return out

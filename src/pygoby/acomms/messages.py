@@ -1,137 +1,126 @@
 """Message classes and extension handles for goby-acomms, from our .proto files.
 
 The .proto files live under src/pygoby/protobuf/goby/acomms/protobuf/ at their upstream import
-paths; this module loads them once into the process-wide pool and names the classes.
+paths; their generated modules (made at build time) register them in protobuf's default pool, and
+this module names the classes, extensions and enum values the rest of pygoby uses.
 """
 
 from __future__ import annotations
 
-from google.protobuf.descriptor import FieldDescriptor
+from google.protobuf.message import Message
 
 from pygoby.protobuf import default_loader
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
+from pygoby.protobuf.goby.acomms.protobuf import (
+    abc_driver_pb2,
+    amac_config_pb2,
+    amac_pb2,
+    dccl_pb2,
+    driver_base_pb2,
+    mm_driver_pb2,
+    mm_receive_statistics_pb2,
+    modem_message_pb2,
+    network_ack_pb2,
+    queue_pb2,
+    store_server_driver_pb2,
+    store_server_pb2,
+    udp_driver_pb2,
+    udp_multicast_driver_pb2,
+)
+from pygoby.protobuf.goby.moos.protobuf import transitional_pb2, ufield_sim_driver_pb2
+from pygoby.protobuf.pygoby.acomms import store_server_auth_pb2
 
 BROADCAST_ID = 0
 QUERY_DESTINATION_ID = -1
 QUERY_SOURCE_ID = -1
 
-_PROTO_FILES = (
-    "goby/acomms/protobuf/modem_message.proto",
-    "goby/acomms/protobuf/driver_base.proto",
-    "goby/acomms/protobuf/queue.proto",
-    "goby/acomms/protobuf/network_ack.proto",
-    "goby/acomms/protobuf/amac_config.proto",
-    "goby/acomms/protobuf/amac.proto",
-    "goby/acomms/protobuf/dccl.proto",
-    "goby/acomms/protobuf/mm_driver.proto",
-    "goby/acomms/protobuf/udp_driver.proto",
-    "goby/acomms/protobuf/udp_multicast_driver.proto",
-    "goby/acomms/protobuf/abc_driver.proto",
-    "goby/acomms/protobuf/store_server.proto",
-    "goby/acomms/protobuf/store_server_driver.proto",
-    "pygoby/acomms/store_server_auth.proto",
-    "goby/moos/protobuf/ufield_sim_driver.proto",
-)
 
-_loader = default_loader()
-for _name in _PROTO_FILES:
-    _loader.load_file(_name)
-
-
-def _cls(full_name: str):
-    return _loader.message_class(full_name)
-
-
-def goby_message_class(full_name: str):
+def goby_message_class(full_name: str) -> type[Message]:
     """pygoby's own messages a mission may name (MACUpdate, RouteCommand, NetworkAck, ...)."""
-    _loader.load_file("goby/acomms/protobuf/route.proto")
-    return _loader.message_class(full_name)
+    loader = default_loader()
+    loader.load_file("goby/acomms/protobuf/route.proto")
+    return loader.message_class(full_name)
 
 
-def extension(full_name: str) -> FieldDescriptor:
+def extension(full_name: str) -> AnyFieldDescriptor:
     """An extension field by full name, for `msg.Extensions[...]`."""
-    return _loader.pool.FindExtensionByName(full_name)
+    return default_loader().pool.FindExtensionByName(full_name)
 
 
-ModemTransmission = _cls("goby.acomms.protobuf.ModemTransmission")
-ModemRaw = _cls("goby.acomms.protobuf.ModemRaw")
-ModemReport = _cls("goby.acomms.protobuf.ModemReport")
-DriverConfig = _cls("goby.acomms.protobuf.DriverConfig")
-ModemDriverStatus = _cls("goby.acomms.protobuf.ModemDriverStatus")
-QueuedMessageEntry = _cls("goby.acomms.protobuf.QueuedMessageEntry")
-QueueManagerConfig = _cls("goby.acomms.protobuf.QueueManagerConfig")
-QueueSize = _cls("goby.acomms.protobuf.QueueSize")
-QueueFlush = _cls("goby.acomms.protobuf.QueueFlush")
-QueuedMessageMeta = _cls("goby.acomms.protobuf.QueuedMessageMeta")
-NetworkAck = _cls("goby.acomms.protobuf.NetworkAck")
-MACConfig = _cls("goby.acomms.protobuf.MACConfig")
-MACUpdate = _cls("goby.acomms.protobuf.MACUpdate")
-DCCLConfig = _cls("goby.acomms.protobuf.DCCLConfig")
-StoreServerRequest = _cls("goby.acomms.protobuf.StoreServerRequest")
-StoreServerResponse = _cls("goby.acomms.protobuf.StoreServerResponse")
+ModemTransmission = modem_message_pb2.ModemTransmission
+ModemRaw = modem_message_pb2.ModemRaw
+ModemReport = modem_message_pb2.ModemReport
+DriverConfig = driver_base_pb2.DriverConfig
+DriverType = driver_base_pb2.DriverType
+ModemDriverStatus = driver_base_pb2.ModemDriverStatus
+QueuedMessageEntry = queue_pb2.QueuedMessageEntry
+QueueManagerConfig = queue_pb2.QueueManagerConfig
+QueueSize = queue_pb2.QueueSize
+QueueFlush = queue_pb2.QueueFlush
+QueuedMessageMeta = queue_pb2.QueuedMessageMeta
+NetworkAck = network_ack_pb2.NetworkAck
+MACConfig = amac_config_pb2.MACConfig
+MACType = amac_config_pb2.MACType
+MACUpdate = amac_pb2.MACUpdate
+DCCLConfig = dccl_pb2.DCCLConfig
+StoreServerRequest = store_server_pb2.StoreServerRequest
+StoreServerResponse = store_server_pb2.StoreServerResponse
 
-MMConfig = _cls("goby.acomms.micromodem.protobuf.Config")
-MMTransmission = _cls("goby.acomms.micromodem.protobuf.Transmission")
-ReceiveStatistics = _cls("goby.acomms.micromodem.protobuf.ReceiveStatistics")
-TransmitStatistics = _cls("goby.acomms.micromodem.protobuf.TransmitStatistics")
-RangingReply = _cls("goby.acomms.micromodem.protobuf.RangingReply")
-MMApplicationAck = _cls("goby.acomms.micromodem.protobuf.MMApplicationAck")
-UDPConfig = _cls("goby.acomms.udp.protobuf.Config")
-ABCConfig = _cls("goby.acomms.abc.protobuf.Config")
-StoreServerConfig = _cls("goby.acomms.store_server.protobuf.Config")
-StoreServerTransmission = _cls("goby.acomms.store_server.protobuf.Transmission")
-StoreServerRequestAuth = _cls("pygoby.acomms.protobuf.StoreServerRequestAuth")
-StoreServerResponseStatus = _cls("pygoby.acomms.protobuf.StoreServerResponseStatus")
-UFldConfig = _cls("goby.moos.ufld.protobuf.Config")
-UFldTransmission = _cls("goby.moos.ufld.protobuf.Transmission")
+MMConfig = mm_driver_pb2.Config
+MMTransmission = mm_driver_pb2.Transmission
+ReceiveStatistics = mm_receive_statistics_pb2.ReceiveStatistics
+TransmitStatistics = mm_driver_pb2.TransmitStatistics
+RangingReply = mm_driver_pb2.RangingReply
+MMApplicationAck = mm_driver_pb2.MMApplicationAck
+UDPConfig = udp_driver_pb2.Config
+ABCConfig = abc_driver_pb2.Config
+StoreServerConfig = store_server_driver_pb2.Config
+StoreServerTransmission = store_server_driver_pb2.Transmission
+StoreServerRequestAuth = store_server_auth_pb2.StoreServerRequestAuth
+StoreServerResponseStatus = store_server_auth_pb2.StoreServerResponseStatus
+UFldConfig = ufield_sim_driver_pb2.Config
+UFldTransmission = ufield_sim_driver_pb2.Transmission
 
 # Goby 1.1 forms (goby.transitional.protobuf): CCL queues and the 1.1 MOOS variables
-V1QueueConfig = _cls("goby.transitional.protobuf.QueueConfig")
-V1ModemDataTransmission = _cls("goby.transitional.protobuf.ModemDataTransmission")
-V1ModemRangingRequest = _cls("goby.transitional.protobuf.ModemRangingRequest")
-V1ModemRangingReply = _cls("goby.transitional.protobuf.ModemRangingReply")
-V1MACUpdate = _cls("goby.transitional.protobuf.MACUpdate")
-V1ModemDataAck = _cls("goby.transitional.protobuf.ModemDataAck")
-V1ModemDataExpire = _cls("goby.transitional.protobuf.ModemDataExpire")
-V1QueueSize = _cls("goby.transitional.protobuf.QueueSize")
-V1QueueFlush = _cls("goby.transitional.protobuf.QueueFlush")
-QUEUE_CCL = (
-    _loader.pool.FindEnumTypeByName("goby.transitional.protobuf.QueueType")
-    .values_by_name["QUEUE_CCL"]
-    .number
-)
-QUEUE_DCCL = (
-    _loader.pool.FindEnumTypeByName("goby.transitional.protobuf.QueueType")
-    .values_by_name["QUEUE_DCCL"]
-    .number
-)
+V1QueueConfig = transitional_pb2.QueueConfig
+V1ModemDataTransmission = transitional_pb2.ModemDataTransmission
+V1ModemRangingRequest = transitional_pb2.ModemRangingRequest
+V1ModemRangingReply = transitional_pb2.ModemRangingReply
+V1MACUpdate = transitional_pb2.MACUpdate
+V1ModemDataAck = transitional_pb2.ModemDataAck
+V1ModemDataExpire = transitional_pb2.ModemDataExpire
+V1QueueSize = transitional_pb2.QueueSize
+V1QueueFlush = transitional_pb2.QueueFlush
+V1RangingType = transitional_pb2.RangingType
+QUEUE_CCL = transitional_pb2.QUEUE_CCL
+QUEUE_DCCL = transitional_pb2.QUEUE_DCCL
 
-MM_CONFIG = extension("goby.acomms.micromodem.protobuf.config")
-MM_TRANSMISSION = extension("goby.acomms.micromodem.protobuf.transmission")
-UDP_CONFIG = extension("goby.acomms.udp.protobuf.config")
-ABC_CONFIG = extension("goby.acomms.abc.protobuf.config")
-STORE_SERVER_CONFIG = extension("goby.acomms.store_server.protobuf.config")
-STORE_SERVER_TRANSMISSION = extension("goby.acomms.store_server.protobuf.transmission")
-STORE_SERVER_AUTH = extension("pygoby.acomms.protobuf.store_server_auth")
-UFLD_CONFIG = extension("goby.moos.ufld.protobuf.config")
-UFLD_TRANSMISSION = extension("goby.moos.ufld.protobuf.transmission")
+MM_CONFIG = mm_driver_pb2.config
+MM_TRANSMISSION = mm_driver_pb2.transmission
+UDP_CONFIG = udp_driver_pb2.config
+UDP_MULTICAST_CONFIG = udp_multicast_driver_pb2.config
+UDPMulticastConfig = udp_multicast_driver_pb2.Config
+ABC_CONFIG = abc_driver_pb2.config
+STORE_SERVER_CONFIG = store_server_driver_pb2.config
+STORE_SERVER_TRANSMISSION = store_server_driver_pb2.transmission
+STORE_SERVER_AUTH = store_server_auth_pb2.store_server_auth
+UFLD_CONFIG = ufield_sim_driver_pb2.config
+UFLD_TRANSMISSION = ufield_sim_driver_pb2.transmission
 
 # enum values used throughout
 DATA = ModemTransmission.DATA
 ACK = ModemTransmission.ACK
 DRIVER_SPECIFIC = ModemTransmission.DRIVER_SPECIFIC
-_MM_TYPE = _loader.pool.FindEnumTypeByName(
-    "goby.acomms.micromodem.protobuf.TransmissionType"
-).values_by_name
-MICROMODEM_TWO_WAY_PING = _MM_TYPE["MICROMODEM_TWO_WAY_PING"].number
-MICROMODEM_REMUS_LBL_RANGING = _MM_TYPE["MICROMODEM_REMUS_LBL_RANGING"].number
-MICROMODEM_NARROWBAND_LBL_RANGING = _MM_TYPE["MICROMODEM_NARROWBAND_LBL_RANGING"].number
-MICROMODEM_MINI_DATA = _MM_TYPE["MICROMODEM_MINI_DATA"].number
-MICROMODEM_FLEXIBLE_DATA = _MM_TYPE["MICROMODEM_FLEXIBLE_DATA"].number
-MICROMODEM_HARDWARE_CONTROL = _MM_TYPE["MICROMODEM_HARDWARE_CONTROL"].number
-MICROMODEM_HARDWARE_CONTROL_REPLY = _MM_TYPE["MICROMODEM_HARDWARE_CONTROL_REPLY"].number
-MICROMODEM_GENERIC_LBL_RANGING = _MM_TYPE["MICROMODEM_GENERIC_LBL_RANGING"].number
-MICROMODEM_FM_SWEEP = _MM_TYPE["MICROMODEM_FM_SWEEP"].number
-MICROMODEM_M_SEQUENCE = _MM_TYPE["MICROMODEM_M_SEQUENCE"].number
+MICROMODEM_TWO_WAY_PING = mm_driver_pb2.MICROMODEM_TWO_WAY_PING
+MICROMODEM_REMUS_LBL_RANGING = mm_driver_pb2.MICROMODEM_REMUS_LBL_RANGING
+MICROMODEM_NARROWBAND_LBL_RANGING = mm_driver_pb2.MICROMODEM_NARROWBAND_LBL_RANGING
+MICROMODEM_MINI_DATA = mm_driver_pb2.MICROMODEM_MINI_DATA
+MICROMODEM_FLEXIBLE_DATA = mm_driver_pb2.MICROMODEM_FLEXIBLE_DATA
+MICROMODEM_HARDWARE_CONTROL = mm_driver_pb2.MICROMODEM_HARDWARE_CONTROL
+MICROMODEM_HARDWARE_CONTROL_REPLY = mm_driver_pb2.MICROMODEM_HARDWARE_CONTROL_REPLY
+MICROMODEM_GENERIC_LBL_RANGING = mm_driver_pb2.MICROMODEM_GENERIC_LBL_RANGING
+MICROMODEM_FM_SWEEP = mm_driver_pb2.MICROMODEM_FM_SWEEP
+MICROMODEM_M_SEQUENCE = mm_driver_pb2.MICROMODEM_M_SEQUENCE
 
 
 def now_us(seconds: float) -> int:

@@ -10,30 +10,34 @@ from __future__ import annotations
 
 import logging
 
+from google.protobuf.message import Message
+
 from pygoby.acomms import messages as acomms_pb
-from pygoby.protobuf import default_loader
+from pygoby.acomms.queue import QueueManager
+from pygoby.acomms.queue.queue import QueuedItem
+from pygoby.protobuf.goby.acomms.protobuf import route_pb2
+from pygoby.protobuf.goby.acomms.protobuf.route_pb2 import StaticRoute
 
 log = logging.getLogger(__name__)
 
-default_loader().load_file("goby/acomms/protobuf/route.proto")
-RouteManagerConfig = default_loader().message_class("goby.acomms.protobuf.RouteManagerConfig")
-RouteCommand = default_loader().message_class("goby.acomms.protobuf.RouteCommand")
+RouteManagerConfig = route_pb2.RouteManagerConfig
+RouteCommand = route_pb2.RouteCommand
 
 NO_ROUTE = -1
 
 
 class RouteManager:
-    def __init__(self, cfg=None) -> None:
+    def __init__(self, cfg: route_pb2.RouteManagerConfig | None = None) -> None:
         self.cfg = RouteManagerConfig()
         if cfg is not None:
             self.cfg.CopyFrom(cfg)
         self.subnets: list = []  # QueueManagers
 
-    def set_route(self, route) -> None:
+    def set_route(self, route: StaticRoute) -> None:
         """Replace the hop list (RouteCommand.new_route)."""
         self.cfg.route.CopyFrom(route)
 
-    def add_subnet_queue(self, queue) -> None:
+    def add_subnet_queue(self, queue: QueueManager) -> None:
         if queue not in self.subnets:
             self.subnets.append(queue)
 
@@ -46,7 +50,7 @@ class RouteManager:
             return self.cfg.default_gateway
         return NO_ROUTE
 
-    def handle_out(self, item, modem_id: int) -> None:
+    def handle_out(self, item: QueuedItem, modem_id: int) -> None:
         """Rewrite a queued item's link destination to the next hop (broadcasts untouched)."""
         if item.dest == acomms_pb.BROADCAST_ID:
             return
@@ -54,7 +58,7 @@ class RouteManager:
         if hop != NO_ROUTE:
             item.dest = hop
 
-    def handle_in(self, msg, encoded: bytes, dest: int, modem_id: int) -> None:
+    def handle_in(self, msg: Message, encoded: bytes, dest: int, modem_id: int) -> None:
         if dest in (modem_id, acomms_pb.BROADCAST_ID):
             return
         hop = self.find_next_hop(modem_id, dest)
@@ -68,7 +72,7 @@ class RouteManager:
         log.debug("no subnet for next hop %d: message for %d not relayed", hop, dest)
 
 
-def bind_router(queue, router: RouteManager) -> None:
+def bind_router(queue: QueueManager, router: RouteManager) -> None:
     router.add_subnet_queue(queue)
     queue.signal_out_route.connect(router.handle_out)
     queue.signal_in_route.connect(router.handle_in)

@@ -14,14 +14,14 @@ Ctrl-C or Exit quits.
 from __future__ import annotations
 
 import asyncio
-
-from google.protobuf.message import Message
+from collections.abc import Sequence
 
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValues, Post
-from pygoby.topside.acomms_config import AcommsMessageSet
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
+from pygoby.protobuf.pygoby.apps.topside_config_pb2 import iCommanderConfig
 from pygoby.topside.commander import (
     KEY_VALUE,
     MULTIPLEX,
@@ -30,17 +30,19 @@ from pygoby.topside.commander import (
     CommandSet,
     SaveFileError,
 )
-from pygoby.topside.icommander import ICommanderTUI
 
 SEND_MULTIPLEX = 2  # pygoby.apps.protobuf.SendStyle
 QUIET = 1  # goby.util.protobuf.GLogConfig.Verbosity
 
 
 class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = ("pygoby/apps/topside_config.proto", "pygoby.apps.protobuf.iCommanderConfig")
+    config_class = iCommanderConfig
+    cfg: iCommanderConfig
     default_name = "iCommander"
 
-    def __init__(self, cfg: Message, *, acomms: AcommsMessageSet | None = None, **kwargs) -> None:
+    def __init__(
+        self, cfg: iCommanderConfig, *, acomms: AcommsMessageSet | None = None, **kwargs
+    ) -> None:
         super().__init__(cfg, **kwargs)
         if not (self.common.HasField("lat_origin") and self.common.HasField("lon_origin")):
             raise ConfigError(
@@ -69,6 +71,9 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
         # empty values mean none, as in Goby 1.1 (its manual's block and --example_config
         # carry `show_variable: ""` and `load: ""`)
         shown = [var for var in cfg.show_variable if var]
+        # textual (pip extra `topside`) is imported here, where a missing one is reported cleanly
+        from pygoby.topside.icommander import ICommanderTUI
+
         self.tui = ICommanderTUI(self.commander, shown, on_exit=self.request_stop)
         for var in self.commander.watched_variables:
             self.subscribe(var, self._on_ack_or_expire)
@@ -122,7 +127,7 @@ class iCommander(GobyMOOSApp):  # noqa: N801 - the program's name
             await self.stop()
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return iCommander.main(argv)
 
 

@@ -29,11 +29,12 @@ onto them:
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import sys
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 from google.protobuf.message import Message
 
@@ -55,15 +56,14 @@ from pygoby.moos.appconfig import prefixed_var_names, read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import LAT_ORIGIN_VAR, LONG_ORIGIN_VAR
+from pygoby.protobuf.goby.moos.protobuf.iFrontSeat_config_pb2 import iFrontSeatConfig
 
 LEGACY_BLACKOUT = 1.0  # s, goby3's registration interval for the DESIRED_* and CTD_* variables
 
 
 class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "goby/moos/protobuf/iFrontSeat_config.proto",
-        "goby.apps.moos.protobuf.iFrontSeatConfig",
-    )
+    config_class = iFrontSeatConfig
+    cfg: iFrontSeatConfig
     default_name = "iFrontSeat"
     # the frontseat link is served through a MOOSDB outage (its lines read, the helm's
     # silence noticed); what the interface posts meanwhile is delivered when the DB is back
@@ -72,7 +72,9 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
     # -- configuration ---------------------------------------------------------------------
 
     @classmethod
-    def main(cls, argv: Sequence[str] | None = None, prog: str | None = None) -> int:
+    def main(
+        cls, argv: Sequence[str] | None = None, prog: str | None = None, command: str | None = None
+    ) -> int:
         """As goby3, the driver named in the environment is loaded before the options are
         read (its configuration extension then parses and shows in --example_config)."""
         try:
@@ -80,12 +82,12 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
         except DriverLoadError as err:
             print(f"iFrontSeat: {err}", file=sys.stderr)
             return 1
-        return super().main(argv, prog)
+        return super().main(argv, prog, command)
 
     @classmethod
-    def load_config_class(cls) -> type[Message]:
+    def load_config_class(cls) -> type[iFrontSeatConfig]:
         fs_config.load_goby2_extensions()
-        return super().load_config_class()
+        return cast(type[iFrontSeatConfig], super().load_config_class())
 
     @classmethod
     def read_config(
@@ -100,7 +102,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
 
     # -- construction ----------------------------------------------------------------------
 
-    def __init__(self, cfg: Message, **kwargs: Any) -> None:
+    def __init__(self, cfg: iFrontSeatConfig, **kwargs: Any) -> None:
         super().__init__(cfg, **kwargs)
         self.var = prefixed_var_names(cfg.moos_var)
         driver, self.interface = fs_config.load_configured_driver(cfg, os.environ, self.clock)
@@ -126,7 +128,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
             (interface.signal_raw_from_frontseat, "raw_in"),
             (interface.signal_raw_to_frontseat, "raw_out"),
         ):
-            signal.connect(lambda message, var=self.var[var]: self.publish_pb(var, message))
+            signal.connect(functools.partial(self.publish_pb, self.var[var]))
         if self.cfg.legacy_cfg.publish_fs_bs_ready:
             interface.signal_state_change.connect(lambda status: self._post(ready_posts(status)))
 
@@ -243,7 +245,7 @@ class iFrontSeat(GobyMOOSApp):  # noqa: N801 - the program's name
 
     # -- frontseat -> MOOS -----------------------------------------------------------------
 
-    def _on_data_from_frontseat(self, data: Message) -> None:
+    def _on_data_from_frontseat(self, data: frontseat_pb.InterfaceData) -> None:
         self.publish_pb(self.var["data_from_frontseat"], data)
         if data.HasField("node_status"):
             self.publish_pb(self.var["node_status"], data.node_status)

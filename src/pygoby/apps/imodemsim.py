@@ -26,8 +26,10 @@ ProcessConfig:
 from __future__ import annotations
 
 import dataclasses
+import functools
 import ipaddress
 import logging
+from collections.abc import Sequence
 from typing import NoReturn
 
 from pygoby.acomms.mmsim.model import MicroModemModel
@@ -36,7 +38,8 @@ from pygoby.acomms.mmsim.server import MMSimServer
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.moos.classic_app import ClassicMOOSApp
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.netsim.range_link import RangeLink
+from pygoby.netsim.sim.range_link import RangeLink
+from pygoby.protobuf.pygoby.moos.classic_app_pb2 import ClassicMOOSAppConfig
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.pty import PtyError, PtyPair, is_live, partner_of
 
@@ -82,7 +85,7 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
         "ModemID = 1                 // NVRAM SRC before the host configures it (pygoby)",
     )
 
-    def __init__(self, cfg, **kwargs) -> None:
+    def __init__(self, cfg: ClassicMOOSAppConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.settings = {s.name.lower(): s for s in self.params}  # the last of a name wins
         for setting in self.params:
@@ -114,7 +117,7 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
             self.position = [self._number(n.lower(), 0.0) for n in names]
         else:
             for index, var in enumerate(LOCATION_TYPES[location]):
-                self.subscribe(var, lambda msg, i=index: self._on_position(i, msg))
+                self.subscribe(var, functools.partial(self._on_position, index))
         self.is_local = location.endswith("local")
         self.geodesy = UTMGeodesy(self.cfg.common.lat_origin, self.cfg.common.lon_origin)
         modem_id = int(self._number("modemid", 1))
@@ -217,7 +220,7 @@ class iModemSim(ClassicMOOSApp):  # noqa: N801 - the program's name
             await super().stop()
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return iModemSim.main(argv)
 
 

@@ -4,29 +4,30 @@ Subscribes to the vehicle's NAV_LAT/NAV_LONG (or NAV_X/NAV_Y with LatOrigin/Long
 NAV_DEPTH, NAV_SPEED and NAV_HEADING and sends a NavUpdate for its `modem_tcp_port` every
 `nav_period` seconds; every Micro-Modem reception pAcommsHandler posts (ACOMMS_MODEM_RECEIVE)
 is pushed as ReceiveStats. The manager's answer is posted to NETSIM_STATUS when it changes.
-The reporting itself is `pygoby.netsim.navreporter.NavReporter`; the manager connection
-(reconnecting) is `pygoby.netsim.client.NetSimClient`.
+The reporting itself is `pygoby.netsim.manager.navreporter.NavReporter`; the manager connection
+(reconnecting) is `pygoby.netsim.manager.client.NetSimClient`.
 """
 
 from __future__ import annotations
 
-from google.protobuf.message import Message
+import functools
+from collections.abc import Sequence
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.netsim.client import NetSimClient, status_name
-from pygoby.netsim.navreporter import NavReporter
+from pygoby.netsim.manager.client import NetSimClient, status_name
+from pygoby.netsim.manager.navreporter import NavReporter
+from pygoby.netsim.manager.protocol import NetSimManagerResponse
+from pygoby.protobuf.pygoby.netsim.inetsimmanager_config_pb2 import iNetSimManagerConfig
 
 
 class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "pygoby/netsim/inetsimmanager_config.proto",
-        "pygoby.netsim.protobuf.iNetSimManagerConfig",
-    )
+    config_class = iNetSimManagerConfig
+    cfg: iNetSimManagerConfig
     default_name = "iNetSimManager"
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: iNetSimManagerConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         common = cfg.common
         origin = None
@@ -50,7 +51,7 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
             cfg.heading_var: "heading",
         }
         for var, name in names.items():
-            self.subscribe(var, lambda msg, name=name: self._nav(name, msg))
+            self.subscribe(var, functools.partial(self._nav, name))
         self.subscribe_pb(cfg.modem_receive_var, acomms_pb.ModemTransmission, self._modem_receive)
         self.register_timer(cfg.nav_period, self.send_nav)
 
@@ -73,12 +74,12 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
         if nav is not None:
             self.netsim.send_navs([nav])
 
-    def _modem_receive(self, transmission: Message) -> None:
+    def _modem_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         stats = self.reporter.receive_stats(transmission)
         if stats and self.netsim.send_stats(stats) is None:
             self.log.info("not connected to netsim_manager: %d receive stats dropped", len(stats))
 
-    def _answer(self, response: Message) -> None:
+    def _answer(self, response: NetSimManagerResponse) -> None:
         status = status_name(response)
         if status != "UPDATE_ACCEPTED":
             self.log.warning("netsim_manager refused request %d: %s", response.request_id, status)
@@ -87,7 +88,7 @@ class iNetSimManager(GobyMOOSApp):  # noqa: N801 - the program's name
             self.publish(self.cfg.status_var, status)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return iNetSimManager.main(argv)
 
 

@@ -13,10 +13,12 @@ default; any other address requires the access token printed at start-up. The ap
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from pygoby.topside.liaison.app import Liaison
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return Liaison.main(argv, prog="liaison", command="pygoby liaison")
 
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import base64
 import functools
+from collections.abc import Callable, Sequence
 
 from google.protobuf.message import Message
 
@@ -24,20 +25,23 @@ from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase, driver_name
 from pygoby.acomms.drivers.ufield import UFldDriver
 from pygoby.acomms.handler import AcommsHandler, DriverSlot, HandlerError, make_driver
-from pygoby.apps.pacommshandler_goby11 import Goby11Variables
-from pygoby.apps.ufield_link import MOOSMailLink
 from pygoby.errors import ConfigError
 from pygoby.frontseat.messages import InterfaceData
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import locate, prefixed_var_names
 from pygoby.moos.protocol import MOOSMessage, text_or_binary
-from pygoby.moos.translator_binding import TranslatorBinding, not_loaded
-from pygoby.topside.acomms_config import PACOMMSHANDLER_CONFIG, AcommsMessageSet
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
+from pygoby.moosacomms.goby11 import Goby11Variables
+from pygoby.moosacomms.translator_binding import TranslatorBinding, not_loaded
+from pygoby.moosacomms.ufield_link import MOOSMailLink
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
+from pygoby.util.clock import Clock
+from pygoby.util.signal import Signal
 
 IFS_DATA_OUT = "ifrontseat_data_out"  # a moos_var field without the prefix
 
 
-def _make_driver(cfg, clock) -> ModemDriverBase | None:
+def _make_driver(cfg: acomms_pb.DriverConfig, clock: Clock) -> ModemDriverBase | None:
     """The handler's drivers; a uField driver gets its own MOOS connection."""
     driver = make_driver(cfg, clock)
     if isinstance(driver, UFldDriver):
@@ -46,13 +50,14 @@ def _make_driver(cfg, clock) -> ModemDriverBase | None:
 
 
 class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = PACOMMSHANDLER_CONFIG
+    config_class = pAcommsHandlerConfig
+    cfg: pAcommsHandlerConfig
     default_name = "pAcommsHandler"
     # the modem, the MAC and the queue keep going through a MOOSDB outage; what they post
     # meanwhile is delivered when the DB is back
     iterate_without_comms = True
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: pAcommsHandlerConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.var = prefixed_var_names(cfg.moos_var, skip=(IFS_DATA_OUT,))
         self.ifs_data_out = getattr(cfg.moos_var, IFS_DATA_OUT)
@@ -130,7 +135,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         work, so a failing slot is logged and contained (it must not look like a driver
         failure or break a slot)."""
         acomms, queue, mac = self.acomms, self.acomms.queue, self.acomms.mac
-        connections = [
+        connections: list[tuple[Signal[...], Callable[..., object]]] = [
             (acomms.signal_raw_incoming, functools.partial(self._post_raw, True)),
             (acomms.signal_raw_outgoing, functools.partial(self._post_raw, False)),
             (acomms.signal_modem_receive, self._poster("driver_receive")),
@@ -219,7 +224,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
             self.binding.tick(self.clock.now())
         self._stop_on_failure(self.acomms.do_work)
 
-    def _stop_on_failure(self, work) -> None:
+    def _stop_on_failure(self, work: Callable[[], object]) -> None:
         try:
             work()
         except HandlerError as err:
@@ -245,7 +250,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         ):
             self.queue.flush_queue(flush)
 
-    def _on_data_on_demand(self, request, message: Message) -> None:
+    def _on_data_on_demand(self, request: acomms_pb.ModemTransmission, message: Message) -> None:
         """ON_DEMAND: a fresh message from the current variables, queued here (so a bad one is
         logged and skipped); `message` is left empty so the queue does not push it again."""
         created = self.binding.create(message.DESCRIPTOR.full_name)
@@ -264,13 +269,13 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
     def _poster(self, key: str):
         return functools.partial(self.publish_pb, self.var[key])
 
-    def _post_raw(self, incoming: bool, raw) -> None:
+    def _post_raw(self, incoming: bool, raw: acomms_pb.ModemRaw) -> None:
         self.publish(
             self.var["driver_raw_in" if incoming else "driver_raw_out"], text_or_binary(raw.raw)
         )
         self.publish_pb(self.var["driver_raw_msg_in" if incoming else "driver_raw_msg_out"], raw)
 
-    def _on_ack(self, ack, original: Message) -> None:
+    def _on_ack(self, ack: acomms_pb.ModemTransmission, original: Message) -> None:
         if not self.goby11.goby11_forms:  # else Goby 1.1's ModemDataAck (Goby11Variables)
             self.publish_pb(self.var["queue_ack_transmission"], ack)
         self.publish_pb(self.var["queue_ack_original_msg"], original)
@@ -284,7 +289,7 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         self.publish_pb(self.var["queue_receive"], message)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return pAcommsHandler.main(argv)
 
 

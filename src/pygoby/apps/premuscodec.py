@@ -5,7 +5,7 @@
 
 REMUS frames arrive on the `mdat_*_var` variables as Goby 1.1 ModemDataTransmission text (what
 pAcommsHandler's CCL queues post on their `in_pubsub_var`) and become NODE_REPORT,
-STATUS_REPORT_IN, CCL_*_IN and `<NAME>_NAV_*` (pygoby.apps.premuscodec_reports). With
+STATUS_REPORT_IN, CCL_*_IN and `<NAME>_NAV_*` (pygoby.moosacomms.remus_reports). With
 `create_status`, our NAV_* become a State frame on `mdat_state_out` every 10 s (once all five
 have arrived); an OUTGOING_COMMAND `MessageType=CCL_REDIRECT,...` becomes a Redirect frame on
 `mdat_redirect_out`, addressed to its DestinationPlatformId. A bad frame or command is logged
@@ -15,17 +15,17 @@ with the reason and skipped. LatOrigin/LongOrigin (the datum of NAV_X/NAV_Y) are
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from functools import partial
 
-from google.protobuf.message import Message
-
 from pygoby.acomms import messages as acomms_pb
-from pygoby.apps.premuscodec_reports import RemusReports
 from pygoby.dccl import DcclError
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import Technique, TranslatorError, parse_for_moos, serialize_for_moos
+from pygoby.moosacomms.remus_reports import RemusReports
+from pygoby.protobuf.pygoby.apps.premuscodec_config_pb2 import pREMUSCodecConfig
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup, atoi
 
@@ -36,13 +36,11 @@ TEXT = Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT  # Goby 1.1's ModemDataTransmiss
 
 
 class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "pygoby/apps/premuscodec_config.proto",
-        "pygoby.apps.protobuf.pREMUSCodecConfig",
-    )
+    config_class = pREMUSCodecConfig
+    cfg: pREMUSCodecConfig
     default_name = "pREMUSCodec"
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: pREMUSCodecConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         if not (self.common.HasField("lat_origin") and self.common.HasField("lon_origin")):
             raise ConfigError(
@@ -96,7 +94,7 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
         if msg.is_double:
             return int(msg.dval) if math.isfinite(msg.dval) else 0
         value = msg.value
-        return atoi(value.decode("latin-1") if isinstance(value, bytes) else value)
+        return atoi(value.decode("latin-1") if isinstance(value, bytes) else str(value))
 
     # ------------------------------------------------------------------ frames in
     def _on_frame(self, kind: str, msg: MOOSMessage) -> None:
@@ -167,7 +165,7 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
     def _on_command(self, msg: MOOSMessage) -> None:
         if msg.is_double:
             return
-        text = msg.value.decode("latin-1") if isinstance(msg.value, bytes) else msg.value
+        text = msg.value.decode("latin-1") if isinstance(msg.value, bytes) else str(msg.value)
         try:
             command = self.reports.redirect_command(text)
         except DcclError as err:
@@ -178,7 +176,7 @@ class pREMUSCodec(GobyMOOSApp):  # noqa: N801 - the program's name
             self._send(self.cfg.mdat_redirect_out, frame, dest)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return pREMUSCodec.main(argv)
 
 

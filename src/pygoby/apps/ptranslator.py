@@ -7,21 +7,22 @@ only wires the configuration to the MOOS application base.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from google.protobuf.message import Message
 
 from pygoby.dccl.libraries import split_libraries
 from pygoby.moos.app import GobyMOOSApp
-from pygoby.moos.translator_binding import MessageTypes, TranslatorBinding
+from pygoby.moosacomms.translator_binding import MessageTypes, TranslatorBinding
+from pygoby.protobuf.goby.apps.moos.protobuf.pTranslator_config_pb2 import pTranslatorConfig
 
 
 class pTranslator(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "goby/apps/moos/protobuf/pTranslator_config.proto",
-        "goby.apps.moos.protobuf.pTranslatorConfig",
-    )
+    config_class = pTranslatorConfig
+    cfg: pTranslatorConfig
     default_name = "pTranslator"
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: pTranslatorConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         libraries, others = split_libraries(  # C++ DCCL codec libraries: pygoby's built-ins
             cfg.load_shared_library,
@@ -58,7 +59,7 @@ class pTranslator(GobyMOOSApp):  # noqa: N801 - the program's name
         self.binding.publish(message)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return pTranslator.main(argv)
 
 

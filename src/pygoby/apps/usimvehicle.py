@@ -11,13 +11,13 @@ NAV_DEPTH, NAV_HEADING and NAV_SPEED every `nav_period` seconds, and posts scrip
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-
-from google.protobuf.message import Message
 
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.util.kinematics import slew
+from pygoby.protobuf.pygoby.apps.usimvehicle_config_pb2 import uSimVehicleConfig
+from pygoby.util.kinematics import advance, slew, turn_toward, wrap_heading
 
 DESIRED = {"DESIRED_HEADING": "heading", "DESIRED_SPEED": "speed", "DESIRED_DEPTH": "depth"}
 
@@ -42,26 +42,22 @@ class VehicleModel:
         if dt <= 0:
             return
         if self.desired_heading is not None:
-            error = (self.desired_heading - self.heading + 180.0) % 360.0 - 180.0
-            self.heading += max(-self.turn_rate * dt, min(self.turn_rate * dt, error))
-        self.heading %= 360.0
+            self.heading = turn_toward(
+                self.heading, wrap_heading(self.desired_heading), self.turn_rate * dt
+            )
         if self.desired_speed is not None:
             self.speed = slew(self.speed, self.desired_speed, self.acceleration * dt)
         if self.desired_depth is not None:
             self.depth = max(0.0, slew(self.depth, self.desired_depth, self.dive_rate * dt))
-        radians = math.radians(self.heading)
-        self.x += self.speed * math.sin(radians) * dt
-        self.y += self.speed * math.cos(radians) * dt
+        self.x, self.y = advance(self.x, self.y, self.speed, self.heading, dt)
 
 
 class uSimVehicle(GobyMOOSApp):  # noqa: N801 - the program's name
-    config_proto = (
-        "pygoby/apps/usimvehicle_config.proto",
-        "pygoby.apps.protobuf.uSimVehicleConfig",
-    )
+    config_class = uSimVehicleConfig
+    cfg: uSimVehicleConfig
     default_name = "uSimVehicle"
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: uSimVehicleConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.vehicle = VehicleModel(
             x=cfg.start_x,
@@ -122,7 +118,7 @@ class uSimVehicle(GobyMOOSApp):  # noqa: N801 - the program's name
             self._next_event = 0
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return uSimVehicle.main(argv)
 
 

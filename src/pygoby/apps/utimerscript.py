@@ -6,9 +6,12 @@ pygoby.moos.timerscript), so that missions run without MOOS-IvP installed.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from pygoby.moos.classic_app import ClassicMOOSApp
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.timerscript import TimerScript
+from pygoby.protobuf.pygoby.moos.classic_app_pb2 import ClassicMOOSAppConfig
 
 STATUS_PERIOD = 5.0
 
@@ -26,7 +29,7 @@ class uTimerScript(ClassicMOOSApp):  # noqa: N801 - the program's name
         "UPON_AWAKE = n/a        // reset or restart when a CONDITION turns true again",
     )
 
-    def __init__(self, cfg, **kwargs) -> None:
+    def __init__(self, cfg: ClassicMOOSAppConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         self.script = TimerScript(self.params, file=self.mission_path)
         for warning in self.script.warnings:
@@ -51,7 +54,7 @@ class uTimerScript(ClassicMOOSApp):  # noqa: N801 - the program's name
             self.request_stop()
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     return uTimerScript.main(argv)
 
 

@@ -44,11 +44,9 @@ from pygoby.dccl.codecs.base import FieldInfo, RepeatedFieldCodec
 from pygoby.dccl.codecs.numeric import f32
 from pygoby.dccl.errors import DcclDecodeError, DcclError, DcclLoadError
 from pygoby.dccl.options import field_extension
-from pygoby.protobuf import builtin_class
-
-MODEL_PROTO = "dccl/arithmetic/protobuf/arithmetic.proto"
-MODEL_NAME = "dccl.arith.protobuf.ArithmeticModel"
-EXTENSIONS_PROTO = "dccl/arithmetic/protobuf/arithmetic_extensions.proto"
+from pygoby.protobuf import enum_type, initialization_errors
+from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_extensions_pb2 import ArithmeticOptions
+from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_pb2 import ArithmeticModel
 
 EOF_SYMBOL = -2
 OUT_OF_RANGE_SYMBOL = -1
@@ -63,11 +61,11 @@ _U32 = (1 << 32) - 1
 _NAN = float("nan")
 
 
-def model_class() -> type[Message]:
-    return builtin_class(MODEL_PROTO, MODEL_NAME)
+def model_class() -> type[ArithmeticModel]:
+    return ArithmeticModel
 
 
-def load_model_file(path: str | os.PathLike[str]) -> Message:
+def load_model_file(path: str | os.PathLike[str]) -> ArithmeticModel:
     """An ArithmeticModel from a TextFormat file (`--arithmetic-model FILE`)."""
     try:
         with open(path) as f:
@@ -81,14 +79,12 @@ class Model:
 
     ENCODER, DECODER = 0, 1
 
-    def __init__(self, user: Message) -> None:
+    def __init__(self, user: ArithmeticModel) -> None:
         def invalid(why: str) -> DcclLoadError:
             return DcclLoadError(f"invalid arithmetic model {user.name!r}: {why}")
 
         if not user.IsInitialized():
-            raise DcclLoadError(
-                f"invalid arithmetic model: missing {user.FindInitializationErrors()}"
-            )
+            raise DcclLoadError(f"invalid arithmetic model: missing {initialization_errors(user)}")
         self.user = user
         self.name = user.name
         self.bounds = list(user.value_bound)
@@ -167,7 +163,7 @@ class ModelManager:
     def __init__(self) -> None:
         self._models: dict[str, Model] = {}
 
-    def set_model(self, model: Message) -> None:
+    def set_model(self, model: ArithmeticModel) -> None:
         """Add or replace a model (fresh frequency tables for adaptive ones)."""
         self._models[model.name] = Model(model)
 
@@ -217,7 +213,7 @@ def _from_wire(category: str, info: FieldInfo):
             & _U64
         )
     if category == "enum":
-        known = {v.number for v in info.descriptor.enum_type.values}
+        known = {v.number for v in enum_type(info.descriptor).values}
         # an unknown number makes the element "not set" (dropped)
         return lambda x: n if (n := cvtt32(x)) in known else None
     raise DcclLoadError(f"{info.name}: dccl.arithmetic cannot code {category} fields")
@@ -228,7 +224,7 @@ class ArithmeticCodec(RepeatedFieldCodec):
 
     def __init__(self, info: FieldInfo) -> None:
         super().__init__(info)
-        options = field_extension(info.options, EXTENSIONS_PROTO, "ArithmeticOptions", 1001)
+        options = field_extension(info.options, ArithmeticOptions, 1001)
         if not options.HasField("model"):
             raise DcclLoadError(f"{info.name}: missing (dccl.field).arithmetic.model")
         self.model_name = options.model
@@ -413,7 +409,7 @@ class ArithmeticCodec(RepeatedFieldCodec):
         return (values[0] if values else None), pos
 
 
-def set_model(codec: Any, model: Message | str | os.PathLike[str]) -> None:
+def set_model(codec: Any, model: ArithmeticModel | str | os.PathLike[str]) -> None:
     """Give `codec` (a pygoby.dccl.Codec) an arithmetic model: an ArithmeticModel message or
     the path of a TextFormat file holding one (C++: ModelManager::set_model)."""
     if not isinstance(model, Message):

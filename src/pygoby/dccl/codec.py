@@ -6,6 +6,7 @@ import logging
 import os
 import time
 from collections.abc import Callable, Iterable, Iterator
+from typing import cast
 
 from google.protobuf import message_factory
 from google.protobuf.descriptor import Descriptor
@@ -24,7 +25,9 @@ from pygoby.dccl.identifier import id_codec as lookup_id_codec
 from pygoby.dccl.options import message_options
 from pygoby.dccl.plan import Part, Planner, root_options
 from pygoby.dccl.registry import DEFAULT_REGISTRY, CodecRegistry
-from pygoby.protobuf import ProtoError, ProtoLoader
+from pygoby.protobuf import ProtoError, ProtoLoader, initialization_errors
+from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_pb2 import ArithmeticModel
+from pygoby.protobuf.descriptors import AnyDescriptor
 from pygoby.util.clock import Clock
 from pygoby.util.names import did_you_mean
 
@@ -83,7 +86,7 @@ class Codec:
             self._conditions = DynamicConditions()
         return self._conditions
 
-    def set_arithmetic_model(self, model: Message | str | os.PathLike[str]) -> None:
+    def set_arithmetic_model(self, model: ArithmeticModel | str | os.PathLike[str]) -> None:
         """Give this Codec a `dccl.arith.protobuf.ArithmeticModel` (a message, or a TextFormat
         file) for `dccl.arithmetic` fields; set models before loading the types that use them.
         A model of the same name is replaced (adaptive ones start afresh)."""
@@ -116,13 +119,13 @@ class Codec:
             raise
 
     # ---------------------------------------------------------------- loading
-    def load(self, message_type: type[Message] | Descriptor) -> type[Message]:
+    def load(self, message_type: type[Message] | AnyDescriptor) -> type[Message]:
         """Validate and compile a message type (a generated class or a descriptor)."""
+        descriptor = _descriptor_of(message_type)
         if isinstance(message_type, Descriptor):
-            descriptor = message_type
-            cls = message_factory.GetMessageClass(descriptor)
+            cls = message_factory.GetMessageClass(message_type)
         else:
-            cls, descriptor = message_type, message_type.DESCRIPTOR
+            cls = cast(type[Message], message_type)
         known = self._by_name.get(descriptor.full_name)
         if known is not None:
             return known.cls
@@ -178,8 +181,8 @@ class Codec:
             raise DcclLoadError(f"{path}: no message has (dccl.msg) options")
         return [self.load(self.loader.message_class(d.full_name)) for d in dccl]
 
-    def unload(self, message_type: type[Message] | Descriptor) -> None:
-        descriptor = getattr(message_type, "DESCRIPTOR", message_type)
+    def unload(self, message_type: type[Message] | AnyDescriptor) -> None:
+        descriptor = _descriptor_of(message_type)
         compiled = self._by_name.pop(descriptor.full_name, None)
         if compiled is not None and compiled.id is not None:
             self._by_id.pop(compiled.id, None)
@@ -187,7 +190,7 @@ class Codec:
     def loaded(self) -> list[type[Message]]:
         return [c.cls for c in self._by_name.values()]
 
-    def _compile(self, cls: type[Message], descriptor: Descriptor) -> CompiledType:
+    def _compile(self, cls: type[Message], descriptor: AnyDescriptor) -> CompiledType:
         root = root_options(descriptor)
         planner = Planner(root, self.registry, self._now, self._lua)
         head = planner.plan_root(descriptor, Part.HEAD)
@@ -231,14 +234,14 @@ class Codec:
             source={name: g.source for name, g in generated.items()},
         )
 
-    def compiled(self, message_type: type[Message] | Descriptor | str) -> CompiledType:
+    def compiled(self, message_type: type[Message] | AnyDescriptor | str) -> CompiledType:
         """The compiled form of a loaded type (loading it first if it is a class/descriptor)."""
         if isinstance(message_type, str):
             try:
                 return self._by_name[message_type]
             except KeyError:
                 raise DcclError(f"message type {message_type!r} is not loaded") from None
-        descriptor = getattr(message_type, "DESCRIPTOR", message_type)
+        descriptor = _descriptor_of(message_type)
         compiled = self._by_name.get(descriptor.full_name)
         if compiled is None:
             self.load(message_type)
@@ -250,7 +253,7 @@ class Codec:
         """Encode a message (its type is loaded on first use)."""
         compiled = self._by_name.get(msg.DESCRIPTOR.full_name) or self.compiled(type(msg))
         if not msg.IsInitialized():
-            missing = ", ".join(msg.FindInitializationErrors())
+            missing = ", ".join(initialization_errors(msg))
             raise DcclEncodeError(f"{compiled.name}: required fields are not set: {missing}")
         strict = self.strict
         try:
@@ -270,20 +273,20 @@ class Codec:
         """Length in bytes of `encode(msg)`."""
         return len(self.encode(msg))
 
-    def analyze(self, message_type: type[Message] | Descriptor | str) -> str:
+    def analyze(self, message_type: type[Message] | AnyDescriptor | str) -> str:
         """A table of the type's fields: codec, part (head/body), bit sizes, and totals."""
         return describe(self.compiled(message_type))
 
-    def definition_hash(self, message_type: type[Message] | Descriptor | str) -> int:
+    def definition_hash(self, message_type: type[Message] | AnyDescriptor | str) -> int:
         """The 64-bit hash of a type's DCCL definition that C++ DCCL's `load()` returns (and
         `dccl.hash` fields send masked); see pygoby.dccl.hashing."""
         compiled = self.compiled(message_type)
         return definition_hash(compiled.cls.DESCRIPTOR, compiled.head, compiled.body)
 
-    def max_size(self, message_type: type[Message] | Descriptor | str) -> int:
+    def max_size(self, message_type: type[Message] | AnyDescriptor | str) -> int:
         return self.compiled(message_type).max_size()
 
-    def min_size(self, message_type: type[Message] | Descriptor | str) -> int:
+    def min_size(self, message_type: type[Message] | AnyDescriptor | str) -> int:
         return self.compiled(message_type).min_size()
 
     # ---------------------------------------------------------------- decoding
@@ -300,7 +303,7 @@ class Codec:
         return self._compiled_for(data, None).cls
 
     def _compiled_for(
-        self, data: bytes, message_type: type[Message] | Descriptor | str | None
+        self, data: bytes, message_type: type[Message] | AnyDescriptor | str | None
     ) -> CompiledType:
         if message_type is not None:
             compiled = self.compiled(message_type)
@@ -312,19 +315,19 @@ class Codec:
                     )
             return compiled
         dccl_id, _ = self.read_id(data)
-        compiled = self._by_id.get(dccl_id)
-        if compiled is None:
+        found = self._by_id.get(dccl_id)
+        if found is None:
             raise DcclDecodeError(f"no message type with id {dccl_id} is loaded")
-        return compiled
+        return found
 
     def decode(
-        self, data: bytes, message_type: type[Message] | Descriptor | str | None = None
+        self, data: bytes, message_type: type[Message] | AnyDescriptor | str | None = None
     ) -> Message:
         """Decode bytes; the type comes from the ID unless given (it must be for omit_id types)."""
         return self.decode_prefix(data, message_type)[0]
 
     def decode_prefix(
-        self, data: bytes, message_type: type[Message] | Descriptor | str | None = None
+        self, data: bytes, message_type: type[Message] | AnyDescriptor | str | None = None
     ) -> tuple[Message, int]:
         """Decode one message from the start of `data`: (message, bytes it used).
 
@@ -354,8 +357,13 @@ class Codec:
         return msg, head_bytes + (used + 7) // 8
 
 
-def _messages_of(descriptors: Iterable[Descriptor]) -> Iterator[Descriptor]:
+def _messages_of(descriptors: Iterable[AnyDescriptor]) -> Iterator[AnyDescriptor]:
     """`descriptors` and every message type nested in them."""
     for descriptor in descriptors:
         yield descriptor
         yield from _messages_of(descriptor.nested_types)
+
+
+def _descriptor_of(message_type: type[Message] | AnyDescriptor) -> AnyDescriptor:
+    """The descriptor of a generated class, or the descriptor itself."""
+    return cast(AnyDescriptor, getattr(message_type, "DESCRIPTOR", message_type))

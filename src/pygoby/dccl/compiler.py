@@ -38,6 +38,7 @@ from pygoby.dccl.plan import (
 )
 from pygoby.dccl.rawtext import extend_raw_strings, set_raw_string
 from pygoby.dccl.trace import FieldTracer
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 
 def _truncated(where: str) -> DcclDecodeError:
@@ -71,7 +72,7 @@ def _register_source(base: str, source: str) -> str:
     same type (another Codec's registry chose other codecs) gets `<dccl BASE #2>`, and so on."""
     lines = source.splitlines(keepends=True)
     filename, copy = f"<dccl {base}>", 1
-    while (entry := linecache.cache.get(filename)) is not None and entry[2] != lines:
+    while (entry := linecache.cache.get(filename)) is not None and entry[2] != lines:  # type: ignore[misc]  # (size, mtime, lines, name)
         copy += 1
         filename = f"<dccl {base} #{copy}>"
     # mtime None: linecache.checkcache() keeps the entry (there is no file to compare against)
@@ -148,7 +149,7 @@ def _set(var: str, field_name: str, value: str) -> str:
     return f"setattr({var}, {field_name!r}, {value})"
 
 
-def _is_string(field: FieldDescriptor) -> bool:
+def _is_string(field: AnyFieldDescriptor) -> bool:
     return field.type == FieldDescriptor.TYPE_STRING
 
 
@@ -189,11 +190,11 @@ class _PartCompiler:
         return start
 
     def _trace_end(
-        self, start: str | None, path: str, value: str, ind: int, field: FieldDescriptor | None
+        self, start: str | None, path: str, value: str, ind: int, field: AnyFieldDescriptor | None
     ) -> None:
         if start is not None:
             if field is not None:
-                self.tracer.fields[path] = field
+                self.tracer.fields[path] = field  # type: ignore[union-attr]  # (start: tracing)
             self.src.add(ind, f"_trace({path!r}, {value}, {start}, pos, {self.bits_var})")
 
     def _trace_id(self, ind: int) -> None:
@@ -243,7 +244,7 @@ def _null_encoding(item: RepeatedItem) -> tuple[int, int]:
     minimum-size (all zero) encoding of a message."""
     codec = item.codec
     if codec is None:
-        return 0, item.child.cpp_min_size()
+        return 0, item.child_node().cpp_min_size()
     if isinstance(codec, FixedWidthCodec):
         return codec.null_raw, codec.bits
     return codec.encode(None, False)
@@ -413,7 +414,7 @@ class EncoderCompiler(_PartCompiler):
                 self.src.add(ind, f"pos += {null_bits}")
             return
         if item.codec is None:
-            self._node(item.child, element, ind, path + "[].")
+            self._node(item.child_node(), element, ind, path + "[].")
         elif conditions is not None and conditions.bounds:
             cond = self._conditioned(item, path, element=True)
             self.src.add(ind, f"r, n = {cond}.encode({var}, m0, {element}, {strict})")
@@ -458,7 +459,7 @@ class EncoderCompiler(_PartCompiler):
         if item.codec is not None:
             self._write_value(item.codec, element, ind + 1, path)
         else:
-            self._node(item.child, element, ind + 1, path + "[].")
+            self._node(item.child_node(), element, ind + 1, path + "[].")
         # missing elements: v2 slots up to max_repeat, v3/v4 padding up to min_repeat, each the
         # element codec's "no value" (all zeros but for a few legacy CCL codecs)
         null_raw, null_bits = _null_encoding(item)
@@ -681,7 +682,7 @@ class DecoderCompiler(_PartCompiler):
             self._index(ind + 1, slot)
             if omits:
                 self.src.add(ind + 1, f"if _dc.omit({dc}, {child_var}, m0, {slot}): continue")
-            self._node(item.child, child_var, ind + 1, path + "[].", checked)
+            self._node(item.child_node(), child_var, ind + 1, path + "[].", checked)
             self.src.add(ind + 1, f"if not {child_var}.ListFields(): {empties} += 1")
             self.src.add(ind, f"for _ in range({empties}): del {container}[-1]")
         elif self.lua is not None:
@@ -695,12 +696,12 @@ class DecoderCompiler(_PartCompiler):
             self.src.add(ind + 1, f"{child_var} = {container}[{before} + {slot}]")
             if omits:
                 self.src.add(ind + 1, f"if _dc.omit({dc}, {child_var}, m0, {slot}): continue")
-            self._node(item.child, child_var, ind + 1, path + "[].", checked)
+            self._node(item.child_node(), child_var, ind + 1, path + "[].", checked)
             self.src.add(ind, f"del {container}[{before} + {count}:]")
         else:
             self.src.add(ind, f"for _ in range({count}):")
             self.src.add(ind + 1, f"{child_var} = {container}.add()")
-            self._node(item.child, child_var, ind + 1, path + "[].", checked)
+            self._node(item.child_node(), child_var, ind + 1, path + "[].", checked)
 
 
 def compile_encoder(

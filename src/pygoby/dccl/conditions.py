@@ -30,26 +30,29 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from google.protobuf import descriptor_pb2
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.errors import DcclError, DcclLoadError
+from pygoby.protobuf import enum_type
+from pygoby.protobuf.dccl.option_extensions_pb2 import DCCLFieldOptions
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
+from pygoby.util.errors import MissingExtraError
+from pygoby.util.extras import needs_extra
 
 _INT64 = (FieldDescriptor.CPPTYPE_INT64, FieldDescriptor.CPPTYPE_UINT64)
 
 
 def _lupa():
     try:
-        from lupa import lua53
-    except ImportError as exc:
-        raise DcclLoadError(
-            "dynamic_conditions are Lua expressions and need the 'lupa' package with Lua 5.3"
-            f" (pip install lupa): {exc}"
-        ) from None
+        with needs_extra("lua", "dynamic_conditions (Lua 5.3 expressions)"):
+            from lupa import lua53
+    except MissingExtraError as exc:
+        raise DcclLoadError(str(exc)) from None
     return lua53
 
 
@@ -61,16 +64,16 @@ def with_return(script: str) -> str:
 class FieldConditions:
     """The dynamic conditions of one field, as the plan uses them."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     required_if: str | None = None  # required_if, or only_if
     omit_if: str | None = None  # omit_if, or "not (only_if)"
     omit_negates: bool = False  # omit_if is an only_if: omit when it is false
     min: str | None = None
     max: str | None = None
-    scripts: dict[str, Any] = field(default_factory=dict)  # compiled, by role
+    scripts: dict[str, Any] = dataclasses.field(default_factory=dict)  # compiled, by role
 
     @classmethod
-    def of(cls, f: FieldDescriptor, options: Message) -> FieldConditions | None:
+    def of(cls, f: AnyFieldDescriptor, options: DCCLFieldOptions) -> FieldConditions | None:
         if not options.HasField("dynamic_conditions"):
             return None
         dc = options.dynamic_conditions
@@ -193,18 +196,18 @@ class DynamicConditions:
                     table[f.containing_oneof.name] = f.name
         return self._set_meta(table, self._defaults(msg.DESCRIPTOR))
 
-    def _value(self, f: FieldDescriptor, value: Any) -> Any:
+    def _value(self, f: AnyFieldDescriptor, value: Any) -> Any:
         cpp = f.cpp_type
         if cpp == FieldDescriptor.CPPTYPE_MESSAGE:
             return self._table(value)
         if cpp == FieldDescriptor.CPPTYPE_ENUM:
-            known = f.enum_type.values_by_number.get(value)
+            known = enum_type(f).values_by_number.get(value)
             return known.name if known is not None else value
         if cpp in _INT64 and value >= 1 << 63:
             return value - (1 << 64)  # a Lua integer is signed 64-bit
         return value
 
-    def _defaults(self, desc: Descriptor):
+    def _defaults(self, desc: AnyDescriptor):
         meta = self._meta.get(desc.full_name)
         if meta is None:
             meta = self.lua.table()
@@ -218,9 +221,9 @@ class DynamicConditions:
         return meta
 
 
-def _synthetic(f: FieldDescriptor) -> bool:
+def _synthetic(f: AnyFieldDescriptor) -> bool:
     oneof = f.containing_oneof
-    return len(oneof.fields) == 1 and oneof.name == "_" + f.name
+    return oneof is not None and len(oneof.fields) == 1 and oneof.name == "_" + f.name
 
 
 @functools.cache
@@ -239,17 +242,17 @@ def _file_proto(serialized: bytes) -> dict[str, descriptor_pb2.FieldDescriptorPr
     return fields
 
 
-def _explicit_default(f: FieldDescriptor) -> str | None:
+def _explicit_default(f: AnyFieldDescriptor) -> str | None:
     """The text of a field's `[default = ...]`, None without one (only singular scalars)."""
     if f.is_repeated or f.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE:
         return None
-    proto = _file_proto(f.file.serialized_pb).get(f.full_name)
+    proto = _file_proto(f.file.serialized_pb).get(f.full_name)  # type: ignore[union-attr]
     if proto is None or not proto.HasField("default_value"):
         return None
     return proto.default_value
 
 
-def _default_value(f: FieldDescriptor, text: str) -> Any:
+def _default_value(f: AnyFieldDescriptor, text: str) -> Any:
     cpp = f.cpp_type
     if cpp == FieldDescriptor.CPPTYPE_ENUM:
         return text  # the value's name

@@ -16,17 +16,17 @@ format. A C++ peer built with another standard library (libc++ on macOS: a diffe
 
 from __future__ import annotations
 
-import dataclasses
-
 from google.protobuf import descriptor_pb2
-from google.protobuf.descriptor import Descriptor, EnumDescriptor, FieldDescriptor, OneofDescriptor
+from google.protobuf.descriptor import FieldDescriptor, OneofDescriptor
 from google.protobuf.message import Message
 
-from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec
-from pygoby.dccl.codecs.numeric import NumericCodec
-from pygoby.dccl.errors import DcclDecodeError, DcclLoadError
+from pygoby.dccl.codecs.enum import EnumCodec
+from pygoby.dccl.codecs.hash import HashCodec
 from pygoby.dccl.options import field_options, message_options
+from pygoby.dccl.plan import MessageItem, RepeatedItem
+from pygoby.protobuf import enum_type, message_type
 from pygoby.protobuf.cpp_text import c_escape, message_text, scalar_text
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyEnumDescriptor, AnyFieldDescriptor
 
 _U64 = (1 << 64) - 1
 _MUL = 0xC6A4A7935BD1E995
@@ -111,19 +111,19 @@ _PROTO_TYPES = {number: "TYPE_" + name.upper() for number, name in _TYPE_NAMES.i
 }
 
 
-def _field_proto(f: FieldDescriptor) -> descriptor_pb2.FieldDescriptorProto:
+def _field_proto(f: AnyFieldDescriptor) -> descriptor_pb2.FieldDescriptorProto:
     proto = descriptor_pb2.DescriptorProto()
-    f.containing_type.CopyToProto(proto)
+    f.containing_type.CopyToProto(proto)  # type: ignore[union-attr]  # (a field of a message)
     return next(p for p in proto.field if p.number == f.number)
 
 
-def _label(f: FieldDescriptor) -> str:
+def _label(f: AnyFieldDescriptor) -> str:
     if f.is_repeated:
         return "LABEL_REPEATED"
     return "LABEL_REQUIRED" if f.is_required else "LABEL_OPTIONAL"
 
 
-def _explicit_json_name(f: FieldDescriptor) -> bool:
+def _explicit_json_name(f: AnyFieldDescriptor) -> bool:
     camel, upper = "", False
     for char in f.name:
         if char == "_":
@@ -134,7 +134,7 @@ def _explicit_json_name(f: FieldDescriptor) -> bool:
     return f.json_name != camel
 
 
-def field_descriptor_text(f: FieldDescriptor) -> str:
+def field_descriptor_text(f: AnyFieldDescriptor) -> str:
     """DebugString() of the FieldDescriptorProto without name, options, type name and
     default (what C++ DCCL hashes for a field)."""
     lines = [f"number: {f.number}\n", f"label: {_label(f)}\n", f"type: {_PROTO_TYPES[f.type]}\n"]
@@ -147,13 +147,13 @@ def field_descriptor_text(f: FieldDescriptor) -> str:
     return "".join(lines)
 
 
-def _field_debug_string(f: FieldDescriptor, depth: int) -> str:
+def _field_debug_string(f: AnyFieldDescriptor, depth: int) -> str:
     """FieldDescriptor::DebugString at `depth` (as inside a oneof)."""
     prefix = " " * (2 * depth)
     if f.type in (FieldDescriptor.TYPE_MESSAGE, FieldDescriptor.TYPE_GROUP):
-        type_name = "." + f.message_type.full_name
+        type_name = "." + message_type(f).full_name
     elif f.type == FieldDescriptor.TYPE_ENUM:
-        type_name = "." + f.enum_type.full_name
+        type_name = "." + enum_type(f).full_name
     else:
         type_name = _TYPE_NAMES[f.type]
     label = "" if f.containing_oneof is not None else _label(f)[6:].lower() + " "
@@ -169,7 +169,7 @@ def oneof_debug_string(oneof: OneofDescriptor) -> str:
     return f"oneof {oneof.name} {{\n{fields}}}\n"
 
 
-def enum_debug_string(enum: EnumDescriptor) -> str:
+def enum_debug_string(enum: AnyEnumDescriptor) -> str:
     proto = descriptor_pb2.EnumDescriptorProto()
     enum.CopyToProto(proto)
     lines = [f"enum {enum.name} {{\n"]
@@ -204,9 +204,6 @@ def enum_debug_string(enum: EnumDescriptor) -> str:
 def _codec_hash(item) -> int:
     """FieldCodecBase::hash() of a field's codec: a sub-message's own hash, an enum's
     DebugString for the default enum codecs, 0 otherwise."""
-    from pygoby.dccl.codecs.enum import EnumCodec
-    from pygoby.dccl.plan import MessageItem, RepeatedItem
-
     if isinstance(item, MessageItem) or (isinstance(item, RepeatedItem) and item.child is not None):
         return node_hash(item.child)
     codec = getattr(item, "codec", None)
@@ -228,7 +225,7 @@ def node_hash(node) -> int:
     return value
 
 
-def definition_hash(descriptor: Descriptor, head, body) -> int:
+def definition_hash(descriptor: AnyDescriptor, head, body) -> int:
     """The 64-bit hash C++ DCCL's `Codec::load` returns for a root type (from its plans)."""
     opts = message_options(descriptor)
     opts.ClearField("max_bytes")
@@ -240,54 +237,8 @@ def definition_hash(descriptor: Descriptor, head, body) -> int:
     return value
 
 
-# ------------------------------------------------------------------ the codec
-class HashCodec(FixedWidthCodec):
-    """A uint32 field sending `definition hash & max` (always, in the required encoding); on
-    decode a different value is an error. The hash is set when the whole type is planned."""
-
-    def __init__(self, info: FieldInfo) -> None:
-        super().__init__(info)
-        opts = info.options
-        lo, hi = opts.min, opts.max
-        if lo != 0:
-            raise DcclLoadError(f"{info.name}: dccl.hash needs (dccl.field).min = 0")
-        if hi > 2**32 - 1 or hi != 2 ** (int(hi).bit_length()) - 1 or hi != int(hi):
-            raise DcclLoadError(
-                f"{info.name}: dccl.hash needs (dccl.field).max = 2^k - 1 (e.g. 255, 4294967295)"
-            )
-        required = dataclasses.replace(info, required=True)
-        self.inner = NumericCodec(required, bounds=(0.0, hi), resolution=1.0, category="uint32")
-        self.bits = self.inner.bits
-        self.mask = int(hi)
-        self.expected = 0
-        inner_to_raw, inner_from_raw = self.inner.to_raw, self.inner.from_raw
-
-        def to_raw(value, strict: bool) -> int:
-            return inner_to_raw(self.expected, strict)
-
-        def from_raw(raw: int) -> int:
-            received = inner_from_raw(raw)
-            if received != self.expected:
-                raise DcclDecodeError(
-                    f"{info.name}: hash mismatch (expected {self.expected}, received {received}):"
-                    " sender and receiver do not use the same DCCL definition"
-                )
-            return received
-
-        self.to_raw, self.from_raw = to_raw, from_raw
-
-    def set_hash(self, full_hash: int) -> None:
-        self.expected = full_hash & self.mask
-        self.null_raw = self.inner.to_raw(self.expected, False)
-
-    def describe(self) -> str:
-        return f"definition hash & {self.mask:#x}"
-
-
 def hash_codecs(node):
     """Every HashCodec in a plan."""
-    from pygoby.dccl.plan import MessageItem, RepeatedItem
-
     for item in node.items:
         codec = getattr(item, "codec", None)
         if isinstance(codec, HashCodec):

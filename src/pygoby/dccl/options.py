@@ -2,57 +2,43 @@
 
 from __future__ import annotations
 
-import functools
-
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
-from pygoby.protobuf import builtin_class, default_loader
+# add-on extensions of DCCLFieldOptions, imported so that they are known to the carriers' pool and
+# parse (and print, for dccl.hash) as the named extensions C++ DCCL sees
+from pygoby.protobuf.dccl.arithmetic.protobuf import arithmetic_extensions_pb2  # noqa: F401
+from pygoby.protobuf.dccl.ccl.protobuf import ccl_extensions_pb2  # noqa: F401
+from pygoby.protobuf.dccl.option_extensions_pb2 import DCCLFieldOptions, DCCLMessageOptions
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor, MessageT
+from pygoby.protobuf.pygoby.dccl.option_carrier_pb2 import (
+    FieldOptionsCarrier,
+    MessageOptionsCarrier,
+)
 from pygoby.protobuf.wire import length_delimited
 
-_CARRIER_PROTO = "pygoby/dccl/option_carrier.proto"
 
-
-# add-on extensions of DCCLFieldOptions, known to the carriers' pool so that they parse (and
-# print, for dccl.hash) as the named extensions C++ DCCL sees
-_EXTENSION_PROTOS = (
-    "dccl/ccl/protobuf/ccl_extensions.proto",
-    "dccl/arithmetic/protobuf/arithmetic_extensions.proto",
-)
-
-
-@functools.cache
-def _carriers() -> tuple[type[Message], type[Message]]:
-    for proto in _EXTENSION_PROTOS:
-        default_loader().load_file(proto)
-    return (
-        builtin_class(_CARRIER_PROTO, "pygoby.dccl.FieldOptionsCarrier"),
-        builtin_class(_CARRIER_PROTO, "pygoby.dccl.MessageOptionsCarrier"),
-    )
-
-
-def field_options(field: FieldDescriptor) -> Message:
+def field_options(field: AnyFieldDescriptor) -> DCCLFieldOptions:
     """The field's DCCLFieldOptions (an empty one when the field has none)."""
-    carrier = _carriers()[0]()
+    carrier = FieldOptionsCarrier()
     if field.has_options:
         carrier.ParseFromString(field.GetOptions().SerializeToString())
     return carrier.field
 
 
-def message_options(descriptor: Descriptor) -> Message:
+def message_options(descriptor: AnyDescriptor) -> DCCLMessageOptions:
     """The message type's DCCLMessageOptions (an empty one when it has none)."""
-    carrier = _carriers()[1]()
+    carrier = MessageOptionsCarrier()
     if descriptor.has_options:
         carrier.ParseFromString(descriptor.GetOptions().SerializeToString())
     return carrier.msg
 
 
-def field_extension(options: Message, proto_file: str, message_name: str, number: int) -> Message:
+def field_extension(options: Message, extension_class: type[MessageT], number: int) -> MessageT:
     """An add-on's extension of DCCLFieldOptions (e.g. `(dccl.field).(arithmetic)`, number
-    1001, or `(dccl.field).(ccl)`, 1000) as a message of `message_name` from our `proto_file`.
+    1001, or `(dccl.field).(ccl)`, 1000) as a message of `extension_class`.
 
     Read from the serialized options, so it works whichever descriptor pool compiled the user's
     .proto file (there the extension is known or an unknown field)."""
-    extension = builtin_class(proto_file, message_name)()
+    extension = extension_class()
     extension.ParseFromString(length_delimited(options.SerializeToString(), number))
     return extension

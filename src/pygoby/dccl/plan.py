@@ -12,13 +12,16 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.dccl.codecs.base import FieldCodec, FieldInfo, RepeatedFieldCodec, field_category
 from pygoby.dccl.conditions import DynamicConditions, FieldConditions
 from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_options, message_options
 from pygoby.dccl.registry import CodecRegistry, DefaultMessageCodec
+from pygoby.protobuf import message_type
+from pygoby.protobuf.dccl.option_extensions_pb2 import DCCLFieldOptions
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 log = logging.getLogger("pygoby.dccl")
 
@@ -48,7 +51,7 @@ class Oneof:
 class ScalarItem:
     """A singular field written by a field codec (any type, incl. messages with a user codec)."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     codec: FieldCodec
     mode: Mode
     oneof: Oneof | None = None
@@ -67,7 +70,7 @@ class ScalarItem:
 class MessageItem:
     """A singular embedded message handled by a built-in message codec."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     child: MessageNode
     mode: Mode
     presence_bit: bool
@@ -85,7 +88,7 @@ class MessageItem:
 class RepeatedItem:
     """A repeated field: count prefix + elements (V >= 3) or max_repeat slots (V = 2)."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     max_repeat: int
     min_repeat: int
     slots: bool  # v2: always max_repeat optional-encoded slots, no prefix
@@ -98,10 +101,14 @@ class RepeatedItem:
         return 0 if self.slots else (self.max_repeat - self.min_repeat).bit_length()
 
     def element_min(self) -> int:
-        return self.codec.min_size() if self.codec else self.child.min_size()
+        return self.codec.min_size() if self.codec else self.child_node().min_size()
 
     def element_max(self) -> int:
-        return self.codec.max_size() if self.codec else self.child.max_size()
+        return self.codec.max_size() if self.codec else self.child_node().max_size()
+
+    def child_node(self) -> MessageNode:
+        assert self.child is not None  # (a repeated message field: no codec, a child)
+        return self.child
 
     def min_size(self) -> int:
         count = self.max_repeat if self.slots else self.min_repeat
@@ -115,7 +122,7 @@ class RepeatedItem:
 class ListItem:
     """A repeated field coded as a whole by a `RepeatedFieldCodec` (e.g. dccl.arithmetic)."""
 
-    field: FieldDescriptor
+    field: AnyFieldDescriptor
     codec: RepeatedFieldCodec
 
     def min_size(self) -> int:
@@ -130,7 +137,7 @@ Item = ScalarItem | MessageItem | RepeatedItem | ListItem
 
 @dataclass
 class MessageNode:
-    descriptor: Descriptor
+    descriptor: AnyDescriptor
     codec_version: int  # version of the message codec handling this message
     items: list[Item] = field(default_factory=list)
     oneofs: list[Oneof] = field(default_factory=list)  # case fields written first (v4 BODY)
@@ -172,7 +179,7 @@ class RootOptions:
     max_bytes: int
 
 
-def root_options(descriptor: Descriptor) -> RootOptions:
+def root_options(descriptor: AnyDescriptor) -> RootOptions:
     opts = message_options(descriptor)
     name = descriptor.full_name
     if not opts.HasField("codec_version"):
@@ -208,7 +215,7 @@ class Planner:
         self.lua = lua  # the Codec's Lua state (made on first use) for dynamic conditions
         self.conditioned = False  # some field has dynamic conditions
 
-    def plan_root(self, descriptor: Descriptor, part: Part) -> MessageNode:
+    def plan_root(self, descriptor: AnyDescriptor, part: Part) -> MessageNode:
         opts = message_options(descriptor)
         name = opts.codec if opts.HasField("codec") else self.default_name
         _, entry = self.registry.resolve(name, self.root.version, "message")
@@ -219,16 +226,24 @@ class Planner:
             self._check_fixed(node)
         return node
 
-    def _codec_name(self, f: FieldDescriptor, fopts) -> str:
+    def _codec_name(self, f: AnyFieldDescriptor, fopts: DCCLFieldOptions) -> str:
         if fopts.HasField("codec"):
             return fopts.codec
         if f.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE:
-            sub = message_options(f.message_type)
+            sub = message_options(message_type(f))
             if sub.HasField("codec"):
                 return sub.codec
         return self.default_name
 
-    def _included(self, f, fopts, part: Part, forced: Part | None, version: int, v2_message: bool):
+    def _included(
+        self,
+        f: AnyFieldDescriptor,
+        fopts: DCCLFieldOptions,
+        part: Part,
+        forced: Part | None,
+        version: int,
+        v2_message: bool,
+    ):
         if forced is not None:
             return forced is part
         if version == 2 and v2_message:
@@ -237,7 +252,7 @@ class Planner:
 
     def _plan_message(
         self,
-        descriptor: Descriptor,
+        descriptor: AnyDescriptor,
         part: Part,
         forced: Part | None,
         version: int,
@@ -277,7 +292,9 @@ class Planner:
                 node.items.append(item)
         return node
 
-    def _plan_field(self, f, part, forced, version, stack, oneofs) -> Item | None:
+    def _plan_field(
+        self, f: AnyFieldDescriptor, part, forced, version, stack, oneofs
+    ) -> Item | None:
         fopts = field_options(f)
         where = f.full_name
         oneof = None
@@ -321,7 +338,7 @@ class Planner:
             child_forced = forced
             if fopts.HasField("in_head"):
                 child_forced = Part.HEAD if fopts.in_head else Part.BODY
-            child = self._plan_message(f.message_type, part, child_forced, entry.version, stack)
+            child = self._plan_message(message_type(f), part, child_forced, entry.version, stack)
             if repeated:
                 return self._repeated(f, fopts, child=child, conditions=conditions)
             mode = self._mode(f, oneof)
@@ -349,19 +366,26 @@ class Planner:
             if mode is not Mode.OPTIONAL:
                 singular = singular.without_required()
             item.conditions = singular
-            if singular.required_if is not None:
+            if singular.required_if is not None:  # type: ignore[union-attr]  # (set just above)
                 required = self._info(f, fopts, category, resolved, required=True)
                 item.required_codec = entry(required)
         return item
 
-    def _mode(self, f: FieldDescriptor, oneof: Oneof | None) -> Mode:
+    def _mode(self, f: AnyFieldDescriptor, oneof: Oneof | None) -> Mode:
         if oneof is not None:
             return Mode.ONEOF
         if f.is_required:
             return Mode.REQUIRED
         return Mode.OPTIONAL
 
-    def _info(self, f, fopts, category, codec_name, required) -> FieldInfo:
+    def _info(
+        self,
+        f: AnyFieldDescriptor,
+        fopts: DCCLFieldOptions,
+        category: str,
+        codec_name: str,
+        required: bool,
+    ) -> FieldInfo:
         return FieldInfo(
             descriptor=f,
             options=fopts,
@@ -373,7 +397,14 @@ class Planner:
             registry=self.registry,
         )
 
-    def _repeated(self, f, fopts, codec=None, child=None, conditions=None) -> RepeatedItem:
+    def _repeated(
+        self,
+        f: AnyFieldDescriptor,
+        fopts: DCCLFieldOptions,
+        codec=None,
+        child=None,
+        conditions=None,
+    ) -> RepeatedItem:
         if not fopts.HasField("max_repeat"):
             raise DcclLoadError(f"{f.full_name}: repeated field needs (dccl.field).max_repeat")
         if fopts.max_repeat < 1:

@@ -13,21 +13,21 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import DecodeError, Message
 
 from pygoby.dccl.errors import DcclDecodeError
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 from pygoby.protobuf.wire import length_delimited_field
 
 
-def _wire(field: FieldDescriptor, values: Sequence[str | bytes]) -> bytes:
+def _wire(field: AnyFieldDescriptor, values: Sequence[str | bytes]) -> bytes:
     return b"".join(
         length_delimited_field(field.number, v.encode() if isinstance(v, str) else bytes(v))
         for v in values
     )
 
 
-def _merge(msg: Message, field: FieldDescriptor, wire: bytes) -> None:
+def _merge(msg: Message, field: AnyFieldDescriptor, wire: bytes) -> None:
     try:
         msg.MergeFromString(wire)
     except DecodeError:
@@ -37,13 +37,13 @@ def _merge(msg: Message, field: FieldDescriptor, wire: bytes) -> None:
         ) from None
 
 
-def set_raw_string(msg: Message, field: FieldDescriptor, data: bytes) -> None:
+def set_raw_string(msg: Message, field: AnyFieldDescriptor, data: bytes) -> None:
     """`msg.<field> = data` for bytes that are not UTF-8 (singular or oneof string field)."""
     _merge(msg, field, _wire(field, [data]))
 
 
 def extend_raw_strings(
-    msg: Message, field: FieldDescriptor, values: Sequence[str | bytes], before: int
+    msg: Message, field: AnyFieldDescriptor, values: Sequence[str | bytes], before: int
 ) -> None:
     """Append `values` to a repeated string field that held `before` elements, in order, when
     some of them are not UTF-8 (a failed `extend` may have appended a part of them)."""

@@ -11,6 +11,7 @@ from pygoby.dccl.ccl.codecs import CCL_FIELD_CODECS
 from pygoby.dccl.codecs.base import ALL_CATEGORIES, NUMERIC_CATEGORIES, FieldCodec, FieldInfo
 from pygoby.dccl.codecs.boolean import BoolCodec
 from pygoby.dccl.codecs.enum import EnumCodec, EnumCodecV2
+from pygoby.dccl.codecs.hash import HashCodec
 from pygoby.dccl.codecs.native_protobuf import NativeProtobufCodec
 from pygoby.dccl.codecs.numeric import NumericCodec
 from pygoby.dccl.codecs.presence import make_presence_codec
@@ -18,7 +19,6 @@ from pygoby.dccl.codecs.static import StaticCodec
 from pygoby.dccl.codecs.strings import FixedBytesCodec, StringCodecV2, StringCodecV3, VarBytesCodec
 from pygoby.dccl.codecs.time import TimeCodec
 from pygoby.dccl.errors import DcclLoadError
-from pygoby.dccl.hashing import HashCodec
 
 CodecFactory = Callable[[FieldInfo], FieldCodec]
 T = TypeVar("T")

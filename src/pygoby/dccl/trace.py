@@ -15,13 +15,14 @@ import logging
 from typing import Any
 
 from google.protobuf import text_format
-from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
+
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 log = logging.getLogger("pygoby.dccl.trace")
 
 
-def show(value: Any, field: FieldDescriptor | None = None) -> str:
+def show(value: Any, field: AnyFieldDescriptor | None = None) -> str:
     """A field value as the trace prints it (enum values by name)."""
     if value is None:
         return "not set"
@@ -40,7 +41,7 @@ class FieldTracer:
 
     def __init__(self, type_name: str, action: str, part: str) -> None:
         self.where = f"{action} {type_name} {part}"
-        self.fields: dict[str, FieldDescriptor] = {}  # by the paths the generated code passes
+        self.fields: dict[str, AnyFieldDescriptor] = {}  # by the paths the generated code passes
 
     def __call__(self, path: str, value: Any, start: int, end: int, bits: int) -> None:
         """`bits` holds the field's bits at positions start..end (LSB first)."""

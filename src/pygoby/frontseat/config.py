@@ -23,7 +23,6 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from google.protobuf import text_format
-from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.frontseat import messages as frontseat_pb
@@ -36,6 +35,9 @@ from pygoby.frontseat.plugins import (
     load_driver,
 )
 from pygoby.protobuf import default_loader
+from pygoby.protobuf.goby.moos.frontseat import abc_frontseat_driver_config_pb2
+from pygoby.protobuf.goby.moos.protobuf.goby_moos_app_pb2 import GobyMOOSAppConfig
+from pygoby.protobuf.goby.moos.protobuf.iFrontSeat_config_pb2 import iFrontSeatConfig
 from pygoby.util.clock import Clock
 
 # The Goby 2 ABC driver's block, `[abc_config] { ... }` directly in the ProcessConfig.
@@ -57,7 +59,9 @@ def import_driver_from_environment(env: Mapping[str, str] = os.environ) -> None:
 
 
 def configured_driver(
-    config_class: type[Message], block_text: str | None, overrides: Sequence[tuple[str, str]]
+    config_class: type[iFrontSeatConfig],
+    block_text: str | None,
+    overrides: Sequence[tuple[str, str]],
 ) -> str | None:
     """`driver_library` from the command line or the ProcessConfig block, read before the block
     is parsed for real (the driver's configuration extension is not loaded yet: unknown
@@ -76,7 +80,7 @@ def configured_driver(
 
 
 def import_configured_driver(
-    config_class: type[Message],
+    config_class: type[iFrontSeatConfig],
     block_text: str | None,
     overrides: Sequence[tuple[str, str]] = (),
     env: Mapping[str, str] = os.environ,
@@ -95,13 +99,13 @@ def import_configured_driver(
 
 def load_goby2_extensions() -> None:
     """Make `[abc_config] { ... }` parse in an iFrontSeatConfig block."""
-    default_loader().load_file(ABC_CONFIG_PROTO)
+    default_loader().load_file(ABC_CONFIG_PROTO)  # (its generated module: no protoc)
 
 
-def migrate_goby2_abc_config(cfg: Message) -> None:
+def migrate_goby2_abc_config(cfg: iFrontSeatConfig) -> None:
     """The Goby 2 form `[abc_config] { ... }` directly in the ProcessConfig becomes frontseat_cfg's
     basic simulator block (same fields: address, port, start position and duration)."""
-    abc = cfg.DESCRIPTOR.file.pool.FindExtensionByName(ABC_CONFIG)
+    abc = abc_frontseat_driver_config_pb2.abc_config
     if not cfg.HasExtension(abc):
         return
     old = cfg.Extensions[abc]
@@ -128,7 +132,9 @@ def migrate_goby2_abc_config(cfg: Message) -> None:
 # -- the driver, from the parsed configuration -----------------------------------------------
 
 
-def frontseat_config(frontseat_cfg: Message, common: Message) -> Message:
+def frontseat_config(
+    frontseat_cfg: frontseat_pb.Config, common: GobyMOOSAppConfig
+) -> frontseat_pb.Config:
     """frontseat_cfg with what the MOOS community says (`common`, a GobyMOOSAppConfig): vehicle
     name, datum, time warp."""
     fs_cfg = type(frontseat_cfg)()

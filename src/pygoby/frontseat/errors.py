@@ -31,8 +31,8 @@ class FrontSeatDriverError(FrontSeatError):
     def __init__(
         self,
         *,
-        helm_error: int | None = None,
-        frontseat_error: int | None = None,
+        helm_error: frontseat_pb.HelmError.ValueType | None = None,
+        frontseat_error: frontseat_pb.FrontSeatError.ValueType | None = None,
         message: str = "",
     ) -> None:
         if helm_error is not None and frontseat_error is not None:

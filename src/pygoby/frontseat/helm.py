@@ -9,7 +9,7 @@ documented design, the default: QUIRKS.md Q-APPS-24); InterfaceBase's pygoby opt
 
 from __future__ import annotations
 
-from pygoby.frontseat.messages import HELM_DRIVE, HELM_NOT_RUNNING, HELM_PARK
+from pygoby.frontseat.messages import HELM_DRIVE, HELM_NOT_RUNNING, HELM_PARK, HelmState
 
 # Trimmed as C's isspace() does (boost::trim in the "C" locale), not Unicode whitespace.
 _WHITESPACE = " \t\n\v\f\r"
@@ -20,7 +20,9 @@ _STATES_BY_SOURCE = {
 }
 
 
-def helm_state_from_ivphelm(value: str, source: str, current: int) -> int:
+def helm_state_from_ivphelm(
+    value: str, source: str, current: HelmState.ValueType
+) -> HelmState.ValueType:
     """The helm state after an IVPHELM_STATE post of `value` by process `source`.
 
     Both are compared trimmed and case-insensitively. A helm process posting anything else

@@ -69,8 +69,15 @@ from pygoby.frontseat.messages import (
     INTERFACE_HELM_ERROR,
     INTERFACE_LISTEN,
     INTERFACE_STANDBY,
+    CommandResponse,
+    FrontSeatError,
+    FrontSeatState,
+    HelmError,
+    HelmState,
+    InterfaceData,
     InterfaceState,
     InterfaceStatus,
+    Raw,
 )
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.geodesy import UTMGeodesy
@@ -98,18 +105,22 @@ class InterfaceBase(abc.ABC):
         self.start_time = self.clock.now()
         self.log = logging.getLogger(f"{__name__}.{type(self).__name__}")
 
-        self._state: int = INTERFACE_STANDBY
-        self._helm_state: int = HELM_NOT_RUNNING
+        self._state: InterfaceState.ValueType = INTERFACE_STANDBY
+        self._helm_state: HelmState.ValueType = HELM_NOT_RUNNING
         self._helm_heard_at = self.start_time  # last set_helm_state(), for helm_state_timeout
-        self._last_helm_error: int = ERROR_HELM_NONE
-        self._last_frontseat_error: int = ERROR_FRONTSEAT_NONE
+        self._last_helm_error: HelmError.ValueType = ERROR_HELM_NONE
+        self._last_frontseat_error: FrontSeatError.ValueType = ERROR_FRONTSEAT_NONE
 
         # A raising subscriber is logged and does not stop the others (nor the interface's tick)
-        self.signal_data_from_frontseat = Signal(contain_errors=True, logger=_log)
-        self.signal_command_response = Signal(contain_errors=True, logger=_log)
-        self.signal_raw_from_frontseat = Signal(contain_errors=True, logger=_log)
-        self.signal_raw_to_frontseat = Signal(contain_errors=True, logger=_log)
-        self.signal_state_change = Signal(contain_errors=True, logger=_log)
+        self.signal_data_from_frontseat: Signal[InterfaceData] = Signal(
+            contain_errors=True, logger=_log
+        )
+        self.signal_command_response: Signal[CommandResponse] = Signal(
+            contain_errors=True, logger=_log
+        )
+        self.signal_raw_from_frontseat: Signal[Raw] = Signal(contain_errors=True, logger=_log)
+        self.signal_raw_to_frontseat: Signal[Raw] = Signal(contain_errors=True, logger=_log)
+        self.signal_state_change: Signal[InterfaceStatus] = Signal(contain_errors=True, logger=_log)
 
         self._geodesy: UTMGeodesy | None = None
         origin = self.cfg.origin
@@ -136,7 +147,7 @@ class InterfaceBase(abc.ABC):
         """Write a Raw message from another process to the frontseat (may be ignored)."""
 
     @abc.abstractmethod
-    def frontseat_state(self) -> int:
+    def frontseat_state(self) -> FrontSeatState.ValueType:
         """The driver's belief of the frontseat's command state (FrontSeatState)."""
 
     @abc.abstractmethod
@@ -156,14 +167,14 @@ class InterfaceBase(abc.ABC):
     # --- state ----------------------------------------------------------------------------
 
     @property
-    def state(self) -> int:
+    def state(self) -> InterfaceState.ValueType:
         return self._state
 
     @property
-    def helm_state(self) -> int:
+    def helm_state(self) -> HelmState.ValueType:
         return self._helm_state
 
-    def set_helm_state(self, state: int) -> None:
+    def set_helm_state(self, state: HelmState.ValueType) -> None:
         """The helm's state from its latest post; call it for every post, changed or not (each
         one restarts the `helm_state_timeout` clock)."""
         self._helm_state = state
@@ -285,7 +296,9 @@ class InterfaceBase(abc.ABC):
             self._change_state(target)
         return False
 
-    def _normal_transition(self, state: int) -> int | None:
+    def _normal_transition(
+        self, state: InterfaceState.ValueType
+    ) -> InterfaceState.ValueType | None:
         if state == INTERFACE_STANDBY:
             return INTERFACE_LISTEN if self.frontseat_providing_data() else None
         if state == INTERFACE_LISTEN:  # -> COMMAND: the frontseat accepts commands, the helm drives
@@ -297,7 +310,9 @@ class InterfaceBase(abc.ABC):
             return INTERFACE_LISTEN
         return None
 
-    def _error_check(self) -> tuple[int | None, int | None] | None:
+    def _error_check(
+        self,
+    ) -> tuple[HelmError.ValueType | None, FrontSeatError.ValueType | None] | None:
         """The error rules in order (used from STANDBY, LISTEN, COMMAND): (helm error, frontseat
         error) of the first rule that fires, or None."""
         now = self.clock.now()
@@ -322,13 +337,13 @@ class InterfaceBase(abc.ABC):
             return None, ERROR_FRONTSEAT_NOT_PROVIDING_DATA
         return None
 
-    def _helm_error_exit(self) -> int | None:
+    def _helm_error_exit(self) -> InterfaceState.ValueType | None:
         if self._helm_state == HELM_DRIVE:  # the helm drives again: its error is cleared
             self._last_helm_error = ERROR_HELM_NONE
             return INTERFACE_STANDBY
         return None
 
-    def _frontseat_error_exit(self) -> int | None:
+    def _frontseat_error_exit(self) -> InterfaceState.ValueType | None:
         error = self._last_frontseat_error
         cleared = (
             error == ERROR_FRONTSEAT_NOT_CONNECTED
@@ -339,7 +354,11 @@ class InterfaceBase(abc.ABC):
             return INTERFACE_STANDBY
         return None
 
-    def _enter_error(self, helm_error: int | None, frontseat_error: int | None) -> None:
+    def _enter_error(
+        self,
+        helm_error: HelmError.ValueType | None,
+        frontseat_error: FrontSeatError.ValueType | None,
+    ) -> None:
         """Error entry (from the error rules or a driver's exception). Signals even when the state
         stays the same (a driver reporting the error state it is already in), as goby3 does."""
         if helm_error is not None:
@@ -351,11 +370,11 @@ class InterfaceBase(abc.ABC):
             target = INTERFACE_FS_ERROR
         self._set_state(target)
 
-    def _change_state(self, target: int) -> None:
+    def _change_state(self, target: InterfaceState.ValueType) -> None:
         if target != self._state:
             self._set_state(target)
 
-    def _set_state(self, target: int) -> None:
+    def _set_state(self, target: InterfaceState.ValueType) -> None:
         previous, self._state = self._state, target
         status = self.status()
         log = self.log.warning if target in ERROR_STATES else self.log.info

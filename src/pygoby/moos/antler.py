@@ -173,8 +173,8 @@ class Antler:
                     "in use by another process: stop it, change ServerPort, or run antler with "
                     "--no-db to use the MOOSDB listening there"
                 )
-            argv = [sys.executable, "-m", "pygoby.cli", "moosdb", str(self.mission_path)]
-            self.db = self._spawn(DB_NAME, argv, new_console=False)
+            db_argv = [sys.executable, "-m", "pygoby.cli", "moosdb", str(self.mission_path)]
+            self.db = self._spawn(DB_NAME, db_argv, new_console=False)
             deadline = time.monotonic() + 10.0
             while not db_listening(host, port):
                 if self.db.proc.poll() is not None:

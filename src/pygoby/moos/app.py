@@ -114,9 +114,12 @@ from pygoby.moos.translator import (
     parse_for_moos,
     post_for_moos,
 )
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf import builtin_class, message_type
+from pygoby.protobuf.descriptors import MessageT
+from pygoby.protobuf.goby.moos.protobuf.goby_moos_app_pb2 import GobyMOOSAppConfig
 from pygoby.util.aiorun import cancel_and_wait
 from pygoby.util.clock import Clock
+from pygoby.util.errors import MissingExtraError
 
 Handler = Callable[[MOOSMessage], None]
 
@@ -144,7 +147,7 @@ class _Timer:
         return True
 
 
-def _app_technique(common: Message) -> Technique:
+def _app_technique(common: GobyMOOSAppConfig) -> Technique:
     try:
         return moos_technique_from_config(common)
     except TranslatorError as err:
@@ -173,7 +176,7 @@ class GobyMOOSApp:
                 raise TypeError(f"{cls.__name__} must set config_class or config_proto")
             config_class = builtin_class(*cls.config_proto)
         common = config_class.DESCRIPTOR.fields_by_name.get("common")
-        if common is None or common.message_type.full_name != COMMON_PROTO[1]:
+        if common is None or message_type(common).full_name != COMMON_PROTO[1]:
             raise TypeError(
                 f"{config_class.DESCRIPTOR.full_name} needs a `common` field of type {COMMON_PROTO[1]}"
             )
@@ -339,7 +342,7 @@ class GobyMOOSApp:
         post = post_for_moos(var, message, self.moos_technique)
         self.publish(post.var, post.value, src_aux=post.source_aux)
 
-    def parse_pb(self, msg: MOOSMessage, cls: type[Message]) -> Message | None:
+    def parse_pb(self, msg: MOOSMessage, cls: type[MessageT]) -> MessageT | None:
         """`msg`'s value as a `cls` message; None, with a warning, when it does not parse."""
         out = cls()
         try:
@@ -352,8 +355,8 @@ class GobyMOOSApp:
     def subscribe_pb(
         self,
         var: str,
-        cls: type[Message],
-        handler: Callable[[Message], None],
+        cls: type[MessageT],
+        handler: Callable[[MessageT], None],
         *,
         ignore_own: bool = False,
     ) -> None:
@@ -421,15 +424,20 @@ class GobyMOOSApp:
         self.request_stop()
 
     async def run(self) -> None:
-        gui = None
+        gui, missing = None, None
         if self.common.show_gui:
-            from pygoby.moos.appgui import gui_for  # textual, only when asked for
-
-            gui = gui_for(self)
-            if gui is not None:
-                self.terminal_handler = gui.handler
+            try:
+                from pygoby.moos.appgui import gui_for  # textual, only when asked for
+            except MissingExtraError as exc:
+                missing = exc
+            else:
+                gui = gui_for(self)
+                if gui is not None:
+                    self.terminal_handler = gui.handler
         await self.start()
-        if self.common.show_gui and gui is None:
+        if missing is not None:
+            self.log.warning("show_gui: %s; the log stays plain text", missing)
+        elif self.common.show_gui and gui is None:
             self.log.info("show_gui: standard output is not a terminal; the log stays plain text")
         try:
             if gui is not None:

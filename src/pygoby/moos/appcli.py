@@ -19,16 +19,46 @@ import sys
 from collections.abc import Sequence
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 from pygoby.errors import ConfigError
 from pygoby.moos.appconfig import collecting_notes
 from pygoby.moos.moosfile import MissionFile
 from pygoby.util.aiorun import StopSignals
 from pygoby.util.console import quiet_broken_pipe
+from pygoby.util.errors import MissingExtraError
 
 if TYPE_CHECKING:
-    from pygoby.moos.app import GobyMOOSApp
+    from google.protobuf.message import Message
+
+
+class CommandLineApp(Protocol):
+    """What the command line needs of an app class and its instances
+    (pygoby.moos.app.GobyMOOSApp is one): typed here so this module does not import the app base
+    that calls it."""
+
+    default_name: ClassVar[str]
+    name: str
+    failure: str | None
+    exit_status: int
+    config_notes: list[str]
+
+    def __init__(
+        self, cfg: Message, *, name: str | None = None, mission: MissionFile | None = None
+    ) -> None: ...
+
+    @classmethod
+    def read_config(
+        cls, mission: MissionFile | None, name: str, overrides: Sequence[tuple[str, str]] = ()
+    ) -> Message: ...
+
+    @classmethod
+    def example_config(cls, name: str | None = None) -> str: ...
+
+    def request_stop(self) -> None: ...
+
+    async def run(self) -> None: ...
+
 
 Overrides = list[tuple[str, str]]
 VERBOSE_ENUM = 4  # goby.util.protobuf.GLogConfig.Verbosity.VERBOSE
@@ -41,7 +71,7 @@ def package_version() -> str:
         return "unknown"
 
 
-def program_name(app_class: type[GobyMOOSApp], argv0: str) -> str:
+def program_name(app_class: type[CommandLineApp], argv0: str) -> str:
     """The name the program was started as; the app's default name when run from Python."""
     base = Path(argv0).name
     if not base or base.endswith(".py") or base in ("python", "python3", "-c"):
@@ -88,9 +118,10 @@ def parse_overrides(rest: list[str]) -> Overrides:
             raise ValueError(f"unexpected argument {item!r}")
         key, eq, value = item[2:].partition("=")
         if not eq:
-            value = next(items, None)
-            if value is None:
+            following = next(items, None)
+            if following is None:
                 raise ValueError(f"option --{key} needs a value")
+            value = following
         out.append((key, value))
     return out
 
@@ -108,7 +139,7 @@ def read_mission(path: str | None, name: str) -> MissionFile | None:
 
 
 def run_app(
-    app_class: type[GobyMOOSApp],
+    app_class: type[CommandLineApp],
     argv: Sequence[str] | None = None,
     prog: str | None = None,
     command: str | None = None,
@@ -130,7 +161,7 @@ def run_app(
     mission = read_mission(known.moos_file or known.mission, name)
     try:
         with collecting_notes() as notes:
-            cfg = app_class.read_config(mission, name, overrides)
+            cfg: Any = app_class.read_config(mission, name, overrides)  # (every app: `common`)
         if known.verbose:  # Verbosity enum: VERBOSE=4, DEBUG1=5, DEBUG2=6, DEBUG3=7
             cfg.common.verbosity = VERBOSE_ENUM + min(known.verbose, 4) - 1
         app = app_class(cfg, name=name, mission=mission)
@@ -138,10 +169,13 @@ def run_app(
     except ConfigError as err:
         print(f"{name}: fatal configuration error: {err}", file=sys.stderr)
         return 1
+    except MissingExtraError as err:  # the app needs a package a pip extra installs
+        print(f"{name}: {err}", file=sys.stderr)
+        return 1
     return quiet_broken_pipe(lambda: run_until_signal(app))
 
 
-def run_until_signal(app: GobyMOOSApp) -> int:
+def run_until_signal(app: CommandLineApp) -> int:
     """Run `app` until SIGINT/SIGTERM asks it to stop (it stops cleanly, or the process ends
     after `STOP_GRACE` s whatever it is doing: pygoby.util.aiorun.StopSignals) or it stops
     itself; its exit status (its `failure`, if any, printed on stderr)."""

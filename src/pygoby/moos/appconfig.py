@@ -24,14 +24,18 @@ import math
 import re
 from collections.abc import Callable, Iterator, Sequence
 from contextvars import ContextVar
+from typing import Any, TypeVar
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.moos import goby11_config
 from pygoby.moos.moosfile import GobyBlock, MissionFile, parse_number
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf import enum_type, initialization_errors
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
+from pygoby.protobuf.goby.moos.protobuf.goby_moos_app_pb2 import GobyMOOSAppConfig
+from pygoby.protobuf.goby.protobuf.option_extensions_pb2 import GobyFieldOptions
 from pygoby.protobuf.textconfig import (
     check_config_values,
     line_of_field,
@@ -39,6 +43,8 @@ from pygoby.protobuf.textconfig import (
     printable_text,
 )
 from pygoby.protobuf.wire import length_delimited
+
+ConfigT = TypeVar("ConfigT", bound=Message)  # an app's configuration message
 
 log = logging.getLogger(__name__)
 
@@ -49,11 +55,11 @@ EXAMPLE_FALLBACK_INDENT = 46
 
 
 @functools.cache
-def _options_class() -> type[Message]:
-    return builtin_class("goby/protobuf/option_extensions.proto", "goby.GobyFieldOptions")
+def _options_class() -> type[GobyFieldOptions]:
+    return GobyFieldOptions
 
 
-def goby_field_options(field: FieldDescriptor) -> Message:
+def goby_field_options(field: AnyFieldDescriptor) -> GobyFieldOptions:
     """The field's `(goby.field)` options (an empty GobyFieldOptions if it has none)."""
     out = _options_class()()
     if not field.has_options:
@@ -72,7 +78,7 @@ def locate(err: ConfigError, mission: MissionFile | None, app_name: str) -> Conf
     """`err` (about the field at `err.field` of the app's configuration) with the mission file
     and the line of that field in the app's ProcessConfig block filled in."""
     block = mission.goby_block(app_name) if mission is not None else None
-    if block is None or err.field is None:
+    if mission is None or block is None or err.field is None:
         return err
     path = mission.path if mission.path else "mission file"
     return err.located(file=path, line=line_of_field(block.text, err.field, block.first_line))
@@ -131,7 +137,7 @@ def apply_moos_globals(config: Message, mission: MissionFile) -> None:
             raise err.located(file=path, line=mission.global_line(name)) from None
 
 
-def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: str) -> None:
+def _set_from_global(config: Message, field: AnyFieldDescriptor, name: str, value: str) -> None:
     """A MOOS global's text as the field's value; text that is no value of its type is an
     error (MOOS would read "abc" as 0: a mistyped ServerPort must not mean port 9000)."""
     kind = field.type
@@ -148,7 +154,7 @@ def _set_from_global(config: Message, field: FieldDescriptor, name: str, value: 
         elif (number := parse_number(value)) is not None:
             setattr(config, field.name, number > 0)
     elif kind == FieldDescriptor.TYPE_ENUM:
-        enum_value = field.enum_type.values_by_name.get(value)
+        enum_value = enum_type(field).values_by_name.get(value)
         if enum_value is None:
             raise ConfigError(
                 f'invalid enumeration "{value}" (MOOS global {name})', field=field.name
@@ -206,14 +212,14 @@ def collecting_notes() -> Iterator[list[str]]:
 
 
 def read_configuration(
-    config_class: type[Message],
+    config_class: type[ConfigT],
     mission: MissionFile | None,
     app_name: str,
     overrides: Sequence[tuple[str, str]] = (),
-    complete: Callable[[Message], None] | None = None,
+    complete: Callable[[ConfigT], None] | None = None,
     notes: list[str] | None = None,
     block_optional: bool = False,
-) -> Message:
+) -> ConfigT:
     """`complete(config)`, if given, runs after the overrides and before the check for required
     fields (an app's own rewriting of older configuration forms). `block_optional`: a mission
     without the app's ProcessConfig block gives the defaults (with the mission's globals). Goby 1.1 and Goby 2 forms are
@@ -248,7 +254,7 @@ def read_configuration(
     apply_overrides(config, overrides)
     if complete is not None:
         complete(config)
-    missing = config.FindInitializationErrors()
+    missing = initialization_errors(config)
     if missing:
         raise ConfigError(f"missing required configuration fields: {', '.join(missing)}")
     check_config_values(config, block_text, file=source, first_line=first_line)
@@ -267,9 +273,9 @@ def _shift(note: str, first_line: int) -> str:
 # --example_config
 
 
-def _format_scalar(field: FieldDescriptor, value: object) -> str:
+def _format_scalar(field: AnyFieldDescriptor, value: object) -> str:
     if field.type == FieldDescriptor.TYPE_ENUM:
-        return field.enum_type.values_by_number[value].name  # type: ignore[index]
+        return enum_type(field).values_by_number[value].name  # type: ignore[index]
     if field.type == FieldDescriptor.TYPE_BOOL:
         return "true" if value else "false"
     if field.type in (FieldDescriptor.TYPE_STRING, FieldDescriptor.TYPE_BYTES):
@@ -281,7 +287,7 @@ def _format_scalar(field: FieldDescriptor, value: object) -> str:
     return str(value)
 
 
-def _label(field: FieldDescriptor) -> str:
+def _label(field: AnyFieldDescriptor) -> str:
     if field.is_repeated:
         return " (repeated)"
     return " (required)" if field.is_required else " (optional)"
@@ -311,16 +317,16 @@ def _wrap_words(comment: str, width: int) -> list[str]:
     return lines
 
 
-def _extensions(descriptor: Descriptor) -> list[FieldDescriptor]:
+def _extensions(descriptor: AnyDescriptor) -> list[AnyFieldDescriptor]:
     """Extensions of `descriptor` loaded into its pool (e.g. driver configurations)."""
     try:
-        found = descriptor.file.pool.FindAllExtensions(descriptor)
+        found = descriptor.file.pool.FindAllExtensions(descriptor)  # type: ignore[arg-type]
     except (AttributeError, KeyError):
         return []
     return sorted(found, key=lambda f: f.number)
 
 
-def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
+def _describe_fields(descriptor: AnyDescriptor, depth: int) -> list[str]:
     out: list[str] = []
     indent = "  " * depth
     for field in [*descriptor.fields, *_extensions(descriptor)]:
@@ -347,7 +353,7 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
         else:
             value = ""
         if field.type == FieldDescriptor.TYPE_ENUM:
-            comment += " (" + ", ".join(v.name for v in field.enum_type.values) + ")"
+            comment += " (" + ", ".join(v.name for v in enum_type(field).values) + ")"
         comment += _label(field)
         if field.has_default_value:
             comment += f" (default={_format_scalar(field, field.default_value)})"
@@ -357,10 +363,10 @@ def _describe_fields(descriptor: Descriptor, depth: int) -> list[str]:
     return out
 
 
-def _placeholder(field: FieldDescriptor) -> str:
+def _placeholder(field: AnyFieldDescriptor) -> str:
     """A value of the field's type that parses (the first enumerator, 0, false, "")."""
     if field.type == FieldDescriptor.TYPE_ENUM:
-        return field.enum_type.values[0].name
+        return enum_type(field).values[0].name
     if field.type == FieldDescriptor.TYPE_BOOL:
         return "false"
     if field.type == FieldDescriptor.TYPE_BYTES:
@@ -374,7 +380,7 @@ def example_config(config_class: type[Message], app_name: str) -> str:
 
 
 def initializer_posts(
-    common: Message, mission: MissionFile | None, log: logging.Logger = log
+    common: GobyMOOSAppConfig, mission: MissionFile | None, log: logging.Logger = log
 ) -> list[tuple[str, float | str]]:
     """The (MOOS variable, value) posts of `common.initializer`: a constant, or a
     global of the mission file (a double that does not parse is NaN); a missing global is
@@ -388,7 +394,10 @@ def initializer_posts(
 
 
 def _initializer_value(
-    ini: Message, common: Message, mission: MissionFile | None, log: logging.Logger
+    ini: GobyMOOSAppConfig.Initializer,
+    common: GobyMOOSAppConfig,
+    mission: MissionFile | None,
+    log: logging.Logger,
 ) -> float | str | None:
     is_double = ini.type == type(common).Initializer.INI_DOUBLE
     if not ini.HasField("global_cfg_var"):
@@ -409,7 +418,7 @@ def _initializer_value(
         return math.nan
 
 
-def prefixed_var_names(names: Message, skip: Sequence[str] = ()) -> dict[str, str]:
+def prefixed_var_names(names: Any, skip: Sequence[str] = ()) -> dict[str, str]:
     """An app's `moos_var` block as {field name: prefix + variable}, for every field but
     `prefix` and those in `skip`."""
     return {

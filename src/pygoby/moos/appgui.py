@@ -20,19 +20,35 @@ import contextlib
 import logging
 import sys
 from collections import deque
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Protocol
 
-from textual.app import App, ComposeResult
-from textual.binding import Binding
-from textual.containers import Horizontal, Vertical
-from textual.css.query import NoMatches
-from textual.widgets import Footer, Header, OptionList, RichLog, Static
-from textual.widgets.option_list import Option
+from pygoby.util.extras import needs_extra
+
+with needs_extra("topside", "common.show_gui's live view"):
+    from textual.app import App, ComposeResult
+    from textual.binding import Binding
+    from textual.containers import Horizontal, Vertical
+    from textual.css.query import NoMatches
+    from textual.widgets import Footer, Header, OptionList, RichLog, Static
+    from textual.widgets.option_list import Option
 
 from pygoby.util.glog import GobyFormatter, group_name, level_for
 
 if TYPE_CHECKING:
-    from pygoby.moos.app import GobyMOOSApp
+    pass
+
+
+class ShownApp(Protocol):
+    """What the live view needs of an app (pygoby.moos.app.GobyMOOSApp is one): typed here so
+    this module does not import the app base that opens it."""
+
+    name: str
+    common: Any  # the app's GobyMOOSAppConfig `common` block
+
+    def status_lines(self) -> list[str]: ...
+
+    def request_stop(self) -> None: ...
+
 
 ALL = "(all groups)"
 KEPT_LINES = 5000
@@ -70,7 +86,7 @@ class AppGUI(App[None]):
     """
     BINDINGS = [Binding("q", "quit_app", "Quit"), Binding("ctrl+c", "quit_app", "Quit", show=False)]
 
-    def __init__(self, app: GobyMOOSApp) -> None:
+    def __init__(self, app: ShownApp) -> None:
         super().__init__()
         self.moos_app = app
         self.handler = LogBuffer(level_for(app.common.verbosity))
@@ -140,7 +156,7 @@ class AppGUI(App[None]):
                 await task
 
 
-def gui_for(app: GobyMOOSApp) -> AppGUI | None:
+def gui_for(app: ShownApp) -> AppGUI | None:
     """The GUI when `common.show_gui` asks for one and stdout is a terminal; else None."""
     if not app.common.show_gui or not sys.stdout.isatty():
         return None

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from google.protobuf.message import Message
 
@@ -27,10 +27,12 @@ from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import apply_moos_globals
 from pygoby.moos.moosfile import MissionFile, Setting, parse_number
+from pygoby.protobuf.pygoby.moos.classic_app_pb2 import ClassicMOOSAppConfig
 
 
 class ClassicMOOSApp(GobyMOOSApp):
-    config_proto = ("pygoby/moos/classic_app.proto", "pygoby.moos.protobuf.ClassicMOOSAppConfig")
+    config_class = ClassicMOOSAppConfig
+    cfg: ClassicMOOSAppConfig
     keep_quotes: ClassVar[bool] = False
     # the block's own `name = value` lines, as `--example_config` prints them
     example_lines: ClassVar[tuple[str, ...]] = ()
@@ -50,7 +52,7 @@ class ClassicMOOSApp(GobyMOOSApp):
             raise ConfigError(
                 "takes no --option overrides: set them in its ProcessConfig block", field=name
             )
-        cfg = cls.load_config_class()()
+        cfg: Any = cls.load_config_class()()  # (a ClassicMOOSAppConfig or a subclass's)
         cfg.common.log = False
         if mission is None:
             return cfg
@@ -70,7 +72,7 @@ class ClassicMOOSApp(GobyMOOSApp):
             setattr(cfg.common, field, max(1, math.ceil(number)))
         return cfg
 
-    def __init__(self, cfg: Message, **kwargs) -> None:
+    def __init__(self, cfg: ClassicMOOSAppConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
         block = self.mission.process_config(self.name, self.keep_quotes) if self.mission else None
         if block is None:

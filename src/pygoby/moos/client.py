@@ -109,9 +109,9 @@ class MOOSClient:
         self.clock = clock or WallClock()
         self.on_message = on_message
         # a failing connect slot is logged (the session goes on); disconnect slots' errors propagate
-        self.signal_connect = Signal(contain_errors=True, logger=log)
-        self.signal_disconnect = Signal()
-        self.signal_refused = Signal(contain_errors=True, logger=log)
+        self.signal_connect: Signal[[]] = Signal(contain_errors=True, logger=log)
+        self.signal_disconnect: Signal[[]] = Signal()
+        self.signal_refused: Signal[MoosRefusedError] = Signal(contain_errors=True, logger=log)
         self.reconnect_interval = reconnect_interval
         self.unreachable = UnreachableWarnings()
         self.outbox_limit = outbox_limit

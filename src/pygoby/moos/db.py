@@ -72,7 +72,7 @@ class _Connection(asyncio.Protocol):
                 self.peer,
                 len(server._connections),
             )
-            transport.abort()
+            transport.abort()  # type: ignore[attr-defined]  # (a stream transport)
             return
         sock = transport.get_extra_info("socket")
         if sock is not None:

@@ -58,10 +58,16 @@ DB_VARIABLES = ("DB_TIME", "DB_UPTIME", "DB_CLIENTS", "DB_VARSUMMARY", "DB_QOS",
 MAX_OUTGOING_PACKET = 1 << 20
 
 _HEADER = struct.Struct("<iiB")
-_MSG_HEAD = struct.Struct("<i4xBB")  # msg_len, (id), msg_type, data_type
 _INT = struct.Struct("<i")
 _NOTIFY = ord(p.NOTIFY)
 _TIMING = ord(p.TIMING)
+# the V10 layout (pygoby.moos.protocol) as the fast path reads it: the id and the two type
+# bytes come as one 6-byte string
+_ID_TYPES_SIZE = p.SRC_AT - p.ID_AT
+_MSG_TYPE_IN_ID_TYPES = p.MSG_TYPE_AT - p.ID_AT
+_DATA_TYPE_IN_ID_TYPES = p.DATA_TYPE_AT - p.ID_AT
+_STRING_LENGTH_SIZE = p.STRING_LENGTH_SIZE
+_TAIL_SIZE = p.MESSAGE_TAIL.size
 _DOUBLE = ord(p.DOUBLE)
 _NOT_SET = ord(p.NOT_SET)
 
@@ -290,15 +296,15 @@ class _Source:
         community, pos = p.read_str(data, pos, stop, "community")
         self.head = bytes(data[at:pos])
         # msg_len, id + msg_type + data_type, these bytes, key length
-        self.layout = struct.Struct(f"<i6s{len(self.head)}si")
+        self.layout = struct.Struct(f"<i{_ID_TYPES_SIZE}s{len(self.head)}si")
         self.src = p.decode_text(src)
         self.publisher = core.clients.get(self.src)
         if community:  # bridged from another community: forwarded untouched
             self.forwarded: bytes | None = None
             self.growth = 0
-        else:  # the DB fills in its own community
-            self.forwarded = self.head[:-4] + core.community_field
-            self.growth = len(core.community_field) - 4
+        else:  # the DB fills in its own community for the empty one (its length alone)
+            self.forwarded = self.head[:-_STRING_LENGTH_SIZE] + core.community_field
+            self.growth = len(core.community_field) - _STRING_LENGTH_SIZE
 
 
 class DBCore:
@@ -335,7 +341,7 @@ class DBCore:
         self.clients: dict[str, ClientRecord] = {}
         self._ready: dict[str, ClientRecord] = {}
         own = p.encode_message(p.notify("_", 0.0, time=0.0, src=self.name))
-        self._source = _Source(self, own, 10, len(own))
+        self._source = _Source(self, own, p.SRC_AT, len(own))
 
     # -- connections ---------------------------------------------------------------------------
 
@@ -402,7 +408,7 @@ class DBCore:
         head = None
         if not client.asynchronous:
             head = p.encode_message(p.MOOSMessage(p.NULL, p.DOUBLE, "", -1.0, now))
-        elif count and end - pos >= p.MESSAGE_FIXED_SIZE and data[pos + 8] == _TIMING:
+        elif count and end - pos >= p.MESSAGE_FIXED_SIZE and data[pos + p.MSG_TYPE_AT] == _TIMING:
             timing, pos = p.decode_message(data, pos, end)
             count -= 1
             timing.dval = now
@@ -449,7 +455,11 @@ class DBCore:
             source.forwarded,
             source.growth,
         )
-        key_at_offset = 10 + len(head)
+        key_at_offset = p.SRC_AT + len(head)
+        # the layout's offsets as locals: the loop below runs for every message the DB gets
+        tail_size, sval_length_in_tail = _TAIL_SIZE, p.SVAL_LENGTH_IN_TAIL
+        msg_type_in, data_type_in = _MSG_TYPE_IN_ID_TYPES, _DATA_TYPE_IN_ID_TYPES
+        length_size = _STRING_LENGTH_SIZE
         had_notify = False
         for _ in range(count):
             try:  # one unpack reads a notification from the remembered source up to its key
@@ -459,20 +469,20 @@ class DBCore:
             if head_seen != head:
                 if end - pos < p.MESSAGE_FIXED_SIZE:
                     raise MoosProtocolError("message truncated before the end of its fixed fields")
-                msg_len, msg_type, _ = _MSG_HEAD.unpack_from(data, pos)
+                msg_len, _, msg_type, _ = p.MESSAGE_START.unpack_from(data, pos)
                 stop = pos + msg_len
                 if msg_len < p.MESSAGE_FIXED_SIZE or stop > end or msg_type != _NOTIFY:
                     self._on_other(client, p.decode_message(data, pos, end)[0], now, answers)
                     pos = stop
                     continue
-                source = self._source = _Source(self, data, pos + 10, stop)
+                source = self._source = _Source(self, data, pos + p.SRC_AT, stop)
                 head, read_start, forwarded, growth = (
                     source.head,
                     source.layout.unpack_from,
                     source.forwarded,
                     source.growth,
                 )
-                key_at_offset = 10 + len(head)
+                key_at_offset = p.SRC_AT + len(head)
                 msg_len, id_types, head_seen, key_len = read_start(data, pos)
             stop = pos + msg_len
             if msg_len < p.MESSAGE_FIXED_SIZE or stop > end:
@@ -480,29 +490,35 @@ class DBCore:
                     f"message length {msg_len} is below "
                     f"{p.MESSAGE_FIXED_SIZE} or runs past the packet end"
                 )
-            if id_types[4] != _NOTIFY:
+            if id_types[msg_type_in] != _NOTIFY:
                 self._on_other(client, p.decode_message(data, pos, stop)[0], now, answers)
                 pos = stop
                 continue
             had_notify = True
-            data_type = id_types[5]
+            data_type = id_types[data_type_in]
             key_at = pos + key_at_offset
-            key_end = key_at + 4 + key_len
-            if key_len < 0 or key_end + 28 > stop:
+            key_end = key_at + length_size + key_len
+            if key_len < 0 or key_end + tail_size > stop:
                 raise MoosProtocolError(
                     f"key length {key_len} is negative or runs past the message end"
                 )
-            (sval_len,) = read_int(data, key_end + 24)
-            if sval_len < 0 or key_end + 28 + sval_len != stop:
+            (sval_len,) = read_int(data, key_end + sval_length_in_tail)
+            if sval_len < 0 or key_end + tail_size + sval_len != stop:
                 raise MoosProtocolError(f"sval length {sval_len} does not end the message")
             if forwarded is None:
                 raw = data[pos:stop]
             else:
                 raw = b"".join((pack_int(msg_len + growth), id_types, forwarded, data[key_at:stop]))
-            var = by_key.get(data[key_at + 4 : key_end])
+            var = by_key.get(data[key_at + length_size : key_end])
             if var is None or var.accepts != data_type:
                 var = self._first_or_mistyped_write(
-                    client, var, data[key_at + 4 : key_end], data_type, source.src, now, len(raw)
+                    client,
+                    var,
+                    data[key_at + length_size : key_end],
+                    data_type,
+                    source.src,
+                    now,
+                    len(raw),
                 )
                 if var is None:
                     pos = stop

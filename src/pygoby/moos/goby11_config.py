@@ -26,11 +26,10 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
-
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
-from google.protobuf.message import Message
+from typing import Any
 
 from pygoby.moos.errors import BlockSyntaxError
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 # ---------------------------------------------------------------------------------------------
 # Tokens and the field tree
@@ -144,8 +143,8 @@ class _Parser:
         else:
             result.value.append(self.take())
             while (
-                self.peek() is not None
-                and self.peek()[0] in "\"'"
+                (following := self.peek()) is not None
+                and following[0] in "\"'"
                 and result.value[-1].text[0] in "\"'"
             ):
                 result.value.append(self.take())  # adjacent strings concatenate
@@ -306,12 +305,12 @@ RULES: dict[str, Rule] = {
 }
 
 
-def _field_type(descriptor: Descriptor | None, key: str) -> Descriptor | None:
+def _field_type(descriptor: AnyDescriptor | None, key: str) -> AnyDescriptor | None:
     if descriptor is None:
         return None
     if key.startswith("["):
         try:
-            found: FieldDescriptor | None = descriptor.file.pool.FindExtensionByName(key[1:-1])
+            found: AnyFieldDescriptor | None = descriptor.file.pool.FindExtensionByName(key[1:-1])
         except KeyError:
             return None
     else:
@@ -319,7 +318,9 @@ def _field_type(descriptor: Descriptor | None, key: str) -> Descriptor | None:
     return found.message_type if found is not None else None
 
 
-def _rewrite(fields: list[Field], descriptor: Descriptor | None, notes: list[str]) -> list[Field]:
+def _rewrite(
+    fields: list[Field], descriptor: AnyDescriptor | None, notes: list[str]
+) -> list[Field]:
     rule = RULES.get(descriptor.full_name) if descriptor is not None else None
     out: list[Field] = []
     for f in fields:
@@ -337,7 +338,7 @@ class Translation:
     notes: list[str]  # what was changed, one line per change
 
 
-def translate(text: str, descriptor: Descriptor) -> Translation:
+def translate(text: str, descriptor: AnyDescriptor) -> Translation:
     """Rewrite the Goby 1.1/2 forms of a ProcessConfig block for `descriptor` (the app's
     configuration type). Raises BlockSyntaxError for a mistake no parser reads past (protobuf's
     would first report a field before it that only this rewriting makes valid). Other text that
@@ -356,7 +357,7 @@ def translate(text: str, descriptor: Descriptor) -> Translation:
     return Translation(render(fields), notes)
 
 
-def finish(config: Message, notes: list[str]) -> None:
+def finish(config: Any, notes: list[str]) -> None:  # (any app's configuration message)
     """The moves that need the parsed message: Goby 1.1 put XML message files in dccl_cfg and
     queue_cfg (and copied each to the other); they all become transitional_cfg.message_file."""
     fields = config.DESCRIPTOR.fields_by_name

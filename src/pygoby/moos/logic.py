@@ -14,6 +14,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 from pygoby.errors import ConfigError
 
@@ -52,8 +53,8 @@ def _closing(text: str, start: int) -> int:
 @dataclass
 class _Node:
     kind: str  # "and", "or", "not", or a relation
-    left: object = None
-    right: object = None
+    left: Any = None  # a _Node, or the variable name of a relation
+    right: Any = None  # a _Node, or a relation's ("variable" | "string" | ..., value)
 
 
 class LogicCondition:
@@ -116,12 +117,12 @@ class LogicCondition:
         if node.kind in ("and", "or"):
             left, right = self._evaluate(node.left, values), self._evaluate(node.right, values)
             return (left and right) if node.kind == "and" else (left or right)
-        left = values.get(node.left)
+        lhs = values.get(node.left)
         kind, raw = node.right
-        right = values.get(raw) if kind == "variable" else raw
-        if left is None or right is None:
+        rhs = values.get(raw) if kind == "variable" else raw
+        if lhs is None or rhs is None:
             return False
-        return _compare(node.kind, left, right)
+        return _compare(node.kind, lhs, rhs)
 
 
 def _closing_balance(text: str) -> int:
@@ -153,4 +154,4 @@ def _compare(relation: str, left: Value, right: Value) -> bool:
         "<=": a <= b,
         ">": a > b,
         ">=": a >= b,
-    }[relation]  # type: ignore[operator]
+    }[relation]

@@ -50,12 +50,29 @@ BINARY = "B"
 NOT_SET = "~"
 
 PACKET_HEADER_SIZE = 9
-MESSAGE_FIXED_SIZE = 54
 _HEADER = struct.Struct("<iiB")
 _INT = struct.Struct("<i")
-_START = struct.Struct("<iiBBi")  # msg_len, id, msg_type, data_type, length of src
-_DOUBLES_LENGTH = struct.Struct("<dddi")  # time, dval, dval2, length of sval
+
+# The V10 message layout (little-endian), read here and by the MOOSDB's fast path (dbcore):
+#   int32 msg_len (the whole message), int32 id, char msg_type, char data_type,
+#   four strings, each an int32 length + bytes: src, src_aux, community, key,
+#   the tail: double time, double dval, double dval2, int32 sval length; then sval's bytes.
+MESSAGE_START = struct.Struct("<iiBB")  # msg_len, id, msg_type, data_type
+ID_AT = 4  # offsets from the start of the message
+MSG_TYPE_AT = 8
+DATA_TYPE_AT = 9
+SRC_AT = MESSAGE_START.size  # the length of src, the first of the four strings
+STRING_LENGTH_SIZE = _INT.size
+MESSAGE_TAIL = struct.Struct("<dddi")  # time, dval, dval2, sval length: right after the key
+SVAL_LENGTH_IN_TAIL = 24  # offset of the sval length from the start of the tail
+MESSAGE_FIXED_SIZE = SRC_AT + 4 * STRING_LENGTH_SIZE + MESSAGE_TAIL.size  # 54: empty strings
+_START = struct.Struct(MESSAGE_START.format + "i")  # ... and the length of src
 _CHARS = tuple(map(chr, range(256)))
+_SRC_BYTES_AT = SRC_AT + STRING_LENGTH_SIZE
+_TAIL_SIZE = MESSAGE_TAIL.size
+_AFTER_COMMUNITY = STRING_LENGTH_SIZE + _TAIL_SIZE  # the bytes a string leaves after it
+_AFTER_AUX = STRING_LENGTH_SIZE + _AFTER_COMMUNITY
+_AFTER_SRC = STRING_LENGTH_SIZE + _AFTER_AUX
 
 Value = float | str | bytes
 
@@ -262,11 +279,11 @@ def _decode_messages(
     data: bytes, pos: int, limit: int, count: int
 ) -> tuple[list[MOOSMessage], int]:
     """`count` messages from data[pos:limit]; and the offset after the last."""
-    msgs = []
+    msgs: list[MOOSMessage] = []
     append = msgs.append
     read_start = _START.unpack_from
     read_int = _INT.unpack_from
-    read_doubles = _DOUBLES_LENGTH.unpack_from
+    read_tail = MESSAGE_TAIL.unpack_from
     chars = _CHARS
     for _ in range(count):
         if limit - pos < MESSAGE_FIXED_SIZE:
@@ -280,31 +297,31 @@ def _decode_messages(
             raise MoosProtocolError(
                 f"message length {msg_len} is below {MESSAGE_FIXED_SIZE} or runs past the packet end"
             )
-        # each string must leave room for the fixed fields after it: 40, 36, 32, 28 bytes
-        pos += 14
-        if n < 0 or pos + n + 40 > stop:
+        # each string must leave room for the lengths of those after it and the tail
+        pos += _SRC_BYTES_AT
+        if n < 0 or pos + n + _AFTER_SRC > stop:
             raise _bad_length("src", n)
         src = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
         pos += n
         (n,) = read_int(data, pos)
-        pos += 4
-        if n < 0 or pos + n + 36 > stop:
+        pos += STRING_LENGTH_SIZE
+        if n < 0 or pos + n + _AFTER_AUX > stop:
             raise _bad_length("src_aux", n)
         aux = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
         pos += n
         (n,) = read_int(data, pos)
-        pos += 4
-        if n < 0 or pos + n + 32 > stop:
+        pos += STRING_LENGTH_SIZE
+        if n < 0 or pos + n + _AFTER_COMMUNITY > stop:
             raise _bad_length("community", n)
         community = data[pos : pos + n].decode("utf-8", "surrogateescape") if n else ""
         pos += n
         (n,) = read_int(data, pos)
-        pos += 4
-        if n < 0 or pos + n + 28 > stop:
+        pos += STRING_LENGTH_SIZE
+        if n < 0 or pos + n + _TAIL_SIZE > stop:
             raise _bad_length("key", n)
         key = data[pos : pos + n].decode("utf-8", "surrogateescape")
-        time_, dval, dval2, sval_len = read_doubles(data, pos + n)
-        pos += n + 28
+        time_, dval, dval2, sval_len = read_tail(data, pos + n)
+        pos += n + _TAIL_SIZE
         if sval_len < 0 or pos + sval_len != stop:
             raise MoosProtocolError(
                 f"sval length {sval_len} does not end the message at its msg_len"

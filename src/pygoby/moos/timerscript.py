@@ -44,7 +44,9 @@ class Event:
 
 
 @dataclass
-class Post:
+class TimedPost:
+    """One post the script makes when an event comes due."""
+
     var: str
     value: Value
 
@@ -52,7 +54,9 @@ class Post:
 def split_quoted(text: str, separator: str = ",") -> list[str]:
     """MOOS-IvP's parseStringQ: split on `separator` outside double quotes (every `"` toggles)
     and outside braces."""
-    parts, current, quoted, braces = [], [], False, 0
+    parts: list[str] = []
+    current: list[str] = []
+    quoted, braces = False, 0
     for c in text:
         if c == '"':
             quoted = not quoted
@@ -205,7 +209,8 @@ class TimerScript:
             self.warnings.append(f"unknown uTimerScript parameter {name!r} ignored")
 
     def _add_event(self, text: str) -> None:
-        var, value, quoted, times, amount, quit_app = "", None, False, (0.0, 0.0), 1, False
+        value: Value | None = None
+        var, quoted, times, amount, quit_app = "", False, (0.0, 0.0), 1, False
         for part in split_quoted(text):
             if part.strip().lower() == "quit":
                 var, value, quit_app = "EXITED_NORMALLY", "uTimerScript", True
@@ -259,10 +264,10 @@ class TimerScript:
                 self.paused = not self.paused
         self.values[var] = value
 
-    def tick(self, now: float) -> list[Post]:
+    def tick(self, now: float) -> list[TimedPost]:
         if self.db_start is None:
             self.db_start = now
-        posts: list[Post] = []
+        posts: list[TimedPost] = []
         ok = all(c.evaluate(self.values) for c in self.conditions)
         if ok and not self.conditions_ok:  # an awakening
             if self.upon_awake == "reset" and self._elapsed > 0:
@@ -276,6 +281,7 @@ class TimerScript:
         if (self.paused or not ok) and self._previous is not None:
             self._paused_time += now - self._previous
         self._previous = now
+        assert self._start is not None  # (set by the start of the script above)
         self._elapsed = ((now - self._start) + self._skip - self._paused_time) * self._warp
         all_posted = False
         if not self.paused and ok:
@@ -307,7 +313,7 @@ class TimerScript:
         self._previous = None
         self._posted = 0
 
-    def _ready_posts(self, now: float, posts: list[Post]) -> bool:
+    def _ready_posts(self, now: float, posts: list[TimedPost]) -> bool:
         for index, event in enumerate(self.events):
             if event.posted or self._elapsed - self._delay < event.time:
                 continue
@@ -319,13 +325,13 @@ class TimerScript:
             posts.append(self._post(event, index, now))
         return all(e.posted for e in self.events)
 
-    def _post(self, event: Event, index: int, now: float) -> Post:
+    def _post(self, event: Event, index: int, now: float) -> TimedPost:
         if event.quit:
             self.quit = True
-            return Post(event.var, event.value)
+            return TimedPost(event.var, event.value)
         value = event.value
         if not isinstance(value, str):
-            return Post(event.var, value)
+            return TimedPost(event.var, value)
         uptime = now - (self.db_start or now)
         macros = {
             "DBTIME": f"{uptime:.2f}",
@@ -337,12 +343,12 @@ class TimerScript:
         }
         whole = re.fullmatch(r"\$[(\[](DBTIME|UTCTIME|UTC|COUNT|TCOUNT)[)\]]", value)
         if whole:  # the macro is the whole value: posted as a double
-            return Post(event.var, float(macros[whole.group(1)]))
+            return TimedPost(event.var, float(macros[whole.group(1)]))
         for name, text in macros.items():
             value = value.replace(f"$({name})", text).replace(f"$[{name}]", text)
         if _is_number(value) and not event.quoted:
-            return Post(event.var, float(value))
-        return Post(event.var, value)
+            return TimedPost(event.var, float(value))
+        return TimedPost(event.var, value)
 
     def _reset(self) -> None:
         if self.reset_max is not None and self.reset_count >= self.reset_max:

@@ -1,14 +1,16 @@
 """pygoby.netsim: a netsim-compatible acoustic network simulator.
 
-* `protocol`: the NETSIM line protocol (sans-I/O codec).
-* `config`, `manager`, `server`: netsim_manager (request checks, latest position per modem
-  port, asyncio TCP server, the `netsim_manager` console script); `gprmc`: its $GPRMC output.
-* `client`: the vehicle side of the manager interface (asyncio, reconnecting).
-* `channel`: the packet-level acoustic channel the modem emulators use; `physics_channel`: the
-  emulators' channel backed by it.
-* `scenario`, `sim`, `realtime`, `eventlog`, `report`: `pygoby netsim run|report` (a scenario
-  file simulated on a virtual clock or in real time, its event log and report).
-* `errors`: the NetsimError family.
+* `manager/`: netsim_manager — the NETSIM line protocol, request processing, the TCP server and
+  `netsim_manager` console script, its $GPRMC output, the vehicle-side client and what
+  iNetSimManager reports.
+* `channel/`: the packet-level acoustic channel physics (geometry, sound speed, absorption,
+  levels, frame-error models).
+* `sim/`: `pygoby netsim run` — scenarios, the simulation on a virtual clock or in real time,
+  the modem emulators' channel backed by `channel/`, and its one-sender-one-receiver form
+  (`range_link`, for iModemSim's multicast channel).
+* `report/`: the event log a simulation writes and `pygoby netsim report`'s plots of it.
+* `sweep/`: parameter sweeps of scenarios.
+* `cli`: the `pygoby netsim` subcommands; `errors`: the NetsimError family.
 """
 
 from pygoby.netsim.errors import (
@@ -25,15 +27,15 @@ from pygoby.util.modules import lazy_exports
 __getattr__, __dir__ = lazy_exports(
     globals(),
     {
-        "ManagerServer": "pygoby.netsim.server",
-        "NetSimClient": "pygoby.netsim.client",
-        "NetSimManager": "pygoby.netsim.manager",
-        "PhysicsChannel": "pygoby.netsim.physics_channel",
-        "RealTimeRun": "pygoby.netsim.realtime",
-        "Simulation": "pygoby.netsim.sim",
-        "load_scenario": "pygoby.netsim.scenario",
-        "parse_config": "pygoby.netsim.config",
-        "parse_scenario": "pygoby.netsim.scenario",
+        "ManagerServer": "pygoby.netsim.manager.server",
+        "NetSimClient": "pygoby.netsim.manager.client",
+        "NetSimManager": "pygoby.netsim.manager.core",
+        "PhysicsChannel": "pygoby.netsim.sim.physics_channel",
+        "RealTimeRun": "pygoby.netsim.sim.realtime",
+        "Simulation": "pygoby.netsim.sim.simulation",
+        "load_scenario": "pygoby.netsim.sim.scenario",
+        "parse_config": "pygoby.netsim.manager.config",
+        "parse_scenario": "pygoby.netsim.sim.scenario",
     },
 )
 

@@ -5,7 +5,21 @@ from pygoby.protobuf.loader import (
     ProtoError,
     ProtoLoader,
     builtin_class,
+    class_of,
     default_loader,
+    enum_type,
+    initialization_errors,
+    message_type,
 )
 
-__all__ = ["BUILTIN_PROTO_DIR", "ProtoError", "ProtoLoader", "builtin_class", "default_loader"]
+__all__ = [
+    "BUILTIN_PROTO_DIR",
+    "ProtoError",
+    "ProtoLoader",
+    "builtin_class",
+    "class_of",
+    "default_loader",
+    "enum_type",
+    "initialization_errors",
+    "message_type",
+]

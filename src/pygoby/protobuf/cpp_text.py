@@ -7,9 +7,13 @@ from __future__ import annotations
 
 import math
 import struct
+from typing import Any
 
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
+
+from pygoby.protobuf import enum_type, message_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 _ESCAPES = {0x0A: "\\n", 0x0D: "\\r", 0x09: "\\t", 0x22: '\\"', 0x27: "\\'", 0x5C: "\\\\"}
 _F32 = struct.Struct("<f")
@@ -56,7 +60,7 @@ def float_text(value: float) -> str:
     return short if _float32(float(short)) == value else f"{value:.9g}"
 
 
-def scalar_text(field: FieldDescriptor, value) -> str:
+def scalar_text(field: AnyFieldDescriptor, value: Any) -> str:
     """A non-message field value as C++ TextFormat prints it."""
     cpp = field.cpp_type
     if cpp == FieldDescriptor.CPPTYPE_STRING:
@@ -69,16 +73,16 @@ def scalar_text(field: FieldDescriptor, value) -> str:
     if cpp == FieldDescriptor.CPPTYPE_FLOAT:
         return float_text(value)
     if cpp == FieldDescriptor.CPPTYPE_ENUM:
-        enum_value = field.enum_type.values_by_number.get(value)
+        enum_value = enum_type(field).values_by_number.get(value)
         return enum_value.name if enum_value is not None else str(value)
     return str(value)
 
 
-def field_label(field: FieldDescriptor) -> str:
+def field_label(field: AnyFieldDescriptor) -> str:
     if field.is_extension:
         return "[" + field.full_name + "]"
     if field.type == FieldDescriptor.TYPE_GROUP:
-        return field.message_type.name
+        return message_type(field).name
     return field.name
 
 

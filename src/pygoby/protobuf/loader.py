@@ -1,25 +1,33 @@
 """Load protobuf message definitions from .proto files at run time.
 
-protoc (from grpcio-tools, in process) compiles the files into a FileDescriptorSet, which is added
-to a descriptor pool; message classes are then made from the pool. Our own .proto files live in
-this folder under their upstream import paths ("dccl/option_extensions.proto", ...), and this
+protoc (from grpcio-tools, in process) compiles users' files into a FileDescriptorSet, which is
+added to a descriptor pool; message classes are then made from the pool. Our own .proto files live
+in this folder under their upstream import paths ("dccl/option_extensions.proto", ...), and this
 folder is always on the include path, so users' files that import them compile unchanged.
+
+Our own files are also compiled at build time into `_pb2` modules beside them (see generate.py),
+which register them in protobuf's default pool. The default loader works on that pool and imports
+those modules instead of running protoc on our files, so a user's file loaded there that imports
+ours gets the very classes pygoby's code uses.
 """
 
 from __future__ import annotations
 
 import functools
+import importlib
 import os
 import tempfile
 from collections.abc import Iterable, Sequence
 from importlib import resources
 from pathlib import Path
+from typing import IO
 
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 from google.protobuf.descriptor import Descriptor, FileDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import PygobyError
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyEnumDescriptor, AnyFieldDescriptor
 
 BUILTIN_PROTO_DIR = Path(__file__).resolve().parent
 
@@ -32,6 +40,30 @@ class ProtoError(PygobyError):
 @functools.cache
 def _well_known_include_dir() -> str:
     return str(resources.files("grpc_tools") / "_proto")
+
+
+def builtin_module_name(name: str) -> str:
+    """The generated module of our .proto import name ("goby/acomms/protobuf/queue.proto" ->
+    "pygoby.protobuf.goby.acomms.protobuf.queue_pb2")."""
+    return f"{__package__}.{name.removesuffix('.proto').replace('/', '.')}_pb2"
+
+
+def is_builtin(name: str) -> bool:
+    """Whether `name` is the import name of one of our own .proto files."""
+    return name.endswith(".proto") and (BUILTIN_PROTO_DIR / name).is_file()
+
+
+def import_builtin(name: str) -> FileDescriptor:
+    """Our .proto file `name`, registered in the default pool by its generated module."""
+    try:
+        module = importlib.import_module(builtin_module_name(name))
+    except ModuleNotFoundError as err:
+        raise ProtoError(
+            f"the generated module of {name} is missing ({err}): run "
+            "`python -m pygoby.protobuf.generate` or reinstall pygoby"
+        ) from None
+    descriptor: FileDescriptor = module.DESCRIPTOR
+    return descriptor
 
 
 class ProtoLoader:
@@ -51,6 +83,8 @@ class ProtoLoader:
         # What we added, as compiled: a descriptor copied back out of the pool is not always
         # byte-identical (e.g. an aliased enum default comes back under its other name).
         self._added: dict[str, bytes] = {}
+        # our own files come from their generated modules when they go to protobuf's default pool
+        self._uses_generated = self.pool is descriptor_pool.Default()
 
     def add_include_dir(self, directory: str | os.PathLike[str]) -> None:
         resolved = Path(directory).resolve()
@@ -99,6 +133,8 @@ class ProtoLoader:
                 name = resolved.name
         else:
             name = candidate.as_posix()
+            if self._uses_generated and is_builtin(name):
+                return import_builtin(name)
             if not any((Path(d) / name).is_file() for d in search):
                 raise ProtoError(f"cannot find .proto file {str(path)!r} (searched {search})")
         try:
@@ -127,6 +163,9 @@ class ProtoLoader:
         return list(fds.file)
 
     def _add(self, file_proto: descriptor_pb2.FileDescriptorProto) -> None:
+        if self._uses_generated and is_builtin(file_proto.name):
+            import_builtin(file_proto.name)
+            return
         compiled = file_proto.SerializeToString(deterministic=True)
         try:
             self.pool.FindFileByName(file_proto.name)
@@ -169,13 +208,13 @@ class ProtoLoader:
 class _captured_stderr:
     """protoc writes its diagnostics to fd 2; capture them for the error message."""
 
-    def __enter__(self):
+    def __enter__(self) -> IO[str]:
         self._file = tempfile.TemporaryFile(mode="w+")
         self._saved = os.dup(2)
         os.dup2(self._file.fileno(), 2)
         return self._file
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         os.dup2(self._saved, 2)
         os.close(self._saved)
         self._file.seek(0)
@@ -183,8 +222,9 @@ class _captured_stderr:
 
 @functools.cache
 def default_loader() -> ProtoLoader:
-    """The process-wide loader used for pygoby's own messages and configs."""
-    return ProtoLoader()
+    """The process-wide loader used for pygoby's own messages and configs: on protobuf's default
+    pool, where the generated modules of our .proto files register them."""
+    return ProtoLoader(pool=descriptor_pool.Default())
 
 
 def builtin_class(proto_file: str, full_name: str) -> type[Message]:
@@ -192,3 +232,30 @@ def builtin_class(proto_file: str, full_name: str) -> type[Message]:
     loader = default_loader()
     loader.load_file(proto_file)
     return loader.message_class(full_name)
+
+
+def enum_type(field: AnyFieldDescriptor) -> AnyEnumDescriptor:
+    """The enum type of an enum field (protobuf types it as optional: None for other fields)."""
+    if field.enum_type is None:
+        raise ProtoError(f"{field.full_name} is not an enum field")
+    return field.enum_type
+
+
+def message_type(field: AnyFieldDescriptor) -> AnyDescriptor:
+    """The message type of a message field (protobuf types it as optional: None for others)."""
+    if field.message_type is None:
+        raise ProtoError(f"{field.full_name} is not a message field")
+    return field.message_type
+
+
+def initialization_errors(message: Message) -> list[str]:
+    """Paths of the required fields `message` lacks ("node[0].track.speed"), as protobuf's
+    FindInitializationErrors gives them (a method its type stubs leave out)."""
+    errors: list[str] = message.FindInitializationErrors()  # type: ignore[attr-defined]
+    return errors
+
+
+def class_of(descriptor: AnyDescriptor) -> type[Message]:
+    """The message class of a descriptor of any pool (protobuf's stubs take only the
+    pure-Python descriptor type)."""
+    return message_factory.GetMessageClass(descriptor)  # type: ignore[arg-type]

@@ -21,22 +21,9 @@ from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
+from pygoby.protobuf.descriptors import INTEGER_FIELD_TYPES, AnyFieldDescriptor
 
 PORT_MAX = 65535
-_INTEGER_TYPES = frozenset(
-    {
-        FieldDescriptor.TYPE_INT32,
-        FieldDescriptor.TYPE_INT64,
-        FieldDescriptor.TYPE_UINT32,
-        FieldDescriptor.TYPE_UINT64,
-        FieldDescriptor.TYPE_SINT32,
-        FieldDescriptor.TYPE_SINT64,
-        FieldDescriptor.TYPE_FIXED32,
-        FieldDescriptor.TYPE_FIXED64,
-        FieldDescriptor.TYPE_SFIXED32,
-        FieldDescriptor.TYPE_SFIXED64,
-    }
-)
 
 
 def read_config_file(
@@ -80,7 +67,7 @@ def _located(
     line: int | None,
     column: int | None,
     lines: list[str],
-    file,
+    file: str | os.PathLike[str] | None,
     first_line: int,
 ) -> ConfigError:
     if line is None:
@@ -105,7 +92,12 @@ def _located(
 _SURROGATE = re.compile("[\udc80-\udcff]")  # a byte of the file that is not UTF-8
 
 
-def _refuse_non_utf8(lines: list[str], file, first_line: int, error: type[ConfigError]) -> None:
+def _refuse_non_utf8(
+    lines: list[str],
+    file: str | os.PathLike[str] | None,
+    first_line: int,
+    error: type[ConfigError],
+) -> None:
     """A non-UTF-8 byte outside comments is a located error here: in a string protobuf could
     not store it, and in an enum value (quoted or not) its parser fails with a SystemError.
     In a `#` comment it is harmless."""
@@ -196,7 +188,7 @@ def line_of_field(text: str, path: str, first_line: int = 1) -> int | None:
     return first_line + code.count("\n", 0, position) if path else None
 
 
-def _integer_values(message: Message, prefix: str) -> Iterator[tuple[str, FieldDescriptor, int]]:
+def _integer_values(message: Message, prefix: str) -> Iterator[tuple[str, AnyFieldDescriptor, int]]:
     for field, value in message.ListFields():
         name = f"[{field.full_name}]" if field.is_extension else field.name
         path = f"{prefix}{name}"
@@ -205,5 +197,5 @@ def _integer_values(message: Message, prefix: str) -> Iterator[tuple[str, FieldD
             item_path = f"{path}[{index}]" if field.is_repeated else path
             if field.type == FieldDescriptor.TYPE_MESSAGE:
                 yield from _integer_values(item, item_path + ".")
-            elif field.type in _INTEGER_TYPES:
+            elif field.type in INTEGER_FIELD_TYPES:
                 yield item_path, field, item

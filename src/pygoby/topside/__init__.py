@@ -1,7 +1,7 @@
 """Topside operator tools: the command composer (`commander`), iCommander in the terminal
-(`icommander`) and liaison in the browser (`liaison`), and pAcommsHandler's configuration and
-message set they share with pAcommsHandler (`acomms_config`). Layer: above acomms and moos,
-below apps. `errors`: the TopsideError family."""
+(`icommander`) and liaison in the browser (`liaison`); pAcommsHandler's configuration and message
+set they read is `pygoby.moosacomms.acomms_config`. Layer: above moosacomms, below apps.
+`errors`: the TopsideError family."""
 
 from pygoby.topside.errors import (
     CommanderError,
@@ -18,19 +18,16 @@ from pygoby.util.modules import lazy_exports
 __getattr__, __dir__ = lazy_exports(
     globals(),
     {
-        "AcommsMessageSet": "pygoby.topside.acomms_config",
         "CommandSet": "pygoby.topside.commander",
         "Commander": "pygoby.topside.commander",
         "ICommanderTUI": "pygoby.topside.icommander",
         "Liaison": "pygoby.topside.liaison",
         "LiaisonState": "pygoby.topside.liaison",
         "WebServer": "pygoby.topside.liaison",
-        "read_acomms_config": "pygoby.topside.acomms_config",
     },
 )
 
 __all__ = [
-    "AcommsMessageSet",
     "CommandSet",
     "Commander",
     "CommanderError",
@@ -44,5 +41,4 @@ __all__ = [
     "TooManyStreamsError",
     "TopsideError",
     "WebServer",
-    "read_acomms_config",
 ]

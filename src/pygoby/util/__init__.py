@@ -5,6 +5,7 @@ others (geodesy, nmea, linebased, aiorun, ...) from their modules."""
 from pygoby.util.clock import Clock, VirtualClock, WallClock
 from pygoby.util.errors import (
     LinkClosedError,
+    MissingExtraError,
     NMEAChecksumError,
     NMEAError,
     NMEAFormatError,
@@ -17,6 +18,7 @@ from pygoby.util.signal import Signal
 __all__ = [
     "Clock",
     "LinkClosedError",
+    "MissingExtraError",
     "ModemIdLookup",
     "NMEAChecksumError",
     "NMEAError",

@@ -50,7 +50,7 @@ class StopSignals:
     def __init__(
         self,
         loop: asyncio.AbstractEventLoop,
-        request_stop: Callable[[], None],
+        request_stop: Callable[[], object],
         name: str,
         grace: float = STOP_GRACE,
     ) -> None:

@@ -1,7 +1,8 @@
 """The errors of the shared utilities. util is a set of independent helpers, not a layer a
 caller catches as a whole, so each kind has its own root directly under `PygobyError`:
 `NMEAError` for text that is not a valid NMEA-0183 sentence, `LinkClosedError` for writing to a
-line link that is not open."""
+line link that is not open, `MissingExtraError` for a feature whose optional package is not
+installed."""
 
 from pygoby.errors import PygobyError
 
@@ -29,3 +30,8 @@ class PtyError(PygobyError, OSError):
 
 class PluginError(PygobyError):
     """No plug-in could be found or loaded under the given name (pygoby.util.plugins)."""
+
+
+class MissingExtraError(PygobyError, ImportError):
+    """A feature's package is not installed; the text names the pip extra that installs it
+    (pygoby.util.extras)."""

@@ -14,7 +14,7 @@ import functools
 import logging
 import os
 from collections import deque
-from typing import Protocol
+from typing import Any, Protocol
 
 from pygoby.util.errors import LinkClosedError
 
@@ -318,7 +318,7 @@ class SerialLink(_StreamLinkBase):
     def __init__(self, port: str, baud: int, delimiter: str = "\r\n") -> None:
         super().__init__(delimiter)
         self.port, self.baud = port, baud
-        self._serial = None
+        self._serial: Any = None  # a serial.Serial once open (pyserial has no type stubs)
         self._transport = _SerialTransport(self)
 
     def describe(self) -> str:

@@ -41,8 +41,8 @@ class NMEASentence:
             token = "$" + token
         # (str and int values are nearly all of them: converted without a call per field;
         # `type(v) is int` is False for bool, which _field_text prints as 1/0)
-        fields = [
-            v if (kind := type(v)) is str else str(v) if kind is int else _field_text(v)
+        fields: list[str] = [
+            v if (kind := type(v)) is str else str(v) if kind is int else _field_text(v)  # type: ignore[misc]  # (v is a str when its type is)
             for v in values
         ]
         sentence = cls((token, *fields))

@@ -19,6 +19,8 @@ import sys
 import time
 from typing import IO, Any
 
+from pygoby.util.extras import needs_extra
+
 REDRAW = 0.25  # wall seconds between redraws
 PLAIN_AFTER = 3.0  # wall seconds before a run that is not on a terminal prints progress lines
 
@@ -39,8 +41,9 @@ class RunProgress:
     def __enter__(self) -> RunProgress:
         self._started = time.monotonic()
         if self.stream.isatty():
-            from rich.console import Console  # imported only for a terminal
-            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+            with needs_extra("sim", "progress bars"):  # imported only for a terminal
+                from rich.console import Console
+                from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
             self._bar = Progress(
                 TextColumn("{task.description}"),

@@ -1,6 +1,6 @@
 """`Signal`: the one callback type of the library (goby's signals, synchronous).
 
-    received = Signal()
+    received: Signal[ModemTransmission] = Signal()   # typed by what its slots are called with
     received.connect(on_receive)        # any number of slots
     received.emit(msg)                  # (or received(msg)): every slot, in connection order
     received.disconnect(on_receive)
@@ -12,31 +12,35 @@ logger=...)`: a subscriber's bug must not stop the emitter, e.g. the frontseat i
 or for one connection (`connect(slot, contain_errors=True, logger=...)`: e.g. an application's
 own slots on library signals). A contained error is logged with its traceback and the other
 slots still run.
+
+A signal is generic over its slots' parameters (a ParamSpec): `Signal[ModemTransmission]` calls
+`slot(msg)`, `Signal[[ModemTransmission, Message]]` calls `slot(ack, original)`, `Signal[[]]`
+calls `slot()`; mypy checks both what is connected and what is emitted.
 """
 
 from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from typing import Any
+from typing import Generic, ParamSpec
 
 log = logging.getLogger(__name__)
 
-Slot = Callable[..., Any]
+P = ParamSpec("P")
 
 
-class Signal:
+class Signal(Generic[P]):
     __slots__ = ("_contain_errors", "_logger", "_slots")
 
     def __init__(self, *, contain_errors: bool = False, logger: logging.Logger | None = None):
         # each slot with the logger of its contained errors (None: its errors propagate)
-        self._slots: list[tuple[Slot, logging.Logger | None]] = []
+        self._slots: list[tuple[Callable[P, object], logging.Logger | None]] = []
         self._contain_errors = contain_errors
         self._logger = logger if logger is not None else log
 
     def connect(
         self,
-        slot: Slot,
+        slot: Callable[P, object],
         *,
         contain_errors: bool | None = None,
         logger: logging.Logger | None = None,
@@ -46,7 +50,7 @@ class Signal:
         contain = self._contain_errors if contain_errors is None else contain_errors
         self._slots.append((slot, (logger or self._logger) if contain else None))
 
-    def disconnect(self, slot: Slot) -> None:
+    def disconnect(self, slot: Callable[P, object]) -> None:
         """Remove the first connection of `slot` (ValueError if it is not connected)."""
         for index, (connected, _) in enumerate(self._slots):
             if connected == slot:
@@ -54,14 +58,14 @@ class Signal:
                 return
         raise ValueError(f"{slot!r} is not connected")
 
-    def emit(self, *args: Any) -> None:
+    def emit(self, *args: P.args, **kwargs: P.kwargs) -> None:
         # (a copy: a slot may connect or disconnect slots while the signal is emitted)
         for slot, logger in tuple(self._slots):
             if logger is None:
-                slot(*args)
+                slot(*args, **kwargs)
                 continue
             try:
-                slot(*args)
+                slot(*args, **kwargs)
             except Exception:
                 logger.exception("%s raised; the other slots still run", _slot_name(slot))
 
@@ -71,5 +75,5 @@ class Signal:
         return len(self._slots)
 
 
-def _slot_name(slot: Slot) -> str:
+def _slot_name(slot: Callable[..., object]) -> str:
     return getattr(slot, "__qualname__", repr(slot))

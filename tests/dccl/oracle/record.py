@@ -39,6 +39,9 @@ from google.protobuf.message import Message
 REPO = Path(__file__).resolve().parents[3]
 sys.path[:0] = [str(REPO / "src"), str(REPO)]
 
+from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_extensions_pb2 import ArithmeticOptions  # noqa: E402
+from pygoby.protobuf.dccl.ccl.protobuf.ccl_extensions_pb2 import LegacyCCLFieldOptions  # noqa: E402
+
 from pygoby.dccl.options import field_extension, field_options, message_options  # noqa: E402
 from pygoby.protobuf import ProtoLoader  # noqa: E402
 from tests.dccl.recorded import (  # noqa: E402
@@ -410,15 +413,9 @@ class Values:
 
 def field_options_ext(f: FieldDescriptor, name: str):
     """An extension of (dccl.field) read from the field's options (arithmetic, ccl)."""
-    proto, cls, number = {
-        "arithmetic": (
-            "dccl/arithmetic/protobuf/arithmetic_extensions.proto",
-            "ArithmeticOptions",
-            1001,
-        ),
-        "ccl": ("dccl/ccl/protobuf/ccl_extensions.proto", "LegacyCCLFieldOptions", 1000),
-    }[name]
-    return field_extension(field_options(f), proto, cls, number)
+    if name == "arithmetic":
+        return field_extension(field_options(f), ArithmeticOptions, 1001)
+    return field_extension(field_options(f), LegacyCCLFieldOptions, 1000)
 
 
 def to_text(msg: Message) -> str:

@@ -56,13 +56,13 @@ BUILTIN_DRIVERS = {
 }
 
 Factory = Callable[[Clock | None], ModemDriverBase]
-_DRIVER_TYPE = acomms_pb.DriverConfig.DESCRIPTOR.fields_by_name["driver_type"].enum_type
+_DRIVER_TYPE = acomms_pb.DriverType.DESCRIPTOR
 
 
 INSTALLED = PluginGroup(ENTRY_POINT_GROUP, "modem driver", PLUGIN_FACTORY, DriverNotFoundError)
 
 
-def driver_type_name(cfg) -> str:
+def driver_type_name(cfg: acomms_pb.DriverConfig) -> str:
     return _DRIVER_TYPE.values_by_number[cfg.driver_type].name
 
 
@@ -74,7 +74,7 @@ def implemented_types() -> list[str]:
     return [v.name for v in _DRIVER_TYPE.values if v.name in types]
 
 
-def driver_factory(cfg) -> Factory:
+def driver_factory(cfg: acomms_pb.DriverConfig) -> Factory:
     """The factory of the driver `cfg` (DriverConfig) selects; DriverNotFoundError otherwise."""
     if cfg.WhichOneof("driver") == "driver_name":
         return plugin_factory(cfg.driver_name)
@@ -120,6 +120,6 @@ def plugin_factory(name: str) -> Factory:
     )
 
 
-def make_driver(cfg, clock: Clock | None = None) -> ModemDriverBase:
+def make_driver(cfg: acomms_pb.DriverConfig, clock: Clock | None = None) -> ModemDriverBase:
     """A driver instance for `cfg` (DriverConfig), not started."""
     return driver_factory(cfg)(clock)

@@ -8,6 +8,7 @@ from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.abc_protocol import format_abc, parse_abc
 from pygoby.acomms.driver_base import ModemDriverBase
 from pygoby.acomms.errors import ABCParseError
+from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
 
@@ -18,13 +19,13 @@ BITRATE = (100, 1000, 10000, 10000, 10000, 10000)
 class ABCDriver(ModemDriverBase):
     DEFAULT_SERIAL_BAUD = 4800
 
-    def __init__(self, clock=None, link=None) -> None:
+    def __init__(self, clock: Clock | None = None, link=None) -> None:
         super().__init__(clock, link)
         self._last_sent_frames: list[int] = []
         self._running = False
         self._configured = False  # CONF lines sent on the current connection
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         self.modem_start(cfg)
         self._running = True
         self._configured = False
@@ -45,7 +46,7 @@ class ABCDriver(ModemDriverBase):
         self.modem_write(text)
         self.emit_raw(False, text.rstrip("\r\n"))
 
-    def handle_initiate_transmission(self, transmission) -> None:
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         msg = acomms_pb.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)

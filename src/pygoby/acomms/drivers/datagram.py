@@ -10,6 +10,7 @@ from google.protobuf.message import DecodeError
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
+from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
 
@@ -20,7 +21,7 @@ class DatagramDriverBase(ModemDriverBase):
     """Subclasses open `self._sock` in startup() and implement `_max_frame_bytes`, `_send` and
     `_handle_transmission`."""
 
-    def __init__(self, clock=None) -> None:
+    def __init__(self, clock: Clock | None = None) -> None:
         super().__init__(clock)
         self._sock: socket.socket | None = None
         self._frame_counter = 0
@@ -30,7 +31,7 @@ class DatagramDriverBase(ModemDriverBase):
             self._sock.close()
             self._sock = None
 
-    def handle_initiate_transmission(self, transmission) -> None:
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         msg = acomms_pb.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)
@@ -64,12 +65,12 @@ class DatagramDriverBase(ModemDriverBase):
                 continue
             self._handle_transmission(msg, data)
 
-    def _max_frame_bytes(self, msg) -> int:
+    def _max_frame_bytes(self, msg: acomms_pb.ModemTransmission) -> int:
         raise NotImplementedError
 
-    def _send(self, msg) -> None:
+    def _send(self, msg: acomms_pb.ModemTransmission) -> None:
         raise NotImplementedError
 
-    def _handle_transmission(self, msg, data: bytes) -> None:
+    def _handle_transmission(self, msg: acomms_pb.ModemTransmission, data: bytes) -> None:
         """A parsed datagram (`data` are its bytes, for the raw log)."""
         raise NotImplementedError

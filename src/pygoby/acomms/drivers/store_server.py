@@ -23,11 +23,12 @@ from pygoby.acomms.rudics import (
 )
 from pygoby.acomms.store_server.auth import AUTH_BYTES, read_secret_file, sign_request
 from pygoby.errors import ConfigError
+from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 11244
-POLL = 1  # store_server.protobuf.Transmission.STORE_SERVER_DRIVER_POLL
+POLL = acomms_pb.StoreServerTransmission.STORE_SERVER_DRIVER_POLL
 # Room in a request for everything but the frames' bytes (ids, times, the transmission's other
 # fields, the request around it), so that one full transmission always fits in one packet.
 TRANSMISSION_OVERHEAD = 256
@@ -36,7 +37,7 @@ TRANSMISSION_OVERHEAD = 256
 class StoreServerDriver(ModemDriverBase):
     DEFAULT_LINE_DELIMITER = "\r"
 
-    def __init__(self, clock=None, link=None) -> None:
+    def __init__(self, clock: Clock | None = None, link=None) -> None:
         super().__init__(clock, link)
         self.ss_cfg = acomms_pb.StoreServerConfig()
         self._outbox: list = []
@@ -48,7 +49,7 @@ class StoreServerDriver(ModemDriverBase):
         self._secret: bytes | None = None
         self._in_flight: list = []  # the outbox of the request awaiting its reply
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         cfg_copy = acomms_pb.DriverConfig()
         cfg_copy.CopyFrom(cfg)
         cfg = cfg_copy
@@ -74,7 +75,7 @@ class StoreServerDriver(ModemDriverBase):
         self.modem_close()
 
     # ------------------------------------------------------------------ sending
-    def handle_initiate_transmission(self, transmission) -> None:
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         msg = acomms_pb.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)

@@ -13,6 +13,7 @@ import socket
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.datagram import DatagramDriverBase
 from pygoby.acomms.errors import ModemDriverError
+from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
 
@@ -20,7 +21,7 @@ Status = acomms_pb.ModemDriverStatus
 
 
 class UDPDriver(DatagramDriverBase):
-    def __init__(self, clock=None) -> None:
+    def __init__(self, clock: Clock | None = None) -> None:
         super().__init__(clock)
         self.udp_cfg = acomms_pb.UDPConfig()
         self._remotes: dict[int, list[tuple[str, int]]] = {}
@@ -32,7 +33,7 @@ class UDPDriver(DatagramDriverBase):
         assert self._sock is not None
         return self._sock.getsockname()[1]
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         if not cfg.HasField("modem_id"):
             raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
         self.cfg = cfg
@@ -56,13 +57,14 @@ class UDPDriver(DatagramDriverBase):
                 raise ModemDriverError(
                     f"cannot resolve {remote.ip}: {exc}", Status.INVALID_CONFIGURATION
                 ) from exc
-            self._remotes.setdefault(remote.modem_id, []).append(info[0][4][:2])
+            host, port = info[0][4][:2]
+            self._remotes.setdefault(remote.modem_id, []).append((str(host), int(port)))
         self._ack_ids = {cfg.modem_id, *self.udp_cfg.additional_application_ack_modem_id}
 
-    def _max_frame_bytes(self, msg) -> int:
+    def _max_frame_bytes(self, msg: acomms_pb.ModemTransmission) -> int:
         return self.udp_cfg.max_frame_size
 
-    def _send(self, msg) -> None:
+    def _send(self, msg: acomms_pb.ModemTransmission) -> None:
         if self._sock is None:
             raise ModemDriverError("UDP driver is not started", Status.CONNECTION_TO_MODEM_FAILED)
         data = msg.SerializeToString()
@@ -84,7 +86,7 @@ class UDPDriver(DatagramDriverBase):
                 log.warning("UDP send to %s failed: %s", address, exc)
         self.emit_raw(False, data)
 
-    def _handle_transmission(self, msg, data: bytes) -> None:
+    def _handle_transmission(self, msg: acomms_pb.ModemTransmission, data: bytes) -> None:
         self.emit_raw(True, data)
         if msg.type != acomms_pb.ACK and msg.ack_requested and msg.dest in self._ack_ids:
             ack = acomms_pb.ModemTransmission(

@@ -14,20 +14,20 @@ import struct
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.datagram import DatagramDriverBase
 from pygoby.acomms.errors import ModemDriverError
-from pygoby.protobuf import default_loader
+from pygoby.util.clock import Clock
 
 log = logging.getLogger(__name__)
 
 Status = acomms_pb.ModemDriverStatus
-_CONFIG = default_loader().pool.FindExtensionByName("goby.acomms.udp_multicast.protobuf.config")
+_CONFIG = acomms_pb.UDP_MULTICAST_CONFIG
 
 
 class UDPMulticastDriver(DatagramDriverBase):
-    def __init__(self, clock=None) -> None:
+    def __init__(self, clock: Clock | None = None) -> None:
         super().__init__(clock)
-        self.mc_cfg = None
+        self.mc_cfg = acomms_pb.UDPMulticastConfig()
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         if not cfg.HasField("modem_id"):
             raise ModemDriverError("modem_id is required", Status.INVALID_CONFIGURATION)
         self.cfg = cfg
@@ -52,11 +52,11 @@ class UDPMulticastDriver(DatagramDriverBase):
         sock.setblocking(False)
         self._sock = sock
 
-    def _max_frame_bytes(self, msg) -> int:
+    def _max_frame_bytes(self, msg: acomms_pb.ModemTransmission) -> int:
         sizes = {rb.rate: rb.bytes for rb in self.mc_cfg.rate_to_bytes}
         return sizes.get(msg.rate, self.mc_cfg.max_frame_size)
 
-    def _send(self, msg) -> None:
+    def _send(self, msg: acomms_pb.ModemTransmission) -> None:
         if self._sock is None:
             raise ModemDriverError("driver is not started", Status.CONNECTION_TO_MODEM_FAILED)
         data = msg.SerializeToString()
@@ -66,7 +66,7 @@ class UDPMulticastDriver(DatagramDriverBase):
             log.warning("multicast send failed: %s", exc)
         self.emit_raw(False, data)
 
-    def _handle_transmission(self, msg, data: bytes) -> None:
+    def _handle_transmission(self, msg: acomms_pb.ModemTransmission, data: bytes) -> None:
         if msg.src == self.modem_id:
             return  # our own transmission looped back
         self.emit_raw(True, data)

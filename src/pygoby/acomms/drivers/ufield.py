@@ -20,13 +20,14 @@ from google.protobuf.message import DecodeError
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
 from pygoby.acomms.errors import ModemDriverError
+from pygoby.util.clock import Clock
 from pygoby.util.modem_id import ModemIdLookup
 
 log = logging.getLogger(__name__)
 
 DEFAULT_FRAME_BYTES = 64
 SOUND_SPEED = 1500.0
-POLL = 1  # goby.moos.ufld.protobuf.Transmission.UFIELD_DRIVER_POLL
+POLL = acomms_pb.UFldTransmission.UFIELD_DRIVER_POLL
 
 
 def parse_moos_pairs(text: str) -> dict[str, str]:
@@ -51,7 +52,9 @@ class MailLink(Protocol):
 
 
 class UFldDriver(ModemDriverBase):
-    def __init__(self, clock=None, publish: Callable[[str, str], None] | None = None) -> None:
+    def __init__(
+        self, clock: Clock | None = None, publish: Callable[[str, str], None] | None = None
+    ) -> None:
         super().__init__(clock)
         self._injected_publish = publish
         self.publish = publish if publish is not None else (lambda var, text: None)
@@ -60,7 +63,7 @@ class UFldDriver(ModemDriverBase):
         self.lookup = ModemIdLookup()
         self._ping_target: str | None = None
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         self.cfg = cfg
         self.ufld = cfg.Extensions[acomms_pb.UFLD_CONFIG]
         if self.ufld.modem_id_lookup_path:
@@ -92,7 +95,7 @@ class UFldDriver(ModemDriverBase):
         return "all" if modem_id == acomms_pb.BROADCAST_ID else self.lookup.name(modem_id)
 
     # ------------------------------------------------------------------ sending
-    def handle_initiate_transmission(self, transmission) -> None:
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         msg = acomms_pb.ModemTransmission()
         msg.CopyFrom(transmission)
         self.signal_modify_transmission.emit(msg)
@@ -122,7 +125,7 @@ class UFldDriver(ModemDriverBase):
         else:
             log.warning("uField driver ignores transmission type %d", msg.type)
 
-    def _send(self, msg) -> None:
+    def _send(self, msg: acomms_pb.ModemTransmission) -> None:
         text = msg.SerializeToString().hex()
         self.publish(self.ufld.outgoing_moos_var, text)
         node_message = (

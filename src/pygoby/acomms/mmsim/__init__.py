@@ -2,20 +2,20 @@
 
 from pygoby.acomms.mmsim.channel import (
     AcousticPacket,
-    Channel,
     ChannelEndpoint,
     LoopbackChannel,
-    PacketKind,
-    Reception,
+    ModemChannel,
+    ModemPacketKind,
+    ModemReception,
 )
 from pygoby.acomms.mmsim.model import MicroModemModel
 
 __all__ = [
     "AcousticPacket",
-    "Channel",
+    "ModemChannel",
     "ChannelEndpoint",
     "LoopbackChannel",
     "MicroModemModel",
-    "PacketKind",
-    "Reception",
+    "ModemPacketKind",
+    "ModemReception",
 ]

@@ -16,7 +16,7 @@ Interface (what a physics channel, e.g. in pygoby.netsim, implements):
   `do_work()`, which whoever runs the modems calls regularly (a discrete-event loop at
   `next_event_time()`); a late call is still made, with the true times in its arguments.
 
-`Reception` carries what the channel decided: the arrival time of the signal's start, per-frame
+`ModemReception` carries what the channel decided: the arrival time of the signal's start, per-frame
 CRC outcome and optional `$CACST` statistics overrides (any ReceiveStatistics field name, e.g.
 `snr_in`, `mse_equalizer`, `doppler`, `spl`).
 """
@@ -33,7 +33,7 @@ from pygoby.util.timeline import Timeline
 DEFAULT_SOUND_SPEED = 1500.0  # m/s
 
 
-class PacketKind(enum.Enum):
+class ModemPacketKind(enum.Enum):
     DATA = "data"  # data frames at a rate (a PSK packet carries its cycle-init in its header)
     CYCLE = "cycle"  # a cycle-init mini-packet: rate 0's own, or a third-party poll
     ACK = "ack"  # acoustic acknowledgement of frames
@@ -47,7 +47,7 @@ class PacketKind(enum.Enum):
 
 @dataclass
 class AcousticPacket:
-    kind: PacketKind
+    kind: ModemPacketKind
     src: int
     dest: int
     rate: int = 0
@@ -65,7 +65,7 @@ class AcousticPacket:
 
 
 @dataclass
-class Reception:
+class ModemReception:
     arrival_time: float  # when the start of the signal reached the receiver
     frame_ok: list[bool] | None = None  # None: every frame good
     stats: dict[str, float] = field(default_factory=dict)
@@ -83,10 +83,10 @@ class ChannelEndpoint(Protocol):
 
     def detect(self, packet: AcousticPacket, arrival: float) -> None: ...
 
-    def receive(self, packet: AcousticPacket, reception: Reception) -> None: ...
+    def receive(self, packet: AcousticPacket, reception: ModemReception) -> None: ...
 
 
-class Channel(Protocol):
+class ModemChannel(Protocol):
     def attach(self, endpoint: ChannelEndpoint) -> None: ...
 
     def detach(self, endpoint: ChannelEndpoint) -> None: ...
@@ -135,14 +135,16 @@ class LoopbackChannel:
         for endpoint in endpoints:
             self.timeline.at(arrival, self._detect, endpoint, packet, arrival)
             self.timeline.at(
-                arrival + packet.duration, self._receive, endpoint, packet, Reception(arrival)
+                arrival + packet.duration, self._receive, endpoint, packet, ModemReception(arrival)
             )
 
     def _detect(self, endpoint: ChannelEndpoint, packet: AcousticPacket, arrival: float) -> None:
         if endpoint in self.endpoints:  # (still attached)
             endpoint.detect(packet, arrival)
 
-    def _receive(self, endpoint: ChannelEndpoint, packet: AcousticPacket, r: Reception) -> None:
+    def _receive(
+        self, endpoint: ChannelEndpoint, packet: AcousticPacket, r: ModemReception
+    ) -> None:
         if endpoint in self.endpoints:
             endpoint.receive(packet, r)
 

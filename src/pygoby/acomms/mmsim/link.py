@@ -3,7 +3,7 @@
 `ModemLink` carries sentences, not text: what the driver writes goes to the model's
 `handle_sentence`, what the model says (NMEA sentences, and `$CACST` as its values) waits until
 the driver reads it. Text is made only where a real line is (serial, pty, TCP). The driver
-recognises this kind of link by its `read_sentences` / `write_sentence`.
+uses it as a `SentenceLink` (pygoby.acomms.drivers.micromodem.sentence_link) as it is.
 """
 
 from __future__ import annotations

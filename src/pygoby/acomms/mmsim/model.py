@@ -1,7 +1,7 @@
 """A sans-I/O model of a WHOI Micro-Modem: its NMEA interface and its timing (what a host sees).
 
 Feed host sentences with `handle_sentence` (or text with `handle_line`); the modem's sentences go
-to `on_output` (or wait in `take_output()`). Acoustic traffic goes through a `Channel`; packets
+to `on_output` (or wait in `take_output()`). Acoustic traffic goes through a `ModemChannel`; packets
 heard from it arrive in `detect` (start of the signal: `$CARXP`) and `receive` (end of the
 signal: `$CACYC`, `$CARXD`, `$CACST`, ...). Everything that takes time is put on a `Timeline`:
 whoever runs the model calls `do_work()` (or runs the shared timeline) and, in a discrete-event
@@ -41,7 +41,12 @@ from pygoby.acomms.drivers.micromodem.statistics import (
     CycleStatistics,
     format_xst,
 )
-from pygoby.acomms.mmsim.channel import AcousticPacket, Channel, PacketKind, Reception
+from pygoby.acomms.mmsim.channel import (
+    AcousticPacket,
+    ModemChannel,
+    ModemPacketKind,
+    ModemReception,
+)
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, FDP_RATES, ModemTiming
 from pygoby.util.clock import Clock
 from pygoby.util.errors import NMEAError
@@ -163,7 +168,7 @@ class MicroModemModel:
         self,
         modem_id: int,
         clock: Clock,
-        channel: Channel | None = None,
+        channel: ModemChannel | None = None,
         *,
         name: str | None = None,
         firmware: str = DEFAULT_FIRMWARE,
@@ -268,7 +273,7 @@ class MicroModemModel:
 
     def handle_sentence(self, s: NMEASentence) -> None:
         sentence_id = s.sentence_id
-        command = _COMMANDS.get(sentence_id) if s.talker_id == "CC" else None
+        command = COMMAND_HANDLERS.get(sentence_id) if s.talker_id == "CC" else None
         if command is None or (sentence_id in _MM2_COMMANDS and not self.mm2):
             self._error("NMEA", 2, f"Unknown command {s.fields[0][1:]}")
             return
@@ -384,7 +389,7 @@ class MicroModemModel:
             self._start_transmit(_Transmit(adr1, adr2, rate, bool(ack), nframes))
         else:  # a third-party cycle-init: an acoustic poll asking adr1 to send
             cycle = AcousticPacket(
-                PacketKind.CYCLE, adr1, adr2, rate, bool(ack), num_frames=nframes
+                ModemPacketKind.CYCLE, adr1, adr2, rate, bool(ack), num_frames=nframes
             )
             self._send(cycle, self.timing.mini_packet, at=self._line_done)
 
@@ -392,7 +397,7 @@ class MicroModemModel:
         self._tx = tx
         if tx.rate == 0:  # the FSK cycle-init goes first, on its own; then the data is asked for
             cycle = AcousticPacket(
-                PacketKind.CYCLE, tx.src, tx.dest, 0, tx.ack, num_frames=tx.num_frames
+                ModemPacketKind.CYCLE, tx.src, tx.dest, 0, tx.ack, num_frames=tx.num_frames
             )
             # (polled acoustically before the host said anything, the line has no time yet: now)
             start = max(self._line_done, self.clock.now())
@@ -437,13 +442,15 @@ class MicroModemModel:
         self._tx = None
         tx.requested = 0
         if tx.frames:  # (nothing to send: nothing goes out)
-            packet = AcousticPacket(PacketKind.DATA, tx.src, tx.dest, tx.rate, tx.ack, tx.frames)
+            packet = AcousticPacket(
+                ModemPacketKind.DATA, tx.src, tx.dest, tx.rate, tx.ack, tx.frames
+            )
             self._send(packet, self.timing.data(tx.rate, len(tx.frames)), at=self._line_done)
 
     def _cmd_mpc(self, s: NMEASentence) -> None:
         src, dest = s.as_int(1, 0, MAX_ADDRESS), s.as_int(2, 0, MAX_ADDRESS)
         self._say("$CAMPC", src, dest)
-        ping = AcousticPacket(PacketKind.PING, src, dest)
+        ping = AcousticPacket(ModemPacketKind.PING, src, dest)
         self._send(ping, self.timing.ping, at=self._line_done)
         self._pings[dest] = ping.tx_time
 
@@ -457,7 +464,7 @@ class MicroModemModel:
             self._error("MUC", 7, "Mini-packet data must be 13 bits")
             return
         self._say("$CAMUC", src, dest, s[3])
-        mini = AcousticPacket(PacketKind.MINI, src, dest, frames=[data])
+        mini = AcousticPacket(ModemPacketKind.MINI, src, dest, frames=[data])
         self._send(mini, self.timing.mini_packet, at=self._line_done)
 
     def _cmd_tdp(self, s: NMEASentence) -> None:
@@ -470,7 +477,7 @@ class MicroModemModel:
         self._say("$CATDP", *s.fields[1:])
         size = self.timing.rates[rate].frame_bytes  # (the payload goes in its rate's frames)
         frames = [data[i : i + size] for i in range(0, len(data), size)]
-        packet = AcousticPacket(PacketKind.FDP, self.modem_id, dest, rate, bool(ack), frames)
+        packet = AcousticPacket(ModemPacketKind.FDP, self.modem_id, dest, rate, bool(ack), frames)
         self._send(packet, self.timing.data(rate, len(frames)), at=self._line_done)
 
     def _cmd_mec(self, s: NMEASentence) -> None:
@@ -480,7 +487,9 @@ class MicroModemModel:
             self._say("$CAMEC", src, dest, line, mode, self._control_line(line, mode, arg))
             return
         self._say("$CAMEC", src, dest, line, mode, arg)
-        command = AcousticPacket(PacketKind.HW_CONTROL, src, dest, hw_control=(line, mode, arg))
+        command = AcousticPacket(
+            ModemPacketKind.HW_CONTROL, src, dest, hw_control=(line, mode, arg)
+        )
         self._send(command, self.timing.mini_packet, at=self._line_done)
 
     def _control_line(self, line: int, mode: int, arg: int) -> int:
@@ -507,7 +516,7 @@ class MicroModemModel:
         timeout_ms = s.as_int(timeout_field, 0, 60_000)
         self._say(echo, *s.fields[1:])
         start = max(self._line_done, self._air_free_at)
-        self._send(AcousticPacket(PacketKind.SIGNAL, self.modem_id, 0), length, at=start)
+        self._send(AcousticPacket(ModemPacketKind.SIGNAL, self.modem_id, 0), length, at=start)
         # no transponders answer: the travel times stay empty
         when = dt.datetime.fromtimestamp(start + self._clock_offset, dt.UTC)
         stamp = f"{when:%H%M%S}.{when.microsecond // 10000:02d}"
@@ -528,7 +537,9 @@ class MicroModemModel:
 
     def _signal(self, s: NMEASentence, echo: str, length: float) -> None:
         self._say(echo, *s.fields[1:])
-        self._send(AcousticPacket(PacketKind.SIGNAL, self.modem_id, 0), length, at=self._line_done)
+        self._send(
+            AcousticPacket(ModemPacketKind.SIGNAL, self.modem_id, 0), length, at=self._line_done
+        )
 
     # ------------------------------------------------------------------ on the water
     def _send(
@@ -572,7 +583,7 @@ class MicroModemModel:
                 "source": packet.src,
                 "dest": packet.dest,
                 "ack_requested": packet.ack_requested,
-                "number_frames_expected": frames if packet.kind is PacketKind.DATA else 0,
+                "number_frames_expected": frames if packet.kind is ModemPacketKind.DATA else 0,
                 "number_frames_sent": frames,
                 "packet_type": _packet_type(packet),
                 "number_bytes": nbytes,
@@ -592,13 +603,13 @@ class MicroModemModel:
 
     # ------------------------------------------------------------------ acoustic receptions
     def detect(self, packet: AcousticPacket, arrival: float) -> None:
-        if packet.kind is not PacketKind.SIGNAL and self._on("RXP"):
+        if packet.kind is not ModemPacketKind.SIGNAL and self._on("RXP"):
             self._emit(_RXP)
 
-    def receive(self, packet: AcousticPacket, reception: Reception) -> None:
+    def receive(self, packet: AcousticPacket, reception: ModemReception) -> None:
         _HEARD[packet.kind](self, packet, reception)
 
-    def _heard_data(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_data(self, p: AcousticPacket, r: ModemReception) -> None:
         if p.rate != 0:  # (a PSK packet's header is its cycle-init)
             self._emit(_heard_cycle_sentence(p, len(p.frames)))
         good: list[int] = []
@@ -617,32 +628,34 @@ class MicroModemModel:
                 self._say("$CAMSG", "BAD_CRC", i + 1)
         self._cst(p, r, frames=len(p.frames), bad=len(p.frames) - len(good))
         if p.ack_requested and p.dest == self.modem_id and p.dest != 0 and good:
-            ack = AcousticPacket(PacketKind.ACK, self.modem_id, p.src, p.rate, acked_frames=good)
+            ack = AcousticPacket(
+                ModemPacketKind.ACK, self.modem_id, p.src, p.rate, acked_frames=good
+            )
             self._send(ack, self.timing.mini_packet)
 
-    def _heard_cycle(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_cycle(self, p: AcousticPacket, r: ModemReception) -> None:
         self._emit(_heard_cycle_sentence(p, p.num_frames))
         self._cst(p, r, frames=0, bad=0)
         if p.src == self.modem_id and self._tx is None:  # polled: send our data
             self._start_transmit(_Transmit(p.src, p.dest, p.rate, p.ack_requested, p.num_frames))
 
-    def _heard_ack(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_ack(self, p: AcousticPacket, r: ModemReception) -> None:
         if p.dest != self.modem_id:
             return
         for frame_no in p.acked_frames:
             self._say("$CAACK", p.src, p.dest, frame_no, 1)
         self._cst(p, r, frames=0, bad=0)
 
-    def _heard_ping(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_ping(self, p: AcousticPacket, r: ModemReception) -> None:
         if p.dest != self.modem_id:
             return
         self._say("$CAMPA", p.src, p.dest)
         # the reply leaves the turnaround time after the ping has been heard
         reply_at = r.arrival_time + p.duration + self._turnaround()
-        reply = AcousticPacket(PacketKind.PING_REPLY, self.modem_id, p.src)
+        reply = AcousticPacket(ModemPacketKind.PING_REPLY, self.modem_id, p.src)
         self.timeline.at(reply_at, self._send, reply, self.timing.ping, None, reply_at)
 
-    def _heard_ping_reply(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_ping_reply(self, p: AcousticPacket, r: ModemReception) -> None:
         sent = self._pings.pop(p.src, None) if p.dest == self.modem_id else None
         if sent is not None:
             round_trip = r.arrival_time - sent - self.timing.ping - self._turnaround()
@@ -651,10 +664,10 @@ class MicroModemModel:
     def _turnaround(self) -> float:
         return max(0, int(self.nvram["TAT"])) / 1000
 
-    def _heard_mini(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_mini(self, p: AcousticPacket, r: ModemReception) -> None:
         self._say("$CAMUA", p.src, p.dest, p.frames[0].hex().upper())
 
-    def _heard_fdp(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_fdp(self, p: AcousticPacket, r: ModemReception) -> None:
         payload = b"".join(p.frames)
         bad = sum(not r.frame_good(i) for i in range(len(p.frames)))
         good = not bad
@@ -669,10 +682,10 @@ class MicroModemModel:
         self._say("$CARDP", p.src, p.dest, p.rate, int(p.ack_requested), 0, triple, "")
         self._cst(p, r, frames=len(p.frames), bad=bad)
 
-    def _heard_signal(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_signal(self, p: AcousticPacket, r: ModemReception) -> None:
         pass  # (sweeps, sequences and navigation pings carry nothing for a modem)
 
-    def _heard_hw_control(self, p: AcousticPacket, r: Reception) -> None:
+    def _heard_hw_control(self, p: AcousticPacket, r: ModemReception) -> None:
         if p.dest != self.modem_id or p.hw_control is None:
             return
         line, mode, arg = p.hw_control
@@ -682,11 +695,15 @@ class MicroModemModel:
         self._say("$CAMEA", p.src, p.dest, line, mode, arg)
         value = self._control_line(line, mode, arg)
         reply = AcousticPacket(
-            PacketKind.HW_CONTROL, self.modem_id, p.src, hw_control=(line, mode, value), reply=True
+            ModemPacketKind.HW_CONTROL,
+            self.modem_id,
+            p.src,
+            hw_control=(line, mode, value),
+            reply=True,
         )
         self._send(reply, self.timing.mini_packet)
 
-    def _cst(self, p: AcousticPacket, r: Reception, frames: int, bad: int) -> None:
+    def _cst(self, p: AcousticPacket, r: ModemReception, frames: int, bad: int) -> None:
         if not self._on("CST"):
             return
         stats = tuple(r.stats.items())
@@ -745,9 +762,9 @@ def _heard_cycle_sentence(p: AcousticPacket, frames: int) -> NMEASentence:
 
 def _packet_type(p: AcousticPacket) -> int:
     """ReceiveStatistics.PacketType: FSK 1, FSK_MINI 2, PSK 3, FLEXIBLE_DATA_PACKET 5."""
-    if p.kind is PacketKind.FDP:
+    if p.kind is ModemPacketKind.FDP:
         return 5
-    if p.kind is PacketKind.DATA:
+    if p.kind is ModemPacketKind.DATA:
         return 1 if p.rate == 0 else 3
     return 2
 
@@ -803,32 +820,39 @@ _CST_DEFAULTS = (
 )
 _RATE, _BAD_FRAMES = CST_FIELD_INDEX["rate"], CST_FIELD_INDEX["number_bad_frames"]
 _RXP = NMEASentence.build("$CARXP", [0])  # (sentences are immutable: one serves every packet)
-_XST_KINDS = (PacketKind.DATA, PacketKind.CYCLE, PacketKind.FDP)
+_XST_KINDS = (ModemPacketKind.DATA, ModemPacketKind.CYCLE, ModemPacketKind.FDP)
 # sentence id -> handler; those only a Micro-Modem 2 knows
-_COMMANDS = {
-    name: getattr(MicroModemModel, "_cmd_" + name.lower())
-    for name in (
-        "CFG",
-        "CFQ",
-        "MSC",
-        "CLK",
-        "CLQ",
-        "TMS",
-        "TMQ",
-        "ALQ",
-        "CYC",
-        "TXD",
-        "MPC",
-        "MUC",
-        "TDP",
-        "MEC",
-        "PDT",
-        "PNT",
-        "PGT",
-        "SWP",
-        "MSQ",
-        "RSP",
-    )
+COMMAND_HANDLERS = {
+    "CFG": MicroModemModel._cmd_cfg,
+    "CFQ": MicroModemModel._cmd_cfq,
+    "MSC": MicroModemModel._cmd_msc,
+    "CLK": MicroModemModel._cmd_clk,
+    "CLQ": MicroModemModel._cmd_clq,
+    "TMS": MicroModemModel._cmd_tms,
+    "TMQ": MicroModemModel._cmd_tmq,
+    "ALQ": MicroModemModel._cmd_alq,
+    "CYC": MicroModemModel._cmd_cyc,
+    "TXD": MicroModemModel._cmd_txd,
+    "MPC": MicroModemModel._cmd_mpc,
+    "MUC": MicroModemModel._cmd_muc,
+    "TDP": MicroModemModel._cmd_tdp,
+    "MEC": MicroModemModel._cmd_mec,
+    "PDT": MicroModemModel._cmd_pdt,
+    "PNT": MicroModemModel._cmd_pnt,
+    "PGT": MicroModemModel._cmd_pgt,
+    "SWP": MicroModemModel._cmd_swp,
+    "MSQ": MicroModemModel._cmd_msq,
+    "RSP": MicroModemModel._cmd_rsp,
 }
 _MM2_COMMANDS = frozenset({"TMS", "TMQ", "ALQ", "TDP"})
-_HEARD = {kind: getattr(MicroModemModel, "_heard_" + kind.value) for kind in PacketKind}
+_HEARD = {
+    ModemPacketKind.DATA: MicroModemModel._heard_data,
+    ModemPacketKind.CYCLE: MicroModemModel._heard_cycle,
+    ModemPacketKind.ACK: MicroModemModel._heard_ack,
+    ModemPacketKind.PING: MicroModemModel._heard_ping,
+    ModemPacketKind.PING_REPLY: MicroModemModel._heard_ping_reply,
+    ModemPacketKind.MINI: MicroModemModel._heard_mini,
+    ModemPacketKind.FDP: MicroModemModel._heard_fdp,
+    ModemPacketKind.HW_CONTROL: MicroModemModel._heard_hw_control,
+    ModemPacketKind.SIGNAL: MicroModemModel._heard_signal,
+}

@@ -31,8 +31,8 @@ from pygoby.acomms.mmsim.channel import (
     AcousticPacket,
     ChannelEndpoint,
     LoopbackChannel,
-    PacketKind,
-    Reception,
+    ModemPacketKind,
+    ModemReception,
 )
 from pygoby.util.clock import Clock
 
@@ -42,7 +42,7 @@ LOOPBACK = "127.0.0.1"
 MAX_DATAGRAM = 16384
 MAX_FRAMES, MAX_FRAME_BYTES = 8, 256  # (the largest packet: rate 5)
 # (sender's [lat, lon, depth], receiver's, packet) -> how the receiver hears it (None: not at all)
-LinkModel = Callable[[Sequence[float], Sequence[float], AcousticPacket], Reception | None]
+LinkModel = Callable[[Sequence[float], Sequence[float], AcousticPacket], ModemReception | None]
 
 
 def packet_to_json(
@@ -82,7 +82,7 @@ def packet_from_json(data: bytes) -> tuple[str, AcousticPacket, list[float] | No
         raise ValueError("more data than a packet carries")
     hw = d["hw"]
     packet = AcousticPacket(
-        PacketKind(d["kind"]),
+        ModemPacketKind(d["kind"]),
         _int(d["src"]),
         _int(d["dest"]),
         _int(d["rate"]),
@@ -92,7 +92,7 @@ def packet_from_json(data: bytes) -> tuple[str, AcousticPacket, list[float] | No
         _int(d["num_frames"]),
         float(d["tx"]),
         float(d["duration"]),
-        None if hw is None else tuple(map(_int, hw[:3])),
+        None if hw is None else (_int(hw[0]), _int(hw[1]), _int(hw[2])),
         bool(d["reply"]),
     )
     if not 0 <= packet.duration < 3600:

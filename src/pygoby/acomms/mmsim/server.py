@@ -17,7 +17,7 @@ import logging
 import os
 import re
 
-from pygoby.acomms.mmsim.channel import Channel
+from pygoby.acomms.mmsim.channel import ModemChannel
 from pygoby.acomms.mmsim.model import MicroModemModel
 from pygoby.util.linebased import open_pty_pair
 from pygoby.util.pty import PtyEnd, open_serial
@@ -52,7 +52,7 @@ class MMSimServer:
     def __init__(
         self,
         model: MicroModemModel,
-        channel: Channel,
+        channel: ModemChannel,
         host: str = "127.0.0.1",
         port: int | None = 0,
         pty_path: str | None = None,

@@ -24,7 +24,7 @@ class CCLQueue(MessageQueue):
         return self.entry.protobuf_name
 
 
-def queue_entry(cfg) -> object:
+def queue_entry(cfg: acomms_pb.V1QueueConfig) -> acomms_pb.QueuedMessageEntry:
     """The QueuedMessageEntry holding a Goby 1.1 QueueConfig's options (for the contest)."""
     return acomms_pb.QueuedMessageEntry(
         protobuf_name=f"CCL:{cfg.name}",
@@ -50,7 +50,7 @@ def goby11_time(seconds: float) -> str:
     return text + (f".{moment.microsecond:06d}" if moment.microsecond else "")
 
 
-def received(transmission, data: bytes, ccl_id: int, frame: int):
+def received(transmission: acomms_pb.ModemTransmission, data: bytes, ccl_id: int, frame: int):
     """The Goby 1.1 ModemDataTransmission of a received CCL frame."""
     out = acomms_pb.V1ModemDataTransmission(
         data=data, frame=frame, ack_requested=transmission.ack_requested

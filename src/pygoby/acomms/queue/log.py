@@ -14,6 +14,7 @@ modem id:
 
 from __future__ import annotations
 
+from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.util.glog import DEBUG1, DEBUG2, VERBOSE, group_logger
 
@@ -101,7 +102,7 @@ class QueueLog:
 
     # -- transmissions ----------------------------------------------------------------------
 
-    def transmission(self, request, names: list[str]) -> None:
+    def transmission(self, request: acomms_pb.ModemTransmission, names: list[str]) -> None:
         if not names:
             if self.out.isEnabledFor(DEBUG1):
                 self.out.log(
@@ -129,7 +130,7 @@ class QueueLog:
             _ack_text(request.ack_requested),
         )
 
-    def reception(self, transmission, names: list[str]) -> None:
+    def reception(self, transmission: acomms_pb.ModemTransmission, names: list[str]) -> None:
         if self.into.isEnabledFor(VERBOSE):
             size = sum(len(frame) for frame in transmission.frame)
             self.into.log(
@@ -144,7 +145,7 @@ class QueueLog:
                 _ack_text(transmission.ack_requested),
             )
 
-    def acknowledged(self, ack, names: list[str]) -> None:
+    def acknowledged(self, ack: acomms_pb.ModemTransmission, names: list[str]) -> None:
         if self.into.isEnabledFor(VERBOSE):
             what = "acknowledges " + ", ".join(names) if names else "no message waits for them"
             self.into.log(
@@ -156,7 +157,7 @@ class QueueLog:
                 what,
             )
 
-    def ack_for_another(self, ack, modem_id: int) -> None:
+    def ack_for_another(self, ack: acomms_pb.ModemTransmission, modem_id: int) -> None:
         self.into.warning("ignoring an ACK for modem %d (we are %d)", ack.dest, modem_id)
 
     def undecodable(self, offset: int, error: Exception) -> None:
@@ -169,7 +170,13 @@ class QueueLog:
     def contests(self) -> bool:
         return self.priority.isEnabledFor(DEBUG2)
 
-    def contest(self, request, frame_used: int, entries: list[tuple[str, str]], winner) -> None:
+    def contest(
+        self,
+        request: acomms_pb.ModemTransmission,
+        frame_used: int,
+        entries: list[tuple[str, str]],
+        winner,
+    ) -> None:
         """`entries`: (queue name, "priority P" or why it could not take part)."""
         lines = "; ".join(f"{name}: {state}" for name, state in entries) or "no queues"
         self.priority.log(

@@ -9,7 +9,7 @@ logs, and in which group, is pygoby.acomms.queue.log.
 
 from __future__ import annotations
 
-from google.protobuf.message import DecodeError
+from google.protobuf.message import DecodeError, Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import QueueError
@@ -19,39 +19,49 @@ from pygoby.acomms.queue.log import QueueLog
 from pygoby.acomms.queue.persist import QueueStore
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
 from pygoby.acomms.queue.roles import Role, compile_roles, timestamp_us
-from pygoby.dccl import DcclError
+from pygoby.dccl import Codec, DcclError
 from pygoby.dccl.dccl1 import DCCL1_FIRST_BYTE, Dccl1Header, is_dccl1_frame, stitch, unstitch
+from pygoby.dccl.dccl1.bridge import Dccl1Bridge
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.signal import Signal
 
 
 class QueueManager:
-    def __init__(self, codec, clock: Clock | None = None) -> None:
+    def __init__(self, codec: Codec, clock: Clock | None = None) -> None:
         """`codec` is a pygoby.dccl.Codec (types are loaded into it as queues are added)."""
         self.codec = codec
-        self._peer_codecs: dict[int, object] = {}  # encrypt_rule: peer id -> Codec
+        self._peer_codecs: dict[int, Codec] = {}  # encrypt_rule: peer id -> Codec
         self.clock: Clock = clock if clock is not None else WallClock()
         self.cfg = acomms_pb.QueueManagerConfig()
         self.queues: dict[int, MessageQueue] = {}  # by DCCL id, kept in ascending order
         self._by_name: dict[str, MessageQueue] = {}
         self.ccl_queues: dict[int, CCLQueue] = {}  # Goby 1.1 raw CCL queues, by CCL id
         # Goby 1.1's own bytes (DCCL1) for the XML types: a pygoby.dccl.dccl1.Dccl1Bridge
-        self.dccl1 = None
+        self.dccl1: Dccl1Bridge | None = None
         self.store: QueueStore | None = None  # the persistent queue (attach_store)
-        self.signal_receive = Signal()  # (message)
-        self.signal_receive_ccl = Signal()  # (Goby 1.1 ModemDataTransmission of a CCL frame)
-        self.signal_ack = Signal()  # (ack ModemTransmission, original message)
-        self.signal_expire = Signal()  # (original message)
-        self.signal_queue_size_change = Signal()  # (QueueSize)
-        self.signal_ccl_queue_size_change = Signal()  # (CCL id, size)
-        self.signal_queued = Signal()  # (queue name, QueuedItem): a message was queued
+        self.signal_receive: Signal[Message] = Signal()  # (message)
+        self.signal_receive_ccl: Signal[acomms_pb.V1ModemDataTransmission] = (
+            Signal()
+        )  # (Goby 1.1 ModemDataTransmission of a CCL frame)
+        self.signal_ack: Signal[[acomms_pb.ModemTransmission, Message]] = (
+            Signal()
+        )  # (ack ModemTransmission, original message)
+        self.signal_expire: Signal[Message] = Signal()  # (original message)
+        self.signal_queue_size_change: Signal[acomms_pb.QueueSize] = Signal()  # (QueueSize)
+        self.signal_ccl_queue_size_change: Signal[[int, int]] = Signal()  # (CCL id, size)
+        # (queue name, QueuedItem): a message was queued
+        self.signal_queued: Signal[[str, QueuedItem]] = Signal()
         # (ModemTransmission, message bytes, DCCL id): a Goby 1.1 DCCL message for us arrived
-        self.signal_receive_dccl1 = Signal()
-        self.signal_data_on_demand = Signal()  # (request ModemTransmission, message to fill)
+        self.signal_receive_dccl1: Signal[[acomms_pb.ModemTransmission, bytes, int]] = Signal()
+        self.signal_data_on_demand: Signal[[acomms_pb.ModemTransmission, Message]] = (
+            Signal()
+        )  # (request ModemTransmission, message to fill)
         # routing (pygoby.acomms.route): the router may rewrite an outgoing item's link dest;
         # link packets for us are offered as (message, its bytes, its own dest, our id)
-        self.signal_out_route = Signal()  # (QueuedItem, modem_id)
-        self.signal_in_route = Signal()  # (message, encoded bytes, message dest, modem_id)
+        self.signal_out_route: Signal[[QueuedItem, int]] = Signal()  # (QueuedItem, modem_id)
+        self.signal_in_route: Signal[[Message, bytes, int, int]] = (
+            Signal()
+        )  # (message, encoded bytes, message dest, modem_id)
         self.log = QueueLog(0)
 
     @property
@@ -59,7 +69,7 @@ class QueueManager:
         return self.cfg.modem_id
 
     # ------------------------------------------------------------------ configuration
-    def set_cfg(self, cfg) -> None:
+    def set_cfg(self, cfg: acomms_pb.QueueManagerConfig) -> None:
         self.cfg = acomms_pb.QueueManagerConfig()
         self.cfg.CopyFrom(cfg)
         self.log = QueueLog(cfg.modem_id)
@@ -94,7 +104,9 @@ class QueueManager:
     def _first_byte(self, name: str, dccl_id: int) -> int:
         return DCCL1_FIRST_BYTE if self._is_dccl1(name) else ccl.dccl_first_byte(dccl_id)
 
-    def add_queue(self, entry, message_class=None) -> MessageQueue:
+    def add_queue(
+        self, entry: acomms_pb.QueuedMessageEntry, message_class: type[Message] | None = None
+    ) -> MessageQueue:
         """Create (or update the options of) the queue for `entry.protobuf_name`.
 
         The type must be known to the codec's loader or given as `message_class`."""
@@ -140,7 +152,7 @@ class QueueManager:
         self._size_changed(queue)
         return queue
 
-    def add_ccl_queue(self, cfg) -> CCLQueue:
+    def add_ccl_queue(self, cfg: acomms_pb.V1QueueConfig) -> CCLQueue:
         """Create (or update) a Goby 1.1 CCL queue from a goby.transitional.protobuf.QueueConfig."""
         if not cfg.HasField("key") or cfg.key.type != acomms_pb.QUEUE_CCL:
             raise QueueError(
@@ -175,7 +187,7 @@ class QueueManager:
         self.ccl_queues[ccl_id] = queue
         return queue
 
-    def push_ccl(self, ccl_id: int, transmission) -> None:
+    def push_ccl(self, ccl_id: int, transmission: acomms_pb.V1ModemDataTransmission) -> None:
         """Queue a raw frame (a Goby 1.1 ModemDataTransmission: `data`, `base.dest`) on the CCL
         queue `ccl_id`; its first byte must be that id."""
         queue = self.ccl_queues.get(ccl_id)
@@ -220,8 +232,8 @@ class QueueManager:
             queue.journal = store
         restored = 0
         for stored in store.items():
-            queue = queues.get(stored.queue)
-            if queue is None or queue.message_class is None:
+            found = queues.get(stored.queue)
+            if found is None or found.message_class is None:
                 self.log.push.warning(
                     "persistent queue %s: a stored %s is kept, but not sent (no such queue is "
                     "configured)",
@@ -229,8 +241,9 @@ class QueueManager:
                     stored.queue,
                 )
                 continue
+            queue = found
             try:
-                message = queue.message_class.FromString(stored.message)
+                message = found.message_class.FromString(stored.message)
             except DecodeError as exc:
                 self.log.push.warning(
                     "persistent queue %s: a stored %s does not parse (%s); dropped",
@@ -264,7 +277,7 @@ class QueueManager:
         )
 
     # ------------------------------------------------------------------ push
-    def push_message(self, msg, encoded: bytes | None = None) -> None:
+    def push_message(self, msg: Message, encoded: bytes | None = None) -> None:
         """Queue a message. `encoded`: its DCCL bytes as received (a relayed message keeps
         them untouched, so encrypted bodies pass through)."""
         queue = self._by_name.get(msg.DESCRIPTOR.full_name)
@@ -297,7 +310,7 @@ class QueueManager:
         when = timestamp_us(getter, msg) if getter is not None else None
         item.time = when if when is not None else acomms_pb.now_us(self.clock.now())
         if encoded is None and self._is_dccl1(queue.name):
-            encoded = self.dccl1.encode(msg)  # type: ignore[union-attr]
+            encoded = self.dccl1.encode(msg)  # type: ignore[union-attr]  # (_is_dccl1: a bridge)
         elif encoded is None:  # encrypt_rule: the passphrase of the message's destination
             encoded = self._peer_codecs.get(dest, self.codec).encode(msg)
         item.encoded = encoded
@@ -310,12 +323,12 @@ class QueueManager:
         self._size_changed(queue)
         self.signal_queued.emit(queue.name, item)
 
-    def message_dest(self, msg) -> int:
+    def message_dest(self, msg: Message) -> int:
         """A message's own destination (its DESTINATION_ID role; 0 without one)."""
         queue = self._by_name.get(msg.DESCRIPTOR.full_name)
         return 0 if queue is None else self._role(queue, Role.DESTINATION_ID, msg, 0)
 
-    def _role(self, queue: MessageQueue, role: int, msg, default: int) -> int:
+    def _role(self, queue: MessageQueue, role: int, msg: Message, default: int) -> int:
         getter = queue.roles.get(role)
         if getter is None:
             return default
@@ -330,7 +343,7 @@ class QueueManager:
         queue.clear()
         self._size_changed(queue)
 
-    def flush_queue(self, flush) -> None:
+    def flush_queue(self, flush: acomms_pb.QueueFlush) -> None:
         queue = self.queues.get(flush.dccl_id)
         if queue is None:
             self.log.push.warning("flush: no queue with DCCL id %d", flush.dccl_id)
@@ -342,7 +355,7 @@ class QueueManager:
         return len(self.queues[dccl_id])
 
     # ------------------------------------------------------------------ data request
-    def handle_modem_data_request(self, request) -> None:
+    def handle_modem_data_request(self, request: acomms_pb.ModemTransmission) -> None:
         now = self.clock.now()
         for queue in self._all_queues():
             queue.clear_stale_waits(request.frame_start, now, self.cfg.minimum_ack_wait_seconds)
@@ -398,7 +411,7 @@ class QueueManager:
 
     def _contest(
         self,
-        request,
+        request: acomms_pb.ModemTransmission,
         used: int,
         limit: int | None,
         now: float,
@@ -435,7 +448,11 @@ class QueueManager:
 
     @staticmethod
     def _excluded(
-        queue: MessageQueue, request, used: int, limit: int | None, now: float
+        queue: MessageQueue,
+        request: acomms_pb.ModemTransmission,
+        used: int,
+        limit: int | None,
+        now: float,
     ) -> str | None:
         """Why `queue` cannot take part in the contest for this frame; None when it can."""
         if len(queue) <= queue.waiting_count:
@@ -463,7 +480,9 @@ class QueueManager:
             return "next message needs an ack and the packet has none"
         return None
 
-    def _refresh_on_demand(self, queue: MessageQueue, request, now: float) -> None:
+    def _refresh_on_demand(
+        self, queue: MessageQueue, request: acomms_pb.ModemTransmission, now: float
+    ) -> None:
         newest = queue.back()
         if newest is not None and now * 1e6 - newest.time <= self.cfg.on_demand_skew_seconds * 1e6:
             return
@@ -491,7 +510,7 @@ class QueueManager:
         return item
 
     # ------------------------------------------------------------------ receive
-    def handle_modem_receive(self, transmission) -> None:
+    def handle_modem_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         if transmission.type == acomms_pb.ACK:
             self._handle_ack(transmission)
         elif transmission.type == acomms_pb.DATA and not self.cfg.skip_decoding:
@@ -511,13 +530,15 @@ class QueueManager:
                     names += self._decode_frame(data, route)
             self.log.reception(transmission, names)
 
-    def _receive_ccl(self, transmission, data: bytes, index: int) -> None:
+    def _receive_ccl(
+        self, transmission: acomms_pb.ModemTransmission, data: bytes, index: int
+    ) -> None:
         if transmission.dest not in (acomms_pb.BROADCAST_ID, self.modem_id):
             return  # not for us (Goby 1.1 ignores messages to other modems)
         frame = transmission.frame_start + index
         self.signal_receive_ccl.emit(ccl.received(transmission, data, data[0], frame))
 
-    def _handle_ack(self, ack) -> None:
+    def _handle_ack(self, ack: acomms_pb.ModemTransmission) -> None:
         if ack.dest != self.modem_id:
             self.log.ack_for_another(ack, self.modem_id)
             return
@@ -556,7 +577,7 @@ class QueueManager:
 
     def _decode_dccl1_frame(self, transmission, data: bytes) -> list[str]:
         """The messages of a Goby 1.1 frame, each decoded and delivered on its own."""
-        names = []
+        names: list[str] = []
         try:
             parts = unstitch(data)
         except DcclError as exc:
@@ -575,7 +596,7 @@ class QueueManager:
         """Decode and deliver one Goby 1.1 DCCL message; its type name, None if it does not
         decode (logged: the other messages of its frame still count)."""
         try:
-            msg = self.dccl1.decode(data, self.clock.now())  # type: ignore[union-attr]
+            msg = self.dccl1.decode(data, self.clock.now())  # type: ignore[union-attr]  # (a bridge)
         except DcclError as exc:
             self.log.undecodable(0, exc)
             return None
@@ -598,7 +619,7 @@ class QueueManager:
         src = self._role(queue, Role.SOURCE_ID, header, 0) if queue is not None else 0
         return self._peer_codecs.get(src, self.codec)
 
-    def _deliver(self, msg) -> None:
+    def _deliver(self, msg: Message) -> None:
         queue = self._by_name.get(msg.DESCRIPTOR.full_name)
         if queue is None:
             self.signal_receive.emit(msg)
@@ -629,7 +650,13 @@ class QueueManager:
                 self.signal_expire.emit(item.msg)
                 self._network_ack(queue, item, acomms_pb.NetworkAck.EXPIRE, self.modem_id)
 
-    def _network_ack(self, queue: MessageQueue, item: QueuedItem, kind: int, ack_src: int) -> None:
+    def _network_ack(
+        self,
+        queue: MessageQueue,
+        item: QueuedItem,
+        kind: acomms_pb.NetworkAck.AckType.ValueType,
+        ack_src: int,
+    ) -> None:
         """NetworkAck for messages from `make_network_ack_for_src_id` sources (never for a
         NetworkAck): delivered here if we sent the original, else offered to the router."""
         if item.src not in self.cfg.make_network_ack_for_src_id:

@@ -115,7 +115,10 @@ class QueueStore:
         rows = self.db.execute(
             "SELECT id, queue, message, encoded, src, dest, time, ack_requested FROM queued ORDER BY id"
         ).fetchall()
-        return [StoredItem(*row[:7], bool(row[7])) for row in rows]
+        return [
+            StoredItem(key, queue, message, encoded, src, dest, time, bool(ack))
+            for key, queue, message, encoded, src, dest, time, ack in rows
+        ]
 
     def forget(self, key: int) -> None:
         self._write("DELETE FROM queued WHERE id = ?", (key,))

@@ -16,16 +16,17 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from pygoby.acomms import messages as acomms_pb
+from google.protobuf.message import Message
 
-Manip = acomms_pb.QueuedMessageEntry.DESCRIPTOR.fields_by_name[
-    "manipulator"
-].enum_type.values_by_name
+from pygoby.protobuf.goby.acomms.protobuf.manipulator_pb2 import Manipulator
+from pygoby.protobuf.goby.acomms.protobuf.queue_pb2 import QueuedMessageEntry
+
+Manip = Manipulator.DESCRIPTOR.values_by_name
 
 
 @dataclass(eq=False, slots=True)
 class QueuedItem:
-    msg: object
+    msg: Message
     encoded: bytes
     src: int
     dest: int
@@ -49,13 +50,13 @@ class QueueJournal(Protocol):
 
 @dataclass(eq=False)
 class MessageQueue:
-    entry: object  # QueuedMessageEntry
+    entry: QueuedMessageEntry
     dccl_id: int
     created: float
     roles: dict = field(default_factory=dict)
     waiting: dict[int, list[QueuedItem]] = field(default_factory=dict)  # frame -> items
     last_send_time: float = 0.0
-    message_class: type | None = None  # the type of its items' messages
+    message_class: type[Message] | None = None  # the type of its items' messages
     journal: QueueJournal | None = None
     _items: deque[QueuedItem] = field(default_factory=deque)
     _live: int = 0

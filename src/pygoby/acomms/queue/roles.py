@@ -6,25 +6,15 @@ import datetime as dt
 import math
 from dataclasses import dataclass
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
+from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import RoleError
+from pygoby.protobuf.descriptors import INTEGER_FIELD_TYPES, AnyDescriptor, AnyFieldDescriptor
 
 Role = acomms_pb.QueuedMessageEntry.Role
-_INTEGER_TYPES = {
-    FieldDescriptor.TYPE_INT32,
-    FieldDescriptor.TYPE_INT64,
-    FieldDescriptor.TYPE_UINT32,
-    FieldDescriptor.TYPE_UINT64,
-    FieldDescriptor.TYPE_SINT32,
-    FieldDescriptor.TYPE_SINT64,
-    FieldDescriptor.TYPE_FIXED32,
-    FieldDescriptor.TYPE_FIXED64,
-    FieldDescriptor.TYPE_SFIXED32,
-    FieldDescriptor.TYPE_SFIXED64,
-    FieldDescriptor.TYPE_ENUM,
-}
+_INTEGER_TYPES = INTEGER_FIELD_TYPES | {FieldDescriptor.TYPE_ENUM}  # (an enum id is a number)
 
 
 @dataclass(frozen=True)
@@ -33,7 +23,7 @@ class RoleGetter:
     static_value: int = 0
     kind: int = FieldDescriptor.TYPE_INT32
 
-    def get(self, msg):
+    def get(self, msg: Message):
         if self.path is None:
             return self.static_value
         value = msg
@@ -44,7 +34,9 @@ class RoleGetter:
         return value
 
 
-def compile_roles(entry, descriptor: Descriptor) -> dict[int, RoleGetter]:
+def compile_roles(
+    entry: acomms_pb.QueuedMessageEntry, descriptor: AnyDescriptor
+) -> dict[int, RoleGetter]:
     """Validate the roles of `entry` against `descriptor`."""
     getters: dict[int, RoleGetter] = {}
     for role in entry.role:
@@ -58,7 +50,8 @@ def compile_roles(entry, descriptor: Descriptor) -> dict[int, RoleGetter]:
             getters[role.type] = RoleGetter(None, role.static_value)
             continue
         path = tuple(role.field.split("."))
-        current, field = descriptor, None
+        current: AnyDescriptor | None = descriptor
+        field: AnyFieldDescriptor | None = None
         for name in path:
             if current is None or name not in current.fields_by_name:
                 raise RoleError(f"{entry.protobuf_name}: no field {role.field!r}")
@@ -79,7 +72,7 @@ def compile_roles(entry, descriptor: Descriptor) -> dict[int, RoleGetter]:
     return getters
 
 
-def timestamp_us(getter: RoleGetter, msg) -> int | None:
+def timestamp_us(getter: RoleGetter, msg: Message) -> int | None:
     value = getter.get(msg)
     if value is None:
         return None

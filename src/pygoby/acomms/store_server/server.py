@@ -120,7 +120,7 @@ class StoreServer:
             log.info("pruned %d delivered or expired transmissions", pruned)
 
 
-def _drop_forged(request) -> None:
+def _drop_forged(request: acomms_pb.StoreServerRequest) -> None:
     """Remove the outbox transmissions that claim another modem as their source."""
     forged = [t for t in request.outbox if t.src != request.modem_id]
     if not forged:
@@ -136,7 +136,7 @@ def _drop_forged(request) -> None:
     request.outbox.extend(kept)
 
 
-def _error_reply(request, error: str) -> bytes:
+def _error_reply(request: acomms_pb.StoreServerRequest, error: str) -> bytes:
     response = acomms_pb.StoreServerResponse(modem_id=request.modem_id)
     if request.HasField("request_id"):
         response.request_id = request.request_id

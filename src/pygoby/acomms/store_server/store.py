@@ -72,7 +72,7 @@ class TransmissionStore:
 
     def exchange(
         self,
-        request,
+        request: acomms_pb.StoreServerRequest,
         now: float,
         max_response_bytes: int | None = None,
         auth_time: float | None = None,

@@ -10,7 +10,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from google.protobuf import message_factory
 from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.dccl.ccl import fields
@@ -18,13 +17,13 @@ from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec
 from pygoby.dccl.codecs.numeric import NumericCodec, f32
 from pygoby.dccl.errors import DcclLoadError
 from pygoby.dccl.options import field_extension
-
-CCL_EXTENSIONS_PROTO = "dccl/ccl/protobuf/ccl_extensions.proto"
+from pygoby.protobuf import class_of, message_type
+from pygoby.protobuf.dccl.ccl.protobuf.ccl_extensions_pb2 import LegacyCCLFieldOptions
 
 
 def ccl_options(info: FieldInfo):
     """The field's `(dccl.field).(ccl)` options (LegacyCCLFieldOptions)."""
-    return field_extension(info.options, CCL_EXTENSIONS_PROTO, "LegacyCCLFieldOptions", 1000)
+    return field_extension(info.options, LegacyCCLFieldOptions, 1000)
 
 
 class _FunctionCodec(FixedWidthCodec):
@@ -131,8 +130,8 @@ class GFIPitchOilCodec(FixedWidthCodec):
 
     def __init__(self, info: FieldInfo) -> None:
         super().__init__(info)
-        cls = message_factory.GetMessageClass(info.descriptor.message_type)
-        names = {f.name for f in info.descriptor.message_type.fields}
+        cls = class_of(message_type(info.descriptor))
+        names = {f.name for f in message_type(info.descriptor).fields}
         if not {"gfi", "pitch", "oil"} <= names:
             raise DcclLoadError(f"{info.name}: _ccl_gfi_pitch_oil needs gfi, pitch and oil fields")
 

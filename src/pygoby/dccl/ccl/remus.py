@@ -596,7 +596,7 @@ class _AlertBase(CCLFrame):
             prefix = f"c{index}_"
             mine = {k[len(prefix) :]: values.pop(k) for k in list(values) if k.startswith(prefix)}
             contacts.append(cls.CONTACT(**mine))
-        return cls(contacts=contacts, **values)
+        return cls(contacts=contacts, **values)  # type: ignore[call-arg]  # (subclasses' field)
 
 
 def _alert_layout(contact: tuple[_Field, ...], starts: tuple[int, ...]) -> tuple[_Field, ...]:
@@ -658,7 +658,7 @@ Alert2.LAYOUT = (
     *_alert_layout(_ALERT2_CONTACT, (11, 18, 25)),
 )
 
-BY_ID: dict[int, type[CCLFrame]] = {cls.ID: cls for cls in (Redirect, Position, State, Ranger)}  # type: ignore[misc]
+BY_ID: dict[int, type[CCLFrame]] = {cls.ID: cls for cls in (Redirect, Position, State, Ranger)}
 
 
 def decode_frame(data: bytes) -> CCLFrame:

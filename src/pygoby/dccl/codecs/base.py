@@ -23,9 +23,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from google.protobuf.descriptor import FieldDescriptor
-from google.protobuf.message import Message
 
 from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError, DcclLoadError
+from pygoby.protobuf.dccl.option_extensions_pb2 import DCCLFieldOptions
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 _CATEGORY_BY_CPPTYPE = {
     FieldDescriptor.CPPTYPE_INT32: "int32",
@@ -44,7 +45,7 @@ SCALAR_CATEGORIES = NUMERIC_CATEGORIES | {"bool", "enum", "string", "bytes"}
 ALL_CATEGORIES = SCALAR_CATEGORIES | {"message"}
 
 
-def field_category(field: FieldDescriptor) -> str:
+def field_category(field: AnyFieldDescriptor) -> str:
     """The DCCL type family of a field: int32, int64, uint32, uint64, double, float, bool, enum,
     string, bytes or message (members of a protobuf family are encoded identically)."""
     if field.cpp_type == FieldDescriptor.CPPTYPE_STRING:
@@ -64,8 +65,8 @@ def ceil_log2(n: float) -> int:
 class FieldInfo:
     """What a codec knows about the field it encodes."""
 
-    descriptor: FieldDescriptor
-    options: Message  # dccl.DCCLFieldOptions
+    descriptor: AnyFieldDescriptor
+    options: DCCLFieldOptions
     category: str
     # required encoding (no "not set" state): v4 `required`, `repeated` elements, oneof members
     # and fields whose dynamic condition makes them required; v3 the same but oneofs; v2
@@ -81,7 +82,7 @@ class FieldInfo:
         return self.descriptor.full_name
 
     def require(self, option: str) -> Any:
-        if not self.options.HasField(option):
+        if not self.options.HasField(option):  # type: ignore[arg-type]  # (a field name)
             raise DcclLoadError(f"{self.name}: missing (dccl.field).{option}")
         return getattr(self.options, option)
 
@@ -130,11 +131,9 @@ class FixedWidthCodec(FieldCodec):
     # repeated field): every default codec writes zeros; some legacy CCL codecs do not.
     null_raw: int = 0
 
-    def to_raw(self, value: Any, strict: bool) -> int:
-        raise NotImplementedError
-
-    def from_raw(self, raw: int) -> Any:
-        raise NotImplementedError
+    # value <-> raw integer: each codec sets them in __init__ (a closure per field: the hot path)
+    to_raw: Callable[..., int]  # (value, strict); root-aware CCL codecs: (root, value, strict)
+    from_raw: Callable[..., Any]  # (raw); root-aware CCL codecs: (root, raw)
 
     def encode(self, value: Any, strict: bool) -> tuple[int, int]:
         return self.to_raw(value, strict), self.bits

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pygoby.dccl.codecs.base import FieldInfo, FixedWidthCodec, ceil_log2
 from pygoby.dccl.errors import DcclLoadError
+from pygoby.protobuf import enum_type
 
 
 class EnumCodec(FixedWidthCodec):
@@ -13,7 +14,7 @@ class EnumCodec(FixedWidthCodec):
 
     def __init__(self, info: FieldInfo) -> None:
         super().__init__(info)
-        values = info.descriptor.enum_type.values
+        values = enum_type(info.descriptor).values
         if not values:
             raise DcclLoadError(f"{info.name}: enum has no values")
         null = 0 if info.required else 1

@@ -18,12 +18,15 @@ negative enum index is "not set".
 from __future__ import annotations
 
 import struct
+from collections.abc import Sequence
 from typing import Any
 
+from google.protobuf.descriptor import EnumValueDescriptor
 from google.protobuf.descriptor import FieldDescriptor as FD
 
 from pygoby.dccl.codecs.base import FieldCodec, FieldInfo
 from pygoby.dccl.errors import DcclDecodeError, DcclLoadError
+from pygoby.protobuf import enum_type
 from pygoby.protobuf.wire import encode_varint
 
 _U64 = (1 << 64) - 1
@@ -69,7 +72,7 @@ class NativeProtobufCodec(FieldCodec):
         self.fixed = _FIXED.get(kind)
         self.width = 8 * (1 if kind == FD.TYPE_BOOL else self.fixed.size if self.fixed else 1)
         if kind == FD.TYPE_ENUM:
-            values = info.descriptor.enum_type.values
+            values: Sequence[EnumValueDescriptor] = enum_type(info.descriptor).values  # type: ignore[assignment]
             self.index = {v.number: i for i, v in reversed(list(enumerate(values)))}
             self.numbers = [v.number for v in values]
         self.to_bytes = self._encoder()

@@ -15,8 +15,8 @@ zero value. A <repeat/> message's converted type has one copy: it is sent as the
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
-from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.dccl1.codec import Dccl1Codec, Dccl1Decoded
@@ -25,6 +25,8 @@ from pygoby.dccl.errors import DcclDecodeError
 from pygoby.dccl.xml import MessageSet
 from pygoby.dccl.xml.convert import enum_value_name
 from pygoby.dccl.xml.model import XmlMessage
+from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 
 class Dccl1Bridge:
@@ -93,16 +95,16 @@ class Dccl1Bridge:
         return msg
 
 
-def _to_value(var, field: FieldDescriptor, value: object) -> Value:
+def _to_value(var, field: AnyFieldDescriptor, value: Any) -> Value:
     if var.kind == "enum":
-        name = field.enum_type.values_by_number[value].name  # type: ignore[index]
+        name = enum_type(field).values_by_number[value].name
         return var.enum_values[[enum_value_name(var, v) for v in var.enum_values].index(name)]
     if var.kind == "hex":
-        return bytes(value).hex()  # type: ignore[arg-type]
-    return value  # type: ignore[return-value]
+        return bytes(value).hex()
+    return value
 
 
-def _from_value(var, field: FieldDescriptor, value: object) -> object:
+def _from_value(var, field: AnyFieldDescriptor, value: object) -> object:
     if value is None:  # only inside arrays: the element's zero value
         zero = {"bool": False, "string": "", "hex": b"", "static": var.static_value or ""}
         if var.kind == "enum":

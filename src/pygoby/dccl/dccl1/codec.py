@@ -24,6 +24,7 @@ import math
 import time as _time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 from pygoby.dccl.crypto import BodyCipher
 from pygoby.dccl.dccl1.values import (
@@ -345,7 +346,7 @@ def _elements(value: object, length: int) -> list[Value]:
     elif value is None:
         items = []
     else:
-        items = [value]  # type: ignore[list-item]
+        items = [value]
     return (items + [None] * length)[:length]
 
 
@@ -411,7 +412,7 @@ class Dccl1Codec:
         return list(self._by_name.values())
 
     def message(self, name_or_id: str | int) -> Dccl1Message:
-        table: Mapping[object, Dccl1Message] = (
+        table: Mapping[Any, Dccl1Message] = (
             self._by_id if isinstance(name_or_id, int) else self._by_name
         )
         try:

@@ -26,8 +26,12 @@ def unbiased_round(value: float, decimals: float) -> float:
     if not math.isfinite(value):
         return value
     scale = math.pow(10.0, decimals)
-    floor = float(math.floor(value * scale))
-    remainder = value * scale - floor
+    scaled = value * scale
+    if not math.isfinite(scaled):
+        # a huge value overflows when scaled: C++'s floor keeps the infinity, and so does 1.1
+        return scaled / scale
+    floor = float(math.floor(scaled))
+    remainder = scaled - floor
     if remainder < 0.5 or (remainder == 0.5 and not int(floor) & 1):
         return floor / scale
     return (floor + 1) / scale

@@ -31,6 +31,9 @@ from pygoby.dccl.xml.model import Publish, PublishVar, Queuing, Var, XmlMessage
 from pygoby.dccl.xml.parser import ALGORITHMS, read_message_file, read_message_set
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoError, ProtoLoader
+from pygoby.protobuf.goby.acomms.protobuf.manipulator_pb2 import Manipulator
+from pygoby.protobuf.goby.acomms.protobuf.queue_pb2 import QueuedMessageEntry
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 
 
 @dataclass
@@ -40,7 +43,7 @@ class MessageSet:
     path: Path
     messages: list[XmlMessage]
     warnings: list[str] = field(default_factory=list)
-    manipulators: tuple[int, ...] = ()  # goby.acomms.protobuf.Manipulator values
+    manipulators: tuple[Manipulator.ValueType, ...] = ()
 
     @property
     def proto_file_name(self) -> str:
@@ -64,10 +67,10 @@ class MessageSet:
         out.write_text(self.proto_text())
         return out
 
-    def queue_entries(self) -> list[Message]:
+    def queue_entries(self) -> list[QueuedMessageEntry]:
         return [convert.queue_entry(m, self.manipulators) for m in self.messages]
 
-    def translator_entries(self) -> list[Message]:
+    def translator_entries(self) -> list[TranslatorEntry]:
         return [convert.translator_entry(m) for m in self.messages]
 
     def register(self, loader: ProtoLoader) -> list[type[Message]]:
@@ -92,7 +95,9 @@ class MessageSet:
         return classes
 
 
-def load_message_set(path: str | os.PathLike[str], manipulators: Iterable[int] = ()) -> MessageSet:
+def load_message_set(
+    path: str | os.PathLike[str], manipulators: Iterable[Manipulator.ValueType] = ()
+) -> MessageSet:
     """Read and check an XML message set file."""
     messages, warnings = read_message_file(path)
     return MessageSet(Path(path), messages, warnings, tuple(manipulators))

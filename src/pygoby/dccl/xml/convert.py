@@ -17,10 +17,12 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from google.protobuf import descriptor_pb2
-from google.protobuf.message import Message
 
 from pygoby.dccl.xml.model import V1_PLACEHOLDER, Publish, Var, XmlMessage
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.goby.acomms.protobuf.manipulator_pb2 import Manipulator
+from pygoby.protobuf.goby.acomms.protobuf.queue_pb2 import QueuedMessageEntry
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 
 DCCL_OPTIONS_PROTO = "dccl/option_extensions.proto"
 CODEC_VERSION = 2
@@ -182,10 +184,10 @@ def proto_text(messages: Iterable[XmlMessage], source: str = "") -> str:
 # Queue and translator entries
 
 
-def queue_entry(msg: XmlMessage, manipulators: Iterable[int] = ()) -> Message:
-    entry = builtin_class(
-        "goby/acomms/protobuf/queue.proto", "goby.acomms.protobuf.QueuedMessageEntry"
-    )()
+def queue_entry(
+    msg: XmlMessage, manipulators: Iterable[Manipulator.ValueType] = ()
+) -> QueuedMessageEntry:
+    entry = QueuedMessageEntry()
     q = msg.queuing
     entry.protobuf_name = msg.name
     entry.ack, entry.blackout_time, entry.max_queue = q.ack, q.blackout_time, q.max_queue
@@ -201,10 +203,8 @@ def queue_entry(msg: XmlMessage, manipulators: Iterable[int] = ()) -> Message:
     return entry
 
 
-def translator_entry(msg: XmlMessage) -> Message:
-    entry = builtin_class(
-        "goby/moos/protobuf/translator.proto", "goby.moos.protobuf.TranslatorEntry"
-    )()
+def translator_entry(msg: XmlMessage) -> TranslatorEntry:
+    entry = TranslatorEntry()
     T = type(entry)
     entry.protobuf_name = msg.name
     entry.use_short_enum = True
@@ -216,7 +216,7 @@ def translator_entry(msg: XmlMessage) -> Message:
         entry.trigger.moos_var = msg.trigger_var
         if msg.mandatory_content:
             entry.trigger.mandatory_content = msg.mandatory_content
-    creates: dict[str, Message] = {}
+    creates: dict[str, TranslatorEntry.CreateParser] = {}
     for var in msg.all_vars():
         _add_create(entry, creates, var)
     highest = max(v.number for v in msg.all_vars())
@@ -226,8 +226,10 @@ def translator_entry(msg: XmlMessage) -> Message:
     return entry
 
 
-def _add_create(entry: Message, creates: dict[str, Message], var: Var) -> None:
-    T = type(entry)
+def _add_create(
+    entry: TranslatorEntry, creates: dict[str, TranslatorEntry.CreateParser], var: Var
+) -> None:
+    T = TranslatorEntry
     if not var.source_var:
         return
     create = creates.get(var.source_var)
@@ -271,8 +273,10 @@ def default_format(msg: XmlMessage, publish: Publish) -> str:
     return ",".join(parts)
 
 
-def _add_publish(entry: Message, msg: XmlMessage, publish: Publish, next_virtual: int) -> int:
-    T = type(entry)
+def _add_publish(
+    entry: TranslatorEntry, msg: XmlMessage, publish: Publish, next_virtual: int
+) -> int:
+    T = TranslatorEntry
     serializer = entry.publish.add(technique=T.TECHNIQUE_FORMAT)
     replacement: dict[int, str] = {}
     v1_index = 0

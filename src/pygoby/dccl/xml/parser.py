@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
+import os
 import re
 import xml.sax
 from collections.abc import Callable, Iterable
@@ -152,9 +153,10 @@ def parse_tree(data: bytes, file: Path) -> Element:
 # children with (minimum, maximum) occurrences and its allowed attributes. `None` maximum: any.
 
 _SOURCE = {"src_var": (0, 1), "moos_var": (0, 1)}
-_HEADER_PIECE = {"name": (1, 1), **_SOURCE}
-_VAR_COMMON = {"name": (1, 1), **_SOURCE, "array_length": (0, 1)}
-SCHEMA: dict[str, tuple[dict[str, tuple[int, int | None]], frozenset[str]]] = {
+Occurs = dict[str, tuple[int, int | None]]  # child tag -> (min, max) occurrences
+_HEADER_PIECE: Occurs = {"name": (1, 1), **_SOURCE}
+_VAR_COMMON: Occurs = {"name": (1, 1), **_SOURCE, "array_length": (0, 1)}
+SCHEMA: dict[str, tuple[Occurs, frozenset[str]]] = {
     "message_set": ({"message": (1, None)}, frozenset()),
     "message": (
         {
@@ -743,14 +745,16 @@ class _Reader:
         return q
 
 
-def read_message_set(data: bytes, file: str | Path = "<xml>") -> tuple[list[XmlMessage], list[str]]:
+def read_message_set(
+    data: bytes, file: str | os.PathLike[str] = "<xml>"
+) -> tuple[list[XmlMessage], list[str]]:
     """Parse and check the XML text of a message set: (messages, warnings)."""
     path = Path(file)
     reader = _Reader(path)
     return reader.read(parse_tree(data, path)), reader.warnings
 
 
-def read_message_file(path: str | Path) -> tuple[list[XmlMessage], list[str]]:
+def read_message_file(path: str | os.PathLike[str]) -> tuple[list[XmlMessage], list[str]]:
     p = Path(path)
     try:
         with open(p, "rb") as handle:

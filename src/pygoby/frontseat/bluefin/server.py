@@ -10,22 +10,17 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import logging
 import sys
 
 from pygoby.frontseat.bluefin.simulator import HuxleyOptions, HuxleySimulator
-from pygoby.util.aiorun import run_until_signal
+from pygoby.frontseat.simserver import DEFAULT_POLL_INTERVAL, SimulatorTCPServer, run_server_main
 from pygoby.util.clock import Clock, WallClock
-from pygoby.util.errors import LinkClosedError
-from pygoby.util.linebased import TCPServerLink
 
 log = logging.getLogger(__name__)
 
-DEFAULT_POLL_INTERVAL = 0.01  # s between looks at the connection
 
-
-class HuxleyServer:
+class HuxleyServer(SimulatorTCPServer):
     """Serves one `HuxleySimulator` on `port` (0 = ephemeral; see `port` once listening)."""
 
     def __init__(
@@ -36,24 +31,12 @@ class HuxleyServer:
         clock: Clock | None = None,
         poll_interval: float = DEFAULT_POLL_INTERVAL,
     ) -> None:
+        super().__init__(port, host, poll_interval)
         self.simulator = simulator if simulator is not None else HuxleySimulator()
         self.clock: Clock = clock if clock is not None else WallClock()
-        self.link = TCPServerLink(port, host=host)
-        self.poll_interval = poll_interval
         self.exchange: list[str] = []  # "< line" received, "> line" sent, in order
         self._session: int | None = None  # link.connections of the current session
         self.steps = 0  # step() calls so far (tests on a virtual clock wait for the next one)
-
-    @property
-    def port(self) -> int:
-        return self.link.port
-
-    async def start(self) -> int:
-        self.link.open()
-        return await self.link.wait_listening()
-
-    def close(self) -> None:
-        self.link.close()
 
     async def serve(self) -> None:
         """Listen (if not yet) and run until cancelled."""
@@ -90,8 +73,7 @@ class HuxleyServer:
     def _send(self, lines: list[str]) -> None:
         for line in lines:
             self.exchange.append(f"> {line}")
-            with contextlib.suppress(LinkClosedError):  # nobody connected: for no one
-                self.link.write(line + "\r\n")
+            self.write_line(line)
 
 
 def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
@@ -157,10 +139,6 @@ def options_from(args: argparse.Namespace) -> HuxleyOptions:
 def main(argv: list[str] | None = None, prog: str | None = None) -> int:
     parser = build_parser(prog)
     args = parser.parse_args(argv)
-    logging.basicConfig(
-        level=logging.DEBUG if args.verbose else logging.INFO,
-        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
-    )
     if not args.nav_rate > 0 or not args.warp > 0:
         parser.error("--nav-rate and --warp must be positive")
     server = HuxleyServer(
@@ -169,12 +147,7 @@ def main(argv: list[str] | None = None, prog: str | None = None) -> int:
         simulator=HuxleySimulator(options_from(args)),
         clock=WallClock(args.warp),
     )
-    try:
-        run_until_signal(server.serve())
-    except OSError as exc:
-        print(f"{parser.prog}: {exc}", file=sys.stderr)
-        return 1
-    return 0
+    return run_server_main(parser, args.verbose, server.serve())
 
 
 if __name__ == "__main__":

@@ -33,12 +33,11 @@ Deviations from upstream:
 
 from __future__ import annotations
 
-import asyncio
 from typing import Any
 
 from pygoby.frontseat import messages as frontseat_pb
+from pygoby.frontseat.drivers.linked import CONNECT_TIMEOUT, LinkedFrontSeat
 from pygoby.frontseat.errors import AbcConfigError, SimulatorProtocolError
-from pygoby.frontseat.interface import InterfaceBase
 from pygoby.frontseat.simulator.protocol import (
     KEY_CMD,
     KEY_CTRL,
@@ -49,12 +48,12 @@ from pygoby.frontseat.simulator.protocol import (
     Start,
     parse_line,
 )
+from pygoby.protobuf import initialization_errors
 from pygoby.util.clock import Clock
 from pygoby.util.errors import LinkClosedError
-from pygoby.util.linebased import LineLink, TCPClientLink
+from pygoby.util.linebased import LineLink
 
 NAV_TIMEOUT = 10.0  # s without NAV before the frontseat counts as not providing data
-CONNECT_TIMEOUT = 10.0  # s start() waits for the first connection
 RECONNECT_INTERVAL = 1.0  # s between connection attempts
 
 _CTRL_STATES = {
@@ -71,7 +70,7 @@ def start_params(cfg: Any) -> Start:
             field="frontseat_cfg",
         )
     sim = cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
-    missing = sim.FindInitializationErrors()
+    missing = initialization_errors(sim)
     if missing:
         raise AbcConfigError(f"lacks required {', '.join(missing)}", field="basic_simulator_config")
     start = sim.start
@@ -90,8 +89,10 @@ def start_params(cfg: Any) -> Start:
         raise AbcConfigError(str(exc), field="basic_simulator_config") from None
 
 
-class AbcFrontSeat(InterfaceBase):
+class AbcFrontSeat(LinkedFrontSeat):
     """Frontseat driver for the basic (ABC) frontseat simulator."""
+
+    peer = "the frontseat simulator"
 
     def __init__(
         self,
@@ -102,48 +103,14 @@ class AbcFrontSeat(InterfaceBase):
         connect_timeout: float = CONNECT_TIMEOUT,
         reconnect_interval: float = RECONNECT_INTERVAL,
     ) -> None:
-        super().__init__(cfg, clock)
+        super().__init__(cfg, clock, connect_timeout=connect_timeout)
         self.start_message = start_params(self.cfg)
         sim = self.cfg.Extensions[frontseat_pb.BASIC_SIMULATOR_CONFIG]
-        self.address = f"{sim.tcp_address}:{sim.tcp_port}"
-        self.link: LineLink = (
-            link
-            if link is not None
-            else TCPClientLink(sim.tcp_address, sim.tcp_port, reconnect_interval=reconnect_interval)
-        )
-        self.connect_timeout = connect_timeout
-        self._frontseat_state: int = frontseat_pb.FRONTSEAT_NOT_CONNECTED
-        self._providing_data = False
-        self._last_nav_time: float | None = None
+        self._attach_link(link, sim.tcp_address, sim.tcp_port, reconnect_interval)
         self._started_connection: int | None = None  # link.connections when START was sent
         self._last_request: Any = None
 
-    # --- lifecycle ---------------------------------------------------------------------------
-
-    async def start(self) -> None:
-        """Open the link and wait up to `connect_timeout` s for the connection (never fails)."""
-        self.link.open()
-        loop = asyncio.get_running_loop()
-        deadline = loop.time() + self.connect_timeout
-        while not self.link.is_open and loop.time() < deadline:
-            await asyncio.sleep(0.05)
-        if not self.link.is_open:
-            self.log.warning(
-                "no connection to the frontseat simulator at %s after %g s; still trying",
-                self.address,
-                self.connect_timeout,
-            )
-
-    async def stop(self) -> None:
-        self.link.close()
-
     # --- InterfaceBase hooks -------------------------------------------------------------------
-
-    def frontseat_state(self) -> int:
-        return self._frontseat_state
-
-    def frontseat_providing_data(self) -> bool:
-        return self._providing_data
 
     def loop(self) -> None:
         self._check_connection()

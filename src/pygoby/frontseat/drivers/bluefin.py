@@ -62,7 +62,6 @@ sentence freed per tick (Q-BLUEFIN-9).
 
 from __future__ import annotations
 
-import asyncio
 import base64
 import bisect
 import logging
@@ -74,15 +73,14 @@ from typing import Any
 from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.bluefin import sentences
 from pygoby.frontseat.bluefin.sentences import NMEAError, NMEASentence
+from pygoby.frontseat.drivers.linked import CONNECT_TIMEOUT, LinkedFrontSeat
 from pygoby.frontseat.errors import BluefinConfigError, FrontSeatDriverError
-from pygoby.frontseat.interface import InterfaceBase
 from pygoby.util.clock import Clock
 from pygoby.util.errors import LinkClosedError
-from pygoby.util.linebased import LineLink, TCPClientLink
+from pygoby.util.linebased import LineLink
 
 _log = logging.getLogger(__name__)
 
-CONNECT_TIMEOUT = 10.0  # s start() waits for the first connection
 MAX_QUEUE = 200  # sentences waiting to be written; beyond, the oldest after the front are dropped
 
 BFCFG = frontseat_pb.BluefinConfig
@@ -155,8 +153,10 @@ def rpm_for_speed(speed: float, table: list[tuple[float, int]]) -> int:
     return int((speed - s0) / (s1 - s0) * (r1 - r0) + r0)
 
 
-class BluefinFrontSeat(InterfaceBase):
+class BluefinFrontSeat(LinkedFrontSeat):
     """Frontseat driver for a Bluefin Huxley (Standard Payload Interface)."""
+
+    peer = "Huxley"
 
     def __init__(
         self,
@@ -166,28 +166,17 @@ class BluefinFrontSeat(InterfaceBase):
         link: LineLink | None = None,
         connect_timeout: float = CONNECT_TIMEOUT,
     ) -> None:
-        super().__init__(cfg, clock)
+        super().__init__(cfg, clock, connect_timeout=connect_timeout)
         self.bf = bluefin_config(self.cfg)
-        self.address = f"{self.bf.huxley_tcp_address}:{self.bf.huxley_tcp_port}"
-        self.link: LineLink = (
-            link
-            if link is not None
-            else TCPClientLink(
-                self.bf.huxley_tcp_address,
-                self.bf.huxley_tcp_port,
-                reconnect_interval=self.bf.reconnect_interval,
-            )
+        self._attach_link(
+            link, self.bf.huxley_tcp_address, self.bf.huxley_tcp_port, self.bf.reconnect_interval
         )
-        self.connect_timeout = connect_timeout
         table: dict[float, int] = {}
         for entry in self.bf.rpm_table:
             table.setdefault(entry.speed, entry.rpm)  # a repeated speed keeps its first rpm
         self.rpm_table = sorted(table.items())
 
-        self._frontseat_state: int = frontseat_pb.FRONTSEAT_NOT_CONNECTED
         self._connection: int | None = None  # link.connections at the last start-up
-        self._providing_data = False
-        self._last_nav_time: float | None = None
         self._last_heartbeat: float | None = None
         self.out: deque[NMEASentence] = deque()  # to write; the front waits for its ACK
         self.pending: deque[NMEASentence] = deque()  # ACKed as pending, waiting for the final ACK
@@ -199,28 +188,7 @@ class BluefinFrontSeat(InterfaceBase):
         self.outstanding: dict[int, Any] = {}  # BluefinCommand -> CommandRequest
         self.payload_status: list[Any] = []  # BluefinExtraData.PayloadStatus
 
-    # --- lifecycle ---------------------------------------------------------------------------
-
-    async def start(self) -> None:
-        """Open the link and wait up to `connect_timeout` s for Huxley (never fails)."""
-        self.link.open()
-        loop = asyncio.get_running_loop()
-        deadline = loop.time() + self.connect_timeout
-        while not self.link.is_open and loop.time() < deadline:
-            await asyncio.sleep(0.05)
-        if not self.link.is_open:
-            self.log.warning("no connection to Huxley at %s yet; still trying", self.address)
-
-    async def stop(self) -> None:
-        self.link.close()
-
     # --- InterfaceBase hooks -------------------------------------------------------------------
-
-    def frontseat_state(self) -> int:
-        return self._frontseat_state
-
-    def frontseat_providing_data(self) -> bool:
-        return self._providing_data
 
     def loop(self) -> None:
         if not self.link.is_open:
@@ -612,9 +580,9 @@ class BluefinFrontSeat(InterfaceBase):
         boy = data.Extensions[frontseat_pb.BLUEFIN_DATA].buoyancy_status
         status, error = sentences.required_int(sentence, 2), sentences.required_int(sentence, 3)
         if status in frontseat_pb.BuoyancyStatus.Status.values():
-            boy.status = status
+            boy.status = frontseat_pb.BuoyancyStatus.Status.ValueType(status)
         if error in frontseat_pb.BuoyancyStatus.Error.values():
-            boy.error = error
+            boy.error = frontseat_pb.BuoyancyStatus.Error.ValueType(error)
         boy.debug_string = sentences.field(sentence, 4)
         boy.buoyancy_newtons = sentences.required_float(sentence, 5)
         self.signal_data_from_frontseat(data)
@@ -624,9 +592,9 @@ class BluefinFrontSeat(InterfaceBase):
         trim = data.Extensions[frontseat_pb.BLUEFIN_DATA].trim_status
         status, error = sentences.required_int(sentence, 2), sentences.required_int(sentence, 3)
         if status in frontseat_pb.TrimStatus.Status.values():
-            trim.status = status
+            trim.status = frontseat_pb.TrimStatus.Status.ValueType(status)
         if error in frontseat_pb.TrimStatus.Error.values():
-            trim.error = error
+            trim.error = frontseat_pb.TrimStatus.Error.ValueType(error)
         trim.debug_string = sentences.field(sentence, 4)
         trim.pitch_trim_degrees = sentences.required_float(sentence, 5)
         trim.roll_trim_degrees = sentences.required_float(sentence, 6)

@@ -42,7 +42,6 @@ Deviations from upstream (listed in QUIRKS.md, and bad-input handling):
 from __future__ import annotations
 
 import logging
-import math
 from dataclasses import dataclass
 
 from pygoby.frontseat.errors import SimulatorProtocolError
@@ -60,7 +59,7 @@ from pygoby.frontseat.simulator.protocol import (
     parse_line,
 )
 from pygoby.util.geodesy import UTMGeodesy
-from pygoby.util.kinematics import slew, wrap_heading
+from pygoby.util.kinematics import advance, slew, turn_toward, wrap_heading
 
 log = logging.getLogger(__name__)
 
@@ -161,18 +160,9 @@ class BasicFrontSeatSimulator:
         vehicle, desired, params = self.vehicle, self.desired, self.params
         vehicle.z = slew(vehicle.z, desired.z, params.z_rate * dt)
 
-        target = desired.heading  # both in [0, 360): one correction gives the shorter way
-        if vehicle.heading - target >= 180.0:
-            target += 360.0
-        elif vehicle.heading - target < -180.0:
-            target -= 360.0
-        vehicle.heading = wrap_heading(slew(vehicle.heading, target, params.hdg_rate * dt))
-
+        vehicle.heading = turn_toward(vehicle.heading, desired.heading, params.hdg_rate * dt)
         vehicle.speed = slew(vehicle.speed, desired.speed, params.accel * dt)
-
-        theta = (90.0 - vehicle.heading) * math.pi / 180.0
-        vehicle.x += vehicle.speed * math.cos(theta) * dt
-        vehicle.y += vehicle.speed * math.sin(theta) * dt
+        vehicle.x, vehicle.y = advance(vehicle.x, vehicle.y, vehicle.speed, vehicle.heading, dt)
 
     def nav(self) -> Nav:
         """The vehicle's navigation in the current datum (a mission must be running)."""

@@ -26,6 +26,7 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 from pygoby.frontseat.errors import SimulatorProtocolError
 
@@ -161,7 +162,7 @@ class Start:
 
     @classmethod
     def from_message(cls, msg: Message) -> Start:
-        optional = {
+        optional: dict[str, Any] = {
             attr: msg.integer(name) if is_int else msg.number(name)
             for name, attr, is_int in _START_OPTIONAL
             if name in msg.fields

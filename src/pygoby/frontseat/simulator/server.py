@@ -10,21 +10,16 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import logging
 import sys
 
+from pygoby.frontseat.simserver import DEFAULT_POLL_INTERVAL, SimulatorTCPServer, run_server_main
 from pygoby.frontseat.simulator.core import BasicFrontSeatSimulator
-from pygoby.util.aiorun import run_until_signal
-from pygoby.util.errors import LinkClosedError
-from pygoby.util.linebased import TCPServerLink
 
 log = logging.getLogger(__name__)
 
-DEFAULT_POLL_INTERVAL = 0.01  # s between checks for received lines
 
-
-class SimulatorServer:
+class SimulatorServer(SimulatorTCPServer):
     """Serves one `BasicFrontSeatSimulator` on `port` (0 = ephemeral; see `port` once listening)."""
 
     def __init__(
@@ -34,21 +29,8 @@ class SimulatorServer:
         simulator: BasicFrontSeatSimulator | None = None,
         poll_interval: float = DEFAULT_POLL_INTERVAL,
     ) -> None:
+        super().__init__(port, host, poll_interval)
         self.simulator = simulator if simulator is not None else BasicFrontSeatSimulator()
-        self.link = TCPServerLink(port, host=host)
-        self.poll_interval = poll_interval
-
-    @property
-    def port(self) -> int:
-        return self.link.port
-
-    async def start(self) -> int:
-        """Listen; returns the port."""
-        self.link.open()
-        return await self.link.wait_listening()
-
-    def close(self) -> None:
-        self.link.close()
 
     async def serve(self) -> None:
         """Listen (if not yet) and run the simulator until cancelled."""
@@ -77,9 +59,7 @@ class SimulatorServer:
     def _send(self, lines: list[str]) -> None:
         for line in lines:
             log.debug("> %s", line)
-            # nobody connected: the line is for no one, as upstream
-            with contextlib.suppress(LinkClosedError):
-                self.link.write(line + "\r\n")
+            self.write_line(line)
 
 
 def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
@@ -105,16 +85,8 @@ def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None, prog: str | None = None) -> int:
     parser = build_parser(prog)
     args = parser.parse_args(argv)
-    logging.basicConfig(
-        level=logging.DEBUG if args.verbose else logging.INFO,
-        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
-    )
-    try:
-        run_until_signal(SimulatorServer(args.port, host=args.host).serve())
-    except OSError as exc:
-        print(f"{parser.prog}: {exc}", file=sys.stderr)
-        return 1
-    return 0
+    server = SimulatorServer(args.port, host=args.host)
+    return run_server_main(parser, args.verbose, server.serve())
 
 
 if __name__ == "__main__":

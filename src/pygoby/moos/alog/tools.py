@@ -21,6 +21,7 @@ from typing import IO, Any
 from pygoby.moos.alog.files import AlogFile
 from pygoby.moos.alog.format import AlogEntry, AlogFormatter, banner
 from pygoby.moos.errors import MoosError, MoosRefusedError
+from pygoby.util.extras import needs_extra
 
 logger = logging.getLogger(__name__)
 
@@ -222,8 +223,9 @@ def _write_jsonl(source: Iterator[tuple], path: Path, progress: Callable[[int], 
 
 
 def _write_parquet(source: Iterator[tuple], path: Path, progress: Callable[[int], None]) -> int:
-    import pyarrow as pa
-    import pyarrow.parquet as pq
+    with needs_extra("sim", "Parquet output"):  # pyarrow, as netsim sweeps' results
+        import pyarrow as pa
+        import pyarrow.parquet as pq
 
     schema = pa.schema(
         [

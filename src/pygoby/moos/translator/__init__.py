@@ -53,24 +53,20 @@ from pygoby.moos.translator.translator import (
     make_post,
     post_for_moos,
 )
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup
 
-TRANSLATOR_PROTO = "goby/moos/protobuf/translator.proto"
 
-
-def entry_class():
+def entry_class() -> type[TranslatorEntry]:
     """The goby.moos.protobuf.TranslatorEntry message class."""
-    from pygoby.protobuf import builtin_class
-
-    return builtin_class(TRANSLATOR_PROTO, "goby.moos.protobuf.TranslatorEntry")
+    return TranslatorEntry
 
 
 __all__ = [
     "LAT_ORIGIN_VAR",
     "LONG_ORIGIN_VAR",
     "MAGIC_PROTOBUF_HEADER",
-    "TRANSLATOR_PROTO",
     "AlgorithmRegistry",
     "ModemIdLookup",
     "MoosValue",

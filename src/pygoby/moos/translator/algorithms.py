@@ -11,6 +11,8 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from google.protobuf.message import Message
+
 from pygoby.moos.translator.conversions import lexical_double, significant_digits
 from pygoby.moos.translator.errors import TranslatorConfigError
 from pygoby.util.geodesy import UTMGeodesy
@@ -180,7 +182,8 @@ class AlgorithmRegistry:
         if self.modem_ids is not None:
             self._add("modem_id2name", self._modem_id2name)
             self._add("modem_id2type", self._modem_id2type)
-            self._add("name2modem_id", lambda v, _r: str(self.modem_ids.modem_id(v)))
+            lookup = self.modem_ids
+            self._add("name2modem_id", lambda v, _r: str(lookup.modem_id(v)))
 
     @staticmethod
     def _reference(name: str, refs: Sequence[str], count: int) -> list[float]:
@@ -220,15 +223,17 @@ class AlgorithmRegistry:
         return modem_id if modem_id < 2**32 else None
 
     def _modem_id2name(self, value: str, _refs: Sequence[str]) -> str:
+        assert self.modem_ids is not None  # (registered only with a lookup)
         modem_id = self._modem_id(value)
         return value if modem_id is None else self.modem_ids.name(modem_id)
 
     def _modem_id2type(self, value: str, _refs: Sequence[str]) -> str:
+        assert self.modem_ids is not None  # (registered only with a lookup)
         modem_id = self._modem_id(value)
         return value if modem_id is None else self.modem_ids.type(modem_id)
 
 
-def run_publish_algorithms(msg, algorithms, registry: AlgorithmRegistry) -> dict[int, str]:
+def run_publish_algorithms(msg: Message, algorithms, registry: AlgorithmRegistry) -> dict[int, str]:
     """Run publish-side algorithms on `msg`; returns {output_virtual_field: value}.
 
     Algorithms with the same output field chain in declaration order (the later ones take the

@@ -91,11 +91,11 @@ def _parse_directive(fmt: str, i: int) -> tuple[Directive, int]:
             return Directive(int(digits.group())), end + 1
         if fmt[end : end + 1] == "$":
             match = _PRINTF_SPEC.match(fmt, end + 1)
-            if not match.group(4):
+            if match is None or not match.group(4):
                 raise TranslatorConfigError(f"format {fmt!r}: bad directive at position {i - 1}")
             return _directive(int(digits.group()), match, fmt), match.end()
     match = _PRINTF_SPEC.match(fmt, i)
-    if not match.group(4):
+    if match is None or not match.group(4):
         raise TranslatorConfigError(f"format {fmt!r}: bad directive at position {i - 1}")
     return _directive(None, match, fmt), match.end()
 

@@ -22,6 +22,8 @@ from pygoby.moos.translator.conversions import (
     significant_digits,
 )
 from pygoby.moos.translator.errors import TranslatorError, UnconvertibleError
+from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 log = logging.getLogger("pygoby.moos.translator")
 
@@ -33,11 +35,11 @@ INT_KINDS = {
 }
 
 
-def is_message(field: FieldDescriptor) -> bool:
+def is_message(field: AnyFieldDescriptor) -> bool:
     return field.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE
 
 
-def is_bytes(field: FieldDescriptor) -> bool:
+def is_bytes(field: AnyFieldDescriptor) -> bool:
     return field.type == FieldDescriptor.TYPE_BYTES
 
 
@@ -50,8 +52,8 @@ def strip_name_from_enum(value_name: str, field_name: str) -> str:
     return value_name if pos < 0 else value_name[:pos] + value_name[pos + len(needle) :]
 
 
-def enum_name(field: FieldDescriptor, number: int, use_short_enum: bool) -> str:
-    value = field.enum_type.values_by_number.get(number)
+def enum_name(field: AnyFieldDescriptor, number: int, use_short_enum: bool) -> str:
+    value = enum_type(field).values_by_number.get(number)
     name = value.name if value is not None else str(number)
     return strip_name_from_enum(name, field.name) if use_short_enum else name
 
@@ -60,7 +62,7 @@ def serialize_message(msg: Message) -> bytes:
     return msg.SerializePartialToString(deterministic=True)
 
 
-def stream_value(field: FieldDescriptor, value, use_short_enum: bool) -> str:
+def stream_value(field: AnyFieldDescriptor, value, use_short_enum: bool) -> str:
     """One element of `field` as Goby's CSV/FORMAT serializers stream it."""
     cpp = field.cpp_type
     if cpp == FieldDescriptor.CPPTYPE_MESSAGE:
@@ -78,12 +80,12 @@ def stream_value(field: FieldDescriptor, value, use_short_enum: bool) -> str:
     return enum_name(field, value, use_short_enum)
 
 
-def default_value(field: FieldDescriptor):
+def default_value(field: AnyFieldDescriptor):
     """The value an unset element reads as: the declared default, else the type default."""
     if not field.is_repeated:
         return field.default_value
     if field.cpp_type == FieldDescriptor.CPPTYPE_ENUM:
-        return field.enum_type.values[0].number
+        return enum_type(field).values[0].number
     if field.cpp_type == FieldDescriptor.CPPTYPE_STRING:
         return b"" if is_bytes(field) else ""
     return _TYPE_DEFAULTS[field.cpp_type]
@@ -100,7 +102,7 @@ _TYPE_DEFAULTS = {
 }
 
 
-def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
+def value_from_string(field: AnyFieldDescriptor, text: str, use_short_enum: bool):
     """Convert `text` to a scalar value for `field` (not for message fields)."""
     cpp = field.cpp_type
     if cpp in INT_KINDS:
@@ -131,12 +133,12 @@ def value_from_string(field: FieldDescriptor, text: str, use_short_enum: bool):
     wanted = field.name.upper() + "_" + text if use_short_enum else text
     if not wanted.isascii():
         # Enum value names are identifiers; protobuf's lookup fails on undecodable bytes.
-        raise UnconvertibleError(f"{text!r} is not a value of enum {field.enum_type.full_name}")
+        raise UnconvertibleError(f"{text!r} is not a value of enum {enum_type(field).full_name}")
     for candidate in (wanted, wanted.upper(), wanted.lower()):
-        value = field.enum_type.values_by_name.get(candidate)
+        value = enum_type(field).values_by_name.get(candidate)
         if value is not None:
             return value.number
-    raise UnconvertibleError(f"{text!r} is not a value of enum {field.enum_type.full_name}")
+    raise UnconvertibleError(f"{text!r} is not a value of enum {enum_type(field).full_name}")
 
 
 def parse_message_bytes(target: Message, data: bytes, where: str) -> None:
@@ -149,7 +151,9 @@ def parse_message_bytes(target: Message, data: bytes, where: str) -> None:
         ) from None
 
 
-def set_from_string(msg: Message, field: FieldDescriptor, text: str, use_short_enum: bool) -> None:
+def set_from_string(
+    msg: Message, field: AnyFieldDescriptor, text: str, use_short_enum: bool
+) -> None:
     """Set singular `field` of `msg` from `text` (message fields: hex of the binary encoding)."""
     if is_message(field):
         parse_message_bytes(getattr(msg, field.name), hex_decode(text), field.name)
@@ -161,7 +165,7 @@ def set_from_string(msg: Message, field: FieldDescriptor, text: str, use_short_e
 
 
 def append_from_string(
-    msg: Message, field: FieldDescriptor, text: str, use_short_enum: bool
+    msg: Message, field: AnyFieldDescriptor, text: str, use_short_enum: bool
 ) -> None:
     """Append one element parsed from `text` to repeated `field`."""
     container = getattr(msg, field.name)
@@ -175,7 +179,7 @@ def append_from_string(
 
 
 def set_element_from_string(
-    msg: Message, field: FieldDescriptor, index: int, text: str, use_short_enum: bool
+    msg: Message, field: AnyFieldDescriptor, index: int, text: str, use_short_enum: bool
 ) -> None:
     """Set element `index` of repeated `field`, padding with default values as needed."""
     container = getattr(msg, field.name)

@@ -12,8 +12,7 @@ import re
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
-from google.protobuf import message_factory
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.moos.translator import boostformat
@@ -30,6 +29,8 @@ from pygoby.moos.translator.fields import (
     set_from_string,
     stream_value,
 )
+from pygoby.protobuf import class_of, message_type
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
 
 _SUBMESSAGE_DIRECTIVE = re.compile(r"%([0-9.]+:)+[0-9.]+%")
 _INDEXED_DIRECTIVE = re.compile(r"%[0-9]+\.[0-9]+%")
@@ -76,16 +77,18 @@ def _walk_path(message: Message, parts: list[str], spec: str, create: bool) -> M
             while len(container) <= index:
                 container.add()
         # Reading past the end (publish side) sees an empty element.
-        message = (
-            container[index]
-            if index < len(container)
-            else message_factory.GetMessageClass(field.message_type)()
-        )
+        message = container[index] if index < len(container) else class_of(message_type(field))()
     return message
 
 
 def _repeated_text(
-    msg, field, start: int, end: int, indexed: bool, delimiter: str, short: bool
+    msg: Message,
+    field: AnyFieldDescriptor,
+    start: int,
+    end: int,
+    indexed: bool,
+    delimiter: str,
+    short: bool,
 ) -> str:
     values = getattr(msg, field.name)
     parts = []
@@ -101,7 +104,7 @@ def _repeated_text(
     return (parts[0] if parts else "") if indexed else delimiter.join(parts)
 
 
-def _scalar_arg(msg: Message, field: FieldDescriptor, short: bool) -> boostformat.Arg:
+def _scalar_arg(msg: Message, field: AnyFieldDescriptor, short: bool) -> boostformat.Arg:
     value = getattr(msg, field.name)
     cpp = field.cpp_type
     if cpp in INT_KINDS:
@@ -142,11 +145,11 @@ def serialize(
         working = working.replace(match.group(0), f"%{max_field}%")
 
     current = working
-    indexed: dict[int, tuple[int, int]] = {}
+    indexed: dict[int, tuple[int, int | None]] = {}
     for match in _INDEXED_DIRECTIVE.finditer(current):
-        field_number, index = match.group(0).strip("%").split(".")
+        number_text, index_text = match.group(0).strip("%").split(".")
         max_field += 1
-        indexed[max_field] = (int(field_number), int(index))
+        indexed[max_field] = (int(number_text), int(index_text))
         working = working.replace(match.group(0), f"%{max_field}%")
 
     args: list[boostformat.Arg] = []
@@ -198,7 +201,7 @@ def _scan(fmt: str):
         i = close + 1
 
 
-def _field_spec(descriptor: Descriptor, spec: str) -> tuple[FieldDescriptor, int | None]:
+def _field_spec(descriptor: AnyDescriptor, spec: str) -> tuple[AnyFieldDescriptor, int | None]:
     parts = spec.split(".")
     number = _int_or_none(parts[0])
     index = _int_or_none(parts[1]) if len(parts) == 2 else None
@@ -212,7 +215,7 @@ def _field_spec(descriptor: Descriptor, spec: str) -> tuple[FieldDescriptor, int
     return field, index
 
 
-def check_parse_format(descriptor: Descriptor, fmt: str) -> None:
+def check_parse_format(descriptor: AnyDescriptor, fmt: str) -> None:
     """Reject create formats that cannot work, before any mail arrives."""
     for kind, _position, spec, *_separator in _scan(fmt.lower()):
         if kind != "directive":
@@ -231,11 +234,11 @@ def check_parse_format(descriptor: Descriptor, fmt: str) -> None:
                     f"Invalid '.' syntax given for format: {spec}. Repeated message, but no "
                     "valid index given. E.g., use '3.4' for index 4 of field 3."
                 )
-            current = field.message_type
+            current = message_type(field)
         _field_spec(current, last)
 
 
-def parsed_fields(descriptor: Descriptor, fmt: str) -> set[int]:
+def parsed_fields(descriptor: AnyDescriptor, fmt: str) -> set[int]:
     """The numbers of the top-level fields a create format sets (for tools that show where a
     field's value comes from)."""
     return {
@@ -246,7 +249,7 @@ def parsed_fields(descriptor: Descriptor, fmt: str) -> set[int]:
 
 
 def check_serialize_format(
-    descriptor: Descriptor, fmt: str, virtual_fields: Collection[int] = ()
+    descriptor: AnyDescriptor, fmt: str, virtual_fields: Collection[int] = ()
 ) -> list[str]:
     """Reject publish formats that cannot render (bad sub-message paths, where goby3 throws
     at every publication; bad directives). Return what renders, as in goby3, but is likely a
@@ -254,7 +257,7 @@ def check_serialize_format(
     nothing past the highest field number) and an element index on a field that is not
     repeated (the whole field is rendered): QUIRKS.md Q-APPS-27. `virtual_fields`: the publish
     algorithms' output_virtual_field numbers."""
-    probe = message_factory.GetMessageClass(descriptor)()
+    probe = class_of(descriptor)()
     for match in _SUBMESSAGE_DIRECTIVE.finditer(fmt):
         spec = match.group(0).strip("%")
         _walk_path(probe, spec.split(":")[:-1], spec, create=False)
@@ -274,14 +277,14 @@ def check_serialize_format(
             )
     plain = _SUBMESSAGE_DIRECTIVE.sub("%%", _INDEXED_DIRECTIVE.sub("%%", fmt))
     for item in boostformat.parse_format(plain):
-        number = getattr(item, "argument", None)
+        argument: int | None = getattr(item, "argument", None)
         if (
-            number is not None
-            and number not in descriptor.fields_by_number
-            and (number not in virtual_fields)
+            argument is not None
+            and argument not in descriptor.fields_by_number
+            and (argument not in virtual_fields)
         ):
             notes.append(
-                f"%{number}% names no field of {descriptor.full_name} (nor an algorithm's "
+                f"%{argument}% names no field of {descriptor.full_name} (nor an algorithm's "
                 "output_virtual_field): it prints 'unknown' or nothing, as in goby3"
             )
     return notes
@@ -341,7 +344,7 @@ def parse(
     return mismatch
 
 
-def _parse_directive(extract, msg, spec, delimiter, algorithms, short, registry) -> None:
+def _parse_directive(extract, msg: Message, spec, delimiter, algorithms, short, registry) -> None:
     if ":" in spec:
         *path, last = spec.split(":")
         sub = _walk_path(msg, path, spec, create=True)

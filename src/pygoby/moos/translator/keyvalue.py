@@ -10,7 +10,6 @@ from __future__ import annotations
 import logging
 from collections.abc import Sequence
 
-from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.moos.translator.algorithms import AlgorithmRegistry, run_publish_algorithms
@@ -20,11 +19,13 @@ from pygoby.moos.translator.fields import (
     set_from_string,
     stream_value,
 )
+from pygoby.protobuf import message_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 log = logging.getLogger("pygoby.moos.translator")
 
 
-def is_set(msg: Message, field: FieldDescriptor) -> bool:
+def is_set(msg: Message, field: AnyFieldDescriptor) -> bool:
     """C++ HasField / FieldSize > 0 semantics."""
     if field.is_repeated:
         return len(getattr(msg, field.name)) > 0
@@ -51,7 +52,7 @@ def val_from_string(text: str, key: str) -> str | None:
     return text[value_start : end if end >= 0 else len(text)]
 
 
-def _sub_value(msg: Message, field: FieldDescriptor, use_short_enum: bool) -> str:
+def _sub_value(msg: Message, field: AnyFieldDescriptor, use_short_enum: bool) -> str:
     """A field inside a flattened sub-message: repeated ones joined by commas, no braces."""
     value = getattr(msg, field.name)
     if field.is_repeated:
@@ -59,11 +60,11 @@ def _sub_value(msg: Message, field: FieldDescriptor, use_short_enum: bool) -> st
     return stream_value(field, value, use_short_enum)
 
 
-def _entry(msg: Message, field: FieldDescriptor, use_short_enum: bool) -> str:
+def _entry(msg: Message, field: AnyFieldDescriptor, use_short_enum: bool) -> str:
     name = field.name
     value = getattr(msg, name)
     if is_message(field):
-        sub_fields = field.message_type.fields
+        sub_fields = message_type(field).fields
         if field.is_repeated:
             return ",".join(
                 f"{name}_{sub.name}={{"
@@ -103,7 +104,7 @@ def serialize(
 
 
 def _set_values(
-    msg: Message, field: FieldDescriptor, values: list[str], index: int, use_short_enum: bool
+    msg: Message, field: AnyFieldDescriptor, values: list[str], index: int, use_short_enum: bool
 ) -> None:
     if field.is_repeated:
         for value in values:
@@ -132,7 +133,7 @@ def parse(
                     value = (registry or AlgorithmRegistry()).run(algorithm.name, value)
             _set_values(msg, field, value.split(","), 0, use_short_enum)
             continue
-        for sub in field.message_type.fields:
+        for sub in message_type(field).fields:
             value = val_from_string(lower, f"{field.name}_{sub.name}")
             if value is None:
                 continue
@@ -181,7 +182,7 @@ def _warn_unknown_keys(lower: str, msg: Message, where: str) -> None:
     for field in msg.DESCRIPTOR.fields:
         known.add(field.name.lower())
         if is_message(field):
-            known.update(f"{field.name}_{sub.name}".lower() for sub in field.message_type.fields)
+            known.update(f"{field.name}_{sub.name}".lower() for sub in message_type(field).fields)
     keys = _top_level_keys(lower)
     type_name = msg.DESCRIPTOR.full_name
     unknown = [k for k in keys if k is not None and k not in known and "(" not in k]

@@ -12,6 +12,7 @@ from pygoby.moos.translator.conversions import hex_decode, hex_encode
 from pygoby.moos.translator.errors import TranslatorConfigError, TranslatorError
 from pygoby.moos.translator.fields import serialize_message
 from pygoby.moos.translator.textformat import message_text, parse_text
+from pygoby.protobuf.goby.moos.protobuf.goby_moos_app_pb2 import GobyMOOSAppConfig
 
 MAGIC_PROTOBUF_HEADER = "@PB"
 
@@ -176,7 +177,7 @@ def dynamic_parse(
 DEFAULT_MOOS_TECHNIQUE = T.TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT
 
 
-def moos_technique_from_config(common: Message | None) -> Technique:
+def moos_technique_from_config(common: GobyMOOSAppConfig | None) -> Technique:
     """The app-internal technique from a GobyMOOSAppConfig: moos_parser_technique wins, else
     use_binary_protobuf picks prefixed binary or prefixed text, else prefixed text."""
     if common is None:

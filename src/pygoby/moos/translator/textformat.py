@@ -12,9 +12,10 @@ from google.protobuf.message import Message
 
 from pygoby.moos.translator.errors import TranslatorError
 from pygoby.protobuf.cpp_text import message_text, scalar_text
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 
 
-def field_value_text(field: FieldDescriptor, value) -> str:
+def field_value_text(field: AnyFieldDescriptor, value) -> str:
     """One value as TextFormat prints it (also goby's PrintFieldValueToString)."""
     if field.cpp_type == FieldDescriptor.CPPTYPE_MESSAGE:
         return "{ " + message_text(value) + "}"

@@ -30,6 +30,7 @@ from pygoby.moos.translator.techniques import (
     serialize_for_moos,
     serialize_protobuf,
 )
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 from pygoby.util.clock import Clock, WallClock
 from pygoby.util.modem_id import ModemIdLookup
 
@@ -133,7 +134,7 @@ class Translator:
 
     def __init__(
         self,
-        entries: Iterable[Message],
+        entries: Iterable[TranslatorEntry],
         resolve: MessageResolver,
         *,
         lat_origin: float = 0.0,
@@ -142,7 +143,7 @@ class Translator:
     ) -> None:
         self.registry = AlgorithmRegistry(lat_origin, lon_origin, modem_ids)
         self._resolve = resolve
-        self._entries: dict[str, Message] = {}
+        self._entries: dict[str, TranslatorEntry] = {}
         self._classes: dict[str, type[Message]] = {}
         self._named_values: dict[str, dict[str, str]] = {}
         for entry in entries:
@@ -150,7 +151,7 @@ class Translator:
 
     # --- configuration -------------------------------------------------------------------
 
-    def add_entry(self, entry: Message) -> list[EntryNote]:
+    def add_entry(self, entry: TranslatorEntry) -> list[EntryNote]:
         """Add one entry; returns what in it behaves as in goby3 but looks like a mistake (to
         log once at start-up); raises TranslatorConfigError where goby3 would crash or
         corrupt data."""
@@ -179,7 +180,7 @@ class Translator:
             if self.registry.find(algorithm.name) is None
         ]
 
-    def _check_entry(self, entry: Message, cls: type[Message]) -> list[EntryNote]:
+    def _check_entry(self, entry: TranslatorEntry, cls: type[Message]) -> list[EntryNote]:
         name = entry.protobuf_name
         descriptor = cls.DESCRIPTOR
         notes: list[EntryNote] = []
@@ -208,12 +209,12 @@ class Translator:
         for index, publish in enumerate(entry.publish):
             technique = Technique(publish.technique)
             notes += self._check_algorithms(name, publish.algorithm, f"publish[{index}]")
-            for algorithm in publish.algorithm:
-                for number in algorithm.reference_field:
+            for publish_algorithm in publish.algorithm:
+                for number in publish_algorithm.reference_field:
                     field = descriptor.fields_by_number.get(number)
                     if field is None or field.is_repeated:
                         raise TranslatorConfigError(
-                            f"{name}: algorithm {algorithm.name!r} reference field {number} is "
+                            f"{name}: algorithm {publish_algorithm.name!r} reference field {number} is "
                             "missing or repeated (must be optional or required)"
                         )
             if technique == Technique.TECHNIQUE_FORMAT:
@@ -244,7 +245,7 @@ class Translator:
         self.registry.set_datum(lat_origin, lon_origin)
 
     @property
-    def entries(self) -> Mapping[str, Message]:
+    def entries(self) -> Mapping[str, TranslatorEntry]:
         return self._entries
 
     def message_class(self, protobuf_name: str) -> type[Message]:
@@ -318,7 +319,12 @@ class Translator:
         return msg
 
     def _apply_create(
-        self, msg, create, technique: Technique, source: MoosValue, short: bool
+        self,
+        msg: Message,
+        create: TranslatorEntry.CreateParser,
+        technique: Technique,
+        source: MoosValue,
+        short: bool,
     ) -> format_technique.FormatMismatch | None:
         if technique in PROTOBUF_TECHNIQUES:
             parse_protobuf(source, msg, technique)
@@ -351,6 +357,7 @@ class Translator:
         for publish in entry.publish:
             technique = Technique(publish.technique)
             var = publish.moos_var
+            value: str | bytes
             short = entry.use_short_enum
             if technique == Technique.TECHNIQUE_FORMAT:
                 args = (publish.repeated_delimiter, publish.algorithm, short, self.registry)
@@ -375,6 +382,7 @@ class Translator:
         short = entry.use_short_enum
         for create in entry.create:
             technique = Technique(create.technique)
+            value: str | bytes
             if technique == Technique.TECHNIQUE_FORMAT:
                 value = format_technique.serialize(
                     msg, create.format, create.repeated_delimiter, (), short
@@ -393,7 +401,7 @@ class Translator:
             posts.append(Post(trigger.moos_var, "", ""))
         return sorted(posts, key=lambda post: post.var)
 
-    def _entry(self, protobuf_name: str) -> Message:
+    def _entry(self, protobuf_name: str) -> TranslatorEntry:
         try:
             return self._entries[protobuf_name]
         except KeyError:

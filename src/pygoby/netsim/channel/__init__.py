@@ -1,17 +1,17 @@
 """Packet-level acoustic channel for the netsim simulator.
 
 The physics are pure functions in small modules (`soundspeed`, `absorption`, `levels`,
-`geometry`, `errors`, `timing`); `model.Channel` combines them into the sans-I/O channel the
+`geometry`, `frame_errors`, `timing`); `model.Channel` combines them into the sans-I/O channel the
 modem emulators call (its API is documented in `pygoby.netsim.channel.model`).
 """
 
-from pygoby.netsim.channel.errors import (
+from pygoby.netsim.channel.frame_errors import (
     LogisticModel,
     RateErrorModels,
     TableModel,
     ThresholdModel,
 )
-from pygoby.netsim.channel.geometry import Position
+from pygoby.netsim.channel.geometry import NavFix
 from pygoby.netsim.channel.model import (
     Band,
     Channel,
@@ -31,7 +31,7 @@ __all__ = [
     "LogisticModel",
     "Outcome",
     "PacketKind",
-    "Position",
+    "NavFix",
     "RateErrorModels",
     "Reception",
     "TableModel",

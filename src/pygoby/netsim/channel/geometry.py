@@ -14,11 +14,13 @@ from dataclasses import dataclass
 
 from pyproj import Geod
 
+from pygoby.protobuf.netsim.messages.netsim_pb2 import NavUpdate
+
 WGS84 = Geod(ellps="WGS84")
 
 
 @dataclass(frozen=True)
-class Position:
+class NavFix:
     """A node's reported state at time `time` (UNIX seconds)."""
 
     lat: float
@@ -29,20 +31,20 @@ class Position:
     heading: float = 0.0  # degrees true
 
     @classmethod
-    def from_nav(cls, nav) -> Position:
+    def from_nav(cls, nav: NavUpdate) -> NavFix:
         """From a netsim NavUpdate."""
         return cls(nav.lat, nav.lon, nav.depth, nav.time, nav.speed, nav.heading)
 
-    def at(self, t: float) -> Position:
+    def at(self, t: float) -> NavFix:
         """Dead-reckoned to time t (straight line along the heading, on the ellipsoid)."""
         # (direct constructor calls: dataclasses.replace is several times slower)
         distance = self.speed * (t - self.time)
         if distance == 0:
             if t == self.time:
                 return self  # frozen: the same position
-            return Position(self.lat, self.lon, self.depth, t, self.speed, self.heading)
+            return NavFix(self.lat, self.lon, self.depth, t, self.speed, self.heading)
         lon, lat, _ = WGS84.fwd(self.lon, self.lat, self.heading, distance)
-        return Position(lat, lon, self.depth, t, self.speed, self.heading)
+        return NavFix(lat, lon, self.depth, t, self.speed, self.heading)
 
 
 def dead_reckoning_offset(speed: float, heading_deg: float, dt: float) -> tuple[float, float]:
@@ -51,7 +53,7 @@ def dead_reckoning_offset(speed: float, heading_deg: float, dt: float) -> tuple[
     return speed * dt * math.cos(angle), speed * dt * math.sin(angle)
 
 
-def horizontal_range(a: Position, b: Position) -> tuple[float, float]:
+def horizontal_range(a: NavFix, b: NavFix) -> tuple[float, float]:
     """(distance m, azimuth deg from a to b) along the WGS-84 geodesic."""
     if 0.0 in (a.lon, a.lat, b.lon, b.lat):  # (-0.0 would share a memo key with 0.0)
         azimuth, _, distance = WGS84.inv(a.lon, a.lat, b.lon, b.lat)
@@ -66,7 +68,7 @@ def _geodesic(lon_a: float, lat_a: float, lon_b: float, lat_b: float) -> tuple[f
     return distance, azimuth
 
 
-def slant_range(a: Position, b: Position) -> float:
+def slant_range(a: NavFix, b: NavFix) -> float:
     distance, _ = horizontal_range(a, b)
     return math.hypot(distance, a.depth - b.depth)
 
@@ -92,7 +94,7 @@ def arrival_delay(
     return tau
 
 
-def closing_speed(tx: Position, rx: Position) -> float:
+def closing_speed(tx: NavFix, rx: NavFix) -> float:
     """Rate (m/s) at which the range between two dead-reckoned nodes shrinks (positive closing)."""
     if tx.speed == 0 and rx.speed == 0:
         return 0.0  # what the ranges below give for two fixed nodes, without four geodesics

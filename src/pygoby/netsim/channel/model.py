@@ -3,7 +3,7 @@
 API (what a modem emulator calls):
 
 * ``channel = Channel(ChannelConfig(...), seed=1)``
-* ``channel.update_position(port, Position(...))`` whenever a node's position is known, or
+* ``channel.update_position(port, NavFix(...))`` whenever a node's position is known, or
   ``manager.on_nav(channel.on_environment_nav_update)`` to follow a `NetSimManager`.
 * ``channel.transmit(Transmission(source=62000, start=t, rate=1, frames=3))`` when a modem starts
   transmitting (start = simulation time now; transmissions must not be registered in the past
@@ -51,6 +51,7 @@ from __future__ import annotations
 import _random
 import bisect
 import enum
+import functools
 import hashlib
 import heapq
 import logging
@@ -60,8 +61,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from pygoby.netsim.channel.absorption import thorp
-from pygoby.netsim.channel.errors import ProtocolModel, RateErrorModels
-from pygoby.netsim.channel.geometry import Position, arrival_delay, closing_speed, slant_range
+from pygoby.netsim.channel.frame_errors import ProtocolModel, RateErrorModels
+from pygoby.netsim.channel.geometry import NavFix, arrival_delay, closing_speed, slant_range
 from pygoby.netsim.channel.levels import (
     noise_level_integrated,
     power_sum_db,
@@ -71,6 +72,7 @@ from pygoby.netsim.channel.levels import (
 from pygoby.netsim.channel.propagation import BellhopLoss
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, harmonic_mean_speed
 from pygoby.netsim.channel.timing import Interval
+from pygoby.protobuf.netsim.messages.netsim_pb2 import EnvironmentNavUpdate
 
 log = logging.getLogger(__name__)
 
@@ -209,14 +211,14 @@ class _Pending:
         return (self.interval.start, self.receiver, self.sequence)
 
 
-_arrival_order = _Pending.arrival_order.fget
+_arrival_order = _Pending.arrival_order.fget  # type: ignore[attr-defined]  # (a property)
 
 
 class Channel:
     def __init__(self, config: ChannelConfig | None = None, seed: int = 0) -> None:
         self.config = config if config is not None else ChannelConfig()
         self.seed = seed
-        self._positions: dict[int, Position] = {}
+        self._positions: dict[int, NavFix] = {}
         # Receptions at each receiver: finished ones (kept while they can still interfere), in
         # the order they finished (batches in arrival order), then pending ones, by arrival.
         self._finished_at: dict[int, list[_Pending]] = {}
@@ -235,25 +237,25 @@ class Channel:
         self._rng = random.Random()
         self._detected: list[Detection] = []  # locked receptions not yet reported
         # The stale position last reported per node, so each one is logged once.
-        self._stale_reported: dict[int, Position] = {}
+        self._stale_reported: dict[int, NavFix] = {}
 
     # -- positions -------------------------------------------------------------------------
 
-    def update_position(self, port: int, position: Position) -> None:
+    def update_position(self, port: int, position: NavFix) -> None:
         self._positions[port] = position
 
-    def on_environment_nav_update(self, update) -> None:
+    def on_environment_nav_update(self, update: EnvironmentNavUpdate) -> None:
         """Listener for `NetSimManager.on_nav` (an EnvironmentNavUpdate)."""
-        self.update_position(update.nav.modem_tcp_port, Position.from_nav(update.nav))
+        self.update_position(update.nav.modem_tcp_port, NavFix.from_nav(update.nav))
 
-    def position(self, port: int) -> Position | None:
+    def position(self, port: int) -> NavFix | None:
         """The last position reported for a node, however old."""
         return self._positions.get(port)
 
     def remove_node(self, port: int) -> None:
         self._positions.pop(port, None)
 
-    def _fresh_position(self, port: int, t: float) -> Position | None:
+    def _fresh_position(self, port: int, t: float) -> NavFix | None:
         position = self._positions.get(port)
         if position is None:
             return None
@@ -324,7 +326,7 @@ class Channel:
                 receiver_now = receiver.at(tx.start)
                 if config.moving_receivers:
                     delay = arrival_delay(
-                        lambda tau, rx=receiver: slant_range(source, rx.at(tx.start + tau)), c
+                        functools.partial(_slant_range_at, source, receiver, tx.start), c
                     )
                 else:
                     delay = slant_range(source, receiver_now) / c
@@ -357,7 +359,7 @@ class Channel:
         return planned
 
     def _loss(
-        self, band: Band, source: Position, receiver: Position, range_m: float, alpha: float
+        self, band: Band, source: NavFix, receiver: NavFix, range_m: float, alpha: float
     ) -> float:
         propagation = self.config.propagation
         if propagation is None:
@@ -545,7 +547,7 @@ class Channel:
         key = f"{self.seed}:{p.sequence}:{p.receiver}".encode()
         rng = self._rng
         _random.Random.seed(rng, int.from_bytes(key + hashlib.sha512(key).digest()))
-        rng.gauss_next = None
+        rng.gauss_next = None  # type: ignore[attr-defined]  # (Random's cached normal variate)
         return rng
 
     @staticmethod
@@ -581,3 +583,8 @@ class Channel:
             self._finished_at[port] = [p for p in finished if p.interval.end > horizon]
         for port, intervals in self._own_tx.items():
             self._own_tx[port] = [i for i in intervals if i.end > horizon]
+
+
+def _slant_range_at(source: NavFix, receiver: NavFix, start: float, tau: float) -> float:
+    """The slant range from `source` to where `receiver` is `tau` s after `start`."""
+    return slant_range(source, receiver.at(start + tau))

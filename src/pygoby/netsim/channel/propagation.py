@@ -26,9 +26,10 @@ from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from google.protobuf.message import Message
-
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile
+from pygoby.protobuf.pygoby.netsim.propagation_pb2 import Bellhop, Propagation
+from pygoby.util.errors import MissingExtraError
+from pygoby.util.extras import needs_extra
 
 log = logging.getLogger(__name__)
 
@@ -55,7 +56,7 @@ class BellhopSettings:
     cached_fields: int = 64
 
     @classmethod
-    def from_proto(cls, msg: Message) -> BellhopSettings:
+    def from_proto(cls, msg: Bellhop) -> BellhopSettings:
         return cls(
             ssp=tuple((p.a, p.b) for p in msg.ssp),
             water_depth=msg.water_depth,
@@ -138,12 +139,11 @@ class BellhopLoss:
                 f"bellhop: the ssp must run from 0 m to the deepest bottom ({s.deepest:g} m)"
             )
         self.ssp = list(s.ssp) if s.ssp else self._sampled_profile()
-        try:
-            import pelagic  # noqa: F401  (checked now: a missing package is a configuration error)
-        except ImportError:
-            raise ValueError(
-                "the BELLHOP model needs the pelagic package: pip install 'pygoby[bellhop]'"
-            ) from None
+        try:  # checked now: a missing package is a configuration error
+            with needs_extra("bellhop", "the BELLHOP model"):
+                import pelagic  # noqa: F401
+        except MissingExtraError as exc:
+            raise ValueError(str(exc)) from None
 
     def _sampled_profile(self) -> list[tuple[float, float]]:
         deepest, c = self.settings.deepest, self.sound_speed
@@ -267,7 +267,7 @@ class BellhopLoss:
         return LossGrid(ranges, depths, loss.astype(float).tolist(), seconds, cpu)
 
 
-def propagation_model(msg: Message | None, sound_speed, spreading: float) -> BellhopLoss | None:
+def propagation_model(msg: Propagation | None, sound_speed, spreading: float) -> BellhopLoss | None:
     """The model a `pygoby.netsim.protobuf.Propagation` asks for (None: empirical).
     Raises ValueError."""
     if msg is None or msg.model == msg.EMPIRICAL:

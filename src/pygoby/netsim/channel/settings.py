@@ -6,10 +6,8 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 
-from google.protobuf.message import Message
-
 from pygoby.netsim.channel.absorption import francois_garrison, thorp, thorp_coa
-from pygoby.netsim.channel.errors import (
+from pygoby.netsim.channel.frame_errors import (
     DEFAULT_RATE_MODELS,
     FrameErrorModel,
     LogisticModel,
@@ -21,16 +19,21 @@ from pygoby.netsim.channel.errors import (
 from pygoby.netsim.channel.model import Band, ChannelConfig, PacketKind
 from pygoby.netsim.channel.propagation import BellhopLoss, propagation_model
 from pygoby.netsim.channel.soundspeed import SoundSpeedProfile, water_profile
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf.netsim.messages.manager_config_pb2 import (
+    ChannelModelConfig,
+    NetSimManagerConfig,
+)
+from pygoby.protobuf.pygoby.netsim.scenario_pb2 import ChannelSettings
+
+# the scenario's channel block and the manager's channel model share these fields
+ChannelSettingsLike = ChannelSettings | ChannelModelConfig
 
 
-def channel_settings_class() -> type[Message]:
-    return builtin_class(
-        "netsim/messages/manager_config.proto", "netsim.protobuf.ChannelModelConfig"
-    )
+def channel_settings_class() -> type[ChannelModelConfig]:
+    return ChannelModelConfig
 
 
-def _rate_model(entry: Message) -> FrameErrorModel:
+def _rate_model(entry: ChannelModelConfig.RateErrorModel) -> FrameErrorModel:
     kind = entry.WhichOneof("model")
     if kind == "table":
         try:
@@ -44,7 +47,7 @@ def _rate_model(entry: Message) -> FrameErrorModel:
     raise ValueError(f"rate_model for rate {entry.rate} has no model")
 
 
-def sound_speed_of(settings: Message) -> float | SoundSpeedProfile:
+def sound_speed_of(settings: ChannelSettingsLike) -> float | SoundSpeedProfile:
     """The sound speed of channel settings with `sound_speed` and `water` fields (an
     environment's ChannelModelConfig, a scenario's ChannelSettings)."""
     if settings.HasField("water"):
@@ -54,13 +57,9 @@ def sound_speed_of(settings: Message) -> float | SoundSpeedProfile:
     return settings.sound_speed
 
 
-def absorption_of(settings: Message) -> Callable[[float], float]:
+def absorption_of(settings: ChannelSettingsLike) -> Callable[[float], float]:
     """The absorption formula (f kHz -> dB/km) of settings with `absorption` and `water`."""
-    name = (
-        settings.DESCRIPTOR.fields_by_name["absorption"]
-        .enum_type.values_by_number[settings.absorption]
-        .name
-    )
+    name = ChannelModelConfig.Absorption.Name(settings.absorption)
     if name == "FRANCOIS_GARRISON":
         w = settings.water  # defaults apply when unset
         return functools.partial(
@@ -69,29 +68,33 @@ def absorption_of(settings: Message) -> Callable[[float], float]:
     return thorp_coa if name == "THORP_COA" else thorp
 
 
-def propagation_of(settings: Message, sound_speed) -> BellhopLoss | None:
+def propagation_of(settings: ChannelSettingsLike, sound_speed) -> BellhopLoss | None:
     """The propagation model of settings with `propagation` and `spreading` fields."""
     if not settings.HasField("propagation"):
         return None
     return propagation_model(settings.propagation, sound_speed, settings.spreading)
 
 
-def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
+def protocol_model_of(settings: ChannelSettingsLike) -> ProtocolModel | None:
+    """The range-based protocol model of settings with a `protocol_model` field, if set."""
+    if not settings.HasField("protocol_model"):
+        return None
+    p = settings.protocol_model
+    return ProtocolModel(
+        p.communication_range,
+        p.detection_range,
+        p.interference_range,
+        p.p_detection,
+        p.p_decoding,
+    )
+
+
+def channel_config_from_proto(settings: ChannelModelConfig) -> tuple[ChannelConfig, int]:
     """(ChannelConfig, seed) for a ChannelModelConfig message. Raises ValueError."""
     sound_speed = sound_speed_of(settings)
     absorption = absorption_of(settings)
     by_rate = dict(DEFAULT_RATE_MODELS)
     by_rate.update({entry.rate: _rate_model(entry) for entry in settings.rate_model})
-    protocol = None
-    if settings.HasField("protocol_model"):
-        p = settings.protocol_model
-        protocol = ProtocolModel(
-            p.communication_range,
-            p.detection_range,
-            p.interference_range,
-            p.p_detection,
-            p.p_decoding,
-        )
     config = ChannelConfig(
         sound_speed=sound_speed,
         source_level=settings.source_level,
@@ -111,13 +114,15 @@ def channel_config_from_proto(settings: Message) -> tuple[ChannelConfig, int]:
         receiver_lock=settings.receiver_lock,
         decode_latency=settings.decode_latency,
         position_staleness=settings.position_staleness,
-        protocol_model=protocol,
+        protocol_model=protocol_model_of(settings),
         propagation=propagation_of(settings, sound_speed),
     )
     return config, settings.seed
 
 
-def environment_channel_configs(manager_config: Message) -> dict[int, tuple[ChannelConfig, int]]:
+def environment_channel_configs(
+    manager_config: NetSimManagerConfig,
+) -> dict[int, tuple[ChannelConfig, int]]:
     """(ChannelConfig, seed) per environment id of a NetSimManagerConfig; environments without
     an `environment_channel` entry get the defaults. Raises ValueError."""
     defaults = channel_config_from_proto(channel_settings_class()())

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+from pygoby.util.extras import needs_extra
 from pygoby.util.ocean import mackenzie_1981
 
 SoundSpeedProfile = Callable[[float], float]  # depth (m) -> sound speed (m/s)
@@ -59,12 +60,17 @@ def unesco_1983(S: float, T68: float, P_dbar: float) -> float:
     )
 
 
+def _gsw():
+    """The gsw package (numpy-based: loaded only when TEOS-10 is used)."""
+    with needs_extra("sim", "TEOS-10 sound speed"):
+        import gsw
+    return gsw
+
+
 def teos10(SA: float, CT: float, P_dbar: float) -> float:
     """TEOS-10 (IOC, SCOR & IAPSO 2010) via `gsw.sound_speed`, which uses the 75-term
     specific-volume polynomial of Roquet et al. (2015); P is sea pressure in dbar."""
-    import gsw  # numpy-based: loaded only when TEOS-10 is used
-
-    return float(gsw.sound_speed(SA, CT, P_dbar))
+    return float(_gsw().sound_speed(SA, CT, P_dbar))
 
 
 def saunders_pressure(depth: float, lat: float) -> float:
@@ -78,9 +84,7 @@ def teos10_pressure(depth: float, lat: float) -> float:
 
     gsw counts height positive up, so z = -depth; the dynamic-height terms are left at zero.
     """
-    import gsw
-
-    return float(gsw.p_from_z(-depth, lat))
+    return float(_gsw().p_from_z(-depth, lat))
 
 
 def harmonic_mean_speed(profile: SoundSpeedProfile, z1: float, z2: float, steps: int = 16) -> float:
@@ -100,8 +104,7 @@ def harmonic_mean_speed(profile: SoundSpeedProfile, z1: float, z2: float, steps:
 def teos10_in_situ(T: float, SP: float, depth: float, lat: float, lon: float) -> float:
     """TEOS-10 sound speed from the practical salinity and in-situ temperature a user knows:
     pressure from depth (`gsw.p_from_z`), then Absolute Salinity and Conservative Temperature."""
-    import gsw
-
+    gsw = _gsw()
     p = teos10_pressure(depth, lat)
     SA = gsw.SA_from_SP(SP, p, lon, lat)
     return teos10(float(SA), float(gsw.CT_from_t(SA, T, p)), p)

@@ -6,19 +6,15 @@ These are modelling choices, not measured modem behaviour.
 
 from __future__ import annotations
 
-from functools import cache, lru_cache
-
-from google.protobuf.message import Message
+from functools import lru_cache
+from typing import Any
 
 from pygoby.netsim.channel.model import Outcome, PacketKind, Reception
-from pygoby.protobuf import builtin_class
-
-MM_STATS_PROTO = "goby/acomms/protobuf/mm_receive_statistics.proto"
+from pygoby.protobuf.goby.acomms.protobuf.mm_receive_statistics_pb2 import ReceiveStatistics
 
 
-@cache
-def receive_statistics_class() -> type[Message]:
-    return builtin_class(MM_STATS_PROTO, "goby.acomms.micromodem.protobuf.ReceiveStatistics")
+def receive_statistics_class() -> type[ReceiveStatistics]:
+    return ReceiveStatistics
 
 
 def _clamp(value: float, low: int, high: int) -> int:
@@ -34,7 +30,7 @@ def receive_statistics(
     bandwidth_hz: float = 5000.0,
     clock_mode: str = "NO_SYNC_TO_PPS_AND_CCCLK_GOOD",
     flexible_data_packet: bool = False,
-) -> Message | None:
+) -> ReceiveStatistics | None:
     """The $CACST a modem would report for this reception, or None if it reports nothing
     (the packet was never detected, or the receiver was busy with another one)."""
     link = link_statistics(reception, carrier_hz, bandwidth_hz)
@@ -53,7 +49,8 @@ def receive_statistics(
         packet_type = "FSK_MINI" if tx.rate == 0 else "PSK_MINI"
     else:
         packet_type = "FSK" if tx.rate == 0 else "PSK"
-    return receive_statistics_class()(
+    # (enum fields given by name, as protobuf's constructors take them)
+    fields: dict[str, Any] = dict(
         mode=mode,
         time=int(round(reception.arrival * 1e6)),
         clock_mode=clock_mode,
@@ -68,6 +65,7 @@ def receive_statistics(
         version=6,
         **link,
     )
+    return receive_statistics_class()(**fields)
 
 
 def link_statistics(

@@ -108,7 +108,8 @@ def sweep_command(args: argparse.Namespace) -> int:
         f"already stored, {len(outcome.failed)} failed; {outcome.wall_s:.1f} s "
         f"({rate:.2f} runs/s)"
     )
-    print(f"results: {store.table_path} ({outcome.table.num_rows} rows)")
+    rows = outcome.table.num_rows if outcome.table is not None else 0
+    print(f"results: {store.table_path} ({rows} rows)")
     if outcome.failed:
         print(
             f"failed runs (reasons in {store.failed_dir}): {', '.join(sorted(outcome.failed))}",

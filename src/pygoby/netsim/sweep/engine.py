@@ -12,7 +12,10 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-import pyarrow as pa
+from pygoby.util.extras import needs_extra
+
+with needs_extra("sim", "netsim sweeps"):
+    import pyarrow as pa
 
 from pygoby.netsim.sweep.plan import RunSpec, SweepPlan
 from pygoby.netsim.sweep.run import RunResult

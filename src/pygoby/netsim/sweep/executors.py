@@ -30,6 +30,8 @@ from concurrent.futures.process import BrokenProcessPool
 from pygoby.netsim.errors import NetsimError
 from pygoby.netsim.sweep.plan import RunSpec
 from pygoby.netsim.sweep.run import RunResult, execute_run
+from pygoby.util.errors import MissingExtraError
+from pygoby.util.extras import needs_extra
 
 log = logging.getLogger(__name__)
 
@@ -102,8 +104,8 @@ class LocalExecutor:
                         broken = True  # the run stays in flight: it runs again
                         continue
                     run = in_flight.pop(future)
-                    if future.exception() is not None:
-                        failed(run, _error_text(future.exception()))
+                    if (error := future.exception()) is not None:
+                        failed(run, _error_text(error))
                     else:
                         done(run, future.result())
         except BaseException:
@@ -135,11 +137,10 @@ class DaskExecutor:
 
     def run(self, runs: Iterable[RunSpec], done: Done, failed: Failed) -> None:
         try:
-            from distributed import Client, as_completed
-        except ImportError:
-            raise SweepExecutorError(
-                "--cluster needs Dask distributed: pip install 'pygoby[cluster]'"
-            ) from None
+            with needs_extra("cluster", "--cluster (Dask distributed)"):
+                from distributed import Client, as_completed
+        except MissingExtraError as exc:
+            raise SweepExecutorError(str(exc)) from None
         try:
             client = Client(self.address, timeout=self.connect_timeout, set_as_default=False)
         except (OSError, TimeoutError) as exc:

@@ -18,8 +18,8 @@ import math
 import random
 import re
 from dataclasses import dataclass
-from functools import cache
 from pathlib import Path
+from typing import Any
 
 from google.protobuf import text_format
 from google.protobuf.descriptor import FieldDescriptor
@@ -27,20 +27,21 @@ from google.protobuf.message import Message
 
 from pygoby.netsim.channel.geometry import WGS84
 from pygoby.netsim.errors import ScenarioError
-from pygoby.netsim.scenario import check_scenario, parse_scenario
-from pygoby.protobuf import builtin_class
+from pygoby.netsim.sim.scenario import check_scenario, parse_scenario
+from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
+from pygoby.protobuf.pygoby.netsim.scenario_pb2 import Scenario
+from pygoby.protobuf.pygoby.netsim.sweep_pb2 import Axis, Layout, Sweep
 from pygoby.protobuf.textconfig import merge_config_text, read_config_file
 
-SWEEP_PROTO = "pygoby/netsim/sweep.proto"
 LAYOUT_PREFIX = "layout."
 _SEGMENT = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[(\d+)\])?$")
 
 Value = int | float | bool | str
 
 
-@cache
-def sweep_class() -> type[Message]:
-    return builtin_class(SWEEP_PROTO, "pygoby.netsim.protobuf.Sweep")
+def sweep_class() -> type[Sweep]:
+    return Sweep
 
 
 @dataclass(frozen=True)
@@ -72,13 +73,13 @@ class SweepPlan:
 # -- loading -------------------------------------------------------------------------------------
 
 
-def load_sweep(path: str | Path) -> tuple[Message, Message]:
+def load_sweep(path: str | Path) -> tuple[Sweep, Scenario]:
     """(sweep, base scenario) from a sweep file. Raises ScenarioError."""
     path = Path(path)
     return parse_sweep(read_config_file(path, error=ScenarioError), path)
 
 
-def parse_sweep(text: str, path: Path | None = None) -> tuple[Message, Message]:
+def parse_sweep(text: str, path: Path | None = None) -> tuple[Sweep, Scenario]:
     sweep = sweep_class()()
     merge_config_text(text, sweep, file=path, error=ScenarioError)
     if sweep.HasField("scenario") == sweep.HasField("scenario_file"):
@@ -124,7 +125,7 @@ def _segments(path: str) -> list[tuple[str, int | None]]:
     return parts
 
 
-def field_descriptor(message_class_descriptor, path: str) -> FieldDescriptor:
+def field_descriptor(message_class_descriptor, path: str) -> AnyFieldDescriptor:
     """The descriptor of the scalar a path ends at (checked against the message type)."""
     descriptor = message_class_descriptor
     segments = _segments(path)
@@ -183,16 +184,16 @@ _KINDS = {
 }
 
 
-def parse_value(field: FieldDescriptor, text: str) -> Value:
+def parse_value(field: AnyFieldDescriptor, text: str) -> Value:
     """A value written as in TextFormat, as the field's Python type (enums by name)."""
     kind = _KINDS[field.cpp_type]
     text = text.strip()
     if field.cpp_type == FieldDescriptor.CPPTYPE_ENUM:
-        by_name = field.enum_type.values_by_name
+        by_name = enum_type(field).values_by_name
         if text in by_name:
             return text
-        if text.lstrip("-").isdigit() and int(text) in field.enum_type.values_by_number:
-            return field.enum_type.values_by_number[int(text)].name
+        if text.lstrip("-").isdigit() and int(text) in enum_type(field).values_by_number:
+            return enum_type(field).values_by_number[int(text)].name
         raise ValueError(f"{text!r} is not one of {', '.join(by_name)}")
     if kind is bool:
         if text.lower() in ("true", "t", "1"):
@@ -214,10 +215,10 @@ def parse_value(field: FieldDescriptor, text: str) -> Value:
     return text
 
 
-def _field_value(field: FieldDescriptor, value: Value):
+def _field_value(field: AnyFieldDescriptor, value: Value):
     """What to assign to the protobuf field (enum names become numbers)."""
     if field.cpp_type == FieldDescriptor.CPPTYPE_ENUM:
-        return field.enum_type.values_by_name[value].number
+        return enum_type(field).values_by_name[str(value)].number
     return value
 
 
@@ -227,9 +228,9 @@ def _field_value(field: FieldDescriptor, value: Value):
 @dataclass(frozen=True)
 class _Axis:
     column: AxisColumn
-    descriptor: FieldDescriptor
+    descriptor: AnyFieldDescriptor
     values: tuple[Value, ...]  # GRID values (or RANDOM choices)
-    span: Message | None
+    span: Axis.Span | None
 
 
 def _axis_line(text: str, field: str) -> int | None:
@@ -239,11 +240,15 @@ def _axis_line(text: str, field: str) -> int | None:
     return None
 
 
-def _axes(sweep: Message, base: Message, path: Path | None, text: str) -> list[_Axis]:
+def _axes(sweep: Sweep, base: Scenario, path: Path | None, text: str) -> list[_Axis]:
     axes, names = [], set()
     layout_descriptor = sweep.DESCRIPTOR.fields_by_name["layout"].message_type
     for axis in sweep.axis:
-        where = {"file": path, "line": _axis_line(text, axis.field), "field": axis.field}
+        where: dict[str, Any] = {
+            "file": path,
+            "line": _axis_line(text, axis.field),
+            "field": axis.field,
+        }
         try:
             if axis.field.startswith(LAYOUT_PREFIX):
                 if not sweep.HasField("layout"):
@@ -275,7 +280,7 @@ def _axes(sweep: Message, base: Message, path: Path | None, text: str) -> list[_
     return axes
 
 
-def _span_values(span: Message, kind: type) -> tuple[Value, ...]:
+def _span_values(span: Axis.Span, kind: type) -> tuple[Value, ...]:
     low, high, steps = getattr(span, "from"), span.to, span.steps
     if steps == 1:
         points = [low]
@@ -333,7 +338,7 @@ RESERVED_COLUMNS = frozenset(
 )
 
 
-def expand(sweep: Message, base: Message, path: Path | None = None, text: str = "") -> SweepPlan:
+def expand(sweep: Sweep, base: Scenario, path: Path | None = None, text: str = "") -> SweepPlan:
     """Every run of the sweep, in a fixed order (points in grid/sample order, then replicates)."""
     axes = _axes(sweep, base, path, text)
     if sweep.replicates > 1 and any(a.column.field == "seed" for a in axes):
@@ -350,11 +355,11 @@ def expand(sweep: Message, base: Message, path: Path | None = None, text: str = 
         try:
             scenario = point_scenario(sweep, base, axes, values)
         except (ValueError, ScenarioError) as exc:  # (a ScenarioError is a ValueError too)
-            params = ", ".join(f"{a.column.name}={v}" for a, v in zip(axes, values, strict=True))
+            shown = ", ".join(f"{a.column.name}={v}" for a, v in zip(axes, values, strict=True))
             field = getattr(exc, "field", None)
             reason = getattr(exc, "reason", str(exc))
             raise ScenarioError(
-                f"{reason} (point {index}: {params})",
+                f"{reason} (point {index}: {shown})",
                 file=path,
                 line=_axis_line(text, field) if field else None,
                 field=field,
@@ -384,7 +389,7 @@ def _set_axis(message: Message, axis: _Axis, path: str, value: Value) -> None:
         raise ScenarioError(str(exc), field=axis.column.field) from None
 
 
-def point_scenario(sweep: Message, base: Message, axes: list[_Axis], values) -> Message:
+def point_scenario(sweep: Sweep, base: Scenario, axes: list[_Axis], values) -> Scenario:
     """The scenario of one point: the layout with its axis values, then the scenario's axes."""
     scenario = type(base)()
     scenario.CopyFrom(base)
@@ -403,7 +408,7 @@ def point_scenario(sweep: Message, base: Message, axes: list[_Axis], values) -> 
     return scenario
 
 
-def apply_layout(scenario: Message, layout: Message) -> None:
+def apply_layout(scenario: Scenario, layout: Layout) -> None:
     """Replace the scenario's nodes by the layout's (fixed, at lat/lon around the origin)."""
     if not scenario.HasField("origin"):
         raise ValueError("a layout needs the scenario's origin")

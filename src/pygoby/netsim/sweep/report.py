@@ -26,10 +26,13 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-import pyarrow as pa
-import pyarrow.parquet as pq
+from pygoby.util.extras import needs_extra
 
-from pygoby.netsim.report import plt, save_figure
+with needs_extra("sim", "netsim sweep reports"):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+from pygoby.netsim.report.plots import plt, save_figure
 from pygoby.netsim.sweep.store import RESULTS_FILE
 
 Z95 = 1.959963984540054  # standard normal 97.5 % quantile

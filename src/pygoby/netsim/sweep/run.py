@@ -28,8 +28,8 @@ import time
 from collections import Counter
 from dataclasses import dataclass, field
 
-from pygoby.netsim.scenario import node_ports, parse_scenario
-from pygoby.netsim.sim import Simulation
+from pygoby.netsim.sim.scenario import node_ports, parse_scenario
+from pygoby.netsim.sim.simulation import Simulation
 from pygoby.netsim.sweep.plan import RunSpec
 
 OUTCOMES = ("good", "bad_frames", "not_detected", "receiver_busy", "half_duplex")

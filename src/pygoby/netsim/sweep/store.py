@@ -22,8 +22,11 @@ import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
-import pyarrow as pa
-import pyarrow.parquet as pq
+from pygoby.util.extras import needs_extra
+
+with needs_extra("sim", "netsim sweeps"):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
 
 from pygoby.netsim.sweep.plan import AxisColumn, RunSpec
 

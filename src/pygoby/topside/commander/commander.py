@@ -28,7 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -45,6 +45,8 @@ from pygoby.moos.translator import (
     make_post,
     serialize_for_moos,
 )
+from pygoby.protobuf import enum_type, initialization_errors
+from pygoby.protobuf.descriptors import AnyFieldDescriptor
 from pygoby.topside.commander import savefile, specials
 from pygoby.topside.commander.fields import FieldSpec, FieldValueError
 from pygoby.topside.commander.messageset import CommandSet, CommandType
@@ -165,7 +167,9 @@ class Commander:
         self.notices: list[Notice] = []
         self._ids = itertools.count(1)
         self.values: Mapping[str, MoosValue] = values if values is not None else {}
-        self.signal_import = Signal()  # (names) after import_xml: new source variables
+        self.signal_import: Signal[list[str]] = (
+            Signal()
+        )  # (names) after import_xml: new source variables
 
     @property
     def source_variables(self) -> set[str]:
@@ -331,7 +335,7 @@ class Commander:
                 values[spec.name] = text
         # what the rules above cannot see: an element of a repeated sub-message left without a
         # required field
-        warnings += [f"{path}: not set" for path in msg.FindInitializationErrors() if "[" in path]
+        warnings += [f"{path}: not set" for path in initialization_errors(msg) if "[" in path]
         try:
             posts = self._posts(kind, msg, values, warnings)
         except TranslatorError as err:
@@ -404,7 +408,7 @@ class Commander:
         variables = self.commands.variables
         return variables.ack_original, variables.expire
 
-    def handle_mail(self, var: str, value: object, when: float | None = None) -> list[Notice]:
+    def handle_mail(self, var: str, value: MoosValue, when: float | None = None) -> list[Notice]:
         """Feed ACOMMS_ACK_ORIGINAL / ACOMMS_EXPIRE mail (not older than the app's start)."""
         ack_var, expire_var = self.watched_variables
         if var not in (ack_var, expire_var):
@@ -450,7 +454,7 @@ class Commander:
     def load(self, path: str | Path) -> list[str]:
         """Open the messages of a save file; returns warnings (unknown messages, values the
         fields refuse). Raises SaveFileError / OSError for an unusable file."""
-        names = {}
+        names: dict[str, Sequence[str]] = {}
         for kind in self.commands.types.values():
             names[kind.short_name] = names[kind.name] = [f.name for f in kind.fields]
         warnings = []
@@ -479,12 +483,12 @@ def _number(text: str) -> float:
     return 1.0 if lowered == "true" else 0.0 if lowered == "false" else float(text)
 
 
-def _convert(spec: FieldSpec, field: FieldDescriptor, text: str) -> object:
+def _convert(spec: FieldSpec, field: AnyFieldDescriptor, text: str) -> object:
     kind = field.type
     if kind == _FD.TYPE_ENUM:
-        for value, shown in zip(field.enum_type.values, spec.enum_values, strict=True):
+        for value, shown in zip(enum_type(field).values, spec.enum_values, strict=True):
             if shown.upper() == text.upper():
-                return value.number
+                return value.number  # type: ignore[attr-defined]  # (an EnumValueDescriptor)
         raise FieldValueError(f"{spec.name}: {text!r} is not one of its values")
     if kind == _FD.TYPE_BOOL:
         return text.lower() in ("true", "1")

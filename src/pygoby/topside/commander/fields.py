@@ -14,30 +14,20 @@ from google.protobuf.descriptor import FieldDescriptor
 
 from pygoby.dccl.options import field_options
 from pygoby.moos.translator.fields import enum_name
+from pygoby.protobuf import enum_type, message_type
+from pygoby.protobuf.descriptors import INTEGER_FIELD_TYPES, AnyFieldDescriptor
 from pygoby.topside.commander import specials
 from pygoby.topside.errors import FieldValueError
 
 _FD = FieldDescriptor
-_INT_TYPES = {
-    _FD.TYPE_INT32,
-    _FD.TYPE_INT64,
-    _FD.TYPE_UINT32,
-    _FD.TYPE_UINT64,
-    _FD.TYPE_SINT32,
-    _FD.TYPE_SINT64,
-    _FD.TYPE_FIXED32,
-    _FD.TYPE_FIXED64,
-    _FD.TYPE_SFIXED32,
-    _FD.TYPE_SFIXED64,
-}
 _UNSIGNED = {_FD.TYPE_UINT32, _FD.TYPE_UINT64, _FD.TYPE_FIXED32, _FD.TYPE_FIXED64}
 _FLOAT_TYPES = {_FD.TYPE_DOUBLE, _FD.TYPE_FLOAT}
 
 
-def _kind(field: FieldDescriptor, codec: str) -> str:
+def _kind(field: AnyFieldDescriptor, codec: str) -> str:
     if codec == "_static" or codec.startswith("dccl.static"):
         return "static"
-    if field.type in _INT_TYPES:
+    if field.type in INTEGER_FIELD_TYPES:
         return "int"
     if field.type in _FLOAT_TYPES:
         return "float"
@@ -82,14 +72,14 @@ class FieldSpec:
     @classmethod
     def from_descriptor(
         cls,
-        field: FieldDescriptor,
+        field: AnyFieldDescriptor,
         source: str = "",
         automatic_from: str = "",
         *,
         path: str = "",
         required: bool | None = None,
         short_enum: bool = False,
-        elements_of: FieldDescriptor | None = None,
+        elements_of: AnyFieldDescriptor | None = None,
     ) -> FieldSpec:
         """`path`: the name inside the command (`pose.x` for a sub-message's field);
         `required`: whether the message needs it (a required field of an optional sub-message
@@ -101,9 +91,9 @@ class FieldSpec:
         kind = _kind(field, options.codec)
         numeric = kind in ("int", "float")
         type_name = (
-            field.message_type.full_name
+            message_type(field).full_name
             if field.type == _FD.TYPE_MESSAGE
-            else field.enum_type.full_name
+            else enum_type(field).full_name
             if field.type == _FD.TYPE_ENUM
             else _TYPE_NAMES.get(field.type, "?")
         )
@@ -132,7 +122,7 @@ class FieldSpec:
             max_length=options.max_length if options.HasField("max_length") else None,
             max_repeat=repeat.max_repeat if repeat.HasField("max_repeat") else None,
             enum_values=tuple(
-                enum_name(field, v.number, short_enum) for v in field.enum_type.values
+                enum_name(field, v.number, short_enum) for v in enum_type(field).values
             )
             if kind == "enum"
             else (),

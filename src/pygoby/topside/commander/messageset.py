@@ -1,5 +1,5 @@
 """The messages an operator can send, with where each field's value comes from, read from the
-message set pAcommsHandler loads (`pygoby.topside.acomms_config.AcommsMessageSet`: its
+message set pAcommsHandler loads (`pygoby.moosacomms.acomms_config.AcommsMessageSet`: its
 `load_proto_file`/`load_shared_library` definitions, `translator_entry` blocks, queues, and the
 Goby 1.1 XML `message_file`s).
 
@@ -24,14 +24,17 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 from pygoby.dccl.xml import XmlMessage
 from pygoby.moos.translator import ModemIdLookup, Technique, Translator, UTMGeodesy
 from pygoby.moos.translator.format import parsed_fields
 from pygoby.moos.translator.techniques import PROTOBUF_TECHNIQUES
-from pygoby.topside.acomms_config import AcommsMessageSet
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
+from pygoby.protobuf.descriptors import AnyDescriptor, AnyFieldDescriptor
+from pygoby.protobuf.goby.acomms.protobuf.queue_pb2 import QueuedMessageEntry
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 from pygoby.topside.commander.fields import FieldSpec
 
 TRIGGER_PUBLISH = 1
@@ -72,7 +75,7 @@ class CommandType:
         raise KeyError(f"{self.name} has no field {name!r}")
 
 
-def _effective_sources(entry: Message, cls: type[Message]) -> dict[int, str]:
+def _effective_sources(entry: TranslatorEntry, cls: type[Message]) -> dict[int, str]:
     """Top-level field number -> the MOOS variable whose create rule sets it last."""
     descriptor = cls.DESCRIPTOR
     trigger = entry.trigger.moos_var
@@ -94,12 +97,12 @@ def _effective_sources(entry: Message, cls: type[Message]) -> dict[int, str]:
 
 
 def _leaves(
-    descriptor: Descriptor,
+    descriptor: AnyDescriptor,
     prefix: str,
     required: bool,
     chain: tuple[str, ...],
-    elements_of: FieldDescriptor | None = None,
-) -> Iterator[tuple[str, FieldDescriptor, bool, FieldDescriptor | None]]:
+    elements_of: AnyFieldDescriptor | None = None,
+) -> Iterator[tuple[str, AnyFieldDescriptor, bool, AnyFieldDescriptor | None]]:
     """(path, field, required all the way down, the repeated sub-message whose elements hold
     it) of every field: singular sub-messages unfolded (`pose.x`), and repeated ones of plain
     fields (`track.x`: one value per element); deeper, recursive and other repeated
@@ -120,7 +123,9 @@ def _leaves(
             yield path, field, needed, elements_of
 
 
-def command_type(entry: Message, cls: type[Message], queue_entry: Message | None) -> CommandType:
+def command_type(
+    entry: TranslatorEntry, cls: type[Message], queue_entry: QueuedMessageEntry | None
+) -> CommandType:
     """A translator entry with a publish trigger (goby3 style)."""
     trigger = entry.trigger.moos_var
     sources = _effective_sources(entry, cls)
@@ -158,7 +163,7 @@ def command_type(entry: Message, cls: type[Message], queue_entry: Message | None
 
 
 def goby11_command_type(
-    msg: XmlMessage, cls: type[Message], queue_entry: Message | None
+    msg: XmlMessage, cls: type[Message], queue_entry: QueuedMessageEntry | None
 ) -> CommandType:
     """A Goby 1.1 XML message, with the fields Goby 1.1's iCommander showed: the named
     source and destination header pieces, then the layout."""
@@ -183,7 +188,7 @@ def goby11_command_type(
     )
 
 
-def _dest_field(queue_entry: Message | None) -> str:
+def _dest_field(queue_entry: QueuedMessageEntry | None) -> str:
     dest_field = ""
     if queue_entry is not None:
         for role in queue_entry.role:
@@ -200,7 +205,7 @@ class AcommsVariables:
     expire: str = "ACOMMS_EXPIRE"
 
     @classmethod
-    def from_config(cls, moos_var: Message) -> AcommsVariables:
+    def from_config(cls, moos_var: pAcommsHandlerConfig.MOOSVariables) -> AcommsVariables:
         return cls(
             moos_var.prefix + moos_var.queue_ack_original_msg,
             moos_var.prefix + moos_var.queue_expire,
@@ -214,7 +219,7 @@ class CommandSet:
     def __init__(
         self,
         translator: Translator,
-        queue_entries: dict[str, Message],
+        queue_entries: dict[str, QueuedMessageEntry],
         *,
         multiplex_var: str = "",
         variables: AcommsVariables = AcommsVariables(),
@@ -245,7 +250,10 @@ class CommandSet:
 
     @classmethod
     def from_pacommshandler(
-        cls, cfg: Message, find: Callable[[str], str] = str, modem_id_lookup_path: str = ""
+        cls,
+        cfg: pAcommsHandlerConfig,
+        find: Callable[[str], str] = str,
+        modem_id_lookup_path: str = "",
     ) -> CommandSet:
         """From a pAcommsHandlerConfig (read from a mission, not yet loaded: its XML files'
         entries are added to it); `find` resolves relative file names (e.g.
@@ -291,9 +299,9 @@ class CommandSet:
         for entry in cfg.translator_entry:
             if entry.protobuf_name in names:
                 self.translator.add_entry(entry)
-        for entry in cfg.queue_cfg.message_entry:
-            if entry.protobuf_name in names:
-                self.queue_entries[entry.protobuf_name] = entry
+        for queue_entry in cfg.queue_cfg.message_entry:
+            if queue_entry.protobuf_name in names:
+                self.queue_entries[queue_entry.protobuf_name] = queue_entry
         goby11 = self.messages.transitional.messages
         for name in names:
             self._add_goby11(goby11[name])

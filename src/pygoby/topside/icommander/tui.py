@@ -18,14 +18,17 @@ import asyncio
 from collections import deque
 from collections.abc import Callable
 
-from textual import events
-from textual.app import App, ComposeResult
-from textual.binding import Binding
-from textual.containers import Vertical, VerticalScroll
-from textual.message_pump import MessagePump
-from textual.screen import ModalScreen, Screen
-from textual.widgets import Footer, Input, Label, OptionList, Static
-from textual.widgets.option_list import Option
+from pygoby.util.extras import needs_extra
+
+with needs_extra("topside", "iCommander's terminal interface"):
+    from textual import events
+    from textual.app import App, ComposeResult
+    from textual.binding import Binding
+    from textual.containers import Vertical, VerticalScroll
+    from textual.message_pump import MessagePump
+    from textual.screen import ModalScreen, Screen
+    from textual.widgets import Footer, Input, Label, OptionList, Static
+    from textual.widgets.option_list import Option
 
 from pygoby.errors import PygobyError
 from pygoby.topside.commander import Commander, Draft, FieldValueError, Notice, Outgoing
@@ -200,7 +203,7 @@ class EditScreen(Screen):
     def _field(self, box: Input) -> str:
         return (box.id or "").removeprefix("field-").replace("--", ".")
 
-    def on_descendant_focus(self, event) -> None:
+    def on_descendant_focus(self, event: events.DescendantFocus) -> None:
         if (
             isinstance(event.widget, Input)
             and event.widget.id
@@ -260,7 +263,7 @@ class EditScreen(Screen):
         if self.commit(name):
             self.app.open_actions(name)  # type: ignore[attr-defined]
 
-    def on_descendant_blur(self, event) -> None:
+    def on_descendant_blur(self, event: events.DescendantBlur) -> None:
         if isinstance(event.widget, Input) and (event.widget.id or "").startswith("field-"):
             self.commit(self._field(event.widget))
 
@@ -459,7 +462,7 @@ class ICommanderTUI(App):
                 opened = [(d.name, d.type.short_name) for d in commander.drafts.values()]
                 self.push_screen(
                     Menu("Choose an active message to switch to:", opened, "switch"),
-                    lambda name: name and self.edit(name),
+                    lambda name: self.edit(name) if name else None,
                 )
             elif action == "time":
                 commander.insert_time(draft, field)

@@ -79,7 +79,9 @@ class Access:
         parts = urlsplit(origin)
         return parts.scheme in ("http", "https") and self.host_allowed(parts.netloc)
 
-    def offered_token(self, headers: Mapping[str, str], query: str, cookies: Mapping[str, str]):
+    def offered_token(
+        self, headers: Mapping[str, str], query: str, cookies: Mapping[str, str]
+    ) -> str:
         from_query = parse_qs(query).get("token", [""])[0]
         bearer = headers.get("authorization", "")
         return (

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from google.protobuf.message import Message
 
@@ -16,20 +17,21 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import MoosValues, Post
-from pygoby.protobuf import builtin_class
-from pygoby.topside.acomms_config import AcommsMessageSet
+from pygoby.moosacomms.acomms_config import AcommsMessageSet
+from pygoby.protobuf.pygoby.apps.topside_config_pb2 import LiaisonAppConfig
 from pygoby.topside.commander import CommanderError, CommandSet
 from pygoby.topside.liaison.state import LiaisonState
 from pygoby.topside.liaison.web import WebServer
 
-CONFIG = ("pygoby/apps/topside_config.proto", "pygoby.apps.protobuf.LiaisonAppConfig")
-
 
 class Liaison(GobyMOOSApp):
-    config_proto = CONFIG
+    config_class = LiaisonAppConfig
+    cfg: LiaisonAppConfig
     default_name = "liaison"
 
-    def __init__(self, cfg: Message, *, acomms: AcommsMessageSet | None = None, **kwargs) -> None:
+    def __init__(
+        self, cfg: LiaisonAppConfig, *, acomms: AcommsMessageSet | None = None, **kwargs: Any
+    ) -> None:
         """`acomms`: the message set of the pAcommsHandler whose messages, queues and MAC cycle
         the pages show (default: the `liaison.commander.pacommshandler_name` block of the
         mission)."""
@@ -77,7 +79,7 @@ class Liaison(GobyMOOSApp):
     def embedded(cls, host: GobyMOOSApp, acomms: AcommsMessageSet) -> Liaison:
         """The liaison a pAcommsHandler (`host`, its block's `liaison` section) serves, as its
         own client of the host's MOOSDB, with the host's message set."""
-        cfg = builtin_class(*CONFIG)()
+        cfg = LiaisonAppConfig()
         cfg.common.CopyFrom(host.common)
         cfg.common.log = False
         cfg.liaison.CopyFrom(acomms.cfg.liaison)
@@ -105,7 +107,7 @@ class Liaison(GobyMOOSApp):
             self.log.warning(
                 "no ProcessConfig = %s block in %s: serving with the defaults",
                 self.name,
-                self.mission.path or "the mission",
+                (self.mission.path if self.mission else None) or "the mission",
             )
         await self.web.start()
         print(f"{self.name}: serving {self.web.url}", flush=True)

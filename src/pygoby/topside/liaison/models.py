@@ -12,6 +12,7 @@ import math
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 from google.protobuf.message import Message
 
@@ -24,6 +25,11 @@ from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import ModemIdLookup, UTMGeodesy, dynamic_parse, parse_for_moos
 from pygoby.moos.translator.keyvalue import val_from_string
 from pygoby.moos.translator.techniques import MoosValue, Technique
+from pygoby.protobuf import enum_type
+from pygoby.protobuf.descriptors import MessageT
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
+    pAcommsHandlerConfig,
+)
 from pygoby.topside.errors import ScopeFilterError
 
 RATE_WINDOW = 10.0  # seconds over which a variable's rate is measured
@@ -158,7 +164,7 @@ class ScopeModel:
 class QueueState:
     name: str
     dccl_id: int | None
-    entry: Message
+    entry: acomms_pb.QueuedMessageEntry
     size: int = 0
     last_sent: float = 0.0
     sent: int = 0
@@ -172,11 +178,11 @@ class QueueState:
 
 
 def _enum_name(msg: Message, field: str) -> str:
-    enum = msg.DESCRIPTOR.fields_by_name[field].enum_type
+    enum = enum_type(msg.DESCRIPTOR.fields_by_name[field])
     return enum.values_by_number[getattr(msg, field)].name
 
 
-def _mm_extension(transmission: Message) -> Message | None:
+def _mm_extension(transmission: acomms_pb.ModemTransmission) -> acomms_pb.MMTransmission | None:
     if transmission.HasExtension(acomms_pb.MM_TRANSMISSION):
         return transmission.Extensions[acomms_pb.MM_TRANSMISSION]
     return None
@@ -189,7 +195,11 @@ class AcommsModel:
     finds the mission's message classes (to name the DCCL messages inside frames)."""
 
     def __init__(
-        self, cfg: Message, resolve: Callable[[str], type[Message]], now: float, history: int = 20
+        self,
+        cfg: pAcommsHandlerConfig,
+        resolve: Callable[[str], type[Message]],
+        now: float,
+        history: int = 20,
     ) -> None:
         names = cfg.moos_var
         self.var = {
@@ -211,7 +221,7 @@ class AcommsModel:
             self.queues[entry.protobuf_name] = QueueState(
                 entry.protobuf_name, dccl_id, entry, last_sent=now
             )
-        self.slots = [
+        self.slots: list[dict[str, Any]] = [
             {
                 "src": s.src,
                 "dest": s.dest,
@@ -231,7 +241,7 @@ class AcommsModel:
         self.tx: deque[dict] = deque(maxlen=history)
         self.rx: deque[dict] = deque(maxlen=history)
         self.timeline: deque[dict] = deque(maxlen=4 * history)
-        self._handlers = {
+        self._handlers: dict[str, Callable[[MoosValue, float], None]] = {
             self.var["queue_size"]: self._on_qsize,
             self.var["mac_slot_start"]: self._on_slot,
             self.var["driver_transmit"]: functools.partial(self._on_modem, True),
@@ -251,7 +261,7 @@ class AcommsModel:
         if handler is not None and isinstance(msg.value, str | bytes):
             handler(msg.value, msg.time)
 
-    def _parse(self, cls: type[Message], value: MoosValue) -> Message | None:
+    def _parse(self, cls: type[MessageT], value: MoosValue) -> MessageT | None:
         out = cls()
         try:
             parse_for_moos(value, out)
@@ -260,7 +270,7 @@ class AcommsModel:
         return out
 
     def _on_driver_status(self, value: MoosValue, when: float) -> None:
-        text = value.decode("utf-8", "replace") if isinstance(value, bytes) else value
+        text = value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
         driver, sep, state = text.partition(": ")
         if sep and len(self.drivers) < 16:  # a handful of drivers; never an unbounded table
             self.drivers[driver] = state[:500]
@@ -285,7 +295,7 @@ class AcommsModel:
             self.slot_index = slot.slot_index if slot.HasField("slot_index") else None
             self.slot_start = slot.time / 1e6 if slot.HasField("time") else when
 
-    def _messages_in(self, transmission: Message) -> list[str]:
+    def _messages_in(self, transmission: acomms_pb.ModemTransmission) -> list[str]:
         names = []
         for frame in transmission.frame:
             data, offset = bytes(frame), 0
@@ -329,7 +339,7 @@ class AcommsModel:
         if transmission is None:
             return
         names = self._messages_in(transmission)
-        row = {
+        row: dict[str, Any] = {
             "time": transmission.time / 1e6 if transmission.HasField("time") else when,
             "src": transmission.src,
             "dest": transmission.dest,

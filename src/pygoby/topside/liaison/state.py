@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 
-from google.protobuf.message import Message
-
 from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.translator import MoosValue, Post
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
+from pygoby.protobuf.pygoby.apps.topside_config_pb2 import LiaisonConfig
 from pygoby.topside.commander import (
     KEY_VALUE,
     MULTIPLEX,
@@ -50,7 +50,7 @@ def record_view(record: SentRecord) -> dict:
         "status": record.status,
         "status_time": record.status_time,
         "text": record.text,
-        "posts": [f"{p.var}: {p.value}" for p in record.posts],
+        "posts": [f"{p.var}: {p.value!s}" for p in record.posts],
     }
 
 
@@ -78,8 +78,8 @@ class LiaisonState:
 
     def __init__(
         self,
-        cfg: Message,  # pygoby.apps.protobuf.LiaisonConfig
-        acomms_cfg: Message,  # pAcommsHandlerConfig of the community
+        cfg: LiaisonConfig,
+        acomms_cfg: pAcommsHandlerConfig,  # of the community
         commands: CommandSet,
         *,
         community: str,

@@ -14,30 +14,33 @@ import contextlib
 import logging
 import secrets
 import socket
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from http.cookies import SimpleCookie
 from pathlib import Path
 from typing import Any
 
-import uvicorn
-from google.protobuf.message import Message as ProtobufMessage
-from starlette.applications import Starlette
-from starlette.middleware import Middleware
-from starlette.requests import Request
-from starlette.responses import (
-    FileResponse,
-    JSONResponse,
-    PlainTextResponse,
-    RedirectResponse,
-    Response,
-    StreamingResponse,
-)
-from starlette.routing import Mount, Route
-from starlette.staticfiles import StaticFiles
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
+from pygoby.util.extras import needs_extra
+
+with needs_extra("topside", "liaison"):
+    import uvicorn
+    from starlette.applications import Starlette
+    from starlette.middleware import Middleware
+    from starlette.requests import Request
+    from starlette.responses import (
+        FileResponse,
+        JSONResponse,
+        PlainTextResponse,
+        RedirectResponse,
+        Response,
+        StreamingResponse,
+    )
+    from starlette.routing import Mount, Route
+    from starlette.staticfiles import StaticFiles
+    from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from pygoby.errors import ConfigError, PygobyError
+from pygoby.protobuf.pygoby.apps.topside_config_pb2 import LiaisonConfig
 from pygoby.topside.commander import (
     Commander,
     CommanderError,
@@ -326,7 +329,7 @@ class _EmbeddedServer(uvicorn.Server):
     server itself."""
 
     @contextlib.contextmanager
-    def capture_signals(self):  # type: ignore[override]
+    def capture_signals(self) -> Iterator[None]:
         yield
 
 
@@ -348,7 +351,7 @@ class WebServer:
     """uvicorn in the running asyncio loop, on a socket bound at construction; `url` once
     started."""
 
-    def __init__(self, state: LiaisonState, cfg: ProtobufMessage, save_dir: str | Path) -> None:
+    def __init__(self, state: LiaisonState, cfg: LiaisonConfig, save_dir: str | Path) -> None:
         """`cfg`: the LiaisonConfig (address, port, token, update_freq, max_streams,
         allowed_host); `save_dir`: the Commander page's save folder."""
         self.address = address = cfg.http_address
@@ -405,3 +408,10 @@ class WebServer:
                 await cancel_and_wait(task)
         elif not task.cancelled():
             task.exception()  # retrieved; the server logs its own errors
+
+
+def needed(draft: Draft | None) -> Draft:
+    """The draft an action works on (a request without "type" has none: a 400)."""
+    if draft is None:
+        raise KeyError("type")
+    return draft

@@ -9,6 +9,7 @@ field is always 0, and usable with every data rate.
 from __future__ import annotations
 
 import logging
+from typing import cast
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.dccl import Codec, DcclError
@@ -35,7 +36,7 @@ class ApplicationAcks:
             ack.part.add(ack_dest=peer, acked_frames=mask)
         return ack
 
-    def prepare(self, msg) -> int:
+    def prepare(self, msg: acomms_pb.ModemTransmission) -> int:
         """Before the data request: number the frames and reserve room for the ack at the start
         of frame 0. Returns the placeholder's size."""
         if self.frame_counter + msg.max_num_frames > MAX_FRAME_NUMBER:
@@ -48,7 +49,7 @@ class ApplicationAcks:
             msg.frame.append(b"\0" * placeholder)
         return placeholder
 
-    def finish(self, msg, placeholder: int) -> bool:
+    def finish(self, msg: acomms_pb.ModemTransmission, placeholder: int) -> bool:
         """After the data request: write the real ack; False if there is nothing to send."""
         has_data = len(msg.frame[0]) > placeholder or any(msg.frame[1:])
         if not has_data and not self.owed:
@@ -62,7 +63,7 @@ class ApplicationAcks:
         return True
 
     # ------------------------------------------------------------------ receiving
-    def strip(self, msg) -> list:
+    def strip(self, msg: acomms_pb.ModemTransmission) -> list:
         """Remove the ack from a received transmission's frame 0, remember what we owe the
         sender and return the ACK transmissions it carries for us."""
         if not msg.frame or not msg.frame[0]:
@@ -71,7 +72,8 @@ class ApplicationAcks:
         try:
             if self.codec.id(data) != self.dccl_id:
                 return []
-            ack, used = self.codec.decode_prefix(data)
+            decoded, used = self.codec.decode_prefix(data)
+            ack = cast(acomms_pb.MMApplicationAck, decoded)  # (the id checked above is its)
         except DcclError as exc:
             log.warning("cannot decode an application ack: %s", exc)
             return []

@@ -20,12 +20,14 @@ import datetime as dt
 import logging
 import math
 from collections import deque
+from collections.abc import Callable, Iterable
 from enum import Enum, auto
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase
 from pygoby.acomms.drivers.micromodem.app_ack import ApplicationAcks
 from pygoby.acomms.drivers.micromodem.rates import RATE_FRAME_BYTES, RATE_NUM_FRAMES, check_rate
+from pygoby.acomms.drivers.micromodem.sentence_link import SentenceLink, sentence_link
 from pygoby.acomms.drivers.micromodem.statistics import (
     CycleStatistics,
     add_cst,
@@ -33,7 +35,9 @@ from pygoby.acomms.drivers.micromodem.statistics import (
     parse_xst,
 )
 from pygoby.acomms.errors import ModemDriverError
-from pygoby.util.errors import LinkClosedError, NMEAError
+from pygoby.protobuf.goby.acomms.protobuf.mm_driver_pb2 import TransmissionType
+from pygoby.util.clock import Clock
+from pygoby.util.errors import NMEAError
 from pygoby.util.nmea import NMEASentence
 
 log = logging.getLogger(__name__)
@@ -75,14 +79,14 @@ class MMDriver(ModemDriverBase):
     DEFAULT_LINE_DELIMITER = "\r"
     RATES = range(len(RATE_NUM_FRAMES))
 
-    def __init__(self, clock=None, link=None) -> None:
+    def __init__(self, clock: Clock | None = None, link=None) -> None:
         super().__init__(clock, link)
         self.mm_cfg = acomms_pb.MMConfig()
         self.phase = Phase.STOPPED
         self.app_acks: ApplicationAcks | None = None
         self.nvram: dict[str, int] = {}
         self.revision: tuple[int, int, int] = (0, 0, 0)
-        self._typed = False  # the link carries sentences, not text
+        self._sentences: SentenceLink | None = None  # the link, read and written as sentences
         self._buoy = 0  # Hydroid gateway buoy id (prefixes)
         self._keep_alive_seconds = 0
         self._reset_state()
@@ -124,13 +128,13 @@ class MMDriver(ModemDriverBase):
     def is_mm2(self) -> bool:
         return self.revision[0] >= 2
 
-    def startup(self, cfg) -> None:
+    def startup(self, cfg: acomms_pb.DriverConfig) -> None:
         self._reset_state()
         self.mm_cfg = cfg.Extensions[acomms_pb.MM_CONFIG]
         self._buoy = self.mm_cfg.hydroid_gateway_id
         self._keep_alive_seconds = self.mm_cfg.keep_alive_seconds
         self.modem_start(cfg)
-        self._typed = hasattr(self.link, "read_sentences")
+        self._sentences = sentence_link(self, self._buoy)
         self.app_acks = None
         if self.mm_cfg.use_application_acks:
             ids = {cfg.modem_id, *self.mm_cfg.additional_application_ack_modem_id}
@@ -159,7 +163,7 @@ class MMDriver(ModemDriverBase):
                 entry = entry.upper()
             self._out.append(NMEASentence.build("$CCCFG", entry.split(",")))
 
-    def update_cfg(self, cfg) -> None:
+    def update_cfg(self, cfg: acomms_pb.DriverConfig) -> None:
         """ACOMMS_DRIVER_CONFIG_UPDATE: send the update's Micro-Modem `nvram_cfg` entries (as at
         start-up) and keep them in the configuration, so that a restart sends them too."""
         entries = list(cfg.Extensions[acomms_pb.MM_CONFIG].nvram_cfg)
@@ -178,13 +182,10 @@ class MMDriver(ModemDriverBase):
         if link_open and not self._link_was_open:
             self._written_at = None  # (re)connected: rewrite the outstanding sentence now
         self._link_was_open = link_open
-        if self._typed:
-            sentences = self.link.read_sentences()
-            if sentences:
-                self._handle_sentences(sentences)
-        else:
-            for line in self.modem_read():
-                self._handle_line(line)
+        assert self._sentences is not None
+        sentences = self._sentences.read_sentences()
+        if sentences:  # (a direct link's empty list: the common case in a simulation)
+            self._handle_sentences(sentences)
         if not link_open:
             return  # a dead link is the link's business (it reconnects); do not count failures
         now = self.clock.now()
@@ -201,7 +202,7 @@ class MMDriver(ModemDriverBase):
             self._keep_alive(now)
         self._try_write(now)
 
-    def handle_initiate_transmission(self, transmission) -> None:
+    def handle_initiate_transmission(self, transmission: acomms_pb.ModemTransmission) -> None:
         if self.link is None or not self.link.is_open:
             # nothing is taken from the queue, so queued messages wait for the link
             log.warning("link to the modem is down: transmission not started")
@@ -219,8 +220,8 @@ class MMDriver(ModemDriverBase):
                 self._initiate_mini(msg)
             elif kind == acomms_pb.MICROMODEM_FLEXIBLE_DATA:
                 self._initiate_fdp(msg)
-            elif kind in self._SIMPLE_COMMANDS:
-                getattr(self, self._SIMPLE_COMMANDS[kind])(msg)
+            elif kind in _SIMPLE_INITIATORS:
+                _SIMPLE_INITIATORS[kind](self, msg)
             else:
                 log.warning("Micro-Modem transmission type %d is not supported", kind)
         else:
@@ -237,20 +238,8 @@ class MMDriver(ModemDriverBase):
     def _try_write(self, now: float) -> None:
         if not self._out or self._written_at is not None or now < self._hold_until:
             return
-        sentence = self._out[0]
-        if self._typed:
-            try:
-                self.link.write_sentence(sentence)
-            except LinkClosedError as exc:
-                raise ModemDriverError(str(exc), Status.CONNECTION_TO_MODEM_FAILED) from exc
-            if self.signal_raw_outgoing or self._raw_log is not None:
-                self._log_raw("[tx] ", sentence.message())
-                self.emit_raw(False, sentence.message())
-        else:
-            text = sentence.message()
-            buoy = self._buoy
-            self.modem_write((f"#M{buoy}" if buoy else "") + text + "\r\n")
-            self.emit_raw(False, text)
+        assert self._sentences is not None
+        self._sentences.write_sentence(self._out[0])
         self._written_at = now
         self._tries += 1
 
@@ -362,31 +351,7 @@ class MMDriver(ModemDriverBase):
             self._clock_set = False
 
     # ------------------------------------------------------------------ incoming
-    def _handle_line(self, line: str) -> None:
-        if self._buoy:
-            line = line[3:]
-        text = line.strip()
-        if not text:
-            return
-        self.emit_raw(True, text)
-        try:
-            sentence = NMEASentence.parse(line)
-        except NMEAError as exc:
-            log.warning("ignoring invalid line from the modem: %s", exc)
-            return
-        self._dispatch((sentence,))
-
-    def _handle_sentences(self, sentences: list) -> None:
-        """Sentences from a typed link (parsed already; `$CACST` as its values)."""
-        if self.signal_raw_incoming or self._raw_log is not None:
-            for sentence in sentences:
-                self._log_raw("[rx] ", sentence.message())
-                self.emit_raw(True, sentence.message())
-                self._dispatch((sentence,))
-        else:
-            self._dispatch(sentences)
-
-    def _dispatch(self, sentences) -> None:
+    def _handle_sentences(self, sentences: Iterable[NMEASentence]) -> None:
         """Handle valid sentences from the modem (received now), in order."""
         for sentence in sentences:
             self._fails = 0
@@ -424,9 +389,10 @@ class MMDriver(ModemDriverBase):
 
     def _on_clk(self, s: NMEASentence) -> None:
         if self._outstanding("CLK"):
-            t = dt.datetime(
-                *(s.as_int(i, *bounds) for i, bounds in enumerate(CLOCK_FIELDS, 1)), tzinfo=dt.UTC
+            year, month, day, hour, minute, second = (
+                s.as_int(i, *bounds) for i, bounds in enumerate(CLOCK_FIELDS, 1)
             )
+            t = dt.datetime(year, month, day, hour, minute, second, tzinfo=dt.UTC)
             self._check_clock(t.timestamp(), whole_seconds=True)
 
     def _on_tms(self, s: NMEASentence) -> None:
@@ -441,7 +407,7 @@ class MMDriver(ModemDriverBase):
         return bool(self._out) and self._written_at is not None and self._out[0].sentence_id == kind
 
     # ------------------------------------------------------------------ data transmission
-    def _initiate_data(self, msg) -> None:
+    def _initiate_data(self, msg: acomms_pb.ModemTransmission) -> None:
         try:
             check_rate(msg.rate)
         except ValueError as exc:
@@ -468,7 +434,7 @@ class MMDriver(ModemDriverBase):
         firmware_ack = c.ack_requested and self.app_acks is None
         self._push("$CCCYC", 0, c.src, c.dest, c.rate, firmware_ack, len(c.frame))
 
-    def _request_data(self, msg) -> bool:
+    def _request_data(self, msg: acomms_pb.ModemTransmission) -> bool:
         """Fill `msg` from the queue (with the application ack if enabled) and cache it;
         False if there is nothing to send."""
         self._expected_acks.clear()
@@ -606,7 +572,7 @@ class MMDriver(ModemDriverBase):
                 self._finish_receive()
 
     def _on_cst(self, s: NMEASentence) -> None:
-        if type(s) is CycleStatistics and s.version >= 6:
+        if isinstance(s, CycleStatistics) and s.version >= 6:
             today = _EPOCH_DATE  # (a dated time of arrival: the reader's date is not used)
         else:
             today = _utc_date(self.clock.now())
@@ -651,7 +617,7 @@ class MMDriver(ModemDriverBase):
         if rx is not None:
             self._emit_data(rx)
 
-    def _emit_data(self, rx) -> None:
+    def _emit_data(self, rx: acomms_pb.ModemTransmission) -> None:
         """Deliver a data reception (after taking out an application ack, if enabled)."""
         if self.app_acks is not None:
             for ack in self.app_acks.strip(rx):
@@ -671,7 +637,12 @@ class MMDriver(ModemDriverBase):
     def _on_mpa(self, s: NMEASentence) -> None:
         self.signal_receive.emit(self._ping_result(*_addresses(s)))
 
-    def _ping_result(self, src: int, dest: int, kind: int = acomms_pb.MICROMODEM_TWO_WAY_PING):
+    def _ping_result(
+        self,
+        src: int,
+        dest: int,
+        kind: TransmissionType.ValueType = acomms_pb.MICROMODEM_TWO_WAY_PING,
+    ) -> acomms_pb.ModemTransmission:
         msg = acomms_pb.ModemTransmission(
             type=acomms_pb.DRIVER_SPECIFIC,
             src=src,
@@ -681,7 +652,7 @@ class MMDriver(ModemDriverBase):
         msg.Extensions[acomms_pb.MM_TRANSMISSION].type = kind
         return msg
 
-    def _initiate_mini(self, msg) -> None:
+    def _initiate_mini(self, msg: acomms_pb.ModemTransmission) -> None:
         msg.max_num_frames, msg.max_frame_bytes = 1, 2
         if msg.src < 0:
             msg.src = self.modem_id
@@ -695,7 +666,7 @@ class MMDriver(ModemDriverBase):
             data[0] &= 0x1F
         self._push("$CCMUC", msg.src, msg.dest, data.hex().upper())
 
-    def _initiate_fdp(self, msg) -> None:
+    def _initiate_fdp(self, msg: acomms_pb.ModemTransmission) -> None:
         msg.max_num_frames = 1
         if not msg.HasField("max_frame_bytes"):
             msg.max_frame_bytes = FDP_MAX_FRAME_BYTES
@@ -745,16 +716,7 @@ class MMDriver(ModemDriverBase):
         msg.frame.append(_hex(s[3], 2))
         self.signal_receive.emit(msg)
 
-    _SIMPLE_COMMANDS = {
-        acomms_pb.MICROMODEM_REMUS_LBL_RANGING: "_initiate_remus_lbl",
-        acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING: "_initiate_narrowband_lbl",
-        acomms_pb.MICROMODEM_GENERIC_LBL_RANGING: "_initiate_generic_lbl",
-        acomms_pb.MICROMODEM_HARDWARE_CONTROL: "_initiate_hardware_control",
-        acomms_pb.MICROMODEM_FM_SWEEP: "_initiate_fm_sweep",
-        acomms_pb.MICROMODEM_M_SEQUENCE: "_initiate_m_sequence",
-    }
-
-    def _lbl_params(self, msg, name: str):
+    def _lbl_params(self, msg: acomms_pb.ModemTransmission, name: str):
         """Configured LBL parameters merged with the request's own."""
         params = type(getattr(self.mm_cfg, name))()
         params.CopyFrom(getattr(self.mm_cfg, name))
@@ -763,7 +725,7 @@ class MMDriver(ModemDriverBase):
             self._push("$CCCFG", "TAT", params.turnaround_ms)
         return params, int(params.lbl_max_range * 2 / 1500 * 1000 + params.turnaround_ms)
 
-    def _initiate_remus_lbl(self, msg) -> None:
+    def _initiate_remus_lbl(self, msg: acomms_pb.ModemTransmission) -> None:
         params, timeout = self._lbl_params(msg, "remus_lbl")
         bits = params.enable_beacons
         self._last_lbl_type = acomms_pb.MICROMODEM_REMUS_LBL_RANGING
@@ -771,7 +733,7 @@ class MMDriver(ModemDriverBase):
             "$CCPDT", 1, self.modem_id % 4 + 1, 0, 0, timeout, *((bits >> i) & 1 for i in range(4))
         )
 
-    def _initiate_narrowband_lbl(self, msg) -> None:
+    def _initiate_narrowband_lbl(self, msg: acomms_pb.ModemTransmission) -> None:
         p, timeout = self._lbl_params(msg, "narrowband_lbl")
         freqs = [*list(p.receive_freq)[:4], 0, 0, 0, 0][:4]
         self._last_lbl_type = acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING
@@ -785,7 +747,7 @@ class MMDriver(ModemDriverBase):
             int(p.transmit_flag),
         )
 
-    def _initiate_generic_lbl(self, msg) -> None:
+    def _initiate_generic_lbl(self, msg: acomms_pb.ModemTransmission) -> None:
         p, timeout = self._lbl_params(msg, "generic_lbl")
         codes = [*list(p.receive_seq_code)[:4], 0, 0, 0, 0][:4]
         self._last_lbl_type = acomms_pb.MICROMODEM_GENERIC_LBL_RANGING
@@ -801,12 +763,12 @@ class MMDriver(ModemDriverBase):
             0,
         )
 
-    def _initiate_hardware_control(self, msg) -> None:
+    def _initiate_hardware_control(self, msg: acomms_pb.ModemTransmission) -> None:
         hw = msg.Extensions[acomms_pb.MM_TRANSMISSION].hw_ctl
         src = msg.src if msg.src >= 0 else self.modem_id
         self._push("$CCMEC", src, msg.dest, hw.line, hw.mode, hw.arg)
 
-    def _initiate_fm_sweep(self, msg) -> None:
+    def _initiate_fm_sweep(self, msg: acomms_pb.ModemTransmission) -> None:
         p = acomms_pb.MMConfig().fm_sweep
         p.CopyFrom(self.mm_cfg.fm_sweep)
         p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].fm_sweep)
@@ -820,7 +782,7 @@ class MMDriver(ModemDriverBase):
             int(p.repetition_period_ms * 10),
         )
 
-    def _initiate_m_sequence(self, msg) -> None:
+    def _initiate_m_sequence(self, msg: acomms_pb.ModemTransmission) -> None:
         p = acomms_pb.MMConfig().m_sequence
         p.CopyFrom(self.mm_cfg.m_sequence)
         p.MergeFrom(msg.Extensions[acomms_pb.MM_TRANSMISSION].m_sequence)
@@ -836,7 +798,7 @@ class MMDriver(ModemDriverBase):
             src, dest = dest, src
         msg = self._ping_result(src, dest, acomms_pb.MICROMODEM_HARDWARE_CONTROL_REPLY)
         hw = msg.Extensions[acomms_pb.MM_TRANSMISSION].hw_ctl
-        hw.line, hw.mode, hw.arg = line, mode, arg
+        hw.line, hw.mode, hw.arg = line, mode, arg  # type: ignore[assignment]  # (in range)
         self.signal_receive.emit(msg)
 
     def _on_tta(self, s: NMEASentence) -> None:
@@ -874,9 +836,36 @@ def _hex(text: str, max_bytes: int) -> bytes:
     return bytes.fromhex(text)
 
 
-# sentence id -> handler (`_on_xyz` handles `XYZ`, whatever the talker)
-_HANDLERS = {
-    name[4:].upper(): handler
-    for name, handler in vars(MMDriver).items()
-    if name.startswith("_on_") and callable(handler)
+# sentence id (whatever the talker) -> its handler
+_HANDLERS: dict[str, Callable[[MMDriver, NMEASentence], None]] = {
+    "REV": MMDriver._on_rev,
+    "ERR": MMDriver._on_err,
+    "CFG": MMDriver._on_cfg,
+    "CLK": MMDriver._on_clk,
+    "TMS": MMDriver._on_tms,
+    "TMQ": MMDriver._on_tmq,
+    "CYC": MMDriver._on_cyc,
+    "DRQ": MMDriver._on_drq,
+    "XST": MMDriver._on_xst,
+    "ACK": MMDriver._on_ack,
+    "RXD": MMDriver._on_rxd,
+    "MSG": MMDriver._on_msg,
+    "CST": MMDriver._on_cst,
+    "MPR": MMDriver._on_mpr,
+    "MPA": MMDriver._on_mpa,
+    "RDP": MMDriver._on_rdp,
+    "MUA": MMDriver._on_mua,
+    "MER": MMDriver._on_mer,
+    "TTA": MMDriver._on_tta,
+}
+
+
+# Micro-Modem transmission type -> the method that starts it by sending its sentences
+_SIMPLE_INITIATORS: dict[int, Callable[[MMDriver, acomms_pb.ModemTransmission], None]] = {
+    acomms_pb.MICROMODEM_REMUS_LBL_RANGING: MMDriver._initiate_remus_lbl,
+    acomms_pb.MICROMODEM_NARROWBAND_LBL_RANGING: MMDriver._initiate_narrowband_lbl,
+    acomms_pb.MICROMODEM_GENERIC_LBL_RANGING: MMDriver._initiate_generic_lbl,
+    acomms_pb.MICROMODEM_HARDWARE_CONTROL: MMDriver._initiate_hardware_control,
+    acomms_pb.MICROMODEM_FM_SWEEP: MMDriver._initiate_fm_sweep,
+    acomms_pb.MICROMODEM_M_SEQUENCE: MMDriver._initiate_m_sequence,
 }

@@ -7,6 +7,7 @@ import functools
 import logging
 import math
 from collections.abc import Mapping
+from typing import Any
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.util.errors import NMEAFormatError
@@ -272,7 +273,9 @@ def parse_xst(sentence: NMEASentence):
     date, time = sentence[1 + off], sentence[2 + off]
     start = 3 + off
     present = min(len(_XST_FIELDS), max(0, len(sentence) - start))
-    fields = dict(zip(_XST_FIELDS[:present], sentence.as_ints(start, start + present), strict=True))
+    fields: dict[str, Any] = dict(
+        zip(_XST_FIELDS[:present], sentence.as_ints(start, start + present), strict=True)
+    )
     for name, (lo, hi) in _XST_ENUM_RANGES.items():
         value = fields.get(name)
         if value is not None and not lo <= value <= hi:

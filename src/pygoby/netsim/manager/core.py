@@ -10,7 +10,7 @@ arrive (the channel and the modem emulators use this).
 
 `ManagerConnection` adds the line protocol for one client connection: feed it the bytes received
 and it returns the response lines to write, logging and skipping bad lines. It has no I/O of its
-own; `pygoby.netsim.server` runs it on asyncio TCP connections.
+own; `pygoby.netsim.manager.server` runs it on asyncio TCP connections.
 
 Difference from upstream (configurable, `reject_nonfinite_position`, default on): a NaN or
 infinite lat, lon or depth is answered UPDATE_FAILED_OUT_OF_DEFINED_REGION; upstream accepts NaN
@@ -24,27 +24,31 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-
-from google.protobuf.message import Message
+from typing import Final, cast
 
 from pygoby.netsim.errors import LineError
-from pygoby.netsim.protocol import (
+from pygoby.netsim.manager.protocol import (
     LEGACY_RESPONSE_NAME,
     RESPONSE_NAME,
+    EnvironmentNavUpdate,
     LineDecoder,
+    NavUpdate,
+    NetSimManagerRequest,
+    NetSimManagerResponse,
+    ReceiveStats,
     encode_line,
-    message_class,
     request_names,
 )
+from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
 from pygoby.util.signal import Signal
 
 log = logging.getLogger(__name__)
 
-NAV_FIELDS = ("modem_tcp_port", "time", "lat", "lon", "depth", "speed", "heading")
+NAV_FIELDS: Final = ("modem_tcp_port", "time", "lat", "lon", "depth", "speed", "heading")
 
 
 def status_enum():
-    return message_class("NetSimManagerResponse").Status
+    return NetSimManagerResponse.Status
 
 
 def peer_ip_string(address: str) -> str:
@@ -60,41 +64,43 @@ def peer_ip_string(address: str) -> str:
 
 @dataclass
 class RequestOutcome:
-    response: Message  # NetSimManagerResponse
-    forwarded: list[Message] = field(default_factory=list)  # EnvironmentNavUpdate, in order
-    stats: list[Message] = field(default_factory=list)  # ReceiveStats, in order
+    response: NetSimManagerResponse
+    forwarded: list[EnvironmentNavUpdate] = field(default_factory=list)  # in order
+    stats: list[ReceiveStats] = field(default_factory=list)  # in order
 
 
-NavListener = Callable[[Message], None]  # called with each forwarded EnvironmentNavUpdate
-StatsListener = Callable[[Message], None]  # called with each ReceiveStats
+NavListener = Callable[[EnvironmentNavUpdate], None]  # called with each forwarded update
+StatsListener = Callable[[ReceiveStats], None]  # called with each ReceiveStats
 
 
 class NetSimManager:
     """The manager's state: configuration, latest position per modem port, listeners."""
 
-    def __init__(self, config: Message) -> None:
+    def __init__(self, config: NetSimManagerConfig) -> None:
         self.config = config
         self._pairs = {pair.modem_tcp_port: pair for pair in config.sim_env_pair}
         self._bounds = {bounds.environment_id: bounds for bounds in config.env_bounds}
-        self._latest: dict[int, Message] = {}
-        self.signal_nav = Signal()  # each forwarded EnvironmentNavUpdate
-        self.signal_stats = Signal()  # each ReceiveStats
-        self._response_cls = message_class("NetSimManagerResponse")
+        self._latest: dict[int, NavUpdate] = {}
+        self.signal_nav: Signal[EnvironmentNavUpdate] = (
+            Signal()
+        )  # each forwarded EnvironmentNavUpdate
+        self.signal_stats: Signal[ReceiveStats] = Signal()  # each ReceiveStats
+        self._response_cls = NetSimManagerResponse
         # the status values, looked up once (each enum attribute access is a Python __getattr__)
         status = status_enum()
         self.accepted = status.UPDATE_ACCEPTED
         self._invalid_port = status.UPDATE_FAILED_INVALID_MODEM_TCP_PORT
         self._invalid_source = status.UPDATE_FAILED_INVALID_SOURCE_ADDRESS
         self._out_of_region = status.UPDATE_FAILED_OUT_OF_DEFINED_REGION
-        self._env_nav_cls = message_class("EnvironmentNavUpdate")
+        self._env_nav_cls = EnvironmentNavUpdate
 
     # -- queries -------------------------------------------------------------------------
 
-    def position(self, modem_tcp_port: int) -> Message | None:
+    def position(self, modem_tcp_port: int) -> NavUpdate | None:
         """Latest accepted NavUpdate of a modem port, or None."""
         return self._latest.get(modem_tcp_port)
 
-    def positions(self) -> dict[int, Message]:
+    def positions(self) -> dict[int, NavUpdate]:
         return dict(self._latest)
 
     def environment_of(self, modem_tcp_port: int) -> int | None:
@@ -111,14 +117,14 @@ class NetSimManager:
 
     # -- processing ----------------------------------------------------------------------
 
-    def handle_request(self, request: Message, peer_ip: str) -> RequestOutcome:
+    def handle_request(self, request: NetSimManagerRequest, peer_ip: str) -> RequestOutcome:
         outcome = RequestOutcome(self._response_cls(request_id=request.id))
         result = self.accepted
         for nav in request.nav:
             result = self._check_nav(nav, peer_ip)
             if result != self.accepted:
                 break
-            if all(map(nav.HasField, NAV_FIELDS)):
+            if all(nav.HasField(name) for name in NAV_FIELDS):
                 update = self._env_nav_cls(
                     environment_id=self._pairs[nav.modem_tcp_port].environment_id
                 )
@@ -136,7 +142,7 @@ class NetSimManager:
             self.signal_stats.emit(stats)
         return outcome
 
-    def _check_nav(self, nav: Message, peer_ip: str) -> int:
+    def _check_nav(self, nav: NavUpdate, peer_ip: str) -> int:
         return self.check_position(nav.modem_tcp_port, nav.lat, nav.lon, nav.depth, peer_ip)
 
     def check_position(
@@ -188,7 +194,9 @@ class ManagerConnection:
                 log.info("%s: preamble %r instead of NETSIM", self.peer_ip, event.preamble[:20])
             if event.parse_error:
                 self._log_bad_line(f"{event.parse_error}; answering the partial request")
-            outcome = self.manager.handle_request(event.message, self.peer_ip)
+            # (the decoder was made with the request class: every message is one)
+            request = cast(NetSimManagerRequest, event.message)
+            outcome = self.manager.handle_request(request, self.peer_ip)
             name = LEGACY_RESPONSE_NAME if event.legacy else RESPONSE_NAME
             replies.append(encode_line(outcome.response, name))
         return replies

@@ -14,10 +14,8 @@ import logging
 import math
 from collections.abc import Mapping
 
-from google.protobuf.message import Message
-
 from pygoby.acomms import messages as acomms_pb
-from pygoby.netsim.protocol import message_class
+from pygoby.netsim.manager.protocol import NavUpdate, ReceiveStats
 from pygoby.util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)
@@ -39,8 +37,8 @@ class NavReporter:
         self.port_of_id_offset = port_of_id_offset
         self.values: dict[str, float] = {}
         self.time = -math.inf  # of the newest value
-        self._nav_class = message_class("NavUpdate")
-        self._stats_class = message_class("ReceiveStats")
+        self._nav_class = NavUpdate
+        self._stats_class = ReceiveStats
 
     def set_origin(self, lat: float, lon: float) -> None:
         self.geodesy = UTMGeodesy(lat, lon)
@@ -63,7 +61,7 @@ class NavReporter:
                 return lat, lon
         return None
 
-    def nav_update(self) -> Message | None:
+    def nav_update(self) -> NavUpdate | None:
         """The vehicle's NavUpdate, or None while its position or depth is unknown."""
         position = self.position()
         if position is None or "depth" not in self.values:
@@ -81,7 +79,7 @@ class NavReporter:
     def port_of(self, modem_id: int) -> int:
         return self.modem_ports.get(modem_id, self.port_of_id_offset + modem_id)
 
-    def receive_stats(self, transmission: Message) -> list[Message]:
+    def receive_stats(self, transmission: acomms_pb.ModemTransmission) -> list[ReceiveStats]:
         """One ReceiveStats per $CACST in a driver reception (none for other transmissions)."""
         if not transmission.HasExtension(acomms_pb.MM_TRANSMISSION):
             return []

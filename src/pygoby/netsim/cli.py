@@ -53,8 +53,13 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run_command(args: argparse.Namespace) -> int:
-    from pygoby.netsim.eventlog import EventLogWriter
-    from pygoby.netsim.scenario import ScenarioError, check_scenario, load_scenario, speed_factor
+    from pygoby.netsim.report.eventlog import EventLogWriter
+    from pygoby.netsim.sim.scenario import (
+        ScenarioError,
+        check_scenario,
+        load_scenario,
+        speed_factor,
+    )
 
     level = logging.WARNING - 10 * args.verbose
     logging.basicConfig(level=level, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
@@ -80,7 +85,7 @@ def run_command(args: argparse.Namespace) -> int:
         return 1
     with log, RunProgress("simulated", scenario.duration, "s") as progress:
         if factor is None:
-            from pygoby.netsim.sim import Simulation
+            from pygoby.netsim.sim.simulation import Simulation
 
             sim = Simulation(scenario, on_event=log)
             try:
@@ -103,7 +108,7 @@ def _report(progress: RunProgress, sim) -> None:
 
 
 async def _run_real_time(scenario, log, progress: RunProgress):
-    from pygoby.netsim.realtime import RealTimeRun
+    from pygoby.netsim.sim.realtime import RealTimeRun
     from pygoby.util.aiorun import StopSignals
 
     run = RealTimeRun(scenario, on_event=log)
@@ -122,8 +127,8 @@ async def _run_real_time(scenario, log, progress: RunProgress):
 
 
 def report_command(args: argparse.Namespace) -> int:
-    from pygoby.netsim.eventlog import read_events
-    from pygoby.netsim.report import summary_lines, write_report
+    from pygoby.netsim.report.eventlog import read_events
+    from pygoby.netsim.report.plots import summary_lines, write_report
 
     window = None
     if args.window:

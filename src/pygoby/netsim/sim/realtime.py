@@ -18,14 +18,13 @@ import logging
 import time
 from collections.abc import Callable
 
-from google.protobuf.message import Message
-
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mmsim.server import MMSimServer
-from pygoby.netsim.scenario import speed_factor
-from pygoby.netsim.server import ManagerServer
-from pygoby.netsim.sim import EventSink, RunSummary, Simulation, driver_config
+from pygoby.netsim.manager.server import ManagerServer
+from pygoby.netsim.sim.scenario import speed_factor
+from pygoby.netsim.sim.simulation import EventSink, RunSummary, Simulation, driver_config
+from pygoby.protobuf.pygoby.netsim.scenario_pb2 import Scenario
 from pygoby.util.clock import Clock, WallClock
 
 log = logging.getLogger(__name__)
@@ -36,7 +35,7 @@ STARTUP_TIMEOUT = 30.0  # wall seconds for the in-process drivers to start
 
 class RealTimeRun:
     def __init__(
-        self, scenario: Message, on_event: EventSink | None = None, clock: Clock | None = None
+        self, scenario: Scenario, on_event: EventSink | None = None, clock: Clock | None = None
     ) -> None:
         """`clock`: share another program's clock (e.g. a MOOS time-warp clock) instead of
         the wall clock times the scenario's speed."""
@@ -61,7 +60,9 @@ class RealTimeRun:
         return self.manager_server.bound_port
 
     def emulator_port(self, modem_id: int) -> int:
-        return self.emulators[modem_id].port
+        port = self.emulators[modem_id].port
+        assert port is not None  # (emulators are started with the simulation)
+        return port
 
     async def start(self) -> None:
         """Listen (manager, emulators) and start the in-process stacks' drivers."""

@@ -7,7 +7,7 @@
   `ports` maps emulator names to ports, or an emulator named by its port ("62000") needs none;
 * positions are whatever the physics Channel knows: follow a NetSimManager with
   ``manager.on_nav(physics.channel.on_environment_nav_update)``, or feed scripted tracks with
-  ``physics.channel.update_position(port, Position(...))``;
+  ``physics.channel.update_position(port, NavFix(...))``;
 * `transmit` registers the packet as a Transmission starting at its `tx_time` and lasting its
   `duration` (the emulator's duration table, pygoby.acomms.mmsim.timing); `do_work` asks the
   Channel at the clock's now which receptions have locked their receivers (the emulator prints
@@ -22,7 +22,7 @@
 * `$CACST` numbers (SNR, SPL, Doppler, ...) come from `pygoby.netsim.channel.stats`; ping replies
   are timed by the emulators themselves (travel times from the arrival times the physics gives);
 * every transmission and reception is emitted by `signal_event` (the `on_event` argument is
-  connected to it) as a dict (JSON-ready), which `pygoby.netsim.eventlog` writes as the run's
+  connected to it) as a dict (JSON-ready), which `pygoby.netsim.report.eventlog` writes as the run's
   event log; an event is only made when someone listens, and `transmissions` and `outcomes`
   (receptions by outcome) count them in any case.
 
@@ -37,10 +37,14 @@ import math
 from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import cast
 
-from pygoby.acomms.mmsim.channel import AcousticPacket, ChannelEndpoint
-from pygoby.acomms.mmsim.channel import PacketKind as ModemPacketKind
-from pygoby.acomms.mmsim.channel import Reception as ModemReception
+from pygoby.acomms.mmsim.channel import (
+    AcousticPacket,
+    ChannelEndpoint,
+    ModemPacketKind,
+    ModemReception,
+)
 from pygoby.netsim.channel import Channel, Outcome, PacketKind, Reception, Transmission
 from pygoby.netsim.channel.stats import link_statistics
 from pygoby.util.clock import Clock
@@ -92,7 +96,7 @@ class PhysicsChannel:
         self.clock = clock
         self.ports = dict(ports or {})
         self.control_rate = control_rate
-        self.signal_event = Signal()
+        self.signal_event: Signal[dict[str, object]] = Signal()
         if on_event is not None:
             self.signal_event.connect(on_event)
         self._endpoints: dict[int, ChannelEndpoint] = {}
@@ -104,7 +108,7 @@ class PhysicsChannel:
         self.outcomes: Counter[str] = Counter()  # receptions by outcome
         self.delivered: Counter[int] = Counter()  # packets handed to each port's modem
 
-    # -- the mmsim Channel interface -----------------------------------------------------------
+    # -- the mmsim ModemChannel interface --------------------------------------------------------
 
     def port_of(self, endpoint: ChannelEndpoint) -> int:
         port = self.ports.get(endpoint.name)
@@ -194,7 +198,8 @@ class PhysicsChannel:
     def _detect(self, receiver: int, transmission: Transmission, arrival: float) -> None:
         endpoint = self._endpoints.get(receiver)
         if endpoint is not None:
-            endpoint.detect(transmission.payload.packet, arrival)
+            sent = cast(_Sent, transmission.payload)  # (what transmit() gave the channel)
+            endpoint.detect(sent.packet, arrival)
 
     def next_event_time(self) -> float | None:
         """When `do_work` next has something to deliver (for discrete-event loops)."""
@@ -203,7 +208,7 @@ class PhysicsChannel:
     # -- delivery --------------------------------------------------------------------------------
 
     def _deliver(self, r: Reception) -> None:
-        sent: _Sent = r.transmission.payload
+        sent = cast(_Sent, r.transmission.payload)
         packet = sent.packet
         endpoint = self._endpoints.get(r.receiver)
         delivered = endpoint is not None and self._heard(r, packet)

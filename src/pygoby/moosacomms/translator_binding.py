@@ -17,7 +17,7 @@ import os
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
-from google.protobuf import descriptor_pool, message_factory, text_format
+from google.protobuf import descriptor_pool, text_format
 from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
@@ -34,7 +34,8 @@ from pygoby.moos.translator import (
     TranslatorError,
     TranslatorRunner,
 )
-from pygoby.protobuf import ProtoError, ProtoLoader
+from pygoby.protobuf import ProtoError, ProtoLoader, class_of
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 from pygoby.util.glog import DEBUG1, VERBOSE, group_logger
 from pygoby.util.libraries import DCCL_CODECS, MESSAGES, builtin_for, is_shared_library, unavailable
 from pygoby.util.modules import import_module_or_file
@@ -114,7 +115,7 @@ class MessageTypes:
             return self.loader.message_class(name)
         with contextlib.suppress(KeyError):
             descriptor = descriptor_pool.Default().FindMessageTypeByName(name)
-            return message_factory.GetMessageClass(descriptor)
+            return class_of(descriptor)
         if self._fallback is not None:
             return self._fallback(name)
         raise ProtoError(f"unknown message type {name!r}")
@@ -162,7 +163,7 @@ class TranslatorBinding:
     def __init__(
         self,
         app: GobyMOOSApp,
-        entries: Iterable[Message],
+        entries: Iterable[TranslatorEntry],
         resolve: Callable[[str], type[Message]],
         on_created: Callable[[Message], None],
         multiplex_vars: Iterable[str] = (),

@@ -18,11 +18,15 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-import matplotlib
+from pygoby.util.extras import needs_extra
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+with needs_extra("sim", "netsim reports"):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
 
 KIND_COLOURS = {
     "data": "tab:blue",
@@ -61,7 +65,8 @@ def bin_success(
         bins = max(1, math.ceil((high - low) / width + 1e-9))
         high = low + bins * width
     width = (high - low) / bins if high > low else 1.0
-    totals, oks = Counter(), Counter()
+    totals: Counter[Any] = Counter()
+    oks: Counter[Any] = Counter()
     for value, ok in zip(values, good, strict=True):
         index = min(int((value - low) / width), bins - 1)
         totals[index] += 1

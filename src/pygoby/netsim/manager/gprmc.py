@@ -12,8 +12,8 @@ import logging
 import math
 from collections.abc import Callable
 
-from google.protobuf.message import Message
-
+from pygoby.netsim.manager.protocol import EnvironmentNavUpdate, NavUpdate
+from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
 from pygoby.util.clock import Clock
 from pygoby.util.nmea import with_checksum
 
@@ -32,7 +32,7 @@ def _degrees_minutes(value: float, degree_digits: int) -> str:
     return f"{degrees:0{degree_digits}d}{whole:02d}.{fraction:04d}"
 
 
-def gprmc_sentence(nav: Message, utc_seconds: float) -> str:
+def gprmc_sentence(nav: NavUpdate, utc_seconds: float) -> str:
     """The sentence (with ``*checksum\\r\\n``) for a NavUpdate at manager time utc_seconds."""
     when = datetime.datetime.fromtimestamp(utc_seconds, datetime.UTC)
     body = ",".join(
@@ -62,7 +62,7 @@ class GpsOutputs:
         self._clock = clock
 
     @classmethod
-    def open_serial(cls, config: Message, clock: Clock) -> GpsOutputs:
+    def open_serial(cls, config: NetSimManagerConfig, clock: Clock) -> GpsOutputs:
         """Open every `gps_out` serial port of a NetSimManagerConfig (pyserial URLs work too)."""
         import serial  # only needed when gps_out is configured
 
@@ -72,7 +72,7 @@ class GpsOutputs:
             writers[entry.modem_tcp_port] = port.write
         return cls(writers, clock)
 
-    def on_nav_update(self, update: Message) -> None:
+    def on_nav_update(self, update: EnvironmentNavUpdate) -> None:
         write = self._writers.get(update.nav.modem_tcp_port)
         if write is None:
             return

@@ -1,5 +1,5 @@
-"""pAcommsHandler's wiring of the Goby 1.1 MOOS variables that goby3 lacks or spells differently
-(the XML message sets themselves are pygoby.acomms.transitional):
+"""pAcommsHandler's handling of the Goby 1.1 MOOS variables that goby3 lacks or spells
+differently (the XML message sets themselves are pygoby.moosacomms.transitional):
 
 * `Goby11Variables`: CCL queues (`out_pubsub_var` -> queue, received frames ->
   `in_pubsub_var`), ACOMMS_INCOMING_DATA / ACOMMS_OUTGOING_DATA (ModemDataTransmission text),
@@ -15,17 +15,25 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.handler import AcommsHandler
 from pygoby.acomms.queue import QueueError
 from pygoby.acomms.queue.ccl import goby11_time
 from pygoby.dccl.dccl1 import is_dccl1_frame
 from pygoby.moos import goby11_config
 from pygoby.moos.protocol import MOOSMessage
+from pygoby.moos.protocol import Value as MoosValue
 from pygoby.moos.translator import Technique, serialize_for_moos
 from pygoby.moos.translator.keyvalue import val_from_string
+from pygoby.protobuf.descriptors import MessageT
+from pygoby.protobuf.goby.moos.protobuf.transitional_pb2 import QueueType as V1QueueType
+from pygoby.protobuf.goby.moos.protobuf.transitional_pb2 import Slot as V1Slot
+from pygoby.util.signal import Signal
 
 INCOMING_DATA = "ACOMMS_INCOMING_DATA"
 OUTGOING_DATA = "ACOMMS_OUTGOING_DATA"
@@ -34,41 +42,40 @@ RANGE_RESPONSE = "ACOMMS_RANGE_RESPONSE"
 POLLER_UPDATE = "ACOMMS_POLLER_UPDATE"
 # Goby 1.1 posted its acomms messages as plain single-line TextFormat
 GOBY11_TECHNIQUE = Technique.TECHNIQUE_PROTOBUF_TEXT_FORMAT
-V1_RANGING = acomms_pb.V1ModemRangingRequest.DESCRIPTOR.fields_by_name[
-    "type"
-].enum_type.values_by_name
 RANGING_TYPES = {  # Goby 1.1 RangingType -> Micro-Modem transmission type
-    V1_RANGING["MODEM_TWO_WAY_PING"].number: acomms_pb.MICROMODEM_TWO_WAY_PING,
-    V1_RANGING["REMUS_LBL_RANGING"].number: acomms_pb.MICROMODEM_REMUS_LBL_RANGING,
+    acomms_pb.V1RangingType.MODEM_TWO_WAY_PING: acomms_pb.MICROMODEM_TWO_WAY_PING,
+    acomms_pb.V1RangingType.REMUS_LBL_RANGING: acomms_pb.MICROMODEM_REMUS_LBL_RANGING,
 }
 V1_RANGING_OF = {v: k for k, v in RANGING_TYPES.items()}
 
 
-def parse_goby11(value: str | bytes, out: Message) -> None:
+def parse_goby11(value: MoosValue, out: Message) -> None:
     """A Goby 1.1 (or goby3) TextFormat string, 1.1 spellings (slot types, ...) translated."""
-    text = value.decode("latin-1") if isinstance(value, bytes) else value
+    text = value.decode("latin-1") if isinstance(value, bytes) else str(value)
     text_format.Merge(goby11_config.translate(text, out.DESCRIPTOR).text, out)
 
 
 V1_UPDATE = acomms_pb.V1MACUpdate.UpdateType
 
 
-def _slot(v1_slot) -> Message:
+def _slot(v1_slot: V1Slot) -> acomms_pb.ModemTransmission:
     slot = acomms_pb.ModemTransmission()
     parse_goby11(text_format.MessageToString(v1_slot), slot)
     return slot
 
 
-def _same_slot(a: Message, b: Message) -> bool:
+def _same_slot(a: acomms_pb.ModemTransmission, b: acomms_pb.ModemTransmission) -> bool:
     return all(
         getattr(a, f) == getattr(b, f) for f in ("src", "dest", "rate", "type", "slot_seconds")
     )
 
 
-def mac_update_from_goby11(value: str | bytes, current: list[Message], src: int) -> Message | None:
+def mac_update_from_goby11(
+    value: MoosValue, current: list[acomms_pb.ModemTransmission], src: int
+) -> acomms_pb.MACUpdate | None:
     """A Goby 1.1 MACUpdate (`dest update_type: ADD|REMOVE|REPLACE slot {...}`) as today's
     MACUpdate against the `current` cycle; None if `value` is not the Goby 1.1 form."""
-    text = value.decode("latin-1") if isinstance(value, bytes) else value
+    text = value.decode("latin-1") if isinstance(value, bytes) else str(value)
     old = acomms_pb.V1MACUpdate()
     try:
         text_format.Merge(text, old)
@@ -96,7 +103,13 @@ class Goby11Variables:
     of ACOMMS_ACK/EXPIRE/QSIZE/FLUSH_QUEUE are used on `var`, the app's variable names)."""
 
     def __init__(
-        self, app, acomms, queue_cfg: Message, enabled: bool, dccl1=None, var=None
+        self,
+        app,
+        acomms: AcommsHandler,
+        queue_cfg: acomms_pb.QueueManagerConfig,
+        enabled: bool,
+        dccl1=None,
+        var=None,
     ) -> None:
         self.app, self.acomms = app, acomms
         self.enabled = enabled  # the 1.1 data variables (only for Goby 1.1 style configurations)
@@ -118,14 +131,15 @@ class Goby11Variables:
         )
         if dccl1 is not None:
             queue = acomms.queue
-            for signal, slot in (
+            connections: tuple[tuple[Signal[...], Callable[..., object]], ...] = (
                 (queue.signal_queued, self._on_dccl1_queued),
                 (queue.signal_receive_dccl1, self._on_dccl1_received),
                 (queue.signal_ack, self._on_ack),
                 (queue.signal_expire, self._on_expire),
                 (queue.signal_queue_size_change, self._on_dccl_size),
                 (queue.signal_ccl_queue_size_change, self._on_ccl_size),
-            ):
+            )
+            for signal, slot in connections:
                 signal.connect(slot, contain_errors=True, logger=app.log)
 
     @property
@@ -145,7 +159,7 @@ class Goby11Variables:
         self.app.publish(var, serialize_for_moos(message, GOBY11_TECHNIQUE))
 
     # ---------------------------------------------------------------- MOOS -> acomms
-    def _parse(self, msg: MOOSMessage, out: Message) -> Message | None:
+    def _parse(self, msg: MOOSMessage, out: MessageT) -> MessageT | None:
         try:
             parse_goby11(msg.value, out)
         except text_format.ParseError as err:
@@ -260,7 +274,9 @@ class Goby11Variables:
         self._publish(OUTGOING_DATA, data)
         self._publish(outgoing, data)
 
-    def _on_dccl1_received(self, transmission: Message, data: bytes, dccl_id: int) -> None:
+    def _on_dccl1_received(
+        self, transmission: acomms_pb.ModemTransmission, data: bytes, dccl_id: int
+    ) -> None:
         out = self._dccl_transmission(
             data, dccl_id, transmission.src, transmission.dest, transmission.time / 1e6
         )
@@ -269,7 +285,7 @@ class Goby11Variables:
         if dccl_id in self.hex_vars:
             self._publish(self.hex_vars[dccl_id][1], out)
 
-    def _on_ack(self, ack: Message, original: Message) -> None:
+    def _on_ack(self, ack: acomms_pb.ModemTransmission, original: Message) -> None:
         out = acomms_pb.V1ModemDataAck(frame=ack.acked_frame[0] if ack.acked_frame else 0)
         out.base.src, out.base.dest = ack.src, ack.dest
         out.base.time = goby11_time(ack.time / 1e6 if ack.HasField("time") else self._now())
@@ -285,23 +301,23 @@ class Goby11Variables:
             out.orig_msg.CopyFrom(orig)
         self._publish(self.var["queue_expire"], out)
 
-    def _on_dccl_size(self, size: Message) -> None:
+    def _on_dccl_size(self, size: acomms_pb.QueueSize) -> None:
         self._publish_size(acomms_pb.QUEUE_DCCL, size.dccl_id, size.size)
 
     def _on_ccl_size(self, ccl_id: int, size: int) -> None:
         self._publish_size(acomms_pb.QUEUE_CCL, ccl_id, size)
 
-    def _publish_size(self, kind: int, queue_id: int, size: int) -> None:
+    def _publish_size(self, kind: V1QueueType.ValueType, queue_id: int, size: int) -> None:
         out = acomms_pb.V1QueueSize(size=size)
         out.key.type, out.key.id = kind, queue_id
         self._publish(self.var["queue_size"], out)
 
-    def _on_ccl_received(self, transmission: Message) -> None:
+    def _on_ccl_received(self, transmission: acomms_pb.V1ModemDataTransmission) -> None:
         var = self.in_vars.get(transmission.queue_key.id)
         if var:
             self._publish(var, transmission)
 
-    def _on_modem_receive(self, transmission: Message) -> None:
+    def _on_modem_receive(self, transmission: acomms_pb.ModemTransmission) -> None:
         if transmission.type == acomms_pb.DATA and self.enabled:
             for index, frame in enumerate(transmission.frame):
                 if self.dccl1 is not None and is_dccl1_frame(bytes(frame)):

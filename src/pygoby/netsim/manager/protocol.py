@@ -35,6 +35,7 @@ from pygoby.netsim.errors import (
     UnknownNameError,
 )
 from pygoby.protobuf import builtin_class
+from pygoby.protobuf.netsim.messages import netsim_pb2
 
 NETSIM_PROTO = "netsim/messages/netsim.proto"
 PREAMBLE = b"NETSIM"
@@ -54,12 +55,19 @@ def message_class(short_name: str) -> type[Message]:
     return builtin_class(NETSIM_PROTO, f"netsim.protobuf.{short_name}")
 
 
-def request_class() -> type[Message]:
-    return message_class("NetSimManagerRequest")
+NavUpdate = netsim_pb2.NavUpdate
+ReceiveStats = netsim_pb2.ReceiveStats
+NetSimManagerRequest = netsim_pb2.NetSimManagerRequest
+NetSimManagerResponse = netsim_pb2.NetSimManagerResponse
+EnvironmentNavUpdate = netsim_pb2.EnvironmentNavUpdate
 
 
-def response_class() -> type[Message]:
-    return message_class("NetSimManagerResponse")
+def request_class() -> type[NetSimManagerRequest]:
+    return NetSimManagerRequest
+
+
+def response_class() -> type[NetSimManagerResponse]:
+    return NetSimManagerResponse
 
 
 def request_names() -> dict[str, type[Message]]:

@@ -12,15 +12,12 @@ import os
 from functools import cache
 
 from google.protobuf import text_format
-from google.protobuf.message import Message
 
 from pygoby.errors import ConfigError
 from pygoby.netsim.channel.settings import environment_channel_configs
-from pygoby.protobuf import builtin_class
+from pygoby.protobuf import initialization_errors
+from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
 from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
-
-CONFIG_PROTO = "netsim/messages/manager_config.proto"
-CONFIG_TYPE = "netsim.protobuf.NetSimManagerConfig"
 
 # Message types whose contents stand for upstream blocks with more fields than pygoby declares.
 _OPEN_BLOCKS = frozenset({"netsim.protobuf.UnusedGoby3Block", "netsim.protobuf.SerialPortConfig"})
@@ -62,8 +59,8 @@ environment_channel {
 
 
 @cache
-def config_class() -> type[Message]:
-    return builtin_class(CONFIG_PROTO, CONFIG_TYPE)
+def config_class() -> type[NetSimManagerConfig]:
+    return NetSimManagerConfig
 
 
 class _Parser(text_format._Parser):  # noqa: SLF001 - per-message control of unknown fields
@@ -71,10 +68,10 @@ class _Parser(text_format._Parser):  # noqa: SLF001 - per-message control of unk
 
     def _MergeField(self, tokenizer, message):  # noqa: N802 - overrides protobuf's method
         self.allow_unknown_field = message.DESCRIPTOR.full_name in _OPEN_BLOCKS
-        super()._MergeField(tokenizer, message)
+        super()._MergeField(tokenizer, message)  # type: ignore[misc]  # (protobuf's private parser)
 
 
-def parse_config(text: str, file: str | os.PathLike[str] | None = None) -> Message:
+def parse_config(text: str, file: str | os.PathLike[str] | None = None) -> NetSimManagerConfig:
     """Parse and validate a TextFormat configuration; raises ConfigError (with `file`:line)."""
     config = config_class()()
     merge_config_text(text, config, file=file, parser=_Parser())
@@ -86,15 +83,15 @@ def parse_config(text: str, file: str | os.PathLike[str] | None = None) -> Messa
     return config
 
 
-def load_config(path: str | os.PathLike[str]) -> Message:
+def load_config(path: str | os.PathLike[str]) -> NetSimManagerConfig:
     """The configuration file at `path`, whatever its bytes: ConfigError for every problem."""
     return parse_config(read_config_file(path), path)
 
 
-def validate_config(config: Message) -> None:
+def validate_config(config: NetSimManagerConfig) -> None:
     """The start-up checks of upstream, in its order; the first failure raises ConfigError."""
     if not config.IsInitialized():
-        missing = ", ".join(config.FindInitializationErrors())
+        missing = ", ".join(initialization_errors(config))
         raise ConfigError(f"configuration is missing required fields: {missing}")
     environments: set[int] = set()
     for bounds in config.env_bounds:

@@ -14,24 +14,23 @@ discrete-event simulation: the sans-I/O cores are connected in memory
 (pygoby.acomms.mmsim.link.ModemLink: the driver's sentences go straight into its emulator and the
 emulator's answers, parsed, into the driver's buffer) and the clock jumps to the next thing that
 can happen — an emulator's timed event, a reception's delivery, a MAC slot, a position update,
-periodic housekeeping — so a day of TDMA traffic runs in seconds. `pygoby.netsim.realtime` runs
+periodic housekeeping — so a day of TDMA traffic runs in seconds. `pygoby.netsim.sim.realtime` runs
 the same objects on the wall clock over TCP.
 
 Events go to `on_event` (`summary()` counts them): `tx` and `rx` from the channel (see
-`pygoby.netsim.physics_channel`), `app_rx` when a queue delivers a status message (port of the
+`pygoby.netsim.sim.physics_channel`), `app_rx` when a queue delivers a status message (port of the
 receiver, src, msg_t: the message's time stamp), `range` when a driver reports a ranging reply (port, src, dest, owtt list).
 """
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
-
-from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.bind import bind
@@ -41,11 +40,11 @@ from pygoby.acomms.mmsim import MicroModemModel
 from pygoby.acomms.mmsim.link import ModemLink
 from pygoby.acomms.queue import QueueManager
 from pygoby.dccl import Codec
-from pygoby.netsim.channel import Channel, Position
-from pygoby.netsim.manager import NetSimManager
-from pygoby.netsim.physics_channel import PhysicsChannel
-from pygoby.netsim.protocol import request_class
-from pygoby.netsim.scenario import (
+from pygoby.netsim.channel import Channel, NavFix
+from pygoby.netsim.manager.core import NetSimManager
+from pygoby.netsim.manager.protocol import request_class
+from pygoby.netsim.sim.physics_channel import PhysicsChannel
+from pygoby.netsim.sim.scenario import (
     TrackFollower,
     channel_config,
     mac_config,
@@ -55,13 +54,14 @@ from pygoby.netsim.scenario import (
     node_status_class,
     start_time,
 )
+from pygoby.protobuf.pygoby.netsim.scenario_pb2 import NodeStatus, Scenario
 from pygoby.util.clock import Clock, VirtualClock
 from pygoby.util.timeline import Timeline
 
 log = logging.getLogger(__name__)
 
 EventSink = Callable[[dict], None]
-DRIVER_WHOI_MICROMODEM = 2
+DRIVER_WHOI_MICROMODEM = acomms_pb.DriverType.DRIVER_WHOI_MICROMODEM
 SLOT_EPSILON = 1e-3  # s: a MAC slot fires once the clock is past its start
 STARTUP_STEP = 0.01  # s: drivers set the modem clock just after a whole second
 STARTUP_LIMIT = 120.0  # s of simulated time for every driver to finish its start-up
@@ -70,13 +70,13 @@ MAX_EXCHANGES = 10_000  # driver <-> emulator sentences at one instant before gi
 LOCAL_IP = "127.0.0.1"
 
 
-def driver_config(modem_id: int, **link) -> Message:
+def driver_config(modem_id: int, **link) -> acomms_pb.DriverConfig:
     cfg = acomms_pb.DriverConfig(driver_type=DRIVER_WHOI_MICROMODEM, modem_id=modem_id, **link)
     cfg.Extensions[acomms_pb.MM_CONFIG].query_cfg_on_startup = False
     return cfg
 
 
-def status_queue_entry(ack: bool) -> Message:
+def status_queue_entry(ack: bool) -> acomms_pb.QueuedMessageEntry:
     entry = acomms_pb.QueuedMessageEntry(
         protobuf_name="pygoby.netsim.protobuf.NodeStatus", ack=ack, max_queue=1, ttl=3600
     )
@@ -139,7 +139,7 @@ class RunSummary:
 
 class Simulation:
     def __init__(
-        self, scenario: Message, clock: Clock | None = None, on_event: EventSink | None = None
+        self, scenario: Scenario, clock: Clock | None = None, on_event: EventSink | None = None
     ) -> None:
         self.scenario = scenario
         self.start = start_time(scenario)
@@ -190,10 +190,10 @@ class Simulation:
             node.queue = QueueManager(self.codec, self.clock)
             node.queue.set_cfg(acomms_pb.QueueManagerConfig(modem_id=node.modem_id))
             node.queue.add_queue(status_queue_entry(traffic.ack), self.status_class)
-            node.queue.signal_receive.connect(lambda msg, n=node: self._status_heard(n, msg))
-            node.mac.signal_slot_start.connect(lambda slot, n=node: self._slot_started(n, slot))
+            node.queue.signal_receive.connect(functools.partial(self._status_heard, node))
+            node.mac.signal_slot_start.connect(functools.partial(self._slot_started, node))
         bind(driver, node.queue, node.mac)
-        driver.signal_receive.connect(lambda msg, n=node: self._modem_heard(n, msg))
+        driver.signal_receive.connect(functools.partial(self._modem_heard, node))
 
     def start_macs(self) -> None:
         """Start the run's traffic: a `node` event per node (its port and modem id, for the
@@ -236,15 +236,15 @@ class Simulation:
         node.queue.push_message(status)
         self.status_sent += 1
 
-    def _slot_started(self, node: SimNode, slot: Message) -> None:
+    def _slot_started(self, node: SimNode, slot: acomms_pb.ModemTransmission) -> None:
         if slot.src == node.modem_id:  # our slot has just taken the last status: queue the next
             self.queue_status(node)
 
-    def _status_heard(self, node: SimNode, msg: Message) -> None:
+    def _status_heard(self, node: SimNode, msg: NodeStatus) -> None:
         node.received[msg.src] += 1
         self._event("app_rx", t=self.clock.now(), port=node.port, src=msg.src, msg_t=msg.time)
 
-    def _modem_heard(self, node: SimNode, msg: Message) -> None:
+    def _modem_heard(self, node: SimNode, msg: acomms_pb.ModemTransmission) -> None:
         """Ranging results the driver reports (two-way pings) become `range` events."""
         if msg.type != acomms_pb.ModemTransmission.DRIVER_SPECIFIC:
             return
@@ -266,7 +266,7 @@ class Simulation:
 
     # -- positions -------------------------------------------------------------------------------
 
-    def track_positions(self) -> list[tuple[int, Position]]:
+    def track_positions(self) -> list[tuple[int, NavFix]]:
         """(modem port, position now) of every node with a scripted track."""
         now = self.clock.now()
         elapsed = now - self.start
@@ -388,7 +388,7 @@ class Simulation:
                     mac = node.mac
                     fired = mac is not None and mac.running and now > mac.next_slot_time
                     if fired:
-                        mac.do_work()
+                        mac.do_work()  # type: ignore[union-attr]  # (fired: a MAC)
                     if every and node.queue is not None:
                         node.queue.do_work()
                     if fired or every or (node.link is not None and node.link.pending):
@@ -408,7 +408,9 @@ class Simulation:
         deadline = clock.now() + STARTUP_LIMIT
         while not all(n.driver is None or n.driver.startup_complete for n in self.nodes):
             if clock.now() > deadline:
-                late = [n.modem_id for n in self.nodes if not n.driver.startup_complete]
+                late = [
+                    n.modem_id for n in self.nodes if n.driver and not n.driver.startup_complete
+                ]
                 raise RuntimeError(f"drivers of nodes {late} did not start")
             self.timeline.run_due()
             for node in self.nodes:

@@ -2,7 +2,7 @@
 
 Written by `EventLogWriter` (an `on_event` sink for `PhysicsChannel` and the simulation runner),
 read back by `read_events` for `pygoby netsim report`. Field meanings are documented where the
-events are made (`pygoby.netsim.physics_channel`, `pygoby.netsim.sim`).
+events are made (`pygoby.netsim.sim.physics_channel`, `pygoby.netsim.sim.simulation`).
 """
 
 from __future__ import annotations

@@ -14,47 +14,44 @@ import dataclasses
 import math
 import time
 from dataclasses import dataclass
-from functools import cache
 from pathlib import Path
-
-from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.mmsim.timing import DEFAULT_TIMING, ModemTiming
-from pygoby.netsim.channel import Band, ChannelConfig, Position
-from pygoby.netsim.channel.errors import ProtocolModel
+from pygoby.netsim.channel import Band, ChannelConfig, NavFix
 from pygoby.netsim.channel.geometry import WGS84
-from pygoby.netsim.channel.settings import absorption_of, propagation_of, sound_speed_of
-from pygoby.netsim.config import config_class as manager_config_class
+from pygoby.netsim.channel.settings import (
+    absorption_of,
+    propagation_of,
+    protocol_model_of,
+    sound_speed_of,
+)
 from pygoby.netsim.errors import ScenarioError
-from pygoby.protobuf import builtin_class
+from pygoby.netsim.manager.config import config_class as manager_config_class
+from pygoby.protobuf import initialization_errors
+from pygoby.protobuf.goby.acomms.protobuf.amac_config_pb2 import MACConfig
+from pygoby.protobuf.netsim.messages.manager_config_pb2 import NetSimManagerConfig
+from pygoby.protobuf.pygoby.netsim.scenario_pb2 import NodeStatus, Scenario, Track, Waypoint
 from pygoby.protobuf.textconfig import check_config_values, merge_config_text, read_config_file
 
-SCENARIO_PROTO = "pygoby/netsim/scenario.proto"
 FIRST_MODEM_PORT = 62000
 VIRTUAL_START = 1_700_000_000.0  # default start of a "max"-speed run (repeatable)
-MAC_FIXED_DECENTRALIZED = (
-    acomms_pb.MACConfig.DESCRIPTOR.fields_by_name["type"]
-    .enum_type.values_by_name["MAC_FIXED_DECENTRALIZED"]
-    .number
-)
+MAC_FIXED_DECENTRALIZED = acomms_pb.MACType.MAC_FIXED_DECENTRALIZED
 
 
-@cache
-def scenario_class() -> type[Message]:
-    return builtin_class(SCENARIO_PROTO, "pygoby.netsim.protobuf.Scenario")
+def scenario_class() -> type[Scenario]:
+    return Scenario
 
 
-@cache
-def node_status_class() -> type[Message]:
-    return builtin_class(SCENARIO_PROTO, "pygoby.netsim.protobuf.NodeStatus")
+def node_status_class() -> type[NodeStatus]:
+    return NodeStatus
 
 
-def load_scenario(path: str | Path) -> Message:
+def load_scenario(path: str | Path) -> Scenario:
     return parse_scenario(read_config_file(path, error=ScenarioError), path)
 
 
-def parse_scenario(text: str, file: str | Path | None = None) -> Message:
+def parse_scenario(text: str, file: str | Path | None = None) -> Scenario:
     scenario = scenario_class()()
     merge_config_text(text, scenario, file=file, error=ScenarioError)
     check_config_values(scenario, text, file=file, error=ScenarioError)
@@ -65,9 +62,9 @@ def parse_scenario(text: str, file: str | Path | None = None) -> Message:
     return scenario
 
 
-def check_scenario(scenario: Message) -> None:
+def check_scenario(scenario: Scenario) -> None:
     if not scenario.IsInitialized():
-        missing = ", ".join(scenario.FindInitializationErrors())
+        missing = ", ".join(initialization_errors(scenario))
         raise ScenarioError(f"scenario is missing required fields: {missing}")
     if not scenario.node:
         raise ScenarioError("a scenario needs at least one node")
@@ -96,7 +93,7 @@ def check_scenario(scenario: Message) -> None:
         channel_config(scenario)  # raises on bad propagation settings (nothing is traced yet)
 
 
-def speed_factor(scenario: Message) -> float | None:
+def speed_factor(scenario: Scenario) -> float | None:
     """None for "max" (virtual clock), else the real-time factor."""
     text = scenario.speed.strip().lower()
     if text == "max":
@@ -110,31 +107,21 @@ def speed_factor(scenario: Message) -> float | None:
     return factor
 
 
-def start_time(scenario: Message) -> float:
+def start_time(scenario: Scenario) -> float:
     if scenario.HasField("start_time"):
         return scenario.start_time
     return VIRTUAL_START if speed_factor(scenario) is None else time.time()
 
 
-def node_ports(scenario: Message) -> list[int]:
+def node_ports(scenario: Scenario) -> list[int]:
     return [
         n.modem_tcp_port if n.HasField("modem_tcp_port") else FIRST_MODEM_PORT + i
         for i, n in enumerate(scenario.node)
     ]
 
 
-def channel_config(scenario: Message) -> ChannelConfig:
+def channel_config(scenario: Scenario) -> ChannelConfig:
     c = scenario.channel
-    protocol = None
-    if c.HasField("protocol_model"):
-        p = c.protocol_model
-        protocol = ProtocolModel(
-            p.communication_range,
-            p.detection_range,
-            p.interference_range,
-            p.p_detection,
-            p.p_decoding,
-        )
     sound_speed = sound_speed_of(c)
     try:
         propagation = propagation_of(c, sound_speed)
@@ -152,13 +139,13 @@ def channel_config(scenario: Message) -> ChannelConfig:
         band=Band(c.carrier_hz, c.bandwidth_hz),
         half_duplex=c.half_duplex,
         receiver_lock=c.receiver_lock,
-        protocol_model=protocol,
+        protocol_model=protocol_model_of(c),
         decode_latency=c.decode_latency,
         position_staleness=c.position_staleness,
     )
 
 
-def modem_timing(scenario: Message) -> ModemTiming:
+def modem_timing(scenario: Scenario) -> ModemTiming:
     """The emulators' duration table: the defaults with the scenario's `modem_timing` over them."""
     t = scenario.modem_timing
     rates = dict(DEFAULT_TIMING.rates)
@@ -183,7 +170,7 @@ def modem_timing(scenario: Message) -> ModemTiming:
     return dataclasses.replace(DEFAULT_TIMING, rates=rates, **others)
 
 
-def manager_config(scenario: Message, endpoint_ip: str = "127.0.0.1") -> Message:
+def manager_config(scenario: Scenario, endpoint_ip: str = "127.0.0.1") -> NetSimManagerConfig:
     """A netsim_manager configuration for the scenario's nodes (one environment, whole Earth)."""
     cfg = manager_config_class()()
     for port in node_ports(scenario):
@@ -203,7 +190,7 @@ def manager_config(scenario: Message, endpoint_ip: str = "127.0.0.1") -> Message
     return cfg
 
 
-def mac_config(scenario: Message, modem_id: int) -> Message:
+def mac_config(scenario: Scenario, modem_id: int) -> MACConfig:
     """The scenario's TDMA cycle for one node (the same slots at every node)."""
     cfg = acomms_pb.MACConfig()
     cfg.CopyFrom(scenario.mac)
@@ -237,7 +224,7 @@ class _Fix:
 class TrackFollower:
     """A node's scripted position at any time (UNIX seconds, given the run's start time)."""
 
-    def __init__(self, track: Message, scenario: Message) -> None:
+    def __init__(self, track: Track, scenario: Scenario) -> None:
         if not track.waypoint:
             raise ScenarioError("a track needs at least one waypoint")
         self.fixes = [self._fix(w, scenario) for w in track.waypoint]
@@ -249,7 +236,7 @@ class TrackFollower:
         self._times = times
 
     @staticmethod
-    def _fix(w: Message, scenario: Message) -> _Fix:
+    def _fix(w: Waypoint, scenario: Scenario) -> _Fix:
         if w.HasField("lat") and w.HasField("lon"):
             lat, lon = w.lat, w.lon
         elif w.HasField("x") or w.HasField("y"):
@@ -263,24 +250,24 @@ class TrackFollower:
             raise ScenarioError(f"waypoint out of range: lat {lat}, lon {lon}, depth {w.depth}")
         return _Fix(w.t, lat, lon, w.depth)
 
-    def position(self, elapsed: float, now: float) -> Position:
+    def position(self, elapsed: float, now: float) -> NavFix:
         """The position `elapsed` seconds after the start, stamped with `now`."""
         fixes = self.fixes
         if len(fixes) == 1:
             f = fixes[0]
             if not self.speed:  # a fixed node: what dead-reckoning below gives, in one step
-                return Position(f.lat, f.lon, f.depth, now, self.speed, self.heading)
-            start = Position(f.lat, f.lon, f.depth, now - elapsed + f.t, self.speed, self.heading)
+                return NavFix(f.lat, f.lon, f.depth, now, self.speed, self.heading)
+            start = NavFix(f.lat, f.lon, f.depth, now - elapsed + f.t, self.speed, self.heading)
             return start.at(now)
         i = bisect.bisect_right(self._times, elapsed)
         if i == 0 or i == len(fixes):  # before the first or after the last: hold
             f = fixes[0 if i == 0 else -1]
-            return Position(f.lat, f.lon, f.depth, now)
+            return NavFix(f.lat, f.lon, f.depth, now)
         a, b = fixes[i - 1], fixes[i]
         azimuth, _, distance = WGS84.inv(a.lon, a.lat, b.lon, b.lat)
         fraction = (elapsed - a.t) / (b.t - a.t)
         lon, lat, _ = WGS84.fwd(a.lon, a.lat, azimuth, distance * fraction)
-        return Position(
+        return NavFix(
             lat,
             lon,
             a.depth + (b.depth - a.depth) * fraction,

@@ -13,9 +13,9 @@ import logging
 import sys
 
 from pygoby.errors import ConfigError
-from pygoby.netsim.config import EXAMPLE_CONFIG, load_config
-from pygoby.netsim.gprmc import GpsOutputs
-from pygoby.netsim.manager import NetSimManager
+from pygoby.netsim.manager.config import EXAMPLE_CONFIG, load_config
+from pygoby.netsim.manager.core import NetSimManager
+from pygoby.netsim.manager.gprmc import GpsOutputs
 from pygoby.util.aiorun import run_until_signal
 from pygoby.util.clock import WallClock
 

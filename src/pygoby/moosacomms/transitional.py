@@ -24,6 +24,8 @@ from pygoby.dccl.dccl1.bridge import Dccl1Bridge
 from pygoby.dccl.xml import MessageSet, XmlMessage, load_message_set
 from pygoby.errors import ConfigError
 from pygoby.protobuf import ProtoLoader
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
+from pygoby.protobuf.goby.moos.protobuf.transitional_pb2 import MessageFile, WireFormat
 
 log = logging.getLogger(__name__)
 
@@ -38,7 +40,7 @@ class TransitionalMessages:
 
     @classmethod
     def expand(
-        cls, cfg: Message, loader: ProtoLoader, find: Callable[[str], str] = str
+        cls, cfg: pAcommsHandlerConfig, loader: ProtoLoader, find: Callable[[str], str] = str
     ) -> TransitionalMessages:
         """Load `cfg.transitional_cfg.message_file` (paths through `find`), register the types
         in `loader` and append their queue and translator entries to `cfg`."""
@@ -49,8 +51,8 @@ class TransitionalMessages:
 
     def add_file(
         self,
-        cfg: Message,
-        message_file: Message,
+        cfg: pAcommsHandlerConfig,
+        message_file: MessageFile,
         loader: ProtoLoader,
         find: Callable[[str], str] = str,
     ) -> MessageSet:
@@ -89,15 +91,14 @@ class TransitionalMessages:
         field's name, else whole: Translator.read_named_values."""
         return {name: msg.single_field_sources() for name, msg in self.messages.items()}
 
-    def speaks_dccl1(self, cfg: Message) -> bool:
+    def speaks_dccl1(self, cfg: pAcommsHandlerConfig) -> bool:
         """Whether the XML messages travel as Goby 1.1's DCCL1 (transitional_cfg.wire_format;
         a Goby 1.1 configuration gets DCCL1 when it does not set it)."""
         transitional = cfg.transitional_cfg
-        wire = transitional.DESCRIPTOR.fields_by_name["wire_format"].enum_type
-        return bool(self.sets) and transitional.wire_format == wire.values_by_name["DCCL1"].number
+        return bool(self.sets) and transitional.wire_format == WireFormat.DCCL1
 
     def dccl1_bridge(
-        self, cfg: Message, loader: ProtoLoader, clock: Callable[[], float]
+        self, cfg: pAcommsHandlerConfig, loader: ProtoLoader, clock: Callable[[], float]
     ) -> Dccl1Bridge:
         """A DCCL1 codec for the XML messages (dccl_cfg.crypto_passphrase; Goby 1.1 encrypts
         with an empty passphrase when none is set), for the queue (QueueManager.use_dccl1)."""

@@ -21,10 +21,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from google.protobuf.message import Message
-
 from pygoby.acomms import messages as acomms_pb
-from pygoby.acomms.transitional import TransitionalMessages
 from pygoby.dccl import Codec, DcclError
 from pygoby.dccl.libraries import BuiltinLibrary, split_libraries
 from pygoby.errors import ConfigError
@@ -32,13 +29,14 @@ from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import read_configuration
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import Translator
-from pygoby.moos.translator_binding import MessageTypes, not_found
-from pygoby.protobuf import ProtoLoader, builtin_class
-
-PACOMMSHANDLER_CONFIG = (
-    "goby/apps/moos/protobuf/pAcommsHandler_config.proto",
-    "goby.apps.moos.protobuf.pAcommsHandlerConfig",
+from pygoby.moosacomms.transitional import TransitionalMessages
+from pygoby.moosacomms.translator_binding import MessageTypes, not_found
+from pygoby.protobuf import ProtoLoader
+from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
+    pAcommsHandlerConfig,
 )
+from pygoby.protobuf.goby.moos.protobuf.transitional_pb2 import MessageFile
+
 XML_PATH_FIELD = "message_file.path"  # dccl_cfg/queue_cfg/transitional_cfg all name it so
 
 ErrorMaker = Callable[
@@ -52,9 +50,9 @@ def _unlocated(reason: str, field: str, value: str) -> ConfigError:
 
 def read_acomms_config(
     mission: MissionFile, block: str = "pAcommsHandler", overrides: Sequence[tuple[str, str]] = ()
-) -> Message:
+) -> pAcommsHandlerConfig:
     """The pAcommsHandlerConfig of `mission`'s ProcessConfig `block` (ConfigError file:line)."""
-    return read_configuration(builtin_class(*PACOMMSHANDLER_CONFIG), mission, block, overrides)
+    return read_configuration(pAcommsHandlerConfig, mission, block, overrides)
 
 
 @dataclass
@@ -64,7 +62,7 @@ class AcommsMessageSet:
     class), the XML message sets (`transitional`) and the built-ins standing for C++ DCCL codec
     libraries (their messages are in `types`; a codec also needs `apply_libraries`)."""
 
-    cfg: Message
+    cfg: pAcommsHandlerConfig
     loader: ProtoLoader
     types: MessageTypes
     transitional: TransitionalMessages
@@ -75,7 +73,7 @@ class AcommsMessageSet:
     @classmethod
     def load(
         cls,
-        cfg: Message,
+        cfg: pAcommsHandlerConfig,
         find: Callable[[str], str] = str,
         search_dirs: Sequence[str] = (),
         config_error: ErrorMaker | None = None,
@@ -121,7 +119,7 @@ class AcommsMessageSet:
 
     @classmethod
     def of_app(
-        cls, app: GobyMOOSApp, block: str, message_files: Sequence[Message] = ()
+        cls, app: GobyMOOSApp, block: str, message_files: Sequence[MessageFile] = ()
     ) -> AcommsMessageSet:
         """The message set of the pAcommsHandler block `block` of `app`'s mission, plus the
         app's own XML `message_files` (Goby 1.1's iCommander had them; a file pAcommsHandler
@@ -130,7 +128,7 @@ class AcommsMessageSet:
         if mission is None:
             raise ConfigError(f"{app.name} needs the mission file with the {block} ProcessConfig")
         if message_files and mission.goby_block(block) is None:
-            cfg = builtin_class(*PACOMMSHANDLER_CONFIG)()
+            cfg = pAcommsHandlerConfig()
         else:
             cfg = read_acomms_config(mission, block)
         out = cls.load(

@@ -3,7 +3,7 @@ link model of the Micro-Modem emulators' multicast channel (`iModemSim` with pos
 each emulator process knows only its own modem and the sender's position a packet carries.
 
     link = RangeLink(ChannelConfig(), seed=1)
-    heard = link([lat, lon, depth], [lat, lon, depth], packet)   # mmsim Reception, or None
+    heard = link([lat, lon, depth], [lat, lon, depth], packet)   # mmsim ModemReception, or None
 
 Travel time and received level come from the range (and depths); frames are lost as the
 rate's error model draws them. Each packet is judged on its own: no interference between
@@ -16,10 +16,10 @@ import itertools
 import math
 from collections.abc import Sequence
 
-from pygoby.acomms.mmsim.channel import AcousticPacket, Reception
-from pygoby.netsim.channel.geometry import Position
+from pygoby.acomms.mmsim.channel import AcousticPacket, ModemReception
+from pygoby.netsim.channel.geometry import NavFix
 from pygoby.netsim.channel.model import Channel, ChannelConfig, Outcome, PacketKind, Transmission
-from pygoby.netsim.physics_channel import PHYSICAL_KIND
+from pygoby.netsim.sim.physics_channel import PHYSICAL_KIND
 
 _SENDER, _RECEIVER = 1, 2
 
@@ -37,12 +37,12 @@ class RangeLink:
 
     def __call__(
         self, sender: Sequence[float], receiver: Sequence[float], packet: AcousticPacket
-    ) -> Reception | None:
+    ) -> ModemReception | None:
         kind = PHYSICAL_KIND[packet.kind]
         framed = kind is PacketKind.DATA
         channel = Channel(self.config, seed=self.seed * 1_000_003 + next(self._count))
         for port, (lat, lon, depth) in ((_SENDER, sender), (_RECEIVER, receiver)):
-            channel.update_position(port, Position(lat, lon, depth, time=packet.tx_time))
+            channel.update_position(port, NavFix(lat, lon, depth, time=packet.tx_time))
         channel.transmit(
             Transmission(
                 source=_SENDER,
@@ -56,7 +56,7 @@ class RangeLink:
         )
         for reception in channel.poll(math.inf):
             if reception.outcome is Outcome.GOOD:
-                return Reception(reception.arrival)
+                return ModemReception(reception.arrival)
             if reception.outcome is Outcome.BAD_FRAMES and framed:
-                return Reception(reception.arrival, frame_ok=list(reception.frames_ok))
+                return ModemReception(reception.arrival, frame_ok=list(reception.frames_ok))
         return None  # not detected, or a control packet with a bad frame

@@ -1,6 +1,7 @@
 """The uField driver's own MOOS connection (goby3: a MOOS client named goby.moos.UFldDriver
 to `moos_server:moos_port`), given to the driver by pAcommsHandler: acomms does not import moos,
-so the link lives with the app (pygoby.acomms.drivers.ufield.MailLink is its interface)."""
+so the link lives in the acomms-on-MOOS layer (pygoby.acomms.drivers.ufield.MailLink is its
+interface)."""
 
 from __future__ import annotations
 

@@ -21,16 +21,18 @@ import asyncio
 import contextlib
 import logging
 from collections.abc import Callable, Iterable
-
-from google.protobuf.message import Message
+from typing import cast
 
 from pygoby.netsim.errors import LineError
-from pygoby.netsim.protocol import (
+from pygoby.netsim.manager.protocol import (
     LEGACY_REQUEST_NAME,
     REQUEST_NAME,
     LineDecoder,
+    NavUpdate,
+    NetSimManagerRequest,
+    NetSimManagerResponse,
+    ReceiveStats,
     encode_line,
-    message_class,
     request_class,
     response_names,
 )
@@ -41,10 +43,10 @@ log = logging.getLogger(__name__)
 
 MAX_REQUEST_ID = 2**31 - 1
 
-ResponseCallback = Callable[[Message], None]
+ResponseCallback = Callable[[NetSimManagerResponse], None]
 
 
-def status_name(response: Message) -> str:
+def status_name(response: NetSimManagerResponse) -> str:
     return response.Status.Name(response.status)
 
 
@@ -58,36 +60,39 @@ class RequestTracker:
         self.request_name = LEGACY_REQUEST_NAME if legacy_names else REQUEST_NAME
         self._next_id = first_id
         self._decoder = LineDecoder(response_names())
-        self._waiting: dict[int, asyncio.Future[Message]] = {}
+        self._waiting: dict[int, asyncio.Future[NetSimManagerResponse]] = {}
 
     def take_id(self) -> int:
         request_id = self._next_id
         self._next_id = 0 if request_id >= MAX_REQUEST_ID else request_id + 1
         return request_id
 
-    def build(self, navs: Iterable[Message] = (), stats: Iterable[Message] = ()) -> Message:
+    def build(
+        self, navs: Iterable[NavUpdate] = (), stats: Iterable[ReceiveStats] = ()
+    ) -> NetSimManagerRequest:
         """A request with the next id (the id is used up even if the request is never sent)."""
         request = request_class()(id=self.take_id())
         request.nav.extend(navs)
         request.stats.extend(stats)
         return request
 
-    def encode(self, request: Message) -> bytes:
+    def encode(self, request: NetSimManagerRequest) -> bytes:
         return encode_line(request, self.request_name)
 
-    def expect(self, request_id: int, future: asyncio.Future[Message]) -> None:
+    def expect(self, request_id: int, future: asyncio.Future[NetSimManagerResponse]) -> None:
         self._waiting[request_id] = future
 
-    def feed(self, data: bytes) -> list[Message]:
+    def feed(self, data: bytes) -> list[NetSimManagerResponse]:
         """Responses decoded from `data`; waiting futures for their ids are resolved."""
-        responses = []
+        responses: list[NetSimManagerResponse] = []
         for event in self._decoder.feed(data):
             if isinstance(event, LineError):
                 log.warning("netsim client: dropped line from manager: %s", event)
                 continue
             if event.parse_error:
                 log.warning("netsim client: %s", event.parse_error)
-            response = event.message
+            # (the decoder was made with the response class: every message is one)
+            response = cast(NetSimManagerResponse, event.message)
             future = self._waiting.pop(response.request_id, None)
             if future is not None and not future.done():
                 future.set_result(response)
@@ -116,13 +121,15 @@ class NetSimClient:
     ) -> None:
         self.host, self.port = host, port
         self.tracker = RequestTracker(legacy_names)
-        self.signal_response = Signal()  # every response received, in arrival order
+        self.signal_response: Signal[NetSimManagerResponse] = (
+            Signal()
+        )  # every response received, in arrival order
         if on_response is not None:
             self.signal_response.connect(on_response)
         self.backoff_initial, self.backoff_max = backoff_initial, backoff_max
         self._writer: asyncio.StreamWriter | None = None
         self._connected = asyncio.Event()
-        self._pending_navs: list[Message] = []
+        self._pending_navs: list[NavUpdate] = []
         self._task: asyncio.Task | None = None
         self.connections = 0  # successful connects so far
 
@@ -142,7 +149,9 @@ class NetSimClient:
         task, self._task = self._task, None
         await cancel_and_wait(task)
 
-    def send_request(self, request: Message) -> asyncio.Future[Message] | None:
+    def send_request(
+        self, request: NetSimManagerRequest
+    ) -> asyncio.Future[NetSimManagerResponse] | None:
         """Write a request built with `tracker.build`; a future for its response, or None if
         not connected (the request is dropped, not queued)."""
         if self._writer is None:
@@ -153,8 +162,8 @@ class NetSimClient:
         return future
 
     def send_navs(
-        self, navs: Iterable[Message], stats: Iterable[Message] = ()
-    ) -> asyncio.Future[Message] | None:
+        self, navs: Iterable[NavUpdate], stats: Iterable[ReceiveStats] = ()
+    ) -> asyncio.Future[NetSimManagerResponse] | None:
         """Report positions (and optionally stats). While disconnected only the newest navs
         are kept, and sent as soon as the connection is back."""
         navs = list(navs)
@@ -164,13 +173,15 @@ class NetSimClient:
             self._pending_navs = navs
         return future
 
-    def send_stats(self, stats: Iterable[Message]) -> asyncio.Future[Message] | None:
+    def send_stats(
+        self, stats: Iterable[ReceiveStats]
+    ) -> asyncio.Future[NetSimManagerResponse] | None:
         return self.send_request(self.tracker.build(stats=stats))
 
     @staticmethod
-    def nav(**fields) -> Message:
+    def nav(**fields) -> NavUpdate:
         """Convenience: a NavUpdate from keyword fields."""
-        return message_class("NavUpdate")(**fields)
+        return NavUpdate(**fields)
 
     async def _run(self) -> None:
         delay = self.backoff_initial
