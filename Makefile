@@ -4,7 +4,10 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench soak figures lint typecheck protos clean screenshots
+.PHONY: demo test check bench soak figures lint typecheck protos clean screenshots
+
+# the tests run in this many processes (pytest-xdist; CI's machine has 2 cores)
+TEST_JOBS ?= 2
 
 # liaison's browser tests drive Debian's chromium (Playwright's own browser download is not used)
 CHROMIUM ?= /usr/bin/chromium
@@ -27,10 +30,19 @@ demo: protos
 $(CHROMIUM):
 	command -v apt-get >/dev/null && (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) || echo "install chromium for liaison's browser tests"
 
+# what CI runs: lint, format, types and every test (property tests at the light hypothesis
+# profile; `make soak` runs them at full depth)
 test: protos $(CHROMIUM)
 	$(PY) -m ruff check src tests benchmarks
+	$(PY) -m ruff format --check src tests benchmarks
 	$(PY) -m mypy
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n $(TEST_JOBS)
+
+# the edit loop's tier (< 90 s): lint and every test but the end-to-end ones (marked e2e);
+# after a failure, `$(PY) -m pytest --lf` runs what failed last
+check: protos
+	$(PY) -m ruff check src tests benchmarks
+	$(PY) -m pytest -q -n $(TEST_JOBS) -m "not e2e"
 
 # the README's liaison pictures, taken by the browser test against a real two-vehicle mission
 screenshots: protos $(CHROMIUM)
@@ -40,10 +52,11 @@ bench: protos
 	$(PY) -m pytest benchmarks -q -o addopts="" --benchmark-only --benchmark-columns=min,mean,ops,rounds
 
 # issue 16's hostile-client and kill -9 scenarios on loopback, with their figures (not in `test`);
-# SOAK_SECONDS per scenario
+# SOAK_SECONDS per scenario; then every property test at full depth (HYPOTHESIS_PROFILE=ci)
 SOAK_SECONDS ?= 20
 soak: protos
 	$(PY) -m benchmarks.soak.run --seconds $(SOAK_SECONDS)
+	HYPOTHESIS_PROFILE=ci $(PY) -m pytest -q -n $(TEST_JOBS) -m hypothesis
 
 # Figures of the examples' READMEs, regenerated from their sources (commit the result).
 EXAMPLE_SWEEP := examples/netsim/sweep_range_rate

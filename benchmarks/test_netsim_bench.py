@@ -1,8 +1,7 @@
 """netsim_manager under load: 64 clients each sending 10 NavUpdates per second to one manager
 process, measuring the response latency (p50 / p99 / max) and the share of requests answered.
 
-The short run (5 s) is part of `make bench`; the full 60 s run of the issue is marked slow
-(`pytest benchmarks -m slow -o addopts=""`). A run with garbage clients alongside checks that
+`make bench` runs the short run (5 s) and the full 60 s run of the issue. A run with garbage clients alongside checks that
 bad input does not cost the well-behaved clients their answers.
 """
 
@@ -16,8 +15,6 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-
-import pytest
 
 from pygoby.netsim.manager.client import NetSimClient
 from pygoby.netsim.manager.protocol import encode_line, request_class
@@ -198,7 +195,6 @@ def test_manager_load_short_with_garbage_clients(benchmark, tmp_path):
     _run_load(benchmark, tmp_path, duration=5.0, garbage_clients=4)
 
 
-@pytest.mark.slow
 def test_manager_load_full_60s(benchmark, tmp_path):
     _run_load(benchmark, tmp_path, duration=60.0)
 

@@ -9,12 +9,15 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from google.protobuf import text_format
 
 import pygoby
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.db import MOOSDB
 from pygoby.util.console import BROKEN_PIPE_STATUS
+
+pytestmark = pytest.mark.e2e
 
 BIN = Path(sys.executable).parent
 PROTO = Path(__file__).resolve().parent.parent / "examples" / "two_vehicles" / "two_vehicles.proto"

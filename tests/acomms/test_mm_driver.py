@@ -12,6 +12,7 @@ from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.util.clock import VirtualClock
 from pygoby.util.linebased import MemoryLink
 from pygoby.util.nmea import NMEASentence
+from tests.hypothesis_profiles import examples
 
 T0 = 1_700_000_000.0  # 2023-11-14T22:13:20Z
 
@@ -553,7 +554,7 @@ FIELD = st.one_of(
 )
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(st.lists(st.tuples(st.sampled_from(MODEM_IDS), st.lists(FIELD, max_size=32)), max_size=8))
 def test_fuzz_modem_lines_never_raise(sentences):
     """Whatever the modem says, the driver logs and carries on (no exception escapes)."""

@@ -22,6 +22,7 @@ from pygoby.acomms.drivers.micromodem.statistics import (
 )
 from pygoby.util.errors import NMEAFormatError
 from pygoby.util.nmea import NMEASentence
+from tests.hypothesis_profiles import examples
 
 DAY = dt.date(2023, 11, 14)
 MIDNIGHT_US = int(dt.datetime(2023, 11, 14, tzinfo=dt.UTC).timestamp()) * 1_000_000
@@ -53,7 +54,7 @@ INTS = (
 )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     toa_us=st.integers(0, 86_400 * 1_000_000 - 1).map(lambda us: us - us % 100),
     mode=st.integers(0, 2),
@@ -142,7 +143,7 @@ def test_add_cst_warns_about_every_short_sentence(caplog):
     assert stats[1] == parse_cst(short, DAY)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.integers(0, 2**33 * 10**6 - 1), st.booleans())
 def test_toa_text_prints_the_utc_time_of_day_and_parse_toa_reads_it(time_us, with_date):
     toa = dt.datetime.fromtimestamp(time_us // 100 * 100 / 1e6, dt.UTC)

@@ -2,6 +2,8 @@
 
 import asyncio
 
+import pytest
+
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
@@ -10,6 +12,8 @@ from pygoby.util.clock import WallClock
 
 from .mm_e2e import run_until, start_emulators, started_driver
 from .queue_helpers import status_link
+
+pytestmark = pytest.mark.e2e
 
 
 async def test_data_with_ack_and_ranging_over_tcp():

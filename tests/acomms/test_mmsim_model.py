@@ -17,6 +17,7 @@ from pygoby.acomms.mmsim.timing import DEFAULT_TIMING
 from pygoby.util.clock import VirtualClock
 from pygoby.util.nmea import NMEASentence
 from pygoby.util.timeline import Timeline
+from tests.hypothesis_profiles import examples
 
 T0 = 1_700_000_000.0  # 2023-11-14T22:13:20Z
 
@@ -417,7 +418,7 @@ FIELDS = st.one_of(
 )
 
 
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=examples(400), deadline=None)
 @given(
     st.lists(
         st.one_of(
@@ -469,6 +470,7 @@ async def test_pygoby_mmsim_command_answers_over_tcp():
         await proc.wait()
 
 
+@pytest.mark.e2e  # (two processes)
 async def test_two_mmsim_processes_hear_each_other_over_their_range(tmp_path):
     import random
 

@@ -34,7 +34,10 @@ def _pyacomms_installed() -> bool:
     return True
 
 
-pytestmark = pytest.mark.skipif(not _pyacomms_installed(), reason="pyacomms (acomms) not installed")
+pytestmark = [
+    pytest.mark.skipif(not _pyacomms_installed(), reason="pyacomms (acomms) not installed"),
+    pytest.mark.e2e,
+]
 
 
 async def test_pyacomms_drives_two_emulators_through_their_api(tmp_path):

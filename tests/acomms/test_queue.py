@@ -10,6 +10,7 @@ from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.queue import QueueError
 from pygoby.acomms.queue.roles import RoleError
 from pygoby.util.clock import VirtualClock
+from tests.hypothesis_profiles import examples
 
 from .queue_helpers import Role, entry, manager
 
@@ -292,7 +293,7 @@ def test_garbage_frames_are_logged_not_fatal(clock, caplog):
     assert [x.value for x in got] == [9] and "cannot decode" in caplog.text
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.binary(max_size=64))
 def test_fuzz_receive_never_raises(data):
     qm, _ = FUZZ

@@ -18,6 +18,7 @@ from pygoby.acomms.handler import AcommsHandler, HandlerError
 from pygoby.acomms.queue import QueueError
 from pygoby.acomms.queue.persist import QueueStore
 from pygoby.util.clock import VirtualClock
+from tests.hypothesis_profiles import examples
 
 from .queue_helpers import Role, entry, manager
 
@@ -175,7 +176,9 @@ def _queue_file_of_several_pages(path) -> int:
 
 
 @settings(
-    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=examples(25),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
 @given(page=st.integers(2, 1000), garbage=st.binary(min_size=7, max_size=64))
 def test_a_damaged_inner_page_is_a_one_line_error(tmp_path_factory, page, garbage):

@@ -18,9 +18,12 @@ from pygoby.acomms.rudics import (
 )
 from pygoby.acomms.store_server import StoreServer, TransmissionStore, serve_store
 from pygoby.util.clock import WallClock
+from tests.hypothesis_profiles import examples
 
 from .mm_e2e import run_until
 from .queue_helpers import status_link
+
+pytestmark = pytest.mark.e2e
 
 
 def schoolbook_convert(data: bytes, source_base: int, sink_base: int) -> bytes:
@@ -35,7 +38,7 @@ def schoolbook_convert(data: bytes, source_base: int, sink_base: int) -> bytes:
     return bytes(out) + b"\0" * (len(data) - len(data.rstrip(b"\0")))
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.binary(max_size=300) | st.binary(min_size=1000, max_size=3000), st.integers(0, 3))
 def test_rudics_round_trip_and_no_cr(data, top_zeros):
     data += b"\0" * top_zeros
@@ -46,7 +49,7 @@ def test_rudics_round_trip_and_no_cr(data, top_zeros):
     assert plain[:-1].replace(b"\xff", b"\r") == schoolbook_convert(data, 256, 255)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(st.binary(max_size=400))
 def test_rudics_parse_of_arbitrary_bytes_raises_only_its_own_error(garbage):
     with contextlib.suppress(RudicsPacketError):
@@ -274,7 +277,7 @@ def test_only_the_holder_of_a_modem_ids_secret_reads_its_mail():
     assert error == "" and len(response.inbox) == 1
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(st.lists(st.integers(0, 4), max_size=6))
 def test_a_signed_modem_cannot_post_mail_as_another(claimed_sources):
     # issue 25, item 8: modem 1, signing with its own secret, claims other sources

@@ -1,6 +1,11 @@
 """Two pAcommsHandler communities for end-to-end tests: embedded MOOSDBs, Micro-Modem emulators
 on real loopback TCP (one perfect acoustic channel), and a MOOS client per community that
-records everything it sees."""
+records everything it sees.
+
+The missions run at MOOSTimeWarp WARP: the apps, the DBs, the recorders and the emulated modems
+share MOOS time (UNIX time x WARP), so the TDMA slots and the modem's timing (the packets on the
+water, the sentences on the serial line) pass WARP times faster than real time; the mission is
+the same one, only its clock runs fast."""
 
 from __future__ import annotations
 
@@ -15,7 +20,8 @@ from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.protocol import MOOSMessage
-from pygoby.util.clock import WallClock
+from pygoby.moos.timewarp import clock_warp, moos_clock
+from pygoby.util.clock import Clock
 
 PROTO = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / "two_vehicles.proto"
 STATUS = "pygoby.examples.SimpleStatus"
@@ -26,6 +32,9 @@ COMMAND = "pygoby.examples.Command"
 # modem's transmissions would queue behind each other, later every cycle (a rate-0 packet alone,
 # cycle-init and data, is ~4.3 s), and the sender's next cycle would come before the ack.
 SLOT_SECONDS = 3
+# (a TDMA cycle is then 0.6 s of real time: slack enough for the host's own delays between the
+# sentences, which the warp does not shorten)
+WARP = 10
 SLOTS = "".join(
     f"    slot {{ src: {src} dest: -1 rate: 1 type: DATA slot_seconds: {SLOT_SECONDS} }}\n"
     for src in (1, 2)
@@ -96,6 +105,7 @@ def mission_text(
     slots: str | None = None,
     driver: str | None = None,
     common: str = "log: false  app_tick: 20  verbosity: WARN",
+    warp: float = WARP,
 ) -> str:
     """vehicle<modem_id>'s mission: `driver` (a driver_cfg block; default: a Micro-Modem on
     `modem_port`), TDMA slots for 1 and 2, the status and command queues and translators."""
@@ -107,6 +117,7 @@ def mission_text(
 ServerHost = localhost
 ServerPort = {db_port}
 Community  = vehicle{modem_id}
+MOOSTimeWarp = {warp:g}
 
 ProcessConfig = pAcommsHandler
 {{
@@ -122,10 +133,11 @@ ProcessConfig = pAcommsHandler
 
 
 class Recorder:
-    """A MOOS client that keeps every notification it receives, by variable."""
+    """A MOOS client that keeps every notification it receives, by variable (`clock`: MOOS time,
+    the DB's)."""
 
-    def __init__(self, name: str, port: int) -> None:
-        self.client = MOOSClient(name, port=port)
+    def __init__(self, name: str, port: int, clock: Clock | None = None) -> None:
+        self.client = MOOSClient(name, port=port, clock=clock)
         self.seen: dict[str, list[MOOSMessage]] = {}
         self._task: asyncio.Task | None = None
 
@@ -199,23 +211,32 @@ async def start_modem(
     return sim
 
 
-async def start_db(stack: contextlib.AsyncExitStack, modem_id: int) -> MOOSDB:
-    """The MOOSDB of community `vehicle<modem_id>`, closed with `stack`."""
-    return await stack.enter_async_context(MOOSDB(port=0, community=f"vehicle{modem_id}"))
+def mission_clock(warp: float = WARP) -> Clock:
+    """MOOS time at the missions' warp."""
+    return moos_clock(warp)
+
+
+async def start_db(stack: contextlib.AsyncExitStack, modem_id: int, warp: float = WARP) -> MOOSDB:
+    """The MOOSDB of community `vehicle<modem_id>` at the missions' warp, closed with `stack`."""
+    db = MOOSDB(port=0, community=f"vehicle{modem_id}", clock=mission_clock(warp))
+    return await stack.enter_async_context(db)
 
 
 async def modem_and_db(
     stack: contextlib.AsyncExitStack, modem_id: int, channel, clock
 ) -> tuple[MMSimServer, MOOSDB]:
-    """An emulated Micro-Modem and the MOOSDB of community `vehicle<modem_id>`."""
-    return await start_modem(stack, modem_id, channel, clock), await start_db(stack, modem_id)
+    """An emulated Micro-Modem and the MOOSDB of community `vehicle<modem_id>`, both on `clock`
+    (MOOS time, at its warp)."""
+    modem = await start_modem(stack, modem_id, channel, clock)
+    return modem, await start_db(stack, modem_id, clock_warp(clock))
 
 
 @contextlib.asynccontextmanager
 async def two_vehicle_missions(tmp_path: Path, mission, watched: list[str], channel, clock):
     """Vehicles 1 and 2, each an emulated Micro-Modem on `channel`, a MOOSDB, the pAcommsHandler
     of the mission file `mission(modem_id, db_port, modem_port)` writes and a recorder of
-    `watched`: yields ([app1, app2], [recorder1, recorder2])."""
+    `watched`, all on `clock` (the missions' MOOS time): yields ([app1, app2], [recorder1,
+    recorder2])."""
     async with contextlib.AsyncExitStack() as stack:
         apps, recorders = [], []
         for modem_id in (1, 2):
@@ -223,7 +244,7 @@ async def two_vehicle_missions(tmp_path: Path, mission, watched: list[str], chan
             path = tmp_path / f"mm{modem_id}.moos"
             path.write_text(mission(modem_id, db.port, sim.port))
             app = pAcommsHandler.from_mission(path, "pAcommsHandler")
-            recorder = Recorder(f"recorder{modem_id}", db.port)
+            recorder = Recorder(f"recorder{modem_id}", db.port, clock)
             await recorder.start(watched)
             stack.push_async_callback(recorder.close)
             await stack.enter_async_context(app)
@@ -235,14 +256,14 @@ async def two_vehicle_missions(tmp_path: Path, mission, watched: list[str], chan
 class MicroModemLink:
     """Micro-Modem emulators on loopback TCP sharing one perfect acoustic channel."""
 
-    def __init__(self) -> None:
+    def __init__(self, warp: float = WARP) -> None:
         self.sims: list[MMSimServer] = []
-        self.channel = LoopbackChannel()
+        self.clock = mission_clock(warp)
+        self.channel = LoopbackChannel(self.clock)
 
     async def start(self, stack: contextlib.AsyncExitStack, dbs: list[MOOSDB]) -> None:
-        clock = WallClock()
         for modem_id in (1, 2):
-            self.sims.append(await start_modem(stack, modem_id, self.channel, clock))
+            self.sims.append(await start_modem(stack, modem_id, self.channel, self.clock))
 
     def driver_cfg(self, modem_id: int) -> str:
         return micromodem_driver(self.sims[modem_id - 1].port)
@@ -254,7 +275,7 @@ class MicroModemLink:
 class TwoCommunities:
     """Link (default: emulated Micro-Modems) + DBs + pAcommsHandlers + recorders; `extra` adds
     config to both apps. A link has `start(stack, dbs)` and `driver_cfg(modem_id)` (the
-    driver_cfg block of that vehicle's mission)."""
+    driver_cfg block of that vehicle's mission); `warp` the missions' MOOSTimeWarp."""
 
     def __init__(
         self,
@@ -263,9 +284,10 @@ class TwoCommunities:
         slots: str | None = None,
         link=None,
         common: str | None = None,
+        warp: float = WARP,
     ) -> None:
-        self.tmp_path, self.extra, self.slots = tmp_path, extra, slots
-        self.link = link if link is not None else MicroModemLink()
+        self.tmp_path, self.extra, self.slots, self.warp = tmp_path, extra, slots, warp
+        self.link = link if link is not None else MicroModemLink(warp)
         self.common = common
         self.stack = contextlib.AsyncExitStack()
 
@@ -276,7 +298,7 @@ class TwoCommunities:
     async def __aenter__(self) -> TwoCommunities:
         self.dbs, self.apps, self.recorders = [], [], []
         for modem_id in (1, 2):
-            self.dbs.append(await start_db(self.stack, modem_id))
+            self.dbs.append(await start_db(self.stack, modem_id, self.warp))
         await self.link.start(self.stack, self.dbs)
         for modem_id, db in zip((1, 2), self.dbs, strict=True):
             path = self.tmp_path / f"vehicle{modem_id}.moos"
@@ -290,10 +312,11 @@ class TwoCommunities:
                     self.slots,
                     self.link.driver_cfg(modem_id),
                     **options,
+                    warp=self.warp,
                 )
             )
             app = pAcommsHandler.from_mission(path, "pAcommsHandler")
-            recorder = Recorder(f"recorder{modem_id}", db.port)
+            recorder = Recorder(f"recorder{modem_id}", db.port, mission_clock(self.warp))
             await recorder.start(WATCHED)
             self.stack.push_async_callback(recorder.close)
             await self.stack.enter_async_context(app)

@@ -15,9 +15,10 @@ from pygoby.acomms.mmsim import LoopbackChannel
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.appconfig import ConfigError
 from pygoby.moos.translator import parse_for_moos
-from pygoby.util.clock import WallClock
 
-from .acomms_mission import PROTO, Recorder, two_vehicle_missions
+from .acomms_mission import PROTO, WARP, Recorder, mission_clock, two_vehicle_missions
+
+pytestmark = pytest.mark.e2e
 
 STATE = "dccl.legacyccl.protobuf.CCLMDATState"
 STATUS = "pygoby.examples.SimpleStatus"
@@ -42,6 +43,7 @@ def mission(modem_id: int, db_port: int, modem_port: int) -> str:
 ServerHost = localhost
 ServerPort = {db_port}
 Community  = mm{modem_id}
+MOOSTimeWarp = {WARP}
 
 ProcessConfig = pAcommsHandler
 {{
@@ -94,7 +96,8 @@ ProcessConfig = pAcommsHandler
 
 def two_vehicles(tmp_path):
     watched = ["REMUS_STATUS_REPORT_IN", "STATUS_REPORT_IN_PB", "ACOMMS_MODEM_TRANSMIT"]
-    return two_vehicle_missions(tmp_path, mission, watched, LoopbackChannel(), WallClock())
+    clock = mission_clock()
+    return two_vehicle_missions(tmp_path, mission, watched, LoopbackChannel(clock), clock)
 
 
 async def test_ccl_state_and_dccl_status_between_two_vehicles(tmp_path):

@@ -16,12 +16,15 @@ from pygoby.errors import ConfigError
 from pygoby.moos.moosfile import MissionFile
 from pygoby.netsim.manager.config import EXAMPLE_CONFIG, load_config, parse_config
 from pygoby.netsim.sim.scenario import ScenarioError, load_scenario, parse_scenario
+from tests.hypothesis_profiles import examples
 
 from .acomms_mission import PROTO
 from .test_pacommshandler_config import EXAMPLE, write
 
 FUZZ = settings(
-    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=examples(200),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
 
 

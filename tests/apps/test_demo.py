@@ -8,7 +8,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from pygoby.netsim.report.eventlog import read_events
+
+pytestmark = pytest.mark.e2e
 
 DEMO = Path(__file__).resolve().parents[2] / "examples" / "two_vehicles" / "run_demo.py"
 

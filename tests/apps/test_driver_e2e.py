@@ -18,7 +18,9 @@ from pygoby.acomms.store_server import StoreServer, TransmissionStore, serve_sto
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 
-from .acomms_mission import MicroModemLink, TwoCommunities
+from .acomms_mission import MicroModemLink, TwoCommunities, mission_clock
+
+pytestmark = pytest.mark.e2e
 
 NAV = {"NAV_X": 100.0, "NAV_Y": -50.0, "NAV_SPEED": 1.5, "NAV_HEADING": -90.0, "NAV_DEPTH": 10.0}
 REPORT = "src=1,x=100,y=-50,speed=1.5,heading=270,depth=10"
@@ -98,7 +100,7 @@ class UFieldLink:
         self.lookup = stack.enter_context(_temp_lookup())
         self.clients = {}
         for modem_id, db in zip((1, 2), dbs, strict=True):
-            client = MOOSClient(f"shoreside_relay{modem_id}", port=db.port)
+            client = MOOSClient(f"shoreside_relay{modem_id}", port=db.port, clock=mission_clock())
             await client.connect()
             stack.push_async_callback(client.close)
             client.subscribe("NODE_MESSAGE_LOCAL")

@@ -23,6 +23,8 @@ from pygoby.errors import ConfigError
 
 from .acomms_mission import Recorder
 
+pytestmark = pytest.mark.e2e
+
 DATA = Path(__file__).resolve().parent / "data" / "dual_status"
 CCL_DATA = Path(__file__).resolve().parent / "data" / "ccl_and_dccl"
 BIN = str(Path(sys.executable).parent)

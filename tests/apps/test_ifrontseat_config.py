@@ -21,6 +21,8 @@ from pygoby.moos.moosfile import MissionFile
 
 from .acomms_mission import Recorder
 
+pytestmark = pytest.mark.e2e
+
 REPO = Path(__file__).resolve().parents[2]
 LOOPBACK = "tests.apps.ifs_loopback_driver"
 FOUND = "drivers found: abc, basic_simulator, bluefin"

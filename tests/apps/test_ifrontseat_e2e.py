@@ -16,6 +16,8 @@ import asyncio
 import contextlib
 import math
 
+import pytest
+
 from pygoby.apps.ifrontseat import iFrontSeat
 from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.simulator.core import BasicFrontSeatSimulator
@@ -26,6 +28,8 @@ from pygoby.moos.timewarp import moos_clock
 from pygoby.moos.translator import parse_for_moos, serialize_for_moos
 
 from .acomms_mission import Recorder
+
+pytestmark = pytest.mark.e2e
 
 WARP = 10
 

@@ -15,6 +15,7 @@ from pygoby.frontseat.legacy import (
     nav_posts,
     ready_posts,
 )
+from tests.hypothesis_profiles import examples
 
 
 def node_status(**pose):
@@ -124,7 +125,7 @@ def test_ready_posts():
 finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(heading=finite, pitch=finite, speed=finite, time=st.floats(0, 4e9))
 def test_nav_posts_are_numbers_for_any_solution(heading, pitch, speed, time):
     status = node_status(heading=heading, pitch=pitch)

@@ -9,6 +9,8 @@ import asyncio
 import logging
 import math
 
+import pytest
+
 from pygoby.apps.ifrontseat import iFrontSeat
 from pygoby.frontseat import messages as frontseat_pb
 from pygoby.moos.client import MOOSClient
@@ -17,6 +19,8 @@ from pygoby.moos.translator import parse_for_moos, serialize_for_moos
 from pygoby.util.geodesy import UTMGeodesy
 
 from .acomms_mission import Recorder
+
+pytestmark = pytest.mark.e2e
 
 DRIVER = "tests.apps.ifs_loopback_driver"
 

@@ -11,6 +11,7 @@ import re
 import sys
 from pathlib import Path
 
+import pytest
 from textual.widgets import OptionList, RichLog, Static
 
 from pygoby.acomms import messages as acomms_pb
@@ -28,8 +29,12 @@ from .acomms_mission import (
     MicroModemLink,
     Recorder,
     TwoCommunities,
+    mission_clock,
     mission_text,
+    start_db,
 )
+
+pytestmark = pytest.mark.e2e
 
 PACOMMSHANDLER = str(Path(sys.executable).with_name("pAcommsHandler"))
 NAV = {"NAV_X": 100.0, "NAV_Y": -50.0, "NAV_SPEED": 1.5, "NAV_HEADING": -90.0, "NAV_DEPTH": 10.0}
@@ -47,9 +52,7 @@ async def test_log_lines_at_each_verbosity_on_a_two_vehicle_run(tmp_path):
     async with contextlib.AsyncExitStack() as stack:
         dbs = []
         for modem_id in (1, 2):
-            dbs.append(
-                await stack.enter_async_context(MOOSDB(port=0, community=f"vehicle{modem_id}"))
-            )
+            dbs.append(await start_db(stack, modem_id))
         link = MicroModemLink()
         await link.start(stack, dbs)
         procs, outputs = [], []
@@ -72,7 +75,7 @@ async def test_log_lines_at_each_verbosity_on_a_two_vehicle_run(tmp_path):
                         PACOMMSHANDLER, str(mission), stdout=sink, stderr=asyncio.subprocess.STDOUT
                     )
                 )
-        r1, r2 = Recorder("r1", dbs[0].port), Recorder("r2", dbs[1].port)
+        r1, r2 = Recorder("r1", dbs[0].port, link.clock), Recorder("r2", dbs[1].port, link.clock)
         for recorder in (r1, r2):
             await recorder.start(
                 ["ACOMMS_ACK", "COMMAND_IN", "ACOMMS_NMEA_IN", "ACOMMS_MAC_SLOT_START", "DB_TIME"]
@@ -237,11 +240,11 @@ async def test_show_gui_off_a_terminal_keeps_plain_text(tmp_path):
     """goby3-examples' missions say show_gui: true; under antler or a pipe that must not break
     the output: one line says so and the log goes on as text (here at -vv: DEBUG1, above the
     mission's VERBOSE)."""
-    async with MOOSDB(port=0) as db:
+    async with MOOSDB(port=0, clock=mission_clock()) as db:
         mission = tmp_path / "gui.moos"
         common = "log: false verbosity: VERBOSE show_gui: true"
         mission.write_text(mission_text(1, db.port, 0, driver="", common=common))
-        recorder = Recorder("watcher", db.port)
+        recorder = Recorder("watcher", db.port, mission_clock())
         await recorder.start(["MODEM_ID"])
         proc = await asyncio.create_subprocess_exec(
             PACOMMSHANDLER,

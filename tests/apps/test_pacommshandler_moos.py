@@ -10,6 +10,8 @@ import logging
 import sys
 from pathlib import Path
 
+import pytest
+
 from pygoby.acomms import messages as acomms_pb
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.dccl import Codec
@@ -18,6 +20,8 @@ from pygoby.moos.db import MOOSDB
 from pygoby.moos.translator import parse_for_moos, serialize_for_moos
 
 from .acomms_mission import COMMAND, PROTO, STATUS, TRANSLATOR_ENTRIES, Recorder
+
+pytestmark = pytest.mark.e2e
 
 MISSION = f"""\
 ServerHost = localhost

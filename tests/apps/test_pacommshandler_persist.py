@@ -14,17 +14,30 @@ import signal
 import sys
 from pathlib import Path
 
+import pytest
+
 from pygoby.acomms.mmsim import LoopbackChannel
 from pygoby.acomms.queue.persist import QueueStore
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.moos.db import MOOSDB
-from pygoby.util.clock import WallClock
 
-from .acomms_mission import Recorder, mission_text, modem_and_db
+from .acomms_mission import (
+    SLOT_SECONDS,
+    WARP,
+    Recorder,
+    mission_clock,
+    mission_text,
+    modem_and_db,
+)
+
+pytestmark = pytest.mark.e2e
 
 PACOMMSHANDLER = str(Path(sys.executable).with_name("pAcommsHandler"))
-TTL = 20  # s: the first command outlives the first kill, the second one does not (and has time
-# left, after the restart, for the driver to start, its slot to come and the ack to return)
+# the commands' ttl, in real seconds (the mission runs at MOOSTimeWarp WARP): the first command
+# does not outlive the first kill, the second one does (and has time left, after the restart,
+# for the process and its driver to start, its slot to come and the ack to return)
+TTL = 14
+CYCLE = 2 * SLOT_SECONDS / WARP  # a TDMA cycle, real seconds
 PERSIST = '  queue_cfg {\n    persistent_queue_file: "vehicle1_queue.sqlite"\n'
 
 
@@ -65,17 +78,18 @@ def command_ids(recorder: Recorder) -> list[str]:
 
 
 async def test_queued_commands_survive_kill_9(tmp_path):
-    channel, clock = LoopbackChannel(), WallClock()
+    clock = mission_clock()
+    channel = LoopbackChannel(clock)
     async with contextlib.AsyncExitStack() as stack:
         sim1, db1 = await modem_and_db(stack, 1, channel, clock)
         text = mission_text(1, db1.port, sim1.port).replace("  queue_cfg {\n", PERSIST, 1)
         mission = tmp_path / "vehicle1.moos"
         mission.write_text(
             text.replace(
-                "ack: true  value_base: 5  ttl: 600", f"ack: true  value_base: 5  ttl: {TTL}"
+                "ack: true  value_base: 5  ttl: 600", f"ack: true  value_base: 5  ttl: {TTL * WARP}"
             )
         )
-        r1 = Recorder("recorder1", db1.port)
+        r1 = Recorder("recorder1", db1.port, clock)
         await r1.start(["ACOMMS_QSIZE", "ACOMMS_EXPIRE", "ACOMMS_ACK_ORIGINAL", "DB_TIME"])
         stack.push_async_callback(r1.close)
         vehicle1 = Vehicle1(tmp_path, mission, db1)
@@ -101,7 +115,7 @@ async def test_queued_commands_survive_kill_9(tmp_path):
         sim2, db2 = await modem_and_db(stack, 2, channel, clock)
         path2 = tmp_path / "vehicle2.moos"
         path2.write_text(mission_text(2, db2.port, sim2.port))
-        r2 = Recorder("recorder2", db2.port)
+        r2 = Recorder("recorder2", db2.port, clock)
         await r2.start(["COMMAND_IN"])
         stack.push_async_callback(r2.close)
         await stack.enter_async_context(pAcommsHandler.from_mission(path2, "pAcommsHandler"))
@@ -122,7 +136,7 @@ async def test_queued_commands_survive_kill_9(tmp_path):
         assert store.items() == []
         store.close()
         await vehicle1.start()
-        await asyncio.sleep(7)  # more than a TDMA cycle
+        await asyncio.sleep(1 + 3 * CYCLE)  # the driver's start and three TDMA cycles
         assert [v for v in command_ids(r2) if "command_id=22" in v] == [command_ids(r2)[0]]
         assert not any("command_id=11" in v for v in command_ids(r2))
         assert len(command_ids(r2)) == 1

@@ -1,31 +1,29 @@
-"""`pygoby dccl` run as a real command."""
+"""`pygoby dccl` as a user runs it: `pygoby.cli.main` in the test's process, with one test of
+the installed console script."""
 
 from __future__ import annotations
 
 import ast
-import os
 import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
+from pygoby.cli import main
 from tests.dccl.vectors import DCCL_VECTORS
+from tests.in_process import Command
 
 PROTO = str(DCCL_VECTORS / "example.proto")
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))  # the installed console script
 
 
-def pygoby(*args: str, stdin: str = "", env: dict | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "pygoby.cli", *args],
-        input=stdin,
-        capture_output=True,
-        text=True,
-        timeout=60,
-        env=env,
-    )
+@pytest.fixture
+def pygoby(capsys, monkeypatch) -> Command:
+    return Command(main, capsys, monkeypatch)
 
 
-def test_encode_lines_with_a_bad_line_in_the_middle() -> None:
+def test_encode_lines_with_a_bad_line_in_the_middle(pygoby) -> None:
     out = pygoby(
         "dccl",
         "encode",
@@ -42,7 +40,7 @@ def test_encode_lines_with_a_bad_line_in_the_middle() -> None:
     assert out.returncode == 1
 
 
-def test_strict_encode_reports_the_field() -> None:
+def test_strict_encode_reports_the_field(pygoby) -> None:
     out = pygoby(
         "dccl", "encode", "--strict", "--proto", PROTO, "--message", "example.Tiny", stdin="a: 9\n"
     )
@@ -50,7 +48,7 @@ def test_strict_encode_reports_the_field() -> None:
     assert out.returncode == 1
 
 
-def test_decode_with_passphrase() -> None:
+def test_decode_with_passphrase(pygoby) -> None:
     out = pygoby(
         "dccl",
         "decode",
@@ -66,7 +64,7 @@ def test_decode_with_passphrase() -> None:
     assert out.stdout.startswith('src: 3 dest: 17 payload: "\\001\\002" t: ')
 
 
-def test_decode_all_good_exits_zero_and_bad_hex_is_reported() -> None:
+def test_decode_all_good_exits_zero_and_bad_hex_is_reported(pygoby) -> None:
     good = pygoby("dccl", "decode", "--proto", PROTO, "--message", "example.Tiny", stdin="042501\n")
     assert (good.returncode, good.stdout) == (0, "a: 5 b: 3 c: true\n")
     bad = pygoby(
@@ -77,14 +75,14 @@ def test_decode_all_good_exits_zero_and_bad_hex_is_reported() -> None:
     assert bad.returncode == 1
 
 
-def test_analyze_prints_the_field_table() -> None:
+def test_analyze_prints_the_field_table(pygoby) -> None:
     out = pygoby("dccl", "analyze", "--proto", PROTO, "--message", "example.Example")
     assert out.returncode == 0
     assert "total:  6..28 bytes (max_bytes 64)" in out.stdout
     assert "pos.lat      body  dccl.default4           25" in out.stdout
 
 
-def test_analyze_without_message_shows_every_dccl_message_of_the_file() -> None:
+def test_analyze_without_message_shows_every_dccl_message_of_the_file(pygoby) -> None:
     out = pygoby("dccl", "analyze", "--proto", PROTO)
     assert out.returncode == 0, out.stderr
     shown = [line.split(":")[0] for line in out.stdout.splitlines() if line.startswith("message ")]
@@ -92,7 +90,7 @@ def test_analyze_without_message_shows_every_dccl_message_of_the_file() -> None:
     assert pygoby("dccl", "encode", "--proto", PROTO).returncode == 2  # encode needs --message
 
 
-def test_unknown_message_is_a_clear_error_with_close_names() -> None:
+def test_unknown_message_is_a_clear_error_with_close_names(pygoby) -> None:
     out = pygoby("dccl", "analyze", "--proto", PROTO, "--message", "example.Nope")
     assert out.returncode == 2
     assert out.stderr == (
@@ -120,8 +118,8 @@ def test_analyze_source_prints_the_generated_python() -> None:
     assert "_trace" not in out.stdout
 
 
-def test_encode_and_decode_trace_each_field_to_stderr() -> None:
-    encoded = console(
+def test_encode_and_decode_trace_each_field_to_stderr(pygoby) -> None:
+    encoded = pygoby(
         "dccl",
         "encode",
         "--trace",
@@ -138,14 +136,14 @@ def test_encode_and_decode_trace_each_field_to_stderr() -> None:
         "encode example.Tiny body: b = 3 (4 bits: 0100)",
         "encode example.Tiny body: c = True (2 bits: 10)",
     ]
-    decoded = console(
+    decoded = pygoby(
         "dccl", "decode", "--trace", "--proto", PROTO, "--message", "example.Tiny", stdin="040500\n"
     )
     assert decoded.stdout == "a: 5\n"
     assert "decode example.Tiny body: c = not set (2 bits: 00)" in decoded.stderr.splitlines()
 
 
-def test_passphrase_from_a_file_or_the_environment_not_the_command_line(tmp_path) -> None:
+def test_passphrase_from_a_file_or_the_environment_not_the_command_line(pygoby, tmp_path) -> None:
     """Issue 16 item 15: the key need not appear in the process list."""
     secret_file = tmp_path / "secret"
     secret_file.write_text("my secret\n")  # as `echo "my secret" > secret` writes it
@@ -163,7 +161,7 @@ def test_passphrase_from_a_file_or_the_environment_not_the_command_line(tmp_path
     )
     assert out.returncode == 0, out.stderr
     assert out.stdout.startswith('src: 3 dest: 17 payload: "\\001\\002" t: ')
-    env = {**os.environ, "PYGOBY_DCCL_PASSPHRASE": "my secret"}
+    env = {"PYGOBY_DCCL_PASSPHRASE": "my secret"}
     out = pygoby(
         "dccl", "decode", "--proto", PROTO, "--message", "example.LongId", stdin=encrypted, env=env
     )

@@ -227,6 +227,7 @@ def test_without_trace_nothing_is_logged_even_at_debug(caplog) -> None:
 ENCODE_VECTORS = [r for r in read_jsonl("vectors.jsonl") if r["hex"] is not None]
 
 
+@pytest.mark.e2e  # (every vector, traced: long for the edit loop)
 def test_every_vector_through_a_traced_codec(caplog) -> None:
     """The traced variant gives the same bytes and messages as the fast one, and its top-level
     lines (fields, oneof cases, id) account for every bit of the head and of the body."""

@@ -24,6 +24,7 @@ from pygoby.dccl.codecs.numeric import f32
 from pygoby.dccl.libraries import builtin_library, split_libraries
 from pygoby.util.clock import VirtualClock
 from tests.dccl.recorded import MODELS, TEST_PROTOS, loader
+from tests.hypothesis_profiles import examples
 
 HEADER = 'syntax = "proto2";\nimport "dccl/option_extensions.proto";\npackage t;\n'
 STATE = "dccl.legacyccl.protobuf.CCLMDATState"
@@ -408,7 +409,7 @@ def fuzz_codecs() -> dict:
     return codecs
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(st.sampled_from(NEW_TYPES), st.binary(max_size=80), st.integers(0, 255))
 def test_new_decoders_never_fail_otherwise(fuzz_codecs, kind, data, first) -> None:
     """Any bytes: a message or a DcclError, never another exception or an endless loop."""

@@ -13,6 +13,7 @@ from pygoby.dccl.options import message_options
 from pygoby.util.clock import VirtualClock
 from tests.dccl.strategies import assert_close, message_strategy
 from tests.dccl.vectors import message_class
+from tests.hypothesis_profiles import examples
 
 NOW = 1_700_000_000.0
 ROUND_TRIP = [
@@ -39,7 +40,9 @@ ALL_TYPES = ROUND_TRIP + [
     ("edge.proto", "edge.Str"),
     ("inhead.proto", "ih.M2"),
 ]
-SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(
+    max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
 
 
 def _codec(passphrase: str | None = None) -> Codec:

@@ -32,6 +32,7 @@ from pygoby.dccl.ccl.remus import (
 )
 from pygoby.dccl.codecs.numeric import f32
 from tests.dccl.remus_cpp import from_json, message_class, read_records, to_message
+from tests.hypothesis_profiles import examples
 
 ALL_TYPES = (State, Redirect, Ranger, Position, Alert, Alert2)
 HALF_HEADING = 360 / 255 / 2
@@ -575,7 +576,7 @@ def test_errors_are_dccl_errors():
 
 
 # ------------------------------------------------------------------ fuzz
-@settings(max_examples=400)
+@settings(max_examples=examples(400))
 @given(st.binary(max_size=40), st.sampled_from([None, *ALL_TYPES]))
 def test_any_bytes_decode_or_raise_ccl_frame_error(data, cls):
     """No input makes a decoder raise anything but CCLFrameError, and whatever decodes can be
@@ -588,7 +589,7 @@ def test_any_bytes_decode_or_raise_ccl_frame_error(data, cls):
     assert type(again) is type(decoded)
 
 
-@settings(max_examples=300)
+@settings(max_examples=examples(300))
 @given(st.sampled_from(ALL_TYPES), st.binary(min_size=32, max_size=32))
 def test_frames_with_the_right_id_and_random_fields(cls, body):
     data = bytes([cls.ID if cls.ID is not None else body[0]]) + body[1:]

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from pygoby.frontseat.bluefin import sentences
 from pygoby.util.errors import NMEAChecksumError, NMEAError
+from tests.hypothesis_profiles import examples
 
 from .bluefin_scenario import T0, driver_on_memory
 
@@ -103,7 +104,7 @@ def test_a_wrong_checksum_is_refused_but_a_raw_out_checksum_is_only_replaced():
     assert sentences.parse_unchecked("$BPMSG,hello*00").message() == "$BPMSG,hello*05"
 
 
-@settings(max_examples=300)
+@settings(max_examples=examples(300))
 @given(st.text(max_size=120))
 def test_the_parser_raises_only_nmea_errors(text):
     with contextlib.suppress(NMEAError):
@@ -120,7 +121,7 @@ _FIELD = st.one_of(
 )
 
 
-@settings(max_examples=150)
+@settings(max_examples=examples(150))
 @given(
     st.sampled_from(
         [

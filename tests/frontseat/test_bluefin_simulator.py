@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 
 from pygoby.frontseat.bluefin import sentences
 from pygoby.frontseat.bluefin.simulator import HuxleyOptions, HuxleySimulator
+from tests.hypothesis_profiles import examples
 
 from .bluefin_scenario import T0
 
@@ -61,7 +62,7 @@ def test_trim_is_pending_then_done_with_a_report():
     assert sentences.parse(report[1]).fields[2:] == ("2", "0", "trim done", "0.5", "0")
 
 
-@settings(max_examples=200)
+@settings(max_examples=examples(200))
 @given(st.text(max_size=100), st.floats(min_value=0, max_value=4e9))
 def test_no_line_makes_it_raise(line, now):
     sim = HuxleySimulator()

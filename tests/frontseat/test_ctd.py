@@ -34,6 +34,7 @@ from pygoby.frontseat.ctd import (
     practical_salinity,
 )
 from pygoby.util.clock import VirtualClock
+from tests.hypothesis_profiles import examples
 
 from .scripted_driver import ScriptedFrontSeat
 
@@ -59,7 +60,7 @@ def test_pss78_zero_trap() -> None:
     assert practical_salinity(0.0, 10.0, 100.0) == 0.0
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     ratio=st.floats(0.1, 1.4),
     t90=st.floats(-2.0, 35.0),

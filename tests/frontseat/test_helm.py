@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 
 from pygoby.frontseat import messages as frontseat_pb
 from pygoby.frontseat.helm import helm_state_from_ivphelm
+from tests.hypothesis_profiles import examples
 
 NOT_RUNNING, DRIVE, PARK = (
     frontseat_pb.HELM_NOT_RUNNING,
@@ -81,7 +82,7 @@ def test_no_timeout_drive_persists_without_posts() -> None:
     assert state == DRIVE
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(value=st.text(), source=st.text(), current=st.sampled_from(ALL))
 def test_random_posts_never_raise_and_give_a_helm_state(value, source, current) -> None:
     state = helm_state_from_ivphelm(value, source, current)

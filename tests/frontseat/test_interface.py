@@ -18,6 +18,7 @@ from pygoby.frontseat.interface import (
 )
 from pygoby.util.clock import VirtualClock
 from pygoby.util.signal import Signal
+from tests.hypothesis_profiles import examples
 
 from .scripted_driver import ScriptedFrontSeat
 
@@ -635,7 +636,7 @@ _steps = st.lists(
 )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(require_helm=st.booleans(), steps=_steps)
 def test_random_sequences_respect_command_and_error_exits(require_helm, steps) -> None:
     driver = make(require_helm=require_helm)

@@ -13,6 +13,7 @@ from pyproj import Geod, Transformer
 
 from pygoby.frontseat import messages as frontseat_pb
 from pygoby.util.clock import VirtualClock
+from tests.hypothesis_profiles import examples
 
 from .scripted_driver import ScriptedFrontSeat
 
@@ -97,7 +98,7 @@ def test_southern_hemisphere_uses_the_origin_zone() -> None:
     assert y < 0
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(x=st.floats(-50_000, 50_000), y=st.floats(-50_000, 50_000))
 def test_round_trip_local_global_local(x: float, y: float) -> None:
     driver = make()

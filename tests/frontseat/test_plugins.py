@@ -21,6 +21,7 @@ from pygoby.frontseat.plugins import (
     load_driver,
 )
 from pygoby.util.clock import VirtualClock
+from tests.hypothesis_profiles import examples
 
 from .scripted_driver import ScriptedFrontSeat
 
@@ -177,7 +178,7 @@ def test_basic_simulator_driver_loads_when_installed() -> None:
         assert type(driver).__module__ == "pygoby.frontseat.drivers.abc"
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(name=st.text(), config=st.one_of(st.none(), st.text()))
 def test_names_never_raise_anything_else(name, config) -> None:
     assert isinstance(canonical_name(name), str)

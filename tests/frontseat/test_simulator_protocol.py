@@ -22,8 +22,9 @@ from pygoby.frontseat.simulator.protocol import (
     format_round_trip,
     parse_line,
 )
+from tests.hypothesis_profiles import examples
 
-FUZZ = settings(max_examples=200, deadline=None)
+FUZZ = settings(max_examples=examples(200), deadline=None)
 
 _libc = ctypes.CDLL(ctypes.util.find_library("c"))
 

@@ -13,6 +13,8 @@ import pytest
 from pygoby.frontseat.simulator.protocol import Nav, parse_line
 from pygoby.frontseat.simulator.server import SimulatorServer
 
+pytestmark = pytest.mark.e2e
+
 
 async def read_until(reader: asyncio.StreamReader, prefix: str, timeout: float = 5.0) -> list[str]:
     """Lines up to and including the first that starts with `prefix`."""

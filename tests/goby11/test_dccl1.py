@@ -18,6 +18,7 @@ from pygoby.dccl.dccl1 import Dccl1Codec, Dccl1Header, stitch, unix_time, unstit
 from pygoby.dccl.errors import DcclDecodeError, DcclEncodeError
 from pygoby.dccl.xml import load_message_set, parse_message_set
 from pygoby.errors import ConfigError
+from tests.hypothesis_profiles import examples
 
 DATA = Path(__file__).parents[1] / "data" / "vectors" / "goby11-dccl1"
 VECTORS = [json.loads(line) for line in (DATA / "vectors.jsonl").read_text().splitlines()]
@@ -263,7 +264,7 @@ def test_header_packs_msb_first() -> None:
     assert header.pack()[:2] == b"\x20\xff"
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(st.binary(max_size=64))
 def test_decoder_fuzz_raises_only_decode_errors(data: bytes) -> None:
     codec = Dccl1Codec()
@@ -287,7 +288,7 @@ def test_a_value_too_large_to_scale_travels_as_out_of_range(huge) -> None:
     assert decoded.values["goto_speed"] is None
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     st.dictionaries(
         st.sampled_from(["goto_x", "goto_y", "lights_on", "new_instructions", "goto_speed"]),
@@ -421,7 +422,7 @@ def test_bridge_round_trips_the_converted_types() -> None:
     assert (received._src_id, received._dest_id, received._time) == (4, 0, 7.0)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.binary(max_size=40))
 def test_bridge_fuzz_gives_protobuf_messages_or_decode_errors(data: bytes) -> None:
     """What the queue decodes from a received 0x20 frame: a message of the converted type, or

@@ -19,8 +19,13 @@ from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.dccl.dccl1 import Dccl1Codec, stitch, unstitch
 from pygoby.dccl.xml import load_message_set
 from pygoby.moos.client import MOOSClient
-from pygoby.util.clock import WallClock
-from tests.apps.acomms_mission import Recorder, modem_and_db, two_vehicle_missions
+from tests.apps.acomms_mission import (
+    WARP,
+    Recorder,
+    mission_clock,
+    modem_and_db,
+    two_vehicle_missions,
+)
 from tests.goby11.missions import micromodem_driver_goby11
 from tests.goby11.seed_listings import EXAMPLES
 
@@ -74,6 +79,7 @@ def mission(db_port: int, modem_port: int) -> str:
     return f"""ServerHost = localhost
 ServerPort = {db_port}
 Community = mm2
+MOOSTimeWarp = {WARP}
 modem_id_lookup_path = {EXAMPLES}/MOOS/ccl_and_dccl/modemidlookup.txt
 
 ProcessConfig = pAcommsHandler
@@ -107,7 +113,7 @@ def status_fields(value: str) -> dict[str, str]:
 
 
 async def test_recorded_goby11_frames_in_and_goby11_bytes_out(tmp_path):
-    clock = WallClock()
+    clock = mission_clock()
     channel = LoopbackChannel(clock, range_m=150)  # 0.1 s away
     goby11 = Goby11Vehicle(clock, channel)
     async with contextlib.AsyncExitStack() as stack:
@@ -115,7 +121,7 @@ async def test_recorded_goby11_frames_in_and_goby11_bytes_out(tmp_path):
         path = tmp_path / "mm2.moos"
         path.write_text(mission(db.port, sim.port))
         app = pAcommsHandler.from_mission(path, "pAcommsHandler")
-        recorder = Recorder("recorder", db.port)
+        recorder = Recorder("recorder", db.port, clock)
         await recorder.start(["STATUS_REPORT_IN"])
         stack.push_async_callback(recorder.close)
         await stack.enter_async_context(app)
@@ -176,6 +182,7 @@ def command_mission(modem_id: int, db_port: int, modem_port: int, expiring: Path
     return f"""ServerHost = localhost
 ServerPort = {db_port}
 Community = mm{modem_id}
+MOOSTimeWarp = {WARP}
 modem_id_lookup_path = {EXAMPLES}/MOOS/ccl_and_dccl/modemidlookup.txt
 
 ProcessConfig = pAcommsHandler
@@ -218,7 +225,7 @@ async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
         "ACOMMS_QSIZE",
         "ACOMMS_EXPIRE",
     ]
-    clock = WallClock()
+    clock = mission_clock()
     channel = LoopbackChannel(clock, range_m=150)
     expiring = tmp_path / "expiring.xml"
     expiring.write_text(EXPIRING)
@@ -232,7 +239,7 @@ async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
     ):
         mm1, _ = apps
         sender, receiver = recorders
-        async with MOOSClient("operator", port=mm1.client.port) as operator:
+        async with MOOSClient("operator", port=mm1.client.port, clock=clock) as operator:
             operator.publish(
                 "OUTGOING_COMMAND", "CommandType=GoTo,Destination=2,goto_x=10,goto_speed=1.5"
             )
@@ -255,7 +262,7 @@ async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
         assert (acomms_pb.QUEUE_DCCL, 1, 1) in {(s.key.type, s.key.id, s.size) for s in sizes}
 
         # SIMPLE_STATUS (id 20) queues every 5 s, sent one per slot at most: flush it 1.1's way
-        async with MOOSClient("operator", port=mm1.client.port) as operator:
+        async with MOOSClient("operator", port=mm1.client.port, clock=clock) as operator:
             start = len(sender.values("ACOMMS_QSIZE"))
             await sender.wait_for(
                 "ACOMMS_QSIZE", lambda v: "id: 20" in v and "size: 0" not in v, timeout=15
@@ -267,7 +274,7 @@ async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
             )
 
         # for modem 5, which no slot serves: expires after its ttl of 1 s
-        async with MOOSClient("operator", port=mm1.client.port) as operator:
+        async with MOOSClient("operator", port=mm1.client.port, clock=clock) as operator:
             operator.publish("EXPIRE_ME", "Dest=5,b=true")
             await operator.flush()
         expired = goby11_text(await sender.wait_for("ACOMMS_EXPIRE"), acomms_pb.V1ModemDataExpire)
@@ -276,7 +283,7 @@ async def test_goby11_moos_interface_of_dccl_messages(tmp_path):
 
         # a received message handed in by another process (as 1.1's tcp_share did)
         count = len(receiver.values("INCOMING_COMMAND"))
-        async with MOOSClient("share", port=apps[1].client.port) as share:
+        async with MOOSClient("share", port=apps[1].client.port, clock=clock) as share:
             command = mm1.messages.loader.message_class("GoToCommand")
             handed = acomms_pb.V1ModemDataTransmission(
                 data=mm1.queue.dccl1.encode(command(goto_x=77, Destination=2, _src_id=1))

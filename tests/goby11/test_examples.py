@@ -20,6 +20,8 @@ from pygoby.moos.timewarp import moos_clock
 from pygoby.util.geodesy import UTMGeodesy
 from tests.goby11.seed_listings import EXAMPLES, LISTINGS, printed
 
+pytestmark = pytest.mark.e2e
+
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))
 WARP = 20
 # upstream Goby's line where the print is cut off (and shows %3$.01f / %6$1f for %3$.0lf / %6$lf)

@@ -22,6 +22,8 @@ from pygoby.util.clock import WallClock
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.pty import PtyEnd, PtyError, PtyPair, is_live, open_serial, partner_of
 
+pytestmark = pytest.mark.e2e
+
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))
 
 

@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from google.protobuf import text_format
 
 from pygoby.acomms import messages as acomms_pb
@@ -21,6 +22,8 @@ from pygoby.util.clock import WallClock
 from tests.apps.acomms_mission import two_vehicle_missions
 from tests.goby11.missions import micromodem_driver_goby11
 from tests.goby11.seed_listings import EXAMPLES
+
+pytestmark = pytest.mark.e2e
 
 SIMPLE_STATUS = EXAMPLES / "xml" / "simple_status.xml"
 
@@ -64,6 +67,8 @@ WATCHED = ["STATUS_REPORT_IN", "ACOMMS_INCOMING_DATA", "ACOMMS_RANGE_RESPONSE", 
 
 
 def two_nodes(tmp_path: Path):
+    # in real time: Goby 1.1's header time is the time of day, placed in the day by the
+    # receiver's clock
     clock = WallClock()
     channel = LoopbackChannel(clock, range_m=0.25 * DEFAULT_SOUND_SPEED)  # 0.25 s away
     return two_vehicle_missions(tmp_path, mission, WATCHED, channel, clock)

@@ -36,6 +36,8 @@ from pygoby.moosacomms.remus_reports import RemusReports
 from pygoby.util.geodesy import UTMGeodesy
 from pygoby.util.modem_id import ModemIdLookup
 
+pytestmark = pytest.mark.e2e
+
 LOOKUP = ModemIdLookup.from_text("1,mm1,topside\n2,mm2,auv\n")
 NOW = 1_700_000_001.5
 

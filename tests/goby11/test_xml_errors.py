@@ -12,6 +12,7 @@ from pygoby.dccl.xml import load_message_set, parse_message_set
 from pygoby.dccl.xml import parser as xml_parser
 from pygoby.errors import ConfigError
 from tests.goby11.seed_listings import EXAMPLES, printed
+from tests.hypothesis_profiles import examples
 
 GOOD_LAYOUT = "<layout><int><name>a</name><max>9</max><min>0</min></int></layout>"
 
@@ -395,7 +396,7 @@ def mutated(draw) -> bytes:
     return bytes(data)
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(300), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.one_of(mutated(), st.binary(max_size=300), st.text(max_size=300).map(str.encode)))
 def test_fuzz_loader_raises_only_config_errors(data):
     try:

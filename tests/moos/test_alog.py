@@ -20,6 +20,7 @@ from pygoby.moos.alog import AlogFile, AlogFormatter, AlogReader, AlogSink, bann
 from pygoby.moos.alog.logger_config import parse_log_request, read_logger_config
 from pygoby.moos.alog.tools import LogToolError, convert
 from pygoby.moos.moosfile import Setting
+from tests.hypothesis_profiles import examples
 
 LOG_START = 1764643673.125
 
@@ -179,7 +180,7 @@ def test_an_over_long_line_is_skipped_in_bounded_memory(
     assert [e.name for e in log] == ["B"] and log.reader.bad_lines == 1  # a second pass
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(st.lists(st.binary(max_size=80) | st.text(max_size=80), max_size=20))
 def test_reader_never_raises(lines: list[bytes | str]) -> None:
     reader = AlogReader()
@@ -190,7 +191,7 @@ def test_reader_never_raises(lines: list[bytes | str]) -> None:
             assert math.isfinite(entry.time) and entry.name and entry.source
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(st.binary(max_size=400), st.integers(0, 400), st.integers(10, 400))
 def test_damaged_files_plain_or_gz_never_raise(data: bytes, cut: int, flip: int) -> None:
     import tempfile
@@ -210,7 +211,7 @@ def test_damaged_files_plain_or_gz_never_raise(data: bytes, cut: int, flip: int)
             assert log.reader.bad_lines + len(entries) <= log.reader.lines
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     st.floats(0, 1e6, allow_nan=False),
     st.from_regex(r"[A-Z_][A-Z0-9_]{0,30}", fullmatch=True),

@@ -9,10 +9,14 @@ import stat
 import sys
 from pathlib import Path
 
+import pytest
+
 from pygoby.moos.antler import child_argv, db_listening
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.moos.moosfile import AntlerRun
+
+pytestmark = pytest.mark.e2e
 
 HERE = Path(__file__).resolve().parent
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))

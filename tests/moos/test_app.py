@@ -21,6 +21,7 @@ from pygoby.moos.db import MOOSDB
 from pygoby.moos.moosfile import MissionFile
 from pygoby.util.aiorun import STOP_GRACE
 from tests.faults import CuttableRelay
+from tests.hypothesis_profiles import examples
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from example_app import pTestApp  # noqa: E402
@@ -294,6 +295,7 @@ async def test_a_second_instance_with_a_taken_name_exits_with_a_clear_error(tmp_
             assert await asyncio.wait_for(first.wait(), 10) == 0
 
 
+@pytest.mark.e2e  # (an app process)
 async def test_an_app_refused_on_reconnect_keeps_trying(tmp_path):
     # The app's link to the DB breaks without the DB noticing (it keeps the stale session for
     # its client timeout and refuses the name meanwhile): the app must come back by itself.
@@ -324,6 +326,7 @@ async def test_an_app_refused_on_reconnect_keeps_trying(tmp_path):
         assert proc.returncode == 0
 
 
+@pytest.mark.e2e  # (an app process, its stop hanging)
 @pytest.mark.parametrize("signals", [["SIGTERM"], ["SIGINT"], ["SIGTERM", "SIGINT"]])
 async def test_a_signal_ends_an_app_whose_stop_hangs(tmp_path, signals):
     async with MOOSDB(port=0) as db:
@@ -379,7 +382,7 @@ async def test_log_file_named_after_app_and_community(tmp_path):
     assert "hello log" in (tmp_path / files[1]).read_text()
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.text(alphabet=st.sampled_from('abc_:{}"#/ \n0123.-=common gain out_var'), max_size=120))
 def test_fuzz_config_block_gives_config_errors_only(text):
     mission = MissionFile.from_text(f"ProcessConfig = pTestApp\n{{\n{text}\n}}\n")

@@ -16,6 +16,8 @@ import pytest
 
 from pygoby.moos.client import MOOSClient
 
+pytestmark = pytest.mark.e2e
+
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))
 
 

@@ -27,7 +27,10 @@ from pygoby.moos.dbcore import (
     DBCore,
 )
 from pygoby.util.clock import VirtualClock
+from tests.hypothesis_profiles import examples
 from tests.moos.rawclient import closed_by_peer, raw_connect
+
+pytestmark = pytest.mark.e2e
 
 PYGOBY = str(Path(sys.executable).with_name("pygoby"))
 
@@ -180,7 +183,9 @@ def _send(core: DBCore, name: str, *msgs: p.MOOSMessage) -> None:
 
 
 @settings(
-    max_examples=50, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=examples(50),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
 @given(
     length=st.integers(MAX_NAME_LENGTH - 2, MAX_NAME_LENGTH + 2) | st.integers(1, 40_000),
@@ -295,7 +300,7 @@ def test_summaries_decode_only_the_variables_written_since_the_last_refresh(monk
     assert [line for line in summary if line.startswith("V2 ")][0].endswith(" D 2.5")
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(
     st.lists(
         st.tuples(st.sampled_from(["A", "B", "C", "Z", "AA"]), st.integers(0, 4), st.booleans()),

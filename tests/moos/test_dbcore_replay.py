@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from pygoby.moos import protocol as p
 from pygoby.moos.dbcore import DBCore
 from pygoby.util.clock import VirtualClock
+from tests.hypothesis_profiles import examples
 
 CLOCK_DEPENDENT_STRINGS = {"DB_VARSUMMARY", "DB_QOS", "DB_RWSUMMARY", "UPOKEDB_STATUS"}
 
@@ -277,7 +278,7 @@ _messages = st.builds(
 )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     st.lists(st.tuples(st.sampled_from(["a", "b"]), st.lists(_messages, max_size=4)), max_size=12)
 )
@@ -313,7 +314,7 @@ _notifications = st.builds(
 )
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(
     st.lists(
         st.tuples(st.sampled_from(["a", "b"]), st.lists(_notifications, min_size=1, max_size=5)),

@@ -6,6 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pygoby.moos.moosfile import MissionFile, strip_comment
+from tests.hypothesis_profiles import examples
 
 MISSION = """\
 // mission for one vehicle
@@ -117,7 +118,7 @@ def test_strip_comment():
     assert strip_comment('a // "quoted"') == "a "
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.text(max_size=400))
 def test_fuzz_reader_never_crashes(text):
     m = MissionFile.from_text(text)

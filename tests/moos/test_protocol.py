@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pygoby.moos import protocol as p
+from tests.hypothesis_profiles import examples
 
 
 def _load(vectors_dir, name):
@@ -160,7 +161,7 @@ def _reference_glob(pattern: str, name: str) -> bool:
     return row[-1]
 
 
-@settings(max_examples=2000, deadline=None)
+@settings(max_examples=examples(2000), deadline=None)
 @given(st.text("ab*?", max_size=8), st.text("abc", max_size=10))
 def test_glob_agrees_with_the_definition(pattern, name):
     assert p.Glob(pattern).match(name) is _reference_glob(pattern, name)
@@ -174,7 +175,7 @@ def test_glob_has_no_catastrophic_backtracking():
     assert p.Glob("*a*a*a*a*a*a*a*a*a*a").match(name)
 
 
-@settings(max_examples=1000, deadline=None)
+@settings(max_examples=examples(1000), deadline=None)
 @given(st.text("a?*", max_size=30), st.text("ab", max_size=40))
 def test_glob_with_many_question_marks_agrees_with_the_definition(pattern, name):
     assert p.Glob(pattern).match(name) is _reference_glob(pattern, name)
@@ -227,14 +228,14 @@ def test_notify_types():
     assert odd.sval == b"caf\xe9" and odd.string == "caf\udce9"
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.binary(max_size=300))
 def test_fuzz_decode_packet_never_crashes(data):
     with contextlib.suppress(p.MoosProtocolError):
         p.decode_packet(data)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.lists(st.binary(max_size=80), max_size=5))
 def test_fuzz_framer_never_crashes(chunks):
     framer = p.PacketFramer(max_packet_size=500)
@@ -248,7 +249,7 @@ def test_fuzz_framer_never_crashes(chunks):
         pass
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(st.lists(st.integers(1, 40), max_size=30), st.integers(1, 6))
 def test_framer_cuts_a_stream_cut_anywhere(cuts, n_packets):
     """However TCP cuts the stream, the framer gives back the packets, each exactly once."""
@@ -271,7 +272,7 @@ def test_framer_cuts_a_stream_cut_anywhere(cuts, n_packets):
 _text = st.text(max_size=20)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     st.builds(
         p.MOOSMessage,

@@ -20,6 +20,7 @@ from pygoby.netsim.manager.protocol import (
     response_class,
 )
 from pygoby.netsim.manager.server import ManagerServer
+from tests.hypothesis_profiles import examples
 
 LOOPBACK = {v["name"]: v["textformat"] for v in of_kind("manager_config")}["loopback"]
 
@@ -131,7 +132,7 @@ async def test_pending_request_fails_when_connection_drops():
     await server.wait_closed()
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.lists(st.binary(max_size=64), max_size=20))
 def test_fuzz_tracker_survives_garbage_and_still_matches(chunks):
     loop = asyncio.new_event_loop()

@@ -27,6 +27,7 @@ from pygoby.netsim.manager.protocol import (
     response_names,
 )
 from pygoby.netsim.manager.server import ManagerServer
+from tests.hypothesis_profiles import examples
 
 CONFIGS = {v["name"]: v["textformat"] for v in of_kind("manager_config")}
 
@@ -269,7 +270,7 @@ _pieces = st.sampled_from(
 )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.lists(st.one_of(st.binary(max_size=40), _pieces), max_size=40))
 def test_fuzz_manager_answers_each_request_line_exactly_once(chunks):
     manager = _manager("loopback")

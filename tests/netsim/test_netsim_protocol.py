@@ -23,6 +23,7 @@ from pygoby.netsim.manager.protocol import (
     response_class,
     response_names,
 )
+from tests.hypothesis_profiles import examples
 
 
 def _accepted(direction: str):
@@ -174,7 +175,7 @@ _tokens = st.sampled_from(
 )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     garbage=st.lists(st.one_of(st.binary(max_size=64), _tokens), max_size=30),
     cuts=st.lists(st.integers(min_value=0, max_value=2000), max_size=8),
@@ -199,7 +200,7 @@ def test_fuzz_garbage_then_a_good_line_always_decodes(garbage, cuts):
         )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.binary(max_size=300))
 def test_fuzz_base64_decoder_total(data):
     decoded = b64decode_libb64(data)

@@ -21,6 +21,9 @@ from pygoby.netsim.report.eventlog import read_events
 from pygoby.netsim.report.plots import bin_success, node_labels, timeline_window
 from pygoby.netsim.sim.realtime import RealTimeRun
 from pygoby.netsim.sim.scenario import ScenarioError, parse_scenario
+from tests.hypothesis_profiles import examples
+
+pytestmark = pytest.mark.e2e
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "netsim" / "tdma8.pb.cfg"
 
@@ -139,14 +142,14 @@ def test_real_time_needs_a_speed_factor_or_a_clock():
     assert run.sim.start == pytest.approx(clock.now(), abs=5)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.text(max_size=200))
 def test_fuzz_scenario_parser_only_raises_scenario_error(text):
     with contextlib.suppress(ScenarioError):
         parse_scenario(text)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     st.lists(
         st.one_of(

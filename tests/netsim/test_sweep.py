@@ -34,6 +34,8 @@ from tests.netsim.sweep_helpers import (
 )
 from tests.netsim.test_sim_cli import png_size
 
+pytestmark = pytest.mark.e2e
+
 
 def plan_of(text: str):
     sweep, base = parse_sweep(text)

@@ -26,6 +26,8 @@ from tests.netsim.sweep_helpers import (
     write_sweep,
 )
 
+pytestmark = pytest.mark.e2e
+
 distributed = pytest.importorskip("distributed")  # (installed by `make test`: pygoby[dev])
 
 

@@ -15,7 +15,7 @@ def topside_mission(net: TwoCommunities, tmp_path: Path, blocks: str) -> Path:
     """vehicle1's mission with `blocks` (ProcessConfig blocks of the operator tools) added."""
     lookup = tmp_path / "modemidlookup.txt"
     lookup.write_text(LOOKUP)
-    text = mission_text(1, net.dbs[0].port, net.sims[0].port, net.extra, net.slots)
+    text = mission_text(1, net.dbs[0].port, net.sims[0].port, net.extra, net.slots, warp=net.warp)
     path = tmp_path / "topside.moos"
     path.write_text(
         f"LatOrigin = 42.358\nLongOrigin = -71.087\nmodem_id_lookup_path = {lookup}\n"

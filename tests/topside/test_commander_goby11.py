@@ -20,6 +20,7 @@ from pygoby.moos.translator import ModemIdLookup, Translator, TranslatorError
 from pygoby.moosacomms.acomms_config import AcommsMessageSet, read_acomms_config
 from pygoby.topside.commander import Commander, CommandSet, FieldValueError
 from pygoby.util.clock import VirtualClock
+from tests.hypothesis_profiles import examples
 
 EXAMPLES = Path(__file__).parents[2] / "examples" / "goby1.1"
 CCL_AND_DCCL = EXAMPLES / "MOOS" / "ccl_and_dccl"
@@ -197,7 +198,7 @@ def test_the_posts_make_simple_status_on_mm1_and_mm2_decodes_it(commands):
     ]
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(
     x=st.integers(-100000, 100000),
     speed=st.integers(-20, 200),

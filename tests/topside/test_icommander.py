@@ -13,6 +13,8 @@ from tests.apps.acomms_mission import Recorder, TwoCommunities
 
 from .mission import topside_mission
 
+pytestmark = pytest.mark.e2e
+
 ICOMMANDER = """
 ProcessConfig = iCommander
 {
@@ -50,7 +52,9 @@ async def fill(pilot, values: dict[str, str]) -> None:
 
 @pytest.mark.timeout(120)
 async def test_send_refusal_preview_and_ack(tmp_path):
-    async with TwoCommunities(tmp_path) as net:
+    # in real time: textual's pilot waits for the screen after each key, and the three apps
+    # ticking MOOSTimeWarp times as often in its event loop slow it more than they save
+    async with TwoCommunities(tmp_path, warp=1) as net:
         (r1, r2) = net.recorders
         await net.ready()
         r1.client.subscribe("COMMAND_OUT")

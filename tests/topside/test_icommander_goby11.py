@@ -14,6 +14,8 @@ from tests.goby11.test_examples import EXAMPLES, localize, run_pair, wait_for
 
 from .test_icommander import type_text
 
+pytestmark = pytest.mark.e2e
+
 ICOMMANDER = """
 ProcessConfig = iCommander
 {

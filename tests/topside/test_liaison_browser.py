@@ -19,6 +19,8 @@ from tests.apps.acomms_mission import TwoCommunities
 
 from .mission import topside_mission
 
+pytestmark = pytest.mark.e2e
+
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 FLAGS = [
     "--headless",

@@ -18,6 +18,8 @@ import pytest
 from pygoby.topside.liaison import is_loopback
 from tests.apps.acomms_mission import TwoCommunities
 
+pytestmark = pytest.mark.e2e
+
 
 def fetch(url: str, body: dict | None = None, headers: dict | None = None) -> tuple[int, str]:
     data = json.dumps(body).encode() if body is not None else None

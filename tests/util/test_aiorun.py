@@ -14,6 +14,8 @@ import pytest
 
 from pygoby.util.aiorun import STOP_GRACE, cancel_and_wait
 
+pytestmark = pytest.mark.e2e
+
 PROGRAM = """
 import asyncio, sys, time
 from pygoby.util.aiorun import run_until_signal

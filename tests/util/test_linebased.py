@@ -16,6 +16,7 @@ from pygoby.util.linebased import (
     TCPServerLink,
     open_pty_pair,
 )
+from tests.hypothesis_profiles import examples
 
 
 async def lines_from(link, count, timeout=5.0):
@@ -149,7 +150,7 @@ def test_splitter_scans_each_byte_once():
     assert calls < 3 * 200_000  # rescanning from the start each time would be ~2000x more
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(
     stream=st.lists(st.sampled_from([b"a", b"bc", b"\r", b"\n", b"\r\n", b"xyz" * 5])).map(
         b"".join

@@ -10,6 +10,7 @@ from pygoby.util.nmea import (
     checksum,
     with_checksum,
 )
+from tests.hypothesis_profiles import examples
 
 SPEC_EXAMPLES = [
     "$CCCFG,SRC,1*31",
@@ -75,7 +76,7 @@ def test_as_int_on_bad_field():
         NMEASentence.parse("$CADRQ,1").as_int(5)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.text(max_size=80))
 def test_fuzz_parse_only_raises_nmea_errors(text):
     try:
@@ -85,7 +86,7 @@ def test_fuzz_parse_only_raises_nmea_errors(text):
     assert NMEASentence.parse(sentence.message()) == sentence
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     st.text(alphabet="ABCDEFGHIJKLMNOPQRSTUVWXYZ", min_size=5, max_size=5),
     st.lists(st.text(alphabet="0123456789abcdefXYZ.-:T ", max_size=12), max_size=8),
@@ -113,7 +114,7 @@ def reference_field_text(value) -> str:
     return str(value)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.lists(FIELD_VALUES, max_size=10))
 def test_build_formats_every_kind_of_value_by_the_field_rule(values):
     s = NMEASentence.build("$CCTXD", values)
@@ -131,7 +132,7 @@ def test_build_refuses_reserved_characters_in_any_field(bad):
         NMEASentence.build("$CCTXD", [1, bad, 2])
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(st.text(alphabet=st.characters(max_codepoint=127), max_size=300))
 def test_checksum_is_the_xor_of_every_character(body):
     expected = 0

@@ -208,9 +208,11 @@ class pAcommsHandler(GobyMOOSApp):  # noqa: N801 - the program's name
         mac = self.acomms.mac
         if mac.running and mac.slots:
             now = mac.slots[(mac.current - 1) % len(mac.slots)]
+            # (a slot due since the last tick starts at the next one: "next in 0.0 s")
+            next_in = max(0.0, mac.next_slot_time - self.clock.now())
             lines.append(
                 f"MAC slot {now.slot_index} ({now.src}->{now.dest}, rate {now.rate}, "
-                f"{now.slot_seconds:g} s); next in {mac.next_slot_time - self.clock.now():.1f} s"
+                f"{now.slot_seconds:g} s); next in {next_in:.1f} s"
             )
         else:
             lines.append("MAC: not running")

@@ -125,11 +125,23 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if args.goby11 or (args.xml and len(args.xml) > 1):
         return _run_goby11(args)
-    if args.trace:
-        handler = logging.StreamHandler(sys.stderr)
-        handler.setFormatter(logging.Formatter("%(message)s"))
-        trace_log.addHandler(handler)
-        trace_log.setLevel(logging.DEBUG)
+    if not args.trace:
+        return _run(args)
+    # the trace goes to this command's stderr, and only while it runs (`main` may be called again
+    # in one process: tests, scripts)
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    trace_log.addHandler(handler)
+    level = trace_log.level
+    trace_log.setLevel(logging.DEBUG)
+    try:
+        return _run(args)
+    finally:
+        trace_log.removeHandler(handler)
+        trace_log.setLevel(level)
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
         passphrase = read_passphrase(args)
         codec = Codec(passphrase=passphrase, strict=args.strict, trace=args.trace)

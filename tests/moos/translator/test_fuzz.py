@@ -18,9 +18,12 @@ from pygoby.moos.translator import (
 )
 from pygoby.moos.translator import format as fmt
 from pygoby.moos.translator.keyvalue import val_from_string
+from tests.hypothesis_profiles import examples
 
 SETTINGS = settings(
-    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=examples(200),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
 TEST_MSG = "pygoby.test.translator.TestMsg"
 

@@ -16,9 +16,12 @@ from hypothesis import strategies as st
 
 from pygoby.moos.protocol import decode_text
 from pygoby.moos.translator import Technique, Translator, TranslatorError, TranslatorRunner
+from tests.hypothesis_profiles import examples
 
 SETTINGS = settings(
-    max_examples=300, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=examples(300),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
 TEST_MSG = "pygoby.test.translator.TestMsg"
 BNR = "pygoby.test.translator.BasicNodeReport"

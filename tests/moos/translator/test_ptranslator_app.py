@@ -193,6 +193,7 @@ async def test_entries_goby3_runs_start_with_one_warning_per_oddity(tmp_path, lo
     ):
         path = tmp_path / "mission.moos"
         path.write_text(mission_text(db.port, lookup_file, entries))
+        caplog.clear()  # (the DB's start is logged at INFO when an earlier test left that level on)
         with caplog.at_level(logging.WARNING):
             app = pTranslator.from_mission(path, "pTranslator")
         assert [r.getMessage() for r in caplog.records] == [
