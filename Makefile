@@ -36,13 +36,13 @@ test: protos $(CHROMIUM)
 	$(PY) -m ruff check src tests benchmarks
 	$(PY) -m ruff format --check src tests benchmarks
 	$(PY) -m mypy
-	$(PY) -m pytest -q -n $(TEST_JOBS)
+	$(PY) -m pytest -q -n $(TEST_JOBS) --dist worksteal
 
 # the edit loop's tier (< 90 s): lint and every test but the end-to-end ones (marked e2e);
 # after a failure, `$(PY) -m pytest --lf` runs what failed last
 check: protos
 	$(PY) -m ruff check src tests benchmarks
-	$(PY) -m pytest -q -n $(TEST_JOBS) -m "not e2e"
+	$(PY) -m pytest -q -n $(TEST_JOBS) --dist worksteal -m "not e2e"
 
 # the README's liaison pictures, taken by the browser test against a real two-vehicle mission
 screenshots: protos $(CHROMIUM)

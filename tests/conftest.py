@@ -37,3 +37,10 @@ def pytest_runtest_makereport(item, call):
         for name, text in report.sections
     ]
     return report
+
+
+def pytest_collection_modifyitems(config, items):
+    """The end-to-end tests (marked e2e: missions, processes, real-time waits) run first, so that
+    with `pytest -n 2` the long ones overlap the thousands of quick tests on the other worker
+    instead of being left to run alone at the end (a stable sort: order within each kind stays)."""
+    items.sort(key=lambda item: item.get_closest_marker("e2e") is None)
