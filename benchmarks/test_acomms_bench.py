@@ -25,7 +25,7 @@ QUEUED = 100_000
 
 def _loaded_manager(ack: bool):
     clock = VirtualClock(1_700_000_000.0)
-    qm, (Status, Bulk, Note) = manager(
+    qm, (Status, _Bulk, _Note) = manager(
         clock,
         entries=[
             entry("Status", ack=ack, max_queue=0, ttl=0),
@@ -59,7 +59,7 @@ def test_pop_one_frame_with_100k_queued(benchmark, loaded):
 
 
 def test_push_with_100k_queued(benchmark, loaded):
-    clock, qm, Status = loaded
+    _clock, qm, Status = loaded
     msg = Status(src=1, dest=2, value=3)
     benchmark(qm.push_message, msg)
     assert qm.size(20) > QUEUED // 2

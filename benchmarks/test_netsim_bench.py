@@ -120,7 +120,7 @@ async def _vehicle(
 
 
 async def _garbage(port: int, stop: asyncio.Event) -> None:
-    reader, writer = await asyncio.open_connection("127.0.0.1", port)
+    _reader, writer = await asyncio.open_connection("127.0.0.1", port)
     blobs = [
         os.urandom(65536),
         b"Z" * (1 << 20),

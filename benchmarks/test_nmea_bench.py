@@ -27,21 +27,21 @@ DAY = dt.date(2023, 11, 14)
 CST_SENTENCE = NMEASentence.parse(CST)
 CST_FIELDS = cst_fields(CST_SENTENCE, DAY)
 CST_TYPED = cycle_statistics(CST_FIELDS, 6)
-XST_VALUES = dict(
-    clock_mode=1,
-    mode=0,
-    probe_length=0,
-    bandwidth=5000,
-    carrier_freq=25000,
-    rate=0,
-    source=1,
-    dest=2,
-    ack_requested=0,
-    number_frames_expected=1,
-    number_frames_sent=1,
-    packet_type=1,
-    number_bytes=32,
-)
+XST_VALUES = {
+    "clock_mode": 1,
+    "mode": 0,
+    "probe_length": 0,
+    "bandwidth": 5000,
+    "carrier_freq": 25000,
+    "rate": 0,
+    "source": 1,
+    "dest": 2,
+    "ack_requested": 0,
+    "number_frames_expected": 1,
+    "number_frames_sent": 1,
+    "packet_type": 1,
+    "number_bytes": 32,
+}
 
 
 @pytest.mark.benchmark(group="nmea")

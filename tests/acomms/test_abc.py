@@ -54,7 +54,7 @@ async def test_abc_driver_queue_to_queue_with_ack():
     d1, d2 = ABCDriver(clock), ABCDriver(clock)
     d1.startup(abc_cfg(1, port))
     d2.startup(abc_cfg(2, port))
-    q1, q2, Status, got, acked = status_link(clock, d1, d2)
+    q1, _q2, Status, got, acked = status_link(clock, d1, d2)
     try:
         await d1.link.wait_open()
         await d2.link.wait_open()
@@ -82,7 +82,7 @@ async def test_simulator_survives_bad_lines_and_a_modem_that_never_reads():
     server = await serve_abc(sim)
     port = server.sockets[0].getsockname()[1]
     try:
-        a_reader, a_writer = await asyncio.open_connection("127.0.0.1", port)
+        _a_reader, a_writer = await asyncio.open_connection("127.0.0.1", port)
         _, b_writer = await asyncio.open_connection("127.0.0.1", port)
         c_reader, c_writer = await asyncio.open_connection("127.0.0.1", port)
         a_writer.write(b"CONF,MAC:nope\r\n" + b"x" * 200_000 + b"\r\nCONF,MAC:1\r\n")

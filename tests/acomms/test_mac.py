@@ -48,14 +48,14 @@ def test_joins_mid_cycle_at_next_boundary_as_in_spec_example():
 
 
 def test_without_start_in_middle_waits_for_cycle_start():
-    clock, mac, _, _ = make(
+    _clock, mac, _, _ = make(
         MAC_FIXED_DECENTRALIZED, [slot(1), slot(2)], start_cycle_in_middle=False
     )
     assert (mac.current, mac.next_slot_time) == (0, DAY + 43220)
 
 
 def test_fixed_reference():
-    clock, mac, _, _ = make(
+    _clock, mac, _, _ = make(
         MAC_FIXED_DECENTRALIZED,
         [slot(1, seconds=7)] * 3,
         now=1000.0,
@@ -88,14 +88,14 @@ def test_mac_none_never_runs():
 
 
 def test_skew_skips_slot_and_realigns():
-    clock, mac, initiated, started = make(MAC_FIXED_DECENTRALIZED, [slot(1), slot(2)])
+    clock, mac, _initiated, started = make(MAC_FIXED_DECENTRALIZED, [slot(1), slot(2)])
     clock.set(DAY + 43215)  # 5 s late for the 43210 slot
     mac.do_work()
     assert started == [] and (mac.current, mac.next_slot_time) == (0, DAY + 43220)
 
 
 def test_mac_update_list_operations_and_cycle_state():
-    clock, mac, _, _ = make(MAC_FIXED_DECENTRALIZED, [slot(1), slot(2)])
+    _clock, mac, _, _ = make(MAC_FIXED_DECENTRALIZED, [slot(1), slot(2)])
 
     def apply(kind, slots=(), **kw):
         return mac.apply_update(U(src=9, dest=1, update_type=kind, slot=list(slots), **kw))
@@ -233,5 +233,5 @@ def test_auto_discovery_expires_silent_vehicle():
 
 @pytest.mark.parametrize("kind", [MAC_FIXED_DECENTRALIZED, MAC_POLLED])
 def test_empty_cycle_stops(kind):
-    clock, mac, _, _ = make(kind, [])
+    _clock, mac, _, _ = make(kind, [])
     assert not mac.running

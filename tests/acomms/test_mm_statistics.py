@@ -198,21 +198,21 @@ def test_parse_xst_fields_enum_ranges_and_short_sentences(caplog):
 
 
 def test_format_xst_prints_what_parse_xst_reads():
-    values = dict(
-        clock_mode=1,
-        mode=0,
-        probe_length=0,
-        bandwidth=5000,
-        carrier_freq=25000,
-        rate=5,
-        source=1,
-        dest=2,
-        ack_requested=True,
-        number_frames_expected=8,
-        number_frames_sent=8,
-        packet_type=3,
-        number_bytes=2048,
-    )
+    values = {
+        "clock_mode": 1,
+        "mode": 0,
+        "probe_length": 0,
+        "bandwidth": 5000,
+        "carrier_freq": 25000,
+        "rate": 5,
+        "source": 1,
+        "dest": 2,
+        "ack_requested": True,
+        "number_frames_expected": 8,
+        "number_frames_sent": 8,
+        "packet_type": 3,
+        "number_bytes": 2048,
+    }
     for version in (0, 6):
         xst = parse_xst(NMEASentence.parse(format_xst(1_700_000_000.25, values, version).message()))
         assert (xst.version, xst.date, xst.time) == (version, "20231114", "221320.2500")

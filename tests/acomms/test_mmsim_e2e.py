@@ -17,7 +17,7 @@ pytestmark = pytest.mark.e2e
 
 
 async def test_data_with_ack_and_ranging_over_tcp():
-    channel, (sim1, sim2) = await start_emulators([1, 2], range_m=1000.0)  # 0.6667 s away
+    _channel, (sim1, sim2) = await start_emulators([1, 2], range_m=1000.0)  # 0.6667 s away
     d1 = await started_driver(1, sim1.port)
     d2 = await started_driver(2, sim2.port, query=True)  # also exercises CFQ,ALL at start-up
     try:
@@ -59,7 +59,7 @@ async def test_data_with_ack_and_ranging_over_tcp():
 
 
 async def test_polled_transmission_rate0_over_tcp():
-    channel, (sim1, sim2) = await start_emulators([1, 2])
+    _channel, (sim1, sim2) = await start_emulators([1, 2])
     d1, d2 = await started_driver(1, sim1.port), await started_driver(2, sim2.port)
     try:
         got1 = []
@@ -79,7 +79,7 @@ async def test_polled_transmission_rate0_over_tcp():
 
 
 async def test_driver_reconnects_after_link_drop_and_resumes():
-    channel, (sim1, sim2) = await start_emulators([1, 2])
+    _channel, (sim1, sim2) = await start_emulators([1, 2])
     d1, d2 = await started_driver(1, sim1.port), await started_driver(2, sim2.port)
     try:
         got2 = []
@@ -127,7 +127,7 @@ async def test_acked_message_queued_during_link_outage_is_delivered_after_reconn
 
     from .queue_helpers import entry, manager
 
-    channel, (sim1, sim2) = await start_emulators([1, 2])
+    _channel, (sim1, sim2) = await start_emulators([1, 2])
     d1, d2 = await started_driver(1, sim1.port), await started_driver(2, sim2.port)
     clock = WallClock()
     q1, (Status, *_) = manager(clock, modem_id=1, entries=[entry("Status")])
@@ -162,11 +162,11 @@ async def test_acked_message_queued_during_link_outage_is_delivered_after_reconn
 
 
 async def test_application_acks_over_tcp():
-    channel, (sim1, sim2) = await start_emulators([1, 2])
+    _channel, (sim1, sim2) = await start_emulators([1, 2])
     d1 = await started_driver(1, sim1.port, use_application_acks=True)
     d2 = await started_driver(2, sim2.port, use_application_acks=True)
     clock = WallClock()
-    q1, q2, Status, got, acked = status_link(clock, d1, d2)
+    q1, _q2, Status, got, acked = status_link(clock, d1, d2)
     try:
         q1.push_message(Status(src=1, dest=2, value=77))
         await asyncio.sleep(0.01)

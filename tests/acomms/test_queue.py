@@ -47,7 +47,7 @@ def clock():
 
 def test_priority_contest_spec_example(clock):
     # spec §5.3: A (1, 1800) and B (4, 1000), both last sent 100 s ago -> B (0.4 > 0.056)
-    qm, (Status, Bulk, Note) = manager(
+    qm, (Status, Bulk, _Note) = manager(
         clock,
         entries=[entry("Status", value_base=1, ttl=1800), entry("Bulk", value_base=4, ttl=1000)],
     )
@@ -64,7 +64,7 @@ def test_priority_contest_spec_example(clock):
 
 
 def test_equal_priority_older_last_send_then_lowest_id(clock):
-    qm, (Status, Bulk, Note) = manager(clock, entries=[entry("Status"), entry("Bulk")])
+    qm, (Status, Bulk, _Note) = manager(clock, entries=[entry("Status"), entry("Bulk")])
     for _ in range(2):
         qm.push_message(Bulk(src=1, dest=2, payload=b"x"))
         qm.push_message(Status(src=1, dest=2, value=3))
@@ -93,7 +93,7 @@ def test_blackout(clock):
 
 
 def test_ttl_expiry_and_infinite_ttl(clock):
-    qm, (Status, Bulk, Note) = manager(
+    qm, (Status, Bulk, _Note) = manager(
         clock, entries=[entry("Status", ttl=60), entry("Bulk", ttl=0)]
     )
     expired = []
@@ -171,7 +171,7 @@ def test_broadcast_never_requests_ack(clock):
 
 
 def test_packing_several_messages_per_frame_and_frames_per_packet(clock):
-    qm, (Status, Bulk, Note) = manager(
+    qm, (Status, Bulk, _Note) = manager(
         clock, entries=[entry("Status", ack=False), entry("Bulk", ack=False)]
     )
     for v in range(5):
@@ -244,7 +244,7 @@ def test_on_demand(clock):
     ].enum_type.values_by_name
     e = entry("Status", ack=False)
     e.manipulator.append(Manip["ON_DEMAND"].number)
-    qm, (Status, *_) = manager(clock, entries=[e])
+    qm, (_Status, *_) = manager(clock, entries=[e])
     counter = iter(range(100))
 
     def make(req, msg):

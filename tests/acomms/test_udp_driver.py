@@ -108,7 +108,7 @@ def test_multicast_queue_to_queue_with_ack():
         drivers.append(d)
     d1, d2 = drivers
     try:
-        q1, q2, Status, got, acked = status_link(clock, d1, d2)
+        q1, _q2, Status, got, acked = status_link(clock, d1, d2)
         q1.push_message(Status(src=1, dest=2, value=8))
         clock.advance(1)
         d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=0))

@@ -6,13 +6,15 @@ before one succeeds) and, per instance, `fail_next_work` (the next do_work raise
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.driver_base import ModemDriverBase, ModemDriverError
 
 
 class ScriptedDriver(ModemDriverBase):
     fail_startups = 0
-    instances: list[ScriptedDriver] = []
+    instances: ClassVar[list[ScriptedDriver]] = []
 
     def __init__(self, clock=None) -> None:
         super().__init__(clock)

@@ -101,7 +101,7 @@ def two_vehicles(tmp_path):
 
 
 async def test_ccl_state_and_dccl_status_between_two_vehicles(tmp_path):
-    async with two_vehicles(tmp_path) as ((app1, app2), (r1, r2)):
+    async with two_vehicles(tmp_path) as ((app1, _app2), (r1, r2)):
         assert app1.acomms.codec.id_codec == "dccl.ccl.id"
         state = await r2.wait_for("REMUS_STATUS_REPORT_IN", timeout=30)
         assert state.startswith(f"@PB[{STATE}] ")

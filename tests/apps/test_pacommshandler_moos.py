@@ -169,7 +169,7 @@ async def test_moos_interface_without_a_modem(tmp_path, caplog):
             await r.close()
 
 
-def pAcommsHandler_interface_data():  # noqa: N802
+def pAcommsHandler_interface_data():
     from pygoby.frontseat.messages import InterfaceData
 
     return InterfaceData()

@@ -231,7 +231,7 @@ def test_decode_xml_without_message_picks_each_lines_type_by_its_dccl_id(capsys,
 
 def test_a_files_only_message_needs_no_name(capsys, monkeypatch):
     xml = str(EXAMPLES / "goby1.1" / "xml" / "simple_status.xml")
-    status, out, err = in_process(capsys, monkeypatch, "dccl", "encode", "--xml", xml, stdin="")
+    status, _out, err = in_process(capsys, monkeypatch, "dccl", "encode", "--xml", xml, stdin="")
     assert status == 0, err
 
 

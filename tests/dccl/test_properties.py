@@ -31,7 +31,8 @@ ROUND_TRIP = [
     ("features.proto", "feat.Oneofs"),
     ("features.proto", "feat.V3Misc"),
 ]
-ALL_TYPES = ROUND_TRIP + [
+ALL_TYPES = [
+    *ROUND_TRIP,
     ("features.proto", "feat.Numeric"),
     ("features.proto", "feat.Time"),
     ("features.proto", "feat.V2Misc"),

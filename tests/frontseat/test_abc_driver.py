@@ -204,7 +204,7 @@ def test_malformed_lines_are_logged_and_skipped_but_still_emitted_raw(rig, caplo
 
 
 def test_lost_connection_goes_back_to_not_connected_and_a_new_one_restarts(rig, caplog):
-    driver, link, rec = rig
+    driver, link, _rec = rig
     connect(driver, link)
     link.feed("CTRL,STATE:PAYLOAD\r\n")
     driver.loop()

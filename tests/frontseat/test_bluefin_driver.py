@@ -248,7 +248,7 @@ def test_cancel_request_id_forgets_the_outstanding_request():
 
 
 def test_navigation_becomes_a_node_status():
-    driver, link, clock = started()
+    driver, link, _clock = started()
     data = []
     driver.signal_data_from_frontseat.connect(data.append)
     feed(
@@ -370,7 +370,7 @@ def test_accepting_commands_hooks(hook, events, expected):
 
 
 def test_data_to_the_frontseat():
-    driver, link, clock = started()
+    driver, link, _clock = started()
     data = frontseat_pb.InterfaceData(dccl_message=b"\x01\x02\xff")
     ctd = data.ctd_sample
     ctd.conductivity, ctd.temperature, ctd.pressure, ctd.time = 4.2, 10.5, 101325.0, T0 - 1

@@ -98,7 +98,7 @@ def test_slot_types_and_dropped_forms():
   queue_cfg { modem_id: 1 message_file { path: "a.xml" } message_file { path: "b.xml" manipulator: LOOPBACK } }
   tcp_share_enable: false tcp_share_port: 11000 tcp_share_to_ip: "1.2.3.4:11000"
   """)
-    ping, remus, narrowband = cfg.mac_cfg.slot
+    _ping, _remus, _narrowband = cfg.mac_cfg.slot
     assert [s.type for s in cfg.mac_cfg.slot] == [acomms_pb.DRIVER_SPECIFIC] * 3
     assert [s.Extensions[acomms_pb.MM_TRANSMISSION].type for s in cfg.mac_cfg.slot] == [
         acomms_pb.MICROMODEM_TWO_WAY_PING,

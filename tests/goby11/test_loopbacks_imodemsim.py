@@ -309,7 +309,7 @@ def test_imodemsim_hears_through_the_range_model_unless_told_perfect(tmp_path):
     app = iModemSim.from_mission(path)
     try:
         assert isinstance(app.channel.link, RangeLink)
-        lat, lon, depth = app.geo_position()
+        lat, lon, _depth = app.geo_position()
         assert (lat, lon) == pytest.approx(UTMGeodesy(42.35, -70.95).to_geo(0, 1000))
     finally:
         app.pair.close()

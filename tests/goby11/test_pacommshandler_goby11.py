@@ -76,7 +76,7 @@ def two_nodes(tmp_path: Path):
 
 async def test_goby11_configuration_runs_with_the_11_variables(tmp_path):
     async with two_nodes(tmp_path) as (apps, recorders):
-        mm1, mm2 = apps
+        mm1, _mm2 = apps
         assert any("VERBOSITY_WARN -> WARN" in note for note in mm1.config_notes)
         assert any("transitional_cfg" in note for note in mm1.config_notes)
         status = await recorders[1].wait_for(

@@ -6,6 +6,7 @@ have arrived, OUTGOING_COMMAND -> Redirect), its configuration and console scrip
 from __future__ import annotations
 
 import asyncio
+import itertools
 import subprocess
 import sys
 from pathlib import Path
@@ -337,7 +338,7 @@ async def test_create_status_every_10_s_once_all_nav_arrived(tmp_path):
         0
     ].longitude == pytest.approx(lon, abs=1.1e-5)
     assert (states[0].heading, states[0].depth) == (32 * 360 / 255, 111.0)
-    gaps = [b.time - a.time for a, b in zip(posts, posts[1:], strict=False)]
+    gaps = [b.time - a.time for a, b in itertools.pairwise(posts)]
     assert all(gap >= 10.0 for gap in gaps)  # MOOS (warped) seconds; each post has its frame's time
     for post, state in zip(posts, states, strict=True):
         assert state.time == TimeDate.at(post.time)._replace(

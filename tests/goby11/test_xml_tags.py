@@ -76,7 +76,7 @@ EVERY_TYPE = xml("""
 
 
 def test_every_layout_type_round_trips_through_dccl_and_the_translator():
-    message_set, codec, (Every,), translator = build(EVERY_TYPE)
+    _message_set, codec, (Every,), translator = build(EVERY_TYPE)
     descriptor = Every.DESCRIPTOR
     assert [(f.name, f.number) for f in descriptor.fields] == [
         ("When", 1),
@@ -258,7 +258,7 @@ def test_seed_example1_scenario_goto_command():
 
 
 def test_publish_format_placeholders_renumbered_and_arrays_indexed():
-    message_set, codec, (P,), translator = build(
+    _message_set, _codec, (P,), translator = build(
         xml("""
   <message><name>P</name><id>3</id><size>32</size>
     <layout>
@@ -332,7 +332,7 @@ ALGORITHM_SET = xml("""
 
 def test_every_algorithm_of_the_manual_runs(tmp_path):
     lookup = ModemIdLookup.from_text("1, topside, ship\n2, mm2, auv\n")
-    _, codec, (Alg,), translator = build(
+    _, codec, (_Alg,), translator = build(
         ALGORITHM_SET, lat_origin=42.35, lon_origin=-70.95, modem_ids=lookup
     )
     created = translator.create(

@@ -9,7 +9,7 @@ import time
 from example_app import pTestApp
 
 
-class pStuckApp(pTestApp):  # noqa: N801 - a program's name
+class pStuckApp(pTestApp):
     def on_stop(self):
         print("stopping", flush=True)
         time.sleep(3600)

@@ -24,7 +24,7 @@ from tests.faults import CuttableRelay
 from tests.hypothesis_profiles import examples
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from example_app import pTestApp  # noqa: E402
+from example_app import pTestApp
 
 HERE = Path(__file__).resolve().parent
 

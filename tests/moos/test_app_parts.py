@@ -21,7 +21,7 @@ from pygoby.moos.moosfile import MissionFile
 from pygoby.protobuf import builtin_class
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from example_app import config_class, pTestApp  # noqa: E402
+from example_app import config_class, pTestApp
 
 MISSION = """\
 ServerHost = localhost

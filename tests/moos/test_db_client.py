@@ -402,7 +402,7 @@ async def test_packets_cut_anywhere_by_tcp_are_all_delivered():
     async with MOOSDB(port=0) as db, MOOSClient("sink", port=db.port) as sink:
         sink.subscribe("CUT")
         await sink.flush()
-        reader, writer = await raw_connect(db.port, "cutter")
+        _reader, writer = await raw_connect(db.port, "cutter")
         writer.get_extra_info("socket").setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         stream = b"".join(
             p.encode_packet(

@@ -106,7 +106,7 @@ async def test_unread_output_stays_within_the_memory_budget(caplog):
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     budget = 1 << 20
     async with MOOSDB(port=0, memory_budget=budget) as db:
-        reader, writer = await raw_connect(db.port, "sleeper")
+        _reader, writer = await raw_connect(db.port, "sleeper")
         sock = writer.get_extra_info("socket")
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
         writer.write(
@@ -297,7 +297,7 @@ def test_summaries_decode_only_the_variables_written_since_the_last_refresh(monk
     assert 0 < len(decoded) < 20
     summary = core.variables["DB_VARSUMMARY"].message().string.splitlines()
     assert len(summary) == len(core.variables)
-    assert [line for line in summary if line.startswith("V2 ")][0].endswith(" D 2.5")
+    assert next(line for line in summary if line.startswith("V2 ")).endswith(" D 2.5")
 
 
 @settings(max_examples=examples(40), deadline=None)
@@ -331,7 +331,7 @@ async def test_a_synchronous_client_that_never_reads_is_dropped_at_the_memory_bu
     caplog.set_level(logging.WARNING, logger="pygoby.moos.db")
     budget = 4 << 20
     async with MOOSDB(port=0, memory_budget=budget) as db:
-        reader, writer = await raw_connect(db.port, "sleeper", asynchronous=False)
+        _reader, writer = await raw_connect(db.port, "sleeper", asynchronous=False)
         writer.write(
             p.encode_packet(
                 [

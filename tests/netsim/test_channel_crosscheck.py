@@ -128,17 +128,17 @@ def test_unesco_against_seawater():
 def free_field_model(**overrides) -> BellhopLoss:
     """Deep isovelocity water with a bottom matched to it (no reflection): only the direct
     path and its surface image remain."""
-    settings = dict(
-        water_depth=5000.0,
-        bottom_speed=1500.0,
-        bottom_density=1.0,
-        bottom_attenuation=0.0,
-        max_range=4000.0,
-        range_step=100.0,
-        depth_step=250.0,
-        source_depth_step=50.0,
-        beams=1000,
-    )
+    settings = {
+        "water_depth": 5000.0,
+        "bottom_speed": 1500.0,
+        "bottom_density": 1.0,
+        "bottom_attenuation": 0.0,
+        "max_range": 4000.0,
+        "range_step": 100.0,
+        "depth_step": 250.0,
+        "source_depth_step": 50.0,
+        "beams": 1000,
+    }
     settings.update(overrides)
     return BellhopLoss(BellhopSettings(**settings), sound_speed=1500.0, spreading=2.0)
 

@@ -195,7 +195,7 @@ async def test_tcp_request_response_and_status_codes(server):
 
 
 async def _garbage_client(port: int, payloads: list[bytes]) -> None:
-    reader, writer = await asyncio.open_connection("127.0.0.1", port)
+    _reader, writer = await asyncio.open_connection("127.0.0.1", port)
     for payload in payloads:
         writer.write(payload)
         await writer.drain()

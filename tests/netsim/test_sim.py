@@ -53,7 +53,7 @@ def test_three_nodes_exchange_status_in_tdma():
 
 
 def test_two_way_ping_slot_reports_true_range():
-    sim, events = run(
+    _sim, events = run(
         f"""duration: 60 {ORIGIN} channel {{ sound_speed: 1490 }}
         mac {{ slot {{ src: 1 dest: 2 type: DRIVER_SPECIFIC slot_seconds: 10
                        [goby.acomms.micromodem.protobuf.transmission] {{ type: MICROMODEM_TWO_WAY_PING }} }} }}
@@ -83,7 +83,7 @@ def test_moving_vehicle_range_follows_its_track():
 
 def test_overlapping_slots_collide():
     # slots shorter than a packet: transmissions overlap at the receivers
-    sim, events = run(
+    _sim, events = run(
         f"""duration: 300 {ORIGIN} mac {{ slot_seconds: 1.5 rate: 1 }}
         {fixed(1, 0)} {fixed(2, 1000)} {fixed(3, 2000)}"""
     )
@@ -161,7 +161,7 @@ def test_scenario_modem_timing_sets_the_emulators_durations():
     text = f"""duration: 120 {ORIGIN} mac {{ slot_seconds: 10 rate: 1 }}
         modem_timing {{ rate {{ rate: 1 lead: 2.0 per_frame: 0 }} mini_packet: 0.8 }}
         {fixed(1, 0)} {fixed(2, 1500)}"""
-    sim, events = run(text)
+    _sim, events = run(text)
     data = [e for e in events if e["event"] == "tx" and e["kind"] == "data"]
     assert data and {e["duration"] for e in data} == {2.0}
     for bad in ("rate { rate: 9 lead: 1 }", "rate { rate: 1 lead: 0 per_frame: 0 }", "ping: -1"):

@@ -100,7 +100,13 @@ def test_key_value_send_posts_and_preview_publishes_nothing(commands):
     posts = []
     commander = make(commands, posts)
     draft = commander.open("pygoby.examples.Command")
-    for name, value in dict(src="1", dest="2", command_id="7", heading="90", speed="1.5").items():
+    for name, value in {
+        "src": "1",
+        "dest": "2",
+        "command_id": "7",
+        "heading": "90",
+        "speed": "1.5",
+    }.items():
         commander.set_value(draft, name, value)
     preview = commander.preview(draft)
     assert posts == []
@@ -173,7 +179,7 @@ def test_ack_and_expire_match_what_was_sent(commands):
     posts = []
     commander = make(commands, posts)
     draft = commander.open("Command")
-    for name, value in dict(dest="2", command_id="7", speed="1.5").items():
+    for name, value in {"dest": "2", "command_id": "7", "speed": "1.5"}.items():
         commander.set_value(draft, name, value)
     first = commander.send(draft)
     commander.set_value(draft, "command_id", "8")

@@ -290,9 +290,13 @@ def test_field_from_another_variable_than_the_trigger_is_editable_and_posted(tmp
     posts = []
     commander = make(commands, posts)
     draft = commander.open("GoToCommand")
-    for name, value in dict(
-        Destination="2", goto_x="100", lights_on="true", new_instructions="dive", goto_speed="1.25"
-    ).items():
+    for name, value in {
+        "Destination": "2",
+        "goto_x": "100",
+        "lights_on": "true",
+        "new_instructions": "dive",
+        "goto_speed": "1.25",
+    }.items():
         commander.set_value(draft, name, value)
     outgoing = commander.preview(draft)
     # the trigger variable last; the static field goes with its variable, as in Goby 1.1

@@ -163,7 +163,7 @@ def test_splitter_same_lines_however_the_stream_is_cut(stream, cuts, delimiter):
     splitter = LineSplitter(delimiter, max_line_bytes=limit)
     got = []
     start = 0
-    for cut in sorted(cuts) + [len(stream)]:
+    for cut in [*sorted(cuts), len(stream)]:
         got += splitter.feed(stream[start:cut])
         start = max(start, cut)
     complete = stream.split(delimiter.encode())[:-1]

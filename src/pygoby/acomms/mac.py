@@ -265,7 +265,7 @@ class MACManager:
         k = round((cycle_start - self.reference_time(cycle_start)) / self.cycle_duration)
         position = n - 1 - int(k % AUTO_ENTROPY == sum(ids) % AUTO_ENTROPY)
         nodes = [self._auto_slot(i) for i in ids]
-        self.slots = nodes[:position] + [self._auto_slot(0)] + nodes[position:]
+        self.slots = [*nodes[:position], self._auto_slot(0), *nodes[position:]]
         self._renumber()
 
     def _auto_expire(self) -> None:

@@ -125,4 +125,4 @@ MICROMODEM_M_SEQUENCE = mm_driver_pb2.MICROMODEM_M_SEQUENCE
 
 def now_us(seconds: float) -> int:
     """Seconds since the epoch -> ModemTransmission time (microseconds)."""
-    return int(round(seconds * 1e6))
+    return round(seconds * 1e6)

@@ -249,7 +249,7 @@ class ArithmeticCodec(RepeatedFieldCodec):
         model = self.model
         total = model.total(Model.ENCODER)
         oor = model.out_of_range_frequency or MAX_FREQUENCY
-        lowest = float(min(oor, min(model.frequency)))
+        lowest = float(min(oor, *model.frequency))
         n = self.max_repeat
         least_probable = math.ceil(n * (math.log2(total) - math.log2(lowest)))
         eof = model.eof_frequency
@@ -268,7 +268,7 @@ class ArithmeticCodec(RepeatedFieldCodec):
         oor = model.out_of_range_frequency or 1
         eof = model.eof_frequency
         empty = math.ceil(math.log2(total) - math.log2(eof)) if eof else _U32
-        highest = float(max(oor, max(model.frequency)))
+        highest = float(max(oor, *model.frequency))
         most_probable = math.ceil(self.max_repeat * (math.log2(total) - math.log2(highest)))
         return min(empty, most_probable)
 

@@ -133,7 +133,7 @@ class _Source:
         source = "\n".join([*comment, *self.lines]) + "\n"
         base = f"{type_name} {func_name}" + (" traced" if traced else "")
         filename = _register_source(base, source)
-        exec(compile(source, filename, "exec"), self.namespace)  # noqa: S102
+        exec(compile(source, filename, "exec"), self.namespace)
         return GeneratedFunction(self.namespace[func_name], source)
 
 

@@ -27,9 +27,9 @@ from pygoby.moos.protocol import MOOSMessage
 from pygoby.moos.timewarp import moos_clock
 
 __all__ = [
+    "MOOSDB",
     "AntlerError",
     "BlockSyntaxError",
-    "MOOSDB",
     "MOOSClient",
     "MOOSMessage",
     "MissionFile",

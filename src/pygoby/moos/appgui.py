@@ -20,13 +20,13 @@ import contextlib
 import logging
 import sys
 from collections import deque
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 from pygoby.util.extras import needs_extra
 
 with needs_extra("topside", "common.show_gui's live view"):
     from textual.app import App, ComposeResult
-    from textual.binding import Binding
+    from textual.binding import Binding, BindingType
     from textual.containers import Horizontal, Vertical
     from textual.css.query import NoMatches
     from textual.widgets import Footer, Header, OptionList, RichLog, Static
@@ -84,7 +84,10 @@ class AppGUI(App[None]):
     #groups { height: 1fr; border: round $accent; }
     #log { border: round $accent; }
     """
-    BINDINGS = [Binding("q", "quit_app", "Quit"), Binding("ctrl+c", "quit_app", "Quit", show=False)]
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("q", "quit_app", "Quit"),
+        Binding("ctrl+c", "quit_app", "Quit", show=False),
+    ]
 
     def __init__(self, app: ShownApp) -> None:
         super().__init__()

@@ -87,20 +87,20 @@ class Variable:
     """One MOOS variable; its value is the last notification as forwarded (`raw`)."""
 
     __slots__ = (
-        "name",
-        "key",
-        "type_code",
         "accepts",
-        "raw",
         "community",
-        "write_time",
-        "write_rate",
-        "last_source",
-        "subscribers",
         "every_update",
-        "timed",
+        "key",
+        "last_source",
+        "name",
+        "raw",
+        "subscribers",
         "summary",
         "summary_of",
+        "timed",
+        "type_code",
+        "write_rate",
+        "write_time",
     )
 
     def __init__(self, name: str) -> None:
@@ -198,19 +198,19 @@ class ClientRecord:
     yet written), wildcard filters, timing statistics and the variables it published."""
 
     __slots__ = (
-        "name",
         "asynchronous",
-        "held",
-        "out",
         "breaks",
         "filters",
-        "latencies_ms",
-        "published",
-        "subscribed",
-        "rw_summary",
-        "refused",
-        "held_counted",
+        "held",
         "held_bytes",
+        "held_counted",
+        "latencies_ms",
+        "name",
+        "out",
+        "published",
+        "refused",
+        "rw_summary",
+        "subscribed",
     )
 
     def __init__(self, name: str, asynchronous: bool) -> None:
@@ -284,7 +284,7 @@ class _Source:
     """What the DB learnt from a message's src/src_aux/community bytes, for the messages that
     follow with the same bytes (normally every message of a client's packet)."""
 
-    __slots__ = ("head", "layout", "forwarded", "growth", "src", "publisher")
+    __slots__ = ("forwarded", "growth", "head", "layout", "publisher", "src")
 
     def __init__(self, core: DBCore, data: bytes, at: int, stop: int) -> None:
         src, pos = p.read_str(data, at, stop, "src")

@@ -522,7 +522,7 @@ class Glob:
     whenever there is one); a piece holding `?` is searched for by bit-parallel matching
     (shift-and: one step per character of the name, whatever the piece's length)."""
 
-    __slots__ = ("pattern", "_pieces", "_min_len", "_searches")
+    __slots__ = ("_min_len", "_pieces", "_searches", "pattern")
 
     def __init__(self, pattern: str) -> None:
         self.pattern = pattern
@@ -560,7 +560,7 @@ def _piece_at(piece: str, name: str, at: int) -> bool:
 class _PieceSearch:
     """The leftmost place of one star-free piece in a name."""
 
-    __slots__ = ("piece", "_masks", "_wild", "_last")
+    __slots__ = ("_last", "_masks", "_wild", "piece")
 
     def __init__(self, piece: str) -> None:
         self.piece = piece

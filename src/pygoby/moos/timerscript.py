@@ -202,7 +202,7 @@ class TimerScript:
         ):
             if not value or any(c.isspace() for c in value):
                 raise ConfigError(f"must be a variable name, not {value!r}")
-            setattr(self, "var_" + name.split("_")[0], value)
+            setattr(self, "var_" + name.split("_", maxsplit=1)[0], value)
         elif name in ("verbose", "appcast", "apptick", "commstick", "maxappticks"):
             pass  # terminal and scheduling settings
         else:

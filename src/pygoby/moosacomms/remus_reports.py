@@ -171,7 +171,7 @@ class RemusReports:
         ]
 
     def _alert(self, frame: Alert, src: int) -> str:
-        pairs = self._alert_head("CCL_ALERT", frame, src) + [("Heading", num(frame.heading))]
+        pairs = [*self._alert_head("CCL_ALERT", frame, src), ("Heading", num(frame.heading))]
         for n, c in enumerate(frame.contacts, start=1):
             pairs += [
                 (f"Contact{n}Id", c.id),

@@ -154,7 +154,7 @@ class ProtoLoader:
             out = os.path.join(tmp, "set.pb")
             args = ["protoc", *(f"-I{d}" for d in search)]
             args += [f"--descriptor_set_out={out}", "--include_imports", name]
-            with _captured_stderr() as err:
+            with _CapturedStderr() as err:
                 status = protoc.main(args)
             if status != 0:
                 raise ProtoError(f"protoc failed on {name}:\n{err.read().strip()}")
@@ -205,7 +205,7 @@ class ProtoLoader:
         return [self.load_file(p, dirs) for p in paths]
 
 
-class _captured_stderr:
+class _CapturedStderr:
     """protoc writes its diagnostics to fd 2; capture them for the error message."""
 
     def __enter__(self) -> IO[str]:

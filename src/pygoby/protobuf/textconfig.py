@@ -42,7 +42,7 @@ def merge_config_text(
     *,
     file: str | os.PathLike[str] | None = None,
     first_line: int = 1,
-    parser: text_format._Parser | None = None,  # noqa: SLF001 - a parser with its own rules
+    parser: text_format._Parser | None = None,
     error: type[ConfigError] = ConfigError,
 ) -> None:
     """Merge TextFormat `text` (starting at `first_line` of `file`) into `message`; problems

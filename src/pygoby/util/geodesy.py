@@ -12,7 +12,7 @@ from pyproj import Transformer
 
 
 def utm_zone(lon: float) -> int:
-    return int(math.floor((lon + 180.0) / 6.0)) % 60 + 1
+    return math.floor((lon + 180.0) / 6.0) % 60 + 1
 
 
 class UTMGeodesy:

@@ -39,10 +39,11 @@ from google.protobuf.message import Message
 REPO = Path(__file__).resolve().parents[3]
 sys.path[:0] = [str(REPO / "src"), str(REPO)]
 
-from pygoby.dccl.options import field_extension, field_options, message_options  # noqa: E402
-from pygoby.protobuf import ProtoLoader  # noqa: E402
 from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_extensions_pb2 import ArithmeticOptions  # noqa: E402
 from pygoby.protobuf.dccl.ccl.protobuf.ccl_extensions_pb2 import LegacyCCLFieldOptions  # noqa: E402
+
+from pygoby.dccl.options import field_extension, field_options, message_options  # noqa: E402
+from pygoby.protobuf import ProtoLoader  # noqa: E402
 from tests.dccl.recorded import (  # noqa: E402
     LIBRARIES,
     MODELS,
@@ -278,7 +279,7 @@ class Values:
             v = rng.uniform(lo, hi)
         if integer:
             lim = INT_LIMITS[f.cpp_type]
-            return max(lim[0], min(lim[1], int(math.floor(v + 0.5))))
+            return max(lim[0], min(lim[1], math.floor(v + 0.5)))
         return v
 
     def native(self, f: FieldDescriptor):
@@ -335,7 +336,7 @@ class Values:
                 if f.cpp_type in (FieldDescriptor.CPPTYPE_UINT32, FieldDescriptor.CPPTYPE_UINT64)
                 else -(2**31)
             )
-            v = max(lo, int(math.floor(v + 0.5)))
+            v = max(lo, math.floor(v + 0.5))
         if self.avoid_top and (bounds[-2] + bounds[-1]) / 2 <= v <= bounds[-1]:
             return bounds[-2]
         return v

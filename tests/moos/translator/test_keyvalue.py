@@ -103,7 +103,7 @@ def test_short_enum_round_trip_and_middle_removal(msgs):
 
 
 def test_virtual_fields_appended(msgs, Entry):
-    def Alg(name, out, primary, refs=()):  # noqa: N802
+    def Alg(name, out, primary, refs=()):
         return Entry.PublishSerializer.Algorithm(
             name=name, output_virtual_field=out, primary_field=primary, reference_field=refs
         )

@@ -148,7 +148,7 @@ class _Common:
     def __init__(self, **fields):
         self._fields = fields
 
-    def HasField(self, name):  # noqa: N802 - protobuf spelling
+    def HasField(self, name):
         return name in self._fields
 
     def __getattr__(self, name):

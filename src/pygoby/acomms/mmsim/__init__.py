@@ -12,10 +12,10 @@ from pygoby.acomms.mmsim.model import MicroModemModel
 
 __all__ = [
     "AcousticPacket",
-    "ModemChannel",
     "ChannelEndpoint",
     "LoopbackChannel",
     "MicroModemModel",
+    "ModemChannel",
     "ModemPacketKind",
     "ModemReception",
 ]

@@ -746,7 +746,7 @@ def _cst_values(stats: tuple[tuple[str, float], ...]) -> tuple:
         elif i == DOPPLER_INDEX:
             values[i] = round(value, 1)
         else:
-            values[i] = value if type(value) is int else int(round(value))
+            values[i] = value if type(value) is int else round(value)
     return tuple(values)
 
 

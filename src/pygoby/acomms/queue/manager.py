@@ -467,8 +467,7 @@ class QueueManager:
         if (
             request.HasField("dest")
             and request.dest != acomms_pb.QUERY_DESTINATION_ID
-            and item.dest != acomms_pb.BROADCAST_ID
-            and item.dest != request.dest
+            and item.dest not in (acomms_pb.BROADCAST_ID, request.dest)
         ):
             return f"next message for {item.dest}, not {request.dest}"
         if (

@@ -81,7 +81,7 @@ def timestamp_us(getter: RoleGetter, msg: Message) -> int | None:
     if getter.kind == FieldDescriptor.TYPE_DOUBLE:
         if not math.isfinite(value):
             raise RoleError(f"TIMESTAMP field {'.'.join(getter.path or ())} is {value}, not a time")
-        return int(round(value * 1e6))  # keep sub-second precision (Q-ACOMMS-10)
+        return round(value * 1e6)  # keep sub-second precision (Q-ACOMMS-10)
     try:
         parsed = dt.datetime.fromisoformat(str(value).replace("Z", "+00:00"))
     except ValueError:
@@ -90,4 +90,4 @@ def timestamp_us(getter: RoleGetter, msg: Message) -> int | None:
         ) from None
     if parsed.tzinfo is None:
         parsed = parsed.replace(tzinfo=dt.UTC)
-    return int(round(parsed.timestamp() * 1e6))
+    return round(parsed.timestamp() * 1e6)

@@ -352,7 +352,7 @@ class State(CCLFrame):
     latitude: float = 0.0
     longitude: float = 0.0
     fix_age: int = 0  # seconds, 4 s steps, at most 1020
-    time: TimeDate = TimeDate()
+    time: TimeDate = field(default_factory=TimeDate)
     heading: float = 0.0
     depth: float = 0.0
     mission_mode: int = 0  # 3 bits (CCLMDATState.MissionMode)
@@ -365,7 +365,7 @@ class State(CCLFrame):
     lat_goal: float = 0.0
     lon_goal: float = 0.0
     battery_percent: int = 0
-    gfi_pitch_oil: GFIPitchOil = GFIPitchOil()
+    gfi_pitch_oil: GFIPitchOil = field(default_factory=GFIPitchOil)
 
     ID = MDAT_STATE
     NAME = "MDAT_STATE"
@@ -617,7 +617,7 @@ class Alert(_AlertBase):
     latitude: float = 0.0
     longitude: float = 0.0
     heading: float = 0.0
-    contacts: list[AlertContact] = _contacts(AlertContact)
+    contacts: list[AlertContact] = _contacts(AlertContact)  # noqa: RUF009 (a default_factory)
     mode: int = MDAT_OASIS  # the id byte
 
     ID = None
@@ -645,7 +645,7 @@ class Alert2(_AlertBase):
     oasis_time: int = 0
     latitude: float = 0.0
     longitude: float = 0.0
-    contacts: list[Alert2Contact] = _contacts(Alert2Contact)
+    contacts: list[Alert2Contact] = _contacts(Alert2Contact)  # noqa: RUF009 (a default_factory)
     mode: int = MDAT_OASIS
 
     ID = None
@@ -676,11 +676,7 @@ def decode_frame(data: bytes) -> CCLFrame:
 
 __all__ = [
     "BY_ID",
-    "CCLEncodeError",
-    "CCLFrame",
-    "CCLFrameError",
     "FRAME_BYTES",
-    "GFIPitchOil",
     "LATLON_STEP",
     "MDAT_OASIS",
     "MDAT_POSITION",
@@ -695,6 +691,10 @@ __all__ = [
     "Alert2",
     "Alert2Contact",
     "AlertContact",
+    "CCLEncodeError",
+    "CCLFrame",
+    "CCLFrameError",
+    "GFIPitchOil",
     "Position",
     "Ranger",
     "Redirect",

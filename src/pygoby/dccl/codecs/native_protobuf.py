@@ -22,7 +22,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from google.protobuf.descriptor import EnumValueDescriptor
-from google.protobuf.descriptor import FieldDescriptor as FD
+from google.protobuf.descriptor import FieldDescriptor as FD  # noqa: N817 (the tables read as C++ DCCL's)
 
 from pygoby.dccl.codecs.base import FieldCodec, FieldInfo
 from pygoby.dccl.errors import DcclDecodeError, DcclLoadError

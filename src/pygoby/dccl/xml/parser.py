@@ -184,7 +184,7 @@ SCHEMA: dict[str, tuple[Occurs, frozenset[str]]] = {
     "src_id": (_HEADER_PIECE, frozenset({"algorithm"})),
     "dest_id": (_HEADER_PIECE, frozenset({"algorithm"})),
     "layout": (
-        {k: (0, None) for k in ("static", "int", "bool", "float", "string", "hex", "enum")},
+        dict.fromkeys(("static", "int", "bool", "float", "string", "hex", "enum"), (0, None)),
         frozenset(),
     ),
     "static": ({"name": (1, 1), "value": (1, 1)}, frozenset({"algorithm"})),
@@ -212,9 +212,8 @@ SCHEMA: dict[str, tuple[Occurs, frozenset[str]]] = {
         frozenset(),
     ),
     "queuing": (
-        {
-            k: (0, 1)
-            for k in (
+        dict.fromkeys(
+            (
                 "ack",
                 "blackout_time",
                 "max_queue",
@@ -223,8 +222,9 @@ SCHEMA: dict[str, tuple[Occurs, frozenset[str]]] = {
                 "newest_first",
                 "priority_base",
                 "priority_time_const",
-            )
-        },
+            ),
+            (0, 1),
+        ),
         frozenset(),
     ),
 }
@@ -435,7 +435,7 @@ class _Reader:
         header_groups = (
             self.check_structure(groups["header"][0], context) if "header" in groups else {}
         )
-        ids = [e for e in (groups.get("id", []) + header_groups.get("id", []))]
+        ids = list(groups.get("id", []) + header_groups.get("id", []))
         if not ids:
             raise self.error(element.line, f"{context} needs an <id> (in <message> or <header>)")
         if len(ids) > 1:

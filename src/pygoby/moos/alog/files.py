@@ -33,7 +33,7 @@ def open_text_or_gz(path: str | os.PathLike[str]) -> IO[bytes]:
     path = Path(path)
     if path.suffix == ".gz":
         return gzip.open(path, "rb")  # type: ignore[return-value]
-    return open(path, "rb")  # noqa: SIM115 - closed by the caller
+    return open(path, "rb")
 
 
 class AlogFile:

@@ -52,7 +52,7 @@ def receive_statistics(
     # (enum fields given by name, as protobuf's constructors take them)
     fields: dict[str, Any] = dict(
         mode=mode,
-        time=int(round(reception.arrival * 1e6)),
+        time=round(reception.arrival * 1e6),
         clock_mode=clock_mode,
         shf_agn=250,
         rate=_clamp(tx.rate, -1, 6),
@@ -95,18 +95,18 @@ def link_statistics(
 def _level_statistics(
     snr: float, received_level: float, noise_level: float, carrier_hz: float, bandwidth_hz: float
 ) -> dict[str, float]:
-    return dict(
-        mfd_power=_clamp(snr / 2, -30, 40),
-        mfd_ratio=_clamp(10 ** (min(snr, 40) / 10) * 10, 0, 16383),
-        spl=round(received_level),
-        snr_rss=_clamp(received_level - noise_level, 0, 255),
-        snr_in=_clamp(snr, -10, 30),
-        snr_out=_clamp(snr + 10, 0, 25),
-        snr_symbols=_clamp(snr + 10, 0, 30),
-        mse_equalizer=_clamp(-snr, -30, 5),
-        data_quality_factor=_clamp(snr * 10, 0, 255),
-        doppler=0.0,  # (set by link_statistics: keeps the fields in $CACST order)
-        stddev_noise=_clamp(noise_level - 40, 0, 255),
-        carrier_freq=_clamp(carrier_hz, 100, 30000),
-        bandwidth=_clamp(bandwidth_hz, 1000, 5000),
-    )
+    return {
+        "mfd_power": _clamp(snr / 2, -30, 40),
+        "mfd_ratio": _clamp(10 ** (min(snr, 40) / 10) * 10, 0, 16383),
+        "spl": round(received_level),
+        "snr_rss": _clamp(received_level - noise_level, 0, 255),
+        "snr_in": _clamp(snr, -10, 30),
+        "snr_out": _clamp(snr + 10, 0, 25),
+        "snr_symbols": _clamp(snr + 10, 0, 30),
+        "mse_equalizer": _clamp(-snr, -30, 5),
+        "data_quality_factor": _clamp(snr * 10, 0, 255),
+        "doppler": 0.0,  # (set by link_statistics: keeps the fields in $CACST order)
+        "stddev_noise": _clamp(noise_level - 40, 0, 255),
+        "carrier_freq": _clamp(carrier_hz, 100, 30000),
+        "bandwidth": _clamp(bandwidth_hz, 1000, 5000),
+    }

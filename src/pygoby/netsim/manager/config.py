@@ -63,7 +63,7 @@ def config_class() -> type[NetSimManagerConfig]:
     return NetSimManagerConfig
 
 
-class _Parser(text_format._Parser):  # noqa: SLF001 - per-message control of unknown fields
+class _Parser(text_format._Parser):
     """TextFormat parser that skips unknown fields only inside the open upstream blocks."""
 
     def _MergeField(self, tokenizer, message):  # noqa: N802 - overrides protobuf's method

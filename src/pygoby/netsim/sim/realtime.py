@@ -103,7 +103,7 @@ class RealTimeRun:
         """Run for the scenario's duration (simulated seconds) or until `request_stop`;
         `progress()` is called at every round (a few hundred a second)."""
         sim = self.sim
-        sim._wall_start = time.perf_counter()  # noqa: SLF001 - the run owns its summary
+        sim._wall_start = time.perf_counter()
         end = sim.start + sim.scenario.duration
         next_position = self.clock.now() + sim.scenario.position_period
         next_housekeeping = self.clock.now() + sim.scenario.housekeeping_period

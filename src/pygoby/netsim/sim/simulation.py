@@ -371,8 +371,7 @@ class Simulation:
             timed = timeline.next_time()
             if timed is not None and timed < t:
                 t = timed
-            if slot + SLOT_EPSILON < t:
-                t = slot + SLOT_EPSILON
+            t = min(t, slot + SLOT_EPSILON)
             clock.set(max(t, now))
             now = clock.now()
             if now >= next_position:

@@ -17,13 +17,14 @@ from __future__ import annotations
 import asyncio
 from collections import deque
 from collections.abc import Callable
+from typing import ClassVar
 
 from pygoby.util.extras import needs_extra
 
 with needs_extra("topside", "iCommander's terminal interface"):
     from textual import events
     from textual.app import App, ComposeResult
-    from textual.binding import Binding
+    from textual.binding import Binding, BindingType
     from textual.containers import Vertical, VerticalScroll
     from textual.message_pump import MessagePump
     from textual.screen import ModalScreen, Screen
@@ -82,7 +83,7 @@ class FieldInput(Input):
     """A field's box: Up/Down and Tab move between fields (an enclosing scroll view must not
     take them to scroll, which left the focus, and so the typing, in a field out of view)."""
 
-    BINDINGS = [
+    BINDINGS: ClassVar[list[BindingType]] = [
         Binding("down", "app.focus_next", "Next field"),
         Binding("up", "app.focus_previous", "Previous field"),
     ]
@@ -95,7 +96,7 @@ class FieldList(VerticalScroll, can_focus=False):
 class Menu(ModalScreen[str | None]):
     """A titled list of choices; Enter picks, Escape cancels."""
 
-    BINDINGS = [Binding("escape", "dismiss_none", "Back")]
+    BINDINGS: ClassVar[list[BindingType]] = [Binding("escape", "dismiss_none", "Back")]
 
     def __init__(self, title: str, choices: list[tuple[str, str]], menu_id: str) -> None:
         super().__init__(id=menu_id)
@@ -117,7 +118,7 @@ class Menu(ModalScreen[str | None]):
 class Prompt(ModalScreen[str | None]):
     """One line of input (a file name)."""
 
-    BINDINGS = [Binding("escape", "dismiss_none", "Cancel")]
+    BINDINGS: ClassVar[list[BindingType]] = [Binding("escape", "dismiss_none", "Cancel")]
 
     def __init__(self, title: str, prompt_id: str) -> None:
         super().__init__(id=prompt_id)

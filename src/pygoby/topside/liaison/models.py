@@ -216,7 +216,7 @@ class AcommsModel:
             try:
                 cls = self.codec.load(resolve(entry.protobuf_name))
                 dccl_id = self.codec.compiled(cls).id
-            except Exception:  # noqa: BLE001 - a type pAcommsHandler skips too; shown without id
+            except Exception:
                 pass
             self.queues[entry.protobuf_name] = QueueState(
                 entry.protobuf_name, dccl_id, entry, last_sent=now
@@ -265,7 +265,7 @@ class AcommsModel:
         out = cls()
         try:
             parse_for_moos(value, out)
-        except Exception:  # noqa: BLE001 - bad mail is skipped, never kills the page
+        except Exception:
             return None
         return out
 
@@ -305,7 +305,7 @@ class AcommsModel:
             while offset < len(data):
                 try:
                     msg, used = self.codec.decode_prefix(data[offset:])
-                except (DcclError, Exception):  # noqa: BLE001 - unknown or encrypted frame
+                except (DcclError, Exception):
                     names.append(self._ccl_name(data) if offset == 0 else "?")
                     break
                 names.append(msg.DESCRIPTOR.full_name)
@@ -564,7 +564,7 @@ class MapModel:
         transmission = acomms_pb.ModemTransmission()
         try:
             parse_for_moos(value, transmission)
-        except Exception:  # noqa: BLE001 - bad mail is skipped
+        except Exception:
             return
         if transmission.type == acomms_pb.ModemTransmission.ACK and not received:
             return

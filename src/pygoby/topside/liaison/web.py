@@ -290,7 +290,7 @@ class AccessGuard:
             await self.app(scope, receive, send)
             return
         request = Request(scope)
-        headers = {k: v for k, v in request.headers.items()}
+        headers = dict(request.headers.items())
         query = scope.get("query_string", b"").decode("latin-1")
         refusal = self.access.refusal(scope["method"], headers, query, request.cookies)
         if refusal is not None:

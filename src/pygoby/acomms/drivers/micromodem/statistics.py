@@ -92,7 +92,7 @@ class CycleStatistics:
     the text is: a version-0 time is a time of day on the reader's date. `values`: mfd_peak ..
     bandwidth in $CACST order, doppler to 0.1, the rest integers (see `cycle_statistics`)."""
 
-    __slots__ = ("version", "mode", "toa_us", "clock_mode", "values")
+    __slots__ = ("clock_mode", "mode", "toa_us", "values", "version")
     talker_id = "CA"
     sentence_id = "CST"
 
