@@ -39,11 +39,10 @@ from google.protobuf.message import Message
 REPO = Path(__file__).resolve().parents[3]
 sys.path[:0] = [str(REPO / "src"), str(REPO)]
 
-from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_extensions_pb2 import ArithmeticOptions  # noqa: E402
-from pygoby.protobuf.dccl.ccl.protobuf.ccl_extensions_pb2 import LegacyCCLFieldOptions  # noqa: E402
-
 from pygoby.dccl.options import field_extension, field_options, message_options  # noqa: E402
 from pygoby.protobuf import ProtoLoader  # noqa: E402
+from pygoby.protobuf.dccl.arithmetic.protobuf.arithmetic_extensions_pb2 import ArithmeticOptions  # noqa: E402
+from pygoby.protobuf.dccl.ccl.protobuf.ccl_extensions_pb2 import LegacyCCLFieldOptions  # noqa: E402
 from tests.dccl.recorded import (  # noqa: E402
     LIBRARIES,
     MODELS,
