@@ -88,12 +88,13 @@ def test_pygoby_publishes_what_goby3_published(case, loaders):
         assert post.source_aux == recorded["src_aux"], var
 
 
-# What pygoby creates where goby3 died (QUIRKS.md Q-APPS-31): `%116.1%` on a repeated enum
-# pads with the enum's first value, as other repeated fields pad with their default, and sets
-# index 1 (to the enum's first value when the input has no name of it).
+# What pygoby creates where goby3 died (QUIRKS.md Q-APPS-10): `%116%` appends the names;
+# `%116.1%` pads with the enum's first value, as other repeated fields pad with their default,
+# and sets index 1 (to the enum's first value when the input has no name of it).
 AFTER_GOBY3_CRASH = {
     "format_repeated_enum_index_empty": "enum_default_repeat={ENUM_A,ENUM_A}",
     "format_repeated_enum_index_given": "enum_default_repeat={ENUM_A,ENUM_B}",
+    "format_repeated_enum_append": "enum_default_repeat={ENUM_A,ENUM_C}",
 }
 
 
