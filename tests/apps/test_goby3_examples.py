@@ -170,7 +170,8 @@ async def test_dual_status_mission_runs_with_paths_changed(tmp_path):
 async def test_ccl_and_dccl_mission_runs_with_paths_changed(tmp_path):
     # Vehicle 2 never has DEPTH (the example initialises it on vehicle 1 only), so its create
     # rule `depth:=%14%` matches nothing: goby3 still creates the SimpleStatus (depth NaN, the
-    # rest filled) and sends it, and so do we, with one warning.
+    # rest filled) and sends it, and so do we, with one warning. goby3's pTranslator's output
+    # for this entry is recorded in tests/data/goby3 (test_goby3_recorded.py).
     missions = copy_mission(tmp_path, random.randint(40000, 60000), CCL_DATA)
     with_proto_file(missions)
     # 10 s TDMA slots each, a message every 5 s: one cycle (20 s) plus start-up

@@ -147,11 +147,15 @@ def test_parse_short_enum(msgs):
     assert out.deploy_mode == 2
 
 
-def test_parse_bytes_and_submessage_hex(msgs):
+def test_parse_bytes_as_text_and_submessage_hex(msgs):
+    # goby3's FORMAT create puts the text itself in a bytes field (its publish and key=value
+    # create use hex); an embedded message is hex of its encoding.
     out = msgs.TestMsg()
-    fmt.parse("01ab;09000000000000f03f", out, "%15%;%17%")
-    assert out.bytes_default_optional == b"\x01\xab"
+    fmt.parse("01ab;09000000000000f03f;é", out, "%15%;%17%;%115%")
+    assert out.bytes_default_optional == b"01ab"
     assert out.msg_default_optional.val == 1
+    assert out.bytes_default_repeat[:] == ["é".encode()]
+    assert fmt.serialize(out, "%15%") == "30316162"
 
 
 def test_a_literal_missing_from_the_input_skips_nothing_and_parsing_goes_on(msgs):

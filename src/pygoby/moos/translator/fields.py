@@ -102,8 +102,12 @@ _TYPE_DEFAULTS = {
 }
 
 
-def value_from_string(field: AnyFieldDescriptor, text: str, use_short_enum: bool):
-    """Convert `text` to a scalar value for `field` (not for message fields)."""
+def value_from_string(
+    field: AnyFieldDescriptor, text: str, use_short_enum: bool, *, bytes_in_hex: bool = True
+):
+    """Convert `text` to a scalar value for `field` (not for message fields). A bytes field
+    reads `text` as hex, or with `bytes_in_hex=False` as the text's own UTF-8 bytes (goby3's
+    FORMAT create: QUIRKS.md Q-APPS-31)."""
     cpp = field.cpp_type
     if cpp in INT_KINDS:
         if is_integer_literal(text) and significant_digits(text) > MAX_INT_DIGITS:
@@ -118,7 +122,7 @@ def value_from_string(field: AnyFieldDescriptor, text: str, use_short_enum: bool
         return as_bool(text)
     if cpp == FieldDescriptor.CPPTYPE_STRING:
         if is_bytes(field):
-            return hex_decode(text)
+            return hex_decode(text) if bytes_in_hex else text.encode("utf-8", "surrogateescape")
         try:
             text.encode("utf-8")
         except UnicodeEncodeError:
@@ -152,20 +156,34 @@ def parse_message_bytes(target: Message, data: bytes, where: str) -> None:
 
 
 def set_from_string(
-    msg: Message, field: AnyFieldDescriptor, text: str, use_short_enum: bool
+    msg: Message,
+    field: AnyFieldDescriptor,
+    text: str,
+    use_short_enum: bool,
+    *,
+    bytes_in_hex: bool = True,
 ) -> None:
     """Set singular `field` of `msg` from `text` (message fields: hex of the binary encoding)."""
     if is_message(field):
         parse_message_bytes(getattr(msg, field.name), hex_decode(text), field.name)
         return
     try:
-        setattr(msg, field.name, value_from_string(field, text, use_short_enum))
+        setattr(
+            msg,
+            field.name,
+            value_from_string(field, text, use_short_enum, bytes_in_hex=bytes_in_hex),
+        )
     except UnconvertibleError as exc:
         log.warning("field %s: %s; field left unchanged", field.name, exc)
 
 
 def append_from_string(
-    msg: Message, field: AnyFieldDescriptor, text: str, use_short_enum: bool
+    msg: Message,
+    field: AnyFieldDescriptor,
+    text: str,
+    use_short_enum: bool,
+    *,
+    bytes_in_hex: bool = True,
 ) -> None:
     """Append one element parsed from `text` to repeated `field`."""
     container = getattr(msg, field.name)
@@ -173,13 +191,19 @@ def append_from_string(
         parse_message_bytes(container.add(), hex_decode(text), field.name)
         return
     try:
-        container.append(value_from_string(field, text, use_short_enum))
+        container.append(value_from_string(field, text, use_short_enum, bytes_in_hex=bytes_in_hex))
     except UnconvertibleError as exc:
         log.warning("field %s: %s; element skipped", field.name, exc)
 
 
 def set_element_from_string(
-    msg: Message, field: AnyFieldDescriptor, index: int, text: str, use_short_enum: bool
+    msg: Message,
+    field: AnyFieldDescriptor,
+    index: int,
+    text: str,
+    use_short_enum: bool,
+    *,
+    bytes_in_hex: bool = True,
 ) -> None:
     """Set element `index` of repeated `field`, padding with default values as needed."""
     container = getattr(msg, field.name)
@@ -191,6 +215,6 @@ def set_element_from_string(
     while len(container) <= index:
         container.append(default_value(field))
     try:
-        container[index] = value_from_string(field, text, use_short_enum)
+        container[index] = value_from_string(field, text, use_short_enum, bytes_in_hex=bytes_in_hex)
     except UnconvertibleError as exc:
         log.warning("field %s[%d]: %s; element left unchanged", field.name, index, exc)

@@ -354,13 +354,15 @@ def _parse_directive(extract, msg: Message, spec, delimiter, algorithms, short, 
     for algorithm in algorithms:
         if algorithm.primary_field == field.number:
             extract = (registry or AlgorithmRegistry()).run(algorithm.name, extract)
+    # A bytes field takes the text itself, not hex (goby3: QUIRKS.md Q-APPS-31); enums are
+    # appended and indexed like every other type (goby3 aborts on a repeated enum: Q-APPS-10).
     if index is not None and field.is_repeated:
-        set_element_from_string(msg, field, index, extract, short)
+        set_element_from_string(msg, field, index, extract, short, bytes_in_hex=False)
     elif field.is_repeated:
         parts = re.split("[" + re.escape(delimiter) + "]", extract) if delimiter else [extract]
-        for part in parts:  # enums too (goby3 aborts on a repeated enum: QUIRKS.md Q-APPS-10)
-            append_from_string(msg, field, part, short)
+        for part in parts:
+            append_from_string(msg, field, part, short, bytes_in_hex=False)
     elif is_message(field):
         parse_message_bytes(getattr(msg, field.name), hex_decode(extract), field.name)
     else:
-        set_from_string(msg, field, extract, short)
+        set_from_string(msg, field, extract, short, bytes_in_hex=False)
