@@ -337,6 +337,33 @@ def test_convert(
     assert msg["value_double"] in (None, "")
 
 
+def _records(path: Path) -> list[dict]:
+    if path.suffix == ".csv":
+        with open(path) as f:
+            return list(csv.DictReader(f))
+    if path.suffix == ".jsonl":
+        return [json.loads(line) for line in path.read_text().splitlines()]
+    return pq.read_table(path).to_pylist()
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".jsonl", ".parquet"])
+def test_convert_in_parallel_gives_the_same_output(
+    alog: Path, tmp_path: Path, suffix: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    part = tmp_path / "part.alog"
+    assert pygoby_main(["log", "clip", str(alog), "2", "4", "-o", str(part)]) == 0
+    inputs = [str(alog), str(part), str(alog)]  # 30 + 7 + 30 rows, in this order
+    serial, parallel = tmp_path / f"serial{suffix}", tmp_path / f"parallel{suffix}"
+    assert pygoby_main(["log", "convert", *inputs, "-o", str(serial)]) == 0
+    capsys.readouterr()
+    assert pygoby_main(["log", "convert", *inputs, "-o", str(parallel), "-j", "2"]) == 0
+    assert capsys.readouterr().out == f"{parallel}: 67 rows\n"
+    records = _records(parallel)
+    assert records == _records(serial) and len(records) == 67
+    assert all(2 <= float(r["time"]) <= 4 for r in records[30:37])  # the clip, second
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # parts removed
+
+
 def test_convert_refuses_unknown_formats(alog: Path, tmp_path: Path) -> None:
     with pytest.raises(LogToolError, match=r"unknown output format '\.xlsx'"):
         convert([alog], tmp_path / "x.xlsx")

@@ -3,7 +3,7 @@
   pygoby log grep FILE VAR... [--source S]       entries of these variables (VAR* = prefix)
   pygoby log summary FILE                        per variable: lines, first/last time, rate, sources
   pygoby log clip FILE T0 T1 -o OUT.alog         the entries between two log times
-  pygoby log convert FILE... -o OUT.parquet      one row per message (.parquet, .csv or .jsonl)
+  pygoby log convert FILE... -o OUT.parquet [-j N]  one row per message (.parquet, .csv, .jsonl)
   pygoby log replay FILE --port P [--warp W]     post the messages into a MOOSDB, original spacing
 
 Damaged lines are skipped; their count is printed on stderr.
@@ -73,6 +73,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     convert = actions.add_parser("convert", help="to Parquet, CSV or JSON lines")
     convert.add_argument("files", nargs="+", metavar="FILE")
     convert.add_argument("-o", "--output", required=True, help="OUT.parquet, OUT.csv or OUT.jsonl")
+    convert.add_argument(
+        "-j",
+        "--jobs",
+        type=int,
+        default=1,
+        metavar="N",
+        help="convert up to N files at once, in parallel processes (the output is the same)",
+    )
     convert.set_defaults(func=convert_command)
 
     replay = actions.add_parser("replay", help="post a log's messages into a MOOSDB (uPlayBack)")
@@ -144,7 +152,7 @@ def convert_command(args: argparse.Namespace) -> int:
         if sys.stderr.isatty():
             sys.stderr.write(f"\r{rows} rows")
 
-    count = convert(args.files, args.output, progress)
+    count = convert(args.files, args.output, progress, jobs=args.jobs)
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     print(f"{args.output}: {count} rows")

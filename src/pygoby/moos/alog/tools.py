@@ -12,8 +12,10 @@ import logging
 import math
 import os
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
@@ -184,15 +186,68 @@ def convert(
     paths: Sequence[str | os.PathLike[str]],
     output: str | os.PathLike[str],
     progress: Callable[[int], None] | None = None,
+    jobs: int = 1,
 ) -> int:
-    """Write every entry of `paths` to `output` (.parquet, .csv or .jsonl); returns the rows."""
+    """Write every entry of `paths` to `output` (.parquet, .csv or .jsonl), file after file;
+    returns the rows. With `jobs` > 1 and several files, each file is converted in its own
+    process (at most `jobs` at once) to a part beside `output`, and the parts are then joined
+    in the files' order: the output is the same as with one job."""
     suffix = Path(output).suffix.lower()
     writer = {".parquet": _write_parquet, ".csv": _write_csv, ".jsonl": _write_jsonl}.get(suffix)
     if writer is None:
         raise LogToolError(
             f"{output}: unknown output format {suffix!r} (use {', '.join(CONVERT_FORMATS)})"
         )
-    return writer(rows(paths), Path(output), progress or (lambda n: None))
+    report = progress or (lambda n: None)
+    if jobs <= 1 or len(paths) <= 1:
+        return writer(rows(paths), Path(output), report)
+    return _convert_in_parallel(paths, Path(output), report, jobs)
+
+
+def _convert_in_parallel(
+    paths: Sequence[str | os.PathLike[str]],
+    output: Path,
+    progress: Callable[[int], None],
+    jobs: int,
+) -> int:
+    with tempfile.TemporaryDirectory(prefix=f".{output.name}.", dir=output.parent) as parts_dir:
+        parts = [Path(parts_dir) / f"{index}{output.suffix}" for index in range(len(paths))]
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            futures = [
+                pool.submit(convert, [path], part) for path, part in zip(paths, parts, strict=True)
+            ]
+            done = 0
+            for future in futures:  # raises the first failure, in the files' order
+                done += future.result()
+                progress(done)
+        return _join_parts(parts, output)
+
+
+def _join_parts(parts: Sequence[Path], output: Path) -> int:
+    """Concatenate converted parts (same format as `output`) into `output`, streaming."""
+    count = 0
+    if output.suffix.lower() == ".parquet":
+        import pyarrow.parquet as pq
+
+        schema = pq.read_schema(parts[0])
+        with pq.ParquetWriter(output, schema) as writer:
+            for part in parts:
+                source = pq.ParquetFile(part)
+                for group in range(source.num_row_groups):
+                    table = source.read_row_group(group)
+                    writer.write_table(table)
+                    count += table.num_rows
+        return count
+    header_lines = 1 if output.suffix.lower() == ".csv" else 0
+    with open(output, "wb") as out:
+        for index, part in enumerate(parts):
+            with open(part, "rb") as source:
+                for number, line in enumerate(source):
+                    if number < header_lines and index > 0:
+                        continue  # one CSV header, the first part's
+                    out.write(line)
+                    count += number >= header_lines
+    return count
 
 
 def _write_csv(source: Iterator[tuple], path: Path, progress: Callable[[int], None]) -> int:
