@@ -7,7 +7,8 @@
                                                  one row per message (.parquet, .csv, .jsonl)
   pygoby log replay FILE --port P [--warp W]     post the messages into a MOOSDB, original spacing
 
-Damaged lines are skipped; their count is printed on stderr.
+Damaged lines are skipped; their count is printed on stderr. (The command line lives with the
+apps: `--mission` wires the .alog tools of moos to moosacomms' decoding.)
 """
 
 from __future__ import annotations
@@ -164,8 +165,7 @@ def convert_command(args: argparse.Namespace) -> int:
 
     decoder = None
     if args.mission is not None:
-        # the command line wires the layers: the decoding is acomms-on-MOOS's
-        from pygoby.moosacomms.alog_decode import MissionDecoder
+        from pygoby.moosacomms.alog_decode import MissionDecoder  # only when asked for
 
         MissionDecoder(args.mission, args.block)  # configuration errors now, not in a worker
         decoder = functools.partial(MissionDecoder, args.mission, args.block)
