@@ -4,7 +4,9 @@ tests/data/frontseat/bluefin_goby3_exchange.txt.
 The record comes from a run of goby3 3.1.5a's C++ iFrontSeat with its bluefin plug-in
 (libgoby_frontseat_bluefin.so.30, built outside the repository) and the C++ MOOSDB, connected to
 `bluefin_frontseat_simulator` (nav 2 Hz) stepped on a 0.1 s grid kept to wall time, while
-pHelmIvP was played by posting IVPHELM_STATE=DRIVE and DESIRED_HEADING/SPEED/DEPTH three times.
+pHelmIvP was played by posting IVPHELM_STATE=DRIVE and DESIRED_HEADING/SPEED/DEPTH three times,
+and the legacy MOOS variables asked for trim, buoyancy, a CTD sample, silent mode, an acoustic
+message and the end of the payload behaviour (the record's header lists the posts).
 Its lines are `<t> < <sentence>` (goby3 to the simulator), `<t> > <sentence>` (the simulator to
 goby3), `<t> + connect` and `<t> - disconnect`, t in s after the UNIX time on the `# T0` line.
 
@@ -79,3 +81,13 @@ def test_goby3s_driver_took_control_and_followed_the_helm():
     # heading, depth, depth kind of each leg the helm asked for, in order
     legs = [["90", "10", "0"], ["180", "20", "0"], ["270", "5", "0"]]
     assert [leg for leg in legs if leg in set_points] == legs
+    # every extra command of goby3's legacy translator reached the simulator and was done (2)
+    for kind in ("TRM", "BOY", "CTD", "SIL", "TMR", "RCE"):
+        assert any(line.startswith(f"$BP{kind},") for line in from_goby3), kind
+        assert any(
+            line.startswith("$BFACK,") and line.split(",")[2:6:3] == [kind, "2"]
+            for line in to_goby3
+        ), kind
+    assert any(line.startswith("$BFTRM,") for line in to_goby3)
+    assert any(line.startswith("$BFBOY,") for line in to_goby3)
+    assert any(line.startswith("$BFMIS,") and "Stopped" in line for line in to_goby3)
