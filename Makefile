@@ -24,8 +24,8 @@ protos: $(STAMP)
 	$(PY) -m pygoby.protobuf.generate
 
 demo: protos
-	$(PY) examples/two_vehicles/run_demo.py
 	$(PY) examples/frontseat/run_demo.py --warp 10 --duration 50
+	$(PY) examples/two_vehicles/run_demo.py  # last: it ends with where its logs are
 
 $(CHROMIUM):
 	command -v apt-get >/dev/null && (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) || echo "install chromium for liaison's browser tests"

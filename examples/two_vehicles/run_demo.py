@@ -10,10 +10,11 @@
    positions. The vehicles broadcast DCCL status reports; the topside sends acknowledged
    commands that send the AUV away, so travel times grow with range until packets are lost. A
    monitor client on each MOOSDB prints what happens, slot by slot; every acoustic transmission
-   and reception goes to an event log (`pygoby netsim report LOG` plots it).
+   and reception goes to an event log (`pygoby netsim report LOG` plots it), and each
+   community's pLogger writes its .alog (`pygoby log summary FILE` reads it).
 
     python examples/two_vehicles/run_demo.py [--warp 25] [--duration 720] [--event-log PATH]
-                                             [--skip-dccl]
+                                             [--log-dir DIR] [--skip-dccl]
 
 `run_mission()` is the reusable part (benchmarks/test_acomms_handler_bench.py uses it).
 """
@@ -142,6 +143,7 @@ class MissionResult:
     simulated_seconds: float
     real_seconds: float
     vehicles: list[VehicleStats]
+    alogs: list[Path] = field(default_factory=list)  # each community's pLogger .alog
 
     @property
     def delivered(self) -> int:
@@ -305,15 +307,18 @@ async def run_mission(
     say=print,
     mission_dir: Path = MISSION_DIR,
     event_log: Path | None = None,
+    log_dir: Path | None = None,
 ) -> MissionResult:
     """Run the two missions of `mission_dir` in this process for `duration` simulated seconds at
     MOOS time warp `warp` (embedded MOOSDBs, emulated Micro-Modems on ephemeral loopback ports
     hearing each other through netsim's physics at the vehicles' NAV_* positions), printing a
     summary line at every TDMA slot, and events, through `say`; the channel's events go to
-    `event_log` (JSON lines) if given."""
+    `event_log` (JSON lines) if given. With `log_dir`, each community's pLogger (from its
+    mission's block) writes its logs there instead of the block's PATH."""
     from pygoby.acomms.mmsim import MicroModemModel
     from pygoby.acomms.mmsim.server import MMSimServer
     from pygoby.apps.pacommshandler import pAcommsHandler
+    from pygoby.apps.plogger import pLogger
     from pygoby.apps.usimvehicle import uSimVehicle
     from pygoby.moos.db import MOOSDB
     from pygoby.moos.moosfile import MissionFile
@@ -328,6 +333,7 @@ async def run_mission(
         codec.load_proto(mission_dir / "two_vehicles.proto", name)
     stats = [VehicleStats(name, modem_id) for name, modem_id in VEHICLES]
     monitors = []
+    loggers: list[pLogger] = []
     real_start = time.monotonic()
     async with contextlib.AsyncExitStack() as stack:
         writer = None
@@ -356,7 +362,8 @@ async def run_mission(
             await monitor.start()
             stack.push_async_callback(monitor.client.close)
             monitors.append(monitor)
-            for app_class in (pAcommsHandler, uSimVehicle):
+            apps: tuple[type, ...] = (pAcommsHandler, uSimVehicle)
+            for app_class in apps + ((pLogger,) if log_dir is not None else ()):
                 cfg = app_class.read_config(mission, app_class.default_name)
                 cfg.common.time_warp_multiplier = int(warp)
                 cfg.common.verbosity = _QUIET  # the monitors report instead
@@ -370,6 +377,11 @@ async def run_mission(
                     mm_cfg = cfg.driver_cfg.Extensions[MM_CONFIG]
                     mm_cfg.nvram_cfg.append("DTO,30")
                 app = app_class(cfg, name=app_class.default_name, mission=mission, port=db.port)
+                if app_class is pLogger:
+                    # the block's `PATH = ./logs` would write into the current directory
+                    app.settings.path = str(log_dir)
+                    app.settings.summary_file = str(log_dir / f".LastOpenedMOOSLogDirectory_{name}")
+                    loggers.append(app)
                 await stack.enter_async_context(app)
         start = clock.now()
         reported = None
@@ -381,7 +393,8 @@ async def run_mission(
             await asyncio.sleep(0.02)
         simulated = clock.now() - start
         say(summary_line(simulated, monitors[0].slot, stats, tally.newest))
-    return MissionResult(simulated, time.monotonic() - real_start, stats)
+        alogs = [app.sink.alog_path for app in loggers if app.sink is not None]
+    return MissionResult(simulated, time.monotonic() - real_start, stats, alogs)
 
 
 def _position_feed(channel, port: int, geodesy):
@@ -424,12 +437,18 @@ def main(argv: list[str] | None = None) -> int:
         type=Path,
         help="acoustic event log to write (default: in a new temporary folder)",
     )
+    parser.add_argument(
+        "--log-dir",
+        type=Path,
+        help="where the pLoggers write (default: beside the event log)",
+    )
     parser.add_argument("--skip-dccl", action="store_true", help="skip the DCCL part")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR, format="%(name)s: %(message)s")
     event_log = (
         args.event_log or Path(tempfile.mkdtemp(prefix="pygoby-demo-")) / "netsim_events.jsonl"
     )
+    log_dir = args.log_dir or event_log.parent
     if not args.skip_dccl:
         print("== pygoby demo 1/2: DCCL ==\n")
         dccl_demo()
@@ -438,7 +457,9 @@ def main(argv: list[str] | None = None) -> int:
         f"(time warp {args.warp:g}) =="
     )
     print(MISSION_INTRO.format(**CHANNEL_SETTINGS, **RATE0_FRAME_ERRORS))
-    result = asyncio.run(run_mission(args.warp, args.duration, say=_say, event_log=event_log))
+    result = asyncio.run(
+        run_mission(args.warp, args.duration, say=_say, event_log=event_log, log_dir=log_dir)
+    )
     print(
         f"\n{result.simulated_seconds:.0f} simulated seconds in {result.real_seconds:.1f} s: "
         f"{result.delivered} messages delivered end to end "
@@ -455,6 +476,9 @@ def main(argv: list[str] | None = None) -> int:
         f"  plot it (success vs range and SNR, timeline): "
         f"pygoby netsim report {event_log} -o DIR"
     )
+    print(f"logs: {log_dir}")
+    for alog in result.alogs:
+        print(f"  {log_line(alog)}")
     topside, unicorn = result.vehicles
     ok = (
         topside.received["status"] > 0
@@ -467,6 +491,16 @@ def main(argv: list[str] | None = None) -> int:
         else "demo FAILED: expected statuses both ways and an acknowledged command"
     )
     return 0 if ok else 1
+
+
+def log_line(alog: Path) -> str:
+    """One line on a pLogger .alog: its lines and variables, and the command that says more."""
+    from pygoby.moos.alog.files import AlogFile
+    from pygoby.moos.alog.tools import summarize
+
+    table = summarize(AlogFile(alog))
+    lines = sum(row.count for row in table.values())
+    return f"{alog.name}: {lines} lines, {len(table)} variables; `pygoby log summary {alog}`"
 
 
 def _say(text: str) -> None:

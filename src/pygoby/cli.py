@@ -16,7 +16,7 @@ SUBCOMMAND_MODULES = [
     "pygoby.dccl.cli",
     "pygoby.acomms.cli",
     "pygoby.moos.cli",
-    "pygoby.moos.alog.cli",
+    "pygoby.apps.log_cli",
     "pygoby.frontseat.cli",
     "pygoby.netsim.cli",
     "pygoby.apps.topside_cli",

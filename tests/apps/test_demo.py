@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from pygoby.moos.alog.files import AlogFile
+from pygoby.moos.alog.tools import summarize
 from pygoby.netsim.report.eventlog import read_events
 
 pytestmark = pytest.mark.e2e
@@ -62,3 +64,18 @@ def test_demo_exits_zero_with_traffic_both_ways_and_range_effects(tmp_path):
     assert all(e["outcome"] == "good" for e in near)
     assert any(e["outcome"] != "good" for e in far)
     assert all(abs(e["owtt"] * 1500 - e["range_m"]) < 1 for e in rx)  # 1500 m/s sound speed
+
+    # each community's pLogger wrote its .alog in the log directory the output names
+    assert f"logs: {tmp_path}" in out
+    alog_lines = re.findall(
+        r"^  ([a-z]+)_\S+\.alog: (\d+) lines, (\d+) variables; `pygoby log summary (\S+)`$",
+        out,
+        re.M,
+    )
+    assert {name for name, *_ in alog_lines} == {"topside", "unicorn"}
+    for _, lines, variables, path in alog_lines:
+        assert Path(path).is_relative_to(tmp_path)
+        table = summarize(AlogFile(path))
+        assert sum(row.count for row in table.values()) == int(lines) > 0
+        assert len(table) == int(variables)
+        assert "ACOMMS_MODEM_TRANSMIT" in table and "NAV_X" in table

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import csv
+import functools
 import gzip
 import json
 import math
@@ -337,6 +338,33 @@ def test_convert(
     assert msg["value_double"] in (None, "")
 
 
+def _records(path: Path) -> list[dict]:
+    if path.suffix == ".csv":
+        with open(path) as f:
+            return list(csv.DictReader(f))
+    if path.suffix == ".jsonl":
+        return [json.loads(line) for line in path.read_text().splitlines()]
+    return pq.read_table(path).to_pylist()
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".jsonl", ".parquet"])
+def test_convert_in_parallel_gives_the_same_output(
+    alog: Path, tmp_path: Path, suffix: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    part = tmp_path / "part.alog"
+    assert pygoby_main(["log", "clip", str(alog), "2", "4", "-o", str(part)]) == 0
+    inputs = [str(alog), str(part), str(alog)]  # 30 + 7 + 30 rows, in this order
+    serial, parallel = tmp_path / f"serial{suffix}", tmp_path / f"parallel{suffix}"
+    assert pygoby_main(["log", "convert", *inputs, "-o", str(serial)]) == 0
+    capsys.readouterr()
+    assert pygoby_main(["log", "convert", *inputs, "-o", str(parallel), "-j", "2"]) == 0
+    assert capsys.readouterr().out == f"{parallel}: 67 rows\n"
+    records = _records(parallel)
+    assert records == _records(serial) and len(records) == 67
+    assert all(2 <= float(r["time"]) <= 4 for r in records[30:37])  # the clip, second
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # parts removed
+
+
 def test_convert_refuses_unknown_formats(alog: Path, tmp_path: Path) -> None:
     with pytest.raises(LogToolError, match=r"unknown output format '\.xlsx'"):
         convert([alog], tmp_path / "x.xlsx")
@@ -363,3 +391,93 @@ def test_cli_errors_are_one_line(
     assert "unknown output format '.xlsx'" in capsys.readouterr().err
     assert pygoby_main(["log", "clip", str(alog), "0", "1", "-o", str(tmp_path / "no/x.alog")]) == 1
     assert capsys.readouterr().err.startswith("pygoby log: [Errno 2] No such file or directory")
+
+
+ACOMMS_DATA = Path(__file__).resolve().parents[1] / "data" / "alog"
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_convert_decodes_the_missions_acomms_variables(
+    tmp_path: Path, jobs: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A handmade log of a mission whose pAcommsHandler names its variables AC_*: protobuf
+    text and `@PB[type]` values of its own DCCL type become `<Type>.<field path>` columns."""
+    alog, mission = ACOMMS_DATA / "acomms.alog", ACOMMS_DATA / "acomms.moos"
+    out = tmp_path / "acomms.parquet"
+    args = ["log", "convert", str(alog), str(alog), "-o", str(out), "-j", jobs]
+    assert pygoby_main([*args, "--mission", str(mission)]) == 0
+    assert capsys.readouterr().out == f"{out}: 14 rows\n"
+    records = pq.read_table(out).to_pylist()
+    assert len(records) == 14 and records[7:] == records[:7]
+    nav, receive, qsize, status, unknown, garbage, other = records[:7]
+    decoded = [name for name in nav if "." in name]
+    assert all(nav[name] is None for name in decoded)  # not an acomms variable
+    assert {k: v for k, v in receive.items() if k in decoded and v is not None} == {
+        "ModemTransmission.src": "2",
+        "ModemTransmission.dest": "1",
+        "ModemTransmission.type": "DATA",
+        "ModemTransmission.frame[0]": "01ab",  # bytes as hex
+        "ModemTransmission.frame[1]": "",
+        "ModemTransmission.[goby.acomms.micromodem.protobuf.transmission]"
+        ".receive_stat[0].mode": "RECEIVE_GOOD",
+        "ModemTransmission.[goby.acomms.micromodem.protobuf.transmission]"
+        ".receive_stat[0].mse_equalizer": "-12",
+    }
+    assert (qsize["QueueSize.dccl_id"], qsize["QueueSize.size"]) == ("20", "3")
+    assert (status["Status.src"], status["Status.depth"]) == ("2", "5.0")
+    assert (status["Status.tags[0]"], status["Status.tags[1]"]) == ("1", "4")
+    # an unknown type, text that does not parse, and the default name the mission renamed:
+    # the row keeps its value and has no decoded fields
+    for row in (unknown, garbage, other):
+        assert all(row[name] is None for name in decoded) and row["value"]
+    assert other["name"] == "ACOMMS_QSIZE"
+
+
+def test_convert_without_mission_has_no_decoded_columns(tmp_path: Path) -> None:
+    out = tmp_path / "plain.csv"
+    assert pygoby_main(["log", "convert", str(ACOMMS_DATA / "acomms.alog"), "-o", str(out)]) == 0
+    with open(out) as f:
+        assert next(csv.reader(f)) == [
+            "time",
+            "utc_time",
+            "name",
+            "source",
+            "type",
+            "value",
+            "value_double",
+        ]
+
+
+def test_convert_with_a_bad_mission_says_where(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mission = tmp_path / "bad.moos"
+    mission.write_text("ProcessConfig = pAcommsHandler\n{\n  modem_id: one\n}\n")
+    alog = str(ACOMMS_DATA / "acomms.alog")
+    out = str(tmp_path / "x.csv")
+    assert pygoby_main(["log", "convert", alog, "-o", out, "--mission", str(mission)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"pygoby log: {mission}:3: modem_id: ") and "Traceback" not in err
+
+
+@settings(max_examples=examples(200), deadline=None)
+@given(
+    name=st.sampled_from(["AC_MODEM_RECEIVE", "AC_QSIZE", "AC_QUEUE_RECEIVE", "AC_RAW_INCOMING"]),
+    value=st.one_of(
+        st.text(max_size=80),
+        st.binary(max_size=40),
+        st.builds(lambda body: f"@PB[logtest.Status] {body}", st.text(max_size=40)),
+    ),
+)
+def test_mission_decoder_never_raises(name: str, value: str | bytes) -> None:
+    from pygoby.moos.alog.format import AlogEntry
+
+    decoded = _acomms_decoder()(AlogEntry(1.0, name, "pAcommsHandler", value))
+    assert all(isinstance(text, str) for text in decoded.values())
+
+
+@functools.cache
+def _acomms_decoder():
+    from pygoby.moosacomms.alog_decode import MissionDecoder
+
+    return MissionDecoder(ACOMMS_DATA / "acomms.moos")

@@ -12,8 +12,10 @@ import logging
 import math
 import os
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
@@ -163,13 +165,22 @@ def clip(log: AlogFile, t0: float, t1: float, out: IO[str]) -> int:
 # -- convert -------------------------------------------------------------------------------------
 
 
-def rows(paths: Iterable[str | os.PathLike[str]]) -> Iterator[tuple[Any, ...]]:
-    """One tuple per entry of each file, in CONVERT_COLUMNS order."""
+Decoder = Callable[[AlogEntry], dict[str, str]]  # a value's decoded fields by column name
+MAX_DECODED_COLUMNS = 2000  # beyond this, decoded fields are left out (a warning says how many)
+
+
+def rows(
+    paths: Iterable[str | os.PathLike[str]],
+    decode: Decoder | None = None,
+    columns: Sequence[str] = (),
+) -> Iterator[tuple[Any, ...]]:
+    """One tuple per entry of each file, in CONVERT_COLUMNS order, then (with `decode`) the
+    decoded fields named in `columns` (None where the entry has none)."""
     for path in paths:
         log = AlogFile(path)
         for entry in log:
             double = entry.value if isinstance(entry.value, float) else None
-            yield (
+            row: tuple[Any, ...] = (
                 entry.time,
                 log.log_start + entry.time,
                 entry.name,
@@ -178,28 +189,122 @@ def rows(paths: Iterable[str | os.PathLike[str]]) -> Iterator[tuple[Any, ...]]:
                 value_text(entry),
                 double,
             )
+            if decode is not None and columns:
+                fields = decode(entry)
+                row += tuple(fields.get(column) for column in columns)
+            yield row
+
+
+def decoded_columns(paths: Iterable[str | os.PathLike[str]], decode: Decoder) -> list[str]:
+    """The decoded fields' names in all of `paths`, in the order first seen (a first pass
+    over the files, so that CSV and Parquet know their columns before the first row)."""
+    columns: dict[str, None] = {}
+    left_out: set[str] = set()
+    for path in paths:
+        for entry in AlogFile(path):
+            for name in decode(entry):
+                if name in columns or name in left_out:
+                    continue
+                if len(columns) < MAX_DECODED_COLUMNS:
+                    columns[name] = None
+                elif len(left_out) < MAX_DECODED_COLUMNS:
+                    left_out.add(name)
+    if left_out:
+        logger.warning(
+            "%s%d decoded fields left out (more than %d columns)",
+            "at least " if len(left_out) == MAX_DECODED_COLUMNS else "",
+            len(left_out),
+            MAX_DECODED_COLUMNS,
+        )
+    return list(columns)
 
 
 def convert(
     paths: Sequence[str | os.PathLike[str]],
     output: str | os.PathLike[str],
     progress: Callable[[int], None] | None = None,
+    jobs: int = 1,
+    decoder: Callable[[], Decoder] | None = None,
+    columns: Sequence[str] | None = None,
 ) -> int:
-    """Write every entry of `paths` to `output` (.parquet, .csv or .jsonl); returns the rows."""
+    """Write every entry of `paths` to `output` (.parquet, .csv or .jsonl), file after file;
+    returns the rows. With `jobs` > 1 and several files, each file is converted in its own
+    process (at most `jobs` at once) to a part beside `output`, and the parts are then joined
+    in the files' order: the output is the same as with one job. `decoder()` makes the
+    function that adds decoded columns (picklable, for the processes); `columns`: those
+    columns when known (else a first pass over the files finds them)."""
     suffix = Path(output).suffix.lower()
     writer = {".parquet": _write_parquet, ".csv": _write_csv, ".jsonl": _write_jsonl}.get(suffix)
     if writer is None:
         raise LogToolError(
             f"{output}: unknown output format {suffix!r} (use {', '.join(CONVERT_FORMATS)})"
         )
-    return writer(rows(paths), Path(output), progress or (lambda n: None))
+    report = progress or (lambda n: None)
+    decode = decoder() if decoder is not None else None
+    if decode is not None and columns is None:
+        columns = decoded_columns(paths, decode)
+    columns = list(columns or ())
+    if jobs <= 1 or len(paths) <= 1:
+        return writer(rows(paths, decode, columns), Path(output), report, columns)
+    return _convert_in_parallel(paths, Path(output), report, jobs, decoder, columns)
 
 
-def _write_csv(source: Iterator[tuple], path: Path, progress: Callable[[int], None]) -> int:
+def _convert_in_parallel(
+    paths: Sequence[str | os.PathLike[str]],
+    output: Path,
+    progress: Callable[[int], None],
+    jobs: int,
+    decoder: Callable[[], Decoder] | None,
+    columns: list[str],
+) -> int:
+    with tempfile.TemporaryDirectory(prefix=f".{output.name}.", dir=output.parent) as parts_dir:
+        parts = [Path(parts_dir) / f"{index}{output.suffix}" for index in range(len(paths))]
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            futures = [
+                pool.submit(convert, [path], part, None, 1, decoder, columns)
+                for path, part in zip(paths, parts, strict=True)
+            ]
+            done = 0
+            for future in futures:  # raises the first failure, in the files' order
+                done += future.result()
+                progress(done)
+        return _join_parts(parts, output)
+
+
+def _join_parts(parts: Sequence[Path], output: Path) -> int:
+    """Concatenate converted parts (same format as `output`) into `output`, streaming."""
+    count = 0
+    if output.suffix.lower() == ".parquet":
+        import pyarrow.parquet as pq
+
+        schema = pq.read_schema(parts[0])
+        with pq.ParquetWriter(output, schema) as writer:
+            for part in parts:
+                source = pq.ParquetFile(part)
+                for group in range(source.num_row_groups):
+                    table = source.read_row_group(group)
+                    writer.write_table(table)
+                    count += table.num_rows
+        return count
+    header_lines = 1 if output.suffix.lower() == ".csv" else 0
+    with open(output, "wb") as out:
+        for index, part in enumerate(parts):
+            with open(part, "rb") as source:
+                for number, line in enumerate(source):
+                    if number < header_lines and index > 0:
+                        continue  # one CSV header, the first part's
+                    out.write(line)
+                    count += number >= header_lines
+    return count
+
+
+def _write_csv(
+    source: Iterator[tuple], path: Path, progress: Callable[[int], None], columns: list[str]
+) -> int:
     count = 0
     with open(path, "w", newline="") as out:
         writer = csv.writer(out)
-        writer.writerow(CONVERT_COLUMNS)
+        writer.writerow((*CONVERT_COLUMNS, *columns))
         for row in source:
             writer.writerow(row)
             count += 1
@@ -208,11 +313,20 @@ def _write_csv(source: Iterator[tuple], path: Path, progress: Callable[[int], No
     return count
 
 
-def _write_jsonl(source: Iterator[tuple], path: Path, progress: Callable[[int], None]) -> int:
+def _write_jsonl(
+    source: Iterator[tuple], path: Path, progress: Callable[[int], None], columns: list[str]
+) -> int:
+    base = len(CONVERT_COLUMNS)
     count = 0
     with open(path, "w") as out:
         for row in source:
-            record = dict(zip(CONVERT_COLUMNS, row, strict=True))
+            record = dict(zip(CONVERT_COLUMNS, row[:base], strict=True))
+            # a decoded field only where the entry has it: JSON lines need no fixed columns
+            record.update(
+                (name, text)
+                for name, text in zip(columns, row[base:], strict=True)
+                if text is not None
+            )
             if record["value_double"] is not None and not math.isfinite(record["value_double"]):
                 record["value_double"] = None  # JSON has no inf or nan
             out.write(json.dumps(record, ensure_ascii=False) + "\n")
@@ -222,7 +336,9 @@ def _write_jsonl(source: Iterator[tuple], path: Path, progress: Callable[[int], 
     return count
 
 
-def _write_parquet(source: Iterator[tuple], path: Path, progress: Callable[[int], None]) -> int:
+def _write_parquet(
+    source: Iterator[tuple], path: Path, progress: Callable[[int], None], columns: list[str]
+) -> int:
     with needs_extra("sim", "Parquet output"):  # pyarrow, as netsim sweeps' results
         import pyarrow as pa
         import pyarrow.parquet as pq
@@ -236,21 +352,23 @@ def _write_parquet(source: Iterator[tuple], path: Path, progress: Callable[[int]
             ("type", pa.string()),
             ("value", pa.string()),
             ("value_double", pa.float64()),
+            *((name, pa.string()) for name in columns),
         ]
     )
+    text_columns = [2, 3, 5, *range(len(CONVERT_COLUMNS), len(schema))]
     count = 0
     with pq.ParquetWriter(path, schema) as writer:
         while True:
             batch = [row for _, row in zip(range(PARQUET_BATCH), source, strict=False)]
             if not batch:
                 break
-            columns: list[Sequence[Any]] = list(zip(*batch, strict=True))
+            values: list[Sequence[Any]] = list(zip(*batch, strict=True))
             # strings keep undecodable bytes as surrogates; Parquet wants valid UTF-8
-            for index in (2, 3, 5):
-                columns[index] = [_utf8(text) for text in columns[index]]
+            for index in text_columns:
+                values[index] = [_utf8(text) for text in values[index]]
             writer.write_table(
                 pa.Table.from_arrays(
-                    [pa.array(col, type=schema.field(i).type) for i, col in enumerate(columns)],
+                    [pa.array(col, type=schema.field(i).type) for i, col in enumerate(values)],
                     schema=schema,
                 )
             )
@@ -259,7 +377,9 @@ def _write_parquet(source: Iterator[tuple], path: Path, progress: Callable[[int]
     return count
 
 
-def _utf8(text: str) -> str:
+def _utf8(text: str | None) -> str | None:
+    if text is None:  # a decoded field the entry does not have
+        return None
     try:
         text.encode()
         return text

@@ -3,10 +3,12 @@
   pygoby log grep FILE VAR... [--source S]       entries of these variables (VAR* = prefix)
   pygoby log summary FILE                        per variable: lines, first/last time, rate, sources
   pygoby log clip FILE T0 T1 -o OUT.alog         the entries between two log times
-  pygoby log convert FILE... -o OUT.parquet      one row per message (.parquet, .csv or .jsonl)
+  pygoby log convert FILE... -o OUT.parquet [-j N] [--mission M.moos]
+                                                 one row per message (.parquet, .csv, .jsonl)
   pygoby log replay FILE --port P [--warp W]     post the messages into a MOOSDB, original spacing
 
-Damaged lines are skipped; their count is printed on stderr.
+Damaged lines are skipped; their count is printed on stderr. (The command line lives with the
+apps: `--mission` wires the .alog tools of moos to moosacomms' decoding.)
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from pygoby.errors import ConfigError
 from pygoby.moos.alog.files import AlogFile
 from pygoby.moos.alog.tools import LogToolError
 
@@ -37,7 +40,7 @@ def reporting_errors(command: Command) -> Command:
             return 1
         try:
             return command(args)
-        except (LogToolError, OSError) as err:
+        except (LogToolError, ConfigError, OSError) as err:
             print(f"pygoby log: {err}", file=sys.stderr)
             return 1
 
@@ -73,6 +76,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     convert = actions.add_parser("convert", help="to Parquet, CSV or JSON lines")
     convert.add_argument("files", nargs="+", metavar="FILE")
     convert.add_argument("-o", "--output", required=True, help="OUT.parquet, OUT.csv or OUT.jsonl")
+    convert.add_argument(
+        "-j",
+        "--jobs",
+        type=int,
+        default=1,
+        metavar="N",
+        help="convert up to N files at once, in parallel processes (the output is the same)",
+    )
+    convert.add_argument(
+        "--mission",
+        metavar="FILE.moos",
+        help="decode the acomms variables of this mission's pAcommsHandler into columns",
+    )
+    convert.add_argument(
+        "--block", default="pAcommsHandler", help="its ProcessConfig (default %(default)s)"
+    )
     convert.set_defaults(func=convert_command)
 
     replay = actions.add_parser("replay", help="post a log's messages into a MOOSDB (uPlayBack)")
@@ -144,7 +163,13 @@ def convert_command(args: argparse.Namespace) -> int:
         if sys.stderr.isatty():
             sys.stderr.write(f"\r{rows} rows")
 
-    count = convert(args.files, args.output, progress)
+    decoder = None
+    if args.mission is not None:
+        from pygoby.moosacomms.alog_decode import MissionDecoder  # only when asked for
+
+        MissionDecoder(args.mission, args.block)  # configuration errors now, not in a worker
+        decoder = functools.partial(MissionDecoder, args.mission, args.block)
+    count = convert(args.files, args.output, progress, jobs=args.jobs, decoder=decoder)
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     print(f"{args.output}: {count} rows")
