@@ -33,15 +33,15 @@ $(CHROMIUM):
 # what CI runs: lint, format, types and every test (property tests at the light hypothesis
 # profile; `make soak` runs them at full depth)
 test: protos $(CHROMIUM)
-	$(PY) -m ruff check src tests benchmarks
-	$(PY) -m ruff format --check src tests benchmarks
+	$(PY) -m ruff check src tests benchmarks examples
+	$(PY) -m ruff format --check src tests benchmarks examples
 	$(PY) -m mypy
 	$(PY) -m pytest -q -n $(TEST_JOBS) --dist worksteal
 
 # the edit loop's tier (< 90 s): lint and every test but the end-to-end ones (marked e2e);
 # after a failure, `$(PY) -m pytest --lf` runs what failed last
 check: protos
-	$(PY) -m ruff check src tests benchmarks
+	$(PY) -m ruff check src tests benchmarks examples
 	$(PY) -m pytest -q -n $(TEST_JOBS) --dist worksteal -m "not e2e"
 
 # the README's liaison pictures, taken by the browser test against a real two-vehicle mission
@@ -67,7 +67,7 @@ figures: protos
 	rm -rf $(EXAMPLE_SWEEP)_results
 
 lint: protos
-	$(PY) -m ruff check src tests benchmarks
+	$(PY) -m ruff check src tests benchmarks examples
 	$(PY) -m mypy
 
 # mypy over src (configured in pyproject.toml), with the stubs of our generated messages

@@ -165,7 +165,7 @@ def _short(value: str) -> str:
 
 
 def _field(value: str, name: str) -> str:
-    head, _, rest = value.partition(f"{name}: ")
+    _, _, rest = value.partition(f"{name}: ")
     return rest.split(" ", 1)[0] if rest else ""
 
 
@@ -193,10 +193,10 @@ class Monitor:
             self.client.subscribe(var)
 
     @staticmethod
-    def _parse(cls, value):
+    def _parse(message_class, value):
         from pygoby.moos.translator import TranslatorError, parse_for_moos
 
-        msg = cls()
+        msg = message_class()
         try:
             parse_for_moos(value, msg)
         except TranslatorError:
