@@ -153,6 +153,16 @@ def rpm_for_speed(speed: float, table: list[tuple[float, int]]) -> int:
     return int((speed - s0) / (s1 - s0) * (r1 - r0) + r0)
 
 
+def _read_status_and_error(sentence: NMEASentence, report: Any) -> None:
+    """Fields 2 and 3 of $BFBOY/$BFTRM into a BuoyancyStatus/TrimStatus's `status` and `error`
+    (a number the enum lacks leaves the field unset)."""
+    enums = report.DESCRIPTOR.fields_by_name
+    for name, index in (("status", 2), ("error", 3)):
+        number = sentences.required_int(sentence, index)
+        if enums[name].enum_type.values_by_number.get(number) is not None:
+            setattr(report, name, number)
+
+
 class BluefinFrontSeat(LinkedFrontSeat):
     """Frontseat driver for a Bluefin Huxley (Standard Payload Interface)."""
 
@@ -578,11 +588,7 @@ class BluefinFrontSeat(LinkedFrontSeat):
     def _bfboy(self, sentence: NMEASentence) -> None:
         data = frontseat_pb.InterfaceData()
         boy = data.Extensions[frontseat_pb.BLUEFIN_DATA].buoyancy_status
-        status, error = sentences.required_int(sentence, 2), sentences.required_int(sentence, 3)
-        if status in frontseat_pb.BuoyancyStatus.Status.values():
-            boy.status = frontseat_pb.BuoyancyStatus.Status.ValueType(status)
-        if error in frontseat_pb.BuoyancyStatus.Error.values():
-            boy.error = frontseat_pb.BuoyancyStatus.Error.ValueType(error)
+        _read_status_and_error(sentence, boy)
         boy.debug_string = sentences.field(sentence, 4)
         boy.buoyancy_newtons = sentences.required_float(sentence, 5)
         self.signal_data_from_frontseat(data)
@@ -590,11 +596,7 @@ class BluefinFrontSeat(LinkedFrontSeat):
     def _bftrm(self, sentence: NMEASentence) -> None:
         data = frontseat_pb.InterfaceData()
         trim = data.Extensions[frontseat_pb.BLUEFIN_DATA].trim_status
-        status, error = sentences.required_int(sentence, 2), sentences.required_int(sentence, 3)
-        if status in frontseat_pb.TrimStatus.Status.values():
-            trim.status = frontseat_pb.TrimStatus.Status.ValueType(status)
-        if error in frontseat_pb.TrimStatus.Error.values():
-            trim.error = frontseat_pb.TrimStatus.Error.ValueType(error)
+        _read_status_and_error(sentence, trim)
         trim.debug_string = sentences.field(sentence, 4)
         trim.pitch_trim_degrees = sentences.required_float(sentence, 5)
         trim.roll_trim_degrees = sentences.required_float(sentence, 6)

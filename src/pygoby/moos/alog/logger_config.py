@@ -66,6 +66,20 @@ class LoggerConfig:
         )
 
 
+# the true/false settings: option name (lower case) -> LoggerConfig attribute
+_FLAG_SETTINGS = {
+    "filetimestamp": "file_time_stamp",
+    "utclogdirectories": "utc_log_directories",
+    "asynclog": "async_log",
+    "wildcardlogging": "wildcard_logging",
+    "compressalogs": "compress",
+    "logauxsrc": "log_aux_src",
+    "markexternalcommunitymessages": "mark_external",
+    "markdatatype": "mark_data_type",
+    "markdataasbinary": "mark_binary",
+}
+
+
 def _bool(value: str) -> bool | None:
     lowered = value.strip().lower()
     return {"true": True, "1": True, "yes": True, "false": False, "0": False, "no": False}.get(
@@ -101,16 +115,12 @@ def read_logger_config(
 
     for s in params:
         key = s.name.lower()
-        if key == "file":
+        if (attribute := _FLAG_SETTINGS.get(key)) is not None:
+            setattr(cfg, attribute, flag(s))
+        elif key == "file":
             cfg.file = s.value.strip()
         elif key == "path":
             cfg.path = s.value.strip()
-        elif key == "filetimestamp":
-            cfg.file_time_stamp = flag(s)
-        elif key == "utclogdirectories":
-            cfg.utc_log_directories = flag(s)
-        elif key == "asynclog":
-            cfg.async_log = flag(s)
         elif key == "synclog":
             on, _, period = s.value.replace(" ", "").partition("@")
             cfg.sync_log = on.lower() == "true"
@@ -119,8 +129,6 @@ def read_logger_config(
                 if number is None:
                     raise error(f"period must be a number, not {period!r}", s)
                 cfg.sync_period = max(number, MIN_SYNC_PERIOD)
-        elif key == "wildcardlogging":
-            cfg.wildcard_logging = flag(s)
         elif key == "wildcardpattern":
             cfg.wildcard_patterns += [p.strip() for p in s.value.split(",") if p.strip()]
         elif key == "wildcardomitpattern":
@@ -135,21 +143,11 @@ def read_logger_config(
                 cfg.logs.append(request)
         elif key == "loggingdirectorysummaryfile":
             cfg.summary_file = s.value.strip()
-        elif key == "compressalogs":
-            cfg.compress = flag(s)
         elif key == "doubleprecision":
             number = parse_number(s.value)
             if number is None or number < 0 or number != int(number) or number > 20:
                 raise error(f"must be a whole number of decimals (0-20), not {s.value!r}", s)
             cfg.double_precision = int(number)
-        elif key == "logauxsrc":
-            cfg.log_aux_src = flag(s)
-        elif key == "markexternalcommunitymessages":
-            cfg.mark_external = flag(s)
-        elif key == "markdatatype":
-            cfg.mark_data_type = flag(s)
-        elif key == "markdataasbinary":
-            cfg.mark_binary = flag(s)
         elif key == "maxalogsize":
             match = _SIZE.fullmatch(s.value.strip())
             if match is None:
