@@ -105,7 +105,11 @@ def test_binary_inline_hex_and_through_the_blog(tmp_path: Path) -> None:
     sink.put_line(plain.line(103.0, "X", "src", 7.0))
     sink.close()
     text = (tmp_path / "L.alog").read_text()
-    assert "<MOOS_BINARY>File=L.blog,Offset=" in text and ",Bytes=5</MOOS_BINARY>" in text
+    # as pLogger: the .blog holds the line's prefix, then the bytes and a newline; the .alog line
+    # ends right after the tag (no space), the offset being where the bytes start in the .blog
+    prefix = plain.prefix(102.0, "RAW", "src")
+    assert (prefix + f"<MOOS_BINARY>File=L.blog,Offset={len(prefix)},Bytes=5</MOOS_BINARY>\n") in text
+    assert (tmp_path / "L.blog").read_bytes() == prefix.encode() + b"\x01\n\x02 \xfe\n"
     assert [e.value for e in AlogFile(tmp_path / "L.alog")] == ["a", b"\x01\n\x02 \xfe", 7.0]
     (tmp_path / "L.blog").unlink()
     log = AlogFile(tmp_path / "L.alog")
@@ -288,12 +292,17 @@ def test_grep_and_summary(alog: Path, capsys: pytest.CaptureFixture[str]) -> Non
     assert len(out.splitlines()) == 20 and "MSG" not in out
     assert "1 damaged lines skipped (the first at line 36)" in err
     assert pygoby_main(["log", "grep", str(alog), "MSG"]) == 0
-    first = capsys.readouterr().out.splitlines()[0]
-    assert first.split(maxsplit=3) == ["0.500", "MSG", "pHelm:bhv", "hello 0"]
+    first = capsys.readouterr().out.splitlines(keepends=True)[0]
+    # the line as the file has it (aloggrep prints lines so), its trailing space included
+    written = AlogFormatter(LOG_START, log_aux_src=True).line(
+        LOG_START + 0.5, "MSG", "pHelm", "hello 0", "bhv"
+    )
+    assert first == written and first.endswith("hello 0 \n")
     assert pygoby_main(["log", "summary", str(alog)]) == 0
     out = capsys.readouterr().out.splitlines()
     nav_x = next(line for line in out if line.startswith("NAV_X "))
-    assert nav_x.split() == ["NAV_X", "10", "33", "0.00", "9.00", "1.00", "uSim"]
+    # chars as alogscan counts them: NAV_X (5) + uSim (4) + the padded value column (13)
+    assert nav_x.split() == ["NAV_X", "10", "220", "0.00", "9.00", "1.00", "uSim"]
     assert out[-1].startswith("3 variables, 30 lines")
 
 

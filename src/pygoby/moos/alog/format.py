@@ -47,7 +47,10 @@ Value = float | str | bytes
 @dataclass(slots=True)
 class AlogEntry:
     """One logged message. `time` is seconds since LOGSTART; `value` is a float (double), str
-    (string) or bytes (binary; `binary_ref` holds the .blog reference while it is unresolved)."""
+    (string) or bytes (binary; `binary_ref` holds the .blog reference while it is unresolved).
+    `line` is the line as the file has it (without its newline) and `value_column` its value
+    column as written (padding and trailing space included): the tools that copy lines, as
+    MOOS-IvP's do, copy these."""
 
     time: float
     name: str
@@ -56,6 +59,8 @@ class AlogEntry:
     source_aux: str = ""
     community: str = ""
     binary_ref: tuple[str, int, int] | None = None
+    line: str = ""
+    value_column: str = ""
 
     @property
     def type(self) -> str:
@@ -129,7 +134,7 @@ class AlogFormatter:
         if isinstance(value, bytes):
             if not self.mark_binary:
                 raise ValueError("binary values go to the .blog unless mark_binary is set")
-            return "B:" + value.hex().upper()
+            return inline_binary(value)
         return "S:" + value if self.mark_data_type else value
 
     def line(
@@ -143,6 +148,11 @@ class AlogFormatter:
     ) -> str:
         """One whole line for a double or string value (or binary with mark_binary)."""
         return f"{self.prefix(msg_time, name, src, src_aux, community)}{self.value_text(value)} \n"
+
+
+def inline_binary(value: bytes) -> str:
+    """A binary value as the MarkDataAsBinary files write it in the value column."""
+    return "B:" + value.hex().upper()
 
 
 def binary_tag(blog_name: str, offset: int, size: int) -> str:
@@ -186,7 +196,9 @@ class AlogReader:
             self._bad(line)
             return None
         src, aux, community = _split_source(source)
-        return AlogEntry(msg_time, name, src, value[0], aux, community, value[1])
+        return AlogEntry(
+            msg_time, name, src, value[0], aux, community, value[1], line, raw or ""
+        )
 
     def _value(self, raw: str) -> tuple[Value, tuple[str, int, int] | None] | None:
         # pLogger ends every value with one space; doubles are padded further
