@@ -108,7 +108,9 @@ def test_binary_inline_hex_and_through_the_blog(tmp_path: Path) -> None:
     # as pLogger: the .blog holds the line's prefix, then the bytes and a newline; the .alog line
     # ends right after the tag (no space), the offset being where the bytes start in the .blog
     prefix = plain.prefix(102.0, "RAW", "src")
-    assert (prefix + f"<MOOS_BINARY>File=L.blog,Offset={len(prefix)},Bytes=5</MOOS_BINARY>\n") in text
+    assert (
+        prefix + f"<MOOS_BINARY>File=L.blog,Offset={len(prefix)},Bytes=5</MOOS_BINARY>\n"
+    ) in text
     assert (tmp_path / "L.blog").read_bytes() == prefix.encode() + b"\x01\n\x02 \xfe\n"
     assert [e.value for e in AlogFile(tmp_path / "L.alog")] == ["a", b"\x01\n\x02 \xfe", 7.0]
     (tmp_path / "L.blog").unlink()
@@ -314,6 +316,20 @@ def test_clip(alog: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     assert all(2 <= e.time <= 4 for e in entries) and len(entries) == 7
     assert {e.full_source for e in entries} == {"uSim", "pHelm:bhv"}
     assert AlogFile(out).log_start == pytest.approx(LOG_START, abs=0.01)
+
+
+def test_clip_keeps_the_helm_domain_whatever_its_time(tmp_path: Path) -> None:
+    path = tmp_path / "helm.alog"
+    fmt = AlogFormatter(LOG_START)
+    posts = [(0.5, "IVPHELM_DOMAIN"), (1.0, "BHV"), (2.5, "BHV"), (4.0, "BHV")]
+    lines = [fmt.line(LOG_START + t, name, "pHelmIvP", "x") for t, name in posts]
+    header = banner(str(path), LOG_START)
+    path.write_text(header + "".join(lines) + "continued text \n")
+    out = tmp_path / "clip.alog"
+    assert pygoby_main(["log", "clip", str(path), "2", "3", "-o", str(out)]) == 0
+    # alogclip's rule: IVPHELM_DOMAIN (alogview needs it) is kept outside the window too; the
+    # banner is copied as it is; the line that is no entry is dropped
+    assert out.read_text() == header + lines[0] + lines[2]
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".jsonl", ".parquet"])

@@ -10,7 +10,8 @@ A file starts with a banner of `%%` lines::
 
 then one line per message, as pLogger pads it: the time since LOGSTART (fixed, 3 decimals,
 left-justified in 15 columns), the variable (20 columns), the source (15 columns; `src:aux`
-with LogAuxSrc, `...@community` with MarkExternalCommunityMessages), the value and one space.
+with LogAuxSrc, `...@community` with MarkExternalCommunityMessages), the value and one space
+(a binary value's `<MOOS_BINARY>` .blog reference ends the line without one).
 Doubles are fixed with DoublePrecision decimals (5 by default) left-justified in 12 columns;
 strings are written as they are. A reader cannot tell the string "3.5" from the double 3.5
 unless the file was written with MarkDataType (`D:`/`S:` before each value), so like MOOS-IvP's
@@ -196,9 +197,7 @@ class AlogReader:
             self._bad(line)
             return None
         src, aux, community = _split_source(source)
-        return AlogEntry(
-            msg_time, name, src, value[0], aux, community, value[1], line, raw or ""
-        )
+        return AlogEntry(msg_time, name, src, value[0], aux, community, value[1], line, raw or "")
 
     def _value(self, raw: str) -> tuple[Value, tuple[str, int, int] | None] | None:
         # pLogger ends every value with one space; doubles are padded further

@@ -100,7 +100,8 @@ class VariableSummary:
 
 
 def summary_source(entry: AlogEntry) -> str:
-    """How a source is listed: without its :aux, with @community for other communities."""
+    """How a source is listed: without its :aux, with @community for other communities
+    (alogscan loses the community when there is an aux too: QUIRKS.md Q-MOOS-18)."""
     return f"{entry.source}@{entry.community}" if entry.community else entry.source
 
 
@@ -109,7 +110,8 @@ def _byte_length(text: str) -> int:
 
 
 def summarize(log: AlogFile) -> dict[str, VariableSummary]:
-    """Per variable: count, first and last time, characters, sources (alogscan's table)."""
+    """Per variable: count, first and last time, characters, sources (alogscan's table,
+    except that entries with an empty value count and sources are compared whole)."""
     table: dict[str, VariableSummary] = {}
     for entry in log:
         row = table.get(entry.name)
@@ -156,7 +158,8 @@ def clip(log: AlogFile, t0: float, t1: float, out: IO[str]) -> int:
     """Write the `%%` lines and the entries with t0 <= time <= t1 as they are in the file,
     as alogclip does (same banner, LOGSTART and times); returns how many entries. A binary
     value from the .blog is written inline as `B:<hex>` instead (the clip needs no .blog),
-    after a `%% BINARY MARKING ON` line."""
+    after a `%% BINARY MARKING ON` line; lines that are not entries are left out, where
+    alogclip keeps them when the window includes time 0 (QUIRKS.md Q-MOOS-19)."""
     marked = False
     count = 0
     for text, entry in log.lines():

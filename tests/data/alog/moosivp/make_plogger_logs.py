@@ -97,7 +97,9 @@ async def run_mission(directory: Path, file: str, options: str) -> None:
                     # a bridge forwards the message with its originating community set: the
                     # DB passes it on untouched (the client API has no publish for this)
                     bridge._queue(
-                        p.notify(name, forwarded, time=bridge.time(), src="pShare", community="bravo")
+                        p.notify(
+                            name, forwarded, time=bridge.time(), src="pShare", community="bravo"
+                        )
                     )
                     await bridge.flush()
                 await asyncio.sleep(0.5 / WARP)
@@ -120,7 +122,10 @@ def main() -> None:
             )
         finally:
             os.chdir(cwd)
-        for name, suffixes in (("plogger_blog", (".alog", ".blog")), ("plogger_inline", (".alog",))):
+        for name, suffixes in (
+            ("plogger_blog", (".alog", ".blog")),
+            ("plogger_inline", (".alog",)),
+        ):
             for suffix in suffixes:
                 shutil.copy(work / name / f"{name}{suffix}", HERE / f"{name}{suffix}")
 
