@@ -19,7 +19,7 @@ from pygoby.cli import main as pygoby_main
 from pygoby.errors import ConfigError
 from pygoby.moos.alog import AlogFile, AlogFormatter, AlogReader, AlogSink, banner
 from pygoby.moos.alog.logger_config import parse_log_request, read_logger_config
-from pygoby.moos.alog.tools import LogToolError, convert
+from pygoby.moos.alog.tools import LogToolError, convert, summarize
 from pygoby.moos.moosfile import Setting
 from tests.hypothesis_profiles import examples
 
@@ -316,6 +316,25 @@ def test_clip(alog: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     assert all(2 <= e.time <= 4 for e in entries) and len(entries) == 7
     assert {e.full_source for e in entries} == {"uSim", "pHelm:bhv"}
     assert AlogFile(out).log_start == pytest.approx(LOG_START, abs=0.01)
+
+
+def test_summary_counts_chars_and_lists_sources_as_alogscan(tmp_path: Path) -> None:
+    path = tmp_path / "s.alog"
+    fmt = AlogFormatter(LOG_START, log_aux_src=True, mark_external=True, own_community="a")
+    path.write_text(
+        banner(str(path), LOG_START)
+        + fmt.line(LOG_START + 1, "V", "pNavX", "ab")
+        + fmt.line(LOG_START + 2, "V", "pNav", "ab", community="b")
+        + fmt.line(LOG_START + 3, "V", "pNav", "ab", "aux", community="b")
+        + fmt.line(LOG_START + 4, "V", "pNav", "ab")
+    )
+    (row,) = summarize(AlogFile(path)).values()
+    # chars: variable + source column up to its first ':' + value column ("ab "): alogscan
+    # drops "@b" where an aux comes first
+    assert row.chars == (1 + 5 + 3) + (1 + 6 + 3) + (1 + 4 + 3) + (1 + 4 + 3)
+    # every source, compared whole (alogscan leaves pNav out: "pNavX" contains it), in the
+    # order first seen, with its community
+    assert list(row.sources) == ["pNavX", "pNav@b", "pNav"]
 
 
 def test_clip_keeps_the_helm_domain_whatever_its_time(tmp_path: Path) -> None:

@@ -109,6 +109,15 @@ def _byte_length(text: str) -> int:
     return len(text) if text.isascii() else len(text.encode("utf-8", "surrogateescape"))
 
 
+def _scan_chars(entry: AlogEntry) -> int:
+    """alogscan's Chars for one line: the bytes of the variable, of the source column up to
+    its first `:` (so `@community` counts only without an aux) and of the value column."""
+    source = _byte_length(entry.source)
+    if entry.community and not entry.source_aux:
+        source += 1 + _byte_length(entry.community)
+    return _byte_length(entry.name) + source + _byte_length(entry.value_column)
+
+
 def summarize(log: AlogFile) -> dict[str, VariableSummary]:
     """Per variable: count, first and last time, characters, sources (alogscan's table,
     except that entries with an empty value count and sources are compared whole)."""
@@ -120,8 +129,7 @@ def summarize(log: AlogFile) -> dict[str, VariableSummary]:
         row.count += 1
         row.first = min(row.first, entry.time)
         row.last = max(row.last, entry.time)
-        source_column = entry.full_source.split(":", 1)[0]
-        row.chars += sum(map(_byte_length, (entry.name, source_column, entry.value_column)))
+        row.chars += _scan_chars(entry)
         if len(row.sources) < MAX_LISTED_SOURCES:
             row.sources[summary_source(entry)] = None
     return table
