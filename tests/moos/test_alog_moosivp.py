@@ -7,6 +7,8 @@ stated rule, and the recording is checked to show the difference."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import re
 from pathlib import Path
 
@@ -218,3 +220,10 @@ def test_clip_without_the_blog_keeps_the_references(
     assert pygoby_main(["log", "clip", str(alone), "1.5", "6", "-o", str(out)]) == 0
     assert "2 binary values not found in the .blog" in capsys.readouterr().err
     assert out.read_bytes() == recorded("plogger_blog", "clip_mid.alog")
+
+
+def test_grep_into_a_text_only_stdout() -> None:
+    out = io.StringIO()  # no .buffer, as under redirect_stdout
+    with contextlib.redirect_stdout(out):
+        assert pygoby_main(["log", "grep", str(LOGS["plogger_blog"]), "NAV_X", "MSG"]) == 0
+    assert out.getvalue().encode() == recorded("plogger_blog", "grep_vars_q.txt")

@@ -122,14 +122,10 @@ def _report_bad_lines(log: AlogFile) -> None:
 
 @reporting_errors
 def grep_command(args: argparse.Namespace) -> int:
-    from pygoby.moos.alog.tools import grep
+    from pygoby.moos.alog.tools import grep, write_lines
 
     log = AlogFile(args.file)
-    sys.stdout.flush()
-    out = sys.stdout.buffer  # the lines' bytes as the file has them, as aloggrep prints them
-    for entry in grep(log, args.variables, args.source):
-        out.write(entry.line.encode("utf-8", "surrogateescape") + b"\n")
-    out.flush()
+    write_lines((entry.line for entry in grep(log, args.variables, args.source)), sys.stdout)
     _report_bad_lines(log)
     return 0
 

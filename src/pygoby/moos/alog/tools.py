@@ -76,6 +76,20 @@ def grep(
         yield entry
 
 
+def write_lines(lines: Iterable[str], out: IO[str]) -> None:
+    """Lines (as read, without newline) to `out` as the bytes the file had, as aloggrep prints
+    them; a text-only `out` (redirect_stdout) gets them as text."""
+    out.flush()
+    binary: IO[bytes] | None = getattr(out, "buffer", None)
+    for line in lines:
+        if binary is not None:
+            binary.write(line.encode("utf-8", "surrogateescape") + b"\n")
+        else:
+            out.write(line + "\n")
+    if binary is not None:
+        binary.flush()
+
+
 # -- summary -------------------------------------------------------------------------------------
 
 MAX_LISTED_SOURCES = 64  # a variable's sources listed in the summary (the rest are not)
