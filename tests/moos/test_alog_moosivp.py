@@ -151,7 +151,7 @@ def test_moosivp_tools_read_every_line_of_our_plogger_logs(log: str) -> None:
     assert f"Total variables: {len(names) - 1}" in scan
 
 
-def test_summary_command_lists_sources_in_the_order_first_seen(
+def test_summary_command_shows_a_bridged_source_with_its_community(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     assert pygoby_main(["log", "summary", str(LOGS["plogger_blog"])]) == 0
