@@ -91,6 +91,15 @@ def test_data_type_marking_keeps_numeric_strings_strings() -> None:
     assert reader.feed(fmt.line(1.0, "A", "s", 3.5)).value == 3.5
     # without marking, a value that is a number is read as a double (as MOOS-IvP's tools do)
     assert AlogReader().feed(AlogFormatter(0.0).line(1.0, "A", "s", "3.5")).value == 3.5
+    # ... as pLogger writes doubles (fixed digits, inf, nan) and MOOS-IvP's isNumber takes
+    # numbers: with an exponent it is a string (pLogger never writes a double so)
+    plain = AlogFormatter(0.0)
+    for text in ("1e5", "2E-3", "0x10", "1.2.3"):
+        assert AlogReader().feed(plain.line(1.0, "A", "s", text)).value == text
+    for text, double in (("12.", 12.0), (".5", 0.5), ("-7", -7.0), ("-inf", -math.inf)):
+        assert AlogReader().feed(plain.line(1.0, "A", "s", text)).value == double
+    assert math.isnan(AlogReader().feed(plain.line(1.0, "A", "s", "-nan")).value)
+    assert AlogReader().feed(plain.line(1.0, "A", "s", math.inf)).value == math.inf
 
 
 def test_binary_inline_hex_and_through_the_blog(tmp_path: Path) -> None:

@@ -2,7 +2,7 @@
 pygoby pLogger logs and the hand-made acomms log (tests/data/alog/moosivp/README.md).
 
 Where pygoby means to match, the bytes must be the same; where it differs on purpose
-(QUIRKS.md Q-MOOS-17 to Q-MOOS-19), the expected output is derived from the recording by the
+(QUIRKS.md Q-MOOS-17 to Q-MOOS-20), the expected output is derived from the recording by the
 stated rule, and the recording is checked to show the difference."""
 
 from __future__ import annotations
@@ -95,8 +95,25 @@ def test_grep_star_is_a_prefix_where_aloggrep_matches_anywhere(
 def test_grep_by_source(log: str, capsysbinary: pytest.CaptureFixture[bytes]) -> None:
     # aloggrep takes a source among its keys; pygoby says --source (any variable: *)
     ours = pygoby_grep(capsysbinary, log, "*", "--source", "vehicle", "--source", "pAcommsHandler")
-    assert ours == recorded(log, "grep_source_gl_q.txt")
     assert ours  # both sources occur
+    # aloggrep leaves out the line before LOGSTART (a negative time)
+    assert lines_of(recorded(log, "grep_source_gl_q.txt")) == after_logstart(lines_of(ours))
+
+
+@pytest.mark.parametrize("log", PLOGGER_LOGS)
+def test_grep_shows_what_was_logged_before_logstart(
+    log: str, capsysbinary: pytest.CaptureFixture[bytes]
+) -> None:
+    ours = lines_of(pygoby_grep(capsysbinary, log, "PRESTART", "SCI_TEXT"))
+    assert [variable(line) for line in ours] == ["PRESTART", "SCI_TEXT"]
+    assert ours[0].startswith(b"-0.5")  # pLogger got it from the DB as it registered
+    assert lines_of(recorded(log, "grep_prestart_q.txt")) == ours[1:]
+
+
+def after_logstart(lines: list[bytes]) -> list[bytes]:
+    """The lines MOOS-IvP's aloggrep and alogscan read as entries: not those with a negative
+    time, which they take for lines that are not entries (QUIRKS.md Q-MOOS-20)."""
+    return [line for line in lines if not line.startswith(b"-")]
 
 
 # -- summary -------------------------------------------------------------------------------------
@@ -120,26 +137,37 @@ def alogscan_table(log: str) -> dict[str, tuple[int, int, str, str, list[str]]]:
 
 
 @pytest.mark.parametrize("log", LOGS)
-def test_summary_matches_alogscans_table(log: str) -> None:
-    theirs = alogscan_table(log)
-    ours = summarize(AlogFile(LOGS[log]))
-    ours_as_rows = {
+def test_summary_matches_alogscans_table(log: str, tmp_path: Path) -> None:
+    # the lines alogscan reads as entries: a time not negative and a value column not empty
+    # (pygoby counts both: QUIRKS.md Q-MOOS-18, Q-MOOS-20)
+    scanned = tmp_path / "scanned.alog"
+    with scanned.open("w", encoding="utf-8", errors="surrogateescape") as out:
+        for text, entry in AlogFile(LOGS[log]).lines():
+            if entry is None or (entry.time >= 0 and entry.value_column):
+                out.write(text + "\n")
+    ours = {
         name: (row.count, row.chars, f"{row.first:.2f}", f"{row.last:.2f}", list(row.sources))
-        for name, row in ours.items()
+        for name, row in summarize(AlogFile(scanned)).items()
     }
-    # alogscan skips an entry whose value is empty (pygoby counts it: a post of "" is a message)
-    empty = {name for name in ours_as_rows if name not in theirs}
-    assert empty == ({"EMPTY"} if log in PLOGGER_LOGS else set())
-    assert all(entry.value == "" for entry in AlogFile(LOGS[log]) if entry.name in empty)
-    assert {name: row for name, row in ours_as_rows.items() if name not in empty} == theirs
+    assert ours == alogscan_table(log)
+    left_out = set(summarize(AlogFile(LOGS[log]))) - set(ours)
+    assert (
+        left_out
+        == {
+            "acomms": set(),
+            "plogger_blog": {"PRESTART", "EMPTY"},
+            "plogger_inline": {"PRESTART"},  # its empty value is written "S:"
+        }[log]
+    )
 
 
 @pytest.mark.parametrize("log", PLOGGER_LOGS)
 def test_moosivp_tools_read_every_line_of_our_plogger_logs(log: str) -> None:
     entries = list(AlogFile(LOGS[log]))
-    names = {entry.name for entry in entries}
-    assert set(alogscan_table(log)) == names - {"EMPTY"}
-    # aloggrep's report counts each entry line as kept or left out, and no line as damage
+    scanned = {e.name for e in entries if e.time >= 0 and e.value_column}
+    assert set(alogscan_table(log)) == scanned
+    assert f"Total variables: {len(scanned)}" in recorded(log, "scan.txt").decode()
+    # aloggrep's report counts each entry line as kept or left out
     report = recorded(log, "grep_vars.txt").decode()
     (kept,) = re.findall(r"Total lines retained: (\d+)", report)
     (left,) = re.findall(r"Total lines excluded: (\d+)", report)
@@ -147,8 +175,6 @@ def test_moosivp_tools_read_every_line_of_our_plogger_logs(log: str) -> None:
         line for line in LOGS[log].read_bytes().splitlines() if not line.startswith(b"%%")
     ]
     assert int(kept) + int(left) == len(entries) == len(not_banner)
-    scan = recorded(log, "scan.txt").decode()
-    assert f"Total variables: {len(names) - 1}" in scan
 
 
 def test_summary_command_shows_a_bridged_source_with_its_community(
@@ -185,7 +211,7 @@ def inline_from_blog(log_path: Path, lines: list[bytes]) -> list[bytes]:
 
 @pytest.mark.parametrize("log", LOGS)
 @pytest.mark.parametrize(
-    ("window", "t0", "t1"), [("clip_mid", "1.5", "6"), ("clip_start", "0", "1.2")]
+    ("window", "t0", "t1"), [("clip_mid", "1.5", "6.5"), ("clip_start", "0", "1.2")]
 )
 def test_clip_writes_alogclips_lines(
     log: str,
@@ -217,7 +243,7 @@ def test_clip_without_the_blog_keeps_the_references(
     alone = tmp_path / "plogger_blog.alog"  # no .blog beside it
     alone.write_bytes(LOGS["plogger_blog"].read_bytes())
     out = tmp_path / "clip.alog"
-    assert pygoby_main(["log", "clip", str(alone), "1.5", "6", "-o", str(out)]) == 0
+    assert pygoby_main(["log", "clip", str(alone), "1.5", "6.5", "-o", str(out)]) == 0
     assert "2 binary values not found in the .blog" in capsys.readouterr().err
     assert out.read_bytes() == recorded("plogger_blog", "clip_mid.alog")
 

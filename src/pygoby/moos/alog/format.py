@@ -36,10 +36,16 @@ BINARY_MARKING = "%% BINARY MARKING ON"
 BINARY_TAG = re.compile(
     r"<MOOS_BINARY>File=(?P<file>[^,]*),Offset=(?P<offset>\d+),Bytes=(?P<size>\d+)</MOOS_BINARY>"
 )
-# a value the MOOS-IvP tools take for a number (their isNumber), plus C++'s inf and nan
+# a number, exponent allowed: a time, LOGSTART, a value marked D:
 _NUMBER_TEXT = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _NUMBER = re.compile(rf"{_NUMBER_TEXT}|[+-]?(?:inf|nan)")
-# TIME VARIABLE SOURCE [VALUE]: one match checks the columns and that the time is a number
+# an unmarked value read as a double: what pLogger writes for one (fixed digits, or C++'s inf
+# and nan), which is also what MOOS-IvP's isNumber takes for a number (no exponent: "1e5" is a
+# string to both)
+_DOUBLE_AS_WRITTEN = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)|[+-]?(?:inf|nan)")
+# TIME VARIABLE SOURCE [VALUE]: one match checks the columns and that the time is a number; a
+# negative time (a value pLogger got from the DB as it registered) is an entry, where MOOS-IvP's
+# aloggrep and alogscan skip it (QUIRKS.md Q-MOOS-20)
 _ENTRY = re.compile(rf"[ \t]*({_NUMBER_TEXT})[ \t]+(\S+)[ \t]+(\S+)(?:[ \t]+(.*))?")
 
 Value = float | str | bytes
@@ -219,7 +225,7 @@ class AlogReader:
             if tag:
                 return b"", (tag["file"], int(tag["offset"]), int(tag["size"]))
         number = raw.rstrip()
-        if _NUMBER.fullmatch(number):
+        if _DOUBLE_AS_WRITTEN.fullmatch(number):
             return float(number), None
         return raw, None
 

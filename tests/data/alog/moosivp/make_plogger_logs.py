@@ -58,6 +58,7 @@ VEHICLE_POSTS: list[tuple[str, float | str | bytes, str]] = [
     ("DESIRED_NAV_X", 10.0, "waypt"),
     ("NUMERIC_TEXT", "3.5", ""),
     ("MSG_LEN", 7.0, ""),
+    ("SCI_TEXT", "1e5", ""),
     ("EMPTY", "", ""),
     ("RAW", b"binary\x00 data", "bhv_b"),
     ("NAV_X", 0.0, ""),
@@ -82,28 +83,36 @@ async def run_mission(directory: Path, file: str, options: str) -> None:
         async with (
             MOOSClient("vehicle", port=db.port, clock=clock) as vehicle,
             MOOSClient("pShare", port=db.port, clock=clock) as bridge,
-            app,
         ):
-            vehicle.subscribe("LOGGER_DIRECTORY")
-            while (await vehicle.receive(5)).key != "LOGGER_DIRECTORY":
-                pass  # pLogger is connected and registered
+            # posted before pLogger starts: pLogger gets it from the DB when it registers and
+            # logs it at its own time, before LOGSTART (a negative time)
+            vehicle.publish("PRESTART", "posted before pLogger started")
+            await vehicle.flush()
+            await asyncio.sleep(0.5 / WARP)
+            async with app:
+                await _post(vehicle, bridge)
             await asyncio.sleep(0.1)
-            bridged = iter(BRIDGED_POSTS)
-            for index, (key, value, aux) in enumerate(VEHICLE_POSTS):
-                vehicle.publish(key, value, src_aux=aux)
-                await vehicle.flush()
-                if index % 5 == 2:
-                    name, forwarded = next(bridged)
-                    # a bridge forwards the message with its originating community set: the
-                    # DB passes it on untouched (the client API has no publish for this)
-                    bridge._queue(
-                        p.notify(
-                            name, forwarded, time=bridge.time(), src="pShare", community="bravo"
-                        )
-                    )
-                    await bridge.flush()
-                await asyncio.sleep(0.5 / WARP)
-            await asyncio.sleep(0.3)
+
+
+async def _post(vehicle: MOOSClient, bridge: MOOSClient) -> None:
+    vehicle.subscribe("LOGGER_DIRECTORY")
+    while (await vehicle.receive(5)).key != "LOGGER_DIRECTORY":
+        pass  # pLogger is connected and registered
+    await asyncio.sleep(0.1)
+    bridged = iter(BRIDGED_POSTS)
+    for index, (key, value, aux) in enumerate(VEHICLE_POSTS):
+        vehicle.publish(key, value, src_aux=aux)
+        await vehicle.flush()
+        if index % 5 == 2:
+            name, forwarded = next(bridged)
+            # a bridge forwards the message with its originating community set: the DB passes
+            # it on untouched (the client API has no publish for this)
+            bridge._queue(
+                p.notify(name, forwarded, time=bridge.time(), src="pShare", community="bravo")
+            )
+            await bridge.flush()
+        await asyncio.sleep(0.5 / WARP)
+    await asyncio.sleep(0.3)
 
 
 def main() -> None:
@@ -117,7 +126,7 @@ def main() -> None:
                 run_mission(
                     work,
                     "plogger_inline",
-                    "  DoublePrecision = 3\n  MarkDataAsBinary = true\n",
+                    "  DoublePrecision = 3\n  MarkDataAsBinary = true\n  MarkDataType = true\n",
                 )
             )
         finally:
