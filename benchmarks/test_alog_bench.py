@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from pygoby.moos.alog import AlogFile, AlogFormatter, banner
-from pygoby.moos.alog.tools import convert
+from pygoby.moos.alog.tools import clip, convert, grep, summarize
 
 ROWS = 20_000
 FORMATTER = AlogFormatter(1000.0, log_aux_src=True)
@@ -42,3 +42,23 @@ def test_read_20k_lines(benchmark, alog):
 @pytest.mark.parametrize("suffix", [".parquet", ".csv"])
 def test_convert_20k_lines(benchmark, alog, tmp_path, suffix):
     assert benchmark(convert, [alog], tmp_path / f"out{suffix}") == ROWS
+
+
+@pytest.mark.benchmark(group="alog")
+def test_summary_20k_lines(benchmark, alog):
+    table = benchmark(lambda: summarize(AlogFile(alog)))
+    assert sum(row.count for row in table.values()) == ROWS
+
+
+@pytest.mark.benchmark(group="alog")
+def test_grep_20k_lines(benchmark, alog):
+    assert benchmark(lambda: sum(1 for _ in grep(AlogFile(alog), ["NAV_*"]))) == ROWS // 2
+
+
+@pytest.mark.benchmark(group="alog")
+def test_clip_20k_lines(benchmark, alog, tmp_path):
+    def clip_all() -> int:
+        with open(tmp_path / "clip.alog", "w") as out:
+            return clip(AlogFile(alog), 0.0, 1e9, out)
+
+    assert benchmark(clip_all) == ROWS

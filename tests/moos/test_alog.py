@@ -19,7 +19,7 @@ from pygoby.cli import main as pygoby_main
 from pygoby.errors import ConfigError
 from pygoby.moos.alog import AlogFile, AlogFormatter, AlogReader, AlogSink, banner
 from pygoby.moos.alog.logger_config import parse_log_request, read_logger_config
-from pygoby.moos.alog.tools import LogToolError, convert
+from pygoby.moos.alog.tools import LogToolError, convert, summarize
 from pygoby.moos.moosfile import Setting
 from tests.hypothesis_profiles import examples
 
@@ -91,6 +91,15 @@ def test_data_type_marking_keeps_numeric_strings_strings() -> None:
     assert reader.feed(fmt.line(1.0, "A", "s", 3.5)).value == 3.5
     # without marking, a value that is a number is read as a double (as MOOS-IvP's tools do)
     assert AlogReader().feed(AlogFormatter(0.0).line(1.0, "A", "s", "3.5")).value == 3.5
+    # ... as pLogger writes doubles (fixed digits, inf, nan) and MOOS-IvP's isNumber takes
+    # numbers: with an exponent it is a string (pLogger never writes a double so)
+    plain = AlogFormatter(0.0)
+    for text in ("1e5", "2E-3", "0x10", "1.2.3"):
+        assert AlogReader().feed(plain.line(1.0, "A", "s", text)).value == text
+    for text, double in (("12.", 12.0), (".5", 0.5), ("-7", -7.0), ("-inf", -math.inf)):
+        assert AlogReader().feed(plain.line(1.0, "A", "s", text)).value == double
+    assert math.isnan(AlogReader().feed(plain.line(1.0, "A", "s", "-nan")).value)
+    assert AlogReader().feed(plain.line(1.0, "A", "s", math.inf)).value == math.inf
 
 
 def test_binary_inline_hex_and_through_the_blog(tmp_path: Path) -> None:
@@ -105,7 +114,13 @@ def test_binary_inline_hex_and_through_the_blog(tmp_path: Path) -> None:
     sink.put_line(plain.line(103.0, "X", "src", 7.0))
     sink.close()
     text = (tmp_path / "L.alog").read_text()
-    assert "<MOOS_BINARY>File=L.blog,Offset=" in text and ",Bytes=5</MOOS_BINARY>" in text
+    # as pLogger: the .blog holds the line's prefix, then the bytes and a newline; the .alog line
+    # ends right after the tag (no space), the offset being where the bytes start in the .blog
+    prefix = plain.prefix(102.0, "RAW", "src")
+    assert (
+        prefix + f"<MOOS_BINARY>File=L.blog,Offset={len(prefix)},Bytes=5</MOOS_BINARY>\n"
+    ) in text
+    assert (tmp_path / "L.blog").read_bytes() == prefix.encode() + b"\x01\n\x02 \xfe\n"
     assert [e.value for e in AlogFile(tmp_path / "L.alog")] == ["a", b"\x01\n\x02 \xfe", 7.0]
     (tmp_path / "L.blog").unlink()
     log = AlogFile(tmp_path / "L.alog")
@@ -288,12 +303,17 @@ def test_grep_and_summary(alog: Path, capsys: pytest.CaptureFixture[str]) -> Non
     assert len(out.splitlines()) == 20 and "MSG" not in out
     assert "1 damaged lines skipped (the first at line 36)" in err
     assert pygoby_main(["log", "grep", str(alog), "MSG"]) == 0
-    first = capsys.readouterr().out.splitlines()[0]
-    assert first.split(maxsplit=3) == ["0.500", "MSG", "pHelm:bhv", "hello 0"]
+    first = capsys.readouterr().out.splitlines(keepends=True)[0]
+    # the line as the file has it (aloggrep prints lines so), its trailing space included
+    written = AlogFormatter(LOG_START, log_aux_src=True).line(
+        LOG_START + 0.5, "MSG", "pHelm", "hello 0", "bhv"
+    )
+    assert first == written and first.endswith("hello 0 \n")
     assert pygoby_main(["log", "summary", str(alog)]) == 0
     out = capsys.readouterr().out.splitlines()
     nav_x = next(line for line in out if line.startswith("NAV_X "))
-    assert nav_x.split() == ["NAV_X", "10", "33", "0.00", "9.00", "1.00", "uSim"]
+    # chars as alogscan counts them: NAV_X (5) + uSim (4) + the padded value column (13)
+    assert nav_x.split() == ["NAV_X", "10", "220", "0.00", "9.00", "1.00", "uSim"]
     assert out[-1].startswith("3 variables, 30 lines")
 
 
@@ -305,6 +325,39 @@ def test_clip(alog: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     assert all(2 <= e.time <= 4 for e in entries) and len(entries) == 7
     assert {e.full_source for e in entries} == {"uSim", "pHelm:bhv"}
     assert AlogFile(out).log_start == pytest.approx(LOG_START, abs=0.01)
+
+
+def test_summary_counts_chars_and_lists_sources_as_alogscan(tmp_path: Path) -> None:
+    path = tmp_path / "s.alog"
+    fmt = AlogFormatter(LOG_START, log_aux_src=True, mark_external=True, own_community="a")
+    path.write_text(
+        banner(str(path), LOG_START)
+        + fmt.line(LOG_START + 1, "V", "pNavX", "ab")
+        + fmt.line(LOG_START + 2, "V", "pNav", "ab", community="b")
+        + fmt.line(LOG_START + 3, "V", "pNav", "ab", "aux", community="b")
+        + fmt.line(LOG_START + 4, "V", "pNav", "ab")
+    )
+    (row,) = summarize(AlogFile(path)).values()
+    # chars: variable + source column up to its first ':' + value column ("ab "): alogscan
+    # drops "@b" where an aux comes first
+    assert row.chars == (1 + 5 + 3) + (1 + 6 + 3) + (1 + 4 + 3) + (1 + 4 + 3)
+    # every source, compared whole (alogscan leaves pNav out: "pNavX" contains it), in the
+    # order first seen, with its community
+    assert list(row.sources) == ["pNavX", "pNav@b", "pNav"]
+
+
+def test_clip_keeps_the_helm_domain_whatever_its_time(tmp_path: Path) -> None:
+    path = tmp_path / "helm.alog"
+    fmt = AlogFormatter(LOG_START)
+    posts = [(0.5, "IVPHELM_DOMAIN"), (1.0, "BHV"), (2.5, "BHV"), (4.0, "BHV")]
+    lines = [fmt.line(LOG_START + t, name, "pHelmIvP", "x") for t, name in posts]
+    header = banner(str(path), LOG_START)
+    path.write_text(header + "".join(lines) + "continued text \n")
+    out = tmp_path / "clip.alog"
+    assert pygoby_main(["log", "clip", str(path), "2", "3", "-o", str(out)]) == 0
+    # alogclip's rule: IVPHELM_DOMAIN (alogview needs it) is kept outside the window too; the
+    # banner is copied as it is; the line that is no entry is dropped
+    assert out.read_text() == header + lines[0] + lines[2]
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".jsonl", ".parquet"])

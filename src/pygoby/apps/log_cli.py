@@ -1,6 +1,6 @@
 """`pygoby log`: look at, cut, convert and replay MOOS .alog files (pLogger's).
 
-  pygoby log grep FILE VAR... [--source S]       entries of these variables (VAR* = prefix)
+  pygoby log grep FILE VAR... [--source S]       lines of these variables (VAR* = prefix)
   pygoby log summary FILE                        per variable: lines, first/last time, rate, sources
   pygoby log clip FILE T0 T1 -o OUT.alog         the entries between two log times
   pygoby log convert FILE... -o OUT.parquet [-j N] [--mission M.moos]
@@ -56,7 +56,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     actions = parser.add_subparsers(dest="log_command", required=True, metavar="ACTION")
 
-    grep = actions.add_parser("grep", help="print the entries of some variables (aloggrep)")
+    grep = actions.add_parser(
+        "grep", help="print the lines of some variables as the file has them (aloggrep -q)"
+    )
     grep.add_argument("file")
     grep.add_argument("variables", nargs="+", metavar="VAR", help="name, or prefix ending in *")
     grep.add_argument("--source", action="append", default=[], help="only from this source")
@@ -120,14 +122,10 @@ def _report_bad_lines(log: AlogFile) -> None:
 
 @reporting_errors
 def grep_command(args: argparse.Namespace) -> int:
-    from pygoby.moos.alog.tools import grep, value_text
+    from pygoby.moos.alog.tools import grep, write_lines
 
     log = AlogFile(args.file)
-    out = sys.stdout
-    for entry in grep(log, args.variables, args.source):
-        out.write(
-            f"{entry.time:<15.3f} {entry.name:<20} {entry.full_source:<15} {value_text(entry)}\n"
-        )
+    write_lines((entry.line for entry in grep(log, args.variables, args.source)), sys.stdout)
     _report_bad_lines(log)
     return 0
 

@@ -60,6 +60,13 @@ class AlogFile:
         return self.reader.log_start or 0.0
 
     def __iter__(self) -> Iterator[AlogEntry]:
+        for _, entry in self.lines():
+            if entry is not None:
+                yield entry
+
+    def lines(self) -> Iterator[tuple[str, AlogEntry | None]]:
+        """Every line (without its newline) with its entry, or None for a `%%` line, a
+        continuation of a multi-line value or damage; over-long lines are only counted."""
         self.reader = AlogReader()  # each pass counts afresh
         self.unresolved_binary = 0
         self._blogs = {}
@@ -71,12 +78,11 @@ class AlogFile:
                             pass
                         self.reader.skip_line()
                         continue
-                    entry = self.reader.feed(decode_line(raw))
-                    if entry is None:
-                        continue
-                    if entry.binary_ref is not None:
+                    text = decode_line(raw).rstrip("\r\n")
+                    entry = self.reader.feed(text)
+                    if entry is not None and entry.binary_ref is not None:
                         self._resolve(entry)
-                    yield entry
+                    yield text, entry
         except (OSError, EOFError, zlib.error) as err:
             # a truncated .gz (a logger killed mid-write) ends the log where it breaks
             log.warning("%s: stopped reading: %s", self.path, err)
@@ -223,7 +229,8 @@ class AlogSink:
                 blog.write(head)
                 offset = blog.tell()
                 blog.write(data + b"\n")
-                line = head + binary_tag(self.blog_name, offset, len(data)).encode() + b" \n"
+                # pLogger ends a binary value's line right after the tag: no trailing space
+                line = head + binary_tag(self.blog_name, offset, len(data)).encode() + b"\n"
             if self.max_bytes and self._alog_bytes + len(line) > self.max_bytes:
                 self._open_alog()
             assert self._alog is not None

@@ -10,7 +10,8 @@ A file starts with a banner of `%%` lines::
 
 then one line per message, as pLogger pads it: the time since LOGSTART (fixed, 3 decimals,
 left-justified in 15 columns), the variable (20 columns), the source (15 columns; `src:aux`
-with LogAuxSrc, `...@community` with MarkExternalCommunityMessages), the value and one space.
+with LogAuxSrc, `...@community` with MarkExternalCommunityMessages), the value and one space
+(a binary value's `<MOOS_BINARY>` .blog reference ends the line without one).
 Doubles are fixed with DoublePrecision decimals (5 by default) left-justified in 12 columns;
 strings are written as they are. A reader cannot tell the string "3.5" from the double 3.5
 unless the file was written with MarkDataType (`D:`/`S:` before each value), so like MOOS-IvP's
@@ -35,10 +36,16 @@ BINARY_MARKING = "%% BINARY MARKING ON"
 BINARY_TAG = re.compile(
     r"<MOOS_BINARY>File=(?P<file>[^,]*),Offset=(?P<offset>\d+),Bytes=(?P<size>\d+)</MOOS_BINARY>"
 )
-# a value the MOOS-IvP tools take for a number (their isNumber), plus C++'s inf and nan
+# a number, exponent allowed: a time, LOGSTART, a value marked D:
 _NUMBER_TEXT = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _NUMBER = re.compile(rf"{_NUMBER_TEXT}|[+-]?(?:inf|nan)")
-# TIME VARIABLE SOURCE [VALUE]: one match checks the columns and that the time is a number
+# an unmarked value read as a double: what pLogger writes for one (fixed digits, or C++'s inf
+# and nan), which is also what MOOS-IvP's isNumber takes for a number (no exponent: "1e5" is a
+# string to both)
+_DOUBLE_AS_WRITTEN = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)|[+-]?(?:inf|nan)")
+# TIME VARIABLE SOURCE [VALUE]: one match checks the columns and that the time is a number; a
+# negative time (a value pLogger got from the DB as it registered) is an entry, where MOOS-IvP's
+# aloggrep and alogscan skip it (QUIRKS.md Q-MOOS-20)
 _ENTRY = re.compile(rf"[ \t]*({_NUMBER_TEXT})[ \t]+(\S+)[ \t]+(\S+)(?:[ \t]+(.*))?")
 
 Value = float | str | bytes
@@ -47,7 +54,10 @@ Value = float | str | bytes
 @dataclass(slots=True)
 class AlogEntry:
     """One logged message. `time` is seconds since LOGSTART; `value` is a float (double), str
-    (string) or bytes (binary; `binary_ref` holds the .blog reference while it is unresolved)."""
+    (string) or bytes (binary; `binary_ref` holds the .blog reference while it is unresolved).
+    `line` is the line as the file has it (without its newline) and `value_column` its value
+    column as written (padding and trailing space included): the tools that copy lines, as
+    MOOS-IvP's do, copy these."""
 
     time: float
     name: str
@@ -56,6 +66,8 @@ class AlogEntry:
     source_aux: str = ""
     community: str = ""
     binary_ref: tuple[str, int, int] | None = None
+    line: str = ""
+    value_column: str = ""
 
     @property
     def type(self) -> str:
@@ -129,7 +141,7 @@ class AlogFormatter:
         if isinstance(value, bytes):
             if not self.mark_binary:
                 raise ValueError("binary values go to the .blog unless mark_binary is set")
-            return "B:" + value.hex().upper()
+            return inline_binary(value)
         return "S:" + value if self.mark_data_type else value
 
     def line(
@@ -143,6 +155,11 @@ class AlogFormatter:
     ) -> str:
         """One whole line for a double or string value (or binary with mark_binary)."""
         return f"{self.prefix(msg_time, name, src, src_aux, community)}{self.value_text(value)} \n"
+
+
+def inline_binary(value: bytes) -> str:
+    """A binary value as the MarkDataAsBinary files write it in the value column."""
+    return "B:" + value.hex().upper()
 
 
 def binary_tag(blog_name: str, offset: int, size: int) -> str:
@@ -186,7 +203,7 @@ class AlogReader:
             self._bad(line)
             return None
         src, aux, community = _split_source(source)
-        return AlogEntry(msg_time, name, src, value[0], aux, community, value[1])
+        return AlogEntry(msg_time, name, src, value[0], aux, community, value[1], line, raw or "")
 
     def _value(self, raw: str) -> tuple[Value, tuple[str, int, int] | None] | None:
         # pLogger ends every value with one space; doubles are padded further
@@ -208,7 +225,7 @@ class AlogReader:
             if tag:
                 return b"", (tag["file"], int(tag["offset"]), int(tag["size"]))
         number = raw.rstrip()
-        if _NUMBER.fullmatch(number):
+        if _DOUBLE_AS_WRITTEN.fullmatch(number):
             return float(number), None
         return raw, None
 
