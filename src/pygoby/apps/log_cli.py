@@ -87,7 +87,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     convert.add_argument(
         "--mission",
         metavar="FILE.moos",
-        help="decode the acomms variables of this mission's pAcommsHandler into columns",
+        help="decode the acomms variables of this mission's pAcommsHandler (and the DCCL "
+        "messages in their frames) and its translator variables into columns",
     )
     convert.add_argument(
         "--block", default="pAcommsHandler", help="its ProcessConfig (default %(default)s)"
@@ -157,22 +158,33 @@ def clip_command(args: argparse.Namespace) -> int:
 
 @reporting_errors
 def convert_command(args: argparse.Namespace) -> int:
-    from pygoby.moos.alog.tools import convert
+    from pygoby.moos.alog.tools import convert, decoded_columns
 
     def progress(rows: int) -> None:
         if sys.stderr.isatty():
             sys.stderr.write(f"\r{rows} rows")
 
     decoder = None
+    columns = None
+    undecodable = None
     if args.mission is not None:
         from pygoby.moosacomms.alog_decode import MissionDecoder  # only when asked for
 
-        MissionDecoder(args.mission, args.block)  # configuration errors now, not in a worker
+        # configuration errors now, not in a worker; the first pass over the files (the
+        # columns) sees every value once, so its decoder counts the undecodable ones
+        first_pass = MissionDecoder(args.mission, args.block)
+        columns = decoded_columns(args.files, first_pass)
+        undecodable = first_pass.undecodable
         decoder = functools.partial(MissionDecoder, args.mission, args.block)
-    count = convert(args.files, args.output, progress, jobs=args.jobs, decoder=decoder)
+    count = convert(
+        args.files, args.output, progress, jobs=args.jobs, decoder=decoder, columns=columns
+    )
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     print(f"{args.output}: {count} rows")
+    if undecodable:
+        counts = ", ".join(f"{name} {n}" for name, n in sorted(undecodable.items()))
+        print(f"values left undecoded (kept raw): {counts}", file=sys.stderr)
     return 0
 
 

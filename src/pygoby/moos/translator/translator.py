@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 from google.protobuf.message import Message
@@ -122,6 +122,8 @@ def post_for_moos(var: str, msg: Message, technique: Technique) -> Post:
 
 
 MessageResolver = Callable[[str], type[Message]]
+# a create or a publish rule: both have technique, format and repeated_delimiter
+_ReadableRule = TranslatorEntry.CreateParser | TranslatorEntry.PublishSerializer
 
 
 class Translator:
@@ -146,6 +148,7 @@ class Translator:
         self._entries: dict[str, TranslatorEntry] = {}
         self._classes: dict[str, type[Message]] = {}
         self._named_values: dict[str, dict[str, str]] = {}
+        self._read_rules: dict[str, list[tuple[str, _ReadableRule, Sequence[object]]]] | None = None
         for entry in entries:
             self.add_entry(entry)
 
@@ -165,6 +168,7 @@ class Translator:
                 f"translator_entry protobuf_name {name!r} is not a loaded message type: {exc}"
             ) from None
         notes = self._check_entry(entry, cls)
+        self._read_rules = None
         self._entries[name] = entry
         self._classes[name] = cls
         return notes
@@ -400,6 +404,76 @@ class Translator:
         ):
             posts.append(Post(trigger.moos_var, "", ""))
         return sorted(posts, key=lambda post: post.var)
+
+    # --- MOOS posts read back (log tools) ----------------------------------------------------
+
+    def read_back(self, var: str, value: MoosValue) -> list[Message]:
+        """The messages `var`'s value gives back, one per rule naming `var`: each create rule
+        reading it (its algorithms applied, as at creation) and each publish rule posting to it
+        (the value as published: publish algorithms only run message -> text). Rules whose
+        value cannot be parsed back are not read: a publish variable name that is itself a
+        format, a publish format with a field the message does not have (an algorithm's
+        virtual field). A format that matches only part of the value counts as not read.
+        Raises TranslatorError when no rule reads the value."""
+        rules = self._readers().get(var, [])
+        messages: list[Message] = []
+        errors: list[str] = []
+        for name, rule, algorithms in rules:
+            entry = self._entries[name]
+            msg = self._classes[name]()
+            technique = Technique(rule.technique)
+            source = moos_value_to_source(value, technique)
+            try:
+                if technique == Technique.TECHNIQUE_FORMAT:
+                    mismatch = format_technique.parse(
+                        as_text(source),
+                        msg,
+                        rule.format,
+                        rule.repeated_delimiter,
+                        algorithms,
+                        entry.use_short_enum,
+                        self.registry,
+                    )
+                    if mismatch is not None:
+                        raise TranslatorError(f"does not match format {rule.format!r}: {mismatch}")
+                elif technique == Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
+                    keyvalue.parse(
+                        as_text(source), msg, algorithms, entry.use_short_enum, self.registry
+                    )
+                else:
+                    parse_protobuf(source, msg, technique)
+            except (TranslatorError, ValueError, KeyError) as exc:
+                errors.append(f"{name}: {exc}")
+                continue
+            messages.append(msg)
+        if rules and not messages:
+            raise TranslatorError(f"{var}: no rule reads the value ({'; '.join(errors)})")
+        return messages
+
+    def read_back_variables(self) -> set[str]:
+        """The variables `read_back` can read."""
+        return set(self._readers())
+
+    def _readers(self) -> dict[str, list[tuple[str, _ReadableRule, Sequence[object]]]]:
+        """{variable: [(entry name, rule, algorithms to apply)]}, built once."""
+        if self._read_rules is not None:
+            return self._read_rules
+        readers: dict[str, list[tuple[str, _ReadableRule, Sequence[object]]]] = {}
+        for name, entry in self._entries.items():
+            descriptor = self._classes[name].DESCRIPTOR
+            for create in entry.create:
+                readers.setdefault(create.moos_var, []).append((name, create, create.algorithm))
+            for publish in entry.publish:
+                if Technique(publish.technique) == Technique.TECHNIQUE_FORMAT:
+                    if "%" in publish.moos_var:
+                        continue
+                    try:
+                        format_technique.check_parse_format(descriptor, publish.format)
+                    except TranslatorError:
+                        continue
+                readers.setdefault(publish.moos_var, []).append((name, publish, ()))
+        self._read_rules = readers
+        return readers
 
     def _entry(self, protobuf_name: str) -> TranslatorEntry:
         try:
