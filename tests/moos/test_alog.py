@@ -409,17 +409,17 @@ def test_convert_decodes_the_missions_acomms_variables(
     args = ["log", "convert", str(alog), str(alog), "-o", str(out), "-j", jobs]
     assert pygoby_main([*args, "--mission", str(mission)]) == 0
     captured = capsys.readouterr()
-    assert captured.out == f"{out}: 38 rows\n"
-    # both copies: the garbage text, a frame that is not DCCL and a cut message in a frame;
-    # an unknown @PB type; a FORMAT publication that does not match its format
+    assert captured.out == f"{out}: 60 rows\n"
+    # in both copies: the garbage text, a frame that is not DCCL and two cut messages in
+    # frames; an unknown @PB type; a FORMAT publication that does not match its format
     assert captured.err == (
-        "values left undecoded (kept raw): AC_MODEM_RECEIVE 6, AC_QUEUE_RECEIVE 2, "
+        "values left undecoded (kept raw): AC_MODEM_RECEIVE 8, AC_QUEUE_RECEIVE 2, "
         "PT_STATUS_FMT 2\n"
     )
     records = pq.read_table(out).to_pylist()
-    assert len(records) == 38 and records[19:] == records[:19]
+    assert len(records) == 60 and records[30:] == records[:30]
     by_name: dict[str, list[dict]] = {}
-    for record in records[:19]:
+    for record in records[:30]:
         by_name.setdefault(record["name"], []).append(record)
     decoded = [name for name in records[0] if "." in name]
 
@@ -427,7 +427,8 @@ def test_convert_decodes_the_missions_acomms_variables(
         return {k: v for k, v in record.items() if k in decoded and v is not None}
 
     assert fields(by_name["NAV_X"][0]) == {}  # not an acomms or translator variable
-    handmade, garbage, packed = by_name["AC_MODEM_RECEIVE"]
+    handmade, garbage, packed, packed_again = by_name["AC_MODEM_RECEIVE"]
+    assert fields(packed_again) == fields(packed)
     assert fields(handmade) == {
         "ModemTransmission.src": "2",
         "ModemTransmission.dest": "1",

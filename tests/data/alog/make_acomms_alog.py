@@ -34,7 +34,7 @@ sent = acomms_pb.ModemTransmission(src=1, dest=2, type=acomms_pb.DATA, time=1764
 sent.frame.append(second)
 published = Status(src=4, depth=7.5, tags=[2])
 
-entries: list[tuple[str, str, str | float | bytes]] = [
+entries: list[tuple] = [  # (name, source, value[, community])
     ("NAV_X", "uSimVehicle", 12.5),
     (
         "AC_MODEM_RECEIVE",
@@ -60,14 +60,28 @@ entries: list[tuple[str, str, str | float | bytes]] = [
     ("PT_STATUS_KV", "pTranslator", key_values(published)),
     ("PT_STATUS_FMT", "pTranslator", "src=4;depth=7.5"),
     ("PT_STATUS_FMT", "pTranslator", "no match here"),
+    # for `pygoby log plot`: the modem id, acks and expiries, a track
+    ("MODEM_ID", "pAcommsHandler", 1.0),
+    ("AC_ACK_ORIGINAL", "pAcommsHandler", serialize_protobuf(published, Technique(5))),
+    ("AC_EXPIRE", "pAcommsHandler", serialize_protobuf(published, Technique(5))),
+    ("AC_ACK_ORIGINAL", "pAcommsHandler", serialize_protobuf(published, Technique(5))),
+    ("NAV_Y", "uSimVehicle", -4.0),
+    ("NAV_X", "uSimVehicle", 13.5),
+    ("NAV_Y", "uSimVehicle", -3.0),
+    ("NAV_X", "uSimVehicle", 14.5),
+    ("NAV_X", "uSimVehicle", 99.0, "other"),  # forwarded from another community: not ours
+    ("AC_MODEM_RECEIVE", "pAcommsHandler", message_text(received)),
+    ("AC_RAW_INCOMING", "pAcommsHandler", 'raw: "$CACST,not,a,statistics,line"'),
 ]
 
 # pLogger's MarkDataType: without it a string that looks like a number (a hex value such as
 # "0804...1e40...") is read back as a double
-formatter = AlogFormatter(0.0, mark_data_type=True, mark_binary=True)
+formatter = AlogFormatter(
+    0.0, mark_external=True, own_community="logtest", mark_data_type=True, mark_binary=True
+)
 with open("acomms.alog", "w") as out:
     out.write(
         banner("acomms.alog", LOG_START, opened_on=LOG_START, mark_data_type=True, mark_binary=True)
     )
-    for index, (name, source, value) in enumerate(entries):
-        out.write(formatter.line(0.5 * (index + 1), name, source, value))
+    for index, (name, source, value, *community) in enumerate(entries):
+        out.write(formatter.line(0.5 * (index + 1), name, source, value, "", *community))
