@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import difflib
+import json
 import shutil
 import signal
 import socket
@@ -15,6 +16,7 @@ import pytest
 from google.protobuf import text_format
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.cli import main as pygoby_main
 from pygoby.moos.alog.files import AlogFile
 from pygoby.moos.alog.tools import summarize
 from pygoby.moos.client import MOOSClient
@@ -189,6 +191,25 @@ async def test_ccl_and_dccl_simple_status_reaches_mm2(tmp_path):
     assert not any("is not available" in err for err in run_pair.stderr)
     assert "STATUS_REPORT_IN" in community_log(directory, "mm2")
     assert "ACOMMS_MODEM_TRANSMIT" in community_log(directory, "mm1")
+    # `pygoby log convert --mission`: the Goby 1.1 frame's DCCL1 bytes, read through the XML
+    # message set, give what mm1 sent; QSIZE is read in Goby 1.1's form
+    (log,) = (directory / "logs").glob("mm2_*/mm2_*.alog")
+    out = directory / "mm2.jsonl"
+    assert (
+        pygoby_main(
+            ["log", "convert", str(log), "--mission", str(directory / "mm2.moos"), "-o", str(out)]
+        )
+        == 0
+    )
+    rows = [json.loads(line) for line in out.read_text().splitlines()]
+    frames = [r for r in rows if r["name"] == "ACOMMS_MODEM_RECEIVE" and r["type"] == "string"]
+    assert frames  # every frame mm2 heard is one of mm1's statuses
+    for frame in frames:
+        assert frame["ModemTransmission.src"] == "1"
+        assert (frame["SIMPLE_STATUS.nav_x"], frame["SIMPLE_STATUS.nav_y"]) == ("100.0", "300.0")
+        assert frame["SIMPLE_STATUS.MessageType"] == "LAMSS_STATUS"
+    sizes = [r for r in rows if r["name"] == "ACOMMS_QSIZE"]
+    assert sizes and all("QueueSize.key.id" in r for r in sizes)
 
 
 def community_log(directory: Path, community: str) -> dict[str, int]:

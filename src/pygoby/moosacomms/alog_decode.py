@@ -53,14 +53,15 @@ from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
 )
 from pygoby.protobuf.goby.apps.moos.protobuf.pTranslator_config_pb2 import pTranslatorConfig
 
-# moos_var fields (pAcommsHandler's names without the prefix) whose values are one fixed type
-FIXED_TYPE_VARIABLES: dict[str, type[Message]] = {
-    "driver_receive": acomms_pb.ModemTransmission,
-    "driver_transmit": acomms_pb.ModemTransmission,
-    "mac_slot_start": acomms_pb.ModemTransmission,
-    "driver_raw_msg_in": acomms_pb.ModemRaw,
-    "driver_raw_msg_out": acomms_pb.ModemRaw,
-    "queue_size": acomms_pb.QueueSize,
+# moos_var fields (pAcommsHandler's names without the prefix) whose values are of fixed types
+# (the first that parses; with a Goby 1.1 configuration QSIZE is Goby 1.1's QueueSize)
+FIXED_TYPE_VARIABLES: dict[str, tuple[type[Message], ...]] = {
+    "driver_receive": (acomms_pb.ModemTransmission,),
+    "driver_transmit": (acomms_pb.ModemTransmission,),
+    "mac_slot_start": (acomms_pb.ModemTransmission,),
+    "driver_raw_msg_in": (acomms_pb.ModemRaw,),
+    "driver_raw_msg_out": (acomms_pb.ModemRaw,),
+    "queue_size": (acomms_pb.QueueSize, acomms_pb.V1QueueSize),
 }
 # the moos_var fields whose ModemTransmission frames carry the DCCL bytes sent and received
 FRAME_VARIABLES = ("driver_receive", "driver_transmit")
@@ -198,11 +199,10 @@ class MissionDecoder:
         """The value's fields as `{"<Type>.<path>": text}`; {} for other variables and for
         values that do not parse (the row keeps its `value`)."""
         messages: list[Message] = []
-        cls = self.fixed.get(entry.name)
+        classes = self.fixed.get(entry.name)
         try:
-            if cls is not None:
-                msg = cls()
-                parse_for_moos(_text_of(entry.value), msg)
+            if classes is not None:
+                msg = _parse_first(_text_of(entry.value), classes)
                 messages.append(msg)
                 if entry.name in self.frames:
                     assert isinstance(msg, acomms_pb.ModemTransmission)
@@ -272,6 +272,18 @@ class MissionDecoder:
             except DcclError:
                 self.undecodable[name] += 1
         return out
+
+
+def _parse_first(value: str | bytes, classes: tuple[type[Message], ...]) -> Message:
+    """`value` as the first of `classes` it parses as; the last one's error if none."""
+    for cls in classes[:-1]:
+        msg = cls()
+        with contextlib.suppress(TranslatorError):
+            parse_for_moos(value, msg)
+            return msg
+    msg = classes[-1]()
+    parse_for_moos(value, msg)
+    return msg
 
 
 def _text_of(value: str | float | bytes) -> str | bytes:
