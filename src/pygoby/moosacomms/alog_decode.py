@@ -23,7 +23,7 @@ from __future__ import annotations
 import contextlib
 import time
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from google.protobuf.descriptor import FieldDescriptor
@@ -52,6 +52,7 @@ from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
     pAcommsHandlerConfig,
 )
 from pygoby.protobuf.goby.apps.moos.protobuf.pTranslator_config_pb2 import pTranslatorConfig
+from pygoby.protobuf.goby.moos.protobuf.translator_pb2 import TranslatorEntry
 
 # moos_var fields (pAcommsHandler's names without the prefix) whose values are of fixed types
 # (the first that parses; with a Goby 1.1 configuration QSIZE is Goby 1.1's QueueSize)
@@ -191,7 +192,14 @@ class MissionDecoder:
         return codec
 
     @staticmethod
-    def _translator(entries, types: MessageTypes, lookup_path: str, mission) -> Translator:
+    def _translator(
+        entries: Iterable[TranslatorEntry],
+        types: MessageTypes,
+        lookup_path: str,
+        mission: MissionFile,
+    ) -> Translator:
+        """The block's entries (TranslatorConfigError as the app would give at start-up); the
+        modem id lookup for the name2modem_id algorithms of create rules."""
         modem_ids = ModemIdLookup.from_file(mission.find_file(lookup_path)) if lookup_path else None
         return Translator(entries, types, modem_ids=modem_ids)
 
