@@ -206,12 +206,12 @@ def convert_command(args: argparse.Namespace) -> int:
 
 @reporting_errors
 def plot_command(args: argparse.Namespace) -> int:
+    # matplotlib (the sim extra) first: a missing extra is said before the logs are read
+    from pygoby.moosacomms.alog_plots import summary_lines, write_log_plots
     from pygoby.moosacomms.alog_series import AcommsVariables, log_series
 
     variables = AcommsVariables.of_mission(args.mission, args.block)
     series = log_series(args.files, variables)
-    from pygoby.moosacomms.alog_plots import summary_lines, write_log_plots  # the sim extra
-
     for path in write_log_plots(series, variables, args.output):
         print(path)
     print("\n".join(summary_lines(series)))

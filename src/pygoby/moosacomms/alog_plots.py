@@ -31,7 +31,7 @@ def plot_transmissions(series: LogSeries, var: AcommsVariables, path: Path) -> P
     modems = sorted({*series.transmissions, *series.receptions})
     if not modems:
         return no_data_figure(
-            path, title, f"no ModemTransmission on {var.transmit} or {var.receive}"
+            path, title, f"the logs have no ModemTransmission on {var.transmit} or {var.receive}"
         )
     row = {modem: index for index, modem in enumerate(modems)}
     fig, ax = plt.subplots(figsize=(12, 1.6 + 0.6 * len(modems)))
@@ -77,7 +77,7 @@ def plot_link_quality(series: LogSeries, var: AcommsVariables, path: Path) -> Pa
     title = "Link quality from the Micro-Modem's $CACST"
     modems = sorted(series.snr_in)
     if not modems:
-        return no_data_figure(path, title, f"no $CACST in ModemRaw on {var.raw_in}")
+        return no_data_figure(path, title, f"the logs have no $CACST in ModemRaw on {var.raw_in}")
     fig, (snr_ax, mse_ax) = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for index, modem in enumerate(modems):
@@ -114,7 +114,7 @@ def plot_acks(series: LogSeries, var: AcommsVariables, path: Path) -> Path:
     title = "Acknowledged and expired messages"
     types = sorted({*series.acked, *series.expired})
     if not types:
-        return no_data_figure(path, title, f"no {var.acked} or {var.expired}")
+        return no_data_figure(path, title, f"the logs have no {var.acked} or {var.expired}")
     fig, ax = plt.subplots(figsize=(10, 5))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for index, name in enumerate(types):
@@ -146,7 +146,9 @@ def plot_tracks(series: LogSeries, path: Path) -> Path:
     title = "Vehicle tracks"
     tracks = {name: track for name, track in sorted(series.tracks.items()) if track.points}
     if not tracks:
-        return no_data_figure(path, title, "no NAV_X/NAV_Y or NAV_LAT/NAV_LONG of the vehicles")
+        return no_data_figure(
+            path, title, "the logs have no NAV_X/NAV_Y or NAV_LAT/NAV_LONG of their vehicles"
+        )
     fig, ax = plt.subplots(figsize=(8, 7))
     units = {track.units for track in tracks.values()}
     for name, track in tracks.items():
