@@ -185,12 +185,13 @@ def summary_lines(series: LogSeries) -> list[str]:
     tx = sum(len(v) for v in series.transmissions.values())
     rx = sum(len(v) for v in series.receptions.values())
     modems = sorted({*series.transmissions, *series.receptions})
+    tracks = ", ".join(f"{name} ({len(t.points)} points)" for name, t in series.tracks.items())
     lines = [
         f"transmissions: {tx} sent, {rx} received, modems {', '.join(map(str, modems)) or '-'}",
         f"$CACST statistics: {sum(len(v) for v in series.snr_in.values())}",
         f"messages: {sum(len(v) for v in series.acked.values())} acked, "
         f"{sum(len(v) for v in series.expired.values())} expired",
-        f"tracks: {', '.join(f'{n} ({len(t.points)} points)' for n, t in series.tracks.items()) or '-'}",
+        f"tracks: {tracks or '-'}",
     ]
     if series.skipped:
         skipped = ", ".join(f"{name} {n}" for name, n in sorted(series.skipped.items()))

@@ -124,6 +124,8 @@ def post_for_moos(var: str, msg: Message, technique: Technique) -> Post:
 MessageResolver = Callable[[str], type[Message]]
 # a create or a publish rule: both have technique, format and repeated_delimiter
 _ReadableRule = TranslatorEntry.CreateParser | TranslatorEntry.PublishSerializer
+# {variable: [(entry name, rule, algorithms to apply)]}
+_RuleIndex = dict[str, list[tuple[str, _ReadableRule, Sequence[object]]]]
 
 
 class Translator:
@@ -148,7 +150,7 @@ class Translator:
         self._entries: dict[str, TranslatorEntry] = {}
         self._classes: dict[str, type[Message]] = {}
         self._named_values: dict[str, dict[str, str]] = {}
-        self._read_rules: dict[str, list[tuple[str, _ReadableRule, Sequence[object]]]] | None = None
+        self._read_rules: _RuleIndex | None = None  # read_back's, built on first use
         for entry in entries:
             self.add_entry(entry)
 
@@ -310,7 +312,9 @@ class Translator:
                 value = keyvalue.val_from_string(source, key)
                 source = source if value is None else value
             try:
-                mismatch = self._apply_create(msg, create, technique, source, entry.use_short_enum)
+                mismatch = self._apply_rule(
+                    msg, create, create.algorithm, source, entry.use_short_enum
+                )
             except TranslatorError as exc:
                 raise type(exc)(f"{protobuf_name} from {create.moos_var}: {exc}") from None
             if mismatch is None:
@@ -322,27 +326,28 @@ class Translator:
                 mismatches.append(found)
         return msg
 
-    def _apply_create(
+    def _apply_rule(
         self,
         msg: Message,
-        create: TranslatorEntry.CreateParser,
-        technique: Technique,
+        rule: _ReadableRule,
+        algorithms: Sequence[object],
         source: MoosValue,
         short: bool,
     ) -> format_technique.FormatMismatch | None:
+        """Parse `source` into `msg` by `rule`'s technique (a create rule, or a publish rule
+        read back), running `algorithms` on the parsed fields."""
+        technique = Technique(rule.technique)
         if technique in PROTOBUF_TECHNIQUES:
             parse_protobuf(source, msg, technique)
         elif technique == Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
-            keyvalue.parse(
-                as_text(source), msg, create.algorithm, short, self.registry, create.moos_var
-            )
+            keyvalue.parse(as_text(source), msg, algorithms, short, self.registry, rule.moos_var)
         else:
             return format_technique.parse(
                 as_text(source),
                 msg,
-                create.format,
-                create.repeated_delimiter,
-                create.algorithm,
+                rule.format,
+                rule.repeated_delimiter,
+                algorithms,
                 short,
                 self.registry,
             )
@@ -424,24 +429,9 @@ class Translator:
             technique = Technique(rule.technique)
             source = moos_value_to_source(value, technique)
             try:
-                if technique == Technique.TECHNIQUE_FORMAT:
-                    mismatch = format_technique.parse(
-                        as_text(source),
-                        msg,
-                        rule.format,
-                        rule.repeated_delimiter,
-                        algorithms,
-                        entry.use_short_enum,
-                        self.registry,
-                    )
-                    if mismatch is not None:
-                        raise TranslatorError(f"does not match format {rule.format!r}: {mismatch}")
-                elif technique == Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
-                    keyvalue.parse(
-                        as_text(source), msg, algorithms, entry.use_short_enum, self.registry
-                    )
-                else:
-                    parse_protobuf(source, msg, technique)
+                mismatch = self._apply_rule(msg, rule, algorithms, source, entry.use_short_enum)
+                if mismatch is not None:
+                    raise TranslatorError(f"does not match format {rule.format!r}: {mismatch}")
             except (TranslatorError, ValueError, KeyError) as exc:
                 errors.append(f"{name}: {exc}")
                 continue
@@ -454,11 +444,11 @@ class Translator:
         """The variables `read_back` can read."""
         return set(self._readers())
 
-    def _readers(self) -> dict[str, list[tuple[str, _ReadableRule, Sequence[object]]]]:
+    def _readers(self) -> _RuleIndex:
         """{variable: [(entry name, rule, algorithms to apply)]}, built once."""
         if self._read_rules is not None:
             return self._read_rules
-        readers: dict[str, list[tuple[str, _ReadableRule, Sequence[object]]]] = {}
+        readers: _RuleIndex = {}
         for name, entry in self._entries.items():
             descriptor = self._classes[name].DESCRIPTOR
             for create in entry.create:
