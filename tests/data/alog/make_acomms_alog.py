@@ -74,8 +74,8 @@ entries: list[tuple] = [  # (name, source, value[, community])
     ("AC_RAW_INCOMING", "pAcommsHandler", 'raw: "$CACST,not,a,statistics,line"'),
 ]
 
-# pLogger's MarkDataType: without it a string that looks like a number (a hex value such as
-# "0804...1e40...") is read back as a double
+# pLogger's MarkDataType: without it a string that looks like a number (a hex value can) is
+# read back as a double
 formatter = AlogFormatter(
     0.0, mark_external=True, own_community="logtest", mark_data_type=True, mark_binary=True
 )
