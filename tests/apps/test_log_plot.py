@@ -61,6 +61,12 @@ def test_series_of_several_files_share_one_time_axis(tmp_path: Path) -> None:
     assert series.receptions[7] == [(114.5, "DATA")]  # after MODEM_ID 7 at 10 s
     assert series.acked["logtest.Status"] == [10.5, 11.5, 110.5, 111.5]
     assert set(series.tracks) == {"acomms", "later"}
+    # a file whose banner has no LOGSTART starts with the others
+    headless = tmp_path / "headless.alog"
+    headless.write_text("".join(line for line in text.splitlines(True) if "LOGSTART" not in line))
+    series = log_series([later, headless], AcommsVariables.of_mission(MISSION, "pAcommsHandler"))
+    assert series.start == pytest.approx(1764643773.12)
+    assert series.transmissions == {1: [(4.5, "DATA"), (4.5, "DATA")]}
 
 
 def test_plot_writes_the_figures(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -106,10 +106,11 @@ def log_series(paths: Iterable[str | os.PathLike[str]], variables: AcommsVariabl
     """The series of all `paths` (each file one logging vehicle)."""
     logs = [AlogFile(path) for path in paths]
     series = LogSeries()
+    # a file without LOGSTART (0) is put at the others' start, not 50 years before them
     starts = [log.log_start for log in logs]
-    series.start = min(starts, default=0.0)
+    series.start = min((start for start in starts if start > 0), default=0.0)
     for log, start in zip(logs, starts, strict=True):
-        _read_file(log, start - series.start, variables, series)
+        _read_file(log, start - series.start if start > 0 else 0.0, variables, series)
     return series
 
 
