@@ -453,37 +453,86 @@ ACOMMS_DATA = Path(__file__).resolve().parents[1] / "data" / "alog"
 def test_convert_decodes_the_missions_acomms_variables(
     tmp_path: Path, jobs: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A handmade log of a mission whose pAcommsHandler names its variables AC_*: protobuf
-    text and `@PB[type]` values of its own DCCL type become `<Type>.<field path>` columns."""
+    """A log of a mission whose pAcommsHandler names its variables AC_* (values made by
+    pygoby's encoder and serializers: make_acomms_alog.py): protobuf text and `@PB[type]`
+    values, the DCCL messages in the frames, and the translator variables of pAcommsHandler
+    and pTranslator become `<Type>.<field path>` columns; what does not decode stays raw."""
     alog, mission = ACOMMS_DATA / "acomms.alog", ACOMMS_DATA / "acomms.moos"
     out = tmp_path / "acomms.parquet"
     args = ["log", "convert", str(alog), str(alog), "-o", str(out), "-j", jobs]
     assert pygoby_main([*args, "--mission", str(mission)]) == 0
-    assert capsys.readouterr().out == f"{out}: 14 rows\n"
+    captured = capsys.readouterr()
+    assert captured.out == f"{out}: 60 rows\n"
+    # in both copies: the garbage text, a frame that is not DCCL and two cut messages in
+    # frames; an unknown @PB type; a FORMAT publication that does not match its format
+    assert captured.err == (
+        "values left undecoded (kept raw): AC_MODEM_RECEIVE 8, AC_QUEUE_RECEIVE 2, "
+        "PT_STATUS_FMT 2\n"
+    )
     records = pq.read_table(out).to_pylist()
-    assert len(records) == 14 and records[7:] == records[:7]
-    nav, receive, qsize, status, unknown, garbage, other = records[:7]
-    decoded = [name for name in nav if "." in name]
-    assert all(nav[name] is None for name in decoded)  # not an acomms variable
-    assert {k: v for k, v in receive.items() if k in decoded and v is not None} == {
+    assert len(records) == 60 and records[30:] == records[:30]
+    by_name: dict[str, list[dict]] = {}
+    for record in records[:30]:
+        by_name.setdefault(record["name"], []).append(record)
+    decoded = [name for name in records[0] if "." in name]
+
+    def fields(record: dict) -> dict[str, str]:
+        return {k: v for k, v in record.items() if k in decoded and v is not None}
+
+    assert fields(by_name["NAV_X"][0]) == {}  # not an acomms or translator variable
+    handmade, garbage, packed, packed_again = by_name["AC_MODEM_RECEIVE"]
+    assert fields(packed_again) == fields(packed)
+    assert fields(handmade) == {
         "ModemTransmission.src": "2",
         "ModemTransmission.dest": "1",
         "ModemTransmission.type": "DATA",
-        "ModemTransmission.frame[0]": "01ab",  # bytes as hex
+        "ModemTransmission.frame[0]": "01ab",  # bytes as hex; not a DCCL message
         "ModemTransmission.frame[1]": "",
         "ModemTransmission.[goby.acomms.micromodem.protobuf.transmission]"
         ".receive_stat[0].mode": "RECEIVE_GOOD",
         "ModemTransmission.[goby.acomms.micromodem.protobuf.transmission]"
         ".receive_stat[0].mse_equalizer": "-12",
     }
+    assert fields(garbage) == {} and garbage["value"] == "this is not protobuf text"
+    # two Status messages packed in the first frame (the second is `Status[1]`); the second
+    # frame's cut message is left out
+    assert {k: v for k, v in fields(packed).items() if k.startswith("Status")} == {
+        "Status.src": "2",
+        "Status.depth": "5.0",
+        "Status.tags[0]": "1",
+        "Status.tags[1]": "4",
+        "Status[1].src": "3",
+        "Status[1].depth": "12.5",
+    }
+    sent = fields(by_name["AC_MODEM_TRANSMIT"][0])
+    assert (sent["Status.src"], sent["Status.depth"], sent["ModemTransmission.src"]) == (
+        "3",
+        "12.5",
+        "1",
+    )
+    qsize = by_name["AC_QSIZE"][0]
     assert (qsize["QueueSize.dccl_id"], qsize["QueueSize.size"]) == ("20", "3")
+    status, unknown = by_name["AC_QUEUE_RECEIVE"]
     assert (status["Status.src"], status["Status.depth"]) == ("2", "5.0")
     assert (status["Status.tags[0]"], status["Status.tags[1]"]) == ("1", "4")
-    # an unknown type, text that does not parse, and the default name the mission renamed:
-    # the row keeps its value and has no decoded fields
-    for row in (unknown, garbage, other):
-        assert all(row[name] is None for name in decoded) and row["value"]
-    assert other["name"] == "ACOMMS_QSIZE"
+    # an unknown type, and the default name the mission renamed: raw value, no fields
+    assert fields(unknown) == {} and unknown["value"].startswith("@PB[logtest.Unknown]")
+    assert fields(by_name["ACOMMS_QSIZE"][0]) == {}
+    # translator variables, each by its rule's technique
+    published = {"Status.src": "4", "Status.depth": "7.5", "Status.tags[0]": "2"}
+    for name in (
+        "STATUS_OUT",  # pAcommsHandler's create: key=value pairs
+        "STATUS_IN",  # pAcommsHandler's publish: prefixed text format
+        "PT_STATUS_TEXT",
+        "PT_STATUS_HEX",
+        "PT_STATUS_BIN",  # a binary value (B: in the log)
+        "PT_STATUS_KV",
+    ):
+        assert fields(by_name[name][0]) == published, name
+    assert fields(by_name["PT_DEPTH"][0]) == {"Status.depth": "3.25"}  # create: format
+    matching, not_matching = by_name["PT_STATUS_FMT"]
+    assert fields(matching) == {"Status.src": "4", "Status.depth": "7.5"}
+    assert fields(not_matching) == {} and not_matching["value"] == "no match here"
 
 
 def test_convert_without_mission_has_no_decoded_columns(tmp_path: Path) -> None:
@@ -513,13 +562,35 @@ def test_convert_with_a_bad_mission_says_where(
     assert err.startswith(f"pygoby log: {mission}:3: modem_id: ") and "Traceback" not in err
 
 
+def _transmission_text(frames: list[bytes]) -> str:
+    """A DATA ModemTransmission in protobuf text format with these frames (octal escapes)."""
+    escaped = ["".join(f"\\{byte:03o}" for byte in frame) for frame in frames]
+    return " ".join(["type: DATA", *(f'frame: "{text}"' for text in escaped)])
+
+
 @settings(max_examples=examples(200), deadline=None)
 @given(
-    name=st.sampled_from(["AC_MODEM_RECEIVE", "AC_QSIZE", "AC_QUEUE_RECEIVE", "AC_RAW_INCOMING"]),
+    name=st.sampled_from(
+        [
+            "AC_MODEM_RECEIVE",
+            "AC_MODEM_TRANSMIT",
+            "AC_QSIZE",
+            "AC_QUEUE_RECEIVE",
+            "AC_RAW_INCOMING",
+            "STATUS_OUT",
+            "PT_STATUS_HEX",
+            "PT_STATUS_BIN",
+            "PT_STATUS_FMT",
+            "PT_DEPTH",
+        ]
+    ),
     value=st.one_of(
         st.text(max_size=80),
         st.binary(max_size=40),
         st.builds(lambda body: f"@PB[logtest.Status] {body}", st.text(max_size=40)),
+        # ModemTransmissions with random frames: the DCCL unpacking of arbitrary bytes
+        st.builds(_transmission_text, st.lists(st.binary(max_size=24), max_size=3)),
+        st.floats(allow_nan=True),
     ),
 )
 def test_mission_decoder_never_raises(name: str, value: str | bytes) -> None:
