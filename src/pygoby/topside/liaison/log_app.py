@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import asyncio
 import os
+from pathlib import Path
 
 from pygoby.moos.appconfig import read_configuration
 from pygoby.moos.moosfile import MissionFile
@@ -20,7 +21,7 @@ from pygoby.moosacomms.acomms_config import AcommsMessageSet, read_acomms_config
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
 from pygoby.protobuf.pygoby.apps.topside_config_pb2 import LiaisonAppConfig
 from pygoby.topside.commander import CommandSet
-from pygoby.topside.errors import CommanderError
+from pygoby.topside.errors import CommanderError, LogFileError
 from pygoby.topside.liaison.log_feed import DEFAULT_SPACING, LogFeed, LogIndex, LogPlayer
 from pygoby.topside.liaison.state import LiaisonState
 from pygoby.topside.liaison.web import WebServer
@@ -44,6 +45,8 @@ class LogLiaison:
         clock: Clock | None = None,
         spacing: float = DEFAULT_SPACING,
     ) -> None:
+        if mission_path is not None and not Path(mission_path).is_file():
+            raise LogFileError(f"{mission_path}: no such mission file")
         self.index = LogIndex.build(log_path, spacing)
         mission = MissionFile.read(mission_path) if mission_path is not None else None
         cfg = read_configuration(LiaisonAppConfig, mission, "liaison", block_optional=True)
