@@ -19,10 +19,17 @@ from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import Post
 from pygoby.moosacomms.acomms_config import AcommsMessageSet, read_acomms_config
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import pAcommsHandlerConfig
-from pygoby.protobuf.pygoby.apps.topside_config_pb2 import LiaisonAppConfig
+from pygoby.protobuf.pygoby.apps.topside_config_pb2 import LiaisonAppConfig, LiaisonConfig
 from pygoby.topside.commander import CommandSet
 from pygoby.topside.errors import CommanderError, LogFileError
-from pygoby.topside.liaison.log_feed import DEFAULT_SPACING, LogFeed, LogIndex, LogPlayer
+from pygoby.topside.liaison.log_feed import (
+    DEFAULT_SPACING,
+    MAX_CHECKPOINTS,
+    MAX_SNAPSHOTS,
+    LogFeed,
+    LogIndex,
+    LogPlayer,
+)
 from pygoby.topside.liaison.state import LiaisonState
 from pygoby.topside.liaison.web import WebServer
 from pygoby.util.clock import Clock, WallClock
@@ -30,6 +37,42 @@ from pygoby.util.clock import Clock, WallClock
 
 def _no_posting(post: Post) -> None:
     raise CommanderError("liaison is replaying a log: there is no MOOSDB to post to")
+
+
+def open_replay(
+    log_path: str | os.PathLike[str],
+    mission_path: str | os.PathLike[str] | None = None,
+    *,
+    spacing: float = DEFAULT_SPACING,
+    max_checkpoints: int = MAX_CHECKPOINTS,
+    max_snapshots: int = MAX_SNAPSHOTS,
+) -> tuple[LogFeed, LiaisonConfig]:
+    """The pages' state over the log at `log_path` (at its start) and the pages' configuration
+    (the mission's `liaison` block, else the defaults). PygobyError (LogFileError,
+    ConfigError) for a log or mission that cannot be used."""
+    if mission_path is not None and not Path(mission_path).is_file():
+        raise LogFileError(f"{mission_path}: no such mission file")
+    index = LogIndex.build(log_path, spacing, max_checkpoints)
+    mission = MissionFile.read(mission_path) if mission_path is not None else None
+    cfg = read_configuration(LiaisonAppConfig, mission, "liaison", block_optional=True)
+    block = cfg.liaison.commander.pacommshandler_name
+    if mission is not None and mission.goby_block(block) is not None:
+        acomms_cfg = read_acomms_config(mission, block)
+        messages = AcommsMessageSet.load(acomms_cfg, mission.find_file, mission.search_dirs())
+    else:
+        messages = AcommsMessageSet.load(pAcommsHandlerConfig())
+    community = cfg.common.community or index.community or index.path.stem
+    state = LiaisonState(
+        cfg.liaison,
+        messages.cfg,
+        CommandSet.from_messages(messages),
+        community=community,
+        now=lambda: index.log_start + feed.time,
+        publish=_no_posting,
+        start_time=index.log_start,
+    )
+    feed = LogFeed(index, state, community, max_snapshots)
+    return feed, cfg.liaison
 
 
 class LogLiaison:
@@ -43,34 +86,12 @@ class LogLiaison:
         *,
         port: int | None = None,
         clock: Clock | None = None,
-        spacing: float = DEFAULT_SPACING,
     ) -> None:
-        if mission_path is not None and not Path(mission_path).is_file():
-            raise LogFileError(f"{mission_path}: no such mission file")
-        self.index = LogIndex.build(log_path, spacing)
-        mission = MissionFile.read(mission_path) if mission_path is not None else None
-        cfg = read_configuration(LiaisonAppConfig, mission, "liaison", block_optional=True)
-        web = cfg.liaison
+        self.feed, web = open_replay(log_path, mission_path)
+        self.index, self.state = self.feed.index, self.feed.state
         if port is not None:
             web.http_port = port
-        block = web.commander.pacommshandler_name
-        if mission is not None and mission.goby_block(block) is not None:
-            acomms_cfg = read_acomms_config(mission, block)
-            messages = AcommsMessageSet.load(acomms_cfg, mission.find_file, mission.search_dirs())
-        else:
-            messages = AcommsMessageSet.load(pAcommsHandlerConfig())
-        community = cfg.common.community or self.index.community or self.index.path.stem
         self.clock = clock or WallClock()
-        self.state = LiaisonState(
-            web,
-            messages.cfg,
-            CommandSet.from_messages(messages),
-            community=community,
-            now=lambda: self.index.log_start + self.feed.time,
-            publish=_no_posting,
-            start_time=self.index.log_start,
-        )
-        self.feed = LogFeed(self.index, self.state, community)
         self.player = LogPlayer(self.feed, self.clock)
         # no save folder: the Commander page is off in log mode
         self.web = WebServer(self.state, web, None, player=self.player)

@@ -171,6 +171,11 @@ class LogFeed:
         return self._next is None or self._next[1].time > self.target
 
     @property
+    def saved_checkpoints(self) -> list[int]:
+        """The checkpoints (indices into the index's) whose pages' state is kept."""
+        return sorted(self._snapshots)
+
+    @property
     def bad_lines(self) -> int:
         """Damaged lines met since the state was last rebuilt."""
         return self.log.reader.bad_lines
