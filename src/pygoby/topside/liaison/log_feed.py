@@ -15,7 +15,8 @@ one is dropped and the spacing doubles); the feed keeps the pages' saved state a
 keep (the Scope's rows with their history, the Acomms page's recent rows, the Map's tracks).
 Going back rebuilds the pages from the nearest saved checkpoint at or before the time (the
 log's start when none is): what is read again is at most the log between two saved
-checkpoints. The log itself is never held in memory: a 1 GB log costs its index.
+checkpoints. The log itself is never held in memory: a 1 GB log costs its index. (A .alog.gz
+cannot be seeked into: getting to a checkpoint decompresses the file up to it.)
 """
 
 from __future__ import annotations
@@ -103,8 +104,8 @@ class LogIndex:
 
     def checkpoint_before(self, t: float) -> int:
         """The index of the last checkpoint whose state comes before log time `t`."""
-        times = [c.time for c in self.checkpoints]  # sorted: running maxima
-        return max(bisect.bisect_right(times, t) - 1, 0)
+        # their times are running maxima of the entries' times: sorted
+        return max(bisect.bisect_right(self.checkpoints, t, key=lambda c: c.time) - 1, 0)
 
 
 def _check_readable(path: Path) -> None:
