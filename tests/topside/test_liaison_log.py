@@ -20,7 +20,7 @@ from pygoby.moos.alog.files import AlogFile
 from pygoby.moos.alog.format import AlogFormatter, banner
 from pygoby.topside.errors import LogControlError, LogFileError
 from pygoby.topside.liaison.log_app import open_replay
-from pygoby.topside.liaison.log_feed import SPEEDS, LogFeed, LogIndex, LogPlayer
+from pygoby.topside.liaison.log_feed import SPEEDS, STEP_BUDGET, LogFeed, LogIndex, LogPlayer
 from pygoby.util.clock import VirtualClock
 from tests.hypothesis_profiles import examples
 
@@ -202,6 +202,21 @@ def test_a_seek_is_done_over_steps_of_bounded_work(tmp_path):
 
 
 # ---------------------------------------------------------------------------------- the player
+def test_one_update_reads_the_log_for_its_work_time_only(tmp_path):
+    path = write_long_log(tmp_path / "long.alog", 2000)
+    feed, _ = open_replay(path, MISSION)
+    player = LogPlayer(feed, VirtualClock(), work_seconds=0.0)  # one step per update
+    player.seek(1999.0)
+    player.update()
+    assert feed.applied == STEP_BUDGET and not feed.caught_up
+    updates = 1
+    while not feed.caught_up:
+        player.update()
+        updates += 1
+    assert updates == math.ceil(feed.applied / STEP_BUDGET) >= 4
+    feed.close()
+
+
 def test_the_player_follows_the_clock_at_its_speed_and_stops_at_the_end():
     feed, _ = open_replay(LOG, MISSION)
     clock = VirtualClock(1000.0)
