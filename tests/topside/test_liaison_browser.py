@@ -338,7 +338,8 @@ async def test_liaison_over_a_recorded_log_in_chromium(tmp_path, browser):
         await page.locator("#log-slider").fill("25")
         nav_x = "document.querySelector('#scope-table tr[data-key=\"NAV_X\"] td.value')"
         await page.wait_for_function(f"{nav_x} && {nav_x}.textContent === '58'")
-        assert "25.0 / 60.2 s" in await page.locator("#log-time").text_content()
+        log_time = "document.querySelector('#log-time').textContent"
+        await page.wait_for_function(f"{log_time}.startsWith('25.0 / 60.2 s ')")
         assert await page.locator('#scope-table tr[data-key="MISSION_PHASE"]').count() == 0
         await shot(page, "log-scope", tmp_path)
 
@@ -372,7 +373,7 @@ async def test_liaison_over_a_recorded_log_in_chromium(tmp_path, browser):
         await page.wait_for_function(f"{nav_x} && {nav_x}.textContent === '98'")
         phase = page.locator('#scope-table tr[data-key="MISSION_PHASE"] td.value')
         assert await phase.text_content() == "survey"
-        assert "45.0 / 60.2 s" in await page.locator("#log-time").text_content()
+        await page.wait_for_function(f"{log_time}.startsWith('45.0 / 60.2 s ')")
 
         await page.goto(f"{base}/commander")
         await page.locator("#cmd-log-note").wait_for()

@@ -80,7 +80,11 @@ async def log_served() -> AsyncIterator[LogServed]:
 async def test_the_replays_controls_move_the_pages_on_virtual_time():
     async with log_served() as s:
         status = await s.status()
-        assert status["file"] == "liaison.alog" and status["duration"] == pytest.approx(60.2)
+        assert (
+            status["replaying"]
+            and status["file"] == "liaison.alog"
+            and status["duration"] == pytest.approx(60.2)
+        )
         assert (status["entries"], status["bad_lines"]) == (223, 1)
         assert str(LOG.parent) not in json.dumps(status)  # the file's name, never its folder
 
@@ -167,4 +171,9 @@ async def test_a_live_liaison_has_no_replay(tmp_path):
 
     async with served(tmp_path) as s:
         status, text = await asyncio.to_thread(s.request, "GET", "/api/log")
+        assert status == 200 and json.loads(text) == {"replaying": False}
+        headers = {"X-Liaison": "1", "Authorization": f"Bearer {s.token}"}
+        status, text = await asyncio.to_thread(
+            s.request, "POST", "/api/log", {"action": "play"}, headers
+        )
         assert status == 404 and "not replaying a log" in text

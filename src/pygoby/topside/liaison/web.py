@@ -303,11 +303,12 @@ LOG_CONTROLS: dict[str, Callable[[LogPlayer, dict], None]] = {
 
 
 async def log_status(request: Request) -> Response:
-    """GET: where the replay is (404 when liaison serves a live community)."""
+    """GET: where the replay is; `replaying` false when liaison serves a live community (every
+    page asks at start, so a live liaison answers too, without an error)."""
     player = _player(request)
     if player is None:
-        return PlainTextResponse("liaison is not replaying a log", 404)
-    return JSONResponse(player.status())
+        return JSONResponse({"replaying": False})
+    return JSONResponse({"replaying": True, **player.status()})
 
 
 async def log_control(request: Request) -> Response:
@@ -327,7 +328,7 @@ async def log_control(request: Request) -> Response:
         control(player, body)
     except (LogControlError, ValueError) as err:
         return JSONResponse({"ok": False, "error": str(err)}, status_code=400)
-    return JSONResponse({"ok": True, **player.status()})
+    return JSONResponse({"ok": True, "replaying": True, **player.status()})
 
 
 ROUTES = [

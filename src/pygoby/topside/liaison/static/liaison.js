@@ -353,8 +353,8 @@ async function logControl(body) {
 
 async function setupLog() {
   const response = await fetch("/api/log");
-  if (!response.ok) return false;
-  const s = await response.json();
+  const s = response.ok ? await response.json() : { replaying: false };
+  if (!s.replaying) return false;
   logMode = true;
   $("#log-bar").hidden = false;
   $("#log-file").textContent = `${s.file}: ${s.entries} entries` + (s.bad_lines ? `, ${s.bad_lines} damaged lines skipped` : "");
