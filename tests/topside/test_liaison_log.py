@@ -137,6 +137,10 @@ def test_the_pages_at_a_time_are_the_logs_values_then():
     assert [row["snr_in"] for row in acomms["rx"]] == [11, 10]
     own = next(n for n in map_page["nodes"] if n["name"] == "logtest")
     assert (own["x"], own["y"]) == (58.0, -29.0)
+    feed.advance(5.0)  # on to 30 s: NAV_X of 29.2 s
+    while not feed.step():
+        pass
+    assert feed.time == 30.0 and json.loads(pages(feed)[0]["NAV_X"])["value"] == "68"
     feed.run_to(50.0)
     scope, acomms, _ = pages(feed)
     assert json.loads(scope["MISSION_PHASE"])["value"] == "return"  # after the damaged line

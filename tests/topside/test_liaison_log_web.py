@@ -8,6 +8,10 @@ import asyncio
 import contextlib
 import http.client
 import json
+import re
+import signal
+import subprocess
+import sys
 from collections.abc import AsyncIterator
 from pathlib import Path
 
@@ -177,3 +181,36 @@ async def test_a_live_liaison_has_no_replay(tmp_path):
             s.request, "POST", "/api/log", {"action": "play"}, headers
         )
         assert status == 404 and "not replaying a log" in text
+
+
+@pytest.mark.e2e
+@pytest.mark.timeout(60)
+def test_pygoby_liaison_log_serves_until_interrupted():
+    """The real command line as a subprocess: it indexes, prints the URL, serves the replay,
+    and ends with status 0 at SIGINT."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "pygoby.cli", "liaison", "--log", str(LOG), "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout is not None
+        summary = proc.stdout.readline()
+        assert (
+            summary == "liaison: liaison.alog: 223 entries over 60.2 s, 1 damaged lines skipped\n"
+        )
+        match = re.fullmatch(
+            r"liaison: serving http://127\.0\.0\.1:(\d+)/scope\?token=\S+\n", proc.stdout.readline()
+        )
+        assert match, "no URL printed"
+        connection = http.client.HTTPConnection("127.0.0.1", int(match.group(1)), timeout=10)
+        connection.request("GET", "/api/log")
+        status = json.loads(connection.getresponse().read())
+        connection.close()
+        assert status["replaying"] and status["entries"] == 223 and status["time"] == 0.0
+        assert status["community"] == "logtest"  # without --mission: that of MOOSDB_logtest
+    finally:
+        proc.send_signal(signal.SIGINT)
+        code = proc.wait(10)
+    assert code == 0, proc.stderr.read() if proc.stderr else ""

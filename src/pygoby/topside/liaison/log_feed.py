@@ -328,6 +328,7 @@ class LogPlayer:
         index, feed = self.feed.index, self.feed
         return {
             "file": index.path.name,
+            "community": feed.community,  # the vehicle whose NAV_* the Map draws
             "log_start": index.log_start,
             "duration": index.end_time,
             "time": round(feed.time, 3),
