@@ -260,7 +260,13 @@ def test_the_player_follows_the_clock_at_its_speed_and_stops_at_the_end():
 def test_files_that_cannot_be_replayed_are_refused_clearly(tmp_path):
     binary = tmp_path / "program.alog"
     binary.write_bytes(bytes(range(256)) * 40)
+    empty = tmp_path / "empty.alog"
+    empty.write_bytes(b"")
+    no_newline = tmp_path / "one-line.alog"
+    no_newline.write_bytes(b"x" * (3 << 20))  # no newline, no columns
     cases = {
+        empty: "empty",
+        no_newline: "not a MOOS .alog",
         tmp_path / "missing.alog": "no such file",
         tmp_path: "not a file",
         binary: "not a MOOS .alog",

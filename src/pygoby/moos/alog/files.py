@@ -76,7 +76,8 @@ class AlogFile:
             with open_text_or_gz(self.path) as stream:
                 offset = 0
                 if start > 0:
-                    for raw, _ in zip(stream, range(HEADER_LINES), strict=False):
+                    for _ in range(HEADER_LINES):
+                        raw = stream.readline(MAX_LINE_BYTES)
                         if raw.startswith(b"%%"):
                             self.reader.feed(decode_line(raw))
                     stream.seek(start)

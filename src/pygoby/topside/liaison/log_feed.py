@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from pygoby.moos import protocol as p
-from pygoby.moos.alog.files import HEADER_LINES, AlogFile, open_text_or_gz
+from pygoby.moos.alog.files import HEADER_LINES, MAX_LINE_BYTES, AlogFile, open_text_or_gz
 from pygoby.moos.alog.format import AlogEntry, AlogReader, decode_line
 from pygoby.moos.alog.tools import DB_SOURCE_PREFIX
 from pygoby.topside.errors import LogControlError, LogFileError
@@ -122,16 +122,19 @@ def _check_readable(path: Path) -> None:
     reader = AlogReader()
     try:
         with open_text_or_gz(path) as stream:
-            head = [raw for raw, _ in zip(stream, range(HEADER_LINES), strict=False)]
+            # bounded lines: a file without newlines must not be read whole here
+            head = [stream.readline(MAX_LINE_BYTES) for _ in range(HEADER_LINES)]
     except OSError as err:
         raise LogFileError(f"{path}: cannot read ({err.strerror or err})") from None
     except EOFError as err:
         raise LogFileError(f"{path}: cannot read ({err})") from None
+    if not head[0]:
+        raise LogFileError(f"{path}: empty")
     looks_like_alog = False
     for raw in head:
         text = decode_line(raw)
         looks_like_alog |= reader.feed(text) is not None or text.startswith("%%")
-    if head and not looks_like_alog:
+    if not looks_like_alog:
         raise LogFileError(f"{path}: not a MOOS .alog (no %% banner and no TIME VAR SOURCE line)")
 
 
