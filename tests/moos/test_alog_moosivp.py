@@ -21,7 +21,7 @@ from pygoby.moos.alog.tools import summarize
 DATA = Path(__file__).resolve().parent.parent / "data" / "alog"
 RECORDED = DATA / "moosivp" / "out"
 LOGS = {
-    "acomms": DATA / "acomms.alog",
+    "acomms": DATA / "moosivp" / "acomms.alog",
     "plogger_blog": DATA / "moosivp" / "plogger_blog.alog",
     "plogger_inline": DATA / "moosivp" / "plogger_inline.alog",
 }
