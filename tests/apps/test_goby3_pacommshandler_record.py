@@ -1,0 +1,363 @@
+"""Replays of goby3 <-> pygoby pAcommsHandler runs: goby3's C++ pAcommsHandler (3.1.5a) as
+modem 1, pygoby's as modem 2, exchanging a status (broadcast) and an acknowledged command each
+way over the UDP driver, the UDP driver with DCCL encryption, and the Micro-Modem driver
+through two `pygoby mmsim` emulators. Each test feeds goby3's recorded bytes or sentences to
+pygoby's codec, drivers or modem emulator and compares with what the run recorded, so a wire
+format regression shows without goby3 installed. The records and how they were made:
+tests/data/goby3/README.md."""
+
+from __future__ import annotations
+
+import json
+import socket
+import time
+from pathlib import Path
+
+import pytest
+from google.protobuf import text_format
+from google.protobuf.message import Message
+
+from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.drivers.udp import UDPDriver
+from pygoby.acomms.mmsim import MicroModemModel
+from pygoby.apps.pacommshandler import pAcommsHandler
+from pygoby.dccl import Codec
+from pygoby.moos.translator import Translator, parse_for_moos
+from pygoby.util.clock import VirtualClock
+from pygoby.util.nmea import NMEASentence
+from tests.acomms.test_mm_driver import Harness as MMDriverHarness
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = ROOT / "tests" / "data" / "goby3"
+PROTO = ROOT / "examples" / "two_vehicles" / "two_vehicles.proto"
+RECORDS = {
+    link: json.loads((DATA / f"pacommshandler_{link}.json").read_text())
+    for link in ("udp", "udp_aes", "mm")
+}
+UDP_LINKS = ["udp", "udp_aes"]
+GOBY3, PYGOBY = "goby3", "pygoby"
+
+
+def posts(record: dict, side: str, var: str) -> list:
+    return [e["value"] for e in record[side] if e["var"] == var]
+
+
+def codec_for(record: dict, passphrase: str | None = "record") -> Codec:
+    """pygoby's DCCL codec with the mission's types; the record's passphrase unless given."""
+    if passphrase == "record":
+        passphrase = record["crypto_passphrase"]
+    codec = Codec(passphrase=passphrase)
+    for name in ("SimpleStatus", "Command"):
+        codec.load_proto(PROTO, f"pygoby.examples.{name}")
+    return codec
+
+
+def parsed(cls: type[Message], text: str) -> Message:
+    msg = cls()
+    parse_for_moos(text, msg)
+    return msg
+
+
+def raw_bytes(text: str) -> bytes:
+    """The bytes of an ACOMMS_RAW_* post (a ModemRaw)."""
+    return parsed(acomms_pb.ModemRaw, text).raw
+
+
+def transmissions(record: dict, side: str, var: str) -> list[acomms_pb.ModemTransmission]:
+    """The datagrams of a side's ACOMMS_RAW_INCOMING / _OUTGOING, parsed."""
+    out = []
+    for text in posts(record, side, var):
+        msg = acomms_pb.ModemTransmission()
+        msg.ParseFromString(raw_bytes(text))
+        out.append(msg)
+    return out
+
+
+def queue_received(record: dict, side: str, codec: Codec) -> list[Message]:
+    """The messages a side published on ACOMMS_QUEUE_RECEIVE, in pygoby's classes."""
+    out = []
+    for text in posts(record, side, "ACOMMS_QUEUE_RECEIVE"):
+        name = text[len("@PB[") : text.index("]")]
+        out.append(parsed(codec.compiled(name).cls, text))
+    return out
+
+
+def decode_frames(codec: Codec, frames) -> list[Message]:
+    """Every DCCL message of the frames (several may share one)."""
+    out = []
+    for frame in frames:
+        data = bytes(frame)
+        while data:
+            msg, used = codec.decode_prefix(data)
+            out.append(msg)
+            data = data[used:]
+    return out
+
+
+def data_frames(sent: list[acomms_pb.ModemTransmission]) -> list[bytes]:
+    return [bytes(f) for t in sent if t.type == acomms_pb.DATA for f in t.frame]
+
+
+@pytest.mark.parametrize("link", list(RECORDS))
+def test_the_record_is_a_full_exchange_both_ways(link):
+    """Each side decoded both of the other's messages and had its command acknowledged."""
+    record = RECORDS[link]
+    for side, peer in ((GOBY3, 2), (PYGOBY, 1)):
+        assert posts(record, side, "STATUS_REPORT_IN")[0].startswith(f"src={peer},")
+        assert len(posts(record, side, "DESIRED_HEADING")) == 1
+        assert len(posts(record, side, "ACOMMS_ACK")) == 1
+        assert len(posts(record, side, "ACOMMS_QUEUE_RECEIVE")) == 2
+
+
+@pytest.mark.parametrize("link", UDP_LINKS)
+def test_pygoby_received_goby3s_datagrams_unchanged(link):
+    record = RECORDS[link]
+    sent = [raw_bytes(t) for t in posts(record, GOBY3, "ACOMMS_RAW_OUTGOING")]
+    heard = [raw_bytes(t) for t in posts(record, PYGOBY, "ACOMMS_RAW_INCOMING")]
+    assert sent and sent == heard
+
+
+@pytest.mark.parametrize("link", UDP_LINKS)
+def test_goby3s_frames_decode_to_what_pygoby_published_and_encode_back(link):
+    record = RECORDS[link]
+    codec = codec_for(record)
+    frames = data_frames(transmissions(record, GOBY3, "ACOMMS_RAW_OUTGOING"))
+    decoded = decode_frames(codec, frames)
+    assert decoded == queue_received(record, PYGOBY, codec)
+    assert b"".join(frames) == b"".join(codec.encode(m) for m in decoded)
+
+
+@pytest.mark.parametrize("link", UDP_LINKS)
+def test_pygoby_encodes_the_frames_goby3_decoded(link):
+    """The messages goby3 published, encoded by pygoby, are the bytes goby3 received."""
+    record = RECORDS[link]
+    codec = codec_for(record)
+    frames = data_frames(transmissions(record, GOBY3, "ACOMMS_RAW_INCOMING"))
+    theirs = queue_received(record, GOBY3, codec)
+    assert b"".join(frames) == b"".join(codec.encode(m) for m in theirs)
+    if record["crypto_passphrase"]:  # the body really is encrypted: in clear it differs
+        clear = codec_for(record, passphrase=None)
+        assert b"".join(frames) != b"".join(clear.encode(m) for m in theirs)
+
+
+@pytest.mark.parametrize("link", UDP_LINKS)
+def test_goby3_acknowledged_the_frames_pygoby_numbered(link):
+    record = RECORDS[link]
+    (command,) = [
+        t
+        for t in transmissions(record, PYGOBY, "ACOMMS_RAW_OUTGOING")
+        if t.type == acomms_pb.DATA and t.ack_requested
+    ]
+    (ack,) = [
+        t for t in transmissions(record, GOBY3, "ACOMMS_RAW_OUTGOING") if t.type == acomms_pb.ACK
+    ]
+    assert (ack.src, ack.dest) == (1, 2)
+    first = command.frame_start
+    assert list(ack.acked_frame) == list(range(first, first + len(command.frame)))
+    assert parsed(acomms_pb.ModemTransmission, posts(record, PYGOBY, "ACOMMS_ACK")[0]) == ack
+
+
+def _free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.parametrize("link", UDP_LINKS)
+def test_pygoby_udp_driver_decodes_goby3s_datagrams_and_acks_as_recorded(link):
+    """goby3's datagrams through a real loopback socket into pygoby's UDP driver: the same
+    transmissions, and for the acknowledged command the ACK pygoby sent in the run (its
+    time aside)."""
+    record = RECORDS[link]
+    peer = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    peer.bind(("127.0.0.1", 0))
+    peer.settimeout(5)
+    cfg = acomms_pb.DriverConfig(modem_id=2)
+    udp = cfg.Extensions[acomms_pb.UDP_CONFIG]
+    udp.local.port = _free_udp_port()
+    udp.remote.add(modem_id=0, ip="127.0.0.1", port=peer.getsockname()[1])
+    driver = UDPDriver(VirtualClock(1_700_000_000.0))
+    received: list[acomms_pb.ModemTransmission] = []
+    driver.signal_receive.connect(received.append)
+    driver.startup(cfg)
+    try:
+        goby3_sent = [raw_bytes(t) for t in posts(record, GOBY3, "ACOMMS_RAW_OUTGOING")]
+        acks = []
+        for data in goby3_sent:
+            before = len(received)
+            peer.sendto(data, ("127.0.0.1", udp.local.port))
+            deadline = time.monotonic() + 5
+            while len(received) == before and time.monotonic() < deadline:
+                driver.do_work()
+            incoming = received[-1]
+            assert incoming.SerializeToString() == data
+            if incoming.type == acomms_pb.DATA and incoming.ack_requested and incoming.dest == 2:
+                reply, _ = peer.recvfrom(65536)
+                acks.append(acomms_pb.ModemTransmission.FromString(reply))
+    finally:
+        driver.shutdown()
+        peer.close()
+    recorded = [
+        t for t in transmissions(record, PYGOBY, "ACOMMS_RAW_OUTGOING") if t.type == acomms_pb.ACK
+    ]
+    assert acks and len(acks) == len(recorded)
+    for ours, then in zip(acks, recorded, strict=True):
+        ours.ClearField("time")
+        then.ClearField("time")
+        assert ours == then
+
+
+# ---------------------------------------------------------------------- Micro-Modem
+
+
+def sentences(record: dict, side: str, var: str) -> list[tuple[float, NMEASentence]]:
+    return [(e["t"], NMEASentence.parse(e["value"])) for e in record[side] if e["var"] == var]
+
+
+def without_time(s: NMEASentence) -> tuple[str, ...]:
+    """A sentence's fields less the modem's clock ($CADRQ's hhmmss)."""
+    fields = s.fields
+    return (fields[0], *fields[2:]) if fields[0] == "$CADRQ" else tuple(fields)
+
+
+TRANSMIT_IDS = ("$CACYC", "$CADRQ", "$CATXD")
+
+
+def transmit_exchange(lines) -> list[tuple[str, ...]]:
+    """The modem's side of the host's own packets: cycle echo, data requests, data echoes."""
+    return [without_time(s) for _, s in lines if s.fields[0] in TRANSMIT_IDS]
+
+
+def test_mmsim_answers_goby3s_driver_as_it_did_in_the_run():
+    """goby3's host sentences, at their recorded times, into pygoby's Micro-Modem model: the
+    same cycle echoes, data requests (two per packet: goby3 cycles for the rate's 8 frames and
+    ends the requests with an empty $CCTXD) and data echoes goby3 received."""
+    record = RECORDS["mm"]
+    clock = VirtualClock(1_700_000_000.0)
+    said: list[tuple[float, NMEASentence]] = []
+    model = MicroModemModel(1, clock, on_output=lambda s: said.append((0.0, s)))
+    start = clock.now()
+    for t, sentence in sentences(record, GOBY3, "ACOMMS_NMEA_OUT"):
+        while (due := model.timeline.next_time()) is not None and due <= start + t:
+            clock.set(due)
+            model.timeline.run_due()
+        clock.set(start + t)
+        model.handle_sentence(sentence)
+    said = [(t, NMEASentence.parse(s.message())) for t, s in said]
+    expected = transmit_exchange(
+        (t, s)
+        for t, s in sentences(record, GOBY3, "ACOMMS_NMEA_IN")
+        if s.fields[0] != "$CACYC" or s.fields[2] == "1"  # (not the peer's cycles heard)
+    )
+    assert transmit_exchange(said) == expected
+    drqs = [s for s in expected if s[0] == "$CADRQ"]
+    assert drqs and {s[-1] for s in drqs} == {"1", "2"}  # the empty $CCTXD ended each packet
+
+
+def test_goby3s_frames_cross_the_water_and_decode_to_what_pygoby_published():
+    record = RECORDS["mm"]
+    codec = codec_for(record)
+    txd = [
+        bytes.fromhex(s[4])
+        for _, s in sentences(record, GOBY3, "ACOMMS_NMEA_OUT")
+        if s.fields[0] == "$CCTXD" and s[4]
+    ]
+    rxd = [
+        bytes.fromhex(s[5])
+        for _, s in sentences(record, PYGOBY, "ACOMMS_NMEA_IN")
+        if s.fields[0] == "$CARXD" and s[1] == "1"
+    ]
+    assert txd and rxd == txd
+    decoded = decode_frames(codec, rxd)
+    assert decoded == queue_received(record, PYGOBY, codec)
+    assert b"".join(rxd) == b"".join(codec.encode(m) for m in decoded)
+
+
+def test_pygoby_mm_driver_answers_the_recorded_data_requests_with_what_goby3_decoded():
+    """The data requests pygoby's driver got in the run, replayed into the driver sans-I/O
+    with the frames of its recorded transmissions: the $CCTXD it writes are the ones it wrote
+    then, and their bytes are pygoby's encoding of the messages goby3 decoded."""
+    record = RECORDS["mm"]
+    codec = codec_for(record)
+    harness = MMDriverHarness(modem_id=2).start()  # (the record starts after the start-up)
+    driver, link = harness.driver, harness.link
+    sent = [
+        parsed(acomms_pb.ModemTransmission, v)
+        for v in posts(record, PYGOBY, "ACOMMS_MODEM_TRANSMIT")
+        if "type: DATA" in v
+    ]
+
+    def fill(msg: acomms_pb.ModemTransmission) -> None:
+        then = sent.pop(0)
+        msg.dest, msg.ack_requested = then.dest, then.ack_requested
+        msg.frame.extend(then.frame)
+
+    driver.signal_data_request.connect(fill)
+    written: list[str] = []
+    for entry in record[PYGOBY]:  # in the order pygoby's app posted them
+        if entry["var"] not in ("ACOMMS_NMEA_IN", "ACOMMS_NMEA_OUT"):
+            continue
+        s = NMEASentence.parse(entry["value"])
+        if entry["var"] == "ACOMMS_NMEA_IN":
+            link.feed(s.message() + "\r")
+        elif s.fields[0] == "$CCCYC" and s[2] == "2":  # the MAC opened our slot here
+            initiate = acomms_pb.ModemTransmission(src=2, dest=-1, rate=int(s[4]))
+            driver.handle_initiate_transmission(initiate)
+        driver.do_work()
+        written += [w.rstrip("\r\n") for w in link.take_written()]
+    ours = [w for w in written if w.startswith("$CCTXD")]
+    recorded = [
+        s.message()
+        for _, s in sentences(record, PYGOBY, "ACOMMS_NMEA_OUT")
+        if s.fields[0] == "$CCTXD"
+    ]
+    assert ours == recorded
+    frames = [bytes.fromhex(NMEASentence.parse(w)[4]) for w in ours]
+    theirs = queue_received(record, GOBY3, codec)
+    assert b"".join(frames) == b"".join(codec.encode(m) for m in theirs)
+
+
+# ---------------------------------------------------------------------- MOOS outputs
+
+TRANSLATED = ("STATUS_REPORT_IN", "COMMAND_IN", "DESIRED_HEADING")
+
+
+def translator_of(record: dict, codec: Codec) -> Translator:
+    """pygoby's translator with the entries of the run's ProcessConfig blocks (the same in both
+    communities' missions)."""
+    block = record["process_config"][PYGOBY]
+    body = block[block.index("{") + 1 : block.rindex("}")]
+    body = body.replace("{local_port}", "0").replace("{remote_port}", "0")
+    cfg = pAcommsHandler.load_config_class()()
+    text_format.Merge(body.replace("{modem_port}", "0"), cfg)
+    goby3_block = record["process_config"][GOBY3]
+    entries = "  translator_entry {"
+    assert block[block.index(entries) :] == goby3_block[goby3_block.index(entries) :]
+    return Translator(list(cfg.translator_entry), lambda name: codec.compiled(name).cls)
+
+
+def published(translator: Translator, messages: list[Message]) -> list[tuple[str, object]]:
+    return [
+        (post.var, post.value)
+        for msg in messages
+        for post in translator.publish(msg)
+        if post.var in TRANSLATED
+    ]
+
+
+def recorded_translations(record: dict, side: str) -> list[tuple[str, object]]:
+    return [(e["var"], e["value"]) for e in record[side] if e["var"] in TRANSLATED]
+
+
+@pytest.mark.parametrize("link", list(RECORDS))
+def test_both_sides_published_what_pygobys_translator_makes_of_the_messages(link):
+    """Each side's STATUS_REPORT_IN, COMMAND_IN and DESIRED_HEADING, from the messages it
+    decoded: pygoby's as recorded, and goby3's the same as pygoby's translator makes."""
+    record = RECORDS[link]
+    codec = codec_for(record)
+    translator = translator_of(record, codec)
+    for side in (PYGOBY, GOBY3):
+        ours = published(translator, queue_received(record, side, codec))
+        assert ours and sorted(ours, key=str) == sorted(
+            recorded_translations(record, side), key=str
+        )
