@@ -8,6 +8,8 @@ tests/data/goby3/README.md."""
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 import json
 import socket
 import time
@@ -26,6 +28,9 @@ from pygoby.moos.translator import Translator, parse_for_moos
 from pygoby.util.clock import VirtualClock
 from pygoby.util.nmea import NMEASentence
 from tests.acomms.test_mm_driver import Harness as MMDriverHarness
+
+from .acomms_mission import Recorder, start_db
+from .test_driver_e2e import _free_port
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data" / "goby3"
@@ -157,12 +162,6 @@ def test_goby3_acknowledged_the_frames_pygoby_numbered(link):
     assert parsed(acomms_pb.ModemTransmission, posts(record, PYGOBY, "ACOMMS_ACK")[0]) == ack
 
 
-def _free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.mark.parametrize("link", UDP_LINKS)
 def test_pygoby_udp_driver_decodes_goby3s_datagrams_and_acks_as_recorded(link):
     """goby3's datagrams through a real loopback socket into pygoby's UDP driver: the same
@@ -174,7 +173,7 @@ def test_pygoby_udp_driver_decodes_goby3s_datagrams_and_acks_as_recorded(link):
     peer.settimeout(5)
     cfg = acomms_pb.DriverConfig(modem_id=2)
     udp = cfg.Extensions[acomms_pb.UDP_CONFIG]
-    udp.local.port = _free_udp_port()
+    udp.local.port = _free_port(socket.SOCK_DGRAM)
     udp.remote.add(modem_id=0, ip="127.0.0.1", port=peer.getsockname()[1])
     driver = UDPDriver(VirtualClock(1_700_000_000.0))
     received: list[acomms_pb.ModemTransmission] = []
@@ -361,3 +360,46 @@ def test_both_sides_published_what_pygobys_translator_makes_of_the_messages(link
         assert ours and sorted(ours, key=str) == sorted(
             recorded_translations(record, side), key=str
         )
+
+
+@pytest.mark.e2e
+@pytest.mark.parametrize("link", UDP_LINKS)
+async def test_pygoby_pacommshandler_publishes_the_record_from_goby3s_datagrams(link, tmp_path):
+    """pygoby's pAcommsHandler from the run's own ProcessConfig block, on a MOOSDB, with goby3's
+    recorded datagrams sent to its UDP port from a real socket: it posts what it posted in
+    the run for them (the translator's variables, the decoded messages and the received
+    transmissions, goby3's acknowledgement among them)."""
+    record = RECORDS[link]
+    peer = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    peer.bind(("127.0.0.1", 0))
+    local = _free_port(socket.SOCK_DGRAM)
+    block = (
+        record["process_config"][PYGOBY]
+        .replace("{local_port}", str(local))
+        .replace("{remote_port}", str(peer.getsockname()[1]))
+        .replace('load_proto_file: "two_vehicles.proto"', f'load_proto_file: "{PROTO}"')
+    )
+    # (not ACOMMS_ACK: goby3's acknowledgement names a frame of the run, which this app never
+    # sent; the ACK itself is among the received transmissions)
+    compared = ("ACOMMS_MODEM_RECEIVE", "ACOMMS_QUEUE_RECEIVE", *TRANSLATED)
+    async with contextlib.AsyncExitStack() as stack:
+        stack.callback(peer.close)
+        db = await start_db(stack, 2, warp=1)
+        mission = tmp_path / "vehicle2.moos"
+        mission.write_text(f"ServerHost = localhost\nServerPort = {db.port}\n{block}")
+        recorder = Recorder("recorder", db.port)
+        await recorder.start(list(compared))
+        stack.push_async_callback(recorder.close)
+        app = pAcommsHandler.from_mission(mission, "pAcommsHandler")
+        await stack.enter_async_context(app)
+        async with asyncio.timeout(10):
+            while not app.acomms.primary.running:
+                await asyncio.sleep(0.05)
+        for text in posts(record, GOBY3, "ACOMMS_RAW_OUTGOING"):
+            peer.sendto(raw_bytes(text), ("127.0.0.1", local))
+        expected = {var: posts(record, PYGOBY, var) for var in compared}
+        async with asyncio.timeout(10):
+            while any(len(recorder.values(v)) < len(expected[v]) for v in compared):
+                await asyncio.sleep(0.05)
+        await asyncio.sleep(0.2)  # (nothing more may come)
+    assert {var: recorder.values(var) for var in compared} == expected
