@@ -178,6 +178,8 @@ def test_pygoby_udp_driver_decodes_goby3s_datagrams_and_acks_as_recorded(link):
     driver = UDPDriver(VirtualClock(1_700_000_000.0))
     received: list[acomms_pb.ModemTransmission] = []
     driver.signal_receive.connect(received.append)
+    reported: list[acomms_pb.ModemTransmission] = []
+    driver.signal_transmit_result.connect(reported.append)
     driver.startup(cfg)
     try:
         goby3_sent = [raw_bytes(t) for t in posts(record, GOBY3, "ACOMMS_RAW_OUTGOING")]
@@ -200,6 +202,13 @@ def test_pygoby_udp_driver_decodes_goby3s_datagrams_and_acks_as_recorded(link):
         t for t in transmissions(record, PYGOBY, "ACOMMS_RAW_OUTGOING") if t.type == acomms_pb.ACK
     ]
     assert acks and len(acks) == len(recorded)
+    # each acknowledgement is reported as a transmission (ACOMMS_MODEM_TRANSMIT), as goby3's is
+    assert reported == acks
+    goby3_reported = [
+        parsed(acomms_pb.ModemTransmission, v)
+        for v in posts(record, GOBY3, "ACOMMS_MODEM_TRANSMIT")
+    ]
+    assert [t.type for t in goby3_reported].count(acomms_pb.ACK) == len(acks)
     for ours, then in zip(acks, recorded, strict=True):
         ours.ClearField("time")
         then.ClearField("time")
