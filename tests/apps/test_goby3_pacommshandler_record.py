@@ -412,3 +412,28 @@ async def test_pygoby_pacommshandler_publishes_the_record_from_goby3s_datagrams(
                 await asyncio.sleep(0.05)
         await asyncio.sleep(0.2)  # (nothing more may come)
     assert {var: recorder.values(var) for var in compared} == expected
+
+
+@pytest.mark.parametrize("link", UDP_LINKS)
+def test_both_sides_post_the_same_variables_and_the_same_raw_bytes(link):
+    """Over UDP both sides post each watched variable as often as the other; the datagrams on
+    ACOMMS_NMEA_OUT are the same bytes, goby3's as a MOOS string and pygoby's as a MOOS binary
+    string (QUIRKS.md Q-APPS-32)."""
+    record = RECORDS[link]
+    counts = {
+        side: sorted({e["var"]: posts(record, side, e["var"]) for e in record[side]}.items())
+        for side in (GOBY3, PYGOBY)
+    }
+    assert [(var, len(v)) for var, v in counts[GOBY3]] == [
+        (var, len(v)) for var, v in counts[PYGOBY]
+    ]
+    for side, kind in ((GOBY3, "string"), (PYGOBY, "binary")):
+        out = [e for e in record[side] if e["var"] == "ACOMMS_NMEA_OUT"]
+        assert {e["type"] for e in out} == {kind}
+        as_bytes = [
+            bytes.fromhex(e["value"])
+            if kind == "binary"
+            else e["value"].encode("utf-8", "surrogateescape")
+            for e in out
+        ]
+        assert as_bytes == [raw_bytes(t) for t in posts(record, side, "ACOMMS_RAW_OUTGOING")]
