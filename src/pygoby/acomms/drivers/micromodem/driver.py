@@ -99,8 +99,9 @@ class MMDriver(ModemDriverBase):
         self._hold_until = 0.0  # no writes before this time (after $CAREV,INIT)
         self._multi_reply = False
         self._last_cfg_at = 0.0
-        # goby3 asks the modem something every keep_alive_seconds, the first time at once: its
-        # first $CCCFQ,SRC follows the start-up $CCMSC in the queue.
+        # goby3 asks the modem something once keep_alive_seconds have passed without a sentence
+        # from it, the first time at once: its first $CCCFQ,SRC follows the start-up $CCMSC in
+        # the queue.
         self._last_keep_alive_at = float("-inf")
         self._clock_set = False
         self._link_was_open = False
@@ -273,9 +274,9 @@ class MMDriver(ModemDriverBase):
             self._fail_front("timeout")
 
     def _keep_alive(self, now: float) -> None:
-        """Every keep_alive_seconds (whatever else is queued or heard, as goby3): ask the modem
-        its time (Micro-Modem 2, at the start of a second for a precise answer) or its source
-        address (before the modem's revision is known, and for Micro-Modem 1)."""
+        """keep_alive_seconds without a sentence from the modem (whatever is queued, as goby3):
+        ask the modem its time (Micro-Modem 2, at the start of a second for a precise answer)
+        or its source address (before the modem's revision is known, and for Micro-Modem 1)."""
         if self.is_mm2:
             self._push("$CCTMQ", 0)
             self._last_keep_alive_at = float(math.floor(now))
@@ -355,6 +356,8 @@ class MMDriver(ModemDriverBase):
         """Handle valid sentences from the modem (received now), in order."""
         for sentence in sentences:
             self._fails = 0
+            # a modem that talks is alive: the keep-alive waits keep_alive_seconds from here
+            self._last_keep_alive_at = self.clock.now()
             handler = _HANDLERS.get(sentence.sentence_id)
             if handler is not None:
                 try:
