@@ -148,6 +148,9 @@ def test_local_data_transmission_rate0_with_ack():
     assert len(h.received) == 1
     ack = h.received[0]
     assert (ack.type, ack.src, ack.dest, list(ack.acked_frame)) == (acomms_pb.ACK, 2, 1, [0])
+    # the statistics' time of arrival is the acknowledgement's time, as for data (goby3)
+    stat = ack.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat[0]
+    assert (ack.time, ack.time_source) == (stat.time, acomms_pb.ModemTransmission.MODEM_TIME)
 
 
 def test_no_data_no_cycle():
