@@ -21,14 +21,16 @@ from google.protobuf import text_format
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.drivers.micromodem import MMDriver
 from pygoby.acomms.drivers.udp import UDPDriver
-from pygoby.acomms.mmsim import MicroModemModel
+from pygoby.acomms.mmsim import LoopbackChannel, MicroModemModel
 from pygoby.apps.pacommshandler import pAcommsHandler
 from pygoby.dccl import Codec
 from pygoby.moos.translator import Translator, parse_for_moos
 from pygoby.util.clock import VirtualClock
+from pygoby.util.linebased import MemoryLink
 from pygoby.util.nmea import NMEASentence
-from tests.acomms.test_mm_driver import Harness as MMDriverHarness
+from pygoby.util.timeline import Timeline
 
 from .acomms_mission import Recorder, start_db
 from .test_driver_e2e import _free_port
@@ -42,6 +44,17 @@ RECORDS = {
 }
 UDP_LINKS = ["udp", "udp_aes"]
 GOBY3, PYGOBY = "goby3", "pygoby"
+
+
+def config_of(record: dict) -> Message:
+    """pygoby's ProcessConfig block of the run, parsed (the ports do not matter here)."""
+    block = record["process_config"][PYGOBY]
+    body = block[block.index("{") + 1 : block.rindex("}")]
+    for port in ("{local_port}", "{remote_port}", "{modem_port}"):
+        body = body.replace(port, "0")
+    cfg = pAcommsHandler.load_config_class()()
+    text_format.Merge(body, cfg)
+    return cfg
 
 
 def posts(record: dict, side: str, var: str) -> list:
@@ -223,44 +236,72 @@ def sentences(record: dict, side: str, var: str) -> list[tuple[float, NMEASenten
     return [(e["t"], NMEASentence.parse(e["value"])) for e in record[side] if e["var"] == var]
 
 
-def without_time(s: NMEASentence) -> tuple[str, ...]:
-    """A sentence's fields less the modem's clock ($CADRQ's hhmmss)."""
-    fields = s.fields
-    return (fields[0], *fields[2:]) if fields[0] == "$CADRQ" else tuple(fields)
+# the fields holding a time of arrival or of transmission to 0.1 ms ($CACST, $CAXST): the
+# recorded times of the host sentences (to 10 ms, as the MOOS client received them) move them
+STAT_TIME_FIELD = {"$CACST": 3, "$CAXST": 3}
 
 
-TRANSMIT_IDS = ("$CACYC", "$CADRQ", "$CATXD")
+def stat_seconds(s: NMEASentence) -> float:
+    """The seconds of day of a $CACST / $CAXST time field."""
+    text = s[STAT_TIME_FIELD[s.fields[0]]]
+    hhmmss = text[-11:]  # (a $CACST v6 field has the date in front)
+    return int(hhmmss[:2]) * 3600 + int(hhmmss[2:4]) * 60 + float(hhmmss[4:])
 
 
-def transmit_exchange(lines) -> list[tuple[str, ...]]:
-    """The modem's side of the host's own packets: cycle echo, data requests, data echoes."""
-    return [without_time(s) for _, s in lines if s.fields[0] in TRANSMIT_IDS]
+def untimed(s: NMEASentence) -> tuple[str, ...]:
+    index = STAT_TIME_FIELD.get(s.fields[0])
+    return tuple(f for i, f in enumerate(s.fields) if i != index)
 
 
-def test_mmsim_answers_goby3s_driver_as_it_did_in_the_run():
-    """goby3's host sentences, at their recorded times, into pygoby's Micro-Modem model: the
-    same cycle echoes, data requests (two per packet: goby3 cycles for the rate's 8 frames and
-    ends the requests with an empty $CCTXD) and data echoes goby3 received."""
+def test_mmsim_tells_both_hosts_what_they_read_in_the_run():
+    """Both drivers' recorded sentences, from their start-up on and at their recorded times,
+    into two of pygoby's Micro-Modem models 750 m apart on one channel (the run's mmsim): each
+    model says to its host exactly what that host read in the run (the start-up and clock
+    answers, cycles, data requests, echoes, receptions, acknowledgements, statistics), times
+    of arrival and of transmission within 10 ms. goby3 cycles for the rate's 8 frames and ends
+    each packet with an empty $CCTXD: the modem then asks for no more (QUIRKS.md Q-ACOMMS-16)."""
     record = RECORDS["mm"]
-    clock = VirtualClock(1_700_000_000.0)
-    said: list[tuple[float, NMEASentence]] = []
-    model = MicroModemModel(1, clock, on_output=lambda s: said.append((0.0, s)))
-    start = clock.now()
-    for t, sentence in sentences(record, GOBY3, "ACOMMS_NMEA_OUT"):
-        while (due := model.timeline.next_time()) is not None and due <= start + t:
-            clock.set(due)
-            model.timeline.run_due()
-        clock.set(start + t)
-        model.handle_sentence(sentence)
-    said = [(t, NMEASentence.parse(s.message())) for t, s in said]
-    expected = transmit_exchange(
-        (t, s)
-        for t, s in sentences(record, GOBY3, "ACOMMS_NMEA_IN")
-        if s.fields[0] != "$CACYC" or s.fields[2] == "1"  # (not the peer's cycles heard)
+    zero = record["zero_time"]
+    ids = {GOBY3: 1, PYGOBY: 2}
+    host_lines = sorted(
+        (e["t"], ids[side], order, NMEASentence.parse(e["value"]))
+        for side in ids
+        for order, e in enumerate(record[side])
+        if e["var"] == "ACOMMS_NMEA_OUT"
     )
-    assert transmit_exchange(said) == expected
-    drqs = [s for s in expected if s[0] == "$CADRQ"]
-    assert drqs and {s[-1] for s in drqs} == {"1", "2"}  # the empty $CCTXD ended each packet
+    clock = VirtualClock(zero + host_lines[0][0])
+    timeline = Timeline(clock)
+    channel = LoopbackChannel(clock, 750.0, 1500.0, timeline)
+    said: dict[int, list[NMEASentence]] = {1: [], 2: []}
+    models = {
+        modem_id: MicroModemModel(
+            modem_id,
+            clock,
+            channel,
+            timeline=timeline,
+            on_output=lambda s, out=said[modem_id]: out.append(NMEASentence.parse(s.message())),
+        )
+        for modem_id in (1, 2)
+    }
+
+    def run_until(t: float) -> None:
+        while (due := timeline.next_time()) is not None and due <= t:
+            clock.set(max(due, clock.now()))
+            timeline.run_due()
+        clock.set(max(t, clock.now()))
+
+    for t, modem_id, _, sentence in host_lines:
+        run_until(zero + t)
+        models[modem_id].handle_sentence(sentence)
+    run_until(zero + host_lines[-1][0] + 10)
+    for side, modem_id in ids.items():
+        read = [s for _, s in sentences(record, side, "ACOMMS_NMEA_IN")]
+        assert [untimed(s) for s in said[modem_id]] == [untimed(s) for s in read]
+        for ours, then in zip(said[modem_id], read, strict=True):
+            if ours.fields[0] in STAT_TIME_FIELD:
+                assert stat_seconds(ours) == pytest.approx(stat_seconds(then), abs=0.01)
+    drqs = [s for s in said[1] if s.fields[0] == "$CADRQ"]
+    assert [s[6] for s in drqs] == ["1", "2", "1", "2"]  # two packets of one frame each
 
 
 def test_goby3s_frames_cross_the_water_and_decode_to_what_pygoby_published():
@@ -282,15 +323,23 @@ def test_goby3s_frames_cross_the_water_and_decode_to_what_pygoby_published():
     assert b"".join(rxd) == b"".join(codec.encode(m) for m in decoded)
 
 
-def test_pygoby_mm_driver_answers_the_recorded_data_requests_with_what_goby3_decoded():
-    """What pygoby's driver read in the run, replayed into the driver sans-I/O at the recorded
-    times, with the frames of its recorded transmissions: it writes what it wrote then (the
-    cycles, the data and the empty $CCTXD that ends each packet, no keep-alive while the modem
-    talks), and the data are pygoby's encoding of the messages goby3 decoded."""
+def test_pygoby_mm_driver_replayed_writes_and_hears_what_it_did_in_the_run():
+    """Everything pygoby's driver read in the run, from its start-up on, replayed into the
+    driver of the run's configuration sans-I/O at the recorded times, with the frames of its
+    recorded transmissions: it writes what it wrote then (start-up, clock setting, cycles, the
+    data and the empty $CCTXD that ends each packet, no keep-alive while the modem talks), it
+    hears what it heard (goby3's data and acknowledgement, timed by the modem's statistics),
+    and the data are pygoby's encoding of the messages goby3 decoded."""
     record = RECORDS["mm"]
     codec = codec_for(record)
-    harness = MMDriverHarness(modem_id=2).start()  # (the record starts after the start-up)
-    driver, link = harness.driver, harness.link
+    cfg = config_of(record)
+    driver_cfg = acomms_pb.DriverConfig()
+    driver_cfg.CopyFrom(cfg.driver_cfg)
+    driver_cfg.modem_id = cfg.modem_id
+    nmea = [e for e in record[PYGOBY] if e["var"] in ("ACOMMS_NMEA_IN", "ACOMMS_NMEA_OUT")]
+    clock = VirtualClock(record["zero_time"] + nmea[0]["t"])
+    link = MemoryLink("\r")
+    driver = MMDriver(clock, link)
     sent = [
         parsed(acomms_pb.ModemTransmission, v)
         for v in posts(record, PYGOBY, "ACOMMS_MODEM_TRANSMIT")
@@ -303,12 +352,12 @@ def test_pygoby_mm_driver_answers_the_recorded_data_requests_with_what_goby3_dec
         msg.frame.extend(then.frame)
 
     driver.signal_data_request.connect(fill)
+    heard: list[acomms_pb.ModemTransmission] = []
+    driver.signal_receive.connect(heard.append)
+    driver.startup(driver_cfg)
     written: list[str] = []
-    start = harness.clock.now()
-    for entry in record[PYGOBY]:  # in the order pygoby's app posted them
-        if entry["var"] not in ("ACOMMS_NMEA_IN", "ACOMMS_NMEA_OUT"):
-            continue
-        harness.clock.set(start + entry["t"])
+    for entry in nmea:  # in the order pygoby's app posted them
+        clock.set(record["zero_time"] + entry["t"])
         s = NMEASentence.parse(entry["value"])
         if entry["var"] == "ACOMMS_NMEA_IN":
             link.feed(s.message() + "\r")
@@ -319,6 +368,9 @@ def test_pygoby_mm_driver_answers_the_recorded_data_requests_with_what_goby3_dec
         written += [w.rstrip("\r\n") for w in link.take_written()]
     recorded = [s.message() for _, s in sentences(record, PYGOBY, "ACOMMS_NMEA_OUT")]
     assert written == recorded
+    expected = posts(record, PYGOBY, "ACOMMS_MODEM_RECEIVE")
+    assert heard == [parsed(acomms_pb.ModemTransmission, v) for v in expected]
+    assert {t.time_source for t in heard} == {acomms_pb.ModemTransmission.MODEM_TIME}
     frames = [bytes.fromhex(NMEASentence.parse(w)[4]) for w in written if w.startswith("$CCTXD")]
     theirs = queue_received(record, GOBY3, codec)
     assert b"".join(frames) == b"".join(codec.encode(m) for m in theirs)
@@ -332,15 +384,11 @@ TRANSLATED = ("STATUS_REPORT_IN", "COMMAND_IN", "DESIRED_HEADING")
 def translator_of(record: dict, codec: Codec) -> Translator:
     """pygoby's translator with the entries of the run's ProcessConfig blocks (the same in both
     communities' missions)."""
-    block = record["process_config"][PYGOBY]
-    body = block[block.index("{") + 1 : block.rindex("}")]
-    body = body.replace("{local_port}", "0").replace("{remote_port}", "0")
-    cfg = pAcommsHandler.load_config_class()()
-    text_format.Merge(body.replace("{modem_port}", "0"), cfg)
-    goby3_block = record["process_config"][GOBY3]
+    block, goby3_block = record["process_config"][PYGOBY], record["process_config"][GOBY3]
     entries = "  translator_entry {"
     assert block[block.index(entries) :] == goby3_block[goby3_block.index(entries) :]
-    return Translator(list(cfg.translator_entry), lambda name: codec.compiled(name).cls)
+    entry_list = list(config_of(record).translator_entry)
+    return Translator(entry_list, lambda name: codec.compiled(name).cls)
 
 
 def published(translator: Translator, messages: list[Message]) -> list[tuple[str, object]]:
