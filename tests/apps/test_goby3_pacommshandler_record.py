@@ -46,9 +46,9 @@ UDP_LINKS = ["udp", "udp_aes"]
 GOBY3, PYGOBY = "goby3", "pygoby"
 
 
-def config_of(record: dict) -> Message:
-    """pygoby's ProcessConfig block of the run, parsed (the ports do not matter here)."""
-    block = record["process_config"][PYGOBY]
+def config_of(record: dict, side: str = "pygoby") -> Message:
+    """A side's ProcessConfig block of the run, parsed (the ports do not matter here)."""
+    block = record["process_config"][side]
     body = block[block.index("{") + 1 : block.rindex("}")]
     for port in ("{local_port}", "{remote_port}", "{modem_port}"):
         body = body.replace(port, "0")
@@ -323,26 +323,25 @@ def test_goby3s_frames_cross_the_water_and_decode_to_what_pygoby_published():
     assert b"".join(rxd) == b"".join(codec.encode(m) for m in decoded)
 
 
-def test_pygoby_mm_driver_replayed_writes_and_hears_what_it_did_in_the_run():
-    """Everything pygoby's driver read in the run, from its start-up on, replayed into the
-    driver of the run's configuration sans-I/O at the recorded times, with the frames of its
-    recorded transmissions: it writes what it wrote then (start-up, clock setting, cycles, the
-    data and the empty $CCTXD that ends each packet, no keep-alive while the modem talks), it
-    hears what it heard (goby3's data and acknowledgement, timed by the modem's statistics),
-    and the data are pygoby's encoding of the messages goby3 decoded."""
-    record = RECORDS["mm"]
-    codec = codec_for(record)
-    cfg = config_of(record)
+TICK = 0.01  # s between the replayed driver's do_work calls (the records' time resolution)
+
+
+def replay_mm_driver(record: dict, side: str) -> tuple[list[str], list[Message]]:
+    """Everything `side`'s driver read in the run, from its start-up on, into a pygoby
+    Micro-Modem driver of that side's configuration, sans-I/O at the recorded times; its
+    transmissions are given the frames of the side's recorded ones. What the driver wrote, and
+    the transmissions it reported received."""
+    cfg = config_of(record, side)
     driver_cfg = acomms_pb.DriverConfig()
     driver_cfg.CopyFrom(cfg.driver_cfg)
     driver_cfg.modem_id = cfg.modem_id
-    nmea = [e for e in record[PYGOBY] if e["var"] in ("ACOMMS_NMEA_IN", "ACOMMS_NMEA_OUT")]
+    nmea = [e for e in record[side] if e["var"] in ("ACOMMS_NMEA_IN", "ACOMMS_NMEA_OUT")]
     clock = VirtualClock(record["zero_time"] + nmea[0]["t"])
     link = MemoryLink("\r")
     driver = MMDriver(clock, link)
     sent = [
         parsed(acomms_pb.ModemTransmission, v)
-        for v in posts(record, PYGOBY, "ACOMMS_MODEM_TRANSMIT")
+        for v in posts(record, side, "ACOMMS_MODEM_TRANSMIT")
         if "type: DATA" in v
     ]
 
@@ -352,28 +351,46 @@ def test_pygoby_mm_driver_replayed_writes_and_hears_what_it_did_in_the_run():
         msg.frame.extend(then.frame)
 
     driver.signal_data_request.connect(fill)
-    heard: list[acomms_pb.ModemTransmission] = []
+    heard: list[Message] = []
     driver.signal_receive.connect(heard.append)
     driver.startup(driver_cfg)
     written: list[str] = []
-    for entry in nmea:  # in the order pygoby's app posted them
-        clock.set(record["zero_time"] + entry["t"])
+    for entry in nmea:  # in the order the side's app posted them
+        while clock.now() + TICK < record["zero_time"] + entry["t"]:  # the app's ticks between
+            clock.advance(TICK)
+            driver.do_work()
+            written += [w.rstrip("\r\n") for w in link.take_written()]
+        clock.set(max(clock.now(), record["zero_time"] + entry["t"]))
         s = NMEASentence.parse(entry["value"])
         if entry["var"] == "ACOMMS_NMEA_IN":
             link.feed(s.message() + "\r")
-        elif s.fields[0] == "$CCCYC" and s[2] == "2":  # the MAC opened our slot here
-            initiate = acomms_pb.ModemTransmission(src=2, dest=-1, rate=int(s[4]))
+        elif s.fields[0] == "$CCCYC" and s[2] == str(cfg.modem_id):  # the MAC opened a slot
+            initiate = acomms_pb.ModemTransmission(src=cfg.modem_id, dest=-1, rate=int(s[4]))
             driver.handle_initiate_transmission(initiate)
         driver.do_work()
         written += [w.rstrip("\r\n") for w in link.take_written()]
-    recorded = [s.message() for _, s in sentences(record, PYGOBY, "ACOMMS_NMEA_OUT")]
-    assert written == recorded
-    expected = posts(record, PYGOBY, "ACOMMS_MODEM_RECEIVE")
+    return written, heard
+
+
+@pytest.mark.parametrize("side", [PYGOBY, GOBY3])
+def test_pygoby_mm_driver_replayed_writes_and_hears_what_the_driver_did_in_the_run(side):
+    """pygoby's driver in its own place and in goby3's, replayed from the start-up on
+    (`replay_mm_driver`): it writes what that side's driver wrote then (start-up, clock
+    setting, cycles, the data and the empty $CCTXD that ends each packet, no keep-alive while
+    the modem talks) and hears what it heard (the data and acknowledgement, timed by the
+    modem's statistics); the data pygoby sent are its encoding of the messages goby3
+    decoded."""
+    record = RECORDS["mm"]
+    written, heard = replay_mm_driver(record, side)
+    assert written == [s.message() for _, s in sentences(record, side, "ACOMMS_NMEA_OUT")]
+    expected = posts(record, side, "ACOMMS_MODEM_RECEIVE")
     assert heard == [parsed(acomms_pb.ModemTransmission, v) for v in expected]
     assert {t.time_source for t in heard} == {acomms_pb.ModemTransmission.MODEM_TIME}
-    frames = [bytes.fromhex(NMEASentence.parse(w)[4]) for w in written if w.startswith("$CCTXD")]
-    theirs = queue_received(record, GOBY3, codec)
-    assert b"".join(frames) == b"".join(codec.encode(m) for m in theirs)
+    if side == PYGOBY:
+        codec = codec_for(record)
+        frames = [bytes.fromhex(NMEASentence.parse(w)[4]) for w in written if "TXD" in w]
+        theirs = queue_received(record, GOBY3, codec)
+        assert b"".join(frames) == b"".join(codec.encode(m) for m in theirs)
 
 
 # ---------------------------------------------------------------------- MOOS outputs
