@@ -176,16 +176,27 @@ def test_goby3_acknowledged_the_frames_pygoby_numbered(link):
     assert parsed(acomms_pb.ModemTransmission, posts(record, PYGOBY, "ACOMMS_ACK")[0]) == ack
 
 
+PEER = {GOBY3: PYGOBY, PYGOBY: GOBY3}
+
+
+def without_time(t: acomms_pb.ModemTransmission) -> acomms_pb.ModemTransmission:
+    t.ClearField("time")
+    return t
+
+
+@pytest.mark.parametrize("side", [PYGOBY, GOBY3])
 @pytest.mark.parametrize("link", UDP_LINKS)
-def test_pygoby_udp_driver_decodes_goby3s_datagrams_and_acks_as_recorded(link):
-    """goby3's datagrams through a real loopback socket into pygoby's UDP driver: the same
-    transmissions, and for the acknowledged command the ACK pygoby sent in the run (its
-    time aside)."""
+def test_pygoby_udp_driver_in_either_place_receives_and_acks_as_recorded(link, side):
+    """The other side's datagrams through a real loopback socket into a pygoby UDP driver with
+    `side`'s modem id: the same transmissions as that side reported received, and the
+    acknowledgements that side sent (their time aside), each reported as a transmission too
+    (ACOMMS_MODEM_TRANSMIT, as goby3 does)."""
     record = RECORDS[link]
+    modem_id = record[f"{side}_modem_id"]
     peer = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     peer.bind(("127.0.0.1", 0))
     peer.settimeout(5)
-    cfg = acomms_pb.DriverConfig(modem_id=2)
+    cfg = acomms_pb.DriverConfig(modem_id=modem_id)
     udp = cfg.Extensions[acomms_pb.UDP_CONFIG]
     udp.local.port = _free_port(socket.SOCK_DGRAM)
     udp.remote.add(modem_id=0, ip="127.0.0.1", port=peer.getsockname()[1])
@@ -195,38 +206,33 @@ def test_pygoby_udp_driver_decodes_goby3s_datagrams_and_acks_as_recorded(link):
     reported: list[acomms_pb.ModemTransmission] = []
     driver.signal_transmit_result.connect(reported.append)
     driver.startup(cfg)
+    acks = []
     try:
-        goby3_sent = [raw_bytes(t) for t in posts(record, GOBY3, "ACOMMS_RAW_OUTGOING")]
-        acks = []
-        for data in goby3_sent:
+        for text in posts(record, PEER[side], "ACOMMS_RAW_OUTGOING"):
             before = len(received)
-            peer.sendto(data, ("127.0.0.1", udp.local.port))
+            peer.sendto(raw_bytes(text), ("127.0.0.1", udp.local.port))
             deadline = time.monotonic() + 5
             while len(received) == before and time.monotonic() < deadline:
                 driver.do_work()
             incoming = received[-1]
-            assert incoming.SerializeToString() == data
-            if incoming.type == acomms_pb.DATA and incoming.ack_requested and incoming.dest == 2:
-                reply, _ = peer.recvfrom(65536)
-                acks.append(acomms_pb.ModemTransmission.FromString(reply))
+            if incoming.type == acomms_pb.DATA and incoming.ack_requested:
+                acks.append(acomms_pb.ModemTransmission.FromString(peer.recvfrom(65536)[0]))
     finally:
         driver.shutdown()
         peer.close()
-    recorded = [
-        t for t in transmissions(record, PYGOBY, "ACOMMS_RAW_OUTGOING") if t.type == acomms_pb.ACK
+    heard = [
+        parsed(acomms_pb.ModemTransmission, v) for v in posts(record, side, "ACOMMS_MODEM_RECEIVE")
     ]
-    assert acks and len(acks) == len(recorded)
-    # each acknowledgement is reported as a transmission (ACOMMS_MODEM_TRANSMIT), as goby3's is
+    assert received == heard
     assert reported == acks
-    goby3_reported = [
-        parsed(acomms_pb.ModemTransmission, v)
-        for v in posts(record, GOBY3, "ACOMMS_MODEM_TRANSMIT")
+    then = [
+        t for t in transmissions(record, side, "ACOMMS_RAW_OUTGOING") if t.type == acomms_pb.ACK
     ]
-    assert [t.type for t in goby3_reported].count(acomms_pb.ACK) == len(acks)
-    for ours, then in zip(acks, recorded, strict=True):
-        ours.ClearField("time")
-        then.ClearField("time")
-        assert ours == then
+    assert acks and [without_time(t) for t in acks] == [without_time(t) for t in then]
+    sent = [
+        parsed(acomms_pb.ModemTransmission, v) for v in posts(record, side, "ACOMMS_MODEM_TRANSMIT")
+    ]
+    assert [t.type for t in sent].count(acomms_pb.ACK) == len(acks)
 
 
 # ---------------------------------------------------------------------- Micro-Modem
