@@ -46,7 +46,7 @@ UDP_LINKS = ["udp", "udp_aes"]
 GOBY3, PYGOBY = "goby3", "pygoby"
 
 
-def config_of(record: dict, side: str = "pygoby") -> Message:
+def config_of(record: dict, side: str = PYGOBY) -> Message:
     """A side's ProcessConfig block of the run, parsed (the ports do not matter here)."""
     block = record["process_config"][side]
     body = block[block.index("{") + 1 : block.rindex("}")]
