@@ -148,6 +148,9 @@ def test_local_data_transmission_rate0_with_ack():
     assert len(h.received) == 1
     ack = h.received[0]
     assert (ack.type, ack.src, ack.dest, list(ack.acked_frame)) == (acomms_pb.ACK, 2, 1, [0])
+    # the statistics' time of arrival is the acknowledgement's time, as for data (goby3)
+    stat = ack.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat[0]
+    assert (ack.time, ack.time_source) == (stat.time, acomms_pb.ModemTransmission.MODEM_TIME)
 
 
 def test_no_data_no_cycle():
@@ -286,17 +289,19 @@ def test_sentences_without_a_handler_are_skipped():
 
 
 def test_caerr_nmea_fails_outstanding_and_keep_alive():
-    h = Harness().start()
-    h.clock.set(T0 + 9.9)
-    assert h.work() == []  # 10 s after the first keep-alive (at T0), heard or not
-    h.clock.set(T0 + 10.0)
-    assert h.work() == [cs("$CCCFQ,SRC")]  # MM1 keep-alive
+    h = Harness().start()  # the modem's last sentence: $CACLK at T0 + 1
+    h.clock.set(T0 + 10.9)
+    assert h.work() == []
+    h.clock.set(T0 + 11.0)
+    assert h.work() == [cs("$CCCFQ,SRC")]  # MM1 keep-alive, 10 s after the modem last spoke
     assert h.modem("$CAERR,000000,NMEA,3,bad") == [cs("$CCCFQ,SRC")]  # resent at once
     h.modem("$CACFG,SRC,1")
     assert h.work() == []
 
 
-def test_mm2_keep_alive_asks_the_time_at_the_start_of_a_second():
+def test_mm2_keep_alive_asks_the_time_after_ten_seconds_without_a_sentence():
+    """goby3 restarts the keep-alive period at every sentence from the modem (the interop
+    record, tests/data/goby3/pacommshandler_mm.json: none while the modem talks)."""
     h = Harness()
     h.driver.startup(h.cfg)
     h.work()
@@ -309,12 +314,17 @@ def test_mm2_keep_alive_asks_the_time_at_the_start_of_a_second():
     h.clock.set(T0 + 0.5)
     assert h.modem("$CATMS,0,2023-11-14T22:13:20.5Z") == []
     assert h.driver.startup_complete
-    h.clock.set(T0 + 10.3)
-    assert h.work() == [cs("$CCTMQ,0")]
-    h.modem("$CATMQ,2023-11-14T22:13:30.3Z,0")
-    h.clock.set(T0 + 19.9)
+    h.clock.set(T0 + 10.4)
     assert h.work() == []
-    h.clock.set(T0 + 20.0)  # 10 s after the whole second of the last one
+    h.clock.set(T0 + 10.5)  # 10 s after $CATMS
+    assert h.work() == [cs("$CCTMQ,0")]
+    h.clock.set(T0 + 11.0)
+    h.modem("$CATMQ,2023-11-14T22:13:30.5Z,0")
+    h.clock.set(T0 + 18.0)
+    assert h.modem("$CARXP,1") == []  # the modem heard something: still alive
+    h.clock.set(T0 + 27.9)
+    assert h.work() == []
+    h.clock.set(T0 + 28.0)
     assert h.work() == [cs("$CCTMQ,0")]
 
 

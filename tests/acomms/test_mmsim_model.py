@@ -194,6 +194,24 @@ def test_a_host_that_never_answers_gets_data_timeout():
     assert [s[5] for _, s in w.said(2, "RXD")] == ["aa"]  # what it had goes out
 
 
+def test_an_empty_txd_ends_the_packet_with_the_frames_already_given():
+    """goby3's driver asks for the rate's every frame ($CCCYC ...,5,1,8) and answers the first
+    $CADRQ it has no data for with an empty $CCTXD, to stop the requests: the modem asks for no
+    more frames, and the packet goes out at once with the frames it has (no DATA_TIMEOUT)."""
+    w = Water(range_m=0.0)
+    w.say(1, "$CCCYC,0,1,2,5,1,8")
+    w.say(1, "$CCTXD,1,2,1," + "ab" * 10)
+    assert [s.fields[5:] for _, s in w.said(1, "DRQ")] == [("256", "1"), ("256", "2")]
+    echo = w.say(1, "$CCTXD,1,2,1,")
+    assert [s.fields[0] for s in echo] == ["$CATXD"] and echo[0][4] == ""
+    w.run(20)
+    assert len(w.said(1, "DRQ")) == 2 and w.said(1, "ERR") == []
+    ((start, end),) = on_air(w, 1)
+    assert end - start == pytest.approx(DEFAULT_TIMING.data(5, 1))  # one frame's air time
+    assert [s[5] for _, s in w.said(2, "RXD")] == ["ab" * 10]
+    assert [s.fields[1:] for _, s in w.said(1, "ACK")] == [("2", "1", "1", "1")]
+
+
 def test_a_second_transmission_waits_for_the_transducer():
     w = Water(range_m=0.0)
     w.say(1, "$CCCYC,0,1,2,1,0,1")

@@ -109,11 +109,15 @@ def test_multicast_queue_to_queue_with_ack():
     d1, d2 = drivers
     try:
         q1, _q2, Status, got, acked = status_link(clock, d1, d2)
+        reported = []
+        d2.signal_transmit_result.connect(reported.append)
         q1.push_message(Status(src=1, dest=2, value=8))
         clock.advance(1)
         d1.handle_initiate_transmission(acomms_pb.ModemTransmission(src=1, dest=-1, rate=0))
         pump(drivers)
         assert [x.value for x in got] == [8] and acked == [8]
+        # the acknowledgement is a transmission too (ACOMMS_MODEM_TRANSMIT), as in goby3
+        assert [(t.type, t.src, t.dest) for t in reported] == [(acomms_pb.ACK, 2, 1)]
     finally:
         for d in drivers:
             d.shutdown()

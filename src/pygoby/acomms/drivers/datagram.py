@@ -42,8 +42,13 @@ class DatagramDriverBase(ModemDriverBase):
         self.signal_data_request.emit(msg)
         self._frame_counter += len(msg.frame)
         if msg.frame and msg.frame[0]:
-            self._send(msg)
-            self.signal_transmit_result.emit(msg)
+            self._transmit(msg)
+
+    def _transmit(self, msg: acomms_pb.ModemTransmission) -> None:
+        """Send a datagram and report it: every datagram sent, an acknowledgement too, is a
+        transmit result (ACOMMS_MODEM_TRANSMIT), as goby3's datagram drivers report theirs."""
+        self._send(msg)
+        self.signal_transmit_result.emit(msg)
 
     def do_work(self) -> None:
         if self._sock is None:

@@ -96,5 +96,5 @@ class UDPDriver(DatagramDriverBase):
                 dest=msg.src,
             )
             ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
-            self._send(ack)
+            self._transmit(ack)
         self.signal_receive.emit(msg)

@@ -73,5 +73,5 @@ class UDPMulticastDriver(DatagramDriverBase):
         if msg.type == acomms_pb.DATA and msg.ack_requested and msg.dest == self.modem_id:
             ack = acomms_pb.ModemTransmission(type=acomms_pb.ACK, src=self.modem_id, dest=msg.src)
             ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
-            self._send(ack)
+            self._transmit(ack)
         self.signal_receive.emit(msg)

@@ -433,6 +433,10 @@ class MicroModemModel:
         self._say("$CATXD", s[1], s[2], s[3], hex_data)
         if data:
             tx.frames.append(data[: self.timing.rates[tx.rate].frame_bytes])
+        # An empty $CCTXD ends the requests: the packet goes out with the frames given so far.
+        # goby3's driver relies on this (it asks for the rate's every frame and answers the first
+        # request it has nothing for with an empty $CCTXD), and a modem that kept asking would
+        # instead hit DATA_TIMEOUT on every such packet (QUIRKS.md Q-ACOMMS-16).
         if data and len(tx.frames) < tx.num_frames:
             self._request_frame(tx)
         else:

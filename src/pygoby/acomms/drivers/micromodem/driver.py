@@ -99,8 +99,9 @@ class MMDriver(ModemDriverBase):
         self._hold_until = 0.0  # no writes before this time (after $CAREV,INIT)
         self._multi_reply = False
         self._last_cfg_at = 0.0
-        # goby3 asks the modem something every keep_alive_seconds, the first time at once: its
-        # first $CCCFQ,SRC follows the start-up $CCMSC in the queue.
+        # goby3 asks the modem something once keep_alive_seconds have passed without a sentence
+        # from it, the first time at once: its first $CCCFQ,SRC follows the start-up $CCMSC in
+        # the queue.
         self._last_keep_alive_at = float("-inf")
         self._clock_set = False
         self._link_was_open = False
@@ -273,9 +274,9 @@ class MMDriver(ModemDriverBase):
             self._fail_front("timeout")
 
     def _keep_alive(self, now: float) -> None:
-        """Every keep_alive_seconds (whatever else is queued or heard, as goby3): ask the modem
-        its time (Micro-Modem 2, at the start of a second for a precise answer) or its source
-        address (before the modem's revision is known, and for Micro-Modem 1)."""
+        """keep_alive_seconds without a sentence from the modem (whatever is queued, as goby3):
+        ask the modem its time (Micro-Modem 2, at the start of a second for a precise answer)
+        or its source address (before the modem's revision is known, and for Micro-Modem 1)."""
         if self.is_mm2:
             self._push("$CCTMQ", 0)
             self._last_keep_alive_at = float(math.floor(now))
@@ -355,6 +356,8 @@ class MMDriver(ModemDriverBase):
         """Handle valid sentences from the modem (received now), in order."""
         for sentence in sentences:
             self._fails = 0
+            # a modem that talks is alive: the keep-alive waits keep_alive_seconds from here
+            self._last_keep_alive_at = self.clock.now()
             handler = _HANDLERS.get(sentence.sentence_id)
             if handler is not None:
                 try:
@@ -578,12 +581,9 @@ class MMDriver(ModemDriverBase):
             today = _utc_date(self.clock.now())
         new_clock = self.revision >= MM2_BITFIELD_CLOCK_REVISION
         if self._ack_msg is not None and self._receive is None and not self._expected_cst:
-            add_cst(
-                self._ack_msg.Extensions[acomms_pb.MM_TRANSMISSION].receive_stat,
-                s,
-                today,
-                new_clock,
-            )
+            ack = self._ack_msg
+            ext = ack.Extensions[acomms_pb.MM_TRANSMISSION]
+            self._apply_statistics(ack, add_cst(ext.receive_stat, s, today, new_clock))
             self._flush_ack()
             return
         # (what _receiving() gives, kept only once the statistics are in: add_cst appends
@@ -596,19 +596,28 @@ class MMDriver(ModemDriverBase):
         ext = rx.Extensions[acomms_pb.MM_TRANSMISSION]
         stat = add_cst(ext.receive_stat, s, today, new_clock)
         self._receive = rx
-        rx.time, rx.time_source = stat.time, acomms_pb.ModemTransmission.MODEM_TIME
         if not rx.HasField("src"):
             rx.src, rx.dest = stat.source, stat.dest
-        if stat.clock_mode in (2, 3):
-            ranging = ext.ranging_reply
-            ranging.one_way_travel_time.append((stat.time % 1_000_000) / 1e6)
-            ranging.ambiguity = acomms_pb.RangingReply.OWTT_SECOND_AMBIGUOUS
-            ranging.receiver_clk_mode = stat.clock_mode
-            ranging.is_one_way_synchronous = True
+        self._apply_statistics(rx, stat)
         self._expected_cst -= 1
         if self._expected_cst <= 0:
             self._finish_receive()
         self._flush_ack()
+
+    @staticmethod
+    def _apply_statistics(
+        msg: acomms_pb.ModemTransmission, stat: acomms_pb.ReceiveStatistics
+    ) -> None:
+        """What a $CACST tells of the reception it closes, data or acknowledgement alike (as
+        goby3): its time of arrival is the message's time (MODEM_TIME), and with the clock
+        synchronised to a PPS it is also a one-way travel time."""
+        msg.time, msg.time_source = stat.time, acomms_pb.ModemTransmission.MODEM_TIME
+        if stat.clock_mode in (2, 3):
+            ranging = msg.Extensions[acomms_pb.MM_TRANSMISSION].ranging_reply
+            ranging.one_way_travel_time.append((stat.time % 1_000_000) / 1e6)
+            ranging.ambiguity = acomms_pb.RangingReply.OWTT_SECOND_AMBIGUOUS
+            ranging.receiver_clk_mode = stat.clock_mode
+            ranging.is_one_way_synchronous = True
 
     def _finish_receive(self) -> None:
         rx, self._receive = self._receive, None
