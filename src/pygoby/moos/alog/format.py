@@ -35,11 +35,22 @@ BINARY_MARKING = "%% BINARY MARKING ON"
 BINARY_TAG = re.compile(
     r"<MOOS_BINARY>File=(?P<file>[^,]*),Offset=(?P<offset>\d+),Bytes=(?P<size>\d+)</MOOS_BINARY>"
 )
+# The patterns are ASCII-only and written with explicit classes (no \d or \S, whose meaning
+# differs between Python's and RE2's regular expressions) because the block parser
+# (pygoby.moos.alog.columns) runs the same pattern texts in pyarrow and must agree line for line.
+# whitespace as C's isspace (the MOOS tools' trimming): a value ending in U+00A0 is not a number
+SPACE = " \t\n\r\f\v"
 # a value the MOOS-IvP tools take for a number (their isNumber), plus C++'s inf and nan
-_NUMBER_TEXT = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
-_NUMBER = re.compile(rf"{_NUMBER_TEXT}|[+-]?(?:inf|nan)")
+NUMBER_TEXT = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+DOUBLE_TEXT = rf"{NUMBER_TEXT}|[+-]?(?:inf|nan)"
+_NUMBER = re.compile(DOUBLE_TEXT)
 # TIME VARIABLE SOURCE [VALUE]: one match checks the columns and that the time is a number
-_ENTRY = re.compile(rf"[ \t]*({_NUMBER_TEXT})[ \t]+(\S+)[ \t]+(\S+)(?:[ \t]+(.*))?")
+_WORD = r"[^ \t\n\r\f\v]+"
+ENTRY_TEXT = (
+    rf"[ \t]*(?P<time>{NUMBER_TEXT})[ \t]+(?P<name>{_WORD})[ \t]+(?P<source>{_WORD})"
+    r"(?:[ \t]+(?P<value>.*))?"
+)
+_ENTRY = re.compile(ENTRY_TEXT)
 
 Value = float | str | bytes
 
@@ -70,6 +81,16 @@ class AlogEntry:
         """The source column as written: `src[:aux][@community]`."""
         text = f"{self.source}:{self.source_aux}" if self.source_aux else self.source
         return f"{text}@{self.community}" if self.community else text
+
+
+def value_text(entry: AlogEntry) -> str:
+    """The value as a string column: doubles as Python prints them, binary as hex."""
+    value = entry.value
+    if isinstance(value, bytes):
+        return value.hex()
+    if isinstance(value, float):
+        return repr(value)
+    return value
 
 
 def banner(
@@ -185,7 +206,7 @@ class AlogReader:
         if value is None:
             self._bad(line)
             return None
-        src, aux, community = _split_source(source)
+        src, aux, community = split_source(source)
         return AlogEntry(msg_time, name, src, value[0], aux, community, value[1])
 
     def _value(self, raw: str) -> tuple[Value, tuple[str, int, int] | None] | None:
@@ -196,7 +217,7 @@ class AlogReader:
             kind, raw = raw[0], raw[2:]
             if kind == "S":
                 return raw, None
-            number = raw.rstrip()
+            number = raw.rstrip(SPACE)
             return (float(number), None) if _NUMBER.fullmatch(number) else None
         if self.binary_marked and raw.startswith("B:"):
             try:
@@ -207,7 +228,7 @@ class AlogReader:
             tag = BINARY_TAG.fullmatch(raw.strip())
             if tag:
                 return b"", (tag["file"], int(tag["offset"]), int(tag["size"]))
-        number = raw.rstrip()
+        number = raw.rstrip(SPACE)
         if _NUMBER.fullmatch(number):
             return float(number), None
         return raw, None
@@ -239,7 +260,7 @@ class AlogReader:
                 self.first_bad_line = self.lines
 
 
-def _split_source(source: str) -> tuple[str, str, str]:
+def split_source(source: str) -> tuple[str, str, str]:
     """`src[:aux][@community]` -> (src, aux, community)."""
     if "@" not in source and ":" not in source:
         return source, "", ""
