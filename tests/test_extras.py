@@ -91,6 +91,18 @@ def test_netsim_report_without_matplotlib_names_the_sim_extra(tmp_path):
     assert "pip install 'pygoby[sim]'" in done.stderr and "Traceback" not in done.stderr
 
 
+def test_log_plot_without_matplotlib_names_the_sim_extra(tmp_path):
+    log = REPO / "tests" / "data" / "alog" / "acomms.alog"
+    done = run_without(
+        "matplotlib",
+        "from pygoby.cli import main\n"
+        f"raise SystemExit(main(['log', 'plot', {str(log)!r}, '-o', {str(tmp_path)!r}]))\n",
+    )
+    assert done.returncode == 1
+    assert "log plots needs" in done.stderr and "pip install 'pygoby[sim]'" in done.stderr
+    assert "Traceback" not in done.stderr and not list(tmp_path.iterdir())
+
+
 def test_liaison_without_starlette_names_the_topside_extra():
     done = run_without(
         "starlette",

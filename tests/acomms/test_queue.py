@@ -12,7 +12,7 @@ from pygoby.acomms.queue.roles import RoleError
 from pygoby.util.clock import VirtualClock
 from tests.hypothesis_profiles import examples
 
-from .queue_helpers import Role, entry, manager
+from .queue_helpers import Role, entry, load_types, manager
 
 T0 = 1_700_000_000.0
 
@@ -376,3 +376,25 @@ def test_loopback_as_sent_minimum_ack_wait_and_flush(clock):
     qm.signal_queue_size_change.connect(lambda qs: sizes.append((qs.dccl_id, qs.size)))
     qm.flush_queue(acomms_pb.QueueFlush(dccl_id=20))
     assert sizes == [(20, 0)] and qm.size(20) == 0
+
+
+def test_unpack_frame_splits_packed_messages_and_stops_at_one_that_does_not_decode():
+    """acomms.queue.frames.unpack_frame (the queue's receive path and the log tools): the
+    messages one after another, each with its own bytes; bytes that do not decode end the
+    frame and are reported at their offset."""
+    from pygoby.acomms.queue.frames import unpack_frame
+    from pygoby.dccl import Codec
+
+    codec = Codec(clock=VirtualClock(1e9))
+    status_cls, _bulk, note_cls = load_types(codec)
+    status, note = status_cls(src=1, dest=2, value=7), note_cls(value=3)
+    first, second = codec.encode(status), codec.encode(note)
+    failures = []
+    data = first + second + b"\xff\xff"
+    unpacked = list(
+        unpack_frame(data, lambda _rest: codec, lambda *failure: failures.append(failure))
+    )
+    assert [(msg.value, used) for msg, used in unpacked] == [(7, first), (3, second)]
+    ((offset, error),) = failures
+    assert offset == len(first) + len(second) and str(error)
+    assert list(unpack_frame(b"", lambda _rest: codec, failures.append)) == []

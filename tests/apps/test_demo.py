@@ -3,6 +3,7 @@ acoustic physics: the AUV drives away, travel times and losses grow with range, 
 
 from __future__ import annotations
 
+import json
 import re
 import subprocess
 import sys
@@ -10,8 +11,10 @@ from pathlib import Path
 
 import pytest
 
+from pygoby.cli import main as pygoby_main
 from pygoby.moos.alog.files import AlogFile
 from pygoby.moos.alog.tools import summarize
+from pygoby.moosacomms.alog_series import AcommsVariables, log_series
 from pygoby.netsim.report.eventlog import read_events
 
 pytestmark = pytest.mark.e2e
@@ -79,3 +82,39 @@ def test_demo_exits_zero_with_traffic_both_ways_and_range_effects(tmp_path):
         assert sum(row.count for row in table.values()) == int(lines) > 0
         assert len(table) == int(variables)
         assert "ACOMMS_MODEM_TRANSMIT" in table and "NAV_X" in table
+
+    # the figures of the day: `pygoby log plot` over both vehicles' logs, read as data
+    logs = [path for *_, path in alog_lines]
+    mission = DEMO.parent / "unicorn.moos"
+    series = log_series(logs, AcommsVariables.of_mission(mission, "pAcommsHandler"))
+    assert set(series.transmissions) == set(series.receptions) == {1, 2}
+    for modem in (1, 2):
+        assert len(series.transmissions[modem]) >= 20  # one DATA transmission per cycle
+        assert len(series.receptions[modem]) >= 20
+        snr = [db for _t, db in series.snr_in[modem]]
+        assert snr[0] > 20 and snr[-1] < snr[0] - 10  # the link weakens as the AUV leaves
+    assert len(series.acked["pygoby.examples.Command"]) >= 1  # the topside's commands
+    unicorn = series.tracks["unicorn"].points
+    assert abs(unicorn[-1][0] - unicorn[0][0]) + abs(unicorn[-1][1] - unicorn[0][1]) > 2000
+    figures = tmp_path / "figures"
+    plot = [sys.executable, "-m", "pygoby.cli", "log", "plot", *logs, "--mission", str(mission)]
+    done = subprocess.run([*plot, "-o", str(figures)], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert sorted(p.name for p in figures.glob("*.png")) == [
+        "acks.png",
+        "link_quality.png",
+        "tracks.png",
+        "transmissions.png",
+    ]
+
+    # `log convert --mission`: the DCCL messages in the AUV's received frames as columns
+    unicorn_log = next(path for name, *_, path in alog_lines if name == "unicorn")
+    out = tmp_path / "unicorn.jsonl"
+    assert (
+        pygoby_main(["log", "convert", unicorn_log, "-o", str(out), "--mission", str(mission)]) == 0
+    )
+    rows = [json.loads(line) for line in out.read_text().splitlines()]
+    received = [r for r in rows if r["name"] == "ACOMMS_MODEM_RECEIVE" and "SimpleStatus.src" in r]
+    assert received and all(r["SimpleStatus.src"] == "1" for r in received)  # the topside's
+    commands = [r for r in rows if r["name"] == "COMMAND_IN"]  # a key=value translator post
+    assert commands and all(r["Command.dest"] == "2" for r in commands)

@@ -1,5 +1,6 @@
 """The example files printed in the Goby 1.1 manual, without the listing's line numbers: what
-examples/goby1.1/ ships, apart from the documented fixes (README, "Coming from Goby 1.1").
+examples/goby1.1/ ships, apart from the documented fixes and additions (README, "Coming from
+Goby 1.1").
 
 The manual is not part of this repository: the project keeps its text (seed document 003) in a
 folder beside the repository (`../shared/seeds/`, or `$PYGOBY_SHARED/seeds/`). Tests that compare
@@ -46,6 +47,27 @@ LISTINGS = {
         2,
     ),
 }
+
+
+def plogger_addition(community: str) -> list[str]:
+    """The lines pygoby adds to each of the manual's missions (README): pLogger in the ANTLER
+    block and its ProcessConfig, so that a run leaves the community's .alog."""
+    return [
+        "    // pygoby's addition (not in the manual): the community's log (pLogger below)",
+        "    Run = pLogger @ NewConsole = false",
+        "// pygoby's addition (not in the manual): the community's log in",
+        f"// logs/{community}_<date>/{community}_<date>.alog (`pygoby log summary FILE`, "
+        "`pygoby log plot FILE`)",
+        "ProcessConfig = pLogger",
+        "{",
+        "    AppTick = 4",
+        "    CommsTick = 4",
+        f"    File = {community}",
+        "    PATH = ./logs",
+        "    WildCardLogging = true",
+        "    LogAuxSrc = true",
+        "}",
+    ]
 
 
 def listing(caption: str, count: int) -> list[str]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import difflib
+import json
 import shutil
 import signal
 import socket
@@ -15,10 +16,13 @@ import pytest
 from google.protobuf import text_format
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.cli import main as pygoby_main
+from pygoby.moos.alog.files import AlogFile
+from pygoby.moos.alog.tools import summarize
 from pygoby.moos.client import MOOSClient
 from pygoby.moos.timewarp import moos_clock
 from pygoby.util.geodesy import UTMGeodesy
-from tests.goby11.seed_listings import EXAMPLES, LISTINGS, printed
+from tests.goby11.seed_listings import EXAMPLES, LISTINGS, plogger_addition, printed
 
 pytestmark = pytest.mark.e2e
 
@@ -43,6 +47,11 @@ def test_shipped_files_are_the_printed_ones(name):
     if name == "xml/simple_status.xml":  # the one documented fix (README, Coming from Goby 1.1)
         assert changed == ["-" + seed[67], "+" + SIMPLE_STATUS_FORMAT]
         assert seed[67].endswith("HDG=%9%,DEP")
+    elif name.endswith(".moos"):  # the one addition: pLogger (README, Coming from Goby 1.1)
+        community = Path(name).stem
+        assert [line for line in changed if line.strip("+-")] == [
+            "+" + line for line in plogger_addition(community)
+        ]
     else:
         assert changed == []
 
@@ -138,6 +147,9 @@ async def test_basic_ccl_bytes_reach_mm2(tmp_path):
     assert received.data == b"\x02\x02\x03\x04"
     assert (received.base.src, received.base.dest, received.queue_key.id) == (1, 2, 2)
     assert not list(tmp_path.glob("ttyLOOP*"))  # the pairs iModemSim made are gone
+    # each community's pLogger (pygoby's addition) left its log: what was sent and received
+    assert "OUT_TEST_32B" in community_log(directory, "mm1")
+    assert "IN_TEST_32B" in community_log(directory, "mm2")
 
 
 async def test_ccl_and_dccl_simple_status_reaches_mm2(tmp_path):
@@ -177,6 +189,33 @@ async def test_ccl_and_dccl_simple_status_reaches_mm2(tmp_path):
         node["LON"]
     ) == pytest.approx(lon, abs=1e-9)
     assert not any("is not available" in err for err in run_pair.stderr)
+    assert "STATUS_REPORT_IN" in community_log(directory, "mm2")
+    assert "ACOMMS_MODEM_TRANSMIT" in community_log(directory, "mm1")
+    # `pygoby log convert --mission`: the Goby 1.1 frame's DCCL1 bytes, read through the XML
+    # message set, give what mm1 sent; QSIZE is read in Goby 1.1's form
+    (log,) = (directory / "logs").glob("mm2_*/mm2_*.alog")
+    out = directory / "mm2.jsonl"
+    assert (
+        pygoby_main(
+            ["log", "convert", str(log), "--mission", str(directory / "mm2.moos"), "-o", str(out)]
+        )
+        == 0
+    )
+    rows = [json.loads(line) for line in out.read_text().splitlines()]
+    frames = [r for r in rows if r["name"] == "ACOMMS_MODEM_RECEIVE" and r["type"] == "string"]
+    assert frames  # every frame mm2 heard is one of mm1's statuses
+    for frame in frames:
+        assert frame["ModemTransmission.src"] == "1"
+        assert (frame["SIMPLE_STATUS.nav_x"], frame["SIMPLE_STATUS.nav_y"]) == ("100.0", "300.0")
+        assert frame["SIMPLE_STATUS.MessageType"] == "LAMSS_STATUS"
+    sizes = [r for r in rows if r["name"] == "ACOMMS_QSIZE"]
+    assert sizes and all("QueueSize.key.id" in r for r in sizes)
+
+
+def community_log(directory: Path, community: str) -> dict[str, int]:
+    """{variable: entries} of the one .alog `community`'s pLogger wrote under logs/."""
+    (path,) = (directory / "logs").glob(f"{community}_*/{community}_*.alog")
+    return {name: row.count for name, row in summarize(AlogFile(path)).items()}
 
 
 # Example 2 carries REMUS State frames only (CCL id 14, mm2 -> mm1); the Redirect command needs
@@ -297,5 +336,6 @@ def test_antler_block_of_the_seed_with_xconfig_and_geometry_lines():
         ("pREMUSCodec", "1"),
         ("pAcommsHandler", "2"),
         ("iModemSim", "3"),
+        ("pLogger", None),  # pygoby's addition
     ]
     assert config.ms_between_launches == 10

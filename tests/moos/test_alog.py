@@ -19,7 +19,7 @@ from pygoby.cli import main as pygoby_main
 from pygoby.errors import ConfigError
 from pygoby.moos.alog import AlogFile, AlogFormatter, AlogReader, AlogSink, banner
 from pygoby.moos.alog.logger_config import parse_log_request, read_logger_config
-from pygoby.moos.alog.tools import LogToolError, convert
+from pygoby.moos.alog.tools import LogToolError, convert, summarize
 from pygoby.moos.moosfile import Setting
 from tests.hypothesis_profiles import examples
 
@@ -91,6 +91,15 @@ def test_data_type_marking_keeps_numeric_strings_strings() -> None:
     assert reader.feed(fmt.line(1.0, "A", "s", 3.5)).value == 3.5
     # without marking, a value that is a number is read as a double (as MOOS-IvP's tools do)
     assert AlogReader().feed(AlogFormatter(0.0).line(1.0, "A", "s", "3.5")).value == 3.5
+    # ... as pLogger writes doubles (fixed digits, inf, nan) and MOOS-IvP's isNumber takes
+    # numbers: with an exponent it is a string (pLogger never writes a double so)
+    plain = AlogFormatter(0.0)
+    for text in ("1e5", "2E-3", "0x10", "1.2.3"):
+        assert AlogReader().feed(plain.line(1.0, "A", "s", text)).value == text
+    for text, double in (("12.", 12.0), (".5", 0.5), ("-7", -7.0), ("-inf", -math.inf)):
+        assert AlogReader().feed(plain.line(1.0, "A", "s", text)).value == double
+    assert math.isnan(AlogReader().feed(plain.line(1.0, "A", "s", "-nan")).value)
+    assert AlogReader().feed(plain.line(1.0, "A", "s", math.inf)).value == math.inf
 
 
 def test_binary_inline_hex_and_through_the_blog(tmp_path: Path) -> None:
@@ -105,7 +114,13 @@ def test_binary_inline_hex_and_through_the_blog(tmp_path: Path) -> None:
     sink.put_line(plain.line(103.0, "X", "src", 7.0))
     sink.close()
     text = (tmp_path / "L.alog").read_text()
-    assert "<MOOS_BINARY>File=L.blog,Offset=" in text and ",Bytes=5</MOOS_BINARY>" in text
+    # as pLogger: the .blog holds the line's prefix, then the bytes and a newline; the .alog line
+    # ends right after the tag (no space), the offset being where the bytes start in the .blog
+    prefix = plain.prefix(102.0, "RAW", "src")
+    assert (
+        prefix + f"<MOOS_BINARY>File=L.blog,Offset={len(prefix)},Bytes=5</MOOS_BINARY>\n"
+    ) in text
+    assert (tmp_path / "L.blog").read_bytes() == prefix.encode() + b"\x01\n\x02 \xfe\n"
     assert [e.value for e in AlogFile(tmp_path / "L.alog")] == ["a", b"\x01\n\x02 \xfe", 7.0]
     (tmp_path / "L.blog").unlink()
     log = AlogFile(tmp_path / "L.alog")
@@ -220,7 +235,9 @@ def test_damaged_files_plain_or_gz_never_raise(data: bytes, cut: int, flip: int)
 )
 def test_round_trip_of_strings(t: float, name: str, value: str) -> None:
     entry = AlogReader().feed(AlogFormatter(0.0).line(t, name, "src", value))
-    assert entry is not None and entry.name == name and entry.time == pytest.approx(t, abs=5e-4)
+    assert (
+        entry is not None and entry.name == name and entry.time == pytest.approx(t, abs=5e-4 + 1e-9)
+    )  # half a millisecond, rounded either way
     if isinstance(entry.value, float):
         assert float(value) == pytest.approx(entry.value, rel=1e-12, abs=1e-5)
     else:
@@ -288,12 +305,17 @@ def test_grep_and_summary(alog: Path, capsys: pytest.CaptureFixture[str]) -> Non
     assert len(out.splitlines()) == 20 and "MSG" not in out
     assert "1 damaged lines skipped (the first at line 36)" in err
     assert pygoby_main(["log", "grep", str(alog), "MSG"]) == 0
-    first = capsys.readouterr().out.splitlines()[0]
-    assert first.split(maxsplit=3) == ["0.500", "MSG", "pHelm:bhv", "hello 0"]
+    first = capsys.readouterr().out.splitlines(keepends=True)[0]
+    # the line as the file has it (aloggrep prints lines so), its trailing space included
+    written = AlogFormatter(LOG_START, log_aux_src=True).line(
+        LOG_START + 0.5, "MSG", "pHelm", "hello 0", "bhv"
+    )
+    assert first == written and first.endswith("hello 0 \n")
     assert pygoby_main(["log", "summary", str(alog)]) == 0
     out = capsys.readouterr().out.splitlines()
     nav_x = next(line for line in out if line.startswith("NAV_X "))
-    assert nav_x.split() == ["NAV_X", "10", "33", "0.00", "9.00", "1.00", "uSim"]
+    # chars as alogscan counts them: NAV_X (5) + uSim (4) + the padded value column (13)
+    assert nav_x.split() == ["NAV_X", "10", "220", "0.00", "9.00", "1.00", "uSim"]
     assert out[-1].startswith("3 variables, 30 lines")
 
 
@@ -305,6 +327,39 @@ def test_clip(alog: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     assert all(2 <= e.time <= 4 for e in entries) and len(entries) == 7
     assert {e.full_source for e in entries} == {"uSim", "pHelm:bhv"}
     assert AlogFile(out).log_start == pytest.approx(LOG_START, abs=0.01)
+
+
+def test_summary_counts_chars_and_lists_sources_as_alogscan(tmp_path: Path) -> None:
+    path = tmp_path / "s.alog"
+    fmt = AlogFormatter(LOG_START, log_aux_src=True, mark_external=True, own_community="a")
+    path.write_text(
+        banner(str(path), LOG_START)
+        + fmt.line(LOG_START + 1, "V", "pNavX", "ab")
+        + fmt.line(LOG_START + 2, "V", "pNav", "ab", community="b")
+        + fmt.line(LOG_START + 3, "V", "pNav", "ab", "aux", community="b")
+        + fmt.line(LOG_START + 4, "V", "pNav", "ab")
+    )
+    (row,) = summarize(AlogFile(path)).values()
+    # chars: variable + source column up to its first ':' + value column ("ab "): alogscan
+    # drops "@b" where an aux comes first
+    assert row.chars == (1 + 5 + 3) + (1 + 6 + 3) + (1 + 4 + 3) + (1 + 4 + 3)
+    # every source, compared whole (alogscan leaves pNav out: "pNavX" contains it), in the
+    # order first seen, with its community
+    assert list(row.sources) == ["pNavX", "pNav@b", "pNav"]
+
+
+def test_clip_keeps_the_helm_domain_whatever_its_time(tmp_path: Path) -> None:
+    path = tmp_path / "helm.alog"
+    fmt = AlogFormatter(LOG_START)
+    posts = [(0.5, "IVPHELM_DOMAIN"), (1.0, "BHV"), (2.5, "BHV"), (4.0, "BHV")]
+    lines = [fmt.line(LOG_START + t, name, "pHelmIvP", "x") for t, name in posts]
+    header = banner(str(path), LOG_START)
+    path.write_text(header + "".join(lines) + "continued text \n")
+    out = tmp_path / "clip.alog"
+    assert pygoby_main(["log", "clip", str(path), "2", "3", "-o", str(out)]) == 0
+    # alogclip's rule: IVPHELM_DOMAIN (alogview needs it) is kept outside the window too; the
+    # banner is copied as it is; the line that is no entry is dropped
+    assert out.read_text() == header + lines[0] + lines[2]
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".jsonl", ".parquet"])
@@ -400,37 +455,86 @@ ACOMMS_DATA = Path(__file__).resolve().parents[1] / "data" / "alog"
 def test_convert_decodes_the_missions_acomms_variables(
     tmp_path: Path, jobs: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A handmade log of a mission whose pAcommsHandler names its variables AC_*: protobuf
-    text and `@PB[type]` values of its own DCCL type become `<Type>.<field path>` columns."""
+    """A log of a mission whose pAcommsHandler names its variables AC_* (values made by
+    pygoby's encoder and serializers: make_acomms_alog.py): protobuf text and `@PB[type]`
+    values, the DCCL messages in the frames, and the translator variables of pAcommsHandler
+    and pTranslator become `<Type>.<field path>` columns; what does not decode stays raw."""
     alog, mission = ACOMMS_DATA / "acomms.alog", ACOMMS_DATA / "acomms.moos"
     out = tmp_path / "acomms.parquet"
     args = ["log", "convert", str(alog), str(alog), "-o", str(out), "-j", jobs]
     assert pygoby_main([*args, "--mission", str(mission)]) == 0
-    assert capsys.readouterr().out == f"{out}: 14 rows\n"
+    captured = capsys.readouterr()
+    assert captured.out == f"{out}: 60 rows\n"
+    # in both copies: the garbage text, a frame that is not DCCL and two cut messages in
+    # frames; an unknown @PB type; a FORMAT publication that does not match its format
+    assert captured.err == (
+        "values left undecoded (kept raw): AC_MODEM_RECEIVE 8, AC_QUEUE_RECEIVE 2, "
+        "PT_STATUS_FMT 2\n"
+    )
     records = pq.read_table(out).to_pylist()
-    assert len(records) == 14 and records[7:] == records[:7]
-    nav, receive, qsize, status, unknown, garbage, other = records[:7]
-    decoded = [name for name in nav if "." in name]
-    assert all(nav[name] is None for name in decoded)  # not an acomms variable
-    assert {k: v for k, v in receive.items() if k in decoded and v is not None} == {
+    assert len(records) == 60 and records[30:] == records[:30]
+    by_name: dict[str, list[dict]] = {}
+    for record in records[:30]:
+        by_name.setdefault(record["name"], []).append(record)
+    decoded = [name for name in records[0] if "." in name]
+
+    def fields(record: dict) -> dict[str, str]:
+        return {k: v for k, v in record.items() if k in decoded and v is not None}
+
+    assert fields(by_name["NAV_X"][0]) == {}  # not an acomms or translator variable
+    handmade, garbage, packed, packed_again = by_name["AC_MODEM_RECEIVE"]
+    assert fields(packed_again) == fields(packed)
+    assert fields(handmade) == {
         "ModemTransmission.src": "2",
         "ModemTransmission.dest": "1",
         "ModemTransmission.type": "DATA",
-        "ModemTransmission.frame[0]": "01ab",  # bytes as hex
+        "ModemTransmission.frame[0]": "01ab",  # bytes as hex; not a DCCL message
         "ModemTransmission.frame[1]": "",
         "ModemTransmission.[goby.acomms.micromodem.protobuf.transmission]"
         ".receive_stat[0].mode": "RECEIVE_GOOD",
         "ModemTransmission.[goby.acomms.micromodem.protobuf.transmission]"
         ".receive_stat[0].mse_equalizer": "-12",
     }
+    assert fields(garbage) == {} and garbage["value"] == "this is not protobuf text"
+    # two Status messages packed in the first frame (the second is `Status[1]`); the second
+    # frame's cut message is left out
+    assert {k: v for k, v in fields(packed).items() if k.startswith("Status")} == {
+        "Status.src": "2",
+        "Status.depth": "5.0",
+        "Status.tags[0]": "1",
+        "Status.tags[1]": "4",
+        "Status[1].src": "3",
+        "Status[1].depth": "12.5",
+    }
+    sent = fields(by_name["AC_MODEM_TRANSMIT"][0])
+    assert (sent["Status.src"], sent["Status.depth"], sent["ModemTransmission.src"]) == (
+        "3",
+        "12.5",
+        "1",
+    )
+    qsize = by_name["AC_QSIZE"][0]
     assert (qsize["QueueSize.dccl_id"], qsize["QueueSize.size"]) == ("20", "3")
+    status, unknown = by_name["AC_QUEUE_RECEIVE"]
     assert (status["Status.src"], status["Status.depth"]) == ("2", "5.0")
     assert (status["Status.tags[0]"], status["Status.tags[1]"]) == ("1", "4")
-    # an unknown type, text that does not parse, and the default name the mission renamed:
-    # the row keeps its value and has no decoded fields
-    for row in (unknown, garbage, other):
-        assert all(row[name] is None for name in decoded) and row["value"]
-    assert other["name"] == "ACOMMS_QSIZE"
+    # an unknown type, and the default name the mission renamed: raw value, no fields
+    assert fields(unknown) == {} and unknown["value"].startswith("@PB[logtest.Unknown]")
+    assert fields(by_name["ACOMMS_QSIZE"][0]) == {}
+    # translator variables, each by its rule's technique
+    published = {"Status.src": "4", "Status.depth": "7.5", "Status.tags[0]": "2"}
+    for name in (
+        "STATUS_OUT",  # pAcommsHandler's create: key=value pairs
+        "STATUS_IN",  # pAcommsHandler's publish: prefixed text format
+        "PT_STATUS_TEXT",
+        "PT_STATUS_HEX",
+        "PT_STATUS_BIN",  # a binary value (B: in the log)
+        "PT_STATUS_KV",
+    ):
+        assert fields(by_name[name][0]) == published, name
+    assert fields(by_name["PT_DEPTH"][0]) == {"Status.depth": "3.25"}  # create: format
+    matching, not_matching = by_name["PT_STATUS_FMT"]
+    assert fields(matching) == {"Status.src": "4", "Status.depth": "7.5"}
+    assert fields(not_matching) == {} and not_matching["value"] == "no match here"
 
 
 def test_convert_without_mission_has_no_decoded_columns(tmp_path: Path) -> None:
@@ -460,13 +564,35 @@ def test_convert_with_a_bad_mission_says_where(
     assert err.startswith(f"pygoby log: {mission}:3: modem_id: ") and "Traceback" not in err
 
 
+def _transmission_text(frames: list[bytes]) -> str:
+    """A DATA ModemTransmission in protobuf text format with these frames (octal escapes)."""
+    escaped = ["".join(f"\\{byte:03o}" for byte in frame) for frame in frames]
+    return " ".join(["type: DATA", *(f'frame: "{text}"' for text in escaped)])
+
+
 @settings(max_examples=examples(200), deadline=None)
 @given(
-    name=st.sampled_from(["AC_MODEM_RECEIVE", "AC_QSIZE", "AC_QUEUE_RECEIVE", "AC_RAW_INCOMING"]),
+    name=st.sampled_from(
+        [
+            "AC_MODEM_RECEIVE",
+            "AC_MODEM_TRANSMIT",
+            "AC_QSIZE",
+            "AC_QUEUE_RECEIVE",
+            "AC_RAW_INCOMING",
+            "STATUS_OUT",
+            "PT_STATUS_HEX",
+            "PT_STATUS_BIN",
+            "PT_STATUS_FMT",
+            "PT_DEPTH",
+        ]
+    ),
     value=st.one_of(
         st.text(max_size=80),
         st.binary(max_size=40),
         st.builds(lambda body: f"@PB[logtest.Status] {body}", st.text(max_size=40)),
+        # ModemTransmissions with random frames: the DCCL unpacking of arbitrary bytes
+        st.builds(_transmission_text, st.lists(st.binary(max_size=24), max_size=3)),
+        st.floats(allow_nan=True),
     ),
 )
 def test_mission_decoder_never_raises(name: str, value: str | bytes) -> None:

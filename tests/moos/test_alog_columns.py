@@ -52,7 +52,7 @@ def test_a_plain_log_takes_the_kernels(tmp_path: Path) -> None:
     for i in range(2000):
         lines.append(FORMATTER.line(100 + i * 0.05, "NAV_X", "uSimMarine", i * 0.25))
         lines.append(FORMATTER.line(100 + i * 0.05, "MSG", "pHelm", f"a = {i}, b c", "bhv"))
-    lines.append("12.5   NAV_Y   src@b   -1e400 \n")  # an overflowing double is inf
+    lines.append("12.5   NAV_Y   src@b   -1e400 \n")  # an exponent: a string, as pLogger reads it
     lines.append("not a line at all\n")
     path.write_text("".join(lines))
     tables = assert_same_rows(path, 16 << 10)

@@ -205,18 +205,20 @@ def test_sweep_in_one_process_and_on_two_gives_the_same_table(tmp_path, capsys):
 
 
 def test_interrupted_sweep_resumes_without_running_anything_twice(tmp_path):
-    sweep = write_sweep(tmp_path, duration=1800)
+    # longer runs, and the signal at the first stored run: on a loaded machine the test's
+    # polling can lag the sweep by several runs, and the sweep must still be half-way
+    sweep = write_sweep(tmp_path, duration=3600)
     output = tmp_path / "out"
     process = start_sweep(sweep, "--jobs", "1", cwd=tmp_path)
     try:
-        wait_for(lambda: len(stored_runs(output)) >= 3, 60, "three stored runs")
+        wait_for(lambda: len(stored_runs(output)) >= 1, 60, "a stored run")
         process.send_signal(signal.SIGINT)
         _, err = process.communicate(timeout=30)
     finally:
         kill_group(process)
     assert process.returncode == 130
     before = run_files(output)
-    assert 3 <= len(before) < 16, "the sweep must have been interrupted half-way"
+    assert 1 <= len(before) < 16, "the sweep must have been interrupted half-way"
     assert f"interrupted: {len(before)} of 16 runs are stored" in err
     assert not list((output / "runs").glob(".*")), "no partial file is left behind"
     resume(sweep, "--jobs", "1", cwd=tmp_path, output=output, before=before, total=16)

@@ -310,3 +310,72 @@ async def test_liaison_on_the_goby11_ccl_and_dccl_mission(tmp_path, browser):
             assert "SIMPLE_STATUS" in await options.evaluate_all(values)
 
     await run_pair(directory, ports, check)
+
+
+@pytest.mark.timeout(120)
+async def test_liaison_over_a_recorded_log_in_chromium(tmp_path, browser):
+    """`pygoby liaison --log liaison.alog --mission acomms.moos` (no MOOSDB): the slider moved
+    to 25 s shows the log's values then on Scope, Acomms and Map; play at 10x on a virtual
+    clock moves them on; the Commander is off with a note."""
+    from pygoby.topside.liaison.log_app import LogLiaison
+    from pygoby.util.clock import VirtualClock
+
+    data = Path(__file__).resolve().parents[1] / "data" / "alog"
+    clock = VirtualClock(5000.0)
+    liaison = LogLiaison(data / "liaison.alog", data / "acomms.moos", port=0, clock=clock)
+    async with liaison:
+        base = liaison.web.url.split("/scope")[0]
+        page = await browser.new_page()
+        console_errors: list[str] = []
+        page.on("console", lambda m: console_errors.append(m.text) if m.type == "error" else None)
+        await page.goto(liaison.web.url)
+        await page.wait_for_function("!location.search.includes('token')")
+        await page.locator("#log-bar").wait_for()
+        assert await page.locator('nav a[data-page="commander"]').is_hidden()
+        assert "1 damaged lines skipped" in await page.locator("#log-file").text_content()
+
+        # the slider to 25 s: NAV_X of 24.2 s (10 + 2 x 24), not yet MISSION_PHASE (30.3 s)
+        await page.locator("#log-slider").fill("25")
+        nav_x = "document.querySelector('#scope-table tr[data-key=\"NAV_X\"] td.value')"
+        await page.wait_for_function(f"{nav_x} && {nav_x}.textContent === '58'")
+        log_time = "document.querySelector('#log-time').textContent"
+        await page.wait_for_function(f"{log_time}.startsWith('25.0 / 60.2 s ')")
+        assert await page.locator('#scope-table tr[data-key="MISSION_PHASE"]').count() == 0
+        await shot(page, "log-scope", tmp_path)
+
+        await page.goto(f"{base}/acomms")
+        await page.locator("#acomms-tx tbody tr").nth(1).wait_for()
+        assert await page.locator("#acomms-tx tbody tr").count() == 2  # at 5.5 and 15.5 s
+        rx = page.locator("#acomms-rx tbody tr").first.locator("td")
+        assert await rx.nth(4).text_content() == "11"  # the SNR of the 18.5 s reception
+
+        await page.goto(f"{base}/map")
+        await page.locator('#map-svg g.node[data-name="logtest"]').wait_for()
+        label = page.locator('#map-svg g.node[data-name="logtest"] text')
+        assert await label.text_content() == "logtest (58, -29)"
+
+        # play at 10x: 2 s of the virtual clock are 20 s of log
+        await page.select_option("#log-speed", "10")
+        await page.click("#log-play")
+        await page.wait_for_function(
+            "document.querySelector('#log-play').dataset.playing === 'true'"
+        )
+        clock.advance(2.0)
+        await page.wait_for_function(
+            "document.querySelector('#map-svg g.node[data-name=\"logtest\"] text')"
+            ".textContent === 'logtest (98, -49)'"
+        )
+        await page.click("#log-play")  # pause
+        await page.wait_for_function(
+            "document.querySelector('#log-play').dataset.playing === 'false'"
+        )
+        await page.goto(f"{base}/scope")
+        await page.wait_for_function(f"{nav_x} && {nav_x}.textContent === '98'")
+        phase = page.locator('#scope-table tr[data-key="MISSION_PHASE"] td.value')
+        assert await phase.text_content() == "survey"
+        await page.wait_for_function(f"{log_time}.startsWith('45.0 / 60.2 s ')")
+
+        await page.goto(f"{base}/commander")
+        await page.locator("#cmd-log-note").wait_for()
+        assert await page.locator("#cmd-send").is_hidden()
+        assert console_errors == []

@@ -86,6 +86,25 @@ def make_driver(cfg: acomms_pb.DriverConfig, clock: Clock) -> ModemDriverBase | 
     return drivers.make_driver(cfg, clock)
 
 
+def make_codec(dccl_cfg: acomms_pb.DCCLConfig, clock: Clock, loader: ProtoLoader | None) -> Codec:
+    """The DCCL codec of a handler's `dccl_cfg` (passphrase, ids sent in the clear, id codec);
+    also for the tools that decode a handler's frames from its logs."""
+    codec = Codec(
+        passphrase=dccl_cfg.crypto_passphrase or None,
+        clock=clock,
+        do_not_encrypt_ids=dccl_cfg.skip_crypto_for_id,
+        loader=loader,
+    )
+    if dccl_cfg.id_codec in ("dccl.default.id", "dccl.ccl.id"):
+        codec.set_id_codec(dccl_cfg.id_codec)
+    elif dccl_cfg.id_codec:
+        log.warning(
+            "dccl_cfg.id_codec %r: custom id codecs are not supported; using the default id codec",
+            dccl_cfg.id_codec,
+        )
+    return codec
+
+
 def wire_driver_cfg(driver_cfg: acomms_pb.DriverConfig, cfg) -> None:
     """pAcommsHandler's special wiring: the uField driver gets the
     top-level `modem_id_lookup_path` and, where its own are unset, the MOOSDB of `common` (so a
@@ -191,20 +210,7 @@ class AcommsHandler:
                 self.primary = slot
             self._forward_informational(slot)
 
-        self.codec = Codec(
-            passphrase=cfg.dccl_cfg.crypto_passphrase or None,
-            clock=clock,
-            do_not_encrypt_ids=cfg.dccl_cfg.skip_crypto_for_id,
-            loader=loader,
-        )
-        if cfg.dccl_cfg.id_codec in ("dccl.default.id", "dccl.ccl.id"):
-            self.codec.set_id_codec(cfg.dccl_cfg.id_codec)
-        elif cfg.dccl_cfg.id_codec:
-            log.warning(
-                "dccl_cfg.id_codec %r: custom id codecs are not supported; using the "
-                "default id codec",
-                cfg.dccl_cfg.id_codec,
-            )
+        self.codec = make_codec(cfg.dccl_cfg, clock, loader)
 
         self.queue_cfg = acomms_pb.QueueManagerConfig()
         self.queue_cfg.CopyFrom(cfg.queue_cfg)

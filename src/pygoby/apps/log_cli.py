@@ -1,10 +1,13 @@
 """`pygoby log`: look at, cut, convert and replay MOOS .alog files (pLogger's).
 
-  pygoby log grep FILE VAR... [--source S]       entries of these variables (VAR* = prefix)
+  pygoby log grep FILE VAR... [--source S]       lines of these variables (VAR* = prefix)
   pygoby log summary FILE                        per variable: lines, first/last time, rate, sources
   pygoby log clip FILE T0 T1 -o OUT.alog         the entries between two log times
   pygoby log convert FILE... -o OUT.parquet [-j N] [--mission M.moos]
                                                  one row per message (.parquet, .csv, .jsonl)
+  pygoby log plot FILE... -o DIR [--mission M.moos]
+                                                 acomms figures: tx/rx per modem, SNR/MSE,
+                                                 acked/expired messages, vehicle tracks (PNG)
   pygoby log replay FILE --port P [--warp W]     post the messages into a MOOSDB, original spacing
 
 Damaged lines are skipped; their count is printed on stderr. (The command line lives with the
@@ -50,13 +53,15 @@ def reporting_errors(command: Command) -> Command:
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "log",
-        help="MOOS .alog files: grep, summary, clip, convert, replay",
+        help="MOOS .alog files: grep, summary, clip, convert, plot, replay",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     actions = parser.add_subparsers(dest="log_command", required=True, metavar="ACTION")
 
-    grep = actions.add_parser("grep", help="print the entries of some variables (aloggrep)")
+    grep = actions.add_parser(
+        "grep", help="print the lines of some variables as the file has them (aloggrep -q)"
+    )
     grep.add_argument("file")
     grep.add_argument("variables", nargs="+", metavar="VAR", help="name, or prefix ending in *")
     grep.add_argument("--source", action="append", default=[], help="only from this source")
@@ -87,12 +92,26 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     convert.add_argument(
         "--mission",
         metavar="FILE.moos",
-        help="decode the acomms variables of this mission's pAcommsHandler into columns",
+        help="decode the acomms variables of this mission's pAcommsHandler (and the DCCL "
+        "messages in their frames) and its translator variables into columns",
     )
     convert.add_argument(
         "--block", default="pAcommsHandler", help="its ProcessConfig (default %(default)s)"
     )
     convert.set_defaults(func=convert_command)
+
+    plot = actions.add_parser("plot", help="acomms figures of a mission's logs (PNG)")
+    plot.add_argument("files", nargs="+", metavar="FILE", help="one .alog per vehicle")
+    plot.add_argument("-o", "--output", required=True, metavar="DIR", help="write the PNGs here")
+    plot.add_argument(
+        "--mission",
+        metavar="FILE.moos",
+        help="its pAcommsHandler's variable names and modem id (default: pAcommsHandler's)",
+    )
+    plot.add_argument(
+        "--block", default="pAcommsHandler", help="its ProcessConfig (default %(default)s)"
+    )
+    plot.set_defaults(func=plot_command)
 
     replay = actions.add_parser("replay", help="post a log's messages into a MOOSDB (uPlayBack)")
     replay.add_argument("file")
@@ -120,14 +139,10 @@ def _report_bad_lines(log: AlogFile) -> None:
 
 @reporting_errors
 def grep_command(args: argparse.Namespace) -> int:
-    from pygoby.moos.alog.tools import grep, value_text
+    from pygoby.moos.alog.tools import grep, write_lines
 
     log = AlogFile(args.file)
-    out = sys.stdout
-    for entry in grep(log, args.variables, args.source):
-        out.write(
-            f"{entry.time:<15.3f} {entry.name:<20} {entry.full_source:<15} {value_text(entry)}\n"
-        )
+    write_lines((entry.line for entry in grep(log, args.variables, args.source)), sys.stdout)
     _report_bad_lines(log)
     return 0
 
@@ -157,22 +172,47 @@ def clip_command(args: argparse.Namespace) -> int:
 
 @reporting_errors
 def convert_command(args: argparse.Namespace) -> int:
-    from pygoby.moos.alog.tools import convert
+    from pygoby.moos.alog.tools import convert, decoded_columns
 
     def progress(rows: int) -> None:
         if sys.stderr.isatty():
             sys.stderr.write(f"\r{rows} rows")
 
     decoder = None
+    columns = None
+    undecodable = None
     if args.mission is not None:
         from pygoby.moosacomms.alog_decode import MissionDecoder  # only when asked for
 
-        MissionDecoder(args.mission, args.block)  # configuration errors now, not in a worker
+        # configuration errors now, not in a worker; the first pass over the files (the
+        # columns) sees every value once, so its decoder counts the undecodable ones
+        first_pass = MissionDecoder(args.mission, args.block)
+        columns = decoded_columns(args.files, first_pass)
+        undecodable = first_pass.undecodable
         decoder = functools.partial(MissionDecoder, args.mission, args.block)
-    count = convert(args.files, args.output, progress, jobs=args.jobs, decoder=decoder)
+    count = convert(
+        args.files, args.output, progress, jobs=args.jobs, decoder=decoder, columns=columns
+    )
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     print(f"{args.output}: {count} rows")
+    if undecodable:
+        counts = ", ".join(f"{name} {n}" for name, n in sorted(undecodable.items()))
+        print(f"values left undecoded (kept raw): {counts}", file=sys.stderr)
+    return 0
+
+
+@reporting_errors
+def plot_command(args: argparse.Namespace) -> int:
+    # matplotlib (the sim extra) first: a missing extra is said before the logs are read
+    from pygoby.moosacomms.alog_plots import summary_lines, write_log_plots
+    from pygoby.moosacomms.alog_series import AcommsVariables, log_series
+
+    variables = AcommsVariables.of_mission(args.mission, args.block)
+    series = log_series(args.files, variables)
+    for path in write_log_plots(series, variables, args.output):
+        print(path)
+    print("\n".join(summary_lines(series)))
     return 0
 
 

@@ -11,7 +11,6 @@ from collections.abc import Sequence
 
 from google.protobuf.message import Message
 
-from pygoby.dccl.libraries import split_libraries
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moosacomms.translator_binding import MessageTypes, TranslatorBinding
 from pygoby.protobuf.goby.apps.moos.protobuf.pTranslator_config_pb2 import pTranslatorConfig
@@ -24,17 +23,10 @@ class pTranslator(GobyMOOSApp):  # noqa: N801 - the program's name
 
     def __init__(self, cfg: pTranslatorConfig, **kwargs) -> None:
         super().__init__(cfg, **kwargs)
-        libraries, others = split_libraries(  # C++ DCCL codec libraries: pygoby's built-ins
-            cfg.load_shared_library,
-            lambda reason, name: self.config_error(reason, "load_shared_library", name),
-        )
         # load_proto_file entries are compiled and loaded as pAcommsHandler does (goby3's
         # pTranslator looks the path up as a type name and aborts: QUIRKS.md Q-APPS-4)
-        types = MessageTypes(
-            [*(p for library in libraries for p in library.proto_files), *cfg.load_proto_file],
-            others,
-            search_dirs=self.search_dirs(),
-            config_error=self.config_error,
+        types = MessageTypes.of_translator_app(
+            cfg.load_proto_file, cfg.load_shared_library, self.search_dirs(), self.config_error
         )
         for entry in cfg.translator_entry:
             types.require(entry.protobuf_name, "translator_entry.protobuf_name")

@@ -9,6 +9,8 @@ pREMUSCodec and the topside tools share.
 * `goby11`: pAcommsHandler's Goby 1.1 MOOS variables (status, MAC updates, CCL queues).
 * `ufield_link`: a Micro-Modem link over uField MOOS mail.
 * `remus_reports`: pREMUSCodec's translation of REMUS CCL reports to and from MOOS variables.
+* `alog_decode`, `alog_series`, `alog_plots`: a mission's acomms and translator variables in .alog
+  files, decoded into columns (`pygoby log convert --mission`) and plotted (`pygoby log plot`).
 """
 
 from pygoby.util.modules import lazy_exports

@@ -20,6 +20,7 @@ from pathlib import Path
 from google.protobuf import descriptor_pool, text_format
 from google.protobuf.message import Message
 
+from pygoby.dccl.libraries import split_libraries
 from pygoby.errors import ConfigError
 from pygoby.moos.app import GobyMOOSApp
 from pygoby.moos.appconfig import locate
@@ -77,6 +78,27 @@ class MessageTypes:
             self._load_library(name)
         for path in proto_files:
             self._load_proto(path)
+
+    @classmethod
+    def of_translator_app(
+        cls,
+        load_proto_file: Iterable[str],
+        load_shared_library: Iterable[str],
+        search_dirs: Sequence[str] = (),
+        config_error: Callable[[str, str, str], ConfigError] | None = None,
+    ) -> MessageTypes:
+        """The types of a pTranslator configuration: its C++ DCCL codec libraries stand for
+        pygoby's built-ins (their .proto files are loaded), the other libraries are modules."""
+        error = config_error or (lambda reason, field, value: ConfigError(reason, field=field))
+        libraries, others = split_libraries(
+            load_shared_library, lambda reason, name: error(reason, "load_shared_library", name)
+        )
+        return cls(
+            [*(p for library in libraries for p in library.proto_files), *load_proto_file],
+            others,
+            search_dirs=search_dirs,
+            config_error=config_error,
+        )
 
     def _load_proto(self, path: str) -> None:
         found = _find(path, self._search_dirs)

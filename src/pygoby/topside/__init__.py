@@ -6,6 +6,8 @@ set they read is `pygoby.moosacomms.acomms_config`. Layer: above moosacomms, bel
 from pygoby.topside.errors import (
     CommanderError,
     FieldValueError,
+    LogControlError,
+    LogFileError,
     SaveFileError,
     ScopeFilterError,
     SpecialError,
@@ -35,6 +37,8 @@ __all__ = [
     "ICommanderTUI",
     "Liaison",
     "LiaisonState",
+    "LogControlError",
+    "LogFileError",
     "SaveFileError",
     "ScopeFilterError",
     "SpecialError",

@@ -30,3 +30,11 @@ class ScopeFilterError(TopsideError, ValueError):
 
 class TooManyStreamsError(TopsideError):
     """Every live-update stream liaison allows is open (max_streams)."""
+
+
+class LogFileError(TopsideError):
+    """A file liaison cannot replay (missing, unreadable, not a MOOS .alog)."""
+
+
+class LogControlError(TopsideError, ValueError):
+    """A log replay request liaison does not take (a speed it does not offer, no number)."""

@@ -464,3 +464,47 @@ def test_invalid_utf8_for_a_string_field_creates_nothing(Entry, loader):
         translator.create(
             TEST_MSG, {"KV": b"int32_default_optional=1,string_default_optional=\xff"}
         )
+
+
+def test_read_back_reads_each_rule_naming_the_variable(Entry, loader, msgs):
+    """`read_back` (the log tools): a create variable through its rule with its algorithms, a
+    publish variable as published; a publish naming an algorithm's virtual field, or whose
+    variable name is a format, is not read back; a value no rule reads is an error."""
+    e = entry(
+        Entry,
+        f"""protobuf_name: "{BNR}"
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "NAV_X" format: "%202%" }}
+        create {{ technique: TECHNIQUE_FORMAT moos_var: "VEHICLE_NAME" format: "%1%"
+                  algorithm {{ name: "to_lower" primary_field: 1 }} }}
+        create {{ technique: TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS moos_var: "NAV_HEADING"
+                  algorithm {{ name: "angle_0_360" primary_field: 201 }} }}
+        publish {{ technique: TECHNIQUE_FORMAT moos_var: "REPORT" format: "NAME=%1%;X=%202%" }}
+        publish {{ technique: TECHNIQUE_FORMAT moos_var: "REPORT_LAT" format: "%100%"
+          algorithm {{ name: "utm_y2lat" output_virtual_field: 100 primary_field: 3 reference_field: 202 }} }}
+        publish {{ technique: TECHNIQUE_FORMAT moos_var: "REPORT_%1%" format: "%202%" }}
+        publish {{ technique: TECHNIQUE_PROTOBUF_NATIVE_HEX moos_var: "REPORT_HEX" }}""",
+    )
+    translator = Translator([e], loader.message_class)
+    assert translator.read_back_variables() == {
+        "NAV_X",
+        "VEHICLE_NAME",
+        "NAV_HEADING",
+        "REPORT",
+        "REPORT_HEX",
+    }
+    assert translator.read_back("NAV_X", 550.0) == [msgs.BasicNodeReport(x=550)]  # a double
+    assert translator.read_back("VEHICLE_NAME", "UNICORN") == [msgs.BasicNodeReport(Name="unicorn")]
+    assert translator.read_back("NAV_HEADING", "heading=-120") == [
+        msgs.BasicNodeReport(heading=240)
+    ]
+    assert translator.read_back("REPORT", "NAME=Unicorn;X=12.5") == [
+        msgs.BasicNodeReport(Name="Unicorn", x=12.5)  # as published: no create algorithms
+    ]
+    report = msgs.BasicNodeReport(Name="a", y=3.5, repeat=[1, 2])
+    (hex_value,) = [p.value for p in translator.publish(report) if p.var == "REPORT_HEX"]
+    assert translator.read_back("REPORT_HEX", hex_value) == [report]
+    assert translator.read_back("OTHER", "x") == []
+    with pytest.raises(TranslatorError, match="REPORT: no rule reads the value"):
+        translator.read_back("REPORT", "nothing like the format")
+    with pytest.raises(TranslatorError, match="REPORT_HEX"):
+        translator.read_back("REPORT_HEX", "not hex")

@@ -15,6 +15,7 @@ from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.errors import QueueError
 from pygoby.acomms.queue import ccl
 from pygoby.acomms.queue.ccl import CCLQueue
+from pygoby.acomms.queue.frames import unpack_frame
 from pygoby.acomms.queue.log import QueueLog
 from pygoby.acomms.queue.persist import QueueStore
 from pygoby.acomms.queue.queue import MessageQueue, QueuedItem
@@ -558,18 +559,9 @@ class QueueManager:
     def _decode_frame(self, data: bytes, route: bool = False) -> list[str]:
         """Decode and deliver the frame's messages; their type names (for the log)."""
         names = []
-        offset = 0
-        while offset < len(data):
-            try:
-                codec = self._codec_for_source(data[offset:])
-                msg, used = codec.decode_prefix(data[offset:])
-            except DcclError as exc:  # keep the messages decoded so far
-                self.log.undecodable(offset, exc)
-                break
+        for msg, encoded in unpack_frame(data, self._codec_for_source, self.log.undecodable):
             if route:
-                encoded = data[offset : offset + used]
                 self.signal_in_route.emit(msg, encoded, self.message_dest(msg), self.modem_id)
-            offset += max(used, 1)
             names.append(msg.DESCRIPTOR.full_name)
             self._deliver(msg)
         return names

@@ -1,7 +1,8 @@
 """Reading and writing .alog files (the I/O around pygoby.moos.alog.format).
 
 * `AlogFile(path)`: iterate its entries (plain or `.gz`), binary values fetched from the
-  `.blog` beside it; damaged lines are skipped and counted (`reader.bad_lines`).
+  `.blog` beside it; damaged lines are skipped and counted (`reader.bad_lines`). `scan(start)`
+  gives each entry's byte offset too, and starts at one of them (liaison's log index).
 * `AlogSink`: the writer pLogger uses: the app thread hands it lines and never waits on the
   disk; a thread writes them, flushes at least twice a second, starts a new file past
   `max_bytes`, and counts the lines it had to drop when its bounded buffer was full.
@@ -15,7 +16,7 @@ import os
 import shutil
 import threading
 import zlib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Generator, Iterator
 from pathlib import Path
 from typing import IO
 
@@ -61,22 +62,52 @@ class AlogFile:
         return self.reader.log_start or 0.0
 
     def __iter__(self) -> Iterator[AlogEntry]:
+        for _, _, entry in self._read():
+            if entry is not None:
+                yield entry
+
+    def lines(self) -> Iterator[tuple[str, AlogEntry | None]]:
+        """Every line (without its newline) with its entry, or None for a `%%` line, a
+        continuation of a multi-line value or damage; over-long lines are only counted."""
+        for _, text, entry in self._read():
+            yield text, entry
+
+    def scan(self, start: int = 0) -> Generator[tuple[int, AlogEntry], None, None]:
+        """(byte offset of its line, entry) for each entry from the line that starts at byte
+        `start` (0, or an offset this method gave). The banner is read first whatever `start`,
+        so that its data-type and binary markings apply. In a `.gz`, getting to `start` means
+        decompressing what lies before it."""
+        for offset, _, entry in self._read(start):
+            if entry is not None:
+                yield offset, entry
+
+    def _read(self, start: int = 0) -> Iterator[tuple[int, str, AlogEntry | None]]:
+        """(byte offset, text, entry or None) of each line from byte `start`."""
         self.reader = AlogReader()  # each pass counts afresh
         self.blogs = BlogFiles(self.path.parent)
         try:
             with open_text_or_gz(self.path) as stream:
+                offset = 0
+                if start > 0:
+                    for _ in range(HEADER_LINES):
+                        raw = stream.readline(MAX_LINE_BYTES)
+                        if raw.startswith(b"%%"):
+                            self.reader.feed(decode_line(raw))
+                    stream.seek(start)
+                    offset = start
                 while raw := stream.readline(MAX_LINE_BYTES):
+                    line_offset, offset = offset, offset + len(raw)
                     if len(raw) == MAX_LINE_BYTES and not raw.endswith(b"\n"):
                         while (rest := stream.readline(MAX_LINE_BYTES)) and rest[-1:] != b"\n":
-                            pass
+                            offset += len(rest)
+                        offset += len(rest)
                         self.reader.skip_line()
                         continue
-                    entry = self.reader.feed(decode_line(raw))
-                    if entry is None:
-                        continue
-                    if entry.binary_ref is not None:
+                    text = decode_line(raw).rstrip("\r\n")
+                    entry = self.reader.feed(text)
+                    if entry is not None and entry.binary_ref is not None:
                         self.blogs.resolve(entry)
-                    yield entry
+                    yield line_offset, text, entry
         except READ_ERRORS as err:
             # a truncated .gz (a logger killed mid-write) ends the log where it breaks
             log.warning("%s: stopped reading: %s", self.path, err)
@@ -242,7 +273,8 @@ class AlogSink:
                 blog.write(head)
                 offset = blog.tell()
                 blog.write(data + b"\n")
-                line = head + binary_tag(self.blog_name, offset, len(data)).encode() + b" \n"
+                # pLogger ends a binary value's line right after the tag: no trailing space
+                line = head + binary_tag(self.blog_name, offset, len(data)).encode() + b"\n"
             if self.max_bytes and self._alog_bytes + len(line) > self.max_bytes:
                 self._open_alog()
             assert self._alog is not None

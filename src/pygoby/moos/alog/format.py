@@ -10,7 +10,8 @@ A file starts with a banner of `%%` lines::
 
 then one line per message, as pLogger pads it: the time since LOGSTART (fixed, 3 decimals,
 left-justified in 15 columns), the variable (20 columns), the source (15 columns; `src:aux`
-with LogAuxSrc, `...@community` with MarkExternalCommunityMessages), the value and one space.
+with LogAuxSrc, `...@community` with MarkExternalCommunityMessages), the value and one space
+(a binary value's `<MOOS_BINARY>` .blog reference ends the line without one).
 Doubles are fixed with DoublePrecision decimals (5 by default) left-justified in 12 columns;
 strings are written as they are. A reader cannot tell the string "3.5" from the double 3.5
 unless the file was written with MarkDataType (`D:`/`S:` before each value), so like MOOS-IvP's
@@ -40,11 +41,17 @@ BINARY_TAG = re.compile(
 # (pygoby.moos.alog.columns) runs the same pattern texts in pyarrow and must agree line for line.
 # whitespace as C's isspace (the MOOS tools' trimming): a value ending in U+00A0 is not a number
 SPACE = " \t\n\r\f\v"
-# a value the MOOS-IvP tools take for a number (their isNumber), plus C++'s inf and nan
+# a number, exponent allowed: a time, LOGSTART, a value marked D:
 NUMBER_TEXT = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
-DOUBLE_TEXT = rf"{NUMBER_TEXT}|[+-]?(?:inf|nan)"
-_NUMBER = re.compile(DOUBLE_TEXT)
-# TIME VARIABLE SOURCE [VALUE]: one match checks the columns and that the time is a number
+_NUMBER = re.compile(rf"{NUMBER_TEXT}|[+-]?(?:inf|nan)")
+# an unmarked value read as a double: what pLogger writes for one (fixed digits, or C++'s inf
+# and nan), which is also what MOOS-IvP's isNumber takes for a number (no exponent: "1e5" is a
+# string to both)
+DOUBLE_TEXT = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)|[+-]?(?:inf|nan)"
+_DOUBLE_AS_WRITTEN = re.compile(DOUBLE_TEXT)
+# TIME VARIABLE SOURCE [VALUE]: one match checks the columns and that the time is a number; a
+# negative time (a value pLogger got from the DB as it registered) is an entry, where MOOS-IvP's
+# aloggrep and alogscan skip it (QUIRKS.md Q-MOOS-20)
 _WORD = r"[^ \t\n\r\f\v]+"
 ENTRY_TEXT = (
     rf"[ \t]*(?P<time>{NUMBER_TEXT})[ \t]+(?P<name>{_WORD})[ \t]+(?P<source>{_WORD})"
@@ -58,7 +65,10 @@ Value = float | str | bytes
 @dataclass(slots=True)
 class AlogEntry:
     """One logged message. `time` is seconds since LOGSTART; `value` is a float (double), str
-    (string) or bytes (binary; `binary_ref` holds the .blog reference while it is unresolved)."""
+    (string) or bytes (binary; `binary_ref` holds the .blog reference while it is unresolved).
+    `line` is the line as the file has it (without its newline) and `value_column` its value
+    column as written (padding and trailing space included): the tools that copy lines, as
+    MOOS-IvP's do, copy these."""
 
     time: float
     name: str
@@ -67,6 +77,8 @@ class AlogEntry:
     source_aux: str = ""
     community: str = ""
     binary_ref: tuple[str, int, int] | None = None
+    line: str = ""
+    value_column: str = ""
 
     @property
     def type(self) -> str:
@@ -150,7 +162,7 @@ class AlogFormatter:
         if isinstance(value, bytes):
             if not self.mark_binary:
                 raise ValueError("binary values go to the .blog unless mark_binary is set")
-            return "B:" + value.hex().upper()
+            return inline_binary(value)
         return "S:" + value if self.mark_data_type else value
 
     def line(
@@ -164,6 +176,11 @@ class AlogFormatter:
     ) -> str:
         """One whole line for a double or string value (or binary with mark_binary)."""
         return f"{self.prefix(msg_time, name, src, src_aux, community)}{self.value_text(value)} \n"
+
+
+def inline_binary(value: bytes) -> str:
+    """A binary value as the MarkDataAsBinary files write it in the value column."""
+    return "B:" + value.hex().upper()
 
 
 def binary_tag(blog_name: str, offset: int, size: int) -> str:
@@ -207,7 +224,7 @@ class AlogReader:
             self._bad(line)
             return None
         src, aux, community = split_source(source)
-        return AlogEntry(msg_time, name, src, value[0], aux, community, value[1])
+        return AlogEntry(msg_time, name, src, value[0], aux, community, value[1], line, raw or "")
 
     def _value(self, raw: str) -> tuple[Value, tuple[str, int, int] | None] | None:
         # pLogger ends every value with one space; doubles are padded further
@@ -229,7 +246,7 @@ class AlogReader:
             if tag:
                 return b"", (tag["file"], int(tag["offset"]), int(tag["size"]))
         number = raw.rstrip(SPACE)
-        if _NUMBER.fullmatch(number):
+        if _DOUBLE_AS_WRITTEN.fullmatch(number):
             return float(number), None
         return raw, None
 

@@ -28,7 +28,7 @@ from pygoby.moos.alog.columns import (
     rows_table,
 )
 from pygoby.moos.alog.files import AlogFile
-from pygoby.moos.alog.format import AlogEntry, AlogFormatter, banner, value_text
+from pygoby.moos.alog.format import BINARY_MARKING, AlogEntry, inline_binary
 from pygoby.moos.errors import MoosError, MoosRefusedError
 from pygoby.util.extras import needs_extra
 
@@ -48,7 +48,8 @@ class LogToolError(MoosError):
 
 
 def matches(name: str, patterns: Sequence[str]) -> bool:
-    """aloggrep's rule: a pattern matches the whole name, or its start when it ends with `*`."""
+    """A pattern matches the whole name, or its start when it ends with `*` (aloggrep's
+    documented rule; its code matches anywhere in the name: QUIRKS.md Q-MOOS-17)."""
     for pattern in patterns:
         if pattern.endswith("*"):
             if name.startswith(pattern[:-1]):
@@ -61,7 +62,8 @@ def matches(name: str, patterns: Sequence[str]) -> bool:
 def grep(
     log: AlogFile, variables: Sequence[str], sources: Sequence[str] = ()
 ) -> Iterator[AlogEntry]:
-    """Entries whose variable (or, with `sources`, also whose source) matches."""
+    """Entries whose variable (and, with `sources`, also whose source, without its :aux and
+    @community) matches. Their `line` is what aloggrep prints for them."""
     for entry in log:
         if variables and not matches(entry.name, variables):
             continue
@@ -70,17 +72,36 @@ def grep(
         yield entry
 
 
+def write_lines(lines: Iterable[str], out: IO[str]) -> None:
+    """Lines (as read, without newline) to `out` as the bytes the file had, as aloggrep prints
+    them; a text-only `out` (redirect_stdout) gets them as text."""
+    out.flush()
+    binary: IO[bytes] | None = getattr(out, "buffer", None)
+    for line in lines:
+        if binary is not None:
+            binary.write(line.encode("utf-8", "surrogateescape") + b"\n")
+        else:
+            out.write(line + "\n")
+    if binary is not None:
+        binary.flush()
+
+
 # -- summary -------------------------------------------------------------------------------------
+
+MAX_LISTED_SOURCES = 64  # a variable's sources listed in the summary (the rest are not)
 
 
 @dataclass
 class VariableSummary:
+    """One variable's row of alogscan's table (plus its rate). `chars` counts as alogscan does:
+    the variable, the source column up to any `:aux`, and the value column as written."""
+
     name: str
     count: int = 0
     first: float = math.inf
     last: float = -math.inf
     chars: int = 0
-    sources: set[str] = field(default_factory=set)
+    sources: dict[str, None] = field(default_factory=dict)  # in the order first seen
 
     @property
     def rate(self) -> float:
@@ -88,8 +109,28 @@ class VariableSummary:
         return (self.count - 1) / span if self.count > 1 and span > 0 else 0.0
 
 
+def summary_source(entry: AlogEntry) -> str:
+    """How a source is listed: without its :aux, with @community for other communities
+    (alogscan loses the community when there is an aux too: QUIRKS.md Q-MOOS-18)."""
+    return f"{entry.source}@{entry.community}" if entry.community else entry.source
+
+
+def _byte_length(text: str) -> int:
+    return len(text) if text.isascii() else len(text.encode("utf-8", "surrogateescape"))
+
+
+def _scan_chars(entry: AlogEntry) -> int:
+    """alogscan's Chars for one line: the bytes of the variable, of the source column up to
+    its first `:` (so `@community` counts only without an aux) and of the value column."""
+    source = _byte_length(entry.source)
+    if entry.community and not entry.source_aux:
+        source += 1 + _byte_length(entry.community)
+    return _byte_length(entry.name) + source + _byte_length(entry.value_column)
+
+
 def summarize(log: AlogFile) -> dict[str, VariableSummary]:
-    """Per variable: count, first and last time, characters of values, sources (alogscan)."""
+    """Per variable: count, first and last time, characters, sources (alogscan's table,
+    except that entries with an empty value count and sources are compared whole)."""
     table: dict[str, VariableSummary] = {}
     for entry in log:
         row = table.get(entry.name)
@@ -98,9 +139,9 @@ def summarize(log: AlogFile) -> dict[str, VariableSummary]:
         row.count += 1
         row.first = min(row.first, entry.time)
         row.last = max(row.last, entry.time)
-        row.chars += len(value_text(entry))
-        if len(row.sources) < 64:
-            row.sources.add(entry.source)
+        row.chars += _scan_chars(entry)
+        if len(row.sources) < MAX_LISTED_SOURCES:
+            row.sources[summary_source(entry)] = None
     return table
 
 
@@ -115,7 +156,7 @@ def summary_lines(log: AlogFile, table: dict[str, VariableSummary]) -> list[str]
         row = table[name]
         lines.append(
             f"{name:<{width}}  {row.count:>8}  {row.chars:>10}  {row.first:>10.2f}  "
-            f"{row.last:>10.2f}  {row.rate:>8.2f}  {','.join(sorted(row.sources))}"
+            f"{row.last:>10.2f}  {row.rate:>8.2f}  {','.join(row.sources)}"
         )
     total = sum(row.count for row in table.values())
     lines.append(
@@ -127,34 +168,36 @@ def summary_lines(log: AlogFile, table: dict[str, VariableSummary]) -> list[str]
 
 # -- clip ----------------------------------------------------------------------------------------
 
+# alogclip keeps these whatever their time: the helm's domain, which alogview needs
+ALWAYS_CLIPPED_IN = frozenset({"IVPHELM_DOMAIN"})
+
 
 def clip(log: AlogFile, t0: float, t1: float, out: IO[str]) -> int:
-    """Write the entries with t0 <= time <= t1 as a new .alog (same LOGSTART, same times);
-    returns how many. Binary values are written inline as hex (the clip has no .blog)."""
-    # times are already relative to LOGSTART; sources keep their :aux and @community
-    formatter = AlogFormatter(0.0, log_aux_src=True, mark_external=True, mark_binary=True)
-    name = getattr(out, "name", "clip.alog")
+    """Write the `%%` lines and the entries with t0 <= time <= t1 as they are in the file,
+    as alogclip does (same banner, LOGSTART and times); returns how many entries. A binary
+    value from the .blog is written inline as `B:<hex>` instead (the clip needs no .blog),
+    after a `%% BINARY MARKING ON` line; lines that are not entries are left out, where
+    alogclip keeps them when the window includes time 0 (QUIRKS.md Q-MOOS-19)."""
+    marked = False
     count = 0
-    wrote_banner = False
-    for entry in log:
-        if not wrote_banner:  # LOGSTART is known once the header has been read
-            out.write(banner(name, log.log_start, mark_binary=True))
-            wrote_banner = True
-        if not t0 <= entry.time <= t1:
+    for text, entry in log.lines():
+        if entry is None:
+            if text.startswith("%"):
+                out.write(text + "\n")
             continue
-        out.write(
-            formatter.line(
-                entry.time,
-                entry.name,
-                entry.source,
-                entry.value,
-                entry.source_aux,
-                entry.community,
-            )
-        )
+        if not (t0 <= entry.time <= t1 or entry.name in ALWAYS_CLIPPED_IN):
+            continue
+        line = text
+        from_blog = entry.value_column.startswith("<MOOS_BINARY>")
+        if from_blog and entry.binary_ref is None and isinstance(entry.value, bytes):
+            if not (marked or log.reader.binary_marked):
+                out.write(BINARY_MARKING + "\n")
+                marked = True
+            # pLogger's inline form: the value, then one space (a .blog tag has none)
+            prefix = text[: len(text) - len(entry.value_column)]
+            line = prefix + inline_binary(entry.value) + " "
+        out.write(line + "\n")
         count += 1
-    if not wrote_banner:
-        out.write(banner(name, log.log_start, mark_binary=True))
     return count
 
 

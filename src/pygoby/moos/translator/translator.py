@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 from google.protobuf.message import Message
@@ -122,6 +122,10 @@ def post_for_moos(var: str, msg: Message, technique: Technique) -> Post:
 
 
 MessageResolver = Callable[[str], type[Message]]
+# a create or a publish rule: both have technique, format and repeated_delimiter
+_ReadableRule = TranslatorEntry.CreateParser | TranslatorEntry.PublishSerializer
+# {variable: [(entry name, rule, algorithms to apply)]}
+_RuleIndex = dict[str, list[tuple[str, _ReadableRule, Sequence[object]]]]
 
 
 class Translator:
@@ -146,6 +150,7 @@ class Translator:
         self._entries: dict[str, TranslatorEntry] = {}
         self._classes: dict[str, type[Message]] = {}
         self._named_values: dict[str, dict[str, str]] = {}
+        self._read_rules: _RuleIndex | None = None  # read_back's, built on first use
         for entry in entries:
             self.add_entry(entry)
 
@@ -165,6 +170,7 @@ class Translator:
                 f"translator_entry protobuf_name {name!r} is not a loaded message type: {exc}"
             ) from None
         notes = self._check_entry(entry, cls)
+        self._read_rules = None
         self._entries[name] = entry
         self._classes[name] = cls
         return notes
@@ -306,7 +312,9 @@ class Translator:
                 value = keyvalue.val_from_string(source, key)
                 source = source if value is None else value
             try:
-                mismatch = self._apply_create(msg, create, technique, source, entry.use_short_enum)
+                mismatch = self._apply_rule(
+                    msg, create, create.algorithm, source, entry.use_short_enum
+                )
             except TranslatorError as exc:
                 raise type(exc)(f"{protobuf_name} from {create.moos_var}: {exc}") from None
             if mismatch is None:
@@ -318,27 +326,28 @@ class Translator:
                 mismatches.append(found)
         return msg
 
-    def _apply_create(
+    def _apply_rule(
         self,
         msg: Message,
-        create: TranslatorEntry.CreateParser,
-        technique: Technique,
+        rule: _ReadableRule,
+        algorithms: Sequence[object],
         source: MoosValue,
         short: bool,
     ) -> format_technique.FormatMismatch | None:
+        """Parse `source` into `msg` by `rule`'s technique (a create rule, or a publish rule
+        read back), running `algorithms` on the parsed fields."""
+        technique = Technique(rule.technique)
         if technique in PROTOBUF_TECHNIQUES:
             parse_protobuf(source, msg, technique)
         elif technique == Technique.TECHNIQUE_COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
-            keyvalue.parse(
-                as_text(source), msg, create.algorithm, short, self.registry, create.moos_var
-            )
+            keyvalue.parse(as_text(source), msg, algorithms, short, self.registry, rule.moos_var)
         else:
             return format_technique.parse(
                 as_text(source),
                 msg,
-                create.format,
-                create.repeated_delimiter,
-                create.algorithm,
+                rule.format,
+                rule.repeated_delimiter,
+                algorithms,
                 short,
                 self.registry,
             )
@@ -400,6 +409,61 @@ class Translator:
         ):
             posts.append(Post(trigger.moos_var, "", ""))
         return sorted(posts, key=lambda post: post.var)
+
+    # --- MOOS posts read back (log tools) ----------------------------------------------------
+
+    def read_back(self, var: str, value: MoosValue) -> list[Message]:
+        """The messages `var`'s value gives back, one per rule naming `var`: each create rule
+        reading it (its algorithms applied, as at creation) and each publish rule posting to it
+        (the value as published: publish algorithms only run message -> text). Rules whose
+        value cannot be parsed back are not read: a publish variable name that is itself a
+        format, a publish format with a field the message does not have (an algorithm's
+        virtual field). A format that matches only part of the value counts as not read.
+        Raises TranslatorError when no rule reads the value."""
+        rules = self._readers().get(var, [])
+        messages: list[Message] = []
+        errors: list[str] = []
+        for name, rule, algorithms in rules:
+            entry = self._entries[name]
+            msg = self._classes[name]()
+            technique = Technique(rule.technique)
+            source = moos_value_to_source(value, technique)
+            try:
+                mismatch = self._apply_rule(msg, rule, algorithms, source, entry.use_short_enum)
+                if mismatch is not None:
+                    raise TranslatorError(f"does not match format {rule.format!r}: {mismatch}")
+            except (TranslatorError, ValueError, KeyError) as exc:
+                errors.append(f"{name}: {exc}")
+                continue
+            messages.append(msg)
+        if rules and not messages:
+            raise TranslatorError(f"{var}: no rule reads the value ({'; '.join(errors)})")
+        return messages
+
+    def read_back_variables(self) -> set[str]:
+        """The variables `read_back` can read."""
+        return set(self._readers())
+
+    def _readers(self) -> _RuleIndex:
+        """{variable: [(entry name, rule, algorithms to apply)]}, built once."""
+        if self._read_rules is not None:
+            return self._read_rules
+        readers: _RuleIndex = {}
+        for name, entry in self._entries.items():
+            descriptor = self._classes[name].DESCRIPTOR
+            for create in entry.create:
+                readers.setdefault(create.moos_var, []).append((name, create, create.algorithm))
+            for publish in entry.publish:
+                if Technique(publish.technique) == Technique.TECHNIQUE_FORMAT:
+                    if "%" in publish.moos_var:
+                        continue
+                    try:
+                        format_technique.check_parse_format(descriptor, publish.format)
+                    except TranslatorError:
+                        continue
+                readers.setdefault(publish.moos_var, []).append((name, publish, ()))
+        self._read_rules = readers
+        return readers
 
     def _entry(self, protobuf_name: str) -> TranslatorEntry:
         try:

@@ -23,10 +23,7 @@ from typing import Any
 from pygoby.util.extras import needs_extra
 
 with needs_extra("sim", "netsim reports"):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from pygoby.util.figures import plt, save_figure
 
 KIND_COLOURS = {
     "data": "tab:blue",
@@ -200,13 +197,6 @@ def plot_timeline(events: list[dict], path: Path, window: tuple[float, float] | 
 
 def _number(label: str) -> int:
     return int(label.rsplit(" ", 1)[1])
-
-
-def save_figure(fig, path: Path) -> Path:
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
 
 
 def write_report(

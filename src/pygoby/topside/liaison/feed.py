@@ -13,7 +13,7 @@ import contextlib
 import json
 import logging
 from collections import Counter
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Callable
 
 from pygoby.topside.errors import TooManyStreamsError
 from pygoby.topside.liaison.models import ScopeFilter
@@ -90,10 +90,18 @@ class PageStream:
 
 class LiveFeed:
     """Ticks `PageSnapshots` every `period` seconds (`run`), and serves `stream`s, at most
-    `max_streams` at once (past that, `admit` raises TooManyStreamsError)."""
+    `max_streams` at once (past that, `admit` raises TooManyStreamsError). `before_tick`, if
+    given, runs first at every tick (a log replay moving the state to the tick's time)."""
 
-    def __init__(self, state: LiaisonState, period: float, max_streams: int) -> None:
+    def __init__(
+        self,
+        state: LiaisonState,
+        period: float,
+        max_streams: int,
+        before_tick: Callable[[], None] | None = None,
+    ) -> None:
         self.snapshots = PageSnapshots(state)
+        self.before_tick = before_tick
         self.period = period
         self.max_streams = max_streams
         self.watched: Counter[str] = Counter()
@@ -134,6 +142,8 @@ class LiveFeed:
                 yield f"data: {text}\n\n"
 
     def tick(self) -> None:
+        if self.before_tick is not None:
+            self.before_tick()
         self.snapshots.build(self.watched)
         ticked, self._ticked = self._ticked, asyncio.Event()
         ticked.set()

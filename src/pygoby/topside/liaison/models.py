@@ -158,6 +158,16 @@ class ScopeModel:
         row = self.rows.get(key)
         return list(row.history) if row is not None else []
 
+    def saved(self) -> object:
+        """What mail changed (for `restore`: a log replay's checkpoint); pickles."""
+        return self.rows
+
+    def restore(self, saved: object) -> None:
+        """Back to what `saved` gave (an unpickled copy: nothing shared with the saved one)."""
+        assert isinstance(saved, dict)
+        self.rows = saved
+        self._keys = sorted(saved)
+
 
 # ---------------------------------------------------------------------------------- Acomms
 @dataclass
@@ -397,6 +407,30 @@ class AcommsModel:
     def _on_expire(self, value: MoosValue, when: float) -> None:
         self._original("expired", value, when)
 
+    def saved(self) -> object:
+        """What mail changed (for `restore`: a log replay's checkpoint); pickles. The queues'
+        configuration stays: only their counts and send times are saved."""
+        queues = {name: (q.size, q.last_sent, q.sent) for name, q in self.queues.items()}
+        return (
+            queues,
+            self.slot_index,
+            self.slot_start,
+            self.tx,
+            self.rx,
+            self.timeline,
+            self.drivers,
+        )
+
+    def restore(self, saved: object) -> None:
+        """Back to what `saved` gave (an unpickled copy: nothing shared with the saved one)."""
+        assert isinstance(saved, tuple)
+        queues, self.slot_index, self.slot_start, self.tx, self.rx, self.timeline, self.drivers = (
+            saved
+        )
+        for name, (size, last_sent, sent) in queues.items():
+            queue = self.queues[name]
+            queue.size, queue.last_sent, queue.sent = size, last_sent, sent
+
     def snapshot(self, now: float) -> dict:
         waiting = [
             q
@@ -578,6 +612,15 @@ class MapModel:
             self.links[(src, self.community)] = when
         elif dest_id > 0:
             self.links[(self.community, self._name(dest_id))] = when
+
+    def saved(self) -> object:
+        """What mail changed (for `restore`: a log replay's checkpoint); pickles."""
+        return (self.nodes, self.links, self.own_id, self._nav)
+
+    def restore(self, saved: object) -> None:
+        """Back to what `saved` gave (an unpickled copy: nothing shared with the saved one)."""
+        assert isinstance(saved, tuple)
+        self.nodes, self.links, self.own_id, self._nav = saved
 
     def snapshot(self, now: float) -> dict:
         return {

@@ -3,6 +3,8 @@ models and the commander core, with JSON-ready views for the web layer."""
 
 from __future__ import annotations
 
+import pickle
+import zlib
 from collections.abc import Callable, Mapping
 
 from pygoby.moos.protocol import MOOSMessage
@@ -123,11 +125,30 @@ class LiaisonState:
                 self.load_warnings += self.commander.load(path)
 
     def handle(self, msg: MOOSMessage) -> None:
+        self.show(msg)
+        if msg.time >= self.start_time:  # older acks are not ours (Goby's stale-mail rule)
+            self.commander.handle_mail(msg.key, msg.value, msg.time)
+
+    def show(self, msg: MOOSMessage) -> None:
+        """The Scope, Acomms and Map pages' part of `handle` (all a log replay updates: the
+        commander's acks are for the commands this liaison sent)."""
         self.scope.update(msg)
         self.acomms.handle(msg)
         self.map.handle(msg)
-        if msg.time >= self.start_time:  # older acks are not ours (Goby's stale-mail rule)
-            self.commander.handle_mail(msg.key, msg.value, msg.time)
+
+    def save_pages(self) -> bytes:
+        """The Scope, Acomms and Map models' state, compressed (a log replay's checkpoint)."""
+        saved = (self.scope.saved(), self.acomms.saved(), self.map.saved())
+        return zlib.compress(pickle.dumps(saved, pickle.HIGHEST_PROTOCOL), 1)
+
+    def restore_pages(self, saved: bytes) -> None:
+        """Back to the pages' state `save_pages` gave."""
+        scope, acomms, nodes = pickle.loads(
+            zlib.decompress(saved)
+        )  # our own bytes, never a client's
+        self.scope.restore(scope)
+        self.acomms.restore(acomms)
+        self.map.restore(nodes)
 
     def page(self, name: str, now: float) -> dict:
         """The Commander, Acomms or Map page's view (the Scope's is `scope.rows_json`)."""

@@ -48,9 +48,10 @@ from pygoby.topside.commander import (
     FieldValueError,
     SaveFileError,
 )
-from pygoby.topside.errors import ScopeFilterError, TooManyStreamsError
+from pygoby.topside.errors import LogControlError, ScopeFilterError, TooManyStreamsError
 from pygoby.topside.liaison.access import Access, SaveFolder, is_loopback
 from pygoby.topside.liaison.feed import PAGES, LiveFeed, PageStream, ScopeStream
+from pygoby.topside.liaison.log_feed import LogPlayer
 from pygoby.topside.liaison.state import LiaisonState, field_view, outgoing_view, record_view
 from pygoby.util.aiorun import cancel_and_wait
 
@@ -66,7 +67,8 @@ class Parts:
 
     state: LiaisonState
     feed: LiveFeed
-    saves: SaveFolder
+    saves: SaveFolder | None  # None: no saving (log mode)
+    player: LogPlayer | None = None  # replaying a log (`pygoby liaison --log`)
 
 
 def _parts(request: Request) -> Parts:
@@ -209,15 +211,21 @@ def _send(parts: Parts, draft: Draft | None, body: dict) -> dict:
     return {"record": record_view(parts.state.commander.send(_needs_draft(draft)))}
 
 
+def _save_folder(parts: Parts) -> SaveFolder:
+    if parts.saves is None:
+        raise SaveFileError("this liaison has no save folder")
+    return parts.saves
+
+
 def _save(parts: Parts, draft: Draft | None, body: dict) -> dict:
     name = str(body["path"])
-    parts.state.commander.save(parts.saves.for_saving(name))
+    parts.state.commander.save(_save_folder(parts).for_saving(name))
     return {}
 
 
 def _load(parts: Parts, draft: Draft | None, body: dict) -> dict:
     name = str(body["path"])
-    path = parts.saves.path(name)
+    path = _save_folder(parts).path(name)
     if not path.is_file():
         raise SaveFileError(f"no save file {name!r} in the save folder")
     try:
@@ -242,6 +250,8 @@ COMMANDER_ACTIONS: dict[str, Action] = {
 async def command(request: Request) -> Response:
     """POST {action, type, field?, text?, ...}: one commander operation."""
     parts = _parts(request)
+    if parts.player is not None:
+        return JSONResponse({"ok": False, "error": LOG_MODE_COMMANDER}, status_code=409)
     try:
         body = await request.json()
         if not isinstance(body, dict):
@@ -261,6 +271,66 @@ async def command(request: Request) -> Response:
         return JSONResponse({"ok": False, "error": str(reason)}, status_code=status)
 
 
+# ---------------------------------------------------------------------------------- log replay
+LOG_MODE_COMMANDER = "liaison is replaying a log: the Commander is off (no MOOSDB to post to)"
+
+
+def _player(request: Request) -> LogPlayer | None:
+    return _parts(request).player
+
+
+def _log_control_seek(player: LogPlayer, body: dict) -> None:
+    player.seek(_number(body, "time"))
+
+
+def _log_control_speed(player: LogPlayer, body: dict) -> None:
+    player.set_speed(_number(body, "speed"))
+
+
+def _number(body: dict, name: str) -> float:
+    value = body.get(name)
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise LogControlError(f"`{name}` is a number")
+    return float(value)
+
+
+LOG_CONTROLS: dict[str, Callable[[LogPlayer, dict], None]] = {
+    "play": lambda player, body: player.play(),
+    "pause": lambda player, body: player.pause(),
+    "seek": _log_control_seek,
+    "speed": _log_control_speed,
+}
+
+
+async def log_status(request: Request) -> Response:
+    """GET: where the replay is; `replaying` false when liaison serves a live community (every
+    page asks at start, so a live liaison answers too, without an error)."""
+    player = _player(request)
+    if player is None:
+        return JSONResponse({"replaying": False})
+    return JSONResponse({"replaying": True, **player.status()})
+
+
+async def log_control(request: Request) -> Response:
+    """POST {action: play|pause|seek|speed, time?, speed?}: the replay's controls; the
+    answer is the status. A seek only aims: the pages get there over the next ticks (each
+    reads a bounded number of entries), so no request reads the log at length."""
+    player = _player(request)
+    if player is None:
+        return PlainTextResponse("liaison is not replaying a log", 404)
+    try:
+        body = await request.json()
+        if not isinstance(body, dict):
+            raise LogControlError("the request is a JSON object {action, ...}")
+        control = LOG_CONTROLS.get(str(body.get("action")))
+        if control is None:
+            raise LogControlError(f"no action {body.get('action')!r} (play, pause, seek, speed)")
+        control(player, body)
+    except (LogControlError, ValueError) as err:
+        return JSONResponse({"ok": False, "error": str(err)}, status_code=400)
+    return JSONResponse({"ok": True, "replaying": True, **player.status()})
+
+
 ROUTES = [
     Route("/", index),
     Route("/scope", page),
@@ -272,6 +342,8 @@ ROUTES = [
     Route("/api/scope/history", history),
     Route("/api/commander/types", types),
     Route("/api/commander", command, methods=["POST"]),
+    Route("/api/log", log_status),
+    Route("/api/log", log_control, methods=["POST"]),
     Mount("/static", StaticFiles(directory=STATIC), name="static"),
 ]
 
@@ -316,11 +388,16 @@ class AccessGuard:
 
 
 def make_app(
-    state: LiaisonState, *, access: Access, feed: LiveFeed, saves: SaveFolder
+    state: LiaisonState,
+    *,
+    access: Access,
+    feed: LiveFeed,
+    saves: SaveFolder | None,
+    player: LogPlayer | None = None,
 ) -> Starlette:
     """The ASGI application: ROUTES behind the AccessGuard."""
     app = Starlette(routes=ROUTES, middleware=[Middleware(AccessGuard, access=access)])
-    app.state.liaison = Parts(state, feed, saves)
+    app.state.liaison = Parts(state, feed, saves, player)
     return app
 
 
@@ -351,18 +428,28 @@ class WebServer:
     """uvicorn in the running asyncio loop, on a socket bound at construction; `url` once
     started."""
 
-    def __init__(self, state: LiaisonState, cfg: LiaisonConfig, save_dir: str | Path) -> None:
+    def __init__(
+        self,
+        state: LiaisonState,
+        cfg: LiaisonConfig,
+        save_dir: str | Path | None,
+        player: LogPlayer | None = None,
+    ) -> None:
         """`cfg`: the LiaisonConfig (address, port, token, update_freq, max_streams,
-        allowed_host); `save_dir`: the Commander page's save folder."""
+        allowed_host); `save_dir`: the Commander page's save folder (None: none); `player`:
+        the log replay the pages show (`pygoby liaison --log`), moved before every tick."""
         self.address = address = cfg.http_address
         self._socket = listen(address, cfg.http_port)
         self.port = self._socket.getsockname()[1]
         self.token = cfg.token or secrets.token_urlsafe(16)
         self._stopping = asyncio.Event()
         period = 1.0 / cfg.update_freq if cfg.update_freq > 0 else 1.0
-        self.feed = LiveFeed(state, period, cfg.max_streams)
+        self.feed = LiveFeed(
+            state, period, cfg.max_streams, before_tick=player.update if player else None
+        )
         access = Access(address, self.token, self.port, cfg.allowed_host)
-        app = make_app(state, access=access, feed=self.feed, saves=SaveFolder(save_dir))
+        saves = SaveFolder(save_dir) if save_dir is not None else None
+        app = make_app(state, access=access, feed=self.feed, saves=saves, player=player)
         config = uvicorn.Config(
             app,
             host=address,

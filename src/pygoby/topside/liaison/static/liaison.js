@@ -1,4 +1,5 @@
-// pygoby liaison: the four pages, fed by Server-Sent Events (/api/events) and JSON POSTs.
+// pygoby liaison: the four pages, fed by Server-Sent Events (/api/events) and JSON POSTs; over a
+// recorded log (pygoby liaison --log), the log bar's controls (/api/log) and no Commander.
 "use strict";
 
 const page = (location.pathname.replace(/^\/+/, "") || "scope").split("/")[0];
@@ -20,9 +21,9 @@ const svg = (tag, attrs = {}) => {
 };
 const clock = (t) => new Date(t * 1000).toISOString().substring(11, 19);
 
-async function post(body) {
+async function post(body, url = "/api/commander") {
   // the token travels as the cookie the printed URL's ?token= left (HttpOnly: never seen here)
-  const response = await fetch("/api/commander", {
+  const response = await fetch(url, {
     method: "POST",
     headers: { "Content-Type": "application/json", "X-Liaison": "1" },
     body: JSON.stringify(body),
@@ -39,7 +40,7 @@ function listen(extra = "") {
   if (source) source.close();
   source = new EventSource(`/api/events?page=${page}${extra}`);
   source.onmessage = (event) => {
-    $("#status").textContent = "live " + new Date().toLocaleTimeString();
+    $("#status").textContent = logMode ? "replaying a log" : "live " + new Date().toLocaleTimeString();
     $("#status").classList.remove("bad");
     renderers[page](JSON.parse(event.data));
   };
@@ -326,6 +327,55 @@ function renderMap(data) {
 
 const renderers = { scope: renderScope, commander: renderCommander, acomms: renderAcomms, map: renderMap };
 
+// ------------------------------------------------------------------------------ log replay
+// The server owns the replay (time, play/pause, speed); the bar shows its status four times a
+// second and posts the controls. The slider is left alone while it is being dragged.
+let logMode = false;
+let sliding = false;
+function renderLog(s) {
+  const slider = $("#log-slider");
+  slider.max = String(s.duration);
+  if (!sliding) slider.value = String(s.target);
+  const shown = sliding ? Number(slider.value) : s.time;
+  setText($("#log-time"), `${shown.toFixed(1)} / ${s.duration.toFixed(1)} s  ${clock(s.log_start + shown)} UTC` +
+    (s.caught_up || sliding ? "" : "  (seeking…)"));
+  $("#log-time").dataset.time = String(s.time);
+  setText($("#log-play"), s.playing ? "❚❚ Pause" : "▶ Play");
+  $("#log-play").dataset.playing = String(s.playing);
+  $("#log-speed").value = String(s.speed);
+}
+
+async function logControl(body) {
+  const r = await post(body, "/api/log");
+  if (r.ok) renderLog(r);
+  else { $("#status").textContent = r.error; $("#status").classList.add("bad"); }
+}
+
+async function setupLog() {
+  const response = await fetch("/api/log");
+  const s = response.ok ? await response.json() : { replaying: false };
+  if (!s.replaying) return false;
+  logMode = true;
+  $("#log-bar").hidden = false;
+  $("#log-file").textContent = `${s.file}: ${s.entries} entries` + (s.bad_lines ? `, ${s.bad_lines} damaged lines skipped` : "");
+  $("#log-speed").replaceChildren(...s.speeds.map((v) => el("option", { value: String(v) }, `${v}×`)));
+  document.querySelector('nav a[data-page="commander"]').hidden = true;
+  const slider = $("#log-slider");
+  slider.addEventListener("input", () => { sliding = true; });
+  slider.addEventListener("change", async () => {
+    await logControl({ action: "seek", time: Number(slider.value) });
+    sliding = false;
+  });
+  $("#log-play").onclick = () => logControl({ action: $("#log-play").dataset.playing === "true" ? "pause" : "play" });
+  $("#log-speed").onchange = () => logControl({ action: "speed", speed: Number($("#log-speed").value) });
+  renderLog(s);
+  setInterval(async () => {
+    const r = await fetch("/api/log");
+    if (r.ok) renderLog(await r.json());
+  }, 250);
+  return true;
+}
+
 // ------------------------------------------------------------------------------ start
 document.querySelectorAll("nav a").forEach((a) => a.classList.toggle("active", a.dataset.page === page));
 const section = document.getElementById(`page-${page}`);
@@ -337,5 +387,14 @@ if (page === "scope") {
     timer = setTimeout(() => listen("&filter=" + encodeURIComponent($("#scope-filter").value)), 250);
   });
 }
-if (page === "commander") setupCommander();
-if (renderers[page]) listen();
+(async () => {
+  const replaying = await setupLog();
+  if (replaying && page === "commander") {
+    // nothing to send to: the page says why instead of offering a form that cannot work
+    $("#cmd-log-note").hidden = false;
+    for (const part of section.querySelectorAll(".toolbar, .split, #cmd-message")) part.hidden = true;
+    return;
+  }
+  if (page === "commander") setupCommander();
+  if (renderers[page]) listen();
+})();
