@@ -28,6 +28,8 @@ FLUSH_PERIOD = 0.5  # s: a kill -9 loses at most about this much
 DEFAULT_MAX_PENDING = 200_000  # lines waiting for the disk before new ones are dropped
 HEADER_LINES = 10  # the banner is within a file's first lines
 MAX_LINE_BYTES = 16 << 20  # longer lines are damage (a file without newlines must not fill memory)
+# what ends reading a file early: a truncated or garbled .gz (a logger killed mid-write), a disk
+READ_ERRORS = (OSError, EOFError, zlib.error)
 
 
 def open_text_or_gz(path: str | os.PathLike[str]) -> IO[bytes]:
@@ -43,8 +45,7 @@ class AlogFile:
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
         self.reader = AlogReader()
-        self.unresolved_binary = 0
-        self._blogs: dict[str, IO[bytes] | None] = {}
+        self.blogs = BlogFiles(self.path.parent)
 
     @property
     def log_start(self) -> float:
@@ -55,7 +56,7 @@ class AlogFile:
                 with open_text_or_gz(self.path) as stream:
                     for raw, _ in zip(stream, range(HEADER_LINES), strict=False):
                         header.feed(decode_line(raw))
-            except (OSError, EOFError, zlib.error):
+            except READ_ERRORS:
                 pass
             return header.log_start or 0.0
         return self.reader.log_start or 0.0
@@ -83,8 +84,7 @@ class AlogFile:
     def _read(self, start: int = 0) -> Iterator[tuple[int, str, AlogEntry | None]]:
         """(byte offset, text, entry or None) of each line from byte `start`."""
         self.reader = AlogReader()  # each pass counts afresh
-        self.unresolved_binary = 0
-        self._blogs = {}
+        self.blogs = BlogFiles(self.path.parent)
         try:
             with open_text_or_gz(self.path) as stream:
                 offset = 0
@@ -106,25 +106,38 @@ class AlogFile:
                     text = decode_line(raw).rstrip("\r\n")
                     entry = self.reader.feed(text)
                     if entry is not None and entry.binary_ref is not None:
-                        self._resolve(entry)
+                        self.blogs.resolve(entry)
                     yield line_offset, text, entry
-        except (OSError, EOFError, zlib.error) as err:
+        except READ_ERRORS as err:
             # a truncated .gz (a logger killed mid-write) ends the log where it breaks
             log.warning("%s: stopped reading: %s", self.path, err)
         finally:
-            for blog in self._blogs.values():
-                if blog is not None:
-                    blog.close()
+            self.blogs.close()
 
-    def _resolve(self, entry: AlogEntry) -> None:
+    @property
+    def unresolved_binary(self) -> int:
+        return self.blogs.unresolved
+
+
+class BlogFiles:
+    """The .blog files beside an .alog, opened when an entry first names one: `resolve(entry)`
+    replaces a `<MOOS_BINARY>` reference by the bytes it points at (counted in `unresolved`
+    when the file or the bytes are missing)."""
+
+    def __init__(self, directory: Path) -> None:
+        self.directory = directory
+        self.unresolved = 0
+        self._open: dict[str, IO[bytes] | None] = {}
+
+    def resolve(self, entry: AlogEntry) -> None:
         assert entry.binary_ref is not None
         name, offset, size = entry.binary_ref
-        if name not in self._blogs:
+        if name not in self._open:
             try:
-                self._blogs[name] = open(self.path.parent / Path(name).name, "rb")  # noqa: SIM115
+                self._open[name] = open(self.directory / Path(name).name, "rb")  # noqa: SIM115
             except OSError:
-                self._blogs[name] = None
-        blog = self._blogs[name]
+                self._open[name] = None
+        blog = self._open[name]
         data = b""
         if blog is not None:
             blog.seek(offset)
@@ -133,7 +146,13 @@ class AlogFile:
             entry.value = data
             entry.binary_ref = None
         else:
-            self.unresolved_binary += 1
+            self.unresolved += 1
+
+    def close(self) -> None:
+        for blog in self._open.values():
+            if blog is not None:
+                blog.close()
+        self._open.clear()
 
 
 class AlogSink:

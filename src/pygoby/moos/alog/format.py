@@ -36,17 +36,28 @@ BINARY_MARKING = "%% BINARY MARKING ON"
 BINARY_TAG = re.compile(
     r"<MOOS_BINARY>File=(?P<file>[^,]*),Offset=(?P<offset>\d+),Bytes=(?P<size>\d+)</MOOS_BINARY>"
 )
+# The patterns are ASCII-only and written with explicit classes (no \d or \S, whose meaning
+# differs between Python's and RE2's regular expressions) because the block parser
+# (pygoby.moos.alog.columns) runs the same pattern texts in pyarrow and must agree line for line.
+# whitespace as C's isspace (the MOOS tools' trimming): a value ending in U+00A0 is not a number
+SPACE = " \t\n\r\f\v"
 # a number, exponent allowed: a time, LOGSTART, a value marked D:
-_NUMBER_TEXT = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
-_NUMBER = re.compile(rf"{_NUMBER_TEXT}|[+-]?(?:inf|nan)")
+NUMBER_TEXT = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+_NUMBER = re.compile(rf"{NUMBER_TEXT}|[+-]?(?:inf|nan)")
 # an unmarked value read as a double: what pLogger writes for one (fixed digits, or C++'s inf
 # and nan), which is also what MOOS-IvP's isNumber takes for a number (no exponent: "1e5" is a
 # string to both)
-_DOUBLE_AS_WRITTEN = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)|[+-]?(?:inf|nan)")
+DOUBLE_TEXT = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)|[+-]?(?:inf|nan)"
+_DOUBLE_AS_WRITTEN = re.compile(DOUBLE_TEXT)
 # TIME VARIABLE SOURCE [VALUE]: one match checks the columns and that the time is a number; a
 # negative time (a value pLogger got from the DB as it registered) is an entry, where MOOS-IvP's
 # aloggrep and alogscan skip it (QUIRKS.md Q-MOOS-20)
-_ENTRY = re.compile(rf"[ \t]*({_NUMBER_TEXT})[ \t]+(\S+)[ \t]+(\S+)(?:[ \t]+(.*))?")
+_WORD = r"[^ \t\n\r\f\v]+"
+ENTRY_TEXT = (
+    rf"[ \t]*(?P<time>{NUMBER_TEXT})[ \t]+(?P<name>{_WORD})[ \t]+(?P<source>{_WORD})"
+    r"(?:[ \t]+(?P<value>.*))?"
+)
+_ENTRY = re.compile(ENTRY_TEXT)
 
 Value = float | str | bytes
 
@@ -82,6 +93,16 @@ class AlogEntry:
         """The source column as written: `src[:aux][@community]`."""
         text = f"{self.source}:{self.source_aux}" if self.source_aux else self.source
         return f"{text}@{self.community}" if self.community else text
+
+
+def value_text(entry: AlogEntry) -> str:
+    """The value as a string column: doubles as Python prints them, binary as hex."""
+    value = entry.value
+    if isinstance(value, bytes):
+        return value.hex()
+    if isinstance(value, float):
+        return repr(value)
+    return value
 
 
 def banner(
@@ -202,7 +223,7 @@ class AlogReader:
         if value is None:
             self._bad(line)
             return None
-        src, aux, community = _split_source(source)
+        src, aux, community = split_source(source)
         return AlogEntry(msg_time, name, src, value[0], aux, community, value[1], line, raw or "")
 
     def _value(self, raw: str) -> tuple[Value, tuple[str, int, int] | None] | None:
@@ -213,7 +234,7 @@ class AlogReader:
             kind, raw = raw[0], raw[2:]
             if kind == "S":
                 return raw, None
-            number = raw.rstrip()
+            number = raw.rstrip(SPACE)
             return (float(number), None) if _NUMBER.fullmatch(number) else None
         if self.binary_marked and raw.startswith("B:"):
             try:
@@ -224,7 +245,7 @@ class AlogReader:
             tag = BINARY_TAG.fullmatch(raw.strip())
             if tag:
                 return b"", (tag["file"], int(tag["offset"]), int(tag["size"]))
-        number = raw.rstrip()
+        number = raw.rstrip(SPACE)
         if _DOUBLE_AS_WRITTEN.fullmatch(number):
             return float(number), None
         return raw, None
@@ -256,7 +277,7 @@ class AlogReader:
                 self.first_bad_line = self.lines
 
 
-def _split_source(source: str) -> tuple[str, str, str]:
+def split_source(source: str) -> tuple[str, str, str]:
     """`src[:aux][@community]` -> (src, aux, community)."""
     if "@" not in source and ":" not in source:
         return source, "", ""

@@ -20,6 +20,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
+from pygoby.moos.alog.columns import (
+    CONVERT_COLUMNS,
+    AlogTables,
+    convert_schema,
+    entry_row,
+    rows_table,
+)
 from pygoby.moos.alog.files import AlogFile
 from pygoby.moos.alog.format import BINARY_MARKING, AlogEntry, inline_binary
 from pygoby.moos.errors import MoosError, MoosRefusedError
@@ -28,7 +35,6 @@ from pygoby.util.extras import needs_extra
 logger = logging.getLogger(__name__)
 
 CONVERT_FORMATS = (".parquet", ".csv", ".jsonl")
-CONVERT_COLUMNS = ("time", "utc_time", "name", "source", "type", "value", "value_double")
 PARQUET_BATCH = 65_536  # rows per Parquet row group written
 CONNECT_TIMEOUT = 5.0  # s for each source's client to reach the DB
 DB_SOURCE_PREFIX = "MOOSDB"  # MOOSDB_<community>: the DB's own posts
@@ -36,16 +42,6 @@ DB_SOURCE_PREFIX = "MOOSDB"  # MOOSDB_<community>: the DB's own posts
 
 class LogToolError(MoosError):
     """A `pygoby log` request that cannot be done (an unknown output format, ...)."""
-
-
-def value_text(entry: AlogEntry) -> str:
-    """The value as a string column: doubles as Python prints them, binary as hex."""
-    value = entry.value
-    if isinstance(value, bytes):
-        return value.hex()
-    if isinstance(value, float):
-        return repr(value)
-    return value
 
 
 # -- grep ----------------------------------------------------------------------------------------
@@ -222,16 +218,7 @@ def rows(
     for path in paths:
         log = AlogFile(path)
         for entry in log:
-            double = entry.value if isinstance(entry.value, float) else None
-            row: tuple[Any, ...] = (
-                entry.time,
-                log.log_start + entry.time,
-                entry.name,
-                entry.full_source,
-                entry.type,
-                value_text(entry),
-                double,
-            )
+            row = entry_row(entry, log.log_start)
             if decode is not None and columns:
                 fields = decode(entry)
                 row += tuple(fields.get(column) for column in columns)
@@ -288,6 +275,8 @@ def convert(
         columns = decoded_columns(paths, decode)
     columns = list(columns or ())
     if jobs <= 1 or len(paths) <= 1:
+        if writer is _write_parquet and not columns:
+            return _write_parquet_by_blocks(paths, Path(output), report)
         return writer(rows(paths, decode, columns), Path(output), report, columns)
     return _convert_in_parallel(paths, Path(output), report, jobs, decoder, columns)
 
@@ -383,51 +372,35 @@ def _write_parquet(
     source: Iterator[tuple], path: Path, progress: Callable[[int], None], columns: list[str]
 ) -> int:
     with needs_extra("sim", "Parquet output"):  # pyarrow, as netsim sweeps' results
-        import pyarrow as pa
         import pyarrow.parquet as pq
 
-    schema = pa.schema(
-        [
-            ("time", pa.float64()),
-            ("utc_time", pa.float64()),
-            ("name", pa.string()),
-            ("source", pa.string()),
-            ("type", pa.string()),
-            ("value", pa.string()),
-            ("value_double", pa.float64()),
-            *((name, pa.string()) for name in columns),
-        ]
-    )
-    text_columns = [2, 3, 5, *range(len(CONVERT_COLUMNS), len(schema))]
     count = 0
-    with pq.ParquetWriter(path, schema) as writer:
+    with pq.ParquetWriter(path, convert_schema(columns)) as writer:
         while True:
             batch = [row for _, row in zip(range(PARQUET_BATCH), source, strict=False)]
             if not batch:
                 break
-            values: list[Sequence[Any]] = list(zip(*batch, strict=True))
-            # strings keep undecodable bytes as surrogates; Parquet wants valid UTF-8
-            for index in text_columns:
-                values[index] = [_utf8(text) for text in values[index]]
-            writer.write_table(
-                pa.Table.from_arrays(
-                    [pa.array(col, type=schema.field(i).type) for i, col in enumerate(values)],
-                    schema=schema,
-                )
-            )
+            writer.write_table(rows_table(batch, columns))
             count += len(batch)
             progress(count)
     return count
 
 
-def _utf8(text: str | None) -> str | None:
-    if text is None:  # a decoded field the entry does not have
-        return None
-    try:
-        text.encode()
-        return text
-    except UnicodeEncodeError:
-        return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+def _write_parquet_by_blocks(
+    paths: Sequence[str | os.PathLike[str]], path: Path, progress: Callable[[int], None]
+) -> int:
+    """Without decoded columns: the block reader's tables, written as they come."""
+    with needs_extra("sim", "Parquet output"):
+        import pyarrow.parquet as pq
+
+    count = 0
+    with pq.ParquetWriter(path, convert_schema([])) as writer:
+        for source in paths:
+            for table in AlogTables(source):
+                writer.write_table(table)
+                count += table.num_rows
+                progress(count)
+    return count
 
 
 # -- replay --------------------------------------------------------------------------------------
