@@ -19,6 +19,20 @@ from pygoby.topside.liaison.web import WebServer
 from .test_commander import MISSION
 
 
+def http_request(
+    port: int, method: str, path: str, body: object = None, headers: dict | None = None
+) -> tuple[int, str]:
+    """One plain HTTP/1.1 request to 127.0.0.1:port (a JSON body): (status, text)."""
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+    try:
+        data = json.dumps(body).encode() if body is not None else None
+        connection.request(method, path, body=data, headers=headers or {})
+        response = connection.getresponse()
+        return response.status, response.read().decode()
+    finally:
+        connection.close()
+
+
 class Served:
     """A WebServer on 127.0.0.1 and its state; `request` is a plain HTTP/1.1 request."""
 
@@ -48,14 +62,7 @@ class Served:
     def request(
         self, method: str, path: str, body: dict | None = None, headers: dict | None = None
     ) -> tuple[int, str]:
-        connection = http.client.HTTPConnection("127.0.0.1", self.web.port, timeout=10)
-        try:
-            data = json.dumps(body).encode() if body is not None else None
-            connection.request(method, path, body=data, headers=headers or {})
-            response = connection.getresponse()
-            return response.status, response.read().decode()
-        finally:
-            connection.close()
+        return http_request(self.web.port, method, path, body, headers)
 
     def post(self, body: dict, headers: dict | None = None) -> tuple[int, str]:
         sent = {

@@ -20,6 +20,8 @@ import pytest
 from pygoby.topside.liaison.log_app import LogLiaison
 from pygoby.util.clock import VirtualClock
 
+from .liaison_server import http_request
+
 DATA = Path(__file__).resolve().parents[1] / "data" / "alog"
 LOG, MISSION = DATA / "liaison.alog", DATA / "acomms.moos"
 
@@ -37,17 +39,7 @@ class LogServed:
     async def request(
         self, method: str, path: str, body: object = None, headers: dict | None = None
     ) -> tuple[int, str]:
-        def call() -> tuple[int, str]:
-            connection = http.client.HTTPConnection("127.0.0.1", self.port, timeout=10)
-            try:
-                data = json.dumps(body).encode() if body is not None else None
-                connection.request(method, path, body=data, headers=headers or {})
-                response = connection.getresponse()
-                return response.status, response.read().decode()
-            finally:
-                connection.close()
-
-        return await asyncio.to_thread(call)
+        return await asyncio.to_thread(http_request, self.port, method, path, body, headers)
 
     async def control(self, body: object, **headers: str) -> tuple[int, str]:
         sent = {

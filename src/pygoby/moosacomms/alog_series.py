@@ -24,6 +24,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from google.protobuf.message import Message
+
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem.statistics import parse_cst
 from pygoby.moos.alog.files import AlogFile
@@ -127,11 +129,7 @@ def _read_file(log: AlogFile, offset: float, var: AcommsVariables, series: LogSe
             own_modem = int(value)
         elif name in (var.transmit, var.receive):
             transmission = acomms_pb.ModemTransmission()
-            try:
-                if isinstance(value, float):
-                    raise TranslatorError("a double")
-                parse_for_moos(value, transmission)
-            except TranslatorError:
+            if not _parsed(value, transmission):
                 series.skipped[name] += 1
                 continue
             kind = acomms_pb.ModemTransmission.TransmissionType.Name(transmission.type)
@@ -192,11 +190,7 @@ def _read_cst(
     series: LogSeries,
 ) -> None:
     raw = acomms_pb.ModemRaw()
-    try:
-        if isinstance(value, float):
-            raise TranslatorError("a double")
-        parse_for_moos(value, raw)
-    except TranslatorError:
+    if not _parsed(value, raw):
         series.skipped[name] += 1
         return
     line = raw.raw.decode("ascii", "replace")
@@ -211,3 +205,15 @@ def _read_cst(
     series.snr_in.setdefault(receiver, []).append((t, float(stat.snr_in)))
     series.snr_out.setdefault(receiver, []).append((t, float(stat.snr_out)))
     series.mse.setdefault(receiver, []).append((t, float(stat.mse_equalizer)))
+
+
+def _parsed(value: float | str | bytes, message: Message) -> bool:
+    """Whether `value` (as pAcommsHandler posts a message: protobuf text) filled `message`; a
+    double or a text that does not parse did not."""
+    if isinstance(value, float):
+        return False
+    try:
+        parse_for_moos(value, message)
+    except TranslatorError:
+        return False
+    return True
