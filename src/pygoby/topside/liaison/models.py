@@ -17,6 +17,7 @@ from typing import Any
 from google.protobuf.message import Message
 
 from pygoby.acomms import messages as acomms_pb
+from pygoby.acomms.queue.frames import unpack_frame
 from pygoby.dccl import Codec, DcclError
 from pygoby.dccl.ccl import remus
 from pygoby.dccl.dccl1 import Dccl1Header, is_dccl1_frame, unstitch
@@ -306,20 +307,19 @@ class AcommsModel:
             self.slot_start = slot.time / 1e6 if slot.HasField("time") else when
 
     def _messages_in(self, transmission: acomms_pb.ModemTransmission) -> list[str]:
-        names = []
-        for frame in transmission.frame:
-            data, offset = bytes(frame), 0
-            if is_dccl1_frame(data):  # Goby 1.1's bytes: the types from the clear headers
-                names += self._dccl1_names(data)
-                continue
-            while offset < len(data):
-                try:
-                    msg, used = self.codec.decode_prefix(data[offset:])
-                except (DcclError, Exception):
-                    names.append(self._ccl_name(data) if offset == 0 else "?")
-                    break
-                names.append(msg.DESCRIPTOR.full_name)
-                offset += max(used, 1)
+        return [name for frame in transmission.frame for name in self._frame_names(bytes(frame))]
+
+    def _frame_names(self, data: bytes) -> list[str]:
+        """The types of the messages in one frame; `?` after one that does not decode."""
+        if is_dccl1_frame(data):  # Goby 1.1's bytes: the types from the clear headers
+            return self._dccl1_names(data)
+        names: list[str] = []
+
+        def undecodable(offset: int, _: DcclError) -> None:
+            names.append(self._ccl_name(data) if offset == 0 else "?")
+
+        for msg, _ in unpack_frame(data, lambda _: self.codec, undecodable):
+            names.append(msg.DESCRIPTOR.full_name)
         return names
 
     def _ccl_name(self, frame: bytes) -> str:
