@@ -65,6 +65,7 @@ def plogger_addition(community: str) -> list[str]:
         f"    File = {community}",
         "    PATH = ./logs",
         "    WildCardLogging = true",
+        "    WildCardOmitPattern = DB_VARSUMMARY, DB_RWSUMMARY  // values of many lines",
         "    LogAuxSrc = true",
         "}",
     ]
