@@ -38,6 +38,7 @@ from benchmarks.soak.kit import (
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.rudics import parse_rudics_packet, serialize_rudics_packet
 from pygoby.moos import protocol as p
+from pygoby.moos.alog import AlogFile
 from pygoby.moos.client import MAX_REFUSED_BACKOFF, MOOSClient
 from pygoby.moos.db import MOOSDB
 from pygoby.util.aiorun import STOP_GRACE
@@ -512,6 +513,76 @@ class AppProcess:
                         await asyncio.sleep(0.02)
 
 
+# -- pLogger: kill -9 while logging ------------------------------------------------------------
+
+PLOGGER_MISSION = """\
+ServerPort = {port}
+Community = soak
+ProcessConfig = pLogger
+{{
+  AppTick = 10
+  CommsTick = 10
+  File = run{run}
+  PATH = {workdir}
+  FileTimeStamp = false
+  Log = COUNT @ 0
+  LoggingDirectorySummaryFile = {workdir}/.LastOpenedMOOSLogDirectory
+}}
+"""
+PLOGGER_RATE = 200.0  # COUNT posts per second
+
+
+async def plogger_kill9(seconds: float, workdir: Path) -> Figures:
+    """pLogger (a process) logging COUNT at 200 Hz, killed with SIGKILL 1 to 3 s after each
+    start and started again on a new file. request = one kill; latency = how much was lost:
+    from the post time of the first value its .alog lacks to the kill (the promise: at most
+    the last second)."""
+    figures = Figures(latency_limit=1.0)
+    posted: dict[int, float] = {}  # COUNT value -> wall time of its post
+    async with (
+        MOOSDB(port=0, community="soak") as db,
+        MOOSClient("soak_counter", port=db.port) as counter,
+    ):
+
+        async def count() -> None:
+            n = 0
+            while True:
+                n += 1
+                posted[n] = time.monotonic()
+                counter.publish("COUNT", float(n))
+                await asyncio.sleep(1 / PLOGGER_RATE)
+
+        counting = asyncio.create_task(count())
+        logger = AppProcess(["pLogger", "plogger.moos"], workdir, db, "pLogger")
+        loop = asyncio.get_running_loop()
+        end = loop.time() + seconds
+        run = 0
+        try:
+            while loop.time() < end:
+                run += 1
+                (workdir / "plogger.moos").write_text(
+                    PLOGGER_MISSION.format(port=db.port, run=run, workdir=workdir)
+                )
+                await logger.start()
+                await asyncio.sleep(0.5)  # its registration for COUNT reaches the DB
+                first = max(posted, default=0) + 1
+                await asyncio.sleep(random.uniform(1.0, 3.0))
+                killed_at = time.monotonic()
+                await logger.kill9()
+                alog = workdir / f"run{run}" / f"run{run}.alog"
+                logged = {int(e.value) for e in AlogFile(alog) if e.name == "COUNT"}
+                missing = [n for n in posted if n >= first and posted[n] < killed_at - 0.05]
+                missing = [n for n in missing if n not in logged]
+                figures.requests += 1
+                figures.answer(killed_at - posted[missing[0]] if missing else 0.0)
+        finally:
+            counting.cancel()
+            await logger.kill9()
+    figures.notes.append(f"{run} kills at {PLOGGER_RATE:g} posts/s")
+    figures.judge()
+    return figures
+
+
 # -- MOOSDB: kill -9 under running apps ---------------------------------------------------------
 
 APPS_MISSION = """\
@@ -898,6 +969,7 @@ SCENARIOS: dict[str, Scenario] = {
     ),
     "store_server: kill -9 every ~3 s under two modems": store_server_kill9,
     "pAcommsHandler: kill -9 at random with a persistent queue": pacommshandler_kill9,
+    "pLogger: kill -9 while logging 200 Hz loses at most the last second": plogger_kill9,
     "MOOSDB: kill -9 every ~3 s under uSimVehicle, pAcommsHandler, pTranslator": moosdb_kill9,
     "apps: SIGTERM as the MOOSDB goes away": sigterm_on_drop,
     "apps: link cut, the DB keeps a stale session": stale_session,
