@@ -88,11 +88,16 @@ class AppLogHandlers:
     """The handlers of one running app's log, attached to its logger and the library's."""
 
     def __init__(
-        self, log: logging.Logger, handlers: list[logging.Handler], library_level: int
+        self,
+        log: logging.Logger,
+        handlers: list[logging.Handler],
+        library_level: int,
+        propagate: bool = True,
     ) -> None:
         self.log = log
         self.handlers = handlers
         self._library_level = library_level  # restored on close
+        self._propagate = propagate  # restored on close
 
     @classmethod
     def open(
@@ -106,7 +111,7 @@ class AppLogHandlers:
         # below that, only the levels some handler shows are made at all
         lowest = min(*(handler.level for handler in handlers), logging.WARNING)
         log.setLevel(min(lowest, DEBUG1))  # the app's own lines are few: all reach handlers
-        log.propagate = False
+        propagate, log.propagate = log.propagate, False
         library = logging.getLogger(LIBRARY_LOGGER)
         saved = library.level
         if library.getEffectiveLevel() > lowest:  # the groups' lines must reach the handlers
@@ -114,7 +119,7 @@ class AppLogHandlers:
         for handler in handlers:
             log.addHandler(handler)
             library.addHandler(handler)
-        return cls(log, handlers, saved)
+        return cls(log, handlers, saved, propagate)
 
     def close(self) -> None:
         library = logging.getLogger(LIBRARY_LOGGER)
@@ -124,3 +129,4 @@ class AppLogHandlers:
             handler.close()
         self.handlers = []
         library.setLevel(self._library_level)
+        self.log.propagate = self._propagate
