@@ -201,6 +201,7 @@ async def test_app_reconnects_reposts_initializers_and_keeps_queued_posts(caplog
     port = db.port
     mission = MissionFile.from_text(_mission(port, BLOCK))
     app = pTestApp(pTestApp.read_config(mission, "pTestApp"), name="pTestApp", mission=mission)
+    app.log.addHandler(caplog.handler)  # the app's log does not propagate to the root
     await app.start(connect_timeout=3)
     await db.stop()
     await _wait_for(lambda: not app.connected)

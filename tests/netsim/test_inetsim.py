@@ -146,7 +146,9 @@ async def test_refused_port_is_posted(tmp_path, manager, caplog):
         path = tmp_path / "mission.moos"
         path.write_text(mission(db.port, server.bound_port, 62009))
         with caplog.at_level(logging.WARNING):
-            async with iNetSimManager.from_mission(path) as app:
+            app = iNetSimManager.from_mission(path)
+            app.log.addHandler(caplog.handler)  # the app's log does not propagate to the root
+            async with app:
                 tester.subscribe("NETSIM_STATUS")
                 await app.netsim.wait_connected(5)
                 tester.publish("NAV_LAT", 42.1)
