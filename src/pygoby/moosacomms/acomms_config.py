@@ -55,6 +55,14 @@ def read_acomms_config(
     return read_configuration(pAcommsHandlerConfig, mission, block, overrides)
 
 
+def acomms_config_or_defaults(mission: MissionFile, block: str) -> pAcommsHandlerConfig:
+    """`read_acomms_config`, or pAcommsHandler's defaults when `mission` has no `block` (a log
+    tool given a mission with pTranslator only still knows the default variable names)."""
+    if mission.goby_block(block) is None:
+        return pAcommsHandlerConfig()
+    return read_acomms_config(mission, block)
+
+
 @dataclass
 class AcommsMessageSet:
     """The message definitions of one pAcommsHandler configuration: `cfg` (with the queue and

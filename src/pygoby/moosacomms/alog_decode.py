@@ -46,7 +46,7 @@ from pygoby.moos.translator import (
     dynamic_parse,
     parse_for_moos,
 )
-from pygoby.moosacomms.acomms_config import AcommsMessageSet, read_acomms_config
+from pygoby.moosacomms.acomms_config import AcommsMessageSet, acomms_config_or_defaults
 from pygoby.moosacomms.translator_binding import MessageTypes
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
     pAcommsHandlerConfig,
@@ -134,8 +134,7 @@ class MissionDecoder:
     def __init__(self, mission_path: str | Path, block: str = "pAcommsHandler") -> None:
         mission = MissionFile.read(mission_path)
         # a mission with pTranslator only still has pAcommsHandler's default variable names
-        has_handler = mission.goby_block(block) is not None
-        cfg = read_acomms_config(mission, block) if has_handler else pAcommsHandlerConfig()
+        cfg = acomms_config_or_defaults(mission, block)
         names = prefixed_var_names(cfg.moos_var)
         self.fixed = {names[field]: cls for field, cls in FIXED_TYPE_VARIABLES.items()}
         self.frames = {names[field] for field in FRAME_VARIABLES}

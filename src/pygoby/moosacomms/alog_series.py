@@ -29,11 +29,12 @@ from google.protobuf.message import Message
 from pygoby.acomms import messages as acomms_pb
 from pygoby.acomms.drivers.micromodem.statistics import parse_cst
 from pygoby.moos.alog.files import AlogFile
+from pygoby.moos.alog.tools import db_community
 from pygoby.moos.appconfig import prefixed_var_names
 from pygoby.moos.moosfile import MissionFile
 from pygoby.moos.translator import TranslatorError, parse_for_moos
 from pygoby.moos.translator.techniques import split_prefix
-from pygoby.moosacomms.acomms_config import read_acomms_config
+from pygoby.moosacomms.acomms_config import acomms_config_or_defaults
 from pygoby.protobuf.goby.apps.moos.protobuf.pAcommsHandler_config_pb2 import (
     pAcommsHandlerConfig,
 )
@@ -43,7 +44,6 @@ from pygoby.util.nmea import NMEASentence
 Points = list[tuple[float, float]]  # (time or x, value or y)
 MODEM_ID_VAR = "MODEM_ID"  # pAcommsHandler posts its modem id at start-up
 CST_PREFIX = "$CACST"
-DB_SOURCE_PREFIX = "MOOSDB_"
 
 
 @dataclass
@@ -74,10 +74,7 @@ class AcommsVariables:
         """From `block` of the mission at `path`; pAcommsHandler's defaults without one."""
         if path is None:
             return cls.of(pAcommsHandlerConfig())
-        mission = MissionFile.read(path)
-        if mission.goby_block(block) is None:
-            return cls.of(pAcommsHandlerConfig())
-        cfg = read_acomms_config(mission, block)
+        cfg = acomms_config_or_defaults(MissionFile.read(path), block)
         return cls.of(cfg, cfg.modem_id if cfg.HasField("modem_id") else None)
 
 
@@ -150,8 +147,8 @@ def _read_file(log: AlogFile, offset: float, var: AcommsVariables, series: LogSe
         elif name in NAV_VARIABLES and isinstance(value, float) and not entry.community:
             nav[name] = value
             _add_track_point(series, track_name, nav, name)
-        elif community is None and entry.source.startswith(DB_SOURCE_PREFIX):
-            community = entry.source[len(DB_SOURCE_PREFIX) :]
+        elif community is None:
+            community = db_community(entry.source)
     # the vehicle's name: its community (its MOOSDB posts as MOOSDB_<community>)
     if community and track_name in series.tracks and community not in series.tracks:
         series.tracks[community] = series.tracks.pop(track_name)

@@ -38,9 +38,18 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-CONVERT_COLUMNS = ("time", "utc_time", "name", "source", "type", "value", "value_double")
+# the columns and their pyarrow types (decoded fields follow, as strings)
+CONVERT_TYPES = (
+    ("time", "double"),
+    ("utc_time", "double"),
+    ("name", "string"),
+    ("source", "string"),
+    ("type", "string"),
+    ("value", "string"),
+    ("value_double", "double"),
+)
+CONVERT_COLUMNS = tuple(name for name, _ in CONVERT_TYPES)
 BLOCK_BYTES = 4 << 20  # parsed at once: memory holds a few times this, whatever the log's size
-READ_BYTES = 8192  # what the line reader's buffer takes from a file at a time (see _blocks)
 # RE2 searches: anchored, the patterns are the line reader's full matches
 _ENTRY = f"^(?:{ENTRY_TEXT})$"
 _DOUBLE = f"^(?:{DOUBLE_TEXT})$"
@@ -61,21 +70,11 @@ def entry_row(entry: AlogEntry, log_start: float) -> tuple[Any, ...]:
 
 
 def convert_schema(columns: list[str]) -> pa.Schema:
-    """CONVERT_COLUMNS' types, then `columns` (decoded fields) as strings."""
+    """CONVERT_TYPES, then `columns` (decoded fields) as strings."""
     import pyarrow as pa
 
-    return pa.schema(
-        [
-            ("time", pa.float64()),
-            ("utc_time", pa.float64()),
-            ("name", pa.string()),
-            ("source", pa.string()),
-            ("type", pa.string()),
-            ("value", pa.string()),
-            ("value_double", pa.float64()),
-            *((name, pa.string()) for name in columns),
-        ]
-    )
+    types = [*CONVERT_TYPES, *((name, "string") for name in columns)]
+    return pa.schema([(name, pa.type_for_alias(alias)) for name, alias in types])
 
 
 class AlogTables:
@@ -156,6 +155,8 @@ class AlogTables:
     def _table(self, block: bytes) -> pa.Table:
         """The block's rows: `%%` lines through the line reader one by one, the lines between
         them through the kernels when they can take them."""
+        import pyarrow as pa
+
         tables: list[pa.Table] = []
         start = 0
         while start < len(block):
@@ -166,8 +167,6 @@ class AlogTables:
                 end = block.find(b"\n%%", start) + 1 or len(block)
                 tables.append(self._lines_table(block[start:end]))
             start = end
-        import pyarrow as pa
-
         if not tables:
             return convert_schema([]).empty_table()
         return pa.concat_tables(tables) if len(tables) > 1 else tables[0]
@@ -197,12 +196,9 @@ class AlogTables:
             if len(raw) >= MAX_LINE_BYTES:
                 self.reader.skip_line()
                 continue
-            entry = self.reader.feed(decode_line(raw))
-            if entry is None:
-                continue
-            if entry.binary_ref is not None:
-                self.blogs.resolve(entry)
-            rows.append(entry_row(entry, self.reader.log_start or 0.0))
+            entry = self.blogs.feed(self.reader, decode_line(raw))
+            if entry is not None:
+                rows.append(entry_row(entry, self.reader.log_start or 0.0))
         self.rows_by_line_reader += len(rows)
         return rows_table(rows, [])
 
@@ -340,8 +336,9 @@ def rows_table(rows: list[tuple[Any, ...]], columns: list[str]) -> pa.Table:
 
     schema = convert_schema(columns)
     values: list[Any] = list(zip(*rows, strict=True)) if rows else [[] for _ in schema]
-    for index in (2, 3, 5, *range(len(CONVERT_COLUMNS), len(schema))):
-        values[index] = [_utf8(text) for text in values[index]]
+    for index, column in enumerate(schema):
+        if column.type == pa.string():
+            values[index] = [_utf8(text) for text in values[index]]
     return pa.Table.from_arrays(
         [pa.array(column, type=schema.field(i).type) for i, column in enumerate(values)],
         schema=schema,

@@ -104,10 +104,7 @@ class AlogFile:
                         self.reader.skip_line()
                         continue
                     text = decode_line(raw).rstrip("\r\n")
-                    entry = self.reader.feed(text)
-                    if entry is not None and entry.binary_ref is not None:
-                        self.blogs.resolve(entry)
-                    yield line_offset, text, entry
+                    yield line_offset, text, self.blogs.feed(self.reader, text)
         except READ_ERRORS as err:
             # a truncated .gz (a logger killed mid-write) ends the log where it breaks
             log.warning("%s: stopped reading: %s", self.path, err)
@@ -128,6 +125,13 @@ class BlogFiles:
         self.directory = directory
         self.unresolved = 0
         self._open: dict[str, IO[bytes] | None] = {}
+
+    def feed(self, reader: AlogReader, line: str) -> AlogEntry | None:
+        """`reader.feed(line)`, a binary value's bytes fetched from its .blog."""
+        entry = reader.feed(line)
+        if entry is not None and entry.binary_ref is not None:
+            self.resolve(entry)
+        return entry
 
     def resolve(self, entry: AlogEntry) -> None:
         assert entry.binary_ref is not None

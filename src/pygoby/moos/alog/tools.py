@@ -40,6 +40,12 @@ CONNECT_TIMEOUT = 5.0  # s for each source's client to reach the DB
 DB_SOURCE_PREFIX = "MOOSDB"  # MOOSDB_<community>: the DB's own posts
 
 
+def db_community(source: str) -> str | None:
+    """The community of a MOOSDB's own post (its source is MOOSDB_<community>), else None."""
+    head, underscore, community = source.partition("_")
+    return community if head == DB_SOURCE_PREFIX and underscore else None
+
+
 class LogToolError(MoosError):
     """A `pygoby log` request that cannot be done (an unknown output format, ...)."""
 

@@ -34,7 +34,7 @@ from pathlib import Path
 from pygoby.moos import protocol as p
 from pygoby.moos.alog.files import HEADER_LINES, MAX_LINE_BYTES, AlogFile, open_text_or_gz
 from pygoby.moos.alog.format import AlogEntry, AlogReader, decode_line
-from pygoby.moos.alog.tools import DB_SOURCE_PREFIX
+from pygoby.moos.alog.tools import db_community
 from pygoby.topside.errors import LogControlError, LogFileError
 from pygoby.topside.liaison.state import LiaisonState
 from pygoby.util.clock import Clock
@@ -93,8 +93,8 @@ class LogIndex:
             entries += 1
             if entries == 1:
                 mark = latest + spacing
-            if not community and entry.source.startswith(DB_SOURCE_PREFIX + "_"):
-                community = entry.source[len(DB_SOURCE_PREFIX) + 1 :]
+            if not community:
+                community = db_community(entry.source) or ""
         return cls(
             path,
             log.log_start,
